@@ -1,0 +1,275 @@
+"""The LOS perturbation assessment of Wang et al. 2017 (sections 2.3-2.4): cost cube, minimum, uncertainty.
+
+For each CrIS granule: inverse geolocation of every FOV to the SBF, the (2n+1)^2 perturbed cones
+collocated with VIIRS I5 (:mod:`monitor.collocate`), and the CrIS I5-equivalent BT (:mod:`monitor.spectral`).
+Then per scan position k over all samples (equation 8):
+
+    G(i, j, k) = STDEV(BT_VIIRS_ij - BT_CrIS),
+
+its minimum refined by a quadratic surface through the 3x3 neighbourhood of the grid minimum
+(Wang 2013), and a bootstrap over granules (over scans when there are fewer than 4 granules) for the
+uncertainty of each offset.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from monitor import collocate
+from monitor.geometry.ground import offset_km
+from monitor.geometry.inverse import inverse_geolocation
+from monitor.geometry.perturb import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, perturbation_grid
+from monitor.result import (FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, N_FOR, AssessmentResult, ForOffset)
+from monitor.sdr import GranuleError, read_file
+from monitor.sdr.pairing import CasePlan, GranuleFiles, plan
+from monitor.spectral import i5_band
+
+LOG = logging.getLogger(__name__)
+FOV5 = 4
+KERNELS = {"top-hat": collocate.TOP_HAT, "response": collocate.SPATIAL_RESPONSE}
+
+
+@dataclass
+class AssessConfig:
+    """Settings of one assessment. The defaults are the paper's."""
+
+    half_steps: int = DEFAULT_HALF_STEPS
+    step_rad: float = DEFAULT_STEP_RAD
+    kernel: str = "top-hat"
+    min_coverage: float = collocate.MIN_COVERAGE
+    min_samples: int = 30
+    flat_contrast: float = 0.03
+    bootstrap: int = 100
+    seed: int = 0
+
+    @property
+    def offsets_rad(self) -> np.ndarray:
+        return perturbation_grid(self.half_steps, self.step_rad)
+
+
+@dataclass
+class GranuleSamples:
+    """Collocated samples of one CrIS granule: per FOV the VIIRS BT of every perturbed cone."""
+
+    key: str
+    info: dict
+    bt_viirs_k: np.ndarray  # (nscan, 30, 9, m, m)
+    bt_cris_k: np.ndarray  # (nscan, 30, 9)
+    usable: np.ndarray  # (nscan, 30, 9)
+    sat_m: np.ndarray  # FOV-5 geometry per (nscan, 30) for the km conversion
+    sbf_to_ecef: np.ndarray
+    alpha_rad: np.ndarray
+    beta_rad: np.ndarray
+    velocity_m_s: np.ndarray
+
+
+@dataclass
+class _SwathCache:
+    keys: tuple = ()
+    swath: object = None
+    names: list = field(default_factory=list)
+
+
+def _load_swath(viirs: list[GranuleFiles], band, cache: _SwathCache):
+    keys = tuple(v.key for v in viirs)
+    if cache.keys == keys:
+        return cache.swath
+    geos, sdrs = [], []
+    for v in viirs:
+        geos.append(read_file(v.geo, kinds=("viirs_geo",))[0])
+        sdrs.append(read_file(v.sdr, kinds=("viirs_sdr",))[0])
+    stack = np.concatenate
+    swath = collocate.build_swath(stack([g.lat_rad for g in geos]), stack([g.lon_rad for g in geos]),
+                                  stack([s.bt_k for s in sdrs]), stack([s.good for s in sdrs]), band)
+    cache.keys, cache.swath = keys, swath
+    return swath
+
+
+def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: AssessConfig, band,
+                      cache: _SwathCache) -> GranuleSamples:
+    """Read one CrIS granule and its VIIRS cover and collocate every FOV for every perturbation."""
+    geo = next(g for g in read_file(cris.geo, kinds=("cris_geo",)) if g.meta.granule_id == cris.geo_meta.granule_id)
+    sdr = next(g for g in read_file(cris.sdr, kinds=("cris_sdr",)) if g.meta.granule_id == cris.sdr_meta.granule_id)
+    if sdr.radiance_lw.shape[:3] != geo.lat_rad.shape:
+        raise GranuleError(cris.sdr, "ES_RealLW", f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO "
+                                                  f"{geo.lat_rad.shape}")
+    valid = geo.valid
+    fill = {k: np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")}
+    fg = inverse_geolocation(fill["lat_rad"], fill["lon_rad"], fill["zenith_rad"], fill["azimuth_rad"],
+                             np.where(valid, geo.range_m, 1e6), geo.for_time_us, geo.mid_time_us,
+                             np.nan_to_num(geo.sc_position_m), np.nan_to_num(geo.sc_velocity_m_s),
+                             np.nan_to_num(geo.sc_attitude_rad))
+    bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
+    swath = _load_swath(viirs, band, cache)
+    offsets = cfg.offsets_rad
+    m = len(offsets)
+    nscan = geo.lat_rad.shape[0]
+    bt_viirs = np.full((nscan, N_FOR, 9, m, m), np.nan, np.float32)
+    coverage = np.zeros((nscan, N_FOR, 9))
+    kernel = KERNELS[cfg.kernel]
+    for k in range(N_FOR):
+        sl = (slice(None), k)
+        shape = fg.alpha_rad[sl].shape
+        mean, cov = collocate.cone_sums(
+            swath, fg.sat_ecef_m[sl].reshape(-1, 3), fg.sbf_to_ecef[sl].reshape(-1, 3, 3),
+            fg.alpha_rad[sl].ravel(), fg.beta_rad[sl].ravel(), offsets, kernel,
+            fov_range_m=np.where(valid[sl], geo.range_m[sl], 1e6).ravel(),
+            fov_cos_zen=np.cos(fill["zenith_rad"][sl]).ravel())
+        bt_viirs[sl] = band.bt_from_radiance(mean).reshape(shape + (m, m))
+        coverage[sl] = np.nanmin(np.where(np.isfinite(cov), cov, 0.0), axis=(-2, -1)).reshape(shape)
+    usable = (valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
+              & np.all(np.isfinite(bt_viirs), axis=(-2, -1)))
+    info = {"granule_id": geo.meta.granule_id, "start": geo.meta.start.isoformat(), "end": geo.meta.end.isoformat(),
+            "cris_geo": cris.geo.name, "cris_sdr": cris.sdr.name,
+            "viirs": [v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
+            "n_fovs": int(valid.sum()), "n_usable": int(usable.sum()),
+            "cris_meta": geo.meta.to_dict(), "viirs_meta": viirs[0].geo_meta.to_dict()}
+    s5 = (slice(None), slice(None), FOV5)
+    return GranuleSamples(cris.key, info, bt_viirs, bt_cris, usable, fg.sat_ecef_m[s5], fg.sbf_to_ecef[s5],
+                          fg.alpha_rad[s5], fg.beta_rad[s5], fg.velocity_ecef_m_s[s5])
+
+
+def _stdev(d, weights=None):
+    """STDEV over samples (axis 0 of d, (N, m, m)); with *weights* (B, N) one surface per row (B, m, m)."""
+    n, m = d.shape[0], d.shape[1]
+    flat = d.reshape(n, -1)
+    if weights is None:
+        return flat.std(axis=0, ddof=1).reshape(m, m)
+    s0 = weights.sum(axis=1, keepdims=True)
+    s1 = weights @ flat
+    s2 = weights @ (flat * flat)
+    var = (s2 - s1 * s1 / s0) / np.maximum(s0 - 1, 1)
+    return np.sqrt(np.maximum(var, 0.0)).reshape(-1, m, m)
+
+
+def find_minimum(cost, contrast=0.03):
+    """Sub-step minimum (x_i, y_j in grid steps from the centre) of a cost surface, and its flags.
+
+    A quadratic surface through the 3x3 neighbourhood of the grid minimum gives the sub-step position
+    (Wang 2013). A minimum on the grid border is flagged ``edge`` and not refined; a surface that
+    rises less than *contrast* (relative) from its minimum to the grid border, or whose fit is not
+    convex, is flagged ``flat``.
+    """
+    m = cost.shape[0]
+    n = (m - 1) // 2
+    flags = []
+    if not np.all(np.isfinite(cost)):
+        return np.nan, np.nan, [FLAG_FLAT]
+    i0, j0 = np.unravel_index(np.argmin(cost), cost.shape)
+    border = np.concatenate([cost[0], cost[-1], cost[1:-1, 0], cost[1:-1, -1]])
+    if (np.mean(border) - cost[i0, j0]) / cost[i0, j0] < contrast:
+        flags.append(FLAG_FLAT)
+    if i0 in (0, m - 1) or j0 in (0, m - 1):
+        return float(i0 - n), float(j0 - n), flags + [FLAG_EDGE]
+    x, y = np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.0, 1.0], indexing="ij")
+    a = np.stack([np.ones(9), x.ravel(), y.ravel(), x.ravel() ** 2, x.ravel() * y.ravel(), y.ravel() ** 2], 1)
+    c = np.linalg.lstsq(a, cost[i0 - 1:i0 + 2, j0 - 1:j0 + 2].ravel(), rcond=None)[0]
+    hess = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
+    if np.linalg.det(hess) <= 0 or hess[0, 0] <= 0:
+        return float(i0 - n), float(j0 - n), sorted(set(flags + [FLAG_FLAT]))
+    dx, dy = np.linalg.solve(hess, -c[1:3])
+    dx, dy = float(np.clip(dx, -1, 1)), float(np.clip(dy, -1, 1))
+    return i0 - n + dx, j0 - n + dy, flags
+
+
+def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
+    """Mean in-track/cross-track km of a turn (rad) at FOR k over the FOV-5 views used, and the Jacobian."""
+    sel = [(s.sat_m[:, k], s.sbf_to_ecef[:, k], s.alpha_rad[:, k], s.beta_rad[:, k], s.velocity_m_s[:, k])
+           for s in samples if np.any(s.usable[:, k])]
+    if not sel:
+        return np.nan, np.nan, np.full((2, 2), np.nan)
+    sat, mat, a, b, v = (np.concatenate(x) for x in zip(*sel))
+    if not np.isfinite(d_alpha + d_beta):
+        return np.nan, np.nan, np.full((2, 2), np.nan)
+    it, ct = offset_km(sat, mat, a, b, v, d_alpha, d_beta)
+    eps = 1e-4
+    ja = offset_km(sat, mat, a, b, v, eps, 0.0)
+    jb = offset_km(sat, mat, a, b, v, 0.0, eps)
+    jac = np.array([[np.mean(ja[0]), np.mean(jb[0])], [np.mean(ja[1]), np.mean(jb[1])]]) / eps
+    return float(np.mean(it)), float(np.mean(ct)), jac
+
+
+def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=None, satellite="") -> AssessmentResult:
+    """The cost cube, per-FOR minimum, bootstrap uncertainty and km offsets of collocated *samples*."""
+    offsets = cfg.offsets_rad
+    m = len(offsets)
+    step_urad = cfg.step_rad * 1e6
+    rng = np.random.default_rng(cfg.seed)
+    cube = np.full((N_FOR, m, m), np.nan)
+    by_granule = len(samples) >= 4
+    fors = []
+    for k in range(N_FOR):
+        diffs, units = [], []
+        for g_i, s in enumerate(samples):
+            use = s.usable[:, k]  # (nscan, 9)
+            d = s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]
+            diffs.append(d.astype(np.float64))
+            scan_idx = np.nonzero(use)[0]
+            units.append(np.full(len(d), g_i) if by_granule else g_i * 1000 + scan_idx)
+        d = np.concatenate(diffs) if diffs else np.empty((0, m, m))
+        unit_ids = np.unique(np.concatenate(units), return_inverse=True)[1] if diffs else np.empty(0, int)
+        n = len(d)
+        flags = []
+        if n < max(cfg.min_samples, 3):
+            flags.append(FLAG_FEW_SAMPLES)
+        if n >= 3:
+            g = _stdev(d)
+            cube[k] = g
+            x, y, fl = find_minimum(g, cfg.flat_contrast)
+            flags += fl
+        else:
+            g = np.full((m, m), np.nan)
+            x = y = np.nan
+        sig_a = sig_b = np.nan
+        if n >= 3 and cfg.bootstrap > 1 and unit_ids.max() >= 1:
+            counts = rng.multinomial(unit_ids.max() + 1, np.full(unit_ids.max() + 1, 1.0 / (unit_ids.max() + 1)),
+                                     size=cfg.bootstrap)
+            gb = _stdev(d, counts[:, unit_ids].astype(float))
+            est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in gb])
+            sig_a, sig_b = np.nanstd(est, axis=0) * step_urad
+        d_alpha, d_beta = x * step_urad, y * step_urad
+        it, ct, jac = _ground_km(samples, k, d_alpha * 1e-6, d_beta * 1e-6)
+        s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * 1e-6) if np.isfinite(sig_a) else np.nan
+        s_ct = float(np.hypot(jac[1, 0] * sig_a, jac[1, 1] * sig_b) * 1e-6) if np.isfinite(sig_a) else np.nan
+        fors.append(ForOffset(
+            for_index=k + 1, d_alpha_urad=float(d_alpha), d_beta_urad=float(d_beta),
+            sigma_alpha_urad=float(sig_a), sigma_beta_urad=float(sig_b),
+            in_track_km=it, cross_track_km=ct, total_km=float(np.hypot(it, ct)),
+            sigma_in_track_km=s_it, sigma_cross_track_km=s_ct, n_samples=int(n),
+            cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
+            cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan, flags=tuple(sorted(set(flags)))))
+    starts = [s.info["start"] for s in samples]
+    ends = [s.info["end"] for s in samples]
+    return AssessmentResult(
+        satellite=satellite, start=min(starts) if starts else "", end=max(ends) if ends else "", fors=fors,
+        granules=[s.info for s in samples], skipped=[{"item": a, "reason": b} for a, b in (skipped or [])],
+        half_steps=cfg.half_steps, step_urad=step_urad, cost_cube_k=cube)
+
+
+def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, should_stop=None) -> AssessmentResult:
+    """Assess every CrIS granule of *case*; granules that fail are skipped with their reason."""
+    cfg = cfg or AssessConfig()
+    band = i5_band(case.satellite)
+    cache = _SwathCache()
+    samples = []
+    skipped = list(case.skipped)
+    for g in case.cris:
+        if should_stop is not None and should_stop():
+            skipped.append((g.key, "not assessed: stop requested"))
+            continue
+        try:
+            samples.append(collocate_granule(g, case.viirs[g.key], cfg, band, cache))
+        except GranuleError as exc:
+            LOG.warning("skipping granule %s: %s", g.key, exc)
+            skipped.append((g.key, str(exc)))
+        if progress is not None:
+            progress(g)
+    return cost_and_offsets(samples, cfg, skipped, case.satellite)
+
+
+def assess_paths(paths, cfg: AssessConfig | None = None, progress=None) -> AssessmentResult:
+    """Find, pair and assess the granules under *paths* (files or directories)."""
+    return assess_plan(plan(paths), cfg, progress)

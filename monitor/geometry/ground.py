@@ -1,0 +1,36 @@
+"""Offset angles expressed as distances on the ground, along and across the ground track."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from monitor.geometry import frames, wgs84
+from monitor.geometry.inverse import forward_geolocation
+
+
+def track_axes(ground_ecef_m, velocity_ecef_m_s):
+    """Unit (along_track, cross_track) horizontal vectors at ground points.
+
+    Along-track is the spacecraft ECEF velocity projected on the local horizontal; cross-track is
+    along x up, i.e. to the right of the flight direction.
+    """
+    up = wgs84.geodetic_up(ground_ecef_m)
+    v = np.asarray(velocity_ecef_m_s, float)
+    along = frames.unit(v - np.sum(v * up, axis=-1, keepdims=True) * up)
+    cross = np.cross(along, up)
+    return along, cross
+
+
+def offset_km(sat_ecef_m, sbf_to_ecef, alpha_rad, beta_rad, velocity_ecef_m_s, d_alpha_rad, d_beta_rad):
+    """Ground displacement (in_track_km, cross_track_km) of turning a LOS by (d_alpha, d_beta) in the SBF.
+
+    Both the original and the turned LOS are intersected with the WGS84 ellipsoid; the difference is
+    projected on the local along-track and cross-track directions at the original point.
+    """
+    p0 = forward_geolocation(sat_ecef_m, sbf_to_ecef, frames.los_from_angles(alpha_rad, beta_rad))
+    p1 = forward_geolocation(sat_ecef_m, sbf_to_ecef,
+                             frames.los_from_angles(np.asarray(alpha_rad) + d_alpha_rad,
+                                                    np.asarray(beta_rad) + d_beta_rad))
+    along, cross = track_axes(p0, velocity_ecef_m_s)
+    d = p1 - p0
+    return np.sum(d * along, axis=-1) / 1e3, np.sum(d * cross, axis=-1) / 1e3

@@ -1,0 +1,26 @@
+"""The LOS perturbation grid of Wang et al. 2017, section 2.3."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from monitor.geometry.frames import los_from_angles
+
+DEFAULT_HALF_STEPS = 10
+DEFAULT_STEP_RAD = 375.0 / 833000.0  # one VIIRS I-band pixel seen from 833 km, ~450 urad
+FOV_DIAMETER_RAD = 16807.5e-6  # CrIS FOV size (0.963 deg)
+
+
+def perturbation_grid(n=DEFAULT_HALF_STEPS, step_rad=DEFAULT_STEP_RAD):
+    """Offsets (i - n) * s, i = 0..2n, in radians: equations (3)-(6); the middle entry is zero."""
+    return (np.arange(2 * n + 1) - n) * step_rad
+
+
+def perturbed_los_sbf(alpha_rad, beta_rad, offsets_rad):
+    """The (2n+1) x (2n+1) perturbed SBF unit vectors LOS_ij of each FOV, equation (7) (axes as in (1)-(2)).
+
+    Returns shape alpha.shape + (2n+1, 2n+1, 3); index i perturbs alpha (in-track), j perturbs beta.
+    """
+    a = np.asarray(alpha_rad, float)[..., None, None] + offsets_rad[:, None]
+    b = np.asarray(beta_rad, float)[..., None, None] + offsets_rad[None, :]
+    return los_from_angles(a, b)

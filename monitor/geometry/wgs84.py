@@ -1,0 +1,107 @@
+"""The WGS84 ellipsoid: geodetic <-> ECEF, the local ENU basis, and ray-ellipsoid intersection.
+
+All positions are Earth-centred Earth-fixed (ECEF) in metres; latitudes and longitudes are geodetic,
+in radians.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+A_M = 6378137.0  # WGS84 equatorial radius
+F = 1.0 / 298.257223563  # WGS84 flattening
+B_M = A_M * (1.0 - F)  # polar radius
+E2 = F * (2.0 - F)  # first eccentricity squared
+OMEGA_EARTH_RAD_S = 7.2921151467e-5  # WGS84 Earth rotation rate
+GM_M3_S2 = 3.986004418e14  # WGS84 gravitational parameter
+J2 = 1.08262668e-3  # EGM96 second zonal harmonic
+
+
+def geodetic_to_ecef(lat_rad, lon_rad, h_m=0.0):
+    """ECEF position (..., 3) in metres of geodetic *lat_rad*, *lon_rad* and ellipsoidal height *h_m*."""
+    lat, lon, h = np.broadcast_arrays(np.asarray(lat_rad, float), np.asarray(lon_rad, float),
+                                      np.asarray(h_m, float))
+    sin_lat = np.sin(lat)
+    n = A_M / np.sqrt(1.0 - E2 * sin_lat**2)
+    return np.stack([(n + h) * np.cos(lat) * np.cos(lon),
+                     (n + h) * np.cos(lat) * np.sin(lon),
+                     (n * (1.0 - E2) + h) * sin_lat], axis=-1)
+
+
+def ecef_to_geodetic(xyz_m):
+    """Geodetic (lat_rad, lon_rad, h_m) of ECEF points (..., 3); Bowring's iteration, converged to < 1 mm."""
+    xyz = np.asarray(xyz_m, float)
+    x, y, z = xyz[..., 0], xyz[..., 1], xyz[..., 2]
+    lon = np.arctan2(y, x)
+    p = np.hypot(x, y)
+    lat = np.arctan2(z, p * (1.0 - E2))
+    for _ in range(5):
+        sin_lat = np.sin(lat)
+        n = A_M / np.sqrt(1.0 - E2 * sin_lat**2)
+        h = p * np.cos(lat) + z * sin_lat - A_M**2 / n
+        lat = np.arctan2(z, p * (1.0 - E2 * n / (n + h)))
+    sin_lat = np.sin(lat)
+    n = A_M / np.sqrt(1.0 - E2 * sin_lat**2)
+    h = p * np.cos(lat) + z * sin_lat - A_M**2 / n
+    return lat, lon, h
+
+
+def enu_basis(lat_rad, lon_rad):
+    """Unit vectors east, north, up (each (..., 3), ECEF) at geodetic *lat_rad*, *lon_rad*."""
+    lat = np.asarray(lat_rad, float)
+    lon = np.asarray(lon_rad, float)
+    sl, cl, so, co = np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon)
+    east = np.stack([-so, co, np.zeros_like(so)], axis=-1)
+    north = np.stack([-sl * co, -sl * so, cl], axis=-1)
+    up = np.stack([cl * co, cl * so, sl], axis=-1)
+    return east, north, up
+
+
+def look_vector_ecef(lat_rad, lon_rad, zenith_rad, azimuth_rad):
+    """Unit vector (..., 3, ECEF) from a ground point toward the satellite.
+
+    *zenith_rad* is the satellite zenith angle at the ground point and *azimuth_rad* its azimuth,
+    clockwise from north (the JPSS ``SatelliteZenithAngle``/``SatelliteAzimuthAngle`` convention).
+    """
+    east, north, up = enu_basis(lat_rad, lon_rad)
+    sz = np.sin(zenith_rad)[..., None]
+    return (sz * np.sin(azimuth_rad)[..., None] * east + sz * np.cos(azimuth_rad)[..., None] * north
+            + np.cos(zenith_rad)[..., None] * up)
+
+
+def zenith_azimuth(ground_ecef_m, sat_ecef_m):
+    """Satellite (zenith_rad, azimuth_rad, range_m) seen from ECEF ground points on the ellipsoid."""
+    lat, lon, _ = ecef_to_geodetic(ground_ecef_m)
+    east, north, up = enu_basis(lat, lon)
+    d = np.asarray(sat_ecef_m) - np.asarray(ground_ecef_m)
+    rng = np.linalg.norm(d, axis=-1)
+    u = d / rng[..., None]
+    zen = np.arccos(np.clip(np.sum(u * up, axis=-1), -1.0, 1.0))
+    az = np.arctan2(np.sum(u * east, axis=-1), np.sum(u * north, axis=-1))
+    return zen, az, rng
+
+
+def intersect_ellipsoid(origin_m, direction, h_m=0.0):
+    """Distance along unit *direction* from ECEF *origin_m* to the first crossing of the ellipsoid.
+
+    The ellipsoid is WGS84 grown by *h_m* on both axes (exact for h_m = 0, the IDPS convention).
+    Returns NaN where the ray misses. Shapes broadcast over the leading axes; the last is 3.
+    """
+    o = np.asarray(origin_m, float)
+    d = np.asarray(direction, float)
+    a = A_M + np.asarray(h_m, float)
+    b = B_M + np.asarray(h_m, float)
+    w = np.stack(np.broadcast_arrays(1.0 / a**2, 1.0 / a**2, 1.0 / b**2), axis=-1)
+    qa = np.sum(d * d * w, axis=-1)
+    qb = 2.0 * np.sum(o * d * w, axis=-1)
+    qc = np.sum(o * o * w, axis=-1) - 1.0
+    disc = qb**2 - 4.0 * qa * qc
+    with np.errstate(invalid="ignore"):
+        t = (-qb - np.sqrt(disc)) / (2.0 * qa)
+    return np.where((disc >= 0) & (t > 0), t, np.nan)
+
+
+def geodetic_up(xyz_m):
+    """Unit normal to the ellipsoid (..., 3) at (or below) ECEF points, i.e. geodetic up."""
+    lat, lon, _ = ecef_to_geodetic(xyz_m)
+    return enu_basis(lat, lon)[2]

@@ -1,0 +1,108 @@
+"""The typed result where the science hands over to the service: per-FOR LOS offsets of one assessment."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+FOV_SIZE_URAD = 16807.5
+N_FOR = 30
+
+FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
+FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
+FLAG_FLAT = "flat"  # the cost surface has no clear minimum (uniform scenes carry no information)
+RELIABILITY_FLAGS = (FLAG_FEW_SAMPLES, FLAG_EDGE, FLAG_FLAT)
+
+
+@dataclass(frozen=True)
+class ForOffset:
+    """Offsets of one scan position (FOR 1..30): the turn to apply to the CrIS LOS to best match VIIRS.
+
+    Angles in microradians (in-track alpha, cross-track beta), distances in km on the ground (in-track
+    positive along the flight direction, cross-track positive to the right), cost in kelvin.
+    """
+
+    for_index: int
+    d_alpha_urad: float
+    d_beta_urad: float
+    sigma_alpha_urad: float
+    sigma_beta_urad: float
+    in_track_km: float
+    cross_track_km: float
+    total_km: float
+    sigma_in_track_km: float
+    sigma_cross_track_km: float
+    n_samples: int
+    cost_min_k: float
+    cost_zero_k: float
+    flags: tuple = ()
+
+    @property
+    def d_alpha_pct_fov(self) -> float:
+        return 100.0 * self.d_alpha_urad / FOV_SIZE_URAD
+
+    @property
+    def d_beta_pct_fov(self) -> float:
+        return 100.0 * self.d_beta_urad / FOV_SIZE_URAD
+
+    @property
+    def reliable(self) -> bool:
+        return not any(f in RELIABILITY_FLAGS for f in self.flags)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["for"] = d.pop("for_index")
+        d["flags"] = list(self.flags)
+        d["d_alpha_pct_fov"] = self.d_alpha_pct_fov
+        d["d_beta_pct_fov"] = self.d_beta_pct_fov
+        return {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in d.items()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "ForOffset":
+        names = cls.__dataclass_fields__
+        kw = {k: d[k] for k in names if k in d and k != "for_index"}
+        kw = {k: (float("nan") if v is None else v) for k, v in kw.items()}
+        kw["flags"] = tuple(d.get("flags", ()))
+        return cls(for_index=int(d["for"]), **kw)
+
+
+@dataclass
+class AssessmentResult:
+    """One assessment of one satellite over a set of granules; all 30 FORs, in FOR order."""
+
+    satellite: str
+    start: str
+    end: str
+    fors: list
+    granules: list = field(default_factory=list)
+    skipped: list = field(default_factory=list)
+    half_steps: int = 10
+    step_urad: float = 375.0 / 833000.0 * 1e6
+    cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
+
+    def to_dict(self, with_cube: bool = False) -> dict:
+        d = {"satellite": self.satellite, "start": self.start, "end": self.end,
+             "half_steps": self.half_steps, "step_urad": self.step_urad,
+             "granules": self.granules, "skipped": self.skipped,
+             "fors": [f.to_dict() for f in self.fors]}
+        if with_cube and self.cost_cube_k is not None:
+            d["cost_cube_k"] = np.round(self.cost_cube_k, 5).tolist()
+        return d
+
+    def to_json(self, with_cube: bool = True) -> str:
+        return json.dumps(self.to_dict(with_cube), indent=1)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "AssessmentResult":
+        cube = d.get("cost_cube_k")
+        return cls(satellite=d["satellite"], start=d["start"], end=d["end"],
+                   fors=[ForOffset.from_dict(f) for f in d["fors"]], granules=d.get("granules", []),
+                   skipped=d.get("skipped", []), half_steps=int(d.get("half_steps", 10)),
+                   step_urad=float(d.get("step_urad", 375.0 / 833000.0 * 1e6)),
+                   cost_cube_k=None if cube is None else np.asarray(cube, float))
+
+    @classmethod
+    def from_json(cls, text: str) -> "AssessmentResult":
+        return cls.from_dict(json.loads(text))

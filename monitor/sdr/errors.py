@@ -1,0 +1,11 @@
+"""The one error type of the readers: it names the file, the field and what is wrong with it."""
+
+
+class GranuleError(ValueError):
+    """A granule that cannot be used. ``str()`` reads ``FILE: FIELD: REASON``."""
+
+    def __init__(self, path, field, reason):
+        self.path = str(path)
+        self.field = field
+        self.reason = reason
+        super().__init__(f"{self.path}: {field}: {reason}")

@@ -1,0 +1,130 @@
+"""Find granule files, pair CrIS SDR with GEO, and attach the VIIRS I5 granules that cover each CrIS granule.
+
+Pairing is by file name (``plat_d_t_e_b``, which an SDR and its GEO share) and, for VIIRS coverage,
+by time. Files that cannot be used are returned with their reason, never dropped silently.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections import defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from monitor.sdr.errors import GranuleError
+from monitor.sdr.names import parse_name
+from monitor.sdr.readers import GranuleMeta, read_metadata
+
+CRIS_SDR = ("SCRIF", "SCRIS")
+CRIS_GEO = ("GCRSO",)
+VIIRS_SDR = ("SVI05",)
+VIIRS_GEO = ("GIMGO", "GITCO")  # ellipsoid geolocation first, as Wang's code; NODD has only GITCO
+COVER_MARGIN = dt.timedelta(seconds=10)
+
+
+@dataclass
+class GranuleFiles:
+    """The files of one granule: SDR and GEO (the same file for combined products) and their metadata."""
+
+    key: str
+    sdr: Path
+    geo: Path
+    sdr_meta: GranuleMeta
+    geo_meta: GranuleMeta
+
+    @property
+    def start(self) -> dt.datetime:
+        return self.geo_meta.start
+
+    @property
+    def end(self) -> dt.datetime:
+        return self.geo_meta.end
+
+
+@dataclass
+class CasePlan:
+    """CrIS granules with the VIIRS granules covering each, and every file or granule left out with why."""
+
+    satellite: str
+    cris: list = field(default_factory=list)  # GranuleFiles
+    viirs: dict = field(default_factory=dict)  # cris key -> list[GranuleFiles], time-ordered
+    skipped: list = field(default_factory=list)  # (path or key, reason)
+
+
+class PlanError(ValueError):
+    """Inputs that cannot form an assessment at all (no files, mixed satellites)."""
+
+
+def find_files(paths) -> list[Path]:
+    """Every ``*.h5`` file under *paths* (files or directories), sorted; missing paths raise PlanError."""
+    out = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            out.extend(sorted(q for q in p.rglob("*.h5") if q.is_file()))
+        elif p.is_file():
+            out.append(p)
+        else:
+            raise PlanError(f"{p}: no such file or directory")
+    return sorted(set(out))
+
+
+def plan(paths) -> CasePlan:
+    """Pair the granule files found under *paths* into a :class:`CasePlan`."""
+    files = find_files(paths)
+    if not files:
+        raise PlanError(f"no .h5 files in {', '.join(map(str, paths))}")
+    skipped = []
+    by_prefix = defaultdict(dict)  # prefix -> key -> (path, meta)
+    platforms = defaultdict(int)
+    for path in files:
+        name = parse_name(path.name)
+        if name is None:
+            skipped.append((str(path), "not a JPSS product file name"))
+            continue
+        try:
+            metas = read_metadata(path)
+        except GranuleError as exc:
+            skipped.append((str(path), str(exc)))
+            continue
+        platforms[name.platform] += 1
+        for meta in metas:
+            key = f"{meta.platform}_{meta.granule_id}" if len(metas) > len(name.products) else name.granule_key
+            prev = by_prefix[meta.product].get(key)
+            if prev is None or prev[0].name < path.name:  # the newest creation time wins
+                by_prefix[meta.product][key] = (path, meta)
+    if len(platforms) > 1:
+        raise PlanError("mixed satellites: " + ", ".join(f"{p} ({n} files)" for p, n in sorted(platforms.items())))
+    if not platforms:
+        raise PlanError("no readable JPSS granule among " + ", ".join(s[0] for s in skipped[:5]))
+    satellite = next(iter(platforms))
+    cris = _pair(by_prefix, CRIS_SDR, CRIS_GEO, skipped)
+    viirs = sorted(_pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped), key=lambda g: g.start)
+    result = CasePlan(satellite, skipped=skipped)
+    for g in sorted(cris, key=lambda g: g.start):
+        cover = [v for v in viirs if v.start <= g.end + COVER_MARGIN and v.end >= g.start - COVER_MARGIN]
+        if not cover:
+            skipped.append((g.key, "no VIIRS I5 granule covers this CrIS granule in time"))
+            continue
+        result.cris.append(g)
+        result.viirs[g.key] = cover
+    return result
+
+
+def _pair(by_prefix, sdr_prefixes, geo_prefixes, skipped) -> list[GranuleFiles]:
+    sdrs = {}
+    for p in sdr_prefixes:
+        for key, v in by_prefix.get(p, {}).items():
+            sdrs.setdefault(key, v)
+    geos = {}
+    for p in geo_prefixes:
+        for key, v in by_prefix.get(p, {}).items():
+            geos.setdefault(key, v)
+    out = []
+    for key in sorted(set(sdrs) | set(geos)):
+        if key not in geos:
+            skipped.append((str(sdrs[key][0]), f"no matching {'/'.join(geo_prefixes)} geolocation file"))
+        elif key not in sdrs:
+            skipped.append((str(geos[key][0]), f"no matching {'/'.join(sdr_prefixes)} file"))
+        else:
+            out.append(GranuleFiles(key, sdrs[key][0], geos[key][0], sdrs[key][1], geos[key][1]))
+    return out

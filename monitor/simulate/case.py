@@ -1,0 +1,325 @@
+"""Simulate a case: CrIS SCRIF + GCRSO and VIIRS SVI05 + GITCO granules with an injected LOS error."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from monitor.geometry import frames, wgs84
+from monitor.sdr import iet
+from monitor.sdr.names import format_name
+from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
+from monitor.simulate import instrument as ins
+from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
+from monitor.simulate.orbit import CircularOrbit
+from monitor.simulate.profiles import load_profile
+from monitor.simulate.scene import Scene, spectra, transmittance
+from monitor.spectral import i5_band, planck_radiance
+
+UTC = dt.timezone.utc
+DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)
+GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # formats.md 1.2
+CRIS_GRANULE_S = 32.0
+VIIRS_GRANULE_S = ins.VIIRS_SCANS * ins.VIIRS_SCAN_S
+ORBIT_PERIOD_S = 6080.0
+CONE_SAMPLES = 256
+T_BINS_K = np.arange(150.0, 350.0001, 0.05)
+BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
+RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
+OBPT_U16, OBPT_F32 = 65533, -999.7
+
+DEFAULT_AUX = {
+    "cris": ["CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops",
+             "CrIS-SDR-CC_{p}_20180426000000Z_20180808000000Z_ee00000000000000Z_PS-1-O-CCR-3542-002-LE-PE_all-_all_all-_ops"],
+    "viirs": ["VIIRS-SDR-GEO-IMG-PARAM-LUT_{p}_20130601000000Z_20130601000000Z_ee00000000000000Z_PS-1-O-CCR-13-1171-JPSS-DPA-009-PE_noaa_all_all-_all",
+              "CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops"],
+}
+
+
+@dataclass
+class SimulationSpec:
+    """What to simulate. Offsets are the per-FOR turn (urad) that takes the GEO LOS onto the true LOS."""
+
+    satellite: str = "j01"
+    granules: int = 14
+    d_alpha_urad: np.ndarray = field(default_factory=lambda: np.zeros(30))
+    d_beta_urad: np.ndarray = field(default_factory=lambda: np.zeros(30))
+    seed: int = 0
+    start: dt.datetime = DEFAULT_START
+    profile: str = "zero"
+    attitude_arcsec: tuple = (0.6, -0.3, 0.5)
+    software_version: str = "I2.3.00.00"
+    aux: dict = field(default_factory=lambda: {k: list(v) for k, v in DEFAULT_AUX.items()})
+    viirs_noise_k: float = 0.3
+    cris_noise: float = 0.05  # mW/(m2 sr cm-1) per channel
+
+
+def _unix_s(when: dt.datetime) -> float:
+    return when.timestamp()
+
+
+def _iet_us(unix_s) -> np.ndarray:
+    return iet.unix_us_to_iet(np.round(np.asarray(unix_s) * 1e6).astype(np.int64))
+
+
+def _granule_id(platform: str, nominal_start_iet_us: int) -> str:
+    return f"{platform.upper()}{(nominal_start_iet_us - GRANULE_ID_EPOCH_IET_US) // 100000:012d}"
+
+
+def _orbit_number(unix_s: float) -> int:
+    return 4790 + int((unix_s - 1540167839.0) // ORBIT_PERIOD_S)
+
+
+class _Clock:
+    """Converts between UTC datetimes, unix seconds and IET for one case."""
+
+    @staticmethod
+    def dt(unix_s: float) -> dt.datetime:
+        return dt.datetime.fromtimestamp(unix_s, UTC)
+
+
+def _sunflower_disk(n: int, radius: float):
+    k = np.arange(n) + 0.5
+    r = radius * np.sqrt(k / n)
+    phi = k * np.pi * (3.0 - np.sqrt(5.0))
+    return r * np.cos(phi), r * np.sin(phi)
+
+
+class Simulator:
+    """Builds the orbit, attitude and scene of a case and writes its granules."""
+
+    def __init__(self, spec: SimulationSpec):
+        self.spec = spec
+        self.t0 = _unix_s(spec.start)
+        rng = np.random.default_rng(spec.seed)
+        self.orbit = CircularOrbit(self.t0, u0_deg=-14.0 + rng.uniform(-3, 3), lon0_deg=rng.uniform(-180, 180))
+        self.scene = Scene(spec.seed)
+        self.band = i5_band(spec.satellite)
+        self.nu = cris_lw_wavenumbers_cm1()
+        tau = transmittance(self.nu)
+        atm = (1 - tau) * planck_radiance(self.nu, 262.0)
+        # VIIRS band radiance of a pixel whose emitting temperature is T, through the same atmosphere.
+        table = planck_radiance(self.nu[None, :], T_BINS_K[:, None])
+        self.planck_table = table
+        self.band_table = (tau * table + atm) @ self.band.weights
+        self.rng = rng
+
+    def attitude_rad(self, unix_s):
+        """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift."""
+        t = np.asarray(unix_s, float) - self.t0
+        base = np.asarray(self.spec.attitude_arcsec, float)
+        drift = 0.1 * np.stack([np.sin(t / 600.0), np.cos(t / 900.0), np.sin(t / 700.0)], -1)
+        return (base + drift) * frames.ARCSEC_RAD
+
+    def state(self, unix_s):
+        r, v = self.orbit.state_ecef(unix_s)
+        return r, v, frames.sbf_to_ecef(r, v, self.attitude_rad(unix_s))
+
+    # ------------------------------------------------------------------ CrIS
+    def cris_granule(self, k: int, out: Path) -> list[str]:
+        spec = self.spec
+        g0 = self.t0 + k * CRIS_GRANULE_S
+        scan_start = g0 + np.arange(4) * ins.CRIS_SCAN_US * 1e-6
+        for_unix = scan_start[:, None] + np.arange(ins.CRIS_N_FOR) * ins.CRIS_FOR_DT_US * 1e-6
+        r, v, m = self.state(for_unix)  # (4, 30, ...)
+        los_true = ins.cris_los_sbf()
+        los_geo = ins.cris_los_sbf(-spec.d_alpha_urad * 1e-6, -spec.d_beta_urad * 1e-6)
+        true_ecef = np.einsum("skij,kfj->skfi", m, los_true)
+        geo_ecef = np.einsum("skij,kfj->skfi", m, los_geo)
+        sat = np.broadcast_to(r[:, :, None, :], geo_ecef.shape)
+        t = wgs84.intersect_ellipsoid(sat, geo_ecef)
+        ground = sat + t[..., None] * geo_ecef
+        lat, lon, _ = wgs84.ecef_to_geodetic(ground)
+        zen, az, rng_m = wgs84.zenith_azimuth(ground, sat)
+        radiance = self._cris_spectra(sat, true_ecef)
+        radiance += self.rng.normal(0.0, spec.cris_noise, radiance.shape)
+
+        for_iet = _iet_us(for_unix)
+        start_iet = for_iet[:, 0]
+        mid_iet = start_iet + ins.CRIS_MID_OFFSET_US
+        r_mid, v_mid = self.orbit.state_ecef(iet.iet_to_unix_us(mid_iet) * 1e-6)
+        att_mid = self.attitude_rad(iet.iet_to_unix_us(mid_iet) * 1e-6) / frames.ARCSEC_RAD
+        begin, end = for_unix[0, 0], for_unix[-1, -1]
+        gid = _granule_id(spec.satellite, int(start_iet[0]) - 4_400_000)
+        attrs = self._granule_attrs(begin, end, int(for_iet[0, 0]), int(for_iet[-1, -1]), gid, 4,
+                                    v[0, 0], lat, lon, spec.aux["cris"], "CrIS-SDR-GEO")
+        geo = {
+            "FORTime": for_iet, "StartTime": start_iet, "MidTime": mid_iet,
+            "Latitude": np.degrees(lat).astype(np.float32), "Longitude": np.degrees(lon).astype(np.float32),
+            "Height": np.zeros(lat.shape, np.float32),
+            "SatelliteRange": rng_m.astype(np.float32),
+            "SatelliteZenithAngle": np.degrees(zen).astype(np.float32),
+            "SatelliteAzimuthAngle": np.degrees(az).astype(np.float32),
+            "SolarZenithAngle": np.full(lat.shape, -999.3, np.float32),
+            "SolarAzimuthAngle": np.full(lat.shape, -999.3, np.float32),
+            "SCPosition": r_mid.astype(np.float32), "SCVelocity": v_mid.astype(np.float32),
+            "SCAttitude": att_mid.astype(np.float32),
+            "QF1_CRISSDRGEO": np.zeros(4, np.uint8), "PadByte1": np.zeros(4, np.uint8),
+        }
+        t_mean = self.band.bt_from_radiance(self.band.band_radiance(radiance))
+        mw = planck_radiance(1208.75 + 0.625 * np.arange(869), t_mean[..., None]).astype(np.float32)
+        sw = planck_radiance(2153.75 + 0.625 * np.arange(637), t_mean[..., None]).astype(np.float32)
+        sdr = {"ES_RealLW": radiance.astype(np.float32), "ES_RealMW": mw, "ES_RealSW": sw,
+               "QF1_SCAN_CRISSDR": np.zeros(4, np.uint8), "QF3_CRISSDR": np.zeros((4, 30, 9, 3), np.uint8)}
+        names = []
+        for prefix, data, tag in (("GCRSO", geo, "GEO"), ("SCRIF", sdr, "SDR")):
+            product = PRODUCTS[prefix]
+            created = _Clock.dt(end + 1800 + (7 if prefix == "GCRSO" else 0))
+            a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1")
+            name = format_name([prefix], spec.satellite, _Clock.dt(begin), _Clock.dt(end),
+                               attrs["N_Beginning_Orbit_Number"], created)
+            write_file(out / name, spec.satellite, created,
+                       [ProductData(product, "CrIS", tag, data, [a], {})])
+            names.append(name)
+        return names
+
+    def _cris_spectra(self, sat, los_ecef):
+        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV cone on the scene, not the VIIRS grid."""
+        x, y = _sunflower_disk(CONE_SAMPLES, np.tan(ins.CRIS_FOV_HALF_ANGLE_RAD))
+        helper = np.where(np.abs(los_ecef[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+        e1 = frames.unit(np.cross(los_ecef, helper))
+        e2 = np.cross(los_ecef, e1)
+        dirs = frames.unit(los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :])
+        origin = np.broadcast_to(sat[..., None, :], dirs.shape)
+        pts = origin + wgs84.intersect_ellipsoid(origin, dirs)[..., None] * dirs
+        lat, lon, _ = wgs84.ecef_to_geodetic(pts)
+        temp = self.scene.temperature_k(lat, lon).reshape(-1, CONE_SAMPLES)
+        nfov = temp.shape[0]
+        pos = (np.clip(temp, T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (T_BINS_K[1] - T_BINS_K[0])
+        b0 = np.floor(pos).astype(np.int64)
+        w1 = pos - b0
+        rows = np.repeat(np.arange(nfov), CONE_SAMPLES) * len(T_BINS_K)
+        hist = np.bincount(rows + b0.ravel(), (1 - w1).ravel(), nfov * len(T_BINS_K))
+        hist += np.bincount(rows + b0.ravel() + 1, w1.ravel(), nfov * len(T_BINS_K))
+        mean_planck = hist.reshape(nfov, -1) @ self.planck_table / CONE_SAMPLES
+        return spectra(self.nu, mean_planck).reshape(sat.shape[:-1] + (len(self.nu),))
+
+    # ------------------------------------------------------------------ VIIRS
+    def viirs_granule(self, g0: float, out: Path, scans_per_chunk: int = 6) -> list[str]:
+        spec = self.spec
+        theta, col_dt = ins.viirs_column_geometry()
+        a_det = ins.viirs_detector_angles_rad()
+        local = frames.unit(np.stack([np.tan(a_det), np.zeros_like(a_det), np.ones_like(a_det)], -1))
+        los_sbf = np.einsum("cij,dj->dci", frames.rot_x(-theta), local)  # (32, 6400, 3)
+        deleted = ins.viirs_bowtie_deleted()
+        nrow = ins.VIIRS_SCANS * ins.VIIRS_DETECTORS
+        lat_out = np.empty((nrow, ins.VIIRS_COLUMNS), np.float32)
+        lon_out = np.empty_like(lat_out)
+        bt_dn = np.empty((nrow, ins.VIIRS_COLUMNS), np.uint16)
+        rad_dn = np.empty_like(bt_dn)
+        scan_start = g0 + np.arange(ins.VIIRS_SCANS) * ins.VIIRS_SCAN_S
+        cwv = float(np.sum(self.band.weights * self.nu))
+        for s0 in range(0, ins.VIIRS_SCANS, scans_per_chunk):
+            ss = slice(s0, s0 + scans_per_chunk)
+            tt = scan_start[ss, None] + col_dt[None, :]
+            r, _, m = self.state(tt)  # (n, 6400, 3), (n, 6400, 3, 3)
+            los = np.einsum("scij,dcj->sdci", m, los_sbf)
+            origin = np.broadcast_to(r[:, None], los.shape)
+            pts = origin + wgs84.intersect_ellipsoid(origin, los)[..., None] * los
+            lat, lon, _ = wgs84.ecef_to_geodetic(pts)
+            temp = self.scene.temperature_k(lat, lon)
+            lrad = np.interp(temp, T_BINS_K, self.band_table)
+            bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, temp.shape)
+            rows = slice(s0 * 32, (s0 + lat.shape[0]) * 32)
+            lat_out[rows] = np.degrees(lat).reshape(-1, ins.VIIRS_COLUMNS)
+            lon_out[rows] = np.degrees(lon).reshape(-1, ins.VIIRS_COLUMNS)
+            bt_dn[rows] = np.clip(np.round((bt - BT_OFFSET) / BT_SCALE), 0, 65527).reshape(-1, ins.VIIRS_COLUMNS)
+            # W/(m2 sr um) from mW/(m2 sr cm-1): L_lambda = L_nu * nu^2 / 1e4 / 1e3
+            lam = self.band.radiance_from_bt(bt) * cwv**2 * 1e-7
+            rad_dn[rows] = np.clip(np.round((lam - RAD_OFFSET) / RAD_SCALE), 0, 65527).reshape(-1, ins.VIIRS_COLUMNS)
+        mask = np.tile(deleted, (ins.VIIRS_SCANS, 1))
+        bt_dn[mask] = OBPT_U16
+        rad_dn[mask] = OBPT_U16
+        lat_out[mask] = OBPT_F32
+        lon_out[mask] = OBPT_F32
+
+        start_iet = _iet_us(scan_start)
+        mid_iet = start_iet + int(ins.VIIRS_EARTH_VIEW_S / 2 * 1e6)
+        mid_unix = iet.iet_to_unix_us(mid_iet) * 1e-6
+        r_mid, v_mid = self.orbit.state_ecef(mid_unix)
+        att_mid = self.attitude_rad(mid_unix) / frames.ARCSEC_RAD
+        end = g0 + VIIRS_GRANULE_S
+        gid = _granule_id(spec.satellite, int(start_iet[0]))
+        valid = ~mask
+        attrs = self._granule_attrs(g0, end, int(start_iet[0]), int(_iet_us(end)), gid, ins.VIIRS_SCANS,
+                                    v_mid[0], np.radians(lat_out[valid][::97]), np.radians(lon_out[valid][::97]),
+                                    spec.aux["viirs"], "VIIRS-IMG-GEO-TC")
+        per_scan = {"StartTime": start_iet, "MidTime": mid_iet, "SCPosition": r_mid.astype(np.float32),
+                    "SCVelocity": v_mid.astype(np.float32), "SCAttitude": att_mid.astype(np.float32),
+                    "QF1_SCAN_VIIRSSDRGEO": np.zeros(ins.VIIRS_SCANS, np.uint8),
+                    "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32)}
+        geo = {"Latitude": lat_out, "Longitude": lon_out, "Height": np.zeros_like(lat_out),
+               "QF2_VIIRSSDRGEO": np.zeros(lat_out.shape, np.uint8), **per_scan}
+        sdr = {"BrightnessTemperature": bt_dn, "BrightnessTemperatureFactors": np.array([BT_SCALE, BT_OFFSET], np.float32),
+               "Radiance": rad_dn, "RadianceFactors": np.array([RAD_SCALE, RAD_OFFSET], np.float32),
+               "QF1_VIIRSIBANDSDR": np.zeros(bt_dn.shape, np.uint8),
+               "QF2_SCAN_SDR": np.zeros(ins.VIIRS_SCANS, np.uint8),
+               "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32)}
+        names = []
+        for prefix, data, tag in (("GITCO", geo, "GEO"), ("SVI05", sdr, "SDR")):
+            product = PRODUCTS[prefix]
+            created = _Clock.dt(end + 1700 + (3 if prefix == "GITCO" else 0))
+            a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1", Band_ID="I5" if tag == "SDR" else "N/A")
+            name = format_name([prefix], spec.satellite, _Clock.dt(g0), _Clock.dt(end),
+                               attrs["N_Beginning_Orbit_Number"], created)
+            write_file(out / name, spec.satellite, created,
+                       [ProductData(product, "VIIRS", tag, data, [a], {}, fills={}, compress=False)])
+            names.append(name)
+        return names
+
+    def _granule_attrs(self, begin, end, begin_iet, end_iet, gid, nscan, v0, lat, lon, aux, coll):
+        p = self.spec.satellite
+        lat_d, lon_d = np.degrees(lat), np.degrees(lon)
+        return {
+            "Ascending/Descending_Indicator": 0 if v0[2] > 0 else 1,
+            **date_time_attrs("Beginning", _Clock.dt(begin)), **date_time_attrs("Ending", _Clock.dt(end)),
+            "East_Bounding_Coordinate": float(np.nanmax(lon_d)), "West_Bounding_Coordinate": float(np.nanmin(lon_d)),
+            "North_Bounding_Coordinate": float(np.nanmax(lat_d)), "South_Bounding_Coordinate": float(np.nanmin(lat_d)),
+            "N_Algorithm_Version": "2.O.000.001", "N_Aux_Filename": [a.format(p=p) for a in aux],
+            "N_Anc_Filename": ["Terrain-Eco-ANC-Tile_20030125000000Z_ee00000000000000Z_NA_NA_S0388_1.O.0.0"],
+            "N_Beginning_Orbit_Number": _orbit_number(begin), "N_Beginning_Time_IET": begin_iet,
+            "N_Ending_Time_IET": end_iet, "N_Granule_ID": gid, "N_Granule_Status": "N/A", "N_Granule_Version": "A1",
+            "N_IDPS_Mode": "ops", "N_Number_Of_Scans": nscan, "N_Software_Version": self.spec.software_version,
+            "N_Spacecraft_Maneuver": "Normal Operations", "N_Primary_Label": "Primary",
+            **date_time_attrs("N_Creation", _Clock.dt(end + 1700)),
+        }
+
+    def viirs_granule_starts(self) -> np.ndarray:
+        """Start times (unix s) of the VIIRS granules that cover the CrIS granules with margin."""
+        first = self.t0 - 5.0
+        last = self.t0 + self.spec.granules * CRIS_GRANULE_S + 5.0
+        ref = self.t0 - 37.3
+        k0 = int(np.floor((first - ref) / VIIRS_GRANULE_S))
+        k1 = int(np.floor((last - ref) / VIIRS_GRANULE_S))
+        return ref + np.arange(k0, k1 + 1) * VIIRS_GRANULE_S
+
+
+def simulate_case(out_dir, satellite="j01", granules=14, profile="paper", seed=0, start=None,
+                  spec: SimulationSpec | None = None, viirs: bool = True) -> dict:
+    """Write a case's granules into *out_dir* and ``truth.json``; return the truth document."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    if spec is None:
+        d_alpha, d_beta = load_profile(profile, seed)
+        spec = SimulationSpec(satellite=satellite, granules=granules, d_alpha_urad=np.asarray(d_alpha, float),
+                              d_beta_urad=np.asarray(d_beta, float), seed=seed,
+                              start=start or DEFAULT_START, profile=profile)
+    sim = Simulator(spec)
+    files = []
+    for k in range(spec.granules):
+        files += sim.cris_granule(k, out)
+    if viirs:
+        for g0 in sim.viirs_granule_starts():
+            files += sim.viirs_granule(float(g0), out)
+    truth = {
+        "satellite": spec.satellite, "profile": spec.profile, "seed": spec.seed,
+        "start": spec.start.isoformat(), "granules": spec.granules, "files": sorted(files),
+        "fors": [{"for": k + 1, "d_alpha_urad": float(a), "d_beta_urad": float(b)}
+                 for k, (a, b) in enumerate(zip(spec.d_alpha_urad, spec.d_beta_urad))],
+    }
+    (out / "truth.json").write_text(json.dumps(truth, indent=1))
+    return truth

@@ -1,0 +1,84 @@
+"""Nominal scan geometry of CrIS and VIIRS I-band as lines of sight in the spacecraft body frame (SBF).
+
+SBF axes: x along track, y to the right of track, z toward nadir. A scan angle theta turns the
+boresight about x so that the cross-track angle beta = atan(y/z) equals theta (FOR 1 on the left).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from monitor.geometry.frames import rot_x, unit
+
+CRIS_N_FOR = 30
+CRIS_N_FOV = 9
+CRIS_FOR_STEP_RAD = np.radians(3.3333)
+CRIS_FOV_SPACING_RAD = 19.1e-3  # FOV centre spacing, ~1.1 deg (EP offsets, formats.md 2.1)
+CRIS_FOV_HALF_ANGLE_RAD = 16807.5e-6 / 2
+CRIS_FOR_DT_US = 200_000
+CRIS_SCAN_US = 8_000_000
+CRIS_MID_OFFSET_US = 2_899_989
+
+VIIRS_DETECTORS = 32
+VIIRS_SCANS = 48
+VIIRS_COLUMNS = 6400
+VIIRS_SCAN_S = 1.7864
+VIIRS_ZONE_COLUMNS = (1280, 736, 2368, 736, 1280)  # aggregation zones, output columns (VcstGeoParameters.h)
+VIIRS_ZONE_AGGREGATION = (1, 2, 3, 2, 1)
+VIIRS_NATIVE_RAD = 155.2e-6  # along-scan native sample; 12608 samples span +-56 deg
+VIIRS_DETECTOR_RAD = 375.0 / 833000.0
+VIIRS_EARTH_VIEW_S = 0.556  # the 112 deg Earth-view sector of the 1.7864 s rotation
+
+
+def cris_scan_angles_rad() -> np.ndarray:
+    """Scan angle of FOR 1..30 (rad), -48.33 deg to +48.33 deg."""
+    return (np.arange(CRIS_N_FOR) - (CRIS_N_FOR - 1) / 2) * CRIS_FOR_STEP_RAD
+
+
+def cris_fov_offsets_rad():
+    """(in_track, cross_track) offsets (rad) of FOV 1..9 at nadir: FOV 7-9 ahead, FOV 1, 4, 7 on the left."""
+    f = np.arange(CRIS_N_FOV)
+    return (f // 3 - 1) * CRIS_FOV_SPACING_RAD, (f % 3 - 1) * CRIS_FOV_SPACING_RAD
+
+
+def cris_los_sbf(d_alpha_rad=None, d_beta_rad=None) -> np.ndarray:
+    """Nominal CrIS LOS (30, 9, 3) in the SBF, optionally turned per FOR by (d_alpha, d_beta) (30,) rad.
+
+    The 3x3 pattern turns with the scan angle (the scene mirror rotates about the optical axis).
+    """
+    theta = cris_scan_angles_rad()
+    da, dc = cris_fov_offsets_rad()
+    c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
+    a = c * da - s * dc
+    b = s * da + c * dc
+    local = unit(np.stack([np.tan(a), np.tan(b), np.ones_like(a)], axis=-1))
+    los = np.einsum("kij,kfj->kfi", rot_x(-theta), local)
+    if d_alpha_rad is None and d_beta_rad is None:
+        return los
+    alpha = np.arctan2(los[..., 0], los[..., 2]) + np.asarray(d_alpha_rad if d_alpha_rad is not None else 0.0)[..., None]
+    beta = np.arctan2(los[..., 1], los[..., 2]) + np.asarray(d_beta_rad if d_beta_rad is not None else 0.0)[..., None]
+    return unit(np.stack([np.tan(alpha), np.tan(beta), np.ones_like(alpha)], axis=-1))
+
+
+def viirs_column_geometry():
+    """Scan angle (rad) and time within the Earth view (s) of each of the 6400 I-band columns."""
+    agg = np.repeat(VIIRS_ZONE_AGGREGATION, VIIRS_ZONE_COLUMNS)
+    native_end = np.cumsum(agg)
+    centre = native_end - agg / 2.0
+    total = native_end[-1]
+    return (centre - total / 2.0) * VIIRS_NATIVE_RAD, centre / total * VIIRS_EARTH_VIEW_S
+
+
+def viirs_bowtie_deleted() -> np.ndarray:
+    """(32, 6400) mask of on-board bow-tie deleted I-band pixels (formats.md 3)."""
+    mask = np.zeros((VIIRS_DETECTORS, VIIRS_COLUMNS), bool)
+    for rows, n in (((0, 1, 30, 31), 2016), ((2, 3, 28, 29), 1280)):
+        for r in rows:
+            mask[r, :n] = True
+            mask[r, -n:] = True
+    return mask
+
+
+def viirs_detector_angles_rad() -> np.ndarray:
+    """In-track angle (rad) of the 32 detectors; detector 0 looks furthest back."""
+    return (np.arange(VIIRS_DETECTORS) - (VIIRS_DETECTORS - 1) / 2) * VIIRS_DETECTOR_RAD

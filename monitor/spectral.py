@@ -1,0 +1,89 @@
+"""Spectral matching of CrIS to VIIRS I5: SRF convolution and band-Planck brightness temperature.
+
+CrIS radiance R(nu) in mW/(m2 sr cm-1) is apodized (Hamming 0.23/0.54/0.23, as Wang's code does),
+integrated with the I5 response S(nu): L = sum R S / sum S, and turned into a brightness temperature
+with the band-integrated Planck function of the same response, inverted through a fine table. The
+same band model turns a VIIRS pixel BT into band radiance, so both sides are averaged in radiance.
+Responses: ``monitor/data/srf`` (NOAA/NG release; NOAA-21 has none public, NOAA-20's is used).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from importlib import resources
+
+import numpy as np
+
+from monitor.sdr.products import cris_lw_wavenumbers_cm1
+
+C1 = 1.191042972e-5  # 2hc^2, mW/(m2 sr cm-4)
+C2 = 1.4387769  # hc/k, cm K
+SRF_FILES = {"npp": "npp_viirs_i05_srf.csv", "j01": "n20_viirs_i05_srf.csv", "j02": "n20_viirs_i05_srf.csv"}
+HAMMING = (0.23, 0.54, 0.23)
+
+
+def planck_radiance(wavenumber_cm1, t_k):
+    """Planck radiance mW/(m2 sr cm-1) at *wavenumber_cm1* for temperature *t_k* (broadcast)."""
+    nu = np.asarray(wavenumber_cm1, float)
+    return C1 * nu**3 / np.expm1(C2 * nu / np.asarray(t_k, float))
+
+
+def load_srf(satellite: str):
+    """(wavenumber_cm1, response) of the VIIRS I5 band of *satellite* (npp, j01, j02), ascending."""
+    name = SRF_FILES.get(satellite)
+    if name is None:
+        raise ValueError(f"no I5 spectral response for satellite {satellite!r} (known: {', '.join(SRF_FILES)})")
+    text = resources.files("monitor.data.srf").joinpath(name).read_text()
+    data = _read_csv(text)
+    order = np.argsort(data[:, 0])
+    return data[order, 0], data[order, 1]
+
+
+def _read_csv(text: str) -> np.ndarray:
+    rows = [line.split(",") for line in text.splitlines() if line and not line.startswith("#")]
+    return np.array([[float(a), float(b)] for a, b in rows[1:]])
+
+
+def apodize_hamming(radiance):
+    """Hamming apodization along the last (channel) axis; the end channels keep their value."""
+    r = np.asarray(radiance)
+    out = r.copy()
+    out[..., 1:-1] = HAMMING[0] * r[..., :-2] + HAMMING[1] * r[..., 1:-1] + HAMMING[2] * r[..., 2:]
+    return out
+
+
+class I5Band:
+    """The VIIRS I5 band of one satellite sampled on the CrIS LW grid, with its band-Planck table."""
+
+    T_MIN_K, T_MAX_K, T_STEP_K = 150.0, 350.0, 0.01
+
+    def __init__(self, satellite: str, wavenumber_cm1=None):
+        self.satellite = satellite
+        self.wavenumber_cm1 = cris_lw_wavenumbers_cm1() if wavenumber_cm1 is None else np.asarray(wavenumber_cm1)
+        nu, s = load_srf(satellite)
+        self.response = np.interp(self.wavenumber_cm1, nu, s, left=0.0, right=0.0)
+        self.weights = self.response / self.response.sum()
+        self._t = np.arange(self.T_MIN_K, self.T_MAX_K + self.T_STEP_K / 2, self.T_STEP_K)
+        self._l = planck_radiance(self.wavenumber_cm1[None, :], self._t[:, None]) @ self.weights
+
+    def band_radiance(self, spectra):
+        """Band radiance mW/(m2 sr cm-1) of spectra on the CrIS LW grid (last axis channels)."""
+        return np.asarray(spectra) @ self.weights
+
+    def cris_band_radiance(self, radiance_lw):
+        """Band radiance of unapodized CrIS LW spectra: Hamming apodization, then the SRF convolution."""
+        return self.band_radiance(apodize_hamming(radiance_lw))
+
+    def radiance_from_bt(self, bt_k):
+        """Band radiance of a band brightness temperature (K); NaN outside 150-350 K."""
+        return np.interp(bt_k, self._t, self._l, left=np.nan, right=np.nan)
+
+    def bt_from_radiance(self, radiance):
+        """Band brightness temperature (K) of a band radiance; NaN outside the table."""
+        return np.interp(radiance, self._l, self._t, left=np.nan, right=np.nan)
+
+
+@lru_cache(maxsize=8)
+def i5_band(satellite: str) -> I5Band:
+    """The cached :class:`I5Band` of *satellite*."""
+    return I5Band(satellite)
