@@ -14,6 +14,8 @@ uncertainty of each offset.
 from __future__ import annotations
 
 import logging
+import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,7 +26,8 @@ from monitor.geometry.inverse import inverse_geolocation
 from monitor.geometry.perturb import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, perturbation_grid
 from monitor.result import (FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, N_FOR, AssessmentResult, ForOffset)
 from monitor.sdr import GranuleError, read_file
-from monitor.sdr.pairing import CasePlan, GranuleFiles, plan
+from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
+from monitor.sdr.readers import read_viirs_geo_scan
 from monitor.spectral import i5_band
 
 LOG = logging.getLogger(__name__)
@@ -66,44 +69,97 @@ class GranuleSamples:
     velocity_m_s: np.ndarray
 
 
+@contextmanager
+def _stage(timings, name):
+    """Add the wall time of the block to timings[name] (seconds) when *timings* is a dict."""
+    t0 = time.perf_counter()
+    try:
+        yield
+    finally:
+        if timings is not None:
+            timings[name] = timings.get(name, 0.0) + time.perf_counter() - t0
+
+
 @dataclass
 class _SwathCache:
-    keys: tuple = ()
-    swath: object = None
-    names: list = field(default_factory=list)
+    """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept."""
+
+    pieces: dict = field(default_factory=dict)
+    keep: int = 2
 
 
-def _load_swath(viirs: list[GranuleFiles], band, cache: _SwathCache):
-    keys = tuple(v.key for v in viirs)
-    if cache.keys == keys:
-        return cache.swath
-    geos, sdrs = [], []
-    for v in viirs:
-        geos.append(read_file(v.geo, kinds=("viirs_geo",))[0])
-        sdrs.append(read_file(v.sdr, kinds=("viirs_sdr",))[0])
-    stack = np.concatenate
-    swath = collocate.build_swath(stack([g.lat_rad for g in geos]), stack([g.lon_rad for g in geos]),
-                                  stack([s.bt_k for s in sdrs]), stack([s.good for s in sdrs]), band)
-    cache.keys, cache.swath = keys, swath
-    return swath
+def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=None):
+    if v.key in cache.pieces:
+        return cache.pieces[v.key]
+    before, after = neighbours(viirs_all, v)
+    with _stage(timings, "read"):
+        geo = read_file(v.geo, kinds=("viirs_geo",))[0]
+        sdr = read_file(v.sdr, kinds=("viirs_sdr",))[0]
+        halo_before = read_viirs_geo_scan(before.geo, -1) if before is not None else None
+        halo_after = read_viirs_geo_scan(after.geo, 0) if after is not None else None
+    if sdr.bt_k.shape != geo.lat_rad.shape:
+        raise GranuleError(v.sdr, "BrightnessTemperature", f"shape {sdr.bt_k.shape} does not match the GEO "
+                                                           f"{geo.lat_rad.shape}")
+    with _stage(timings, "geometry"):
+        piece = collocate.swath_piece(geo.lat_rad, geo.lon_rad, sdr.bt_k, sdr.good, band, halo_before, halo_after)
+    while len(cache.pieces) >= cache.keep:
+        cache.pieces.pop(next(iter(cache.pieces)))
+    cache.pieces[v.key] = piece
+    return piece
+
+
+def _load_swath(viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, timings=None):
+    pieces = [_piece(v, viirs_all, band, cache, timings) for v in viirs]
+    with _stage(timings, "geometry"):
+        return collocate.ViirsSwath.from_pieces(pieces)
 
 
 def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: AssessConfig, band,
-                      cache: _SwathCache) -> GranuleSamples:
-    """Read one CrIS granule and its VIIRS cover and collocate every FOV for every perturbation."""
-    geo = next(g for g in read_file(cris.geo, kinds=("cris_geo",)) if g.meta.granule_id == cris.geo_meta.granule_id)
-    sdr = next(g for g in read_file(cris.sdr, kinds=("cris_sdr",)) if g.meta.granule_id == cris.sdr_meta.granule_id)
+                      cache: _SwathCache, timings=None, viirs_all=None) -> GranuleSamples:
+    """Read one CrIS granule and its VIIRS cover and collocate every FOV for every perturbation.
+
+    *timings*, when a dict, accumulates seconds per stage: read, geometry, collocation.
+    """
+    with _stage(timings, "read"):
+        geo = next(g for g in read_file(cris.geo, kinds=("cris_geo",))
+                   if g.meta.granule_id == cris.geo_meta.granule_id)
+        sdr = next(g for g in read_file(cris.sdr, kinds=("cris_sdr",))
+                   if g.meta.granule_id == cris.sdr_meta.granule_id)
     if sdr.radiance_lw.shape[:3] != geo.lat_rad.shape:
         raise GranuleError(cris.sdr, "ES_RealLW", f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO "
                                                   f"{geo.lat_rad.shape}")
+    with _stage(timings, "geometry"):
+        fg, valid, fill = _cris_geometry(geo)
+    with _stage(timings, "spectral"):
+        bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
+    swath = _load_swath(viirs, viirs_all or viirs, band, cache, timings)
+    with _stage(timings, "collocation"):
+        bt_viirs, coverage = _collocate_fors(swath, geo, fg, valid, fill, cfg, band)
+    usable = (valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
+              & np.all(np.isfinite(bt_viirs), axis=(-2, -1)))
+    info = {"granule_id": geo.meta.granule_id, "start": geo.meta.start.isoformat(), "end": geo.meta.end.isoformat(),
+            "cris_geo": cris.geo.name, "cris_sdr": cris.sdr.name,
+            "viirs": [v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
+            "n_fovs": int(valid.sum()), "n_usable": int(usable.sum()),
+            "cris_meta": geo.meta.to_dict(), "viirs_meta": viirs[0].geo_meta.to_dict()}
+    s5 = (slice(None), slice(None), FOV5)
+    return GranuleSamples(cris.key, info, bt_viirs, bt_cris, usable, fg.sat_ecef_m[s5], fg.sbf_to_ecef[s5],
+                          fg.alpha_rad[s5], fg.beta_rad[s5], fg.velocity_ecef_m_s[s5])
+
+
+def _cris_geometry(geo):
+    """Inverse geolocation of a CrIS GEO granule, with fill FOVs given harmless values and masked."""
     valid = geo.valid
     fill = {k: np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")}
     fg = inverse_geolocation(fill["lat_rad"], fill["lon_rad"], fill["zenith_rad"], fill["azimuth_rad"],
                              np.where(valid, geo.range_m, 1e6), geo.for_time_us, geo.mid_time_us,
                              np.nan_to_num(geo.sc_position_m), np.nan_to_num(geo.sc_velocity_m_s),
                              np.nan_to_num(geo.sc_attitude_rad))
-    bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
-    swath = _load_swath(viirs, band, cache)
+    return fg, valid, fill
+
+
+def _collocate_fors(swath, geo, fg, valid, fill, cfg, band):
+    """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone and the worst coverage per FOV, FOR by FOR."""
     offsets = cfg.offsets_rad
     m = len(offsets)
     nscan = geo.lat_rad.shape[0]
@@ -120,16 +176,7 @@ def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: Assess
             fov_cos_zen=np.cos(fill["zenith_rad"][sl]).ravel())
         bt_viirs[sl] = band.bt_from_radiance(mean).reshape(shape + (m, m))
         coverage[sl] = np.nanmin(np.where(np.isfinite(cov), cov, 0.0), axis=(-2, -1)).reshape(shape)
-    usable = (valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
-              & np.all(np.isfinite(bt_viirs), axis=(-2, -1)))
-    info = {"granule_id": geo.meta.granule_id, "start": geo.meta.start.isoformat(), "end": geo.meta.end.isoformat(),
-            "cris_geo": cris.geo.name, "cris_sdr": cris.sdr.name,
-            "viirs": [v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
-            "n_fovs": int(valid.sum()), "n_usable": int(usable.sum()),
-            "cris_meta": geo.meta.to_dict(), "viirs_meta": viirs[0].geo_meta.to_dict()}
-    s5 = (slice(None), slice(None), FOV5)
-    return GranuleSamples(cris.key, info, bt_viirs, bt_cris, usable, fg.sat_ecef_m[s5], fg.sbf_to_ecef[s5],
-                          fg.alpha_rad[s5], fg.beta_rad[s5], fg.velocity_ecef_m_s[s5])
+    return bt_viirs, coverage
 
 
 def _stdev(d, weights=None):
@@ -249,27 +296,68 @@ def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=N
         half_steps=cfg.half_steps, step_urad=step_urad, cost_cube_k=cube)
 
 
-def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, should_stop=None) -> AssessmentResult:
-    """Assess every CrIS granule of *case*; granules that fail are skipped with their reason."""
-    cfg = cfg or AssessConfig()
-    band = i5_band(case.satellite)
+def _collocate_run(cris: list, viirs: dict, viirs_all: list, satellite: str, cfg: AssessConfig,
+                   progress=None, should_stop=None, timings=None):
+    """Collocate a time-ordered run of CrIS granules; returns (samples, skipped)."""
+    band = i5_band(satellite)
     cache = _SwathCache()
-    samples = []
-    skipped = list(case.skipped)
-    for g in case.cris:
+    samples, skipped = [], []
+    for g in cris:
         if should_stop is not None and should_stop():
             skipped.append((g.key, "not assessed: stop requested"))
             continue
         try:
-            samples.append(collocate_granule(g, case.viirs[g.key], cfg, band, cache))
+            samples.append(collocate_granule(g, viirs[g.key], cfg, band, cache, timings, viirs_all))
         except GranuleError as exc:
             LOG.warning("skipping granule %s: %s", g.key, exc)
             skipped.append((g.key, str(exc)))
         if progress is not None:
             progress(g)
-    return cost_and_offsets(samples, cfg, skipped, case.satellite)
+    return samples, skipped
 
 
-def assess_paths(paths, cfg: AssessConfig | None = None, progress=None) -> AssessmentResult:
+def _worker(args):
+    cris, viirs, viirs_all, satellite, cfg = args
+    timings = {}
+    samples, skipped = _collocate_run(cris, viirs, viirs_all, satellite, cfg, timings=timings)
+    return samples, skipped, timings
+
+
+def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, should_stop=None,
+                timings=None, workers: int = 1) -> AssessmentResult:
+    """Assess every CrIS granule of *case*; granules that fail are skipped with their reason.
+
+    *progress* is called after each granule; *should_stop* is polled before each (a stop request
+    skips the rest, recorded); *timings*, a dict, collects seconds per stage (summed over workers).
+    With *workers* > 1 the time-ordered granules are split into that many runs, one process each
+    (progress and stop requests then apply per run, at its end).
+    """
+    cfg = cfg or AssessConfig()
+    skipped = list(case.skipped)
+    if workers > 1 and len(case.cris) > 1:
+        import concurrent.futures as cf
+        import multiprocessing as mp
+        runs = [list(r) for r in np.array_split(np.array(case.cris, dtype=object), min(workers, len(case.cris)))]
+        jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg) for r in runs]
+        samples = []
+        with cf.ProcessPoolExecutor(len(jobs), mp_context=mp.get_context("spawn")) as pool:
+            for run, (s, k, t) in zip(runs, pool.map(_worker, jobs)):
+                samples += s
+                skipped += k
+                for name, sec in t.items():
+                    if timings is not None:
+                        timings[name] = timings.get(name, 0.0) + sec
+                if progress is not None:
+                    for g in run:
+                        progress(g)
+    else:
+        samples, k = _collocate_run(case.cris, case.viirs, case.viirs_all, case.satellite, cfg,
+                                    progress, should_stop, timings)
+        skipped += k
+    with _stage(timings, "cost"):
+        return cost_and_offsets(samples, cfg, skipped, case.satellite)
+
+
+def assess_paths(paths, cfg: AssessConfig | None = None, progress=None, workers: int = 1) -> AssessmentResult:
     """Find, pair and assess the granules under *paths* (files or directories)."""
-    return assess_plan(plan(paths), cfg, progress)
+    return assess_plan(plan(paths), cfg, progress, workers=workers)

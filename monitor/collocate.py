@@ -35,16 +35,13 @@ TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)
 SPATIAL_RESPONSE = tuple((np.radians(r), c) for r, c in
                          ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065)))
 MIN_COVERAGE = 0.97
+BLOCK = 8192  # candidate pixels per block of the interval computation
+PAD = 48  # margin of the j difference arrays, wider than any run beyond the grid (2h/s ~ 37)
 
 
 @dataclass
-class ViirsSwath:
-    """VIIRS I5 pixels of one or more consecutive granules stacked along rows, ready for collocation.
-
-    ecef_m (rows, cols, 3) float32 (0.5 m resolution); radiance (rows, cols) I5 band
-    radiance mW/(m2 sr cm-1), NaN where unusable; area_m2 the footprint with scan overlap removed.
-    Per-column spacings (m) size the search windows.
-    """
+class SwathPiece:
+    """One VIIRS granule prepared for collocation (see :class:`ViirsSwath` for the fields)."""
 
     ecef_m: np.ndarray
     radiance: np.ndarray
@@ -56,9 +53,50 @@ class ViirsSwath:
     tree_rows: np.ndarray
     tree_cols: np.ndarray
 
+
+@dataclass
+class ViirsSwath:
+    """VIIRS I5 pixels of one or more consecutive granules stacked along rows, ready for collocation.
+
+    ecef_m (rows, cols, 3) float32 (0.5 m resolution); radiance (rows, cols) I5 band radiance
+    mW/(m2 sr cm-1), NaN where unusable; area_m2 the pixel footprint with scan overlap removed.
+    Per-column spacings (m) size the search windows; one KD-tree per piece finds the pixel nearest a
+    FOV centre.
+    """
+
+    ecef_m: np.ndarray
+    radiance: np.ndarray
+    area_m2: np.ndarray
+    col_spacing_m: np.ndarray
+    advance_m: np.ndarray
+    det_step_m: np.ndarray
+    pieces: list
+
     @property
     def shape(self):
         return self.radiance.shape
+
+    @classmethod
+    def from_pieces(cls, pieces: list[SwathPiece]) -> "ViirsSwath":
+        def cat(name):
+            return np.concatenate([getattr(p, name) for p in pieces]) if len(pieces) > 1 else getattr(pieces[0], name)
+        return cls(cat("ecef_m"), cat("radiance"), cat("area_m2"), pieces[0].col_spacing_m,
+                   np.nanmean([p.advance_m for p in pieces], axis=0), pieces[0].det_step_m, list(pieces))
+
+    def nearest(self, points_m):
+        """(row, col) of the usable pixel (on a 4 x 4 subgrid) nearest each ECEF point."""
+        best = np.full(len(points_m), np.inf)
+        row = np.zeros(len(points_m), np.intp)
+        col = np.zeros(len(points_m), np.intp)
+        offset = 0
+        for p in self.pieces:
+            dist, idx = p.tree.query(points_m)
+            better = dist < best
+            best[better] = dist[better]
+            row[better] = p.tree_rows[idx[better]] + offset
+            col[better] = p.tree_cols[idx[better]]
+            offset += p.radiance.shape[0]
+        return row, col
 
 
 def _half_diff(p, axis):
@@ -74,52 +112,65 @@ def _half_diff(p, axis):
     return np.where(np.isfinite(both), both, np.where(np.isfinite(fwd), fwd, bwd))
 
 
-def _scan_multiplicity(pos):
-    """How many scans cover each pixel centre; *pos* is (nscan, 32, cols, 3) ECEF with NaN for deleted pixels."""
-    nscan = pos.shape[0]
-    valid = np.isfinite(pos[..., 0])
-    idx = np.arange(DETECTORS)[None, :, None]
-    first = np.where(valid, idx, DETECTORS).min(axis=1)  # (nscan, cols)
-    last = np.where(valid, idx, -1).max(axis=1)
-    take = np.take_along_axis
-    p_first = take(pos, first.clip(0, DETECTORS - 1)[:, None, :, None], axis=1)[:, 0].astype(np.float64)
-    p_last = take(pos, last.clip(0, DETECTORS - 1)[:, None, :, None], axis=1)[:, 0].astype(np.float64)
+def _scan_ends(scan):
+    """First and last valid detector positions (float64, (cols, 3)) of one scan (32, cols, 3) and its step."""
+    valid = np.isfinite(scan[..., 0])
+    first = np.argmax(valid, axis=0)
+    last = DETECTORS - 1 - np.argmax(valid[::-1], axis=0)
+    cols = np.arange(scan.shape[1])
+    p_first = scan[first, cols].astype(np.float64)
+    p_last = scan[last, cols].astype(np.float64)
+    step = np.linalg.norm(p_last - p_first, axis=-1) / np.maximum(last - first, 1)
+    return p_first, p_last, step
+
+
+def _scan_multiplicity(scan, ends, k):
+    """How many scans cover each pixel centre of scan k (32, cols, 3): itself and any neighbour whose
+    first-to-last valid detector span (half a detector added each side) holds the pixel along track.
+
+    *ends* maps scan index to :func:`_scan_ends` output and may hold the neighbouring granules' scans.
+    """
+    p_first, p_last, step = ends[k]
     u = p_last - p_first
     u /= np.linalg.norm(u, axis=-1, keepdims=True)
-    step = np.linalg.norm(p_last - p_first, axis=-1) / np.maximum(last - first, 1)
-    mult = np.ones(valid.shape, np.float32)
-    for k in range(nscan):
-        s_pix = np.einsum("dcx,cx->dc", pos[k] - p_first[k].astype(np.float32), u[k].astype(np.float32))
-        for n in (k - 1, k + 1):
-            if 0 <= n < nscan:
-                lo = np.einsum("cx,cx->c", p_first[n] - p_first[k], u[k]) - step[k] / 2
-                hi = np.einsum("cx,cx->c", p_last[n] - p_first[k], u[k]) + step[k] / 2
-                mult[k] += (s_pix >= lo) & (s_pix <= hi)
+    s_pix = np.einsum("dcx,cx->dc", scan - p_first.astype(np.float32), u.astype(np.float32))
+    mult = np.ones(scan.shape[:2], np.float32)
+    for n in (k - 1, k + 1):
+        if n in ends:
+            lo = np.einsum("cx,cx->c", ends[n][0] - p_first, u) - step / 2
+            hi = np.einsum("cx,cx->c", ends[n][1] - p_first, u) + step / 2
+            mult += (s_pix >= lo) & (s_pix <= hi)
     return mult
 
 
-def build_swath(lat_rad, lon_rad, bt_k, good, band) -> ViirsSwath:
-    """A :class:`ViirsSwath` from stacked VIIRS rows (scans of 32 detectors) of geolocation and I5 BT.
+def swath_piece(lat_rad, lon_rad, bt_k, good, band, before=None, after=None) -> SwathPiece:
+    """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
 
-    *band* is the :class:`monitor.spectral.I5Band` that turns a pixel BT into band radiance.
+    *band* (:class:`monitor.spectral.I5Band`) turns pixel BT into band radiance. *before* and *after*
+    are optional (lat_rad, lon_rad) of the neighbouring granules' adjacent scan, so that the scan
+    overlap at the granule's first and last scan is counted as inside a continuous swath. Work goes
+    scan by scan: large temporaries are slow to allocate.
     """
     rows, cols = lat_rad.shape
     nscan = rows // DETECTORS
     pos = np.empty((rows, cols, 3), np.float32)  # NaN where the geolocation is fill
-    for r0 in range(0, rows, 4 * DETECTORS):
-        sl = slice(r0, r0 + 4 * DETECTORS)
+    radiance = np.empty((rows, cols), np.float32)
+    for k in range(nscan):
+        sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
         pos[sl] = wgs84.geodetic_to_ecef(lat_rad[sl], lon_rad[sl], 0.0)
+        radiance[sl] = band.radiance_from_bt(np.where(good[sl], bt_k[sl], np.nan))
     scan = pos.reshape(nscan, DETECTORS, cols, 3)
-    mult = _scan_multiplicity(scan).reshape(rows, cols)
+    ends = {k: _scan_ends(scan[k]) for k in range(nscan)}
+    for k, halo in ((-1, before), (nscan, after)):
+        if halo is not None:
+            ends[k] = _scan_ends(wgs84.geodetic_to_ecef(*halo, 0.0))
     area = np.empty((rows, cols), np.float32)
     for k in range(nscan):
         sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
-        along_scan = _half_diff(scan[k], axis=1)
-        along_track = _half_diff(scan[k], axis=0)
-        area[sl] = np.linalg.norm(np.cross(along_scan, along_track), axis=-1) / mult[sl]
-    radiance = band.radiance_from_bt(np.where(good, bt_k, np.nan)).astype(np.float32)
-    usable = np.isfinite(radiance) & np.isfinite(area) & np.isfinite(pos[..., 0])
-    radiance[~usable] = np.nan
+        cross = np.cross(_half_diff(scan[k], axis=1), _half_diff(scan[k], axis=0))
+        area[sl] = np.linalg.norm(cross, axis=-1) / _scan_multiplicity(scan[k], ends, k)
+        bad = ~(np.isfinite(radiance[sl]) & np.isfinite(area[sl]))
+        radiance[sl][bad] = np.nan
 
     mid = scan[nscan // 2]
     col_spacing = np.nanmedian(np.linalg.norm(_half_diff(mid, axis=1), axis=-1), axis=0)
@@ -128,11 +179,16 @@ def build_swath(lat_rad, lon_rad, bt_k, good, band) -> ViirsSwath:
         advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
     else:
         advance = det_step * DETECTORS
-    r_idx, c_idx = np.nonzero(usable[::4, ::4])
+    r_idx, c_idx = np.nonzero(np.isfinite(radiance[::4, ::4]))
     r_idx, c_idx = r_idx * 4, c_idx * 4
     tree = cKDTree(pos[r_idx, c_idx].astype(np.float64))
-    return ViirsSwath(pos, radiance, area, _fill_nan(col_spacing), _fill_nan(advance), _fill_nan(det_step),
+    return SwathPiece(pos, radiance, area, _fill_nan(col_spacing), _fill_nan(advance), _fill_nan(det_step),
                       tree, r_idx, c_idx)
+
+
+def build_swath(lat_rad, lon_rad, bt_k, good, band) -> ViirsSwath:
+    """A :class:`ViirsSwath` from stacked rows of consecutive VIIRS scans (one piece)."""
+    return ViirsSwath.from_pieces([swath_piece(lat_rad, lon_rad, bt_k, good, band)])
 
 
 def _ellipsoid_normal(p):
@@ -183,8 +239,7 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     t = wgs84.intersect_ellipsoid(sat_m, los0)
     centre = sat_m + t[:, None] * los0
     ok_fov = np.isfinite(t)
-    _, nearest = swath.tree.query(np.where(ok_fov[:, None], centre, 0.0))
-    row0, col0 = swath.tree_rows[nearest], swath.tree_cols[nearest]
+    row0, col0 = swath.nearest(np.where(ok_fov[:, None], centre, 0.0))
     rng = fov_range_m if fov_range_m is not None else t
     cz = fov_cos_zen if fov_cos_zen is not None else np.abs(np.sum(wgs84.geodetic_up(centre) * los0, -1))
     hr, hc = _window_half_sizes(swath, col0, np.where(ok_fov, rng, 1e6), np.where(ok_fov, cz, 1.0), rho)
@@ -193,97 +248,97 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     rr = row0[:, None] + np.arange(-R, R + 1)
     cc = col0[:, None] + np.arange(-C, C + 1)
     inside = ((rr >= 0) & (rr < nrow))[:, :, None] & ((cc >= 0) & (cc < ncol))[:, None, :]
-    rr, cc = np.clip(rr, 0, nrow - 1), np.clip(cc, 0, ncol - 1)
-    rad_w = swath.radiance[rr[:, :, None], cc[:, None, :]]
-    keep = inside & np.isfinite(rad_w) & ok_fov[:, None, None]
-    f_idx, wr, wc = np.nonzero(keep)
-    r_pix, c_pix = rr[f_idx, wr], cc[f_idx, wc]
-    vec = swath.ecef_m[r_pix, c_pix].astype(np.float64) - sat_m[f_idx]
+    flat = np.clip(rr, 0, nrow - 1)[:, :, None] * ncol + np.clip(cc, 0, ncol - 1)[:, None, :]
+    flat = np.where(inside & ok_fov[:, None, None], flat, -1).reshape(nf, -1)
+    # Coarse angle test in float32 on the whole window, exact tests on what survives.
+    f_idx, w_idx = np.nonzero(flat >= 0)
+    pix = flat[f_idx, w_idx]
+    pos32 = swath.ecef_m.reshape(-1, 3)[pix]
+    vec32 = pos32 - sat_m.astype(np.float32)[f_idx]
+    cos32 = np.einsum("kx,kx->k", vec32, los0.astype(np.float32)[f_idx]) / np.linalg.norm(vec32, axis=-1)
+    near = (cos32 >= np.float32(np.cos(rho * 1.01))) & np.isfinite(swath.radiance.reshape(-1)[pix])
+    f_idx, pix = f_idx[near], pix[near]
+    r_pix, c_pix = np.divmod(pix, ncol)
+    vec = swath.ecef_m.reshape(-1, 3)[pix].astype(np.float64) - sat_m[f_idx]
     dist = np.linalg.norm(vec, axis=-1)
     d_ecef = vec / dist[:, None]
-    near = np.sum(d_ecef * los0[f_idx], -1) >= np.cos(rho)
-    f_idx, r_pix, c_pix, d_ecef, dist = f_idx[near], r_pix[near], c_pix[near], d_ecef[near], dist[near]
     d = np.einsum("kji,kj->ki", sbf_to_ecef[f_idx], d_ecef)  # pixel directions in each FOV's SBF
+    # The union of the perturbed cones is a rounded rectangle in (alpha, beta): drop what lies outside.
+    half_a = np.abs(offsets_rad).max() + 1.02 * h_max / np.cos(beta_rad[f_idx])
+    half_b = np.abs(offsets_rad).max() + 1.02 * h_max
+    in_box = ((np.abs(np.arctan2(d[:, 0], d[:, 2]) - alpha_rad[f_idx]) <= half_a)
+              & (np.abs(np.arctan2(d[:, 1], d[:, 2]) - beta_rad[f_idx]) <= half_b))
+    f_idx, r_pix, c_pix, d_ecef, dist, d = (x[in_box] for x in (f_idx, r_pix, c_pix, d_ecef, dist, d))
     cos_view = -np.sum(_ellipsoid_normal(swath.ecef_m[r_pix, c_pix]) * d_ecef, -1)
     weight = swath.area_m2[r_pix, c_pix] * cos_view / dist**2  # steradians seen from CrIS
     value = swath.radiance[r_pix, c_pix].astype(np.float64)
 
     tan_a = np.tan(offsets_rad[:, None] + alpha_rad[None, :])  # (m, F)
-    sums = np.zeros((nf, m, m + 1))
-    wsum = np.zeros((nf, m, m + 1))
+    width = m + 2 * PAD  # runs may start or end off the grid; the margin keeps them in their own row
+    size = nf * m * width
+    acc = np.zeros(2 * size)  # weighted radiance sums, then weight sums, as difference arrays along j
     solid = 0.0
+    rows = (np.arange(m)[:, None] * width).astype(np.float32)
+    shift_f = (n + PAD - beta_rad / step).astype(np.float32)
     for h, c_k in kernel:
-        lo, hi = _j_intervals(d, tan_a[:, f_idx], np.cos(h), beta_rad[f_idx], step, n)
-        start, stop = _run_index(f_idx, lo, hi, m, m + 1)
-        _add_runs(sums, start, stop, weight * value * c_k)
-        _add_runs(wsum, start, stop, weight * c_k)
+        g2 = np.cos(h) ** 2
+        g2k = g2 * (1.0 + tan_a * tan_a)
+        wv = weight * value * c_k
+        wk = weight * c_k
+        for b0 in range(0, len(f_idx), BLOCK):  # blocks small enough to stay in cache
+            blk = slice(b0, b0 + BLOCK)
+            fb = f_idx[blk]
+            lo, hi = _j_intervals(d[blk], tan_a[:, fb], g2k[:, fb], g2, np.float32(1.0 / step), shift_f[fb])
+            base = rows + (fb * (m * width)).astype(np.float32)
+            np.clip(lo, 0, width - 1, out=lo)
+            np.clip(hi, 0, width - 1, out=hi)
+            lo += base
+            hi += base
+            start = lo.astype(np.intp).ravel()
+            stop = hi.astype(np.intp).ravel()
+            for off, val in ((0, wv[blk]), (size, wk[blk])):
+                v = np.broadcast_to(val, lo.shape).ravel()
+                acc[off:off + size] += np.bincount(start, v, size) - np.bincount(stop, v, size)
         solid += c_k * 2 * np.pi * (1 - np.cos(h))
-    sums = np.cumsum(sums, axis=-1)[..., :m]
-    wsum = np.cumsum(wsum, axis=-1)[..., :m]
+    acc = np.cumsum(acc.reshape(2, nf, m, width), axis=-1)[..., PAD:PAD + m]
+    sums, wsum = acc[0], acc[1]
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(wsum > 0, sums / wsum, np.nan)
     return mean, wsum / solid
 
 
-def _j_intervals(d, tan_a, cos_h, beta0, step, n):
-    """First and last j per row i and pixel, arrays (m, N), whose cone holds the pixel; lo > hi when none.
+def _j_intervals(d, tan_a, g2k, g2, scale, shift):
+    """Run start and stop per row i and pixel, float arrays (m, N) of j + PAD; start = stop when empty.
 
-    Solves (c + dy t)^2 >= cos^2 h (K + t^2) with c = dx tan A_i + dz, K = 1 + tan^2 A_i, t = tan B_j.
-    Rows come first so every operation runs over the long pixel axis; in-place to spare memory traffic.
+    Solves (c + dy t)^2 >= g2 (K + t^2) with c = dx tan A_i + dz, K = 1 + tan^2 A_i, t = tan B_j and
+    g2 = cos^2 h: the solution in t is one interval, and B_j = beta + (j - n) s gives the j run.
+    *g2k* is g2 K (m, N); *scale* is 1/s and *shift* n + PAD - beta/s per pixel. The quadratic needs
+    float64; the arctan and rounding run in float32 (0.1 urad). Rows come first so that every
+    operation runs over the long pixel axis.
     """
     dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
-    g2 = cos_h * cos_h
+    a2 = dy * dy - g2
     c = tan_a * dx
     c += dz
     b1 = c * dy
-    k = tan_a * tan_a
-    k += 1.0
-    k *= g2
     disc = c * c
-    disc -= k
-    a2 = dy * dy - g2
+    disc -= g2k
     disc *= -a2
     disc += b1 * b1
-    bad = (disc <= 0) | (c <= 0)
     np.maximum(disc, 0.0, out=disc)
     sq = np.sqrt(disc, out=disc)
-    scale = 1.0 / step
-    shift = n - beta0 * scale
     inv_a2 = 1.0 / a2
     lo = np.subtract(sq, b1, out=c)
     lo *= inv_a2
-    np.arctan(lo, out=lo)
-    lo *= scale
-    lo += shift - 1e-9
-    np.ceil(lo, out=lo)
     hi = np.add(b1, sq, out=b1)
     hi *= -inv_a2
-    np.arctan(hi, out=hi)
-    hi *= scale
-    hi += shift + 1e-9
-    np.floor(hi, out=hi)
-    np.clip(lo, 0, 2 * n + 1, out=lo)
-    np.clip(hi, -1, 2 * n, out=hi)
-    lo[bad] = 2 * n + 1
-    hi[bad] = -1
-    return lo.astype(np.int32), hi.astype(np.int32)
-
-
-def _run_index(f_idx, lo, hi, m, w):
-    """Flat difference-array indices of run starts and ends; empty runs go to a spare last slot."""
-    base = (f_idx[None, :] * m + np.arange(m)[:, None]) * w
-    spare = len(f_idx) and (f_idx.max() + 1) * m * w
-    empty = lo > hi
-    start = base + lo
-    stop = base + hi + 1
-    start[empty] = spare
-    stop[empty] = spare
-    return start.ravel(), stop.ravel()
-
-
-def _add_runs(arr, start, stop, val):
-    """Add *val* (per pixel) to every run [start, stop) of the flat difference array *arr* (F, m, w)."""
-    size = arr.size + 1
-    v = np.broadcast_to(val[None, :], (len(start) // len(val), len(val))).ravel()
-    flat = np.bincount(start, v, size) - np.bincount(stop, v, size)
-    arr += flat[:-1].reshape(arr.shape)
+    lo32 = np.arctan(lo.astype(np.float32))
+    hi32 = np.arctan(hi.astype(np.float32))
+    lo32 *= scale
+    lo32 += shift
+    hi32 *= scale
+    hi32 += shift
+    np.ceil(lo32, out=lo32)
+    np.floor(hi32, out=hi32)
+    hi32 += 1
+    return lo32, hi32

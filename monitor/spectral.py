@@ -55,7 +55,7 @@ def apodize_hamming(radiance):
 class I5Band:
     """The VIIRS I5 band of one satellite sampled on the CrIS LW grid, with its band-Planck table."""
 
-    T_MIN_K, T_MAX_K, T_STEP_K = 150.0, 350.0, 0.01
+    T_MIN_K, T_MAX_K, T_STEP_K = 150.0, 350.0, 0.02
 
     def __init__(self, satellite: str, wavenumber_cm1=None):
         self.satellite = satellite
@@ -75,8 +75,16 @@ class I5Band:
         return self.band_radiance(apodize_hamming(radiance_lw))
 
     def radiance_from_bt(self, bt_k):
-        """Band radiance of a band brightness temperature (K); NaN outside 150-350 K."""
-        return np.interp(bt_k, self._t, self._l, left=np.nan, right=np.nan)
+        """Band radiance of a band brightness temperature (K); NaN outside 150-350 K.
+
+        The table is uniform in temperature, so the interpolation is index arithmetic.
+        """
+        x = (np.asarray(bt_k, np.float64) - self.T_MIN_K) / self.T_STEP_K
+        with np.errstate(invalid="ignore"):
+            ok = (x >= 0) & (x <= len(self._t) - 1)
+        i = np.clip(np.where(ok, x, 0).astype(np.intp), 0, len(self._t) - 2)
+        w = x - i
+        return np.where(ok, self._l[i] * (1 - w) + self._l[i + 1] * w, np.nan)
 
     def bt_from_radiance(self, radiance):
         """Band brightness temperature (K) of a band radiance; NaN outside the table."""

@@ -20,6 +20,14 @@ CRIS_GEO = ("GCRSO",)
 VIIRS_SDR = ("SVI05",)
 VIIRS_GEO = ("GIMGO", "GITCO")  # ellipsoid geolocation first, as Wang's code; NODD has only GITCO
 COVER_MARGIN = dt.timedelta(seconds=10)
+CONTIGUOUS = dt.timedelta(seconds=5)  # VIIRS granules this close in time form one continuous swath
+
+
+def neighbours(viirs_all: list, granule) -> tuple:
+    """The VIIRS granules just before and just after *granule* in a continuous swath (None if absent)."""
+    before = next((v for v in viirs_all if abs(v.end - granule.start) < CONTIGUOUS and v.key != granule.key), None)
+    after = next((v for v in viirs_all if abs(v.start - granule.end) < CONTIGUOUS and v.key != granule.key), None)
+    return before, after
 
 
 @dataclass
@@ -48,6 +56,7 @@ class CasePlan:
     satellite: str
     cris: list = field(default_factory=list)  # GranuleFiles
     viirs: dict = field(default_factory=dict)  # cris key -> list[GranuleFiles], time-ordered
+    viirs_all: list = field(default_factory=list)  # every paired VIIRS granule, time-ordered
     skipped: list = field(default_factory=list)  # (path or key, reason)
 
 
@@ -99,7 +108,7 @@ def plan(paths) -> CasePlan:
     satellite = next(iter(platforms))
     cris = _pair(by_prefix, CRIS_SDR, CRIS_GEO, skipped)
     viirs = sorted(_pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped), key=lambda g: g.start)
-    result = CasePlan(satellite, skipped=skipped)
+    result = CasePlan(satellite, skipped=skipped, viirs_all=viirs)
     for g in sorted(cris, key=lambda g: g.start):
         cover = [v for v in viirs if v.start <= g.end + COVER_MARGIN and v.end >= g.start - COVER_MARGIN]
         if not cover:

@@ -175,7 +175,9 @@ def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform:
 
 def _clean(path, dataset: str, raw: np.ndarray, f) -> np.ndarray:
     if f.kind == "float":
-        out = raw.astype(np.float64 if raw.dtype == np.float64 or raw.ndim < 4 else np.float32)
+        # Per-scan and per-FOV fields become float64; VIIRS pixel arrays and spectra stay float32 (memory).
+        wide = raw.dtype == np.float64 or (raw.ndim < 4 and f.per != "row")
+        out = raw.astype(np.float64 if wide else np.float32)
         out[is_float_fill(raw)] = np.nan
         return out * f.to_si if f.to_si != 1.0 else out
     if f.kind == "scaled":
@@ -319,3 +321,22 @@ def read_metadata(path) -> list[GranuleMeta]:
                 n = int(np.asarray(h5[aggr].attrs["AggregateNumberGranules"]).ravel()[0])
             metas.extend(_granule_meta(path, h5, product, k, platform) for k in range(n))
         return metas
+
+
+def read_viirs_geo_scan(path, scan: int):
+    """(lat_rad, lon_rad) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the end)."""
+    path = Path(path)
+    with _open(path) as h5:
+        product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
+        if product is None:
+            raise GranuleError(path, "All_Data", "no VIIRS geolocation product")
+        out = []
+        for key in ("lat_rad", "lon_rad"):
+            f = product.fields[key]
+            name = f"{product.data_group}/{f.dataset}"
+            if name not in h5:
+                raise GranuleError(path, name, "missing dataset")
+            rows = h5[name].shape[0]
+            start = (scan % (rows // product.rows_per_scan)) * product.rows_per_scan
+            out.append(_clean(path, name, h5[name][start:start + product.rows_per_scan], f))
+        return tuple(out)

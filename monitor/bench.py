@@ -1,0 +1,95 @@
+"""``crisgeo bench``: wall time of each stage of an assessment on a simulated case, FOVs/s, peak memory."""
+
+from __future__ import annotations
+
+import resource
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from monitor.assess import AssessConfig, _cris_geometry, assess_plan
+from monitor.sdr import read_file
+from monitor.sdr.pairing import plan
+from monitor.simulate.case import simulate_case
+
+
+def peak_rss_mb(who=resource.RUSAGE_SELF) -> float:
+    """Peak resident memory so far, MB (Linux ru_maxrss is in KB); RUSAGE_CHILDREN gives the largest child."""
+    return resource.getrusage(who).ru_maxrss / 1024.0
+
+
+def _pyresample_reference(case, cfg, max_granules=1):
+    """Time the zero-offset and all-perturbation collocation with pyresample's radius neighbour search.
+
+    For each perturbed LOS the ground point is computed and pyresample finds the VIIRS pixels within
+    the largest ground radius a cone can reach; the angle test then keeps those in the cone. Returns
+    (seconds, FOVs) for *max_granules* CrIS granules, or None when pyresample is not installed.
+    """
+    try:
+        from pyresample import geometry as prgeo
+        from pyresample import kd_tree
+    except ImportError:
+        return None
+    from monitor.geometry import frames, wgs84
+    from monitor.geometry.perturb import perturbed_los_sbf
+    g = case.cris[0]
+    v = case.viirs[g.key]
+    geo = read_file(g.geo, kinds=("cris_geo",))[0]
+    vgeo = [read_file(x.geo, kinds=("viirs_geo",))[0] for x in v]
+    lat = np.degrees(np.concatenate([x.lat_rad for x in vgeo]))
+    lon = np.degrees(np.concatenate([x.lon_rad for x in vgeo]))
+    ok = np.isfinite(lat)
+    source = prgeo.SwathDefinition(lons=lon[ok], lats=lat[ok])
+    t0 = time.perf_counter()
+    fg, valid, _ = _cris_geometry(geo)
+    los = perturbed_los_sbf(fg.alpha_rad, fg.beta_rad, cfg.offsets_rad)  # (4,30,9,m,m,3)
+    los_e = np.einsum("skfij,skfabj->skfabi", fg.sbf_to_ecef, los)
+    sat = np.broadcast_to(fg.sat_ecef_m[..., None, None, :], los_e.shape)
+    ground = sat + wgs84.intersect_ellipsoid(sat, los_e)[..., None] * los_e
+    glat, glon, _ = wgs84.ecef_to_geodetic(ground.reshape(-1, 3))
+    target = prgeo.SwathDefinition(lons=np.degrees(glon), lats=np.degrees(glat))
+    radius = float(np.nanmax(np.linalg.norm(ground - sat, axis=-1))) * 0.0085 / 0.5
+    kd_tree.get_neighbour_info(source, target, radius_of_influence=radius, neighbours=64)
+    del frames
+    return time.perf_counter() - t0, int(valid.sum())
+
+
+def run_bench(args) -> int:
+    cfg = AssessConfig()
+    with tempfile.TemporaryDirectory() as tmp:
+        data = Path(args.data) if args.data else Path(tmp)
+        t0 = time.perf_counter()
+        if not (data / "truth.json").exists():
+            simulate_case(data, granules=args.granules, profile="paper", seed=1)
+        t_sim = time.perf_counter() - t0
+        timings = {}
+        t0 = time.perf_counter()
+        case = plan([data])
+        timings["read"] = time.perf_counter() - t0
+        result = assess_plan(case, cfg, timings=timings, workers=args.workers)
+        wall = time.perf_counter() - t0
+        n_fov = sum(gr["n_fovs"] for gr in result.granules)
+        print(f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(cfg.offsets_rad) ** 2} "
+              f"perturbations (simulation {t_sim:.1f} s, not counted)")
+        for stage in ("read", "geometry", "spectral", "collocation", "cost"):
+            t = timings.get(stage, 0.0)
+            print(f"  {stage:<12} {t:8.2f} s  {n_fov / t if t else float('inf'):10.0f} FOVs/s (summed over workers)")
+        print(f"  {'total':<12} {wall:8.2f} s  {n_fov / wall:10.0f} FOVs/s")
+        own, child = peak_rss_mb(), peak_rss_mb(resource.RUSAGE_CHILDREN)
+        workers = max(1, min(args.workers, len(result.granules)))
+        if workers > 1:
+            print(f"peak memory: {own:.0f} MB main process + {workers} workers x {child:.0f} MB (largest) "
+                  f"<= {own + workers * child:.0f} MB in all")
+        else:
+            print(f"peak memory: {own:.0f} MB")
+        if args.pyresample:
+            ref = _pyresample_reference(case, cfg)
+            if ref is None:
+                print("pyresample reference: not installed (pip install pyresample)")
+            else:
+                secs, nf = ref
+                print(f"pyresample radius search (64 nearest, one granule, no angle test or averaging): "
+                      f"{secs:.2f} s for {nf} FOVs = {nf / secs:.0f} FOVs/s")
+    return 0

@@ -1,0 +1,126 @@
+"""The ``crisgeo`` command line. Exit status: 0 success, 2 bad input (one line on stderr), 1 failure."""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import logging
+import sys
+from pathlib import Path
+
+EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class BadInput(Exception):
+    """An error in what the user gave; reported as one line, exit status 2."""
+
+
+def _iso(text: str) -> dt.datetime:
+    try:
+        when = dt.datetime.fromisoformat(text.replace("Z", "+00:00"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an ISO 8601 time: {text!r}") from None
+    return when if when.tzinfo else when.replace(tzinfo=dt.timezone.utc)
+
+
+def cmd_simulate(args) -> int:
+    from monitor.simulate.case import simulate_case
+    try:
+        truth = simulate_case(args.out, satellite=args.satellite, granules=args.granules, profile=args.profile,
+                              seed=args.seed, start=args.start)
+    except ValueError as exc:
+        raise BadInput(str(exc)) from None
+    print(f"wrote {len(truth['files'])} files and truth.json to {args.out} "
+          f"({args.satellite}, {args.granules} CrIS granules, profile {args.profile}, seed {args.seed})")
+    return EXIT_OK
+
+
+def format_table(result) -> str:
+    """The per-FOR table printed by ``crisgeo assess``."""
+    head = (f"{'FOR':>3} {'d_alpha':>8} {'+-':>5} {'d_beta':>8} {'+-':>5} {'in-trk':>7} {'x-trk':>7} "
+            f"{'total':>6} {'N':>5} {'G_min':>6} {'G_0':>6}  flags")
+    units = f"{'':>3} {'urad':>8} {'':>5} {'urad':>8} {'':>5} {'km':>7} {'km':>7} {'km':>6} {'':>5} {'K':>6} {'K':>6}"
+    lines = [f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules", head, units]
+    for f in result.fors:
+        lines.append(f"{f.for_index:>3} {f.d_alpha_urad:8.0f} {f.sigma_alpha_urad:5.0f} {f.d_beta_urad:8.0f} "
+                     f"{f.sigma_beta_urad:5.0f} {f.in_track_km:7.3f} {f.cross_track_km:7.3f} {f.total_km:6.3f} "
+                     f"{f.n_samples:5d} {f.cost_min_k:6.3f} {f.cost_zero_k:6.3f}  {','.join(f.flags)}")
+    for s in result.skipped:
+        lines.append(f"skipped {s['item']}: {s['reason']}")
+    return "\n".join(lines)
+
+
+def cmd_assess(args) -> int:
+    from monitor.assess import AssessConfig, assess_paths
+    from monitor.sdr.pairing import PlanError
+    if args.steps < 1 or args.step_urad <= 0:
+        raise BadInput("--steps must be >= 1 and --step-urad > 0")
+    cfg = AssessConfig(half_steps=args.steps, step_rad=args.step_urad * 1e-6, kernel=args.kernel)
+    try:
+        result = assess_paths(args.paths, cfg, workers=args.workers)
+    except PlanError as exc:
+        raise BadInput(str(exc)) from None
+    if not result.granules:
+        reasons = "; ".join(f"{s['item']}: {s['reason']}" for s in result.skipped[:3])
+        raise BadInput(f"no CrIS granule could be assessed ({reasons})")
+    print(format_table(result))
+    if args.out:
+        Path(args.out).write_text(result.to_json())
+        print(f"wrote {args.out}")
+    return EXIT_OK
+
+
+def cmd_bench(args) -> int:
+    from monitor.bench import run_bench
+    return run_bench(args)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="crisgeo", description=__doc__)
+    p.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("simulate", help="write simulated CrIS/VIIRS granules with an injected LOS error")
+    s.add_argument("--out", required=True, help="output directory")
+    s.add_argument("--satellite", choices=("npp", "j01", "j02"), default="j01")
+    s.add_argument("--granules", type=int, default=14, help="consecutive CrIS granules (default 14, as the paper)")
+    s.add_argument("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)")
+    s.set_defaults(func=cmd_simulate)
+
+    a = sub.add_parser("assess", help="assess CrIS geolocation against VIIRS I5 for the granules given")
+    a.add_argument("paths", nargs="+", help="granule files or directories")
+    a.add_argument("--out", help="write the result JSON here")
+    a.add_argument("--steps", type=int, default=10, help="perturbation steps each side of zero (grid 2n+1)")
+    a.add_argument("--step-urad", type=float, default=375.0 / 833000.0 * 1e6, help="perturbation step, urad")
+    a.add_argument("--kernel", choices=("top-hat", "response"), default="top-hat",
+                   help="FOV weighting: top-hat cone or the CrIS spatial response")
+    a.add_argument("--workers", type=int, default=1, help="worker processes over granules")
+    a.set_defaults(func=cmd_assess)
+
+    b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")
+    b.add_argument("--granules", type=int, default=14)
+    b.add_argument("--data", help="case directory to reuse or create (default: a temporary directory)")
+    b.add_argument("--pyresample", action="store_true", help="also time pyresample's radius search as a reference")
+    b.add_argument("--workers", type=int, default=2, help="worker processes (default 2, the machine's cores)")
+    b.set_defaults(func=cmd_bench)
+    return p
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    try:
+        return args.func(args)
+    except BadInput as exc:
+        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
