@@ -24,7 +24,8 @@ from monitor import collocate
 from monitor.geometry.ground import offset_km
 from monitor.geometry.inverse import inverse_geolocation
 from monitor.geometry.perturb import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, perturbation_grid
-from monitor.result import (FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, N_FOR, AssessmentResult, ForOffset)
+from monitor.result import (FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, N_FOR, AssessmentResult,
+                            ForOffset)
 from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_viirs_geo_scan
@@ -45,6 +46,7 @@ class AssessConfig:
     min_coverage: float = collocate.MIN_COVERAGE
     min_samples: int = 30
     flat_contrast: float = 0.03
+    max_sigma_urad: float = 250.0  # ~0.55 perturbation step, 1.5 % of the FOV
     bootstrap: int = 100
     seed: int = 0
 
@@ -277,6 +279,8 @@ def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=N
             gb = _stdev(d, counts[:, unit_ids].astype(float))
             est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in gb])
             sig_a, sig_b = np.nanstd(est, axis=0) * step_urad
+            if max(sig_a, sig_b) > cfg.max_sigma_urad:
+                flags.append(FLAG_UNCERTAIN)
         d_alpha, d_beta = x * step_urad, y * step_urad
         it, ct, jac = _ground_km(samples, k, d_alpha * 1e-6, d_beta * 1e-6)
         s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * 1e-6) if np.isfinite(sig_a) else np.nan

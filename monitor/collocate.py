@@ -278,8 +278,8 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     size = nf * m * width
     acc = np.zeros(2 * size)  # weighted radiance sums, then weight sums, as difference arrays along j
     solid = 0.0
-    rows = (np.arange(m)[:, None] * width).astype(np.float32)
-    shift_f = (n + PAD - beta_rad / step).astype(np.float32)
+    rows = (np.arange(m)[:, None] * width).astype(np.float64)
+    shift_f = n + PAD - beta_rad / step
     for h, c_k in kernel:
         g2 = np.cos(h) ** 2
         g2k = g2 * (1.0 + tan_a * tan_a)
@@ -288,8 +288,8 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
         for b0 in range(0, len(f_idx), BLOCK):  # blocks small enough to stay in cache
             blk = slice(b0, b0 + BLOCK)
             fb = f_idx[blk]
-            lo, hi = _j_intervals(d[blk], tan_a[:, fb], g2k[:, fb], g2, np.float32(1.0 / step), shift_f[fb])
-            base = rows + (fb * (m * width)).astype(np.float32)
+            lo, hi = _j_intervals(d[blk], tan_a[:, fb], g2k[:, fb], g2, 1.0 / step, shift_f[fb])
+            base = rows + (fb * (m * width)).astype(np.float64)
             np.clip(lo, 0, width - 1, out=lo)
             np.clip(hi, 0, width - 1, out=hi)
             lo += base
@@ -313,8 +313,8 @@ def _j_intervals(d, tan_a, g2k, g2, scale, shift):
     Solves (c + dy t)^2 >= g2 (K + t^2) with c = dx tan A_i + dz, K = 1 + tan^2 A_i, t = tan B_j and
     g2 = cos^2 h: the solution in t is one interval, and B_j = beta + (j - n) s gives the j run.
     *g2k* is g2 K (m, N); *scale* is 1/s and *shift* n + PAD - beta/s per pixel. The quadratic needs
-    float64; the arctan and rounding run in float32 (0.1 urad). Rows come first so that every
-    operation runs over the long pixel axis.
+    float64 throughout (float32 would misplace pixels within 0.05 urad of a cone edge). Rows come first
+    so that every operation runs over the long pixel axis.
     """
     dx, dy, dz = d[:, 0], d[:, 1], d[:, 2]
     a2 = dy * dy - g2
@@ -332,13 +332,13 @@ def _j_intervals(d, tan_a, g2k, g2, scale, shift):
     lo *= inv_a2
     hi = np.add(b1, sq, out=b1)
     hi *= -inv_a2
-    lo32 = np.arctan(lo.astype(np.float32))
-    hi32 = np.arctan(hi.astype(np.float32))
-    lo32 *= scale
-    lo32 += shift
-    hi32 *= scale
-    hi32 += shift
-    np.ceil(lo32, out=lo32)
-    np.floor(hi32, out=hi32)
-    hi32 += 1
-    return lo32, hi32
+    lo = np.arctan(lo, out=lo)
+    hi = np.arctan(hi, out=hi)
+    lo *= scale
+    lo += shift
+    hi *= scale
+    hi += shift
+    np.ceil(lo, out=lo)
+    np.floor(hi, out=hi)
+    hi += 1
+    return lo, hi

@@ -13,7 +13,8 @@ N_FOR = 30
 FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
 FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
 FLAG_FLAT = "flat"  # the cost surface has no clear minimum (uniform scenes carry no information)
-RELIABILITY_FLAGS = (FLAG_FEW_SAMPLES, FLAG_EDGE, FLAG_FLAT)
+FLAG_UNCERTAIN = "uncertain"  # the bootstrap spread of the offset exceeds the configured limit
+RELIABILITY_FLAGS = (FLAG_FEW_SAMPLES, FLAG_EDGE, FLAG_FLAT, FLAG_UNCERTAIN)
 
 
 @dataclass(frozen=True)

@@ -104,7 +104,8 @@ def plan(paths) -> CasePlan:
     if len(platforms) > 1:
         raise PlanError("mixed satellites: " + ", ".join(f"{p} ({n} files)" for p, n in sorted(platforms.items())))
     if not platforms:
-        raise PlanError("no readable JPSS granule among " + ", ".join(s[0] for s in skipped[:5]))
+        raise PlanError("no readable JPSS granule: " + "; ".join(s[1] if s[0] in s[1] else f"{s[0]}: {s[1]}"
+                                                                 for s in skipped[:3]))
     satellite = next(iter(platforms))
     cris = _pair(by_prefix, CRIS_SDR, CRIS_GEO, skipped)
     viirs = sorted(_pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped), key=lambda g: g.start)

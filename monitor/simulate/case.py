@@ -54,6 +54,7 @@ class SimulationSpec:
     attitude_arcsec: tuple = (0.6, -0.3, 0.5)
     software_version: str = "I2.3.00.00"
     aux: dict = field(default_factory=lambda: {k: list(v) for k, v in DEFAULT_AUX.items()})
+    viirs_lead_s: float = 10.9  # a VIIRS granule starts this long before the first CrIS granule
     viirs_noise_k: float = 0.3
     cris_noise: float = 0.05  # mW/(m2 sr cm-1) per channel
 
@@ -292,7 +293,7 @@ class Simulator:
         """Start times (unix s) of the VIIRS granules that cover the CrIS granules with margin."""
         first = self.t0 - 5.0
         last = self.t0 + self.spec.granules * CRIS_GRANULE_S + 5.0
-        ref = self.t0 - 37.3
+        ref = self.t0 - self.spec.viirs_lead_s
         k0 = int(np.floor((first - ref) / VIIRS_GRANULE_S))
         k1 = int(np.floor((last - ref) / VIIRS_GRANULE_S))
         return ref + np.arange(k0, k1 + 1) * VIIRS_GRANULE_S

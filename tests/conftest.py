@@ -1,0 +1,51 @@
+"""Shared fixtures: real NOAA-20 GEO granules shipped with the tests, and small simulated cases."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from monitor.assess import AssessConfig, assess_paths
+from monitor.simulate.case import simulate_case
+
+REAL_DIR = Path(__file__).parent / "data" / "real"
+
+
+@pytest.fixture(scope="session")
+def real_geo_files():
+    files = sorted(REAL_DIR.glob("GCRSO_j01_*.h5"))
+    assert len(files) == 10
+    return files
+
+
+class CaseCache:
+    """Simulated cases and their assessments, made once per test session."""
+
+    def __init__(self, factory):
+        self.factory = factory
+        self.cases = {}
+
+    def get(self, profile="paper", seed=1, granules=2, satellite="j01"):
+        key = (profile, seed, granules, satellite)
+        if key not in self.cases:
+            out = self.factory.mktemp(f"case_{profile}_{seed}_{granules}_{satellite}")
+            truth = simulate_case(out, satellite=satellite, granules=granules, profile=profile, seed=seed)
+            result = assess_paths([out], AssessConfig(bootstrap=30))
+            self.cases[key] = (out, truth, result)
+        return self.cases[key]
+
+
+@pytest.fixture(scope="session")
+def cases(tmp_path_factory):
+    return CaseCache(tmp_path_factory)
+
+
+def truth_arrays(truth):
+    return (np.array([f["d_alpha_urad"] for f in truth["fors"]]), np.array([f["d_beta_urad"] for f in truth["fors"]]))
+
+
+def load_truth(case_dir):
+    return json.loads((Path(case_dir) / "truth.json").read_text())

@@ -1,0 +1,164 @@
+import datetime as dt
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+
+from monitor.sdr import GranuleError, read_file
+from monitor.sdr.readers import read_metadata, read_viirs_geo_scan
+from monitor.sdr.products import PRODUCTS
+from monitor.simulate.case import simulate_case
+from monitor.simulate.jpss_h5 import ProductData, write_file
+
+
+def test_real_gcrso_fields_units_and_metadata(real_geo_files):
+    (g,) = read_file(real_geo_files[0])
+    assert g.meta.platform == "j01" and g.meta.granule_id == "J01002208398383" and g.meta.n_scans == 4
+    assert g.meta.software_version == "I2.1.03.00" and g.meta.algorithm_version == "2.O.000.001"
+    assert any(a.startswith("CMNGEO-PARAM-LUT_j01") for a in g.meta.aux_files)
+    assert any(a.startswith("CrIS-SDR-ENGPKT-BACKUP-AUX") for a in g.meta.aux_files)
+    assert g.meta.start == dt.datetime(2018, 10, 22, 0, 23, 59, 983966, tzinfo=dt.timezone.utc)
+    assert g.lat_rad.shape == (4, 30, 9) and g.for_time_us.shape == (4, 30)
+    assert np.all(np.abs(g.lat_rad) < np.pi / 2) and g.valid.all()
+    assert 833e3 < g.range_m.min() < 840e3 and 1.4e6 < g.range_m.max() < 1.5e6
+    # SCAttitude is arcseconds in the file: ~0.03-0.8 arcsec -> ~1e-7..4e-6 rad
+    assert np.all(np.abs(g.sc_attitude_rad) < 5e-6)
+    # Large negative positions are values, not fills
+    assert np.all(np.isfinite(g.sc_position_m)) and np.min(g.sc_position_m) < -1000
+
+
+def _copy(src, dst):
+    shutil.copy(src, dst)
+    dst.chmod(0o644)
+    return dst
+
+
+def test_truncated_and_non_hdf5_files_name_the_file(real_geo_files, tmp_path):
+    bad = tmp_path / real_geo_files[0].name
+    bad.write_bytes(real_geo_files[0].read_bytes()[:20000])
+    with pytest.raises(GranuleError) as e:
+        read_file(bad)
+    assert str(bad) in str(e.value) and "HDF5" in str(e.value)
+    text = tmp_path / "GCRSO_j01_d20181022_t0023599_e0024297_b04790_c20181022005852745013_noac_ops.h5"
+    text.write_text("not hdf5")
+    with pytest.raises(GranuleError, match="not a readable HDF5 file"):
+        read_file(text)
+
+
+def test_missing_dataset_is_named(real_geo_files, tmp_path):
+    f = _copy(real_geo_files[0], tmp_path / real_geo_files[0].name)
+    with h5py.File(f, "r+") as h5:
+        del h5["All_Data/CrIS-SDR-GEO_All/SatelliteRange"]
+    with pytest.raises(GranuleError) as e:
+        read_file(f)
+    assert e.value.field == "All_Data/CrIS-SDR-GEO_All/SatelliteRange" and e.value.reason == "missing dataset"
+
+
+def test_all_fill_granule_is_rejected_and_partial_fill_masked(real_geo_files, tmp_path):
+    f = _copy(real_geo_files[0], tmp_path / real_geo_files[0].name)
+    with h5py.File(f, "r+") as h5:
+        lat = h5["All_Data/CrIS-SDR-GEO_All/Latitude"]
+        lat[1, 5, :] = -999.3
+    (g,) = read_file(f)
+    assert np.isnan(g.lat_rad[1, 5]).all() and not g.valid[1, 5].any() and g.valid[0].all()
+    with h5py.File(f, "r+") as h5:
+        h5["All_Data/CrIS-SDR-GEO_All/Latitude"][...] = -999.9
+    with pytest.raises(GranuleError, match="only fill values"):
+        read_file(f)
+
+
+def test_wrong_axis0_is_reported(real_geo_files, tmp_path):
+    f = _copy(real_geo_files[0], tmp_path / real_geo_files[0].name)
+    with h5py.File(f, "r+") as h5:
+        del h5["All_Data/CrIS-SDR-GEO_All/FORTime"]
+        h5["All_Data/CrIS-SDR-GEO_All/FORTime"] = np.zeros((3, 30), np.int64)
+    with pytest.raises(GranuleError, match="axis 0 has 3 entries, expected 4"):
+        read_file(f)
+
+
+def _gran_attrs(h5, coll):
+    a = h5[f"Data_Products/{coll}/{coll}_Gran_0"].attrs
+    out = {}
+    for k, v in a.items():
+        v = np.asarray(v)
+        if v.dtype.kind == "S":
+            items = [x.decode() for x in v.ravel()]
+            out[k] = items[0] if v.size == 1 and k not in ("N_Aux_Filename", "N_Anc_Filename") else items
+        else:
+            out[k] = v.ravel()[0].item()
+    return out
+
+
+def test_aggregated_file_splits_into_granules(real_geo_files, tmp_path):
+    product = PRODUCTS["GCRSO"]
+    data, attrs = {}, []
+    for f in real_geo_files[:3]:
+        with h5py.File(f, "r") as h5:
+            g = h5["All_Data/CrIS-SDR-GEO_All"]
+            for k in g:
+                data.setdefault(k, []).append(g[k][()])
+            attrs.append(_gran_attrs(h5, "CrIS-SDR-GEO"))
+    data = {k: np.concatenate(v) for k, v in data.items()}
+    out = tmp_path / "GCRSO_j01_d20181022_t0023599_e0025337_b04790_c20181022010000000000_noac_ops.h5"
+    write_file(out, "j01", dt.datetime(2018, 10, 22, 1, tzinfo=dt.timezone.utc),
+               [ProductData(product, "CrIS", "GEO", data, attrs, {k: 4 for k in data})])
+    grans = read_file(out)
+    assert [g.meta.granule_id for g in grans] == [read_file(f)[0].meta.granule_id for f in real_geo_files[:3]]
+    for g, f in zip(grans, real_geo_files[:3]):
+        single = read_file(f)[0]
+        np.testing.assert_array_equal(g.lat_rad, single.lat_rad)
+        np.testing.assert_array_equal(g.for_time_us, single.for_time_us)
+    assert len(read_metadata(out)) == 3
+    with h5py.File(out, "r") as h5:  # region references point at each granule's scans
+        ref = h5["Data_Products/CrIS-SDR-GEO/CrIS-SDR-GEO_Gran_1"][0]
+        assert h5[ref][ref].shape[0] == 4
+
+
+@pytest.fixture(scope="module")
+def sim_cris(tmp_path_factory):
+    out = tmp_path_factory.mktemp("cris_only")
+    simulate_case(out, granules=1, profile="zero", seed=5, viirs=False)
+    return out
+
+
+def test_simulated_cris_sdr_geo_read_back(sim_cris):
+    (geo,) = read_file(next(sim_cris.glob("GCRSO_*.h5")))
+    (sdr,) = read_file(next(sim_cris.glob("SCRIF_*.h5")))
+    assert sdr.radiance_lw.shape == (4, 30, 9, 717) and sdr.good.all()
+    assert sdr.wavenumber_cm1[0] == 648.75 and sdr.wavenumber_cm1[-1] == pytest.approx(1096.25)
+    assert geo.valid.all() and geo.meta.granule_id == sdr.meta.granule_id
+    with h5py.File(next(sim_cris.glob("GCRSO_*.h5")), "r") as h5:
+        assert h5.userblock_size == 1024
+        assert h5.attrs["Platform_Short_Name"].shape == (1, 1)
+    head = next(sim_cris.glob("GCRSO_*.h5")).read_bytes()[:1024]
+    assert head.startswith(b"<HDF_UserBlock>") and b"CrIS-SDR-GEO" in head
+
+
+def test_combined_file_holds_both_products(sim_cris, tmp_path):
+    geo_file = next(sim_cris.glob("GCRSO_*.h5"))
+    sdr_file = next(sim_cris.glob("SCRIF_*.h5"))
+    parts = []
+    for f, prefix, tag in ((geo_file, "GCRSO", "GEO"), (sdr_file, "SCRIF", "SDR")):
+        p = PRODUCTS[prefix]
+        with h5py.File(f, "r") as h5:
+            data = {k: v[()] for k, v in h5[p.data_group].items()}
+            parts.append(ProductData(p, "CrIS", tag, data, [_gran_attrs(h5, p.collection)], {}))
+    out = tmp_path / geo_file.name.replace("GCRSO_", "GCRSO-SCRIF_")
+    write_file(out, "j01", dt.datetime(2024, 6, 1, tzinfo=dt.timezone.utc), parts)
+    kinds = sorted(type(g).__name__ for g in read_file(out))
+    assert kinds == ["CrisGeoGranule", "CrisSdrGranule"]
+
+
+def test_viirs_files_scaled_and_bowtie_filled(cases):
+    out, _, _ = cases.get()
+    (sdr,) = read_file(next(out.glob("SVI05_*.h5")))
+    (geo,) = read_file(next(out.glob("GITCO_*.h5")))
+    assert sdr.bt_k.shape == geo.lat_rad.shape == (1536, 6400)
+    assert 180 < np.nanmin(sdr.bt_k) and np.nanmax(sdr.bt_k) < 330
+    # bow-tie deletion: detector rows 0, 1, 30, 31 lose the first and last 2016 samples
+    assert np.isnan(sdr.bt_k[0, :2016]).all() and np.isfinite(sdr.bt_k[0, 2016:4384]).all()
+    assert np.isnan(geo.lat_rad[31, -2016:]).all() and np.isfinite(geo.lat_rad[15]).all()
+    assert np.isnan(sdr.bt_k[2, :1280]).all() and np.isfinite(sdr.bt_k[2, 1280]).all()
+    lat, lon = read_viirs_geo_scan(next(out.glob("GITCO_*.h5")), -1)
+    np.testing.assert_array_equal(lat, geo.lat_rad[-32:])

@@ -1,0 +1,69 @@
+import json
+import shutil
+
+import pytest
+
+from monitor.cli import main
+from monitor.simulate.case import simulate_case
+
+
+def test_assess_writes_the_contract_json(cases, tmp_path, capsys):
+    out, _, _ = cases.get()
+    res = tmp_path / "r.json"
+    assert main(["assess", str(out), "--out", str(res)]) == 0
+    table = capsys.readouterr().out
+    assert "FOR" in table and "d_beta" in table
+    doc = json.loads(res.read_text())
+    assert doc["satellite"] == "j01" and len(doc["fors"]) == 30 and len(doc["granules"]) == 2
+    keys = {"for", "d_alpha_urad", "d_beta_urad", "sigma_alpha_urad", "sigma_beta_urad", "in_track_km",
+            "cross_track_km", "total_km", "n_samples", "cost_min_k", "cost_zero_k", "flags"}
+    assert keys <= set(doc["fors"][0])
+    assert doc["start"] < doc["end"]
+
+
+def test_missing_path_is_exit_2_with_one_line(tmp_path, capsys):
+    assert main(["assess", str(tmp_path / "nope")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no such file" in err[0]
+
+
+def test_only_corrupt_files_is_exit_2(tmp_path, capsys):
+    (tmp_path / "GCRSO_j01_d20181022_t0023599_e0024297_b04790_c20181022005852745013_noac_ops.h5").write_text("x")
+    assert main(["assess", str(tmp_path)]) == 2
+    assert "not a readable HDF5 file" in capsys.readouterr().err
+
+
+def test_mixed_satellites_is_exit_2(real_geo_files, tmp_path, capsys):
+    simulate_case(tmp_path / "npp", satellite="npp", granules=1, profile="zero", viirs=False)
+    assert main(["assess", str(real_geo_files[0]), str(tmp_path / "npp")]) == 2
+    assert "mixed satellites" in capsys.readouterr().err
+
+
+def test_cris_without_viirs_in_time_is_exit_2(tmp_path, capsys):
+    simulate_case(tmp_path, granules=1, profile="zero", viirs=False)
+    assert main(["assess", str(tmp_path)]) == 2
+    assert "no VIIRS I5 granule covers" in capsys.readouterr().err
+
+
+def test_corrupt_granule_is_skipped_and_recorded(cases, tmp_path, capsys):
+    out, _, _ = cases.get()
+    work = tmp_path / "case"
+    work.mkdir()
+    for f in out.glob("*.h5"):
+        (work / f.name).symlink_to(f)
+    geo = sorted(out.glob("GCRSO_*.h5"))[1]
+    (work / geo.name).unlink()
+    broken = work / geo.name
+    broken.write_bytes(geo.read_bytes()[:5000])
+    res = tmp_path / "r.json"
+    assert main(["assess", str(work), "--out", str(res)]) == 0
+    doc = json.loads(res.read_text())
+    assert len(doc["granules"]) == 1
+    reasons = " ".join(s["reason"] for s in doc["skipped"])
+    assert geo.name in " ".join(s["item"] for s in doc["skipped"]) and "HDF5" in reasons
+    assert "skipped" in capsys.readouterr().out
+
+
+def test_simulate_cli_rejects_bad_profile(tmp_path, capsys):
+    assert main(["simulate", "--out", str(tmp_path), "--profile", "nonsense", "--granules", "1"]) == 2
+    assert "profile" in capsys.readouterr().err
