@@ -321,9 +321,10 @@ def _collocate_run(cris: list, viirs: dict, viirs_all: list, satellite: str, cfg
 
 
 def _worker(args):
-    cris, viirs, viirs_all, satellite, cfg = args
+    cris, viirs, viirs_all, satellite, cfg, stop_event = args
     timings = {}
-    samples, skipped = _collocate_run(cris, viirs, viirs_all, satellite, cfg, timings=timings)
+    samples, skipped = _collocate_run(cris, viirs, viirs_all, satellite, cfg, timings=timings,
+                                      should_stop=stop_event.is_set if stop_event is not None else None)
     return samples, skipped, timings
 
 
@@ -333,33 +334,55 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
 
     *progress* is called after each granule; *should_stop* is polled before each (a stop request
     skips the rest, recorded); *timings*, a dict, collects seconds per stage (summed over workers).
-    With *workers* > 1 the time-ordered granules are split into that many runs, one process each
-    (progress and stop requests then apply per run, at its end).
+    With *workers* > 1 the time-ordered granules are split into that many runs, one process each;
+    a stop request reaches the workers through an event they poll between granules.
     """
     cfg = cfg or AssessConfig()
     skipped = list(case.skipped)
     if workers > 1 and len(case.cris) > 1:
-        import concurrent.futures as cf
-        import multiprocessing as mp
         runs = [list(r) for r in np.array_split(np.array(case.cris, dtype=object), min(workers, len(case.cris)))]
-        jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg) for r in runs]
         samples = []
-        with cf.ProcessPoolExecutor(len(jobs), mp_context=mp.get_context("spawn")) as pool:
-            for run, (s, k, t) in zip(runs, pool.map(_worker, jobs)):
-                samples += s
-                skipped += k
-                for name, sec in t.items():
-                    if timings is not None:
-                        timings[name] = timings.get(name, 0.0) + sec
-                if progress is not None:
-                    for g in run:
-                        progress(g)
+        for run, (s, k, t) in zip(runs, _in_processes(runs, case, cfg, should_stop)):
+            samples += s
+            skipped += k
+            for name, sec in t.items():
+                if timings is not None:
+                    timings[name] = timings.get(name, 0.0) + sec
+            for g in run if progress is not None else ():
+                progress(g)
     else:
         samples, k = _collocate_run(case.cris, case.viirs, case.viirs_all, case.satellite, cfg,
                                     progress, should_stop, timings)
         skipped += k
     with _stage(timings, "cost"):
         return cost_and_offsets(samples, cfg, skipped, case.satellite)
+
+
+def _in_processes(runs, case, cfg, should_stop):
+    """Collocate each run of granules in its own (spawned) process; a stop request is relayed to them."""
+    import concurrent.futures as cf
+    import multiprocessing as mp
+    import threading
+    ctx = mp.get_context("spawn")
+    manager = ctx.Manager() if should_stop is not None else None
+    event = manager.Event() if manager is not None else None
+    done = threading.Event()
+
+    def relay():
+        while not done.wait(0.2):
+            if should_stop():
+                event.set()
+                return
+    if event is not None:
+        threading.Thread(target=relay, daemon=True).start()
+    jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg, event) for r in runs]
+    try:
+        with cf.ProcessPoolExecutor(len(jobs), mp_context=ctx) as pool:
+            return list(pool.map(_worker, jobs))
+    finally:
+        done.set()
+        if manager is not None:
+            manager.shutdown()
 
 
 def assess_paths(paths, cfg: AssessConfig | None = None, progress=None, workers: int = 1) -> AssessmentResult:

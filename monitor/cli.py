@@ -70,6 +70,89 @@ def cmd_assess(args) -> int:
     return EXIT_OK
 
 
+def _load(args):
+    from monitor.config import ConfigError, load_config
+    try:
+        return load_config(args.config)
+    except ConfigError as exc:
+        raise BadInput(f"{args.config}: {exc}") from None
+
+
+def _day(text: str) -> dt.date:
+    try:
+        return dt.date.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a date (YYYY-MM-DD): {text!r}") from None
+
+
+def cmd_run(args) -> int:
+    from monitor.service import AlreadyRunning, InstanceLock, Service
+    cfg = _load(args)
+    sats = [args.satellite] if args.satellite else cfg.satellites
+    if args.satellite and args.satellite not in cfg.satellites:
+        raise BadInput(f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")
+    bar = None
+    if sys.stderr.isatty():
+        from tqdm import tqdm
+        bar = tqdm(unit="granule", desc="assessing")
+    service = Service(cfg, progress=(lambda g: bar.update(1)) if bar else None)
+    try:
+        with InstanceLock(cfg.state_dir):
+            outcomes = []
+            for sat in sats:
+                outcomes += [service.run(sat, args.date)] if args.date else service.catch_up(sat)
+    except AlreadyRunning as exc:
+        raise BadInput(str(exc)) from None
+    finally:
+        if bar is not None:
+            bar.close()
+    for o in outcomes:
+        print(f"{o.satellite} {o.day}: {o.status}" + (f" ({o.reason})" if o.reason else ""))
+        if o.result is not None:
+            print(format_table(o.result))
+    if not outcomes:
+        print("nothing to do: every day of the catch-up window is done")
+    return EXIT_FAIL if any(o.status == "failed" for o in outcomes) else EXIT_OK
+
+
+def cmd_daemon(args) -> int:
+    from monitor.service import AlreadyRunning, Service
+    cfg = _load(args)
+    try:
+        Service(cfg).daemon()
+    except AlreadyRunning as exc:
+        raise BadInput(str(exc)) from None
+    return EXIT_OK
+
+
+def cmd_status(args) -> int:
+    from monitor.service import next_run
+    from monitor.store.sqlite import Store
+    cfg = _load(args)
+    store = Store(cfg.store.sqlite)
+    try:
+        runs = {r["satellite"]: r for r in store.last_runs()}
+        for sat in cfg.satellites:
+            r = runs.get(sat)
+            if r is None:
+                print(f"{sat}: no run yet")
+                continue
+            print(f"{sat}: last run {r['day']} {r['status']} (finished {r['finished'] or '-'})"
+                  + (f": {r['reason']}" if r["reason"] else ""))
+            day = store.latest_day(sat)
+            if day is not None:
+                print(f"  latest results: {day}")
+                print(f"  {'FOR':>3} {'d_alpha':>8} {'d_beta':>8} {'in-trk':>7} {'x-trk':>7} {'total':>6}  flags")
+                for f in store.day_result(sat, day):
+                    print(f"  {f.for_index:>3} {f.d_alpha_urad:8.0f} {f.d_beta_urad:8.0f} {f.in_track_km:7.3f} "
+                          f"{f.cross_track_km:7.3f} {f.total_km:6.3f}  {','.join(f.flags)}")
+        print(f"next scheduled run: {next_run(cfg.schedule):%Y-%m-%d %H:%M} UTC")
+        print(f"outbox: {store.outbox_size()} point(s) waiting")
+    finally:
+        store.close()
+    return EXIT_OK
+
+
 def cmd_bench(args) -> int:
     from monitor.bench import run_bench
     return run_bench(args)
@@ -98,6 +181,20 @@ def build_parser() -> argparse.ArgumentParser:
                    help="FOV weighting: top-hat cone or the CrIS spatial response")
     a.add_argument("--workers", type=int, default=1, help="worker processes over granules")
     a.set_defaults(func=cmd_assess)
+
+    r = sub.add_parser("run", help="one run of the daily job (the missed days, or --date), then exit")
+    r.add_argument("--config", required=True)
+    r.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    r.add_argument("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD")
+    r.set_defaults(func=cmd_run)
+
+    d = sub.add_parser("daemon", help="the long-running service (systemd)")
+    d.add_argument("--config", required=True)
+    d.set_defaults(func=cmd_daemon)
+
+    st = sub.add_parser("status", help="last run per satellite, latest per-FOR table, next run, outbox size")
+    st.add_argument("--config", required=True)
+    st.set_defaults(func=cmd_status)
 
     b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")
     b.add_argument("--granules", type=int, default=14)

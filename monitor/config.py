@@ -1,0 +1,256 @@
+"""The service configuration: one YAML file, validated on load; secrets only from the environment.
+
+Every error names the key and the problem (``ConfigError: store.publish[0].url: missing``). Keys whose
+value is a secret end in ``_env`` and hold the *name* of an environment variable, never the secret.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+SATELLITES = ("npp", "j01", "j02")
+NODD_BUCKETS = {"npp": "noaa-nesdis-snpp-pds", "j01": "noaa-nesdis-n20-pds", "j02": "noaa-nesdis-n21-pds"}
+
+
+class ConfigError(ValueError):
+    """A configuration problem, naming the key."""
+
+
+@dataclass
+class SourceConfig:
+    kind: str  # simulated | local | nodd
+    path: Path | None = None
+    endpoint: str = "https://{bucket}.s3.amazonaws.com"
+    buckets: dict = field(default_factory=lambda: dict(NODD_BUCKETS))
+    timeout_s: float = 60.0
+    retries: int = 5
+    backoff_s: float = 1.5
+    daily_budget_mb: float = 6000.0
+    retention_days: int = 7
+    granules: int = 4
+    profile: str = "paper"
+    seed: int = 0
+
+
+@dataclass
+class ScheduleConfig:
+    time_utc: dt.time = dt.time(3, 30)
+    catch_up_days: int = 7
+    misfire_grace_hours: float = 6.0
+    lag_days: int = 1  # assess the day that ended this many days ago
+
+
+@dataclass
+class SceneConfig:
+    candidates: int = 40
+    keep: int = 14
+    min_inhomogeneity_k: float = 0.5
+
+
+@dataclass
+class AssessmentConfig:
+    half_steps: int = 10
+    step_urad: float = 375.0 / 833000.0 * 1e6
+    kernel: str = "top-hat"
+    workers: int = 2
+
+
+@dataclass
+class PublishConfig:
+    kind: str  # influx2 | influx1
+    url: str
+    measurement: str = "cris_geolocation"
+    bucket: str = "crisgeo"
+    org: str = "-"
+    token_env: str | None = None
+    database: str = "crisgeo"
+    username_env: str | None = None
+    password_env: str | None = None
+    timeout_s: float = 30.0
+
+    def secret(self, key: str) -> str | None:
+        name = getattr(self, key)
+        return os.environ.get(name) if name else None
+
+
+@dataclass
+class StoreConfig:
+    sqlite: Path
+    publish: list = field(default_factory=list)
+
+
+@dataclass
+class Config:
+    path: Path
+    satellites: list
+    state_dir: Path
+    source: SourceConfig
+    schedule: ScheduleConfig
+    scenes: SceneConfig
+    assessment: AssessmentConfig
+    store: StoreConfig
+    alerts: dict = field(default_factory=dict)
+    report_dir: Path | None = None
+    dashboard_url: str | None = None
+
+    @property
+    def cache_dir(self) -> Path:
+        return self.state_dir / "cache"
+
+
+def _get(doc: dict, key: str, typ, where: str, default=None, required=False):
+    if key not in doc or doc[key] is None:
+        if required:
+            raise ConfigError(f"{where}{key}: missing")
+        return default
+    value = doc[key]
+    if typ is float and isinstance(value, int) and not isinstance(value, bool):
+        value = float(value)
+    if not isinstance(value, typ) or (typ in (int, float) and isinstance(value, bool)):
+        raise ConfigError(f"{where}{key}: expected {typ.__name__}, got {type(value).__name__} {value!r}")
+    return value
+
+
+def _positive(value, where):
+    if value <= 0:
+        raise ConfigError(f"{where}: must be > 0, got {value}")
+    return value
+
+
+def _known(doc: dict, allowed: set, where: str):
+    unknown = sorted(set(doc) - allowed)
+    if unknown:
+        raise ConfigError(f"{where}{unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _section(doc, key):
+    value = doc.get(key) or {}
+    if not isinstance(value, dict):
+        raise ConfigError(f"{key}: expected a mapping")
+    return value
+
+
+SECRET_WORDS = re.compile(r"(token|password|secret|webhook)$", re.I)
+
+
+def _no_inline_secrets(doc, where=""):
+    if isinstance(doc, dict):
+        for k, v in doc.items():
+            if SECRET_WORDS.search(str(k)) and v not in (None, ""):
+                raise ConfigError(f"{where}{k}: secrets may not be written in the file; "
+                                  f"name an environment variable with {k}_env")
+            _no_inline_secrets(v, f"{where}{k}.")
+    elif isinstance(doc, list):
+        for i, v in enumerate(doc):
+            _no_inline_secrets(v, f"{where[:-1]}[{i}].")
+
+
+def load_config(path) -> Config:
+    """Load and validate the YAML configuration at *path*; relative paths are relative to the file."""
+    path = Path(path)
+    try:
+        doc = yaml.safe_load(path.read_text())
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read ({exc.strerror})") from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{path}: not valid YAML ({exc})") from None
+    if not isinstance(doc, dict):
+        raise ConfigError(f"{path}: expected a mapping at the top level")
+    _no_inline_secrets(doc)
+    _known(doc, {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts",
+                 "report_dir", "dashboard_url"}, "")
+    base = path.resolve().parent
+
+    def rel(p):
+        p = Path(os.path.expandvars(p)).expanduser()
+        return p if p.is_absolute() else base / p
+
+    sats = _get(doc, "satellites", list, "", required=True)
+    for i, s in enumerate(sats):
+        if s not in SATELLITES:
+            raise ConfigError(f"satellites[{i}]: {s!r} is not one of {', '.join(SATELLITES)}")
+    if not sats:
+        raise ConfigError("satellites: empty")
+    state_dir = rel(_get(doc, "state_dir", str, "", required=True))
+
+    s = _section(doc, "source")
+    _known(s, set(SourceConfig.__dataclass_fields__), "source.")
+    kind = _get(s, "kind", str, "source.", required=True)
+    if kind not in ("simulated", "local", "nodd"):
+        raise ConfigError(f"source.kind: {kind!r} is not one of simulated, local, nodd")
+    source = SourceConfig(kind=kind)
+    if kind == "local":
+        source.path = rel(_get(s, "path", str, "source.", required=True))
+    for key in ("timeout_s", "backoff_s", "daily_budget_mb"):
+        setattr(source, key, _positive(_get(s, key, float, "source.", getattr(source, key)), f"source.{key}"))
+    for key in ("retries", "retention_days", "granules", "seed"):
+        setattr(source, key, _get(s, key, int, "source.", getattr(source, key)))
+    source.profile = _get(s, "profile", str, "source.", source.profile)
+    source.endpoint = _get(s, "endpoint", str, "source.", source.endpoint)
+    buckets = _get(s, "buckets", dict, "source.", None)
+    if buckets:
+        source.buckets.update({str(k): str(v) for k, v in buckets.items()})
+    if source.granules < 1 or source.retries < 0 or source.retention_days < 0:
+        raise ConfigError("source.granules must be >= 1, source.retries and source.retention_days >= 0")
+
+    sc = _section(doc, "schedule")
+    _known(sc, {"time_utc", "catch_up_days", "misfire_grace_hours", "lag_days"}, "schedule.")
+    schedule = ScheduleConfig()
+    t = _get(sc, "time_utc", str, "schedule.", "03:30")
+    m = re.fullmatch(r"(\d{1,2}):(\d{2})", t)
+    if not m or int(m[1]) > 23 or int(m[2]) > 59:
+        raise ConfigError(f"schedule.time_utc: {t!r} is not HH:MM")
+    schedule.time_utc = dt.time(int(m[1]), int(m[2]))
+    schedule.catch_up_days = _get(sc, "catch_up_days", int, "schedule.", 7)
+    schedule.lag_days = _get(sc, "lag_days", int, "schedule.", 1)
+    schedule.misfire_grace_hours = _positive(_get(sc, "misfire_grace_hours", float, "schedule.", 6.0),
+                                             "schedule.misfire_grace_hours")
+
+    se = _section(doc, "scenes")
+    _known(se, {"candidates", "keep", "min_inhomogeneity_k"}, "scenes.")
+    scenes = SceneConfig(_positive(_get(se, "candidates", int, "scenes.", 40), "scenes.candidates"),
+                         _positive(_get(se, "keep", int, "scenes.", 14), "scenes.keep"),
+                         _get(se, "min_inhomogeneity_k", float, "scenes.", 0.5))
+
+    a = _section(doc, "assessment")
+    _known(a, set(AssessmentConfig.__dataclass_fields__), "assessment.")
+    assessment = AssessmentConfig(_positive(_get(a, "half_steps", int, "assessment.", 10), "assessment.half_steps"),
+                                  _positive(_get(a, "step_urad", float, "assessment.", AssessmentConfig.step_urad),
+                                            "assessment.step_urad"),
+                                  _get(a, "kernel", str, "assessment.", "top-hat"),
+                                  _positive(_get(a, "workers", int, "assessment.", 2), "assessment.workers"))
+    if assessment.kernel not in ("top-hat", "response"):
+        raise ConfigError(f"assessment.kernel: {assessment.kernel!r} is not top-hat or response")
+
+    st = _section(doc, "store")
+    _known(st, {"sqlite", "publish"}, "store.")
+    store = StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite"))))
+    for i, p in enumerate(_get(st, "publish", list, "store.", [])):
+        where = f"store.publish[{i}]."
+        if not isinstance(p, dict):
+            raise ConfigError(f"{where[:-1]}: expected a mapping")
+        _known(p, set(PublishConfig.__dataclass_fields__), where)
+        pk = _get(p, "kind", str, where, required=True)
+        if pk not in ("influx2", "influx1"):
+            raise ConfigError(f"{where}kind: {pk!r} is not influx2 or influx1")
+        url = _get(p, "url", str, where, required=True)
+        if not re.match(r"https?://", url):
+            raise ConfigError(f"{where}url: {url!r} is not an http(s) URL")
+        pc = PublishConfig(kind=pk, url=url.rstrip("/"))
+        for key in ("measurement", "bucket", "org", "database", "token_env", "username_env", "password_env"):
+            setattr(pc, key, _get(p, key, str, where, getattr(pc, key)))
+        pc.timeout_s = _positive(_get(p, "timeout_s", float, where, 30.0), f"{where}timeout_s")
+        store.publish.append(pc)
+
+    alerts = _section(doc, "alerts")
+    report_dir = doc.get("report_dir")
+    return Config(path=path, satellites=list(sats), state_dir=state_dir, source=source, schedule=schedule,
+                  scenes=scenes, assessment=assessment, store=store, alerts=alerts,
+                  report_dir=rel(report_dir) if report_dir else None,
+                  dashboard_url=_get(doc, "dashboard_url", str, "", None))

@@ -1,0 +1,113 @@
+"""The daily run for one satellite-day: list, select scenes, fetch, assess, store, publish.
+
+Idempotent: a day's results are replaced in one transaction, never duplicated. Each run is a row in
+the ledger (``runs``): ok, no_data (recorded, with the reason), failed, interrupted. Days without an
+ok or no_data run within the catch-up window are redone, oldest first.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+import time
+from dataclasses import dataclass, field
+
+from monitor.assess import AssessConfig, assess_plan
+from monitor.scenes import select_scenes
+from monitor.sdr.pairing import PlanError, plan
+from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
+from monitor.store.timeseries import drain_outbox, result_lines, target_name
+
+LOG = logging.getLogger(__name__)
+
+
+class Stopped(Exception):
+    """A stop was requested between two steps of a run."""
+
+
+@dataclass
+class RunOutcome:
+    satellite: str
+    day: dt.date
+    status: str
+    reason: str | None = None
+    run_id: int | None = None
+    result: object = None
+    timings: dict = field(default_factory=dict)
+
+
+def days_to_run(store, satellite: str, today: dt.date, catch_up_days: int, lag_days: int = 1) -> list[dt.date]:
+    """The days of the catch-up window (ending *lag_days* before *today*) without a completed run, oldest first."""
+    done = store.done_days(satellite)
+    last = today - dt.timedelta(days=lag_days)
+    window = [last - dt.timedelta(days=k) for k in range(max(catch_up_days, 1))]
+    return sorted(d for d in window if d not in done)
+
+
+def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, progress=None) -> RunOutcome:
+    """Process one satellite-day end to end; never raises for bad data, records every outcome."""
+    stop = should_stop or (lambda: False)
+    run_id = store.begin_run(satellite, day)
+    timings = {}
+    t0 = time.perf_counter()
+    try:
+        source.start_day()
+        listing = source.list_day(satellite, day, ALL_PRODUCTS)
+        timings["list"] = time.perf_counter() - t0
+        if not any(f.product in ("GCRSO",) for f in listing):
+            reason = f"no CrIS GEO granule of {satellite} on {day} in the source"
+            store.finish_run(run_id, "no_data", reason)
+            return RunOutcome(satellite, day, "no_data", reason, run_id, timings=timings)
+        if stop():
+            raise Stopped
+        t1 = time.perf_counter()
+        chosen, decisions = select_scenes(listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep,
+                                          cfg.scenes.min_inhomogeneity_k)
+        timings["select"] = time.perf_counter() - t1
+        if not chosen:
+            reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in decisions}))[:500]
+            store.finish_run(run_id, "no_data", reason, summary={"selection": decisions[:50]})
+            return RunOutcome(satellite, day, "no_data", reason, run_id, timings=timings)
+        t1 = time.perf_counter()
+        paths, fetch_skipped = [], []
+        for c in chosen:
+            if stop():
+                raise Stopped
+            paths += [source.fetch(c.sdr), source.fetch(c.geo)]
+            for vs, vg in c.viirs:
+                try:
+                    paths += [source.fetch(vs), source.fetch(vg)]
+                except (SourceError, BudgetExceeded) as exc:
+                    fetch_skipped.append((vs.name, str(exc)))
+        timings["fetch"] = time.perf_counter() - t1
+        t1 = time.perf_counter()
+        case = plan(sorted(set(paths)))
+        case.skipped += fetch_skipped
+        a = cfg.assessment
+        result = assess_plan(case, AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6,
+                                                kernel=a.kernel), progress=progress, should_stop=stop,
+                             workers=a.workers)
+        timings["assess"] = time.perf_counter() - t1
+        if stop():
+            raise Stopped
+        if not result.granules:
+            reason = "no granule could be assessed: " + "; ".join(s["reason"] for s in result.skipped[:3])
+            store.finish_run(run_id, "failed", reason)
+            store.add_event("run_failed", satellite, f"{day}: {reason}")
+            return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings)
+        lines = {target_name(p): result_lines(p.measurement, satellite, day, result.fors) for p in cfg.store.publish}
+        store.save_day(run_id, satellite, day, result, decisions, lines)
+        return RunOutcome(satellite, day, "ok", None, run_id, result, timings)
+    except Stopped:
+        store.finish_run(run_id, "interrupted", "stop requested")
+        return RunOutcome(satellite, day, "interrupted", "stop requested", run_id, timings=timings)
+    except (SourceError, PlanError, OSError) as exc:
+        reason = f"{type(exc).__name__}: {exc}"
+        store.finish_run(run_id, "failed", reason)
+        store.add_event("run_failed", satellite, f"{day}: {reason}")
+        return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings)
+    finally:
+        t1 = time.perf_counter()
+        if cfg.store.publish:
+            drain_outbox(store, cfg.store.publish)
+        timings["publish"] = time.perf_counter() - t1

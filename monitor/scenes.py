@@ -1,0 +1,99 @@
+"""Scene selection: the day's CrIS granules whose scenes are inhomogeneous enough to pin the geolocation.
+
+Candidates are spread evenly over the day; only the small CrIS files are fetched to score them. The
+score is the inhomogeneity of the CrIS I5-equivalent brightness temperature at the FOV scale: the mean,
+over the granule's FORs, of the standard deviation of the 9 FOV BTs (K). Clouds over ocean and
+coastlines score high; uniform scenes carry no information and score near the noise. Granules
+without VIIRS I5 and GEO coverage in the listing are skipped before anything is fetched. Every
+candidate gets a decision and its reason.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from monitor.sdr import GranuleError, read_file
+from monitor.sources import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR, BudgetExceeded, SourceError
+from monitor.spectral import i5_band
+
+LOG = logging.getLogger(__name__)
+COVER_MARGIN = dt.timedelta(seconds=10)
+
+
+@dataclass
+class Candidate:
+    key: str
+    sdr: object
+    geo: object
+    viirs: list  # [(sdr, geo)] listed VIIRS pairs covering it
+    score_k: float = float("nan")
+
+
+def _pairs(files, sdr_prefixes, geo_prefixes):
+    sdr = {f.parsed.granule_key: f for f in files if f.product in sdr_prefixes}
+    geo = {f.parsed.granule_key: f for f in files if f.product in geo_prefixes}
+    both = sorted(set(sdr) & set(geo), key=lambda k: geo[k].parsed.start)
+    single = sorted(set(sdr) ^ set(geo))
+    return [(k, sdr[k], geo[k]) for k in both], single
+
+
+def inhomogeneity_k(radiance_lw, satellite: str) -> float:
+    """Mean over FORs of the standard deviation of the 9 FOV I5-equivalent BTs (K)."""
+    band = i5_band(satellite)
+    bt = band.bt_from_radiance(band.cris_band_radiance(radiance_lw))
+    return float(np.nanmean(np.nanstd(bt, axis=-1)))
+
+
+def select_scenes(listing, source, satellite: str, candidates: int, keep: int, min_score_k: float):
+    """(chosen candidates, decisions) for one satellite-day; decisions are dicts granule/score_k/decision/reason."""
+    decisions = []
+    cris, unpaired = _pairs(listing, CRIS_SDR, CRIS_GEO)
+    for key in unpaired:
+        decisions.append({"granule": key, "decision": "rejected", "reason": "SDR or GEO file missing in the listing"})
+    viirs, _ = _pairs(listing, VIIRS_SDR, VIIRS_GEO)
+    if len(cris) > candidates:
+        picks = set(np.round(np.linspace(0, len(cris) - 1, candidates)).astype(int))
+        for i, (key, _, _) in enumerate(cris):
+            if i not in picks:
+                decisions.append({"granule": key, "decision": "not considered",
+                                  "reason": f"outside the {candidates} candidates spread over the day"})
+        cris = [c for i, c in enumerate(cris) if i in picks]
+    pool = []
+    for key, sdr, geo in cris:
+        start, end = geo.parsed.start, geo.parsed.end
+        cover = [(vs, vg) for _, vs, vg in viirs
+                 if vg.parsed.start <= end + COVER_MARGIN and vg.parsed.end >= start - COVER_MARGIN]
+        if not cover:
+            decisions.append({"granule": key, "decision": "rejected", "reason": "no VIIRS I5 + GEO granule covers it"})
+            continue
+        try:
+            sdr_path = source.fetch(sdr)
+            source.fetch(geo)
+            (granule,) = [g for g in read_file(sdr_path, kinds=("cris_sdr",))][:1]
+            score = inhomogeneity_k(np.where(granule.good[..., None], granule.radiance_lw, np.nan), satellite)
+        except BudgetExceeded as exc:
+            decisions.append({"granule": key, "decision": "rejected", "reason": str(exc)})
+            break
+        except (SourceError, GranuleError, ValueError) as exc:
+            decisions.append({"granule": key, "decision": "rejected", "reason": f"unusable CrIS granule: {exc}"})
+            continue
+        pool.append(Candidate(key, sdr, geo, cover, score))
+    pool.sort(key=lambda c: -c.score_k)
+    chosen = []
+    for c in pool:
+        if not np.isfinite(c.score_k) or c.score_k < min_score_k:
+            decisions.append({"granule": c.key, "score_k": c.score_k, "decision": "rejected",
+                              "reason": f"too homogeneous ({c.score_k:.2f} K < {min_score_k} K)"})
+        elif len(chosen) >= keep:
+            decisions.append({"granule": c.key, "score_k": c.score_k, "decision": "rejected",
+                              "reason": f"the {keep} more inhomogeneous granules were kept"})
+        else:
+            chosen.append(c)
+            decisions.append({"granule": c.key, "score_k": c.score_k, "decision": "chosen",
+                              "reason": f"inhomogeneity {c.score_k:.2f} K, rank {len(chosen)}"})
+    chosen.sort(key=lambda c: c.geo.parsed.start)
+    return chosen, decisions

@@ -1,0 +1,194 @@
+"""The long-running service: one daily job per satellite under APScheduler, run by systemd.
+
+* BlockingScheduler in UTC; per-satellite cron job with coalesce, one instance at a time and a misfire
+  grace of hours; a catch-up job at start redoes the missed days (bounded window).
+* SIGTERM/SIGINT set a stop event that the run polls between steps and granules, then the scheduler
+  shuts down; a run cut short is recorded as interrupted and redone at the next start.
+* A single-instance lock (flock on the state directory) keeps a second copy from running.
+* sd_notify READY/STATUS/WATCHDOG/STOPPING over $NOTIFY_SOCKET, when systemd provides one.
+* A job that fails or is missed becomes an event in the store, which the alerting layer reads.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import fcntl
+import logging
+import os
+import signal
+import socket
+import threading
+from pathlib import Path
+
+from monitor.pipeline import days_to_run, run_day
+from monitor.sources import make_source
+from monitor.store.sqlite import Store
+
+LOG = logging.getLogger(__name__)
+UTC = dt.timezone.utc
+
+
+def sd_notify(message: str) -> bool:
+    """Send *message* (e.g. ``READY=1``) to systemd's notify socket; False when not under systemd."""
+    addr = os.environ.get("NOTIFY_SOCKET")
+    if not addr:
+        return False
+    if addr.startswith("@"):
+        addr = "\0" + addr[1:]
+    try:
+        with socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as s:
+            s.connect(addr)
+            s.sendall(message.encode())
+        return True
+    except OSError as exc:
+        LOG.warning("sd_notify failed: %s", exc)
+        return False
+
+
+def next_run(schedule, now: dt.datetime | None = None) -> dt.datetime:
+    """The next scheduled daily run (UTC) of a :class:`monitor.config.ScheduleConfig`."""
+    now = now or dt.datetime.now(UTC)
+    nxt = now.replace(hour=schedule.time_utc.hour, minute=schedule.time_utc.minute, second=0, microsecond=0)
+    return nxt if nxt > now else nxt + dt.timedelta(days=1)
+
+
+class AlreadyRunning(RuntimeError):
+    """Another crisgeo process holds the state directory's lock."""
+
+
+class InstanceLock:
+    """An exclusive flock on ``state_dir/crisgeo.lock``, held for the life of the process."""
+
+    def __init__(self, state_dir: Path):
+        self.path = Path(state_dir) / "crisgeo.lock"
+        self.fh = None
+
+    def __enter__(self):
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.fh = open(self.path, "a+")
+        try:
+            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            self.fh.close()
+            raise AlreadyRunning(f"{self.path}: another crisgeo process is running on this state directory") from None
+        self.fh.seek(0)
+        self.fh.truncate()
+        self.fh.write(str(os.getpid()))
+        self.fh.flush()
+        return self
+
+    def __exit__(self, *exc):
+        fcntl.flock(self.fh, fcntl.LOCK_UN)
+        self.fh.close()
+
+
+class Service:
+    """Runs satellite-days for a configuration; the daemon adds the scheduler and signals."""
+
+    def __init__(self, cfg, progress=None):
+        self.cfg = cfg
+        self.stop_event = threading.Event()
+        self.progress = progress
+        self.source = make_source(cfg)
+        self.scheduler = None
+
+    def store(self) -> Store:
+        return Store(self.cfg.store.sqlite)
+
+    def run(self, satellite: str, day: dt.date):
+        store = self.store()
+        try:
+            LOG.info("run %s %s", satellite, day)
+            sd_notify(f"STATUS=assessing {satellite} {day}")
+            out = run_day(self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress)
+            LOG.info("run %s %s: %s%s", satellite, day, out.status, f" ({out.reason})" if out.reason else "")
+            self._after_run(store, out)
+            return out
+        finally:
+            store.close()
+
+    def _after_run(self, store, outcome):
+        """Hook for what follows a run (alerts, report): see the alerts and report packages."""
+
+    def catch_up(self, satellite: str, today: dt.date | None = None) -> list:
+        """Run the days of the catch-up window that have no completed run, oldest first."""
+        today = today or dt.datetime.now(UTC).date()
+        store = self.store()
+        try:
+            store.interrupt_stale_runs()
+            days = days_to_run(store, satellite, today, self.cfg.schedule.catch_up_days, self.cfg.schedule.lag_days)
+        finally:
+            store.close()
+        outcomes = []
+        for day in days:
+            if self.stop_event.is_set():
+                break
+            outcomes.append(self.run(satellite, day))
+        return outcomes
+
+    def daily_job(self, satellite: str):
+        self.catch_up(satellite)
+
+    # -- daemon
+    def daemon(self):
+        from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED
+        from apscheduler.schedulers.blocking import BlockingScheduler
+        from apscheduler.triggers.cron import CronTrigger
+        sch = self.cfg.schedule
+        with InstanceLock(self.cfg.state_dir):
+            self.scheduler = BlockingScheduler(timezone=UTC, job_defaults={
+                "coalesce": True, "max_instances": 1, "misfire_grace_time": int(sch.misfire_grace_hours * 3600)})
+            now = dt.datetime.now(UTC)
+            for sat in self.cfg.satellites:
+                trigger = CronTrigger(hour=sch.time_utc.hour, minute=sch.time_utc.minute, timezone=UTC)
+                self.scheduler.add_job(self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}",
+                                       next_run_time=now)  # catch up at start, then daily
+            self.scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
+            for sig in (signal.SIGTERM, signal.SIGINT):
+                signal.signal(sig, self._on_signal)
+            watchdog = self._start_watchdog()
+            sd_notify("READY=1")
+            sd_notify("STATUS=scheduled daily at " + sch.time_utc.strftime("%H:%M UTC"))
+            LOG.info("crisgeo daemon started for %s; daily at %s UTC", ", ".join(self.cfg.satellites),
+                     sch.time_utc.strftime("%H:%M"))
+            try:
+                self.scheduler.start()
+            finally:
+                self.stop_event.set()
+                if watchdog is not None:
+                    watchdog.join(timeout=5)
+                LOG.info("crisgeo daemon stopped")
+
+    def _on_signal(self, signum, frame):
+        LOG.info("signal %d: stopping after the current step", signum)
+        sd_notify("STOPPING=1")
+        self.stop_event.set()
+        if self.scheduler is not None:
+            self.scheduler.shutdown(wait=False)
+
+    def _job_event(self, event):
+        from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MISSED
+        kind = {EVENT_JOB_ERROR: "job_error", EVENT_JOB_MISSED: "job_missed"}.get(event.code, "job_skipped")
+        detail = f"{event.job_id}: {getattr(event, 'exception', None) or kind} (scheduled {event.scheduled_run_time})"
+        LOG.error("scheduler: %s", detail)
+        store = self.store()
+        try:
+            store.add_event(kind, event.job_id.split("-", 1)[-1], detail)
+        finally:
+            store.close()
+
+    def _start_watchdog(self):
+        usec = os.environ.get("WATCHDOG_USEC")
+        if not usec:
+            return None
+        interval = int(usec) / 1e6 / 2
+
+        def ping():
+            while not self.stop_event.wait(interval):
+                sched = self.scheduler
+                if sched is not None and sched.running:
+                    sd_notify("WATCHDOG=1")
+        t = threading.Thread(target=ping, name="watchdog", daemon=True)
+        t.start()
+        return t
+

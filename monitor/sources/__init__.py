@@ -1,0 +1,65 @@
+"""Where granules come from: a local directory tree, NOAA's NODD buckets over HTTPS, or the simulator.
+
+A source lists the files of one satellite-day by product and fetches a listed file to a local path.
+It knows file names and transport, nothing of the science.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass
+from pathlib import Path
+
+from monitor.sdr.names import JpssName, parse_name
+
+CRIS_SDR = ("SCRIF", "SCRIS")
+CRIS_GEO = ("GCRSO",)
+VIIRS_SDR = ("SVI05",)
+VIIRS_GEO = ("GITCO", "GIMGO")
+ALL_PRODUCTS = CRIS_SDR + CRIS_GEO + VIIRS_SDR + VIIRS_GEO
+
+
+class SourceError(RuntimeError):
+    """A listing or a download failed after its retries."""
+
+
+class BudgetExceeded(SourceError):
+    """The day's download budget is spent."""
+
+
+@dataclass(frozen=True)
+class ListedFile:
+    """A granule file a source can fetch: its name, size in bytes (None if unknown) and location."""
+
+    name: str
+    size: int | None
+    location: str
+    parsed: JpssName
+
+    @property
+    def product(self) -> str:
+        return self.parsed.products[0]
+
+
+def listed(name: str, size, location: str) -> ListedFile | None:
+    """A :class:`ListedFile` for a safe JPSS file name, or None for anything else (path parts, odd names)."""
+    if "/" in name or "\\" in name or name.startswith("."):
+        return None
+    parsed = parse_name(name)
+    return None if parsed is None else ListedFile(name, size, location, parsed)
+
+
+def on_day(f: ListedFile, day: dt.date) -> bool:
+    return f.parsed.start.date() == day
+
+
+def make_source(cfg):
+    """The source named by the configuration's ``source.kind``."""
+    from monitor.sources.local import LocalSource, SimulatedSource
+    from monitor.sources.nodd import NoddSource
+    kind = cfg.source.kind
+    if kind == "local":
+        return LocalSource(cfg.source.path)
+    if kind == "simulated":
+        return SimulatedSource(cfg.state_dir / "simulated", cfg.source)
+    return NoddSource(cfg.source, Path(cfg.cache_dir))

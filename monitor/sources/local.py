@@ -1,0 +1,54 @@
+"""Local sources: a directory tree of granule files, and the simulator writing such a tree."""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+from pathlib import Path
+
+from monitor.sources import ListedFile, listed, on_day
+
+LOG = logging.getLogger(__name__)
+
+
+class LocalSource:
+    """Granule files anywhere below *root*; fetching returns the file itself."""
+
+    def __init__(self, root):
+        self.root = Path(root)
+
+    def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
+        if not self.root.is_dir():
+            raise FileNotFoundError(f"source.path {self.root}: no such directory")
+        out = []
+        for p in sorted(self.root.rglob("*.h5")):
+            f = listed(p.name, p.stat().st_size, str(p))
+            if f is not None and f.parsed.platform == satellite and f.product in products \
+                    and abs((f.parsed.start.date() - day).days) <= 1:
+                out.append(f)
+        return [f for f in out if on_day(f, day) or f.product not in ("SCRIF", "SCRIS", "GCRSO")]
+
+    def fetch(self, f: ListedFile) -> Path:
+        return Path(f.location)
+
+    def start_day(self):
+        """Nothing to reset for a local tree."""
+
+
+class SimulatedSource(LocalSource):
+    """The offline default: each satellite-day is simulated once (paper error profile) into *root*."""
+
+    def __init__(self, root, source_cfg):
+        super().__init__(root)
+        self.cfg = source_cfg
+
+    def list_day(self, satellite, day, products):
+        from monitor.simulate.case import simulate_case
+        target = self.root / satellite / day.isoformat()
+        if not (target / "truth.json").exists():
+            LOG.info("simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target)
+            start = dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc)
+            simulate_case(target, satellite=satellite, granules=self.cfg.granules, profile=self.cfg.profile,
+                          seed=self.cfg.seed + day.toordinal() % 1000, start=start)
+        self.root.mkdir(parents=True, exist_ok=True)
+        return LocalSource(target).list_day(satellite, day, products)

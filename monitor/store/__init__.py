@@ -1,0 +1,1 @@
+"""Stores: the embedded SQLite store (runs, results, granules, outbox) and time-series publishers."""

@@ -1,0 +1,271 @@
+"""The embedded store: one SQLite file in WAL mode, with a schema version and forward migrations.
+
+It holds the runs (the ledger of processed days), the per-FOR results with their flags, the granules
+used with their metadata (aux file lists, software versions), the scene-selection decisions, the cost
+cubes, service events, and the outbox of time-series points still to publish. A day's results are
+replaced in one transaction, so a re-run never duplicates and a crash never leaves half a day.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import sqlite3
+from pathlib import Path
+
+import numpy as np
+
+from monitor.result import AssessmentResult, ForOffset
+
+UTC = dt.timezone.utc
+
+MIGRATIONS = [
+    # 1: the first schema
+    """
+    CREATE TABLE runs (
+        id INTEGER PRIMARY KEY, satellite TEXT NOT NULL, day TEXT NOT NULL,
+        started TEXT NOT NULL, finished TEXT, status TEXT NOT NULL, reason TEXT,
+        n_granules INTEGER DEFAULT 0, summary TEXT);
+    CREATE INDEX runs_day ON runs (satellite, day);
+    CREATE TABLE results (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, for_index INTEGER NOT NULL, run_id INTEGER NOT NULL,
+        d_alpha_urad REAL, d_beta_urad REAL, sigma_alpha_urad REAL, sigma_beta_urad REAL,
+        in_track_km REAL, cross_track_km REAL, total_km REAL, sigma_in_track_km REAL,
+        sigma_cross_track_km REAL, n_samples INTEGER, cost_min_k REAL, cost_zero_k REAL, flags TEXT,
+        PRIMARY KEY (satellite, day, for_index));
+    CREATE TABLE granules (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, granule_id TEXT NOT NULL,
+        start TEXT, cris_geo TEXT, cris_sdr TEXT, viirs TEXT, n_usable INTEGER,
+        software_version TEXT, algorithm_version TEXT, cris_aux TEXT, viirs_aux TEXT, viirs_software TEXT,
+        PRIMARY KEY (satellite, day, granule_id));
+    CREATE TABLE selection (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, granule TEXT NOT NULL,
+        score_k REAL, decision TEXT NOT NULL, reason TEXT);
+    CREATE INDEX selection_day ON selection (satellite, day);
+    CREATE TABLE cost_cubes (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, half_steps INTEGER,
+        step_urad REAL, cube BLOB, PRIMARY KEY (satellite, day));
+    CREATE TABLE skipped (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, item TEXT, reason TEXT);
+    CREATE TABLE events (
+        id INTEGER PRIMARY KEY, time TEXT NOT NULL, kind TEXT NOT NULL, satellite TEXT, detail TEXT);
+    CREATE TABLE outbox (
+        id INTEGER PRIMARY KEY, target TEXT NOT NULL, satellite TEXT, day TEXT, line TEXT NOT NULL,
+        created TEXT NOT NULL, attempts INTEGER DEFAULT 0, last_error TEXT);
+    """,
+]
+
+RESULT_FIELDS = ("d_alpha_urad", "d_beta_urad", "sigma_alpha_urad", "sigma_beta_urad", "in_track_km",
+                 "cross_track_km", "total_km", "sigma_in_track_km", "sigma_cross_track_km", "n_samples",
+                 "cost_min_k", "cost_zero_k")
+
+
+def now_iso() -> str:
+    return dt.datetime.now(UTC).isoformat(timespec="seconds")
+
+
+def _num(v):
+    return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
+
+
+class Store:
+    """The SQLite store. One connection per Store; use from one thread at a time."""
+
+    def __init__(self, path):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.db = sqlite3.connect(self.path, timeout=30, isolation_level=None)
+        self.db.row_factory = sqlite3.Row
+        self.db.execute("PRAGMA journal_mode=WAL")
+        self.db.execute("PRAGMA synchronous=FULL")
+        self.db.execute("PRAGMA foreign_keys=ON")
+        self._migrate()
+
+    def close(self):
+        self.db.close()
+
+    # -- schema
+    @property
+    def schema_version(self) -> int:
+        return self.db.execute("PRAGMA user_version").fetchone()[0]
+
+    def _migrate(self):
+        version = self.schema_version
+        if version > len(MIGRATIONS):
+            raise RuntimeError(f"{self.path}: schema version {version} is newer than this program "
+                               f"({len(MIGRATIONS)}); upgrade crisgeo")
+        for v in range(version, len(MIGRATIONS)):
+            with self.transaction():
+                for stmt in filter(str.strip, MIGRATIONS[v].split(";")):
+                    self.db.execute(stmt)
+                self.db.execute(f"PRAGMA user_version={v + 1}")
+
+    def transaction(self):
+        return _Transaction(self.db)
+
+    # -- runs (the ledger)
+    def begin_run(self, satellite: str, day: dt.date) -> int:
+        with self.transaction():
+            cur = self.db.execute("INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, 'running')",
+                                  (satellite, day.isoformat(), now_iso()))
+            return cur.lastrowid
+
+    def finish_run(self, run_id: int, status: str, reason: str | None = None, n_granules: int = 0,
+                   summary: dict | None = None):
+        with self.transaction():
+            self._finish(run_id, status, reason, n_granules, summary)
+
+    def _finish(self, run_id, status, reason, n_granules, summary):
+        self.db.execute("UPDATE runs SET finished=?, status=?, reason=?, n_granules=?, summary=? WHERE id=?",
+                        (now_iso(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id))
+
+    def interrupt_stale_runs(self) -> int:
+        """Mark runs left 'running' by a killed process as 'interrupted'; returns how many."""
+        with self.transaction():
+            cur = self.db.execute("UPDATE runs SET status='interrupted', finished=?, "
+                                  "reason='process ended during the run' WHERE status='running'", (now_iso(),))
+            return cur.rowcount
+
+    def done_days(self, satellite: str) -> set:
+        """Days with a completed run (results stored, or recorded as having no data)."""
+        rows = self.db.execute("SELECT DISTINCT day FROM runs WHERE satellite=? AND status IN ('ok', 'no_data')",
+                               (satellite,))
+        return {dt.date.fromisoformat(r[0]) for r in rows}
+
+    def last_runs(self) -> list:
+        return [dict(r) for r in self.db.execute(
+            "SELECT r.* FROM runs r JOIN (SELECT satellite, MAX(id) AS id FROM runs GROUP BY satellite) m "
+            "ON r.id = m.id ORDER BY r.satellite")]
+
+    def runs(self, satellite: str | None = None) -> list:
+        q = "SELECT * FROM runs" + (" WHERE satellite=?" if satellite else "") + " ORDER BY id"
+        return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
+
+    # -- results
+    def save_day(self, run_id: int, satellite: str, day: dt.date, result: AssessmentResult,
+                 selection: list, outbox_lines: dict):
+        """Replace the day's results, granules, selection and cube, queue its points, close the run: atomic."""
+        d = day.isoformat()
+        with self.transaction():
+            for table in ("results", "granules", "selection", "cost_cubes", "skipped"):
+                self.db.execute(f"DELETE FROM {table} WHERE satellite=? AND day=?", (satellite, d))
+            for f in result.fors:
+                self.db.execute(
+                    f"INSERT INTO results (satellite, day, for_index, run_id, {', '.join(RESULT_FIELDS)}, flags) "
+                    f"VALUES (?, ?, ?, ?, {', '.join('?' * len(RESULT_FIELDS))}, ?)",
+                    (satellite, d, f.for_index, run_id, *[_num(getattr(f, k)) for k in RESULT_FIELDS],
+                     json.dumps(list(f.flags))))
+            for g in result.granules:
+                cm, vm = g.get("cris_meta", {}), g.get("viirs_meta", {})
+                self.db.execute(
+                    "INSERT OR REPLACE INTO granules VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    (satellite, d, run_id, g["granule_id"], g["start"], g["cris_geo"], g["cris_sdr"],
+                     json.dumps(g["viirs"]), g["n_usable"], cm.get("software_version"), cm.get("algorithm_version"),
+                     json.dumps(cm.get("aux_files", [])), json.dumps(vm.get("aux_files", [])),
+                     vm.get("software_version")))
+            for s in selection:
+                self.db.execute("INSERT INTO selection VALUES (?, ?, ?, ?, ?, ?, ?)",
+                                (satellite, d, run_id, s["granule"], _num(s.get("score_k")), s["decision"],
+                                 s.get("reason")))
+            for s in result.skipped:
+                self.db.execute("INSERT INTO skipped VALUES (?, ?, ?, ?, ?)",
+                                (satellite, d, run_id, s["item"], s["reason"]))
+            if result.cost_cube_k is not None:
+                self.db.execute("INSERT INTO cost_cubes VALUES (?, ?, ?, ?, ?, ?)",
+                                (satellite, d, run_id, result.half_steps, result.step_urad,
+                                 np.asarray(result.cost_cube_k, np.float32).tobytes()))
+            self.db.execute("DELETE FROM outbox WHERE satellite=? AND day=?", (satellite, d))
+            for target, lines in outbox_lines.items():
+                for line in lines:
+                    self.db.execute("INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, ?, ?, ?)",
+                                    (target, satellite, d, line, now_iso()))
+            self._finish(run_id, "ok", None, len(result.granules),
+                         {"reliable_fors": sum(f.reliable for f in result.fors),
+                          "max_total_km": max((f.total_km for f in result.fors if np.isfinite(f.total_km)),
+                                              default=None)})
+
+    def day_result(self, satellite: str, day: dt.date) -> list[ForOffset]:
+        rows = self.db.execute("SELECT * FROM results WHERE satellite=? AND day=? ORDER BY for_index",
+                               (satellite, day.isoformat())).fetchall()
+        out = []
+        for r in rows:
+            kw = {k: (float("nan") if r[k] is None else r[k]) for k in RESULT_FIELDS}
+            kw["n_samples"] = int(r["n_samples"] or 0)
+            out.append(ForOffset(for_index=r["for_index"], flags=tuple(json.loads(r["flags"])), **kw))
+        return out
+
+    def latest_day(self, satellite: str) -> dt.date | None:
+        r = self.db.execute("SELECT MAX(day) FROM results WHERE satellite=?", (satellite,)).fetchone()[0]
+        return dt.date.fromisoformat(r) if r else None
+
+    def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> list:
+        q = "SELECT * FROM results WHERE satellite=?"
+        args = [satellite]
+        if since:
+            q += " AND day >= ?"
+            args.append(since.isoformat())
+        if until:
+            q += " AND day <= ?"
+            args.append(until.isoformat())
+        return [dict(r) for r in self.db.execute(q + " ORDER BY day, for_index", args)]
+
+    def granules(self, satellite: str, day: dt.date | None = None) -> list:
+        q = "SELECT * FROM granules WHERE satellite=?" + (" AND day=?" if day else "") + " ORDER BY day, start"
+        return [dict(r) for r in self.db.execute(q, (satellite, day.isoformat()) if day else (satellite,))]
+
+    def selection(self, satellite: str, day: dt.date) -> list:
+        return [dict(r) for r in self.db.execute("SELECT * FROM selection WHERE satellite=? AND day=?",
+                                                 (satellite, day.isoformat()))]
+
+    def cost_cube(self, satellite: str, day: dt.date):
+        r = self.db.execute("SELECT half_steps, cube FROM cost_cubes WHERE satellite=? AND day=?",
+                            (satellite, day.isoformat())).fetchone()
+        if r is None:
+            return None
+        m = 2 * r["half_steps"] + 1
+        return np.frombuffer(r["cube"], np.float32).reshape(-1, m, m)
+
+    # -- events (failures, misses: the alerting layer reads them)
+    def add_event(self, kind: str, satellite: str | None, detail: str):
+        with self.transaction():
+            self.db.execute("INSERT INTO events (time, kind, satellite, detail) VALUES (?, ?, ?, ?)",
+                            (now_iso(), kind, satellite, detail))
+
+    def events(self, kind: str | None = None) -> list:
+        q = "SELECT * FROM events" + (" WHERE kind=?" if kind else "") + " ORDER BY id"
+        return [dict(r) for r in self.db.execute(q, (kind,) if kind else ())]
+
+    # -- outbox
+    def outbox(self, target: str, limit: int = 5000) -> list:
+        return [dict(r) for r in self.db.execute("SELECT id, line FROM outbox WHERE target=? ORDER BY id LIMIT ?",
+                                                 (target, limit))]
+
+    def outbox_size(self, target: str | None = None) -> int:
+        q = "SELECT COUNT(*) FROM outbox" + (" WHERE target=?" if target else "")
+        return self.db.execute(q, (target,) if target else ()).fetchone()[0]
+
+    def outbox_delivered(self, ids: list):
+        with self.transaction():
+            self.db.executemany("DELETE FROM outbox WHERE id=?", [(i,) for i in ids])
+
+    def outbox_failed(self, ids: list, error: str):
+        with self.transaction():
+            self.db.executemany("UPDATE outbox SET attempts = attempts + 1, last_error=? WHERE id=?",
+                                [(error[:500], i) for i in ids])
+
+
+class _Transaction:
+    def __init__(self, db):
+        self.db = db
+        self.depth_outer = False
+
+    def __enter__(self):
+        self.depth_outer = not self.db.in_transaction
+        if self.depth_outer:
+            self.db.execute("BEGIN IMMEDIATE")
+        return self.db
+
+    def __exit__(self, exc_type, exc, tb):
+        if self.depth_outer:
+            self.db.execute("ROLLBACK" if exc_type else "COMMIT")
+        return False
