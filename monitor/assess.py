@@ -55,6 +55,10 @@ class AssessConfig:
         return perturbation_grid(self.half_steps, self.step_rad)
 
 
+class StopRequested(Exception):
+    """The caller asked to stop; raised between FORs so that a stop takes effect within a second."""
+
+
 @dataclass
 class GranuleSamples:
     """Collocated samples of one CrIS granule: per FOV the VIIRS BT of every perturbed cone."""
@@ -117,7 +121,7 @@ def _load_swath(viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathC
 
 
 def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: AssessConfig, band,
-                      cache: _SwathCache, timings=None, viirs_all=None) -> GranuleSamples:
+                      cache: _SwathCache, timings=None, viirs_all=None, should_stop=None) -> GranuleSamples:
     """Read one CrIS granule and its VIIRS cover and collocate every FOV for every perturbation.
 
     *timings*, when a dict, accumulates seconds per stage: read, geometry, collocation.
@@ -136,7 +140,7 @@ def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: Assess
         bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
     swath = _load_swath(viirs, viirs_all or viirs, band, cache, timings)
     with _stage(timings, "collocation"):
-        bt_viirs, coverage = _collocate_fors(swath, geo, fg, valid, fill, cfg, band)
+        bt_viirs, coverage = _collocate_fors(swath, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
               & np.all(np.isfinite(bt_viirs), axis=(-2, -1)))
     info = {"granule_id": geo.meta.granule_id, "start": geo.meta.start.isoformat(), "end": geo.meta.end.isoformat(),
@@ -160,7 +164,7 @@ def _cris_geometry(geo):
     return fg, valid, fill
 
 
-def _collocate_fors(swath, geo, fg, valid, fill, cfg, band):
+def _collocate_fors(swath, geo, fg, valid, fill, cfg, band, should_stop=None):
     """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone and the worst coverage per FOV, FOR by FOR."""
     offsets = cfg.offsets_rad
     m = len(offsets)
@@ -169,6 +173,8 @@ def _collocate_fors(swath, geo, fg, valid, fill, cfg, band):
     coverage = np.zeros((nscan, N_FOR, 9))
     kernel = KERNELS[cfg.kernel]
     for k in range(N_FOR):
+        if should_stop is not None and should_stop():
+            raise StopRequested
         sl = (slice(None), k)
         shape = fg.alpha_rad[sl].shape
         mean, cov = collocate.cone_sums(
@@ -311,7 +317,10 @@ def _collocate_run(cris: list, viirs: dict, viirs_all: list, satellite: str, cfg
             skipped.append((g.key, "not assessed: stop requested"))
             continue
         try:
-            samples.append(collocate_granule(g, viirs[g.key], cfg, band, cache, timings, viirs_all))
+            samples.append(collocate_granule(g, viirs[g.key], cfg, band, cache, timings, viirs_all, should_stop))
+        except StopRequested:
+            skipped.append((g.key, "not assessed: stop requested"))
+            continue
         except GranuleError as exc:
             LOG.warning("skipping granule %s: %s", g.key, exc)
             skipped.append((g.key, str(exc)))

@@ -96,8 +96,10 @@ def cmd_run(args) -> int:
         from tqdm import tqdm
         bar = tqdm(unit="granule", desc="assessing")
     service = Service(cfg, progress=(lambda g: bar.update(1)) if bar else None)
+    service.handle_signals()
     try:
         with InstanceLock(cfg.state_dir):
+            service.recover()
             outcomes = []
             for sat in sats:
                 outcomes += [service.run(sat, args.date)] if args.date else service.catch_up(sat)

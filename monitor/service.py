@@ -110,12 +110,26 @@ class Service:
     def _after_run(self, store, outcome):
         """Hook for what follows a run (alerts, report): see the alerts and report packages."""
 
+    def recover(self):
+        """Mark runs left 'running' by a killed process as interrupted (call with the instance lock held)."""
+        store = self.store()
+        try:
+            n = store.interrupt_stale_runs()
+            if n:
+                LOG.warning("%d run(s) were cut short by a previous process; their days will be redone", n)
+        finally:
+            store.close()
+
+    def handle_signals(self):
+        """SIGTERM and SIGINT request a clean stop between steps."""
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            signal.signal(sig, self._on_signal)
+
     def catch_up(self, satellite: str, today: dt.date | None = None) -> list:
         """Run the days of the catch-up window that have no completed run, oldest first."""
         today = today or dt.datetime.now(UTC).date()
         store = self.store()
         try:
-            store.interrupt_stale_runs()
             days = days_to_run(store, satellite, today, self.cfg.schedule.catch_up_days, self.cfg.schedule.lag_days)
         finally:
             store.close()
@@ -136,6 +150,7 @@ class Service:
         from apscheduler.triggers.cron import CronTrigger
         sch = self.cfg.schedule
         with InstanceLock(self.cfg.state_dir):
+            self.recover()
             self.scheduler = BlockingScheduler(timezone=UTC, job_defaults={
                 "coalesce": True, "max_instances": 1, "misfire_grace_time": int(sch.misfire_grace_hours * 3600)})
             now = dt.datetime.now(UTC)
@@ -144,8 +159,7 @@ class Service:
                 self.scheduler.add_job(self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}",
                                        next_run_time=now)  # catch up at start, then daily
             self.scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
-            for sig in (signal.SIGTERM, signal.SIGINT):
-                signal.signal(sig, self._on_signal)
+            self.handle_signals()
             watchdog = self._start_watchdog()
             sd_notify("READY=1")
             sd_notify("STATUS=scheduled daily at " + sch.time_utc.strftime("%H:%M UTC"))

@@ -1,0 +1,74 @@
+"""The daily run on a local source: outcomes recorded, idempotent, corrupt input skipped."""
+
+import datetime as dt
+import shutil
+
+import pytest
+
+from monitor.config import load_config
+from monitor.pipeline import days_to_run, run_day
+from monitor.sources.local import LocalSource
+from monitor.store.sqlite import Store
+
+DAY = dt.date(2024, 6, 1)
+
+
+def make_config(tmp_path, data_dir, extra=""):
+    p = tmp_path / "c.yaml"
+    p.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
+                 f"source: {{kind: local, path: {data_dir}}}\nassessment: {{workers: 1}}\n"
+                 f"schedule: {{catch_up_days: 3}}\n{extra}")
+    return load_config(p)
+
+
+def test_run_is_recorded_and_idempotent(cases, tmp_path):
+    data, _, _ = cases.get()
+    cfg = make_config(tmp_path, data)
+    store = Store(cfg.store.sqlite)
+    src = LocalSource(data)
+    first = run_day(cfg, store, src, "j01", DAY)
+    assert first.status == "ok" and len(first.result.fors) == 30
+    second = run_day(cfg, store, src, "j01", DAY)
+    assert second.status == "ok"
+    assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
+    assert store.db.execute("SELECT COUNT(DISTINCT run_id) FROM results").fetchone()[0] == 1
+    decisions = store.selection("j01", DAY)
+    assert len(decisions) == 2 and all(d["decision"] == "chosen" and d["score_k"] > 0.5 for d in decisions)
+    assert [f.d_beta_urad for f in store.day_result("j01", DAY)] == [f.d_beta_urad for f in second.result.fors]
+
+
+def test_a_day_without_data_is_recorded(cases, tmp_path):
+    data, _, _ = cases.get()
+    cfg = make_config(tmp_path, data)
+    store = Store(cfg.store.sqlite)
+    out = run_day(cfg, store, LocalSource(data), "j01", DAY + dt.timedelta(days=3))
+    assert out.status == "no_data" and "no CrIS GEO granule" in out.reason
+    assert store.runs()[0]["status"] == "no_data"
+    assert DAY + dt.timedelta(days=3) in store.done_days("j01")
+    assert days_to_run(store, "j01", DAY + dt.timedelta(days=5), 4) == [DAY + dt.timedelta(days=k) for k in (1, 2, 4)]
+
+
+def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_path):
+    data, _, _ = cases.get()
+    work = tmp_path / "data"
+    work.mkdir()
+    for f in data.glob("*.h5"):
+        (work / f.name).symlink_to(f)
+    sdr = sorted(data.glob("SCRIF_*.h5"))[0]
+    (work / sdr.name).unlink()
+    (work / sdr.name).write_bytes(sdr.read_bytes()[:4000])
+    cfg = make_config(tmp_path, work)
+    store = Store(cfg.store.sqlite)
+    out = run_day(cfg, store, LocalSource(work), "j01", DAY)
+    assert out.status == "ok" and len(out.result.granules) == 1
+    rejected = [d for d in store.selection("j01", DAY) if d["decision"] == "rejected"]
+    assert len(rejected) == 1 and "unusable CrIS granule" in rejected[0]["reason"] and sdr.name in rejected[0]["reason"]
+    assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
+
+
+def test_source_failure_is_a_failed_run_and_an_event(tmp_path):
+    cfg = make_config(tmp_path, tmp_path / "missing")
+    store = Store(cfg.store.sqlite)
+    out = run_day(cfg, store, LocalSource(tmp_path / "missing"), "j01", DAY)
+    assert out.status == "failed" and "no such directory" in out.reason
+    assert store.events("run_failed")[0]["satellite"] == "j01"

@@ -1,0 +1,147 @@
+"""The service as a process: SIGKILL mid-run, SIGTERM mid-run, the daemon under a fake systemd, the unit."""
+
+import datetime as dt
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from monitor.store.sqlite import Store
+
+ROOT = Path(__file__).resolve().parent.parent
+CRISGEO = [sys.executable, "-m", "monitor.cli"]
+DAY = "2024-06-01"
+
+
+def _config(tmp_path, data, workers=1):
+    p = tmp_path / "c.yaml"
+    p.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
+                 f"assessment: {{workers: {workers}}}\nschedule: {{catch_up_days: 2}}\n")
+    return p
+
+
+def _wait_for(pred, timeout=120.0):
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        if pred():
+            return True
+        time.sleep(0.2)
+    return False
+
+
+def _status(db):
+    if not db.exists():
+        return []
+    s = Store(db)
+    try:
+        return [r["status"] for r in s.runs()]
+    finally:
+        s.close()
+
+
+def _assessing(proc_log: Path):
+    return proc_log.exists() and "run j01 2024-06-01" in proc_log.read_text()
+
+
+def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
+    data, _, _ = cases.get()
+    cfg = _config(tmp_path, data)
+    db = tmp_path / "state" / "crisgeo.sqlite"
+    log = tmp_path / "log"
+    with open(log, "w") as fh:
+        p = subprocess.Popen(CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT)
+    assert _wait_for(lambda: _assessing(log))
+    time.sleep(3)  # inside scene selection or collocation
+    p.kill()
+    p.wait()
+    s = Store(db)
+    assert [r["status"] for r in s.runs()] == ["running"]
+    assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0  # nothing half-written
+    s.close()
+    r = subprocess.run(CRISGEO + ["run", "--config", str(cfg), "--date", DAY], capture_output=True, text=True,
+                       cwd=ROOT, timeout=600)
+    assert r.returncode == 0, r.stderr
+    s = Store(db)
+    assert [r["status"] for r in s.runs()] == ["interrupted", "ok"]
+    assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_sigterm_mid_run_stops_within_seconds_and_consistent(cases, tmp_path, workers):
+    data, _, _ = cases.get()
+    cfg = _config(tmp_path, data, workers)
+    log = tmp_path / "log"
+    with open(log, "w") as fh:
+        p = subprocess.Popen(CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT)
+    assert _wait_for(lambda: _assessing(log))
+    time.sleep(6)  # well into the assessment
+    t0 = time.time()
+    p.send_signal(signal.SIGTERM)
+    p.wait(timeout=60)
+    stopped_in = time.time() - t0
+    assert stopped_in < 10, stopped_in
+    assert _status(tmp_path / "state" / "crisgeo.sqlite") == ["interrupted"]
+    s = Store(tmp_path / "state" / "crisgeo.sqlite")
+    assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0
+
+
+def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    cfg = _config(tmp_path, empty)
+    sock_path = str(tmp_path / "notify.sock")
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    sock.bind(sock_path)
+    sock.settimeout(60)
+    env = dict(os.environ, NOTIFY_SOCKET=sock_path, WATCHDOG_USEC="400000")
+    p = subprocess.Popen(CRISGEO + ["daemon", "--config", str(cfg)], env=env, cwd=ROOT,
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        got = set()
+        while not {"READY=1", "WATCHDOG=1"} <= got:
+            got.add(sock.recv(4096).decode())
+        # the catch-up runs at start and records the days without data
+        assert _wait_for(lambda: _status(tmp_path / "state" / "crisgeo.sqlite").count("no_data") == 2, 60)
+        # a second instance on the same state directory is refused
+        r = subprocess.run(CRISGEO + ["run", "--config", str(cfg)], capture_output=True, text=True, cwd=ROOT)
+        assert r.returncode == 2 and "another crisgeo process" in r.stderr
+        p.send_signal(signal.SIGTERM)
+        assert p.wait(timeout=20) == 0
+        while "STOPPING=1" not in got:
+            got.add(sock.recv(4096).decode())
+    finally:
+        if p.poll() is None:
+            p.kill()
+        sock.close()
+
+
+def test_status_command(cases, tmp_path):
+    data, _, _ = cases.get()
+    cfg = _config(tmp_path, tmp_path / "none")
+    (tmp_path / "none").mkdir()
+    r = subprocess.run(CRISGEO + ["status", "--config", str(cfg)], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0 and "j01: no run yet" in r.stdout and "outbox: 0" in r.stdout
+
+
+def _verify(unit: Path):
+    return subprocess.run(["systemd-analyze", "verify", str(unit)], capture_output=True, text=True)
+
+
+@pytest.mark.skipif(shutil.which("systemd-analyze") is None, reason="systemd-analyze not installed")
+def test_systemd_unit_verifies_without_any_warning(tmp_path):
+    text = (ROOT / "systemd" / "crisgeo.service").read_text()
+    assert "Type=notify" in text and "WatchdogSec=" in text and "ProtectSystem=strict" in text
+    # ExecStart must name an existing program on the test machine
+    unit = tmp_path / "crisgeo.service"
+    unit.write_text(text.replace("/opt/crisgeo/.venv/bin/crisgeo", sys.executable + " -m monitor.cli"))
+    r = _verify(unit)
+    assert r.returncode == 0 and r.stderr.strip() == "", r.stderr
+    bad = tmp_path / "crisgeo-bad.service"
+    bad.write_text(unit.read_text().replace("Restart=on-failure", "Restrat=on-failure"))
+    assert "Unknown key" in _verify(bad).stderr  # the check above can fail
