@@ -112,6 +112,8 @@ def cmd_run(args) -> int:
         print(f"{o.satellite} {o.day}: {o.status}" + (f" ({o.reason})" if o.reason else ""))
         if o.result is not None:
             print(format_table(o.result))
+        if o.timings:
+            print("wall time per stage: " + ", ".join(f"{k} {v:.1f} s" for k, v in o.timings.items()))
     if not outcomes:
         print("nothing to do: every day of the catch-up window is done")
     return EXIT_FAIL if any(o.status == "failed" for o in outcomes) else EXIT_OK
