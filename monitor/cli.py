@@ -157,6 +157,62 @@ def cmd_status(args) -> int:
     return EXIT_OK
 
 
+def cmd_alerts(args) -> int:
+    from alerts.engine import evaluate_and_deliver, fmt_alerts
+    from alerts.settings import AlertConfigError
+    from alerts.state import AlertState
+    from monitor.service import Service
+    from monitor.store.sqlite import Store
+    cfg = _load(args)
+    service = Service(cfg)
+    try:
+        settings = service.alert_settings()
+    except AlertConfigError as exc:
+        raise BadInput(str(exc)) from None
+    store = Store(cfg.store.sqlite)
+    now = dt.datetime.now(dt.timezone.utc)
+    try:
+        if args.action == "silence":
+            if args.until is None or not args.reason:
+                raise BadInput("alerts silence needs --until and --reason")
+            if args.until <= now:
+                raise BadInput("--until must be in the future")
+            AlertState(store).silence(args.rule, args.satellite, args.until, args.reason, now)
+            print(f"silenced rule={args.rule or '*'} satellite={args.satellite or '*'} until {args.until:%Y-%m-%d %H:%M} UTC")
+        elif args.action == "evaluate":
+            print(evaluate_and_deliver(store, settings, cfg.satellites, now))
+        else:
+            print(fmt_alerts(store, now))
+    finally:
+        store.close()
+    return EXIT_OK
+
+
+def cmd_events(args) -> int:
+    from alerts.changes import Change, add_to_calendar, all_changes
+    from monitor.service import Service
+    from monitor.store.sqlite import Store
+    cfg = _load(args)
+    settings = Service(cfg).alert_settings()
+    if settings.events_file is None:
+        raise BadInput("alerts.events_file is not set in the configuration")
+    if args.action == "add":
+        if not (args.satellite and args.time and args.instrument and args.description):
+            raise BadInput("events add needs --satellite, --time, --instrument and --description")
+        add_to_calendar(settings.events_file, Change(args.time, args.satellite, args.instrument, args.kind,
+                                                     args.description, "calendar"))
+        print(f"added to {settings.events_file}")
+        return EXIT_OK
+    store = Store(cfg.store.sqlite)
+    try:
+        for sat in cfg.satellites:
+            for c in all_changes(store, sat, settings.events_file):
+                print(f"{sat} {c.label()}")
+    finally:
+        store.close()
+    return EXIT_OK
+
+
 def cmd_bench(args) -> int:
     from monitor.bench import run_bench
     return run_bench(args)
@@ -199,6 +255,25 @@ def build_parser() -> argparse.ArgumentParser:
     st = sub.add_parser("status", help="last run per satellite, latest per-FOR table, next run, outbox size")
     st.add_argument("--config", required=True)
     st.set_defaults(func=cmd_status)
+
+    al = sub.add_parser("alerts", help="list firing, silenced and resolved alerts; silence; evaluate now")
+    al.add_argument("action", choices=("list", "silence", "evaluate"), nargs="?", default="list")
+    al.add_argument("--config", required=True)
+    al.add_argument("--rule", choices=("spec", "jump", "stale", "failure"))
+    al.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    al.add_argument("--until", type=_iso, help="end of the silence (ISO 8601, UTC)")
+    al.add_argument("--reason", default="")
+    al.set_defaults(func=cmd_alerts)
+
+    ev = sub.add_parser("events", help="list the known changes, or add one to the events calendar")
+    ev.add_argument("action", choices=("list", "add"), nargs="?", default="list")
+    ev.add_argument("--config", required=True)
+    ev.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    ev.add_argument("--time", type=_iso)
+    ev.add_argument("--instrument", choices=("cris", "viirs", "common"))
+    ev.add_argument("--kind", default="change", help="ep_upload, lut_change, software, ...")
+    ev.add_argument("--description")
+    ev.set_defaults(func=cmd_events)
 
     b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")
     b.add_argument("--granules", type=int, default=14)

@@ -107,8 +107,28 @@ class Service:
         finally:
             store.close()
 
+    def alert_settings(self):
+        from alerts.settings import load_alert_settings
+        return load_alert_settings(self.cfg.alerts, self.cfg.path.resolve().parent, self.cfg.report_dir,
+                                   self.cfg.dashboard_url)
+
     def _after_run(self, store, outcome):
-        """Hook for what follows a run (alerts, report): see the alerts and report packages."""
+        """After every run: evaluate the alert rules and deliver what is queued."""
+        self.check_alerts(store)
+
+    def check_alerts(self, store=None):
+        """Evaluate the alert rules for every satellite and deliver the queue; a broken channel never
+        stops the service."""
+        from alerts.engine import evaluate_and_deliver
+        own = store is None
+        store = store or self.store()
+        try:
+            counts = evaluate_and_deliver(store, self.alert_settings(), self.cfg.satellites)
+            if counts["queued"] or counts["sent"] or counts["failed"]:
+                LOG.info("alerts: %s", counts)
+        finally:
+            if own:
+                store.close()
 
     def recover(self):
         """Mark runs left 'running' by a killed process as interrupted (call with the instance lock held)."""
@@ -158,6 +178,7 @@ class Service:
                 trigger = CronTrigger(hour=sch.time_utc.hour, minute=sch.time_utc.minute, timezone=UTC)
                 self.scheduler.add_job(self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}",
                                        next_run_time=now)  # catch up at start, then daily
+            self.scheduler.add_job(self.check_alerts, "interval", hours=1, id="alerts", name="alert timer")
             self.scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
             self.handle_signals()
             watchdog = self._start_watchdog()
@@ -188,6 +209,7 @@ class Service:
         store = self.store()
         try:
             store.add_event(kind, event.job_id.split("-", 1)[-1], detail)
+            self.check_alerts(store)
         finally:
             store.close()
 

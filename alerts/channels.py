@@ -1,0 +1,137 @@
+"""Delivery channels: a log file, email (SMTP with STARTTLS and a verified TLS context), Slack webhook.
+
+A send either succeeds, fails for now (``Transient``: the queue retries later), or fails for good
+(``Permanent``: a configuration error, logged, not retried). No message or log line ever contains the
+webhook URL or a password.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import logging
+import smtplib
+import ssl
+import time
+from email.message import EmailMessage
+from pathlib import Path
+
+import requests
+
+from alerts.settings import secret
+
+LOG = logging.getLogger(__name__)
+
+
+class Transient(Exception):
+    """Try again later (server down, rate limited, 5xx)."""
+
+    def __init__(self, message, retry_after_s: float = 300.0):
+        super().__init__(message)
+        self.retry_after_s = retry_after_s
+
+
+class Permanent(Exception):
+    """A configuration or payload error: retrying will not help."""
+
+
+class LogChannel:
+    name = "log"
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+
+    def send(self, msg):
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        with open(self.path, "a") as fh:
+            fh.write(f"--- {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} {msg['subject']}\n")
+            fh.write(msg["text"].rstrip() + "\n")
+
+
+class EmailChannel:
+    name = "email"
+
+    def __init__(self, settings):
+        self.s = settings
+
+    def send(self, msg):
+        s = self.s
+        m = EmailMessage()
+        m["Subject"] = msg["subject"]
+        m["From"] = s.sender
+        m["To"] = ", ".join(s.to)
+        m.set_content(msg["text"])
+        m.add_alternative(msg["html"], subtype="html")
+        for path in msg.get("attachments", []):
+            p = Path(path)
+            if p.is_file():
+                m.add_attachment(p.read_bytes(), maintype="image", subtype="png", filename=p.name)
+        user, password = secret(s.username_env), secret(s.password_env)
+        try:
+            with smtplib.SMTP(s.host, s.port, timeout=s.timeout_s) as smtp:
+                if s.starttls:
+                    smtp.starttls(context=ssl.create_default_context(cafile=s.cafile))
+                if user:
+                    smtp.login(user, password or "")
+                smtp.send_message(m)
+        except smtplib.SMTPAuthenticationError as exc:
+            raise Permanent(f"SMTP login refused for the configured user ({exc.smtp_code})") from None
+        except (smtplib.SMTPNotSupportedError, ssl.SSLCertVerificationError) as exc:
+            raise Permanent(f"SMTP TLS problem: {type(exc).__name__}: {exc}") from None
+        except smtplib.SMTPResponseException as exc:
+            if 400 <= exc.smtp_code < 500:
+                raise Transient(f"SMTP {exc.smtp_code}") from None
+            raise Permanent(f"SMTP {exc.smtp_code} {exc.smtp_error!r}") from None
+        except (OSError, smtplib.SMTPException) as exc:
+            raise Transient(f"SMTP {s.host}:{s.port}: {type(exc).__name__}") from None
+
+
+class SlackChannel:
+    """Slack incoming webhook: 200 ``ok`` is success; 429 honours Retry-After; 5xx is retried; 4xx is permanent."""
+
+    name = "slack"
+
+    def __init__(self, settings, sleep=time.sleep):
+        self.s = settings
+        self.sleep = sleep
+
+    def send(self, msg):
+        url = secret(self.s.webhook_env)
+        if not url:
+            raise Permanent(f"Slack webhook: environment variable {self.s.webhook_env} is not set")
+        payload = {"text": msg["text"][:3500],
+                   "blocks": [{"type": "section", "text": {"type": "mrkdwn", "text": b[:2900]}} for b in msg["blocks"]]}
+        delay = 1.0
+        for attempt in range(self.s.retries + 1):
+            try:
+                r = requests.post(url, data=json.dumps(payload), headers={"Content-Type": "application/json"},
+                                  timeout=self.s.timeout_s)
+            except requests.RequestException as exc:
+                raise Transient(f"Slack webhook unreachable ({type(exc).__name__})") from None
+            if r.status_code == 200 and r.text.strip() == "ok":
+                return
+            if r.status_code == 429:
+                wait = float(r.headers.get("Retry-After", "1") or 1)
+                if wait > self.s.max_wait_s or attempt == self.s.retries:
+                    raise Transient(f"Slack rate limit, retry after {wait:.0f} s", retry_after_s=wait)
+                self.sleep(wait)
+                continue
+            if r.status_code >= 500:
+                if attempt == self.s.retries:
+                    raise Transient(f"Slack HTTP {r.status_code}")
+                self.sleep(delay)
+                delay *= 2
+                continue
+            raise Permanent(f"Slack HTTP {r.status_code} {r.text.strip()[:100]!r}: check the webhook configuration")
+        raise Transient("Slack: retries exhausted")
+
+
+def make_channels(settings) -> dict:
+    out = {}
+    if settings.log:
+        out["log"] = LogChannel(settings.log)
+    if settings.email:
+        out["email"] = EmailChannel(settings.email)
+    if settings.slack:
+        out["slack"] = SlackChannel(settings.slack)
+    return out

@@ -1,0 +1,186 @@
+"""Evaluate the rules, update alert state, queue one message per satellite, deliver the queue.
+
+Lifecycle (Alertmanager's conventions): an alert is notified when it starts firing, repeated while it
+fires (every ``repeat_hours``), and notified when it resolves. Silenced alerts keep their state but
+send nothing. Everything a run decides is committed before any channel is tried.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import html
+import json
+import logging
+
+
+from alerts.changes import all_changes
+from alerts.channels import Permanent, Transient, make_channels
+from alerts.rules import failure_finding, jump_findings, spec_finding, stale_finding
+from alerts.state import AlertState
+
+LOG = logging.getLogger(__name__)
+UTC = dt.timezone.utc
+
+
+def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
+    s = settings.rules
+    out = [f for f in (spec_finding(store, satellite, s), stale_finding(store, satellite, s, now),
+                       failure_finding(store, satellite)) if f is not None]
+    latest = store.latest_day(satellite)
+    if latest is not None:
+        changes = all_changes(store, satellite, settings.events_file)
+        out += jump_findings(store, satellite, changes, s, latest)
+    return out
+
+
+def _trend(store, satellite: str, days: int = 7) -> list[str]:
+    rows = store.series(satellite)
+    by_day = {}
+    for r in rows:
+        if r["total_km"] is not None:
+            by_day.setdefault(r["day"], []).append((r["total_km"], r["for_index"]))
+    lines = []
+    for d in sorted(by_day)[-days:]:
+        worst, k = max(by_day[d])
+        lines.append(f"{d}: worst FOR {k} total {worst:.2f} km")
+    return lines
+
+
+def build_message(store, satellite: str, items: list, settings) -> dict:
+    """One message for a satellite: every alert that started, repeats or resolved, with evidence."""
+    counts = {}
+    for kind, _ in items:
+        counts[kind] = counts.get(kind, 0) + 1
+    head = ", ".join(f"{n} {k}" for k, n in counts.items())
+    worst = "critical" if any(f.severity == "critical" and k != "resolved" for k, f in items) else \
+        ("resolved" if all(k == "resolved" for k, _ in items) else "warning")
+    subject = f"[crisgeo] {satellite} {worst.upper()}: {head} - " + "; ".join(f.rule for _, f in items)
+    blocks, text = [], []
+    for kind, f in items:
+        title = f"{kind.upper()} {f.rule} ({f.severity if kind != 'resolved' else 'resolved'}): {f.summary}"
+        text += [title] + [f"  {line}" for line in f.lines] + [""]
+        blocks.append("*" + _slack_escape(title) + "*\n" + "\n".join(_slack_escape(x) for x in f.lines[:25]))
+    day = store.latest_day(satellite)
+    if day is not None:
+        grans = store.granules(satellite, day)
+        text.append(f"assessment of {day}: {len(grans)} granule pair(s): "
+                    + ", ".join(g["granule_id"] for g in grans[:14]))
+    trend = _trend(store, satellite)
+    if trend:
+        text += ["trend (last days):"] + [f"  {t}" for t in trend]
+    where = []
+    if settings.report_dir:
+        where.append(f"report: {settings.report_dir / satellite / 'index.html'}")
+    if settings.dashboard_url:
+        where.append(f"dashboard: {settings.dashboard_url}")
+    text += where
+    if trend or where:
+        blocks.append(_slack_escape("\n".join(["trend:"] + trend + where)))
+    body = "\n".join(text)
+    attachments = []
+    if settings.report_dir and (settings.report_dir / satellite / "trend.png").is_file():
+        attachments.append(str(settings.report_dir / satellite / "trend.png"))
+    return {"subject": subject, "text": body,
+            "html": f"<html><body><h3>{html.escape(subject)}</h3><pre>{html.escape(body)}</pre></body></html>",
+            "blocks": blocks, "attachments": attachments}
+
+
+def _slack_escape(s: str) -> str:
+    return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> list:
+    """Update alert state from the rules and queue the messages; returns [(satellite, message)] queued."""
+    now = now or dt.datetime.now(UTC)
+    state = AlertState(store)
+    repeat = dt.timedelta(hours=settings.rules.repeat_hours)
+    queued = []
+    for sat in satellites:
+        found = findings_for(store, sat, settings, now)
+        items = []
+        with store.transaction():
+            for f in found:
+                prev = state.get(f.fingerprint)
+                quiet = state.silenced(f.rule, sat, now) is not None
+                if prev is None or prev["status"] != "firing":
+                    kind = "firing"
+                elif prev["last_notified"] is None or now - dt.datetime.fromisoformat(prev["last_notified"]) >= repeat:
+                    kind = "repeat"
+                else:
+                    kind = None
+                notify = kind is not None and not quiet
+                state.upsert(f, "firing", now, notified=notify)
+                if notify:
+                    items.append((kind, f))
+            current = {f.fingerprint for f in found}
+            for prev in state.firing(sat):
+                if prev["fingerprint"] not in current:
+                    state.resolve(prev["fingerprint"], now)
+                    if state.silenced(prev["rule"], sat, now) is None:
+                        from alerts.rules import Finding
+                        items.append(("resolved", Finding(prev["rule"], sat, prev["severity"],
+                                                          f"resolved: {prev['summary']}", [], prev["grp"] or "")))
+            if items:
+                msg = build_message(store, sat, items, settings)
+                for channel in settings.channels:
+                    state.enqueue(channel, sat, msg, now)
+                queued.append((sat, msg))
+    return queued
+
+
+def deliver(store, settings, now: dt.datetime | None = None, channels=None) -> dict:
+    """Try every due delivery once; returns counts by outcome. Never raises for a channel."""
+    now = now or dt.datetime.now(UTC)
+    state = AlertState(store)
+    channels = channels if channels is not None else make_channels(settings)
+    counts = {"sent": 0, "retry": 0, "failed": 0}
+    for d in state.due(now):
+        ch = channels.get(d["channel"])
+        if ch is None:
+            state.mark(d["id"], "failed", now, f"channel {d['channel']} is no longer configured")
+            counts["failed"] += 1
+            continue
+        try:
+            ch.send(json.loads(d["body"]))
+        except Transient as exc:
+            wait = max(exc.retry_after_s, 60.0 * min(2 ** d["attempts"], 60))
+            state.mark(d["id"], "pending", now, str(exc), retry_after_s=wait)
+            LOG.warning("alert delivery via %s postponed: %s", d["channel"], exc)
+            counts["retry"] += 1
+        except Permanent as exc:
+            state.mark(d["id"], "failed", now, str(exc))
+            LOG.error("alert delivery via %s failed (configuration error): %s", d["channel"], exc)
+            counts["failed"] += 1
+        else:
+            state.mark(d["id"], "sent", now)
+            counts["sent"] += 1
+    return counts
+
+
+def evaluate_and_deliver(store, settings, satellites, now=None) -> dict:
+    queued = evaluate(store, settings, satellites, now)
+    counts = deliver(store, settings, now)
+    counts["queued"] = len(queued)
+    return counts
+
+
+def fmt_alerts(store, now: dt.datetime) -> str:
+    """The ``crisgeo alerts list`` view: firing, silenced, recently resolved."""
+    state = AlertState(store)
+    rows = state.all()
+    lines = []
+    for r in rows:
+        if r["status"] == "resolved" and r["resolved"] and \
+                now - dt.datetime.fromisoformat(r["resolved"]) > dt.timedelta(days=7):
+            continue
+        quiet = state.silenced(r["rule"], r["satellite"], now)
+        status = "silenced" if quiet and r["status"] == "firing" else r["status"]
+        lines.append(f"{status:<9} {r['severity'] or '':<8} {r['fingerprint']:<28} since {r['started']}"
+                     + (f" resolved {r['resolved']}" if r["status"] == "resolved" else "") + f"  {r['summary']}")
+    for s in state.silences(now):
+        lines.append(f"silence   rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: {s['reason']}")
+    pending = state.deliveries("pending")
+    lines.append(f"{len(pending)} message(s) waiting for delivery")
+    return "\n".join(lines) if rows or pending else "no alerts"
+
+

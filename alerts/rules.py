@@ -1,0 +1,228 @@
+"""Alert rules: specification breach, jump (with the change that preceded it), stale data, failed runs.
+
+Each rule turns what the store holds into findings, one per satellite (and per jump). A finding is
+identified by rule + satellite + group, which is what the alert state tracks.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from alerts.changes import preceding_change
+
+UTC = dt.timezone.utc
+N_FOR = 30
+COMPONENTS = (("in_track_km", "in-track"), ("cross_track_km", "cross-track"))
+GROUPS = {"FOR 1-10": range(0, 10), "FOR 11-20": range(10, 20), "FOR 21-30": range(20, 30), "all FORs": range(30)}
+
+
+@dataclass
+class RuleSettings:
+    spec_km: float = 1.5
+    min_jump_km: float = 0.25
+    jump_z: float = 5.0  # blind search, any day of the recent window
+    jump_z_at_change: float = 3.5  # at the date of a known change
+    pre_days: int = 21
+    min_pre_days: int = 7
+    min_post_days: int = 2
+    post_days: int = 14
+    blind_window_days: int = 7
+    change_window_days: int = 30
+    attribution_days: int = 10
+    active_days: int = 14
+    stale_hours: float = 36.0
+    repeat_hours: float = 24.0
+
+
+@dataclass
+class Finding:
+    rule: str
+    satellite: str
+    severity: str
+    summary: str
+    lines: list = field(default_factory=list)
+    group: str = ""
+    data: dict = field(default_factory=dict)
+
+    @property
+    def fingerprint(self) -> str:
+        return f"{self.rule}:{self.satellite}:{self.group}"
+
+
+def _f(x):
+    return x is not None and math.isfinite(x)
+
+
+def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
+    """FORs of the latest day whose in-track, cross-track or total error exceeds the specification.
+
+    Critical when the breach holds beyond the uncertainty (value - 2 sigma > spec), warning otherwise.
+    FORs flagged unreliable never alert.
+    """
+    day = store.latest_day(satellite)
+    if day is None:
+        return None
+    rows = []
+    for f in store.day_result(satellite, day):
+        if not f.reliable:
+            continue
+        sig_total = (math.hypot(f.in_track_km * f.sigma_in_track_km, f.cross_track_km * f.sigma_cross_track_km)
+                     / f.total_km if _f(f.sigma_in_track_km) and f.total_km > 0 else float("nan"))
+        checks = (("in-track", abs(f.in_track_km), f.sigma_in_track_km), ("cross-track", abs(f.cross_track_km),
+                  f.sigma_cross_track_km), ("total", f.total_km, sig_total))
+        over = [(name, v, sg) for name, v, sg in checks if _f(v) and v > s.spec_km]
+        if not over:
+            continue
+        critical = all(_f(sg) and v - 2 * sg > s.spec_km for _, v, sg in over)
+        rows.append((f, over, critical))
+    if not rows:
+        return None
+    severity = "critical" if any(c for _, _, c in rows) else "warning"
+    fors = [f.for_index for f, _, _ in rows]
+    lines = [f"FOR {f.for_index:2d}: in-track {f.in_track_km:+.2f} +- {f.sigma_in_track_km:.2f} km, cross-track "
+             f"{f.cross_track_km:+.2f} +- {f.sigma_cross_track_km:.2f} km, total {f.total_km:.2f} km "
+             f"(spec {s.spec_km} km){'' if c else ' (within 2 sigma of the spec)'}" for f, _, c in rows]
+    return Finding("spec", satellite, severity,
+                   f"{satellite}: {len(rows)} FOR(s) beyond the {s.spec_km} km specification on {day}: "
+                   f"FOR {', '.join(map(str, fors))}", lines,
+                   data={"day": day.isoformat(), "fors": fors})
+
+
+def _series(store, satellite: str):
+    rows = store.series(satellite)
+    days = sorted({r["day"] for r in rows})
+    index = {d: i for i, d in enumerate(days)}
+    values = {c: np.full((len(days), N_FOR), np.nan) for c, _ in COMPONENTS}
+    for r in rows:
+        if any(f in json.loads(r["flags"] or "[]") for f in ("few_samples", "edge", "flat", "uncertain")):
+            continue
+        for c, _ in COMPONENTS:
+            if r[c] is not None:
+                values[c][index[r["day"]], r["for_index"] - 1] = r[c]
+    return [dt.date.fromisoformat(d) for d in days], values
+
+
+def step_test(y: np.ndarray, days: list, split: dt.date, s: RuleSettings):
+    """(delta_km, z) of a step at *split* in the daily series *y*, or None when the windows are too short.
+
+    Robust two-sample comparison: difference of medians after/before the split, scaled by the MAD of
+    the pre-split days (floored at 20 m) with the sampling error of a median (sqrt(pi/2) / sqrt(n)).
+    """
+    d = np.array([x.toordinal() for x in days])
+    k = split.toordinal()
+    pre = y[(d < k) & (d >= k - s.pre_days) & np.isfinite(y)]
+    post = y[(d >= k) & (d < k + s.post_days) & np.isfinite(y)]
+    if len(pre) < s.min_pre_days or len(post) < s.min_post_days:
+        return None
+    delta = float(np.median(post) - np.median(pre))
+    scale = max(1.4826 * float(np.median(np.abs(pre - np.median(pre)))), 0.02)
+    se = scale * math.sqrt(math.pi / 2) * math.sqrt(1 / len(pre) + 1 / len(post))
+    return delta, delta / se
+
+
+def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -> list[dict]:
+    """Steps in the FOR-group series, at known change days (lower threshold) and blind in the recent window.
+
+    Returns one dict per split day found: split, groups [(group, component, delta, z)], fors (per-FOR
+    deltas of the components that jumped), known (whether the split is a change day).
+    """
+    if not days:
+        return []
+    last = days[-1]
+    candidates = {}
+    for c in change_days:
+        if last - dt.timedelta(days=s.change_window_days) <= c <= last:
+            candidates[c] = True
+    for k in range(s.blind_window_days):
+        candidates.setdefault(last - dt.timedelta(days=k), False)
+    found = []
+    for split, known in sorted(candidates.items()):
+        threshold = s.jump_z_at_change if known else s.jump_z
+        hits = []
+        for comp, label in COMPONENTS:
+            for g, idx in GROUPS.items():
+                sub = values[comp][:, list(idx)]
+                ok = np.sum(np.isfinite(sub), axis=1) >= len(idx) / 2
+                with np.errstate(all="ignore"):
+                    y = np.where(ok, np.nanmean(sub, axis=1), np.nan)
+                t = step_test(y, days, split, s)
+                if t and abs(t[0]) >= s.min_jump_km and abs(t[1]) >= threshold:
+                    hits.append((g, label, t[0], t[1]))
+        if hits:
+            fors = {}
+            for comp, label in COMPONENTS:
+                if not any(h[1] == label for h in hits):
+                    continue
+                for i in range(N_FOR):
+                    t = step_test(values[comp][:, i], days, split, s)
+                    if t and abs(t[0]) >= s.min_jump_km:
+                        fors.setdefault(i + 1, []).append((label, t[0]))
+            found.append({"split": split, "groups": hits, "fors": fors, "known": known,
+                          "score": max(abs(h[3]) for h in hits)})
+    # a blind step is seen at several neighbouring split days: keep the strongest of each cluster
+    found.sort(key=lambda j: j["split"])
+    kept = []
+    for j in found:
+        if kept and (j["split"] - kept[-1]["split"]).days <= 3 and not (j["known"] and not kept[-1]["known"]):
+            if j["score"] > kept[-1]["score"] and not kept[-1]["known"]:
+                kept[-1] = j
+            continue
+        kept.append(j)
+    return kept
+
+
+def jump_findings(store, satellite: str, changes: list, s: RuleSettings, today: dt.date) -> list[Finding]:
+    days, values = _series(store, satellite)
+    jumps = detect_jumps(days, values, sorted({c.time.date() for c in changes}), s)
+    out = []
+    for j in jumps:
+        if (today - j["split"]).days > s.active_days:
+            continue
+        change = preceding_change(changes, j["split"], s.attribution_days)
+        cause = (f"preceded by {change.label()}" if change else
+                 f"no known change in the {s.attribution_days} days before it")
+        who = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS/VIIRS common"}[change.instrument] if change else "unknown"
+        groups = "; ".join(f"{g} {label} {d:+.2f} km (z {z:+.1f})" for g, label, d, z in j["groups"])
+        lines = [f"step from {j['split']}: {groups}", f"attribution: {cause}"]
+        lines += [f"FOR {k:2d}: " + ", ".join(f"{label} {d:+.2f} km" for label, d in v) for k, v in sorted(j["fors"].items())]
+        out.append(Finding("jump", satellite, "warning",
+                           f"{satellite}: geolocation jump from {j['split']} ({who} change before it)" if change else
+                           f"{satellite}: geolocation jump from {j['split']} with no known change before it",
+                           lines, group=j["split"].isoformat(),
+                           data={"split": j["split"].isoformat(), "instrument": change.instrument if change else None,
+                                 "fors": sorted(j["fors"]), "change": change.label() if change else None}))
+    return out
+
+
+def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> Finding | None:
+    """No successful assessment for longer than the limit (counted from the first run if none succeeded)."""
+    runs = store.runs(satellite)
+    if not runs:
+        return None
+    ok = [r for r in runs if r["status"] == "ok"]
+    since = dt.datetime.fromisoformat((ok[-1]["finished"] if ok else runs[0]["started"]))
+    age = (now - since).total_seconds() / 3600
+    if age <= s.stale_hours:
+        return None
+    what = f"last successful assessment {ok[-1]['day']} finished {ok[-1]['finished']}" if ok else "no successful assessment yet"
+    return Finding("stale", satellite, "critical", f"{satellite}: no successful assessment for {age:.0f} h",
+                   [what, f"latest run: {runs[-1]['day']} {runs[-1]['status']} {runs[-1]['reason'] or ''}".strip()])
+
+
+def failure_finding(store, satellite: str) -> Finding | None:
+    """The latest run failed, or the scheduler reported a failed or missed job since the last good run."""
+    runs = store.runs(satellite)
+    last_ok = max((r["id"] for r in runs if r["status"] in ("ok", "no_data")), default=0)
+    failed = [r for r in runs if r["id"] > last_ok and r["status"] == "failed"]
+    last_ok_time = next((r["finished"] for r in runs if r["id"] == last_ok), "")
+    jobs = [e for e in store.events() if e["kind"] in ("job_error", "job_missed", "job_skipped")
+            and e["satellite"] == satellite and e["time"] > (last_ok_time or "")]
+    if not failed and not jobs:
+        return None
+    lines = [f"run {r['day']}: {r['reason']}" for r in failed] + [f"scheduler: {e['detail']}" for e in jobs]
+    return Finding("failure", satellite, "critical", f"{satellite}: {len(lines)} failed or missed run(s)", lines)

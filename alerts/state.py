@@ -1,0 +1,99 @@
+"""Alert state, silences and the delivery queue, in the service's SQLite file (own tables and version)."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+
+SCHEMA = [
+    """
+    CREATE TABLE IF NOT EXISTS alert_meta (version INTEGER NOT NULL);
+    CREATE TABLE IF NOT EXISTS alert_state (
+        fingerprint TEXT PRIMARY KEY, rule TEXT NOT NULL, satellite TEXT NOT NULL, grp TEXT, severity TEXT,
+        status TEXT NOT NULL, started TEXT, last_notified TEXT, resolved TEXT, summary TEXT, lines TEXT);
+    CREATE TABLE IF NOT EXISTS silences (
+        id INTEGER PRIMARY KEY, rule TEXT, satellite TEXT, until TEXT NOT NULL, reason TEXT NOT NULL, created TEXT);
+    CREATE TABLE IF NOT EXISTS deliveries (
+        id INTEGER PRIMARY KEY, channel TEXT NOT NULL, satellite TEXT, subject TEXT NOT NULL, body TEXT NOT NULL,
+        created TEXT NOT NULL, status TEXT NOT NULL, attempts INTEGER DEFAULT 0, next_attempt TEXT,
+        last_error TEXT, sent TEXT)
+    """,
+]
+
+
+def iso(t: dt.datetime) -> str:
+    return t.astimezone(dt.timezone.utc).isoformat(timespec="seconds")
+
+
+class AlertState:
+    """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries."""
+
+    def __init__(self, store):
+        self.store = store
+        self.db = store.db
+        with store.transaction():
+            for stmt in filter(str.strip, SCHEMA[0].split(";")):
+                self.db.execute(stmt)
+            if self.db.execute("SELECT COUNT(*) FROM alert_meta").fetchone()[0] == 0:
+                self.db.execute("INSERT INTO alert_meta VALUES (1)")
+
+    def get(self, fingerprint: str):
+        r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
+        return dict(r) if r else None
+
+    def firing(self, satellite: str | None = None) -> list:
+        q = "SELECT * FROM alert_state WHERE status='firing'" + (" AND satellite=?" if satellite else "")
+        return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
+
+    def all(self) -> list:
+        return [dict(r) for r in self.db.execute("SELECT * FROM alert_state ORDER BY satellite, rule, grp")]
+
+    def upsert(self, finding, status: str, now: dt.datetime, notified: bool):
+        prev = self.get(finding.fingerprint)
+        started = prev["started"] if prev and prev["status"] == "firing" else iso(now)
+        last = iso(now) if notified else (prev["last_notified"] if prev else None)
+        self.db.execute(
+            "INSERT OR REPLACE INTO alert_state VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (finding.fingerprint, finding.rule, finding.satellite, finding.group, finding.severity, status, started,
+             last, None, finding.summary, json.dumps(finding.lines)))
+
+    def resolve(self, fingerprint: str, now: dt.datetime):
+        self.db.execute("UPDATE alert_state SET status='resolved', resolved=? WHERE fingerprint=?",
+                        (iso(now), fingerprint))
+
+    # -- silences
+    def silence(self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime):
+        with self.store.transaction():
+            self.db.execute("INSERT INTO silences (rule, satellite, until, reason, created) VALUES (?, ?, ?, ?, ?)",
+                            (rule, satellite, iso(until), reason, iso(now)))
+
+    def silenced(self, rule: str, satellite: str, now: dt.datetime) -> dict | None:
+        r = self.db.execute("SELECT * FROM silences WHERE until > ? AND (rule IS NULL OR rule=?) "
+                            "AND (satellite IS NULL OR satellite=?) ORDER BY until DESC",
+                            (iso(now), rule, satellite)).fetchone()
+        return dict(r) if r else None
+
+    def silences(self, now: dt.datetime) -> list:
+        return [dict(r) for r in self.db.execute("SELECT * FROM silences WHERE until > ? ORDER BY until", (iso(now),))]
+
+    # -- delivery queue
+    def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime):
+        self.db.execute("INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
+                        "VALUES (?, ?, ?, ?, ?, 'pending', ?)",
+                        (channel, satellite, message["subject"], json.dumps(message), iso(now), iso(now)))
+
+    def due(self, now: dt.datetime) -> list:
+        return [dict(r) for r in self.db.execute(
+            "SELECT * FROM deliveries WHERE status='pending' AND next_attempt <= ? ORDER BY id", (iso(now),))]
+
+    def deliveries(self, status: str | None = None) -> list:
+        q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"
+        return [dict(r) for r in self.db.execute(q, (status,) if status else ())]
+
+    def mark(self, delivery_id: int, status: str, now: dt.datetime, error: str | None = None,
+             retry_after_s: float = 0.0):
+        with self.store.transaction():
+            self.db.execute(
+                "UPDATE deliveries SET status=?, attempts=attempts+1, last_error=?, next_attempt=?, sent=? WHERE id=?",
+                (status, error, iso(now + dt.timedelta(seconds=retry_after_s)),
+                 iso(now) if status == "sent" else None, delivery_id))
