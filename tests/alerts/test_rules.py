@@ -1,0 +1,100 @@
+import datetime as dt
+import json
+
+import numpy as np
+import pytest
+
+from alerts.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
+from alerts.rules import RuleSettings, failure_finding, spec_finding, stale_finding
+from benchmarks.jump_detection import false_alarms, jump_trial
+from monitor.result import AssessmentResult, ForOffset
+from monitor.store.sqlite import Store
+
+DAY = dt.date(2024, 6, 1)
+UTC = dt.timezone.utc
+
+
+def _for(k, it, ct, sig=0.05, flags=()):
+    return ForOffset(k, 0.0, 0.0, 10.0, 10.0, it, ct, float(np.hypot(it, ct)), sig, sig, 100, 0.1, 0.2, tuple(flags))
+
+
+def _result(fors, granules=()):
+    return AssessmentResult("j01", "", "", fors, list(granules))
+
+
+def _granule(gid, cris_aux, viirs_aux, sw="I2.1.03.00"):
+    return {"granule_id": gid, "start": "t", "cris_geo": "g", "cris_sdr": "s", "viirs": [], "n_usable": 1,
+            "cris_meta": {"aux_files": cris_aux, "software_version": sw, "algorithm_version": "2.O"},
+            "viirs_meta": {"aux_files": viirs_aux, "software_version": "I2.0"}}
+
+
+def test_spec_severity_uses_the_uncertainty(tmp_path):
+    s = Store(tmp_path / "s.sqlite")
+    fors = [_for(k, 0.1, 0.2) for k in range(1, 31)]
+    fors[27] = _for(28, 0.2, 1.6, sig=0.2)  # 1.6 - 2 x 0.2 < 1.5: warning
+    fors[29] = _for(30, -0.7, 4.4, sig=0.1)  # critical
+    fors[28] = _for(29, 0.1, 3.0, flags=("flat",))  # unreliable: never alerts
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors), [], {})
+    f = spec_finding(s, "j01", RuleSettings())
+    assert f.severity == "critical" and f.data["fors"] == [28, 30]
+    assert "within 2 sigma" in f.lines[0] and "within 2 sigma" not in f.lines[1]
+    fors[29] = _for(30, -0.7, 1.55, sig=0.1)
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors), [], {})
+    assert spec_finding(s, "j01", RuleSettings()).severity == "warning"
+
+
+def test_stale_and_failure(tmp_path):
+    s = Store(tmp_path / "s.sqlite")
+    assert stale_finding(s, "j01", RuleSettings(), dt.datetime.now(UTC)) is None
+    run = s.begin_run("j01", DAY)
+    s.finish_run(run, "failed", "SourceError: listing: HTTP 503")
+    f = failure_finding(s, "j01")
+    assert f.severity == "critical" and "HTTP 503" in f.lines[0]
+    later = dt.datetime.now(UTC) + dt.timedelta(hours=40)
+    assert "no successful assessment" in stale_finding(s, "j01", RuleSettings(), later).lines[0]
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result([_for(k, 0, 0) for k in range(1, 31)]), [], {})
+    assert failure_finding(s, "j01") is None and stale_finding(s, "j01", RuleSettings(), dt.datetime.now(UTC)) is None
+
+
+def test_metadata_changes_name_the_instrument(tmp_path):
+    s = Store(tmp_path / "s.sqlite")
+    viirs_lut = "VIIRS-SDR-GEO-IMG-PARAM-LUT_j01_20130601000000Z_20130601000000Z_ee00000000000000Z_PS-1-O-CCR-{}_all"
+    cris = ["CrIS-SDR-CC_j01_20180426000000Z_x_ops", "CrIS-SDR-ENGPKT-BACKUP-AUX_j01_{}_ops"]
+    for i, (vl, eng) in enumerate([("1171", "a"), ("1171", "b"), ("2042", "c")]):
+        day = DAY + dt.timedelta(days=i)
+        g = _granule(f"J{i}", [cris[0], cris[1].format(eng)], [viirs_lut.format(vl)])
+        s.save_day(s.begin_run("j01", day), "j01", day, _result([_for(1, 0, 0)], [g]), [], {})
+    changes = metadata_changes(s, "j01")
+    assert len(changes) == 1  # the engineering-packet backup AUX changes every run and is ignored
+    assert changes[0].instrument == "viirs" and "2042" in changes[0].description
+    assert changes[0].time.date() == DAY + dt.timedelta(days=2)
+
+
+def test_calendar_round_trip_and_attribution(tmp_path):
+    cal = tmp_path / "events.yaml"
+    c = Change(dt.datetime(2014, 2, 27, tzinfo=UTC), "npp", "cris", "ep_upload", "EP v36", "calendar")
+    add_to_calendar(cal, c)
+    (back,) = load_calendar(cal)
+    assert back == c
+    assert preceding_change([back], dt.date(2014, 2, 28)) == back
+    assert preceding_change([back], dt.date(2014, 2, 26)) is None
+    assert preceding_change([back], dt.date(2014, 3, 30)) is None  # too long after
+    cal.write_text("events:\n  - {satellite: npp, time: 2014-01-01, instrument: modis}\n")
+    with pytest.raises(ValueError, match=r"events\[0\]: instrument 'modis'"):
+        load_calendar(cal)
+
+
+def test_shipped_calendar_holds_the_known_history():
+    from pathlib import Path
+    events = load_calendar(Path(__file__).resolve().parents[2] / "configs" / "events.yaml")
+    assert any(e.kind == "ep_upload" and e.time.date() == dt.date(2014, 2, 27) for e in events)
+    assert any(e.instrument == "viirs" and e.time == dt.datetime(2012, 11, 22, 16, 32, tzinfo=UTC) for e in events)
+
+
+def test_jumps_found_and_attributed_and_noise_stays_quiet():
+    """A reduced run of benchmarks/jump_detection.py (the full figures are in the issue notes)."""
+    rng = np.random.default_rng(7)
+    s = RuleSettings()
+    res = [jump_trial(rng, 0.3, s) for _ in range(12)]
+    assert sum(r[0] for r in res) >= 11 and all(r[1] for r in res if r[0])
+    assert sum(false_alarms(rng, 1, s)) <= 1
