@@ -5,6 +5,7 @@ from __future__ import annotations
 import resource
 import tempfile
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +33,7 @@ def _pyresample_reference(case, cfg, max_granules=1):
         from pyresample import kd_tree
     except ImportError:
         return None
-    from monitor.geometry import frames, wgs84
+    from monitor.geometry import wgs84
     from monitor.geometry.perturb import perturbed_los_sbf
     g = case.cris[0]
     v = case.viirs[g.key]
@@ -51,8 +52,9 @@ def _pyresample_reference(case, cfg, max_granules=1):
     glat, glon, _ = wgs84.ecef_to_geodetic(ground.reshape(-1, 3))
     target = prgeo.SwathDefinition(lons=np.degrees(glon), lats=np.degrees(glat))
     radius = float(np.nanmax(np.linalg.norm(ground - sat, axis=-1))) * 0.0085 / 0.5
-    kd_tree.get_neighbour_info(source, target, radius_of_influence=radius, neighbours=64)
-    del frames
+    with warnings.catch_warnings():  # it warns, rightly, that a cone holds far more than 64 pixels
+        warnings.simplefilter("ignore")
+        kd_tree.get_neighbour_info(source, target, radius_of_influence=radius, neighbours=64)
     return time.perf_counter() - t0, int(valid.sum())
 
 
@@ -90,6 +92,7 @@ def run_bench(args) -> int:
                 print("pyresample reference: not installed (pip install pyresample)")
             else:
                 secs, nf = ref
-                print(f"pyresample radius search (64 nearest, one granule, no angle test or averaging): "
+                print(f"pyresample radius search for the same 441 perturbed LOS per FOV, one granule, only the "
+                      f"64 nearest pixels (a cone holds 1000-12000) and no angle test or averaging: "
                       f"{secs:.2f} s for {nf} FOVs = {nf / secs:.0f} FOVs/s")
     return 0
