@@ -15,7 +15,8 @@ import logging
 
 from alerts.changes import all_changes
 from alerts.channels import Permanent, Transient, make_channels
-from alerts.rules import failure_finding, jump_findings, spec_finding, stale_finding
+from alerts.rules import (failure_finding, jump_findings, processing_change_findings, spec_finding,
+                          stale_finding)
 from alerts.state import AlertState
 
 LOG = logging.getLogger(__name__)
@@ -30,6 +31,7 @@ def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
     if latest is not None:
         changes = all_changes(store, satellite, settings.events_file)
         out += jump_findings(store, satellite, changes, s, latest)
+    out += processing_change_findings(store, satellite, s, latest or now.date())
     return out
 
 

@@ -226,3 +226,21 @@ def failure_finding(store, satellite: str) -> Finding | None:
         return None
     lines = [f"run {r['day']}: {r['reason']}" for r in failed] + [f"scheduler: {e['detail']}" for e in jobs]
     return Finding("failure", satellite, "critical", f"{satellite}: {len(lines)} failed or missed run(s)", lines)
+
+
+def processing_change_findings(store, satellite: str, s: RuleSettings, today: dt.date) -> list[Finding]:
+    """CrIS geolocation processing changes found by the LOS fingerprint in the last ``active_days``."""
+    out = []
+    for e in store.events():
+        if e["kind"] != "change:cris" or e["satellite"] != satellite:
+            continue
+        d = json.loads(e["detail"])
+        if d.get("origin") != "fingerprint":
+            continue
+        when = dt.datetime.fromisoformat(d["time"])
+        if (today - when.date()).days > s.active_days:
+            continue
+        out.append(Finding("processing", satellite, "warning", f"{satellite}: {d['description']}",
+                           [f"seen in the GEO files from {when:%Y-%m-%d %H:%M:%S} UTC, before any VIIRS comparison"],
+                           group=when.date().isoformat(), data=d))
+    return out

@@ -213,6 +213,43 @@ def cmd_events(args) -> int:
     return EXIT_OK
 
 
+def cmd_fingerprint(args) -> int:
+    import json
+
+    from monitor import fingerprint as fpr
+    from monitor.sdr import GranuleError, read_file
+    from monitor.sdr.pairing import PlanError, find_files
+    try:
+        files = find_files(args.paths)
+    except PlanError as exc:
+        raise BadInput(str(exc)) from None
+    prints, skipped = [], []
+    for f in files:
+        try:
+            for g in read_file(f, kinds=("cris_geo",)):
+                prints.append(fpr.granule_print(g))
+        except GranuleError as exc:
+            skipped.append(str(exc))
+    if not prints:
+        raise BadInput("no readable CrIS GEO granule" + (f" ({skipped[0]})" if skipped else ""))
+    prints.sort(key=lambda p: p.start)
+    day = fpr.day_print(prints)
+    within = fpr.change_within(prints, args.threshold_urad) if len(prints) >= 4 else None
+    if args.json:
+        doc = day.to_dict()
+        doc["skipped"] = skipped
+        doc["change_within"] = None if within is None else {"first_granule": prints[within[0]].granule_id,
+                                                             "fors": within[1]}
+        print(json.dumps(doc, indent=1))
+    else:
+        print(fpr.format_print(day))
+        for s in skipped:
+            print(f"skipped {s}")
+        print("no step within these granules" if within is None else
+              f"step from granule {prints[within[0]].granule_id} at FOR {', '.join(map(str, within[1]))}")
+    return EXIT_OK
+
+
 def cmd_bench(args) -> int:
     from monitor.bench import run_bench
     return run_bench(args)
@@ -259,7 +296,7 @@ def build_parser() -> argparse.ArgumentParser:
     al = sub.add_parser("alerts", help="list firing, silenced and resolved alerts; silence; evaluate now")
     al.add_argument("action", choices=("list", "silence", "evaluate"), nargs="?", default="list")
     al.add_argument("--config", required=True)
-    al.add_argument("--rule", choices=("spec", "jump", "stale", "failure"))
+    al.add_argument("--rule", choices=("spec", "jump", "stale", "failure", "processing"))
     al.add_argument("--satellite", choices=("npp", "j01", "j02"))
     al.add_argument("--until", type=_iso, help="end of the silence (ISO 8601, UTC)")
     al.add_argument("--reason", default="")
@@ -274,6 +311,12 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--kind", default="change", help="ep_upload, lut_change, software, ...")
     ev.add_argument("--description")
     ev.set_defaults(func=cmd_events)
+
+    fp = sub.add_parser("fingerprint", help="per-FOR LOS fingerprint (SBF angles) of CrIS GEO files")
+    fp.add_argument("paths", nargs="+")
+    fp.add_argument("--json", action="store_true")
+    fp.add_argument("--threshold-urad", type=float, default=10.0)
+    fp.set_defaults(func=cmd_fingerprint)
 
     b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")
     b.add_argument("--granules", type=int, default=14)
@@ -296,6 +339,8 @@ def main(argv=None) -> int:
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:  # output piped into head and the like
+        return EXIT_OK
 
 
 if __name__ == "__main__":

@@ -54,6 +54,12 @@ class SceneConfig:
 
 
 @dataclass
+class FingerprintConfig:
+    granules: int = 100  # GEO granules per day, spread over the day
+    threshold_urad: float = 10.0
+
+
+@dataclass
 class AssessmentConfig:
     half_steps: int = 10
     step_urad: float = 375.0 / 833000.0 * 1e6
@@ -96,6 +102,7 @@ class Config:
     assessment: AssessmentConfig
     store: StoreConfig
     alerts: dict = field(default_factory=dict)
+    fingerprint: FingerprintConfig = field(default_factory=FingerprintConfig)
     report_dir: Path | None = None
     dashboard_url: str | None = None
 
@@ -164,7 +171,7 @@ def load_config(path) -> Config:
         raise ConfigError(f"{path}: expected a mapping at the top level")
     _no_inline_secrets(doc)
     _known(doc, {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts",
-                 "report_dir", "dashboard_url"}, "")
+                 "fingerprint", "report_dir", "dashboard_url"}, "")
     base = path.resolve().parent
 
     def rel(p):
@@ -248,9 +255,14 @@ def load_config(path) -> Config:
         pc.timeout_s = _positive(_get(p, "timeout_s", float, where, 30.0), f"{where}timeout_s")
         store.publish.append(pc)
 
+    fp = _section(doc, "fingerprint")
+    _known(fp, {"granules", "threshold_urad"}, "fingerprint.")
+    fingerprint = FingerprintConfig(_positive(_get(fp, "granules", int, "fingerprint.", 100), "fingerprint.granules"),
+                                    _positive(_get(fp, "threshold_urad", float, "fingerprint.", 10.0),
+                                              "fingerprint.threshold_urad"))
     alerts = _section(doc, "alerts")
     report_dir = doc.get("report_dir")
     return Config(path=path, satellites=list(sats), state_dir=state_dir, source=source, schedule=schedule,
-                  scenes=scenes, assessment=assessment, store=store, alerts=alerts,
+                  scenes=scenes, assessment=assessment, store=store, alerts=alerts, fingerprint=fingerprint,
                   report_dir=rel(report_dir) if report_dir else None,
                   dashboard_url=_get(doc, "dashboard_url", str, "", None))

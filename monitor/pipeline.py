@@ -12,9 +12,15 @@ import logging
 import time
 from dataclasses import dataclass, field
 
+import json
+
+import numpy as np
+
+from monitor import fingerprint as fpr
 from monitor.assess import AssessConfig, assess_plan
 from monitor.scenes import select_scenes
 from monitor.sdr.pairing import PlanError, plan
+from monitor.sdr import GranuleError, read_file
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
 from monitor.store.timeseries import drain_outbox, result_lines, target_name
 
@@ -44,6 +50,55 @@ def days_to_run(store, satellite: str, today: dt.date, catch_up_days: int, lag_d
     return sorted(d for d in window if d not in done)
 
 
+def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -> dict | None:
+    """Compute, store and compare the day's LOS fingerprint from a sample of its GEO granules.
+
+    A step against the previous day, or within the day, becomes a ``change:cris`` event (used for jump
+    attribution and notified by the alerts). Problems are logged, never fatal to the run.
+    """
+    geos = sorted((f for f in listing if f.product == "GCRSO" and f.parsed.start.date() == day),
+                  key=lambda f: f.parsed.start)
+    if not geos:
+        return None
+    picks = np.unique(np.round(np.linspace(0, len(geos) - 1, min(cfg.fingerprint.granules, len(geos)))).astype(int))
+    prints = []
+    for i in picks:
+        try:
+            (g,) = read_file(source.fetch(geos[i]), kinds=("cris_geo",))[:1]
+            prints.append(fpr.granule_print(g))
+        except (SourceError, GranuleError, ValueError) as exc:
+            LOG.warning("fingerprint: skipping %s: %s", geos[i].name, exc)
+    if not prints:
+        return None
+    today = fpr.day_print(prints)
+    prev = store.fingerprint(satellite, day)
+    reference = fpr.DayPrint.from_dict(prev[1]) if prev else None
+    body = today.to_dict()
+    thr = cfg.fingerprint.threshold_urad
+    within = fpr.change_within(prints, thr, reference=reference) if len(prints) >= 4 else None
+    between = fpr.compare_days(reference, today, thr) if reference is not None else None
+    change = None
+    if within is not None:
+        k, fors, da, db = within
+        change = {"time": prints[k].start, "granule": prints[k].granule_id, "fors": fors, "da": da, "db": db}
+    elif between is not None and between[0]:
+        fors, da, db = between
+        change = {"time": f"{day.isoformat()}T00:00:00+00:00", "granule": prints[0].granule_id, "fors": fors,
+                  "da": da, "db": db}
+    if change is not None:
+        big = max(float(np.nanmax(np.abs(change["da"]))), float(np.nanmax(np.abs(change["db"]))))
+        desc = (f"CrIS geolocation processing changed (LOS fingerprint): FOR {', '.join(map(str, change['fors']))}, "
+                f"up to {big:.0f} urad, from granule {change['granule']}")
+        body["change"] = {"time": change["time"], "granule": change["granule"], "fors": change["fors"],
+                          "d_alpha_urad": np.round(change["da"], 1).tolist(),
+                          "d_beta_urad": np.round(change["db"], 1).tolist()}
+        store.add_event("change:cris", satellite, json.dumps({"time": change["time"], "kind": "processing_change",
+                                                              "description": desc, "origin": "fingerprint"}))
+        LOG.warning("%s %s: %s", satellite, day, desc)
+    store.save_fingerprint(satellite, day, body)
+    return body
+
+
 def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, progress=None) -> RunOutcome:
     """Process one satellite-day end to end; never raises for bad data, records every outcome."""
     stop = should_stop or (lambda: False)
@@ -60,6 +115,9 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
             return RunOutcome(satellite, day, "no_data", reason, run_id, timings=timings)
         if stop():
             raise Stopped
+        t1 = time.perf_counter()
+        fingerprint_day(cfg, store, source, satellite, day, listing)
+        timings["fingerprint"] = time.perf_counter() - t1
         t1 = time.perf_counter()
         chosen, decisions = select_scenes(listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep,
                                           cfg.scenes.min_inhomogeneity_k)

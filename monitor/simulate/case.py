@@ -54,6 +54,7 @@ class SimulationSpec:
     attitude_arcsec: tuple = (0.6, -0.3, 0.5)
     software_version: str = "I2.3.00.00"
     aux: dict = field(default_factory=lambda: {k: list(v) for k, v in DEFAULT_AUX.items()})
+    cris_sdr: bool = True  # False: GEO files only (fast; for fingerprint series)
     viirs_lead_s: float = 10.9  # a VIIRS granule starts this long before the first CrIS granule
     viirs_noise_k: float = 0.3
     cris_noise: float = 0.05  # mW/(m2 sr cm-1) per channel
@@ -136,8 +137,9 @@ class Simulator:
         ground = sat + t[..., None] * geo_ecef
         lat, lon, _ = wgs84.ecef_to_geodetic(ground)
         zen, az, rng_m = wgs84.zenith_azimuth(ground, sat)
-        radiance = self._cris_spectra(sat, true_ecef)
-        radiance += self.rng.normal(0.0, spec.cris_noise, radiance.shape)
+        if spec.cris_sdr:
+            radiance = self._cris_spectra(sat, true_ecef)
+            radiance += self.rng.normal(0.0, spec.cris_noise, radiance.shape)
 
         for_iet = _iet_us(for_unix)
         start_iet = for_iet[:, 0]
@@ -161,13 +163,16 @@ class Simulator:
             "SCAttitude": att_mid.astype(np.float32),
             "QF1_CRISSDRGEO": np.zeros(4, np.uint8), "PadByte1": np.zeros(4, np.uint8),
         }
-        t_mean = self.band.bt_from_radiance(self.band.band_radiance(radiance))
-        mw = planck_radiance(1208.75 + 0.625 * np.arange(869), t_mean[..., None]).astype(np.float32)
-        sw = planck_radiance(2153.75 + 0.625 * np.arange(637), t_mean[..., None]).astype(np.float32)
-        sdr = {"ES_RealLW": radiance.astype(np.float32), "ES_RealMW": mw, "ES_RealSW": sw,
-               "QF1_SCAN_CRISSDR": np.zeros(4, np.uint8), "QF3_CRISSDR": np.zeros((4, 30, 9, 3), np.uint8)}
+        products = [("GCRSO", geo, "GEO")]
+        if spec.cris_sdr:
+            t_mean = self.band.bt_from_radiance(self.band.band_radiance(radiance))
+            mw = planck_radiance(1208.75 + 0.625 * np.arange(869), t_mean[..., None]).astype(np.float32)
+            sw = planck_radiance(2153.75 + 0.625 * np.arange(637), t_mean[..., None]).astype(np.float32)
+            products.append(("SCRIF", {"ES_RealLW": radiance.astype(np.float32), "ES_RealMW": mw, "ES_RealSW": sw,
+                                       "QF1_SCAN_CRISSDR": np.zeros(4, np.uint8),
+                                       "QF3_CRISSDR": np.zeros((4, 30, 9, 3), np.uint8)}, "SDR"))
         names = []
-        for prefix, data, tag in (("GCRSO", geo, "GEO"), ("SCRIF", sdr, "SDR")):
+        for prefix, data, tag in products:
             product = PRODUCTS[prefix]
             created = _Clock.dt(end + 1800 + (7 if prefix == "GCRSO" else 0))
             a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1")

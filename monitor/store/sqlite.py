@@ -53,6 +53,12 @@ MIGRATIONS = [
         id INTEGER PRIMARY KEY, target TEXT NOT NULL, satellite TEXT, day TEXT, line TEXT NOT NULL,
         created TEXT NOT NULL, attempts INTEGER DEFAULT 0, last_error TEXT);
     """,
+    # 2: the daily LOS fingerprint of CrIS geolocation processing
+    """
+    CREATE TABLE fingerprints (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, computed TEXT NOT NULL, body TEXT NOT NULL,
+        PRIMARY KEY (satellite, day));
+    """,
 ]
 
 RESULT_FIELDS = ("d_alpha_urad", "d_beta_urad", "sigma_alpha_urad", "sigma_beta_urad", "in_track_km",
@@ -224,6 +230,18 @@ class Store:
             return None
         m = 2 * r["half_steps"] + 1
         return np.frombuffer(r["cube"], np.float32).reshape(-1, m, m)
+
+    # -- fingerprints
+    def save_fingerprint(self, satellite: str, day: dt.date, body: dict):
+        with self.transaction():
+            self.db.execute("INSERT OR REPLACE INTO fingerprints VALUES (?, ?, ?, ?)",
+                            (satellite, day.isoformat(), now_iso(), json.dumps(body)))
+
+    def fingerprint(self, satellite: str, before: dt.date):
+        """(day, body) of the latest fingerprint strictly before *before*, or None."""
+        r = self.db.execute("SELECT day, body FROM fingerprints WHERE satellite=? AND day < ? ORDER BY day DESC LIMIT 1",
+                            (satellite, before.isoformat())).fetchone()
+        return None if r is None else (dt.date.fromisoformat(r["day"]), json.loads(r["body"]))
 
     # -- events (failures, misses: the alerting layer reads them)
     def add_event(self, kind: str, satellite: str | None, detail: str):

@@ -1,0 +1,155 @@
+"""The daily LOS fingerprint of CrIS geolocation processing, from the GEO files alone.
+
+The LOS of each FOR in the spacecraft body frame, recovered from a granule's own geolocation fields by
+the inverse geolocation, is set by the engineering packet's mapping angles. Its per-FOR FOV-5 angles
+(alpha in-track, beta cross-track) and the pattern of the 9 FOVs around FOV 5 are therefore a
+fingerprint of the EP in force: an upload that changes the mirror angles shows as a step in it, with
+no VIIRS data needed.
+
+On the real NOAA-20 granules of 2018-10-22 the FOV-5 angles scatter from scan to scan by <= 2 urad
+in-track but 1.5-9.5 urad cross-track depending on the FOR (largest at FOR 1, 11, 21: scene-mirror
+servo errors, formats.md 2.5), and the cross-track angle of those FORs drifts by ~20 urad within five
+minutes. The step threshold of each FOR and direction is therefore set from the measured scatter:
+max(10 urad, 4 x the scan-to-scan standard deviation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from monitor.geometry.inverse import inverse_geolocation
+
+FOV5 = 4
+URAD = 1e6
+
+
+@dataclass
+class GranulePrint:
+    """Per-FOR FOV-5 angles of one granule (urad, means over its scans) and the FOV pattern (30, 9)."""
+
+    granule_id: str
+    start: str
+    alpha_urad: np.ndarray
+    beta_urad: np.ndarray
+    pattern_alpha_urad: np.ndarray
+    pattern_beta_urad: np.ndarray
+    scan_alpha_urad: np.ndarray  # (nscan, 30), for the scatter
+    scan_beta_urad: np.ndarray
+
+
+@dataclass
+class DayPrint:
+    """The fingerprint of a set of granules: per-FOR means and scan-to-scan scatter (urad)."""
+
+    alpha_urad: np.ndarray
+    beta_urad: np.ndarray
+    sd_alpha_urad: np.ndarray
+    sd_beta_urad: np.ndarray
+    pattern_alpha_urad: np.ndarray
+    pattern_beta_urad: np.ndarray
+    granules: list = field(default_factory=list)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "DayPrint":
+        rows = sorted(d["fors"], key=lambda r: r["for"])
+        col = lambda k: np.array([r[k] for r in rows], float)  # noqa: E731
+        return cls(col("alpha_urad"), col("beta_urad"), col("sd_alpha_urad"), col("sd_beta_urad"),
+                   np.array([r["pattern_alpha_urad"] for r in rows]), np.array([r["pattern_beta_urad"] for r in rows]),
+                   list(d.get("granules", [])))
+
+    def to_dict(self) -> dict:
+        return {"granules": self.granules, "fors": [
+            {"for": k + 1, "alpha_urad": float(self.alpha_urad[k]), "beta_urad": float(self.beta_urad[k]),
+             "sd_alpha_urad": float(self.sd_alpha_urad[k]), "sd_beta_urad": float(self.sd_beta_urad[k]),
+             "pattern_alpha_urad": np.round(self.pattern_alpha_urad[k], 2).tolist(),
+             "pattern_beta_urad": np.round(self.pattern_beta_urad[k], 2).tolist()} for k in range(len(self.alpha_urad))]}
+
+
+def granule_print(geo) -> GranulePrint:
+    """The fingerprint of one CrIS GEO granule (a :class:`monitor.sdr.CrisGeoGranule`)."""
+    valid = geo.valid
+    args = [np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")]
+    fg = inverse_geolocation(*args, np.where(valid, geo.range_m, 1e6), geo.for_time_us, geo.mid_time_us,
+                             np.nan_to_num(geo.sc_position_m), np.nan_to_num(geo.sc_velocity_m_s),
+                             np.nan_to_num(geo.sc_attitude_rad))
+    a = np.where(valid, fg.alpha_rad, np.nan) * URAD
+    b = np.where(valid, fg.beta_rad, np.nan) * URAD
+    with np.errstate(all="ignore"):
+        return GranulePrint(geo.meta.granule_id, geo.meta.start.isoformat(),
+                            np.nanmean(a[:, :, FOV5], axis=0), np.nanmean(b[:, :, FOV5], axis=0),
+                            np.nanmean(a - a[:, :, FOV5:FOV5 + 1], axis=0), np.nanmean(b - b[:, :, FOV5:FOV5 + 1], axis=0),
+                            a[:, :, FOV5], b[:, :, FOV5])
+
+
+def day_print(prints: list[GranulePrint]) -> DayPrint:
+    """Combine granule fingerprints: medians over granules, scatter over all scans."""
+    sa = np.concatenate([p.scan_alpha_urad for p in prints])
+    sb = np.concatenate([p.scan_beta_urad for p in prints])
+    with np.errstate(all="ignore"):
+        return DayPrint(np.nanmedian([p.alpha_urad for p in prints], axis=0),
+                        np.nanmedian([p.beta_urad for p in prints], axis=0),
+                        np.nanstd(sa, axis=0), np.nanstd(sb, axis=0),
+                        np.nanmedian([p.pattern_alpha_urad for p in prints], axis=0),
+                        np.nanmedian([p.pattern_beta_urad for p in prints], axis=0),
+                        [p.granule_id for p in prints])
+
+
+K_SIGMA = 4.0
+
+
+def thresholds(sd_alpha_urad, sd_beta_urad, threshold_urad: float = 10.0):
+    """Per-FOR step thresholds (urad): max(threshold, 4 x scan-to-scan scatter), per direction."""
+    return (np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_alpha_urad)),
+            np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_beta_urad)))
+
+
+def _changed_fors(before_a, before_b, after_a, after_b, thr_a, thr_b):
+    da, db = after_a - before_a, after_b - before_b
+    fors = [k + 1 for k in range(len(da)) if abs(da[k]) > thr_a[k] or abs(db[k]) > thr_b[k]]
+    return fors, da, db
+
+
+def compare_days(previous: DayPrint, current: DayPrint, threshold_urad: float = 10.0):
+    """(FORs changed, d_alpha_urad, d_beta_urad) between two daily fingerprints.
+
+    Thresholds use the larger scatter of the two days: a step between days does not widen either.
+    """
+    return _changed_fors(previous.alpha_urad, previous.beta_urad, current.alpha_urad, current.beta_urad,
+                         *thresholds(np.fmax(previous.sd_alpha_urad, current.sd_alpha_urad),
+                                     np.fmax(previous.sd_beta_urad, current.sd_beta_urad), threshold_urad))
+
+
+def change_within(prints: list[GranulePrint], threshold_urad: float = 10.0, min_side: int = 2,
+                  reference: DayPrint | None = None):
+    """The first granule after a step within a time-ordered day, or None.
+
+    For every split with at least *min_side* granules on each side, the granule-median fingerprints
+    before and after are compared; the split with the largest step beyond its threshold wins. The
+    thresholds come from the scatter of *reference* (the previous day) or, without one, of the whole
+    day, so that the scene-mirror servo excursions of the noisy FORs do not pass for a change.
+    Returns (index of the first changed granule, FORs changed, d_alpha_urad, d_beta_urad).
+    """
+    ref = reference or day_print(prints)
+    thr = thresholds(ref.sd_alpha_urad, ref.sd_beta_urad, threshold_urad)
+    a = np.array([p.alpha_urad for p in prints])
+    b = np.array([p.beta_urad for p in prints])
+    best = None
+    for k in range(min_side, len(prints) - min_side + 1):
+        fors, da, db = _changed_fors(np.nanmedian(a[:k], 0), np.nanmedian(b[:k], 0), np.nanmedian(a[k:], 0),
+                                     np.nanmedian(b[k:], 0), *thr)
+        excess = float(np.nanmax(np.concatenate([np.abs(da) / thr[0], np.abs(db) / thr[1]])))
+        if fors and (best is None or excess > best[0]):
+            best = (excess, k, fors, da, db)
+    return None if best is None else best[1:]
+
+
+def format_print(day: DayPrint) -> str:
+    """The per-FOR table printed by ``crisgeo fingerprint``."""
+    lines = [f"{len(day.granules)} granule(s)",
+             f"{'FOR':>3} {'alpha5':>10} {'sd':>5} {'beta5':>10} {'sd':>5}   (urad, SBF, FOV 5; sd: scan to scan)"]
+    for k in range(len(day.alpha_urad)):
+        lines.append(f"{k + 1:>3} {day.alpha_urad[k]:10.1f} {day.sd_alpha_urad[k]:5.1f} {day.beta_urad[k]:10.1f} "
+                     f"{day.sd_beta_urad[k]:5.1f}")
+    return "\n".join(lines)
