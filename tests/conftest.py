@@ -49,3 +49,14 @@ def truth_arrays(truth):
 
 def load_truth(case_dir):
     return json.loads((Path(case_dir) / "truth.json").read_text())
+
+
+def tree_with_truncated(src, dst, victim, keep_bytes=5000):
+    """*dst*: links to every granule of *src*, except *victim* (a path in *src*), copied truncated."""
+    dst.mkdir()
+    for f in src.glob("*.h5"):
+        if f.name == victim.name:
+            (dst / f.name).write_bytes(f.read_bytes()[:keep_bytes])
+        else:
+            (dst / f.name).symlink_to(f)
+    return dst

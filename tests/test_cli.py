@@ -1,9 +1,9 @@
 import json
-import shutil
 
 import pytest
 
 from monitor.cli import main
+from tests.conftest import tree_with_truncated
 from monitor.simulate.case import simulate_case
 
 
@@ -47,14 +47,8 @@ def test_cris_without_viirs_in_time_is_exit_2(tmp_path, capsys):
 
 def test_corrupt_granule_is_skipped_and_recorded(cases, tmp_path, capsys):
     out, _, _ = cases.get()
-    work = tmp_path / "case"
-    work.mkdir()
-    for f in out.glob("*.h5"):
-        (work / f.name).symlink_to(f)
     geo = sorted(out.glob("GCRSO_*.h5"))[1]
-    (work / geo.name).unlink()
-    broken = work / geo.name
-    broken.write_bytes(geo.read_bytes()[:5000])
+    work = tree_with_truncated(out, tmp_path / "case", geo)
     res = tmp_path / "r.json"
     assert main(["assess", str(work), "--out", str(res)]) == 0
     doc = json.loads(res.read_text())

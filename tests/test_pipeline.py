@@ -1,7 +1,6 @@
 """The daily run on a local source: outcomes recorded, idempotent, corrupt input skipped."""
 
 import datetime as dt
-import shutil
 
 import pytest
 
@@ -9,6 +8,7 @@ from monitor.config import load_config
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources.local import LocalSource
 from monitor.store.sqlite import Store
+from tests.conftest import tree_with_truncated
 
 DAY = dt.date(2024, 6, 1)
 
@@ -50,13 +50,8 @@ def test_a_day_without_data_is_recorded(cases, tmp_path):
 
 def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_path):
     data, _, _ = cases.get()
-    work = tmp_path / "data"
-    work.mkdir()
-    for f in data.glob("*.h5"):
-        (work / f.name).symlink_to(f)
     sdr = sorted(data.glob("SCRIF_*.h5"))[0]
-    (work / sdr.name).unlink()
-    (work / sdr.name).write_bytes(sdr.read_bytes()[:4000])
+    work = tree_with_truncated(data, tmp_path / "data", sdr, keep_bytes=4000)
     cfg = make_config(tmp_path, work)
     store = Store(cfg.store.sqlite)
     out = run_day(cfg, store, LocalSource(work), "j01", DAY)
