@@ -76,12 +76,9 @@ def _orbit_number(unix_s: float) -> int:
     return 4790 + int((unix_s - 1540167839.0) // ORBIT_PERIOD_S)
 
 
-class _Clock:
-    """Converts between UTC datetimes, unix seconds and IET for one case."""
-
-    @staticmethod
-    def dt(unix_s: float) -> dt.datetime:
-        return dt.datetime.fromtimestamp(unix_s, UTC)
+def _utc(unix_s: float) -> dt.datetime:
+    """Timezone-aware UTC datetime of UTC seconds since 1970."""
+    return dt.datetime.fromtimestamp(unix_s, UTC)
 
 
 def _sunflower_disk(n: int, radius: float):
@@ -174,9 +171,9 @@ class Simulator:
         names = []
         for prefix, data, tag in products:
             product = PRODUCTS[prefix]
-            created = _Clock.dt(end + 1800 + (7 if prefix == "GCRSO" else 0))
+            created = _utc(end + 1800 + (7 if prefix == "GCRSO" else 0))
             a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1")
-            name = format_name([prefix], spec.satellite, _Clock.dt(begin), _Clock.dt(end),
+            name = format_name([prefix], spec.satellite, _utc(begin), _utc(end),
                                attrs["N_Beginning_Orbit_Number"], created)
             write_file(out / name, spec.satellite, created,
                        [ProductData(product, "CrIS", tag, data, [a], {})])
@@ -268,9 +265,9 @@ class Simulator:
         names = []
         for prefix, data, tag in (("GITCO", geo, "GEO"), ("SVI05", sdr, "SDR")):
             product = PRODUCTS[prefix]
-            created = _Clock.dt(end + 1700 + (3 if prefix == "GITCO" else 0))
+            created = _utc(end + 1700 + (3 if prefix == "GITCO" else 0))
             a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1", Band_ID="I5" if tag == "SDR" else "N/A")
-            name = format_name([prefix], spec.satellite, _Clock.dt(g0), _Clock.dt(end),
+            name = format_name([prefix], spec.satellite, _utc(g0), _utc(end),
                                attrs["N_Beginning_Orbit_Number"], created)
             write_file(out / name, spec.satellite, created,
                        [ProductData(product, "VIIRS", tag, data, [a], {}, fills={}, compress=False)])
@@ -282,7 +279,7 @@ class Simulator:
         lat_d, lon_d = np.degrees(lat), np.degrees(lon)
         return {
             "Ascending/Descending_Indicator": 0 if v0[2] > 0 else 1,
-            **date_time_attrs("Beginning", _Clock.dt(begin)), **date_time_attrs("Ending", _Clock.dt(end)),
+            **date_time_attrs("Beginning", _utc(begin)), **date_time_attrs("Ending", _utc(end)),
             "East_Bounding_Coordinate": float(np.nanmax(lon_d)), "West_Bounding_Coordinate": float(np.nanmin(lon_d)),
             "North_Bounding_Coordinate": float(np.nanmax(lat_d)), "South_Bounding_Coordinate": float(np.nanmin(lat_d)),
             "N_Algorithm_Version": "2.O.000.001", "N_Aux_Filename": [a.format(p=p) for a in aux],
@@ -291,7 +288,7 @@ class Simulator:
             "N_Ending_Time_IET": end_iet, "N_Granule_ID": gid, "N_Granule_Status": "N/A", "N_Granule_Version": "A1",
             "N_IDPS_Mode": "ops", "N_Number_Of_Scans": nscan, "N_Software_Version": self.spec.software_version,
             "N_Spacecraft_Maneuver": "Normal Operations", "N_Primary_Label": "Primary",
-            **date_time_attrs("N_Creation", _Clock.dt(end + 1700)),
+            **date_time_attrs("N_Creation", _utc(end + 1700)),
         }
 
     def viirs_granule_starts(self) -> np.ndarray:
