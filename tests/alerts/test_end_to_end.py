@@ -62,7 +62,10 @@ alerts:
     assert service.run("j01", DAY2).status == "ok"  # corrected geolocation
     assert len(inbox.messages) == 2 and len(webhook.received) == 2
     m2 = email.message_from_bytes(inbox.messages[1].content, policy=policy.default)
-    assert "RESOLVED" in m2["Subject"] and "resolved" in m2.get_body(("plain",)).get_content()
+    body2 = m2.get_body(("plain",)).get_content()
+    assert "1 resolved" in m2["Subject"] and "RESOLVED spec" in body2
+    # the corrected GEO has another LOS fingerprint: the same message announces the processing change
+    assert "FIRING processing" in body2 and "CrIS geolocation processing changed" in body2
 
 
 def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp_path):
