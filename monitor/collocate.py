@@ -255,8 +255,10 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     pix = flat[f_idx, w_idx]
     pos32 = swath.ecef_m.reshape(-1, 3)[pix]
     vec32 = pos32 - sat_m.astype(np.float32)[f_idx]
-    cos32 = np.einsum("kx,kx->k", vec32, los0.astype(np.float32)[f_idx]) / np.linalg.norm(vec32, axis=-1)
-    near = (cos32 >= np.float32(np.cos(rho * 1.01))) & np.isfinite(swath.radiance.reshape(-1)[pix])
+    dot32 = np.einsum("kx,kx->k", vec32, los0.astype(np.float32)[f_idx])
+    cos2 = np.float32(np.cos(rho * 1.01) ** 2)
+    near = (dot32 > 0) & (dot32 * dot32 >= cos2 * np.einsum("kx,kx->k", vec32, vec32))  # angle <= rho, no sqrt
+    near &= np.isfinite(swath.radiance.reshape(-1)[pix])
     f_idx, pix = f_idx[near], pix[near]
     r_pix, c_pix = np.divmod(pix, ncol)
     vec = swath.ecef_m.reshape(-1, 3)[pix].astype(np.float64) - sat_m[f_idx]
@@ -268,8 +270,8 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     half_b = np.abs(offsets_rad).max() + 1.02 * h_max
     in_box = ((np.abs(np.arctan2(d[:, 0], d[:, 2]) - alpha_rad[f_idx]) <= half_a)
               & (np.abs(np.arctan2(d[:, 1], d[:, 2]) - beta_rad[f_idx]) <= half_b))
-    f_idx, r_pix, c_pix, d_ecef, dist, d = (x[in_box] for x in (f_idx, r_pix, c_pix, d_ecef, dist, d))
-    cos_view = -np.sum(_ellipsoid_normal(swath.ecef_m[r_pix, c_pix]) * d_ecef, -1)
+    f_idx, r_pix, c_pix, d_ecef, dist, d, vec = (x[in_box] for x in (f_idx, r_pix, c_pix, d_ecef, dist, d, vec))
+    cos_view = -np.sum(_ellipsoid_normal(vec + sat_m[f_idx]) * d_ecef, -1)
     weight = swath.area_m2[r_pix, c_pix] * cos_view / dist**2  # steradians seen from CrIS
     value = swath.radiance[r_pix, c_pix].astype(np.float64)
 
