@@ -40,28 +40,12 @@ PAD = 48  # margin of the j difference arrays, wider than any run beyond the gri
 
 
 @dataclass
-class SwathPiece:
-    """One VIIRS granule prepared for collocation (see :class:`ViirsSwath` for the fields)."""
-
-    ecef_m: np.ndarray
-    radiance: np.ndarray
-    area_m2: np.ndarray
-    col_spacing_m: np.ndarray
-    advance_m: np.ndarray
-    det_step_m: np.ndarray
-    tree: cKDTree
-    tree_rows: np.ndarray
-    tree_cols: np.ndarray
-
-
-@dataclass
-class ViirsSwath:
-    """VIIRS I5 pixels of one or more consecutive granules stacked along rows, ready for collocation.
+class PixelArrays:
+    """VIIRS I5 pixels ready for collocation, rows of 32-detector scans.
 
     ecef_m (rows, cols, 3) float32 (0.5 m resolution); radiance (rows, cols) I5 band radiance
     mW/(m2 sr cm-1), NaN where unusable; area_m2 the pixel footprint with scan overlap removed.
-    Per-column spacings (m) size the search windows; one KD-tree per piece finds the pixel nearest a
-    FOV centre.
+    Per-column spacings (m) size the search windows.
     """
 
     ecef_m: np.ndarray
@@ -70,6 +54,21 @@ class ViirsSwath:
     col_spacing_m: np.ndarray
     advance_m: np.ndarray
     det_step_m: np.ndarray
+
+
+@dataclass
+class SwathPiece(PixelArrays):
+    """One VIIRS granule prepared for collocation, with a KD-tree of its pixels on a 4 x 4 subgrid."""
+
+    tree: cKDTree
+    tree_rows: np.ndarray
+    tree_cols: np.ndarray
+
+
+@dataclass
+class ViirsSwath(PixelArrays):
+    """One or more consecutive prepared granules stacked along rows; the pieces keep their KD-trees."""
+
     pieces: list
 
     @property
