@@ -24,14 +24,92 @@ def _iso(text: str) -> dt.datetime:
 
 
 def cmd_simulate(args) -> int:
-    from monitor.simulate.case import simulate_case
+    from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
+    if (args.true_ep is None) != (args.ground_ep is None):
+        raise BadInput("--true-ep and --ground-ep go together")
     try:
+        spec = None
+        if args.true_ep:
+            spec = SimulationSpec(satellite=args.satellite, granules=args.granules, seed=args.seed,
+                                  start=args.start or DEFAULT_START, profile="ep",
+                                  true_ep=_ep(args.true_ep, args.satellite), ground_ep=_ep(args.ground_ep, args.satellite))
         truth = simulate_case(args.out, satellite=args.satellite, granules=args.granules, profile=args.profile,
-                              seed=args.seed, start=args.start)
+                              seed=args.seed, start=args.start, spec=spec)
     except ValueError as exc:
         raise BadInput(str(exc)) from None
+    error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {args.profile}"
     print(f"wrote {len(truth['files'])} files and truth.json to {args.out} "
-          f"({args.satellite}, {args.granules} CrIS granules, profile {args.profile}, seed {args.seed})")
+          f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {args.seed})")
+    return EXIT_OK
+
+
+def _ep(path, satellite=None):
+    from monitor.mapping.engpkt import load_ep
+    try:
+        return load_ep(path, satellite)
+    except ValueError as exc:
+        raise BadInput(str(exc)) from None
+
+
+def cmd_optimize(args) -> int:
+    import json
+
+    from monitor.mapping.engpkt import save_ep
+    from monitor.mapping.optimize import optimize
+    from monitor.result import AssessmentResult
+    try:
+        result = AssessmentResult.from_json(Path(args.result).read_text())
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise BadInput(f"{args.result}: not an assessment result ({exc})") from None
+    ep = _ep(args.ep)
+    try:
+        opt = optimize(result, ep, source=str(args.result))
+    except ValueError as exc:
+        raise BadInput(str(exc)) from None
+    print(f"EP {ep.version} ({ep.satellite}) corrected by {args.result} ({result.start} .. {result.end}, "
+          f"{len(result.granules)} granules)")
+    print(opt.table())
+    save_ep(opt.ep, args.out, like=args.ep)
+    print(f"wrote {args.out}")
+    if args.table_json:
+        Path(args.table_json).write_text(json.dumps([r.to_dict() for r in opt.rows], indent=1))
+    return EXIT_OK
+
+
+def cmd_regeolocate(args) -> int:
+    from monitor.mapping.regeolocate import regeolocate_file
+    from monitor.sdr import GranuleError
+    ep = _ep(args.ep)
+    failed = 0
+    for path in args.files:
+        try:
+            out = regeolocate_file(ep, path, args.out)
+            print(f"wrote {out}")
+        except (GranuleError, ValueError, OSError) as exc:
+            failed += 1
+            print(f"skipped {path}: {exc}", file=sys.stderr)
+    if failed == len(args.files):
+        raise BadInput("no file could be regeolocated")
+    return EXIT_FAIL if failed else EXIT_OK
+
+
+def cmd_geolocate(args) -> int:
+    import json
+
+    from monitor.mapping.regeolocate import compare_with_files
+    from monitor.sdr import GranuleError
+    ep = _ep(args.ep)
+    try:
+        rows = compare_with_files(ep, args.files)
+    except (GranuleError, ValueError) as exc:
+        raise BadInput(str(exc)) from None
+    if args.json:
+        print(json.dumps({"ep": ep.version, "satellite": ep.satellite, "fors": [r.to_dict() for r in rows]}, indent=1))
+        return EXIT_OK
+    print(f"EP {ep.version} geolocation vs the files' own latitude/longitude ({len(args.files)} file(s)), metres")
+    print(f"{'FOR':>3} {'FOVs':>6} {'median':>8} {'p99':>8} {'max':>8}")
+    for r in rows:
+        print(f"{r.for_index:>3} {r.n:>6} {r.median_m:8.1f} {r.p99_m:8.1f} {r.max_m:8.1f}")
     return EXIT_OK
 
 
@@ -267,7 +345,28 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)")
+    s.add_argument("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)")
+    s.add_argument("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)")
     s.set_defaults(func=cmd_simulate)
+
+    o = sub.add_parser("optimize", help="new scene-mirror angles (EP) from an assessment result (paper section 4)")
+    o.add_argument("result", help="assessment result JSON (crisgeo assess --out)")
+    o.add_argument("--ep", required=True, help="the EP in force when the assessed data were made (XML or YAML)")
+    o.add_argument("--out", required=True, help="the proposed EP, in the format of --ep")
+    o.add_argument("--table-json", help="also write the old/new angle table as JSON here")
+    o.set_defaults(func=cmd_optimize)
+
+    rg = sub.add_parser("regeolocate", help="write copies of CrIS GEO files geolocated with another EP")
+    rg.add_argument("files", nargs="+")
+    rg.add_argument("--ep", required=True)
+    rg.add_argument("--out", required=True, help="output directory (never the input's)")
+    rg.set_defaults(func=cmd_regeolocate)
+
+    gl = sub.add_parser("geolocate", help="compare an EP's geolocation with CrIS GEO files' own, per FOR")
+    gl.add_argument("files", nargs="+")
+    gl.add_argument("--ep", required=True)
+    gl.add_argument("--json", action="store_true")
+    gl.set_defaults(func=cmd_geolocate)
 
     a = sub.add_parser("assess", help="assess CrIS geolocation against VIIRS I5 for the granules given")
     a.add_argument("paths", nargs="+", help="granule files or directories")

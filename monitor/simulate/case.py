@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.geometry import frames, wgs84
+from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
 from monitor.sdr import iet
 from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
@@ -58,6 +59,24 @@ class SimulationSpec:
     viirs_lead_s: float = 10.9  # a VIIRS granule starts this long before the first CrIS granule
     viirs_noise_k: float = 0.3
     cris_noise: float = 0.05  # mW/(m2 sr cm-1) per channel
+    true_ep: EngineeringPacket | None = None  # with ground_ep: radiances from true_ep, GEO from ground_ep
+    ground_ep: EngineeringPacket | None = None
+
+    def __post_init__(self):
+        if (self.true_ep is None) != (self.ground_ep is None):
+            raise ValueError("a simulation in EP terms needs both the true EP and the ground-processing EP")
+        if self.true_ep is not None:
+            for ep in (self.true_ep, self.ground_ep):
+                if ep.satellite != self.satellite:
+                    raise ValueError(f"EP {ep.version} is for {ep.satellite}, the simulation for {self.satellite}")
+            self.d_alpha_urad, self.d_beta_urad = ep_offsets_urad(self.true_ep, self.ground_ep)
+
+
+def ep_offsets_urad(true_ep: EngineeringPacket, ground_ep: EngineeringPacket):
+    """Per-FOR (d_alpha, d_beta) (urad) of FOV 5 from the ground-processing LOS to the true one."""
+    a_true, b_true = fov5_angles(true_ep)
+    a_geo, b_geo = fov5_angles(ground_ep)
+    return (a_true - a_geo) * 1e6, (b_true - b_geo) * 1e6
 
 
 def _unix_s(when: dt.datetime) -> float:
@@ -106,6 +125,11 @@ class Simulator:
         self.planck_table = table
         self.band_table = (tau * table + atm) @ self.band.weights
         self.rng = rng
+        if spec.true_ep is not None:
+            self.los_true, self.los_geo = los_spacecraft(spec.true_ep), los_spacecraft(spec.ground_ep)
+        else:
+            self.los_true = ins.cris_los_sbf()
+            self.los_geo = ins.cris_los_sbf(-spec.d_alpha_urad * 1e-6, -spec.d_beta_urad * 1e-6)
 
     def attitude_rad(self, unix_s):
         """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift."""
@@ -125,10 +149,8 @@ class Simulator:
         scan_start = g0 + np.arange(4) * ins.CRIS_SCAN_US * 1e-6
         for_unix = scan_start[:, None] + np.arange(ins.CRIS_N_FOR) * ins.CRIS_FOR_DT_US * 1e-6
         r, v, m = self.state(for_unix)  # (4, 30, ...)
-        los_true = ins.cris_los_sbf()
-        los_geo = ins.cris_los_sbf(-spec.d_alpha_urad * 1e-6, -spec.d_beta_urad * 1e-6)
-        true_ecef = np.einsum("skij,kfj->skfi", m, los_true)
-        geo_ecef = np.einsum("skij,kfj->skfi", m, los_geo)
+        true_ecef = np.einsum("skij,kfj->skfi", m, self.los_true)
+        geo_ecef = np.einsum("skij,kfj->skfi", m, self.los_geo)
         sat = np.broadcast_to(r[:, :, None, :], geo_ecef.shape)
         t = wgs84.intersect_ellipsoid(sat, geo_ecef)
         ground = sat + t[..., None] * geo_ecef
@@ -321,6 +343,8 @@ def simulate_case(out_dir, satellite="j01", granules=14, profile="paper", seed=0
     truth = {
         "satellite": spec.satellite, "profile": spec.profile, "seed": spec.seed,
         "start": spec.start.isoformat(), "granules": spec.granules, "files": sorted(files),
+        "engineering_packets": None if spec.true_ep is None else
+        {"true": spec.true_ep.version, "ground": spec.ground_ep.version},
         "fors": [{"for": k + 1, "d_alpha_urad": float(a), "d_beta_urad": float(b)}
                  for k, (a, b) in enumerate(zip(spec.d_alpha_urad, spec.d_beta_urad))],
     }

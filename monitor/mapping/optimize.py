@@ -1,0 +1,114 @@
+"""New scene-mirror angles from an assessment (Wang et al. 2017, section 4.1).
+
+The assessment gives, per FOR, the turn (d_alpha, d_beta) that puts the CrIS LOS on VIIRS. Which of
+the table-2 angles is wrong cannot be told from 2 x 30 numbers, so, as in the paper, the 2 x 30
+scene-selection-mirror angles absorb the whole correction (equations 19-23). FORs whose offsets are
+not trustworthy (flagged or missing) keep their angles, and the table says why.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass
+
+import numpy as np
+
+from monitor.geometry.instrument import N_FOR, EngineeringPacket, corrected_ssm_angles
+from monitor.result import AssessmentResult
+
+URAD = 1e-6
+
+
+@dataclass(frozen=True)
+class AngleRow:
+    """Old and new scene-mirror angles of one FOR (urad); *kept* names why a FOR was left unchanged."""
+
+    for_index: int
+    old_roll_urad: float
+    new_roll_urad: float
+    old_pitch_urad: float
+    new_pitch_urad: float
+    d_alpha_urad: float
+    d_beta_urad: float
+    kept: str = ""
+
+    @property
+    def d_roll_urad(self) -> float:
+        return self.new_roll_urad - self.old_roll_urad
+
+    @property
+    def d_pitch_urad(self) -> float:
+        return self.new_pitch_urad - self.old_pitch_urad
+
+    def to_dict(self) -> dict:
+        return {"for": self.for_index, "old_roll_urad": self.old_roll_urad, "new_roll_urad": self.new_roll_urad,
+                "d_roll_urad": self.d_roll_urad, "old_pitch_urad": self.old_pitch_urad,
+                "new_pitch_urad": self.new_pitch_urad, "d_pitch_urad": self.d_pitch_urad,
+                "d_alpha_urad": self.d_alpha_urad, "d_beta_urad": self.d_beta_urad, "kept": self.kept}
+
+
+@dataclass(frozen=True)
+class Optimization:
+    """The proposed EP and the per-FOR table behind it."""
+
+    ep: EngineeringPacket
+    rows: list
+
+    @property
+    def kept(self) -> list:
+        return [r for r in self.rows if r.kept]
+
+    def table(self) -> str:
+        """The old/new angle table as fixed-width text (urad)."""
+        lines = ["FOR  ActualCrosstrackAngleRoll (urad)       ActualIntrackAnglePitch (urad)   assessed (urad)",
+                 "        old        new       diff          old      new     diff     d_alpha  d_beta  note"]
+        for r in self.rows:
+            lines.append(f"{r.for_index:3d} {r.old_roll_urad:10.1f} {r.new_roll_urad:10.1f} {r.d_roll_urad:9.1f}"
+                         f"    {r.old_pitch_urad:9.1f} {r.new_pitch_urad:8.1f} {r.d_pitch_urad:8.1f}"
+                         f"    {r.d_alpha_urad:8.1f} {r.d_beta_urad:7.1f}  {r.kept}")
+        if self.kept:
+            lines.append(f"{len(self.kept)} FOR(s) kept their angles: "
+                         + ", ".join(f"FOR {r.for_index} ({r.kept})" for r in self.kept))
+        return "\n".join(lines)
+
+
+def _why_kept(f) -> str:
+    if not (np.isfinite(f.d_alpha_urad) and np.isfinite(f.d_beta_urad)):
+        return "no offset (NaN)"
+    if not f.reliable:
+        return "flagged " + "+".join(f.flags)
+    return ""
+
+
+def optimize(result: AssessmentResult, ep: EngineeringPacket, source: str = "") -> Optimization:
+    """The EP with scene-mirror angles that cancel the offsets of *result*, assessed on data made with *ep*.
+
+    Raises ValueError when the result is for another satellite than the EP or does not have 30 FORs.
+    """
+    if result.satellite != ep.satellite:
+        raise ValueError(f"assessment {source or ''} is for {result.satellite}, the EP {ep.version} for "
+                         f"{ep.satellite}: an EP is only corrected by its own satellite's assessment")
+    if len(result.fors) != N_FOR or [f.for_index for f in result.fors] != list(range(1, N_FOR + 1)):
+        raise ValueError(f"assessment {source}: needs FORs 1..30 in order, got {len(result.fors)} entries")
+    reasons = [_why_kept(f) for f in result.fors]
+    use = np.array([not r for r in reasons])
+    d_alpha = np.array([f.d_alpha_urad for f in result.fors], float)
+    d_beta = np.array([f.d_beta_urad for f in result.fors], float)
+    roll, pitch = corrected_ssm_angles(ep, np.where(use, d_alpha, 0.0) * URAD, np.where(use, d_beta, 0.0) * URAD)
+    roll = np.where(use, roll, ep.ssm_crosstrack_roll_rad)
+    pitch = np.where(use, pitch, ep.ssm_intrack_pitch_rad)
+    granules = list(result.granules)
+    provenance = {
+        "derived_from": ep.version,
+        "derived_by": "crisgeo optimize (Wang et al. 2017 section 4.1, equations 19-23)",
+        "created": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+        "assessment": {"file": source, "satellite": result.satellite, "start": result.start, "end": result.end,
+                       "n_granules": len(granules), "first_granule": granules[0] if granules else None,
+                       "last_granule": granules[-1] if granules else None},
+        "fors_kept": {str(f.for_index): r for f, r in zip(result.fors, reasons) if r},
+    }
+    new_ep = ep.with_ssm_angles(roll, pitch, version=f"{ep.version}+crisgeo", provenance=provenance)
+    rows = [AngleRow(k + 1, ep.ssm_crosstrack_roll_rad[k] / URAD, roll[k] / URAD,
+                     ep.ssm_intrack_pitch_rad[k] / URAD, pitch[k] / URAD, d_alpha[k], d_beta[k], reasons[k])
+            for k in range(N_FOR)]
+    return Optimization(new_ep, rows)
