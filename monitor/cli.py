@@ -312,12 +312,17 @@ def cmd_fingerprint(args) -> int:
         raise BadInput("no readable CrIS GEO granule" + (f" ({skipped[0]})" if skipped else ""))
     prints.sort(key=lambda p: p.start)
     day = fpr.day_print(prints)
+    from monitor.mapping.engpkt import load_library
+    library, problems = load_library(args.ep_library or [])
+    matches = fpr.identify_ep(day, library, _geo_platform(files))
     within = fpr.change_within(prints, args.threshold_urad) if len(prints) >= 4 else None
     if args.json:
         doc = day.to_dict()
         doc["skipped"] = skipped
         doc["change_within"] = None if within is None else {"first_granule": prints[within[0]].granule_id,
                                                              "fors": within[1]}
+        doc["ep_match"] = [m.to_dict() for m in matches]
+        doc["ep_library_problems"] = problems
         print(json.dumps(doc, indent=1))
     else:
         print(fpr.format_print(day))
@@ -325,7 +330,16 @@ def cmd_fingerprint(args) -> int:
             print(f"skipped {s}")
         print("no step within these granules" if within is None else
               f"step from granule {prints[within[0]].granule_id} at FOR {', '.join(map(str, within[1]))}")
+        print(fpr.format_matches(matches))
+        for p in problems:
+            print(f"EP library: {p}")
     return EXIT_OK
+
+
+def _geo_platform(files):
+    from monitor.sdr.names import parse_name
+    platforms = {parsed.platform for parsed in map(parse_name, (Path(f).name for f in files)) if parsed}
+    return platforms.pop() if len(platforms) == 1 else None
 
 
 def cmd_bench(args) -> int:
@@ -415,6 +429,8 @@ def build_parser() -> argparse.ArgumentParser:
     fp.add_argument("paths", nargs="+")
     fp.add_argument("--json", action="store_true")
     fp.add_argument("--threshold-urad", type=float, default=10.0)
+    fp.add_argument("--ep-library", action="append", metavar="PATH",
+                    help="EP file or directory to identify the EP from (repeatable; default: the packaged real EPs)")
     fp.set_defaults(func=cmd_fingerprint)
 
     b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")

@@ -57,6 +57,7 @@ class SceneConfig:
 class FingerprintConfig:
     granules: int = 100  # GEO granules per day, spread over the day
     threshold_urad: float = 10.0
+    ep_library: tuple = ()  # EP files/directories to identify the EP from; empty: the packaged real EPs
 
 
 @dataclass
@@ -256,10 +257,16 @@ def load_config(path) -> Config:
         store.publish.append(pc)
 
     fp = _section(doc, "fingerprint")
-    _known(fp, {"granules", "threshold_urad"}, "fingerprint.")
+    _known(fp, {"granules", "threshold_urad", "ep_library"}, "fingerprint.")
+    library = fp.get("ep_library") or []
+    if isinstance(library, str):
+        library = [library]
+    if not isinstance(library, list) or not all(isinstance(x, str) for x in library):
+        raise ConfigError(f"fingerprint.ep_library: expected a list of paths, got {library!r}")
     fingerprint = FingerprintConfig(_positive(_get(fp, "granules", int, "fingerprint.", 100), "fingerprint.granules"),
                                     _positive(_get(fp, "threshold_urad", float, "fingerprint.", 10.0),
-                                              "fingerprint.threshold_urad"))
+                                              "fingerprint.threshold_urad"),
+                                    tuple(rel(x) for x in library))
     alerts = _section(doc, "alerts")
     report_dir = doc.get("report_dir")
     return Config(path=path, satellites=list(sats), state_dir=state_dir, source=source, schedule=schedule,

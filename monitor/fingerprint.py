@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from monitor.geometry.instrument import EngineeringPacket, fov5_angles
 from monitor.geometry.inverse import inverse_geolocation
 
 FOV5 = 4
@@ -143,6 +144,56 @@ def change_within(prints: list[GranulePrint], threshold_urad: float = 10.0, min_
         if fors and (best is None or excess > best[0]):
             best = (excess, k, fors, da, db)
     return None if best is None else best[1:]
+
+
+@dataclass(frozen=True)
+class EpMatch:
+    """How well one EP's model explains a fingerprint: per-FOR residual (fingerprint - model, urad)."""
+
+    name: str
+    satellite: str
+    version: str
+    d_alpha_urad: np.ndarray
+    d_beta_urad: np.ndarray
+
+    @property
+    def rms_urad(self) -> float:
+        """RMS over FORs of the residual in both directions."""
+        return float(np.sqrt(np.nanmean(np.concatenate([self.d_alpha_urad, self.d_beta_urad]) ** 2)))
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "satellite": self.satellite, "version": self.version, "rms_urad": self.rms_urad,
+                "d_alpha_urad": np.round(self.d_alpha_urad, 1).tolist(),
+                "d_beta_urad": np.round(self.d_beta_urad, 1).tolist()}
+
+
+def identify_ep(day: DayPrint, library: dict, satellite: str | None = None) -> list[EpMatch]:
+    """The EPs of *library* (name -> EngineeringPacket), best first, by how well they explain *day*.
+
+    Each EP's model FOV-5 angles (equations 14-18 and the mounting) are compared with the fingerprint's
+    per-FOR medians. With *satellite*, EPs of other satellites are left out. On real NOAA-20 data the
+    right EP leaves ~30 urad (the servo and in-track residuals of formats.md 2.5); a wrong one, hundreds.
+    """
+    matches = []
+    for name, ep in library.items():
+        if satellite is not None and ep.satellite != satellite:
+            continue
+        alpha, beta = fov5_angles(ep)
+        matches.append(EpMatch(name, ep.satellite, ep.version, day.alpha_urad - alpha * URAD,
+                               day.beta_urad - beta * URAD))
+    return sorted(matches, key=lambda m: m.rms_urad)
+
+
+def format_matches(matches: list[EpMatch]) -> str:
+    """Ranked EP matches, with the best one's per-FOR residual."""
+    if not matches:
+        return "no EP in the library to compare with"
+    lines = ["EP identification (fingerprint - EP model, FOV 5):"]
+    lines += [f"  {m.name:<40} {m.satellite:<4} {m.version:<20} rms {m.rms_urad:9.1f} urad" for m in matches]
+    best = matches[0]
+    lines.append(f"best: {best.name}; residual per FOR (urad), in-track / cross-track:")
+    lines += [f"  FOR {k + 1:>2} {best.d_alpha_urad[k]:8.1f} {best.d_beta_urad[k]:8.1f}" for k in range(len(best.d_alpha_urad))]
+    return "\n".join(lines)
 
 
 def format_print(day: DayPrint) -> str:

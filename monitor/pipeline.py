@@ -17,6 +17,7 @@ import json
 import numpy as np
 
 from monitor import fingerprint as fpr
+from monitor.mapping.engpkt import load_library
 from monitor.assess import AssessConfig, assess_plan
 from monitor.scenes import select_scenes
 from monitor.sdr.pairing import PlanError, plan
@@ -74,6 +75,12 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
     prev = store.fingerprint(satellite, day)
     reference = fpr.DayPrint.from_dict(prev[1]) if prev else None
     body = today.to_dict()
+    library, problems = load_library(cfg.fingerprint.ep_library)
+    for problem in problems:
+        LOG.warning("fingerprint: EP library: %s", problem)
+    matches = fpr.identify_ep(today, library, satellite)
+    if matches:
+        body["ep_match"] = [m.to_dict() for m in matches[:3]]
     thr = cfg.fingerprint.threshold_urad
     within = fpr.change_within(prints, thr, reference=reference) if len(prints) >= 4 else None
     between = fpr.compare_days(reference, today, thr) if reference is not None else None
@@ -89,6 +96,8 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
         big = max(float(np.nanmax(np.abs(change["da"]))), float(np.nanmax(np.abs(change["db"]))))
         desc = (f"CrIS geolocation processing changed (LOS fingerprint): FOR {', '.join(map(str, change['fors']))}, "
                 f"up to {big:.0f} urad, from granule {change['granule']}")
+        if matches:
+            desc += f"; best-matching EP {matches[0].name} ({matches[0].version}, rms {matches[0].rms_urad:.0f} urad)"
         body["change"] = {"time": change["time"], "granule": change["granule"], "fors": change["fors"],
                           "d_alpha_urad": np.round(change["da"], 1).tolist(),
                           "d_beta_urad": np.round(change["db"], 1).tolist()}

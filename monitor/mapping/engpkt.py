@@ -232,3 +232,25 @@ def save_ep(ep: EngineeringPacket, out_path, like=None) -> Path:
     header = "# CrIS engineering packet (crisgeo YAML form of the EP XML; angles in urad)\n"
     out.write_text(header + yaml.safe_dump(ep_to_yaml_doc(ep), sort_keys=False, width=200, default_flow_style=None))
     return out
+
+
+def load_library(paths) -> tuple[dict, list]:
+    """EPs from files and directories (``*.xml``, ``*.yaml``, ``*.yml``): ({name: EP}, [problems]).
+
+    With no paths the library is the real EPs shipped in the package; unreadable files are reported,
+    not fatal.
+    """
+    paths = list(paths)
+    library = {} if paths else {PACKAGED[sat]: load_ep(packaged_path(sat)) for sat in PACKAGED}
+    problems = []
+    for p in map(Path, paths):
+        if not p.exists():
+            problems.append(f"{p}: no such file or directory")
+            continue
+        files = sorted(f for f in p.iterdir() if f.suffix in (".xml", ".yaml", ".yml")) if p.is_dir() else [p]
+        for f in files:
+            try:
+                library[f.name] = load_ep(f)
+            except EngPktError as exc:
+                problems.append(str(exc))
+    return library, problems

@@ -1,0 +1,24 @@
+"""The whole loop of section 4: assess -> optimize -> regeolocate -> assess again (issue #6)."""
+
+import numpy as np
+import pytest
+
+from monitor.mapping.closed_loop import run_closed_loop
+
+
+def _check(rep):
+    a2, b2, it, ct = rep.residual()
+    assert np.max(np.abs(rep.roll_error_urad)) <= 100 and np.max(np.abs(rep.pitch_error_urad)) <= 100, rep.table()
+    assert np.nanmax(np.abs(a2)) <= 150 and np.nanmax(np.abs(b2)) <= 150, rep.table()
+    assert np.nanmax(np.abs(it)) <= 0.15 and np.nanmax(np.abs(ct)) <= 0.15, rep.table()
+    # the first assessment did see the injected error (up to ~1200 urad cross-track at FOR 30)
+    assert rep.first.fors[29].d_beta_urad > 1000
+
+
+def test_closed_loop_four_granules(tmp_path, error_ep, nominal_ep):
+    _check(run_closed_loop(tmp_path, error_ep, nominal_ep, granules=4, seed=2))
+
+
+@pytest.mark.slow
+def test_closed_loop_paper_size(tmp_path, error_ep, nominal_ep):
+    _check(run_closed_loop(tmp_path, error_ep, nominal_ep, granules=14, seed=1))
