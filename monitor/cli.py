@@ -32,7 +32,7 @@ def cmd_simulate(args) -> int:
         if args.true_ep:
             spec = SimulationSpec(satellite=args.satellite, granules=args.granules, seed=args.seed,
                                   start=args.start or DEFAULT_START, profile="ep",
-                                  true_ep=_ep(args.true_ep, args.satellite), ground_ep=_ep(args.ground_ep, args.satellite))
+                                  true_ep=_ep(args.true_ep), ground_ep=_ep(args.ground_ep))
         truth = simulate_case(args.out, satellite=args.satellite, granules=args.granules, profile=args.profile,
                               seed=args.seed, start=args.start, spec=spec)
     except ValueError as exc:

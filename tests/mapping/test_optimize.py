@@ -81,3 +81,12 @@ def test_cli_optimize_bad_inputs(tmp_path, capsys):
     assert main(["optimize", str(res), "--ep", str(packaged_path("j01")), "--out", str(tmp_path / "x.xml")]) == 2
     assert "is for npp" in capsys.readouterr().err
     assert not (tmp_path / "x.xml").exists()
+
+
+def test_cli_simulate_in_ep_terms_checks_its_inputs(tmp_path, capsys):
+    from monitor.mapping.engpkt import packaged_path
+    v115, v37 = str(packaged_path("j01")), str(packaged_path("npp"))
+    assert main(["simulate", "--out", str(tmp_path / "a"), "--true-ep", v115]) == 2
+    assert "go together" in capsys.readouterr().err
+    assert main(["simulate", "--out", str(tmp_path / "b"), "--true-ep", v115, "--ground-ep", v37]) == 2
+    assert "EP V37 is for npp, the simulation for j01" in capsys.readouterr().err
