@@ -79,9 +79,8 @@ def build_message(store, satellite: str, items: list, settings) -> dict:
     if trend or where:
         blocks.append(_slack_escape("\n".join(["trend:"] + trend + where)))
     body = "\n".join(text)
-    attachments = []
-    if settings.report_dir and (settings.report_dir / satellite / "trend.png").is_file():
-        attachments.append(str(settings.report_dir / satellite / "trend.png"))
+    # the report is regenerated between evaluation and delivery; the e-mail attaches the plot if it exists then
+    attachments = [str(settings.report_dir / satellite / "trend.png")] if settings.report_dir else []
     return {"subject": subject, "text": body,
             "html": f"<html><body><h3>{html.escape(subject)}</h3><pre>{html.escape(body)}</pre></body></html>",
             "blocks": blocks, "attachments": attachments}

@@ -342,6 +342,31 @@ def _geo_platform(files):
     return platforms.pop() if len(platforms) == 1 else None
 
 
+def cmd_report(args) -> int:
+    import time
+
+    from alerts.settings import AlertConfigError
+    from monitor.report.html import build_report, options_from_config
+    from monitor.store.sqlite import Store
+    cfg = _load(args)
+    if args.satellite and args.satellite not in cfg.satellites:
+        raise BadInput(f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")
+    if args.since and args.until and args.since > args.until:
+        raise BadInput(f"--since {args.since} is after --until {args.until}")
+    try:
+        opts = options_from_config(cfg, [args.satellite] if args.satellite else None, args.since, args.until)
+    except AlertConfigError as exc:
+        raise BadInput(f"{cfg.path}: {exc}") from None
+    t0 = time.perf_counter()
+    store = Store(cfg.store.sqlite)
+    try:
+        index = build_report(store, args.out or cfg.report_dir or "report", opts)
+    finally:
+        store.close()
+    print(f"wrote {index} ({', '.join(opts.satellites)}) in {time.perf_counter() - t0:.1f} s")
+    return EXIT_OK
+
+
 def cmd_bench(args) -> int:
     from monitor.bench import run_bench
     return run_bench(args)
@@ -432,6 +457,14 @@ def build_parser() -> argparse.ArgumentParser:
     fp.add_argument("--ep-library", action="append", metavar="PATH",
                     help="EP file or directory to identify the EP from (repeatable; default: the packaged real EPs)")
     fp.set_defaults(func=cmd_fingerprint)
+
+    rp = sub.add_parser("report", help="the self-contained HTML trend report (one page per satellite)")
+    rp.add_argument("--config", required=True)
+    rp.add_argument("--out", help="output directory (default: report_dir of the configuration)")
+    rp.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    rp.add_argument("--since", type=_day, help="first day shown, YYYY-MM-DD")
+    rp.add_argument("--until", type=_day, help="last day shown, YYYY-MM-DD")
+    rp.set_defaults(func=cmd_report)
 
     b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")
     b.add_argument("--granules", type=int, default=14)

@@ -113,19 +113,34 @@ class Service:
                                    self.cfg.dashboard_url)
 
     def _after_run(self, store, outcome):
-        """After every run: evaluate the alert rules and deliver what is queued."""
-        self.check_alerts(store)
+        """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the
+        e-mails attach its trend plot), deliver what is queued."""
+        self.check_alerts(store, report=True)
 
-    def check_alerts(self, store=None):
-        """Evaluate the alert rules for every satellite and deliver the queue; a broken channel never
-        stops the service."""
-        from alerts.engine import evaluate_and_deliver
+    def regenerate_report(self, store):
+        """Rewrite the HTML report into ``report_dir``; a report problem never stops the service."""
+        if not self.cfg.report_dir:
+            return
+        from monitor.report.html import build_report, options_from_config
+        try:
+            build_report(store, self.cfg.report_dir, options_from_config(self.cfg))
+        except Exception:  # noqa: BLE001 - matplotlib, disk or data surprises are logged, not fatal
+            LOG.exception("report: could not regenerate %s", self.cfg.report_dir)
+
+    def check_alerts(self, store=None, report: bool = False):
+        """Evaluate the alert rules for every satellite and deliver the queue (regenerating the report in
+        between when *report*); a broken channel never stops the service."""
+        from alerts.engine import deliver, evaluate
         own = store is None
         store = store or self.store()
         try:
-            counts = evaluate_and_deliver(store, self.alert_settings(), self.cfg.satellites)
-            if counts["queued"] or counts["sent"] or counts["failed"]:
-                LOG.info("alerts: %s", counts)
+            settings = self.alert_settings()
+            queued = evaluate(store, settings, self.cfg.satellites)
+            if report:
+                self.regenerate_report(store)
+            counts = deliver(store, settings)
+            if queued or counts["sent"] or counts["failed"]:
+                LOG.info("alerts: %d queued, %s", len(queued), counts)
         finally:
             if own:
                 store.close()

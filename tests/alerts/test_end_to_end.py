@@ -38,6 +38,7 @@ state_dir: {tmp_path / 'state'}
 source: {{kind: local, path: {two_days}}}
 assessment: {{workers: 1}}
 dashboard_url: http://grafana.test/d/crisgeo
+report_dir: {tmp_path / 'report'}
 alerts:
   log: {tmp_path / 'alerts.log'}
   email: {{host: localhost, port: {port}, from: crisgeo@test, to: [sdr@test], cafile: {cafile},
@@ -54,6 +55,9 @@ alerts:
         assert f"FOR {k}:" in body
     assert "FOR 15:" not in body and "http://grafana.test/d/crisgeo" in body and "granule pair(s)" in body
     assert "FOR 30" in webhook.received[0]["text"]
+    # the report was regenerated before the message left: it shows the alert, the e-mail carries its plot
+    assert "FOR 30" in (tmp_path / "report" / "j01" / "index.html").read_text()
+    assert [p.get_filename() for p in m.iter_attachments()] == ["trend.png"]
     assert webhook.url not in (tmp_path / "alerts.log").read_text()
 
     assert service.run("j01", DAY1).status == "ok"  # the same day again: nothing new
@@ -66,6 +70,8 @@ alerts:
     assert "1 resolved" in m2["Subject"] and "RESOLVED spec" in body2
     # the corrected GEO has another LOS fingerprint: the same message announces the processing change
     assert "FIRING processing" in body2 and "CrIS geolocation processing changed" in body2
+    page = (tmp_path / "report" / "j01" / "index.html").read_text()
+    assert "2 day(s) shown" in page and "CrIS geolocation processing changed" in page
 
 
 def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp_path):

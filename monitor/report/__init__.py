@@ -1,0 +1,1 @@
+"""Trend review: the self-contained HTML report (figures with matplotlib)."""

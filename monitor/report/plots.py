@@ -1,0 +1,146 @@
+"""The report's figures (matplotlib, Agg): the paper's figures 5c, 7 and 8, and their evolution over time.
+
+Every function takes plain arrays and writes one PNG; none reads the store.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.dates as mdates  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+FOV_SIZE_URAD = 16807.5
+FORS = np.arange(1, 31)
+DPI = 90
+CHANGE_COLOURS = {"cris": "tab:purple", "viirs": "tab:green", "common": "tab:brown"}
+
+
+def _save(fig, path: Path) -> Path:
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
+
+
+def latest_km(path, in_track_km, cross_track_km, sigma_in_km, sigma_cross_km, reliable, spec_km, title):
+    """Per-FOR offsets on the ground with 1-sigma bars and the +-spec band (Wang et al. 2017 figure 8)."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.6), sharey=True, constrained_layout=True)
+    for ax, v, s, name in ((axes[0], in_track_km, sigma_in_km, "in-track"),
+                           (axes[1], cross_track_km, sigma_cross_km, "cross-track")):
+        ax.axhspan(-spec_km, spec_km, color="tab:green", alpha=0.08, label=f"+-{spec_km:g} km specification")
+        for y in (-spec_km, spec_km):
+            ax.axhline(y, color="tab:green", lw=1, ls="--")
+        ax.axhline(0, color="0.6", lw=0.8)
+        ok = np.asarray(reliable, bool)
+        ax.errorbar(FORS[ok], np.asarray(v)[ok], yerr=np.asarray(s)[ok], fmt="o", ms=4, color="tab:blue",
+                    capsize=2, label="offset +- 1 sigma")
+        if np.any(~ok):
+            ax.plot(FORS[~ok], np.asarray(v)[~ok], "x", color="tab:red", label="flagged")
+        ax.set_title(f"{name} error (km)")
+        ax.set_xlabel("FOR (scan position)")
+        ax.set_xlim(0, 31)
+        ax.grid(alpha=0.3)
+    hi = np.nanmax(np.abs(np.concatenate([in_track_km, cross_track_km, [spec_km]])))
+    axes[0].set_ylim(-1.15 * hi, 1.15 * hi)
+    axes[0].legend(loc="lower left", fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, Path(path))
+
+
+def latest_urad(path, d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_urad, title):
+    """Per-FOR LOS offset angles in urad with a % of FOV axis (Wang et al. 2017 figure 7)."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.4), constrained_layout=True)
+    for ax, v, s, name in ((axes[0], d_alpha_urad, sigma_alpha_urad, "in-track d_alpha"),
+                           (axes[1], d_beta_urad, sigma_beta_urad, "cross-track d_beta")):
+        ax.axhline(0, color="0.6", lw=0.8)
+        ax.errorbar(FORS, v, yerr=s, fmt="o", ms=4, color="tab:blue", capsize=2)
+        ax.set_title(f"{name} (urad)")
+        ax.set_xlabel("FOR (scan position)")
+        ax.set_xlim(0, 31)
+        ax.grid(alpha=0.3)
+        pct = ax.secondary_yaxis("right", functions=(lambda u: 100 * u / FOV_SIZE_URAD,
+                                                     lambda p: p * FOV_SIZE_URAD / 100))
+        pct.set_ylabel("% of FOV")
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, Path(path))
+
+
+def _mark_changes(ax, changes, label=True):
+    seen = set()
+    for when, instrument, text in changes:
+        colour = CHANGE_COLOURS.get(instrument, "0.3")
+        lab = f"{instrument} change" if label and instrument not in seen else None
+        seen.add(instrument)
+        ax.axvline(when, color=colour, lw=1.2, ls=":", label=lab)
+
+
+def heatmaps(path, days, in_track_km, cross_track_km, spec_km, changes, title):
+    """FOR x day heat maps of in-track and cross-track km; *days* (n,) dates, arrays (n, 30), NaN gaps."""
+    days = [dt.datetime(d.year, d.month, d.day) for d in days]
+    x0, x1 = mdates.date2num(days[0] - dt.timedelta(hours=12)), mdates.date2num(days[-1] + dt.timedelta(hours=12))
+    vmax = max(spec_km, float(np.nanmax(np.abs(np.concatenate([in_track_km.ravel(), cross_track_km.ravel()]))))
+                if np.any(np.isfinite(in_track_km)) else spec_km)
+    fig, axes = plt.subplots(2, 1, figsize=(11, 5.6), sharex=True, constrained_layout=True)
+    for ax, v, name in ((axes[0], in_track_km, "in-track"), (axes[1], cross_track_km, "cross-track")):
+        im = ax.imshow(np.asarray(v, float).T, aspect="auto", origin="lower", cmap="RdBu_r", vmin=-vmax, vmax=vmax,
+                       extent=(x0, x1, 0.5, 30.5), interpolation="nearest")
+        ax.set_ylabel("FOR")
+        ax.set_title(f"{name} error (km)", fontsize=10)
+        fig.colorbar(im, ax=ax, label="km", pad=0.01)
+        _mark_changes(ax, changes, label=False)
+    axes[1].xaxis_date()
+    axes[1].xaxis.set_major_formatter(mdates.ConciseDateFormatter(axes[1].xaxis.get_major_locator()))
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, Path(path))
+
+
+def trend_lines(path, days, fors, in_track_km, cross_track_km, spec_km, changes, alerts, title):
+    """Chosen FORs over time with the spec band; change lines and alert markers (triangles)."""
+    days = [dt.datetime(d.year, d.month, d.day) for d in days]
+    fig, axes = plt.subplots(2, 1, figsize=(11, 5.6), sharex=True, constrained_layout=True)
+    for ax, v, name in ((axes[0], in_track_km, "in-track"), (axes[1], cross_track_km, "cross-track")):
+        ax.axhspan(-spec_km, spec_km, color="tab:green", alpha=0.08)
+        for y in (-spec_km, spec_km):
+            ax.axhline(y, color="tab:green", lw=1, ls="--")
+        for k in fors:
+            ax.plot(days, v[:, k - 1], "-", marker="." if len(days) < 60 else None, lw=1.2, label=f"FOR {k}")
+        _mark_changes(ax, changes, label=ax is axes[0])
+        for when in alerts:
+            ax.plot([when], [spec_km * 1.1], "v", color="tab:red", ms=8,
+                    label="alert" if ax is axes[0] and when == alerts[0] else None)
+        ax.set_ylabel("km")
+        ax.set_title(f"{name} error (km)", fontsize=10)
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper left", fontsize=8, ncol=4)
+    axes[1].xaxis.set_major_formatter(mdates.ConciseDateFormatter(axes[1].xaxis.get_major_locator()))
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, Path(path))
+
+
+def cost_contour(path, cube_k, for_index, step_urad, d_alpha_urad, d_beta_urad, title):
+    """Cost surface G of one FOR over the 21 x 21 offsets with its minimum marked (figure 5c).
+
+    *cube_k* (2n+1, 2n+1): index i in-track, j cross-track; axes in urad.
+    """
+    n = (cube_k.shape[0] - 1) // 2
+    offsets = np.arange(-n, n + 1) * step_urad
+    fig, ax = plt.subplots(figsize=(5.6, 4.8), constrained_layout=True)
+    cs = ax.contourf(offsets, offsets, cube_k, levels=20, cmap="viridis")
+    ax.contour(offsets, offsets, cube_k, levels=10, colors="white", linewidths=0.5, alpha=0.6)
+    fig.colorbar(cs, ax=ax, label="STDEV(BT_CrIS - BT_VIIRS) (K)")
+    i, j = np.unravel_index(np.nanargmin(cube_k), cube_k.shape)
+    ax.plot(offsets[j], offsets[i], "r+", ms=16, mew=2, label="grid minimum")
+    if np.isfinite(d_alpha_urad) and np.isfinite(d_beta_urad):
+        ax.plot(d_beta_urad, d_alpha_urad, "wo", mfc="none", ms=10, label="refined estimate")
+    ax.plot(0, 0, "k.", label="as geolocated")
+    ax.set_xlabel("cross-track offset d_beta (urad)")
+    ax.set_ylabel("in-track offset d_alpha (urad)")
+    ax.set_title(f"FOR {for_index}", fontsize=10)
+    ax.legend(fontsize=8, loc="lower right")
+    fig.suptitle(title, fontsize=9)
+    return _save(fig, Path(path))

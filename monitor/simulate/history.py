@@ -1,0 +1,51 @@
+"""A synthetic history of daily per-FOR results, for the trend report, dashboards and their benchmarks.
+
+Not the science: a fast stand-in for years of daily runs (paper-like profile, slow drift, noise, one
+step at a given day), written through the store's own ``save_day`` like real runs.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+
+import numpy as np
+
+from monitor.result import FLAG_FLAT, AssessmentResult, ForOffset
+from monitor.simulate.profiles import paper_profile
+
+KM_PER_URAD = 0.00083  # at nadir; enough for a picture
+
+
+def day_result(satellite: str, day: dt.date, rng, step_urad: float = 0.0, with_cube: bool = True) -> AssessmentResult:
+    """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR 21-30."""
+    d_alpha, d_beta = paper_profile()
+    d_alpha = 0.3 * d_alpha + rng.normal(0, 15, 30)
+    d_beta = 0.3 * d_beta + rng.normal(0, 15, 30) + np.where(np.arange(30) >= 20, step_urad, 0.0)
+    scan = np.abs(np.linspace(-48.3, 48.3, 30))
+    stretch = 1.0 / np.cos(np.radians(scan)) ** 2
+    fors = []
+    for k in range(30):
+        it, ct = d_alpha[k] * KM_PER_URAD, d_beta[k] * KM_PER_URAD * stretch[k]
+        fors.append(ForOffset(k + 1, float(d_alpha[k]), float(d_beta[k]), 12.0, 14.0, float(it), float(ct),
+                              float(np.hypot(it, ct)), 0.01, 0.012 * stretch[k], 500, 0.8, 1.2,
+                              (FLAG_FLAT,) if rng.random() < 0.01 else ()))
+    cube = None
+    if with_cube:
+        off = (np.arange(21) - 10) * 450.0
+        cube = 0.8 + 1e-7 * ((off[:, None] - d_alpha[:, None, None]) ** 2 + (off[None, :] - d_beta[:, None, None]) ** 2)
+    start = dt.datetime(day.year, day.month, day.day, 12, tzinfo=dt.timezone.utc).isoformat()
+    return AssessmentResult(satellite, start, start, fors, cost_cube_k=cube)
+
+
+def fill_store(store, satellites, first: dt.date, days: int, step_day: int | None = None, step_urad: float = 800.0,
+               seed: int = 0, cubes: str = "last") -> list[dt.date]:
+    """Write *days* daily results per satellite from *first*; cost cubes on every day or only the last."""
+    rng = np.random.default_rng(seed)
+    out = [first + dt.timedelta(days=i) for i in range(days)]
+    for sat in satellites:
+        for i, day in enumerate(out):
+            step = step_urad if step_day is not None and i >= step_day else 0.0
+            result = day_result(sat, day, rng, step, with_cube=cubes == "all" or i == days - 1)
+            run = store.begin_run(sat, day)
+            store.save_day(run, sat, day, result, [], {})
+    return out

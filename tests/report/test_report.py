@@ -1,0 +1,116 @@
+"""The HTML trend report: empty store, one run, years of runs; opened in a real headless Chromium."""
+
+import datetime as dt
+import json
+import os
+import shutil
+import time
+
+import pytest
+import yaml
+
+from alerts.state import AlertState
+from monitor.cli import main
+from monitor.report.html import ReportOptions, build_report
+from monitor.simulate.history import fill_store
+from monitor.store.sqlite import Store
+from tests.servers import require
+
+SATS = ["npp", "j01", "j02"]
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture
+def store(tmp_path):
+    s = Store(tmp_path / "s.sqlite")
+    yield s
+    s.close()
+
+
+def _calendar(tmp_path, day):
+    path = tmp_path / "events.yaml"
+    path.write_text(yaml.safe_dump({"events": [{"time": f"{day}T00:00:00Z", "satellite": "j01", "instrument": "cris",
+                                                "kind": "ep_upload", "description": "EP V116 uploaded"}]}))
+    return path
+
+
+def test_empty_store(store, tmp_path):
+    index = build_report(store, tmp_path / "rep", ReportOptions(satellites=SATS))
+    assert "no data" in index.read_text()
+    for sat in SATS:
+        page = (tmp_path / "rep" / sat / "index.html").read_text()
+        assert "No assessment in the store" in page and "<img" not in page
+
+
+def test_single_run(store, tmp_path):
+    fill_store(store, ["j01"], dt.date(2026, 11, 20), 1)
+    build_report(store, tmp_path / "rep", ReportOptions(satellites=["j01"]))
+    sat = tmp_path / "rep" / "j01"
+    for name in ("latest_km", "latest_urad", "heatmap", "trend", "cost"):
+        assert (sat / f"{name}.png").read_bytes()[:8] == PNG
+    page = (sat / "index.html").read_text()
+    assert "2026-11-20" in page and "Latest values" in page and "http" not in page.split("<body>")[1]
+
+
+def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
+    days = fill_store(store, ["j01"], dt.date(2025, 1, 1), 400, step_day=300)
+    AlertState(store)  # creates its tables
+    store.db.execute("INSERT INTO alert_state VALUES ('spec:j01:x','spec','j01','x','critical','firing',"
+                     "'2025-10-28T00:00:00+00:00',NULL,NULL,'FOR 30 cross-track 2.5 km over the 1.5 km spec','[]')")
+    store.db.commit()
+    opts = ReportOptions(satellites=["j01"], calendar=_calendar(tmp_path, days[300]))
+    build_report(store, tmp_path / "rep", opts)
+    page = (tmp_path / "rep" / "j01" / "index.html").read_text()
+    assert "EP V116 uploaded" in page and "FOR 30 cross-track 2.5 km" in page and "out of specification" in page
+    assert "400 day(s) shown" in page
+    summary = json.loads((tmp_path / "rep" / "report.json").read_text())
+    assert summary[0]["worst_for"] == 30 and summary[0]["firing"] == 1
+    # --since/--until through the command line
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml.safe_dump({"satellites": ["j01"], "state_dir": str(tmp_path / "st"),
+                                   "source": {"kind": "simulated"}, "store": {"sqlite": str(tmp_path / "s.sqlite")}}))
+    assert main(["report", "--config", str(cfg), "--out", str(tmp_path / "r2"), "--since", "2025-03-01",
+                 "--until", "2025-03-31"]) == 0
+    assert "31 day(s) shown" in (tmp_path / "r2" / "j01" / "index.html").read_text()
+    assert main(["report", "--config", str(cfg), "--since", "2025-03-31", "--until", "2025-03-01"]) == 2
+
+
+def _chromium_driver(tmp_path):
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    options = webdriver.ChromeOptions()
+    options.binary_location = require("chromium")
+    for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1280,2400",
+                f"--user-data-dir={tmp_path / 'chrome-profile'}"):
+        options.add_argument(arg)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    return webdriver.Chrome(service=Service(require("chromedriver")), options=options)
+
+
+def test_report_in_headless_chromium(store, tmp_path):
+    days = fill_store(store, SATS, dt.date(2025, 6, 1), 120, step_day=90)
+    build_report(store, tmp_path / "rep", ReportOptions(satellites=SATS, calendar=_calendar(tmp_path, days[90])))
+    driver = _chromium_driver(tmp_path)
+    try:
+        for page in ["index.html"] + [f"{s}/index.html" for s in SATS]:
+            driver.get((tmp_path / "rep" / page).as_uri())
+            images = driver.execute_script(
+                "return Array.from(document.images).map(i => [i.src, i.complete, i.naturalWidth]);")
+            assert all(ok and width > 0 for _, ok, width in images), images
+            if page != "index.html":
+                assert len(images) == 5
+            errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+            assert not errors, errors
+        driver.get((tmp_path / "rep" / "j01" / "index.html").as_uri())
+        shot = tmp_path / "report_j01.png"
+        assert driver.save_screenshot(str(shot)) and shot.read_bytes()[:8] == PNG
+        # a broken image is noticed: the check above can fail
+        (tmp_path / "rep" / "j01" / "trend.png").write_bytes(b"not a png")
+        driver.get((tmp_path / "rep" / "j01" / "index.html").as_uri())
+        time.sleep(0.2)
+        widths = driver.execute_script("return Array.from(document.images).map(i => i.naturalWidth);")
+        assert 0 in widths
+    finally:
+        driver.quit()
+    if os.environ.get("CRISGEO_SCREENSHOT_DIR"):
+        shutil.copy(shot, os.environ["CRISGEO_SCREENSHOT_DIR"])
