@@ -363,7 +363,7 @@ def cmd_report(args) -> int:
         index = build_report(store, args.out or cfg.report_dir or "report", opts)
     finally:
         store.close()
-    print(f"wrote {index} ({', '.join(opts.satellites)}) in {time.perf_counter() - t0:.1f} s")
+    print(f"wrote {Path(index).resolve()} ({', '.join(opts.satellites)}) in {time.perf_counter() - t0:.1f} s")
     return EXIT_OK
 
 

@@ -23,7 +23,7 @@ from monitor.scenes import select_scenes
 from monitor.sdr.pairing import PlanError, plan
 from monitor.sdr import GranuleError, read_file
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
-from monitor.store.timeseries import drain_outbox, result_lines, target_name
+from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
 LOG = logging.getLogger(__name__)
 
@@ -108,6 +108,22 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
     return body
 
 
+def publish_changes(cfg, store, satellite: str) -> None:
+    """Queue every known change of *satellite* for the time-series stores (dashboard annotations)."""
+    if not cfg.store.publish:
+        return
+    from alerts.changes import all_changes
+    from alerts.settings import AlertConfigError, load_alert_settings
+    try:
+        calendar = load_alert_settings(cfg.alerts, cfg.path.resolve().parent).events_file
+        changes = all_changes(store, satellite, calendar)
+    except (AlertConfigError, ValueError, OSError) as exc:
+        LOG.warning("changes not published: %s", exc)
+        return
+    for p in cfg.store.publish:
+        store.queue_lines(target_name(p), satellite, change_lines(p.measurement, changes))
+
+
 def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, progress=None) -> RunOutcome:
     """Process one satellite-day end to end; never raises for bad data, records every outcome."""
     stop = should_stop or (lambda: False)
@@ -164,6 +180,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
             return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings)
         lines = {target_name(p): result_lines(p.measurement, satellite, day, result.fors) for p in cfg.store.publish}
         store.save_day(run_id, satellite, day, result, decisions, lines)
+        publish_changes(cfg, store, satellite)
         return RunOutcome(satellite, day, "ok", None, run_id, result, timings)
     except Stopped:
         store.finish_run(run_id, "interrupted", "stop requested")

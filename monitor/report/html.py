@@ -171,8 +171,12 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     span = f"{name}, {days[0].isoformat()} .. {latest.isoformat()} ({len(days)} days)"
     plots.heatmaps(sat_dir / "heatmap.png", days, arrays["in_track_km"], arrays["cross_track_km"], opts.spec_km,
                    marks, span)
+    # an alert fires after the run of the day it concerns: mark it on the last day plotted at that time
+    lo, hi = dt.datetime.combine(days[0], dt.time()), dt.datetime.combine(days[-1], dt.time())
+    alert_days = sorted({min(max(dt.datetime.combine(t.date(), dt.time()) - dt.timedelta(days=1), lo), hi)
+                         for t in alert_times if t.date() >= days[0]})
     plots.trend_lines(sat_dir / "trend.png", days, opts.trend_fors, arrays["in_track_km"], arrays["cross_track_km"],
-                      opts.spec_km, marks, alert_times, span)
+                      opts.spec_km, marks, alert_days, span)
     cube = store.cost_cube(satellite, latest)
     cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
     if cube is not None and worst is not None:

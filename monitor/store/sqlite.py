@@ -254,6 +254,13 @@ class Store:
         return [dict(r) for r in self.db.execute(q, (kind,) if kind else ())]
 
     # -- outbox
+    def queue_lines(self, target: str, satellite: str | None, lines: list):
+        """Queue points not tied to a day's results (e.g. change annotations)."""
+        with self.transaction():
+            for line in lines:
+                self.db.execute("INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, NULL, ?, ?)",
+                                (target, satellite, line, now_iso()))
+
     def outbox(self, target: str, limit: int = 5000) -> list:
         return [dict(r) for r in self.db.execute("SELECT id, line FROM outbox WHERE target=? ORDER BY id LIMIT ?",
                                                  (target, limit))]

@@ -8,6 +8,9 @@ Measurement ``cris_geolocation`` (configurable), one point per satellite, day an
   cross_track_km, total_km, cost_min_k, cost_zero_k
 * integer field: n_samples; boolean field: reliable
 
+Known changes (calendar, metadata, fingerprint) go to ``cris_geolocation_change`` (see :func:`change_lines`),
+re-sent after every run, for the dashboards' annotations.
+
 A field's type never changes (InfluxDB 1.x rejects a type change), and a non-finite value is left out of
 its point rather than written (InfluxDB rejects NaN; VictoriaMetrics would store garbage). Points are
 queued in the store's outbox in the same transaction as the day's results and deleted only once the
@@ -49,6 +52,20 @@ def result_lines(measurement: str, satellite: str, day: dt.date, fors) -> list[s
                 p = p.field(name, float(value))
         p = p.field("n_samples", int(f.n_samples)).field("reliable", bool(f.reliable))
         lines.append(p.time(when, WritePrecision.S).to_line_protocol())
+    return lines
+
+
+def change_lines(measurement: str, changes) -> list[str]:
+    """Line-protocol points of known changes (measurement ``<measurement>_change``, for dashboard annotations).
+
+    Tags satellite, instrument, kind, origin; string field ``description``; time = the change time. The
+    same change written again overwrites its point (same measurement, tags and time).
+    """
+    lines = []
+    for c in changes:
+        p = (Point(f"{measurement}_change").tag("satellite", c.satellite).tag("instrument", c.instrument)
+             .tag("kind", c.kind).tag("origin", c.origin).field("description", c.description))
+        lines.append(p.time(c.time, WritePrecision.S).to_line_protocol())
     return lines
 
 

@@ -73,3 +73,23 @@ def test_server_down_then_up_nothing_lost_nothing_twice(cases, tmp_path):
         assert drain_outbox(store, [cfg])[target_name(cfg)] == (0, 0)
         series = vm_export(url, "cris_geolocation_total_km")
         assert len(series) == 30 and all(len(s["values"]) == 2 for s in series)
+
+
+def test_known_changes_reach_influxdb_for_annotations(tmp_path):
+    from monitor.config import load_config
+    from monitor.pipeline import publish_changes
+    (tmp_path / "events.yaml").write_text(
+        "events:\n  - {time: '2024-05-20T08:00:00Z', satellite: j01, instrument: viirs, kind: lut_change,\n"
+        "     description: VIIRS-SDR-GEO-IMG-PARAM-LUT update}\n")
+    with influxdb1(tmp_path / "influx") as url:
+        (tmp_path / "c.yaml").write_text(
+            f"satellites: [j01]\nstate_dir: {tmp_path / 'st'}\nsource: {{kind: simulated}}\n"
+            f"store: {{publish: [{{kind: influx1, url: '{url}', database: crisgeo}}]}}\n"
+            "alerts: {events_file: events.yaml}\n")
+        cfg = load_config(tmp_path / "c.yaml")
+        store = Store(cfg.store.sqlite)
+        publish_changes(cfg, store, "j01")
+        publish_changes(cfg, store, "j01")  # re-sent after every run: overwrites, never duplicates
+        assert drain_outbox(store, cfg.store.publish)[target_name(cfg.store.publish[0])] == (2, 0)
+        (series,) = influxql(url, "crisgeo", 'SELECT "description", "instrument" FROM "cris_geolocation_change"')
+        assert series["values"] == [[1716192000, "VIIRS-SDR-GEO-IMG-PARAM-LUT update", "viirs"]]
