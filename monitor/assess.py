@@ -22,6 +22,7 @@ import numpy as np
 
 from monitor import collocate
 from monitor.geometry.ground import offset_km
+from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import inverse_geolocation
 from monitor.geometry.perturb import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, perturbation_grid
 from monitor.result import (FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, N_FOR, AssessmentResult,
@@ -32,7 +33,6 @@ from monitor.sdr.readers import read_viirs_geo_scan
 from monitor.spectral import i5_band
 
 LOG = logging.getLogger(__name__)
-FOV5 = 4
 KERNELS = {"top-hat": collocate.TOP_HAT, "response": collocate.SPATIAL_RESPONSE}
 
 

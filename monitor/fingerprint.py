@@ -19,11 +19,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.geometry.instrument import EngineeringPacket, fov5_angles
+from monitor.geometry.instrument import FOV5, URAD, fov5_angles
 from monitor.geometry.inverse import inverse_geolocation
 
-FOV5 = 4
-URAD = 1e6
 
 
 @dataclass
@@ -75,8 +73,8 @@ def granule_print(geo) -> GranulePrint:
     fg = inverse_geolocation(*args, np.where(valid, geo.range_m, 1e6), geo.for_time_us, geo.mid_time_us,
                              np.nan_to_num(geo.sc_position_m), np.nan_to_num(geo.sc_velocity_m_s),
                              np.nan_to_num(geo.sc_attitude_rad))
-    a = np.where(valid, fg.alpha_rad, np.nan) * URAD
-    b = np.where(valid, fg.beta_rad, np.nan) * URAD
+    a = np.where(valid, fg.alpha_rad, np.nan) / URAD
+    b = np.where(valid, fg.beta_rad, np.nan) / URAD
     with np.errstate(all="ignore"):
         return GranulePrint(geo.meta.granule_id, geo.meta.start.isoformat(),
                             np.nanmean(a[:, :, FOV5], axis=0), np.nanmean(b[:, :, FOV5], axis=0),
@@ -179,8 +177,8 @@ def identify_ep(day: DayPrint, library: dict, satellite: str | None = None) -> l
         if satellite is not None and ep.satellite != satellite:
             continue
         alpha, beta = fov5_angles(ep)
-        matches.append(EpMatch(name, ep.satellite, ep.version, day.alpha_urad - alpha * URAD,
-                               day.beta_urad - beta * URAD))
+        matches.append(EpMatch(name, ep.satellite, ep.version, day.alpha_urad - alpha / URAD,
+                               day.beta_urad - beta / URAD))
     return sorted(matches, key=lambda m: m.rms_urad)
 
 

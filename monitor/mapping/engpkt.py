@@ -19,9 +19,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from monitor.geometry.instrument import N_FOR, N_FOV, EngineeringPacket
+from monitor.geometry.instrument import N_FOR, N_FOV, URAD, EngineeringPacket
 
-URAD = 1e-6
 
 # (model field, path in the EP, number of values); a triple/pair path lists its components.
 _ANGLES = (

@@ -13,10 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from monitor.geometry.instrument import N_FOR, EngineeringPacket, corrected_ssm_angles
+from monitor.geometry.instrument import N_FOR, URAD, EngineeringPacket, corrected_ssm_angles
 from monitor.result import AssessmentResult
 
-URAD = 1e-6
 
 
 @dataclass(frozen=True)

@@ -177,12 +177,11 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
                          for t in alert_times if t.date() >= days[0]})
     plots.trend_lines(sat_dir / "trend.png", days, opts.trend_fors, arrays["in_track_km"], arrays["cross_track_km"],
                       opts.spec_km, marks, alert_days, span)
-    cube = store.cost_cube(satellite, latest)
+    stored = store.cost_cube(satellite, latest)
     cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
-    if cube is not None and worst is not None:
+    if stored is not None and worst is not None:
+        cube, step = stored
         runs = [r for r in store.runs(satellite) if r["day"] == latest.isoformat() and r["status"] == "ok"]
-        step = store.db.execute("SELECT step_urad FROM cost_cubes WHERE satellite=? AND day=?",
-                                (satellite, latest.isoformat())).fetchone()[0]
         plots.cost_contour(sat_dir / "cost.png", np.asarray(cube[worst.for_index - 1], float), worst.for_index, step,
                            worst.d_alpha_urad, worst.d_beta_urad, f"{title}: worst FOR {worst.for_index}, "
                            f"{worst.total_km:.2f} km" + (f" (run {runs[-1]['id']})" if runs else ""))

@@ -224,12 +224,13 @@ class Store:
                                                  (satellite, day.isoformat()))]
 
     def cost_cube(self, satellite: str, day: dt.date):
-        r = self.db.execute("SELECT half_steps, cube FROM cost_cubes WHERE satellite=? AND day=?",
+        """(cube_k (30, 2n+1, 2n+1), step_urad) of the day's assessment, or None."""
+        r = self.db.execute("SELECT half_steps, step_urad, cube FROM cost_cubes WHERE satellite=? AND day=?",
                             (satellite, day.isoformat())).fetchone()
         if r is None:
             return None
         m = 2 * r["half_steps"] + 1
-        return np.frombuffer(r["cube"], np.float32).reshape(-1, m, m)
+        return np.frombuffer(r["cube"], np.float32).reshape(-1, m, m), r["step_urad"]
 
     # -- fingerprints
     def save_fingerprint(self, satellite: str, day: dt.date, body: dict):

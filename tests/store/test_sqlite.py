@@ -35,7 +35,8 @@ def test_save_day_replaces_and_queues(cases, tmp_path):
     assert s.outbox_size() == 30 and len(s.granules("j01", DAY)) == 2
     assert [r["status"] for r in s.runs("j01")] == ["ok", "ok"]
     assert s.day_result("j01", DAY) == result.fors
-    assert s.cost_cube("j01", DAY).shape == (30, 21, 21)
+    cube, step_urad = s.cost_cube("j01", DAY)
+    assert cube.shape == (30, 21, 21) and step_urad == pytest.approx(375.0 / 833000.0 * 1e6)
     assert s.done_days("j01") == {DAY}
     g = s.granules("j01", DAY)[0]
     assert "CMNGEO-PARAM-LUT" in g["cris_aux"] and "VIIRS-SDR-GEO-IMG-PARAM-LUT" in g["viirs_aux"]
