@@ -258,21 +258,29 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     cos2 = np.float32(np.cos(rho * 1.01) ** 2)
     near = (dot32 > 0) & (dot32 * dot32 >= cos2 * np.einsum("kx,kx->k", vec32, vec32))  # angle <= rho, no sqrt
     near &= np.isfinite(swath.radiance.reshape(-1)[pix])
-    f_idx, pix = f_idx[near], pix[near]
-    r_pix, c_pix = np.divmod(pix, ncol)
-    vec = swath.ecef_m.reshape(-1, 3)[pix].astype(np.float64) - sat_m[f_idx]
-    dist = np.linalg.norm(vec, axis=-1)
-    d_ecef = vec / dist[:, None]
-    d = np.einsum("kji,kj->ki", sbf_to_ecef[f_idx], d_ecef)  # pixel directions in each FOV's SBF
-    # The union of the perturbed cones is a rounded rectangle in (alpha, beta): drop what lies outside.
-    half_a = np.abs(offsets_rad).max() + 1.02 * h_max / np.cos(beta_rad[f_idx])
+    f_idx, pix, pos32 = f_idx[near], pix[near], pos32[near]
+    vec = pos32.astype(np.float64)
+    vec -= sat_m[f_idx]
+    # Pixel directions in each FOV's SBF (unnormalised); the pixels come sorted by FOV.
+    bounds = np.searchsorted(f_idx, np.arange(nf + 1))
+    d = np.empty_like(vec)
+    for f in np.flatnonzero(np.diff(bounds)):
+        np.matmul(vec[bounds[f]:bounds[f + 1]], sbf_to_ecef[f], out=d[bounds[f]:bounds[f + 1]])
+    # The union of the perturbed cones is a rounded rectangle in (alpha, beta): drop what lies outside,
+    # comparing tangents (d_z > 0 within rho of the LOS).
+    half_a = np.abs(offsets_rad).max() + 1.02 * h_max / np.cos(beta_rad)
     half_b = np.abs(offsets_rad).max() + 1.02 * h_max
-    in_box = ((np.abs(np.arctan2(d[:, 0], d[:, 2]) - alpha_rad[f_idx]) <= half_a)
-              & (np.abs(np.arctan2(d[:, 1], d[:, 2]) - beta_rad[f_idx]) <= half_b))
-    f_idx, r_pix, c_pix, d_ecef, dist, d, vec = (x[in_box] for x in (f_idx, r_pix, c_pix, d_ecef, dist, d, vec))
-    cos_view = -np.sum(_ellipsoid_normal(vec + sat_m[f_idx]) * d_ecef, -1)
-    weight = swath.area_m2[r_pix, c_pix] * cos_view / dist**2  # steradians seen from CrIS
-    value = swath.radiance[r_pix, c_pix].astype(np.float64)
+    tan_lim = np.tan(np.stack([alpha_rad - half_a, alpha_rad + half_a, beta_rad - half_b, beta_rad + half_b]))
+    lim = tan_lim[:, f_idx] * d[:, 2]
+    in_box = (d[:, 0] >= lim[0]) & (d[:, 0] <= lim[1]) & (d[:, 1] >= lim[2]) & (d[:, 1] <= lim[3])
+    f_idx, pix, vec, d = f_idx[in_box], pix[in_box], vec[in_box], d[in_box]
+    dist2 = np.einsum("kx,kx->k", vec, vec)
+    dist = np.sqrt(dist2)
+    d /= dist[:, None]
+    up = _ellipsoid_normal(vec + sat_m[f_idx])
+    cos_view = -np.einsum("kx,kx->k", up, vec) / dist
+    weight = swath.area_m2.reshape(-1)[pix] * cos_view / dist2  # steradians seen from CrIS
+    value = swath.radiance.reshape(-1)[pix].astype(np.float64)
 
     tan_a = np.tan(offsets_rad[:, None] + alpha_rad[None, :])  # (m, F)
     width = m + 2 * PAD  # runs may start or end off the grid; the margin keeps them in their own row
