@@ -92,6 +92,7 @@ class _SwathCache:
 
     pieces: dict = field(default_factory=dict)
     keep: int = 2
+    swath: tuple = ((), None)  # the last stacked swath and the keys of its pieces
 
 
 def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=None):
@@ -115,9 +116,14 @@ def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=N
 
 
 def _load_swath(viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, timings=None):
+    keys = tuple(v.key for v in viirs)
+    if cache.swath[0] == keys:  # consecutive CrIS granules often lie on the same VIIRS granules
+        return cache.swath[1]
     pieces = [_piece(v, viirs_all, band, cache, timings) for v in viirs]
     with _stage(timings, "geometry"):
-        return collocate.ViirsSwath.from_pieces(pieces)
+        cache.swath = ((), None)  # let the old stack go before the new one is made
+        cache.swath = (keys, collocate.ViirsSwath.from_pieces(pieces))
+    return cache.swath[1]
 
 
 def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: AssessConfig, band,

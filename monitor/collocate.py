@@ -36,6 +36,7 @@ SPATIAL_RESPONSE = tuple((np.radians(r), c) for r, c in
                          ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065)))
 MIN_COVERAGE = 0.97
 BLOCK = 8192  # candidate pixels per block of the interval computation
+BLOCK_PX = 4  # VIIRS pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
 PAD = 48  # margin of the j difference arrays, wider than any run beyond the grid (2h/s ~ 37)
 
 
@@ -45,12 +46,15 @@ class PixelArrays:
 
     ecef_m (rows, cols, 3) float32 (0.5 m resolution); radiance (rows, cols) I5 band radiance
     mW/(m2 sr cm-1), NaN where unusable; area_m2 the pixel footprint with scan overlap removed.
-    Per-column spacings (m) size the search windows.
+    block_centre_m (rows/4, cols/4, 3) and block_radius_m bound the usable pixels of each 4 x 4 block
+    (NaN where it has none); per-column spacings (m) size the search windows.
     """
 
     ecef_m: np.ndarray
     radiance: np.ndarray
     area_m2: np.ndarray
+    block_centre_m: np.ndarray
+    block_radius_m: np.ndarray
     col_spacing_m: np.ndarray
     advance_m: np.ndarray
     det_step_m: np.ndarray
@@ -79,7 +83,8 @@ class ViirsSwath(PixelArrays):
     def from_pieces(cls, pieces: list[SwathPiece]) -> "ViirsSwath":
         def cat(name):
             return np.concatenate([getattr(p, name) for p in pieces]) if len(pieces) > 1 else getattr(pieces[0], name)
-        return cls(cat("ecef_m"), cat("radiance"), cat("area_m2"), pieces[0].col_spacing_m,
+        return cls(cat("ecef_m"), cat("radiance"), cat("area_m2"), cat("block_centre_m"), cat("block_radius_m"),
+                   pieces[0].col_spacing_m,
                    np.nanmean([p.advance_m for p in pieces], axis=0), pieces[0].det_step_m, list(pieces))
 
     def nearest(self, points_m):
@@ -109,6 +114,31 @@ def _half_diff(p, axis):
     bwd[tuple(b)] = fwd[tuple(a)]
     both = (fwd + bwd) * 0.5
     return np.where(np.isfinite(both), both, np.where(np.isfinite(fwd), fwd, bwd))
+
+
+def _block_reduce(ufunc, p):
+    """*ufunc* (np.fmin or np.fmax) over each B x B block of p (rows, cols, 3), as strided pairwise steps."""
+    for axis in (0, 1):
+        parts = [p[(slice(None),) * axis + (slice(k, None, BLOCK_PX),)] for k in range(BLOCK_PX)]
+        p = parts[0]
+        for q in parts[1:]:
+            p = ufunc(p, q)
+    return p
+
+
+def _blocks(pos, usable):
+    """Centre (float64 (rows/B, cols/B, 3), m) and radius (m) of a sphere holding the usable pixels of each
+    B x B block: the centre and half diagonal of their bounding box.
+
+    *pos* (rows, cols, 3) float32 ECEF of pixels, *usable* (rows, cols); rows are a multiple of B (whole
+    scans), columns are padded. Blocks without a usable pixel get NaN, which fails every later test.
+    """
+    cols = usable.shape[1]
+    p = np.pad(np.where(usable[..., None], pos, np.float32(np.nan)), ((0, 0), (0, -cols % BLOCK_PX), (0, 0)),
+               constant_values=np.nan)
+    lo = _block_reduce(np.fmin, p).astype(np.float64)  # fmin and fmax skip NaN
+    hi = _block_reduce(np.fmax, p).astype(np.float64)
+    return (lo + hi) / 2, np.linalg.norm(hi - lo, axis=-1) / 2 + 1.0  # 1 m for the float32 rounding
 
 
 def _scan_ends(scan):
@@ -178,11 +208,16 @@ def swath_piece(lat_rad, lon_rad, bt_k, good, band, before=None, after=None) -> 
         advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
     else:
         advance = det_step * DETECTORS
+    centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
+    radius = np.empty(centre.shape[:2])
+    for k in range(nscan):  # scan by scan: blocks never straddle two scans
+        sl, bl = slice(k * DETECTORS, (k + 1) * DETECTORS), slice(k * DETECTORS // BLOCK_PX, (k + 1) * DETECTORS // BLOCK_PX)
+        centre[bl], radius[bl] = _blocks(pos[sl], np.isfinite(radiance[sl]))
     r_idx, c_idx = np.nonzero(np.isfinite(radiance[::4, ::4]))
     r_idx, c_idx = r_idx * 4, c_idx * 4
     tree = cKDTree(pos[r_idx, c_idx].astype(np.float64))
-    return SwathPiece(pos, radiance, area, _fill_nan(col_spacing), _fill_nan(advance), _fill_nan(det_step),
-                      tree, r_idx, c_idx)
+    return SwathPiece(pos, radiance, area, centre, radius, _fill_nan(col_spacing), _fill_nan(advance),
+                      _fill_nan(det_step), tree, r_idx, c_idx)
 
 
 def build_swath(lat_rad, lon_rad, bt_k, good, band) -> ViirsSwath:
@@ -242,23 +277,34 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     rng = fov_range_m if fov_range_m is not None else t
     cz = fov_cos_zen if fov_cos_zen is not None else np.abs(np.sum(wgs84.geodetic_up(centre) * los0, -1))
     hr, hc = _window_half_sizes(swath, col0, np.where(ok_fov, rng, 1e6), np.where(ok_fov, cz, 1.0), rho)
-    R, C = int(hr.max()), int(hc.max())
+    # Candidates: the pixel blocks of the search window that can reach within rho of the LOS.
+    R, C = int(hr.max()) // BLOCK_PX + 1, int(hc.max()) // BLOCK_PX + 1
+    nbr, nbc = swath.block_radius_m.shape
+    rr = row0[:, None] // BLOCK_PX + np.arange(-R, R + 1)
+    cc = col0[:, None] // BLOCK_PX + np.arange(-C, C + 1)
+    inside = ((rr >= 0) & (rr < nbr))[:, :, None] & ((cc >= 0) & (cc < nbc))[:, None, :]
+    flat = np.clip(rr, 0, nbr - 1)[:, :, None] * nbc + np.clip(cc, 0, nbc - 1)[:, None, :]
+    f_idx, w_idx = np.nonzero((inside & ok_fov[:, None, None]).reshape(nf, -1))
+    blk = flat.reshape(nf, -1)[f_idx, w_idx]
+    vec = swath.block_centre_m.reshape(-1, 3)[blk] - sat_m[f_idx]
+    dist = np.linalg.norm(vec, axis=-1)
+    radius = swath.block_radius_m.reshape(-1)[blk]
+    with np.errstate(invalid="ignore"):
+        reach = rho * 1.01 + np.arcsin(np.minimum(radius / dist, 1.0))  # angle of LOS to a pixel of the block
+        near = np.einsum("kx,kx->k", vec, los0[f_idx]) >= dist * np.cos(np.minimum(reach, np.pi))
+    f_idx, blk = f_idx[near], blk[near]
+    b_row, b_col = np.divmod(blk, nbc)
     nrow, ncol = swath.shape
-    rr = row0[:, None] + np.arange(-R, R + 1)
-    cc = col0[:, None] + np.arange(-C, C + 1)
-    inside = ((rr >= 0) & (rr < nrow))[:, :, None] & ((cc >= 0) & (cc < ncol))[:, None, :]
-    flat = np.clip(rr, 0, nrow - 1)[:, :, None] * ncol + np.clip(cc, 0, ncol - 1)[:, None, :]
-    flat = np.where(inside & ok_fov[:, None, None], flat, -1).reshape(nf, -1)
-    # Coarse angle test in float32 on the whole window, exact tests on what survives.
-    f_idx, w_idx = np.nonzero(flat >= 0)
-    pix = flat[f_idx, w_idx]
+    r_pix = (b_row * BLOCK_PX)[:, None, None] + np.arange(BLOCK_PX)[:, None]
+    c_pix = np.minimum((b_col * BLOCK_PX)[:, None, None] + np.arange(BLOCK_PX), ncol - 1)
+    pix = (r_pix * ncol + c_pix).reshape(-1)
+    f_idx = np.repeat(f_idx, BLOCK_PX * BLOCK_PX)
+    usable = np.isfinite(swath.radiance.reshape(-1)[pix])
+    if ncol % BLOCK_PX:  # the padded last block column repeats the last pixel column: count it once
+        usable &= np.broadcast_to((b_col * BLOCK_PX)[:, None, None] + np.arange(BLOCK_PX) < ncol,
+                                  r_pix.shape[:1] + (BLOCK_PX, BLOCK_PX)).reshape(-1)
+    f_idx, pix = f_idx[usable], pix[usable]
     pos32 = swath.ecef_m.reshape(-1, 3)[pix]
-    vec32 = pos32 - sat_m.astype(np.float32)[f_idx]
-    dot32 = np.einsum("kx,kx->k", vec32, los0.astype(np.float32)[f_idx])
-    cos2 = np.float32(np.cos(rho * 1.01) ** 2)
-    near = (dot32 > 0) & (dot32 * dot32 >= cos2 * np.einsum("kx,kx->k", vec32, vec32))  # angle <= rho, no sqrt
-    near &= np.isfinite(swath.radiance.reshape(-1)[pix])
-    f_idx, pix, pos32 = f_idx[near], pix[near], pos32[near]
     vec = pos32.astype(np.float64)
     vec -= sat_m[f_idx]
     # Pixel directions in each FOV's SBF (unnormalised); the pixels come sorted by FOV.

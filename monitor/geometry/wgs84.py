@@ -23,9 +23,12 @@ def geodetic_to_ecef(lat_rad, lon_rad, h_m=0.0):
                                       np.asarray(h_m, float))
     sin_lat = np.sin(lat)
     n = A_M / np.sqrt(1.0 - E2 * sin_lat**2)
-    return np.stack([(n + h) * np.cos(lat) * np.cos(lon),
-                     (n + h) * np.cos(lat) * np.sin(lon),
-                     (n * (1.0 - E2) + h) * sin_lat], axis=-1)
+    r = (n + h) * np.cos(lat)  # distance from the polar axis
+    out = np.empty(lat.shape + (3,))
+    np.multiply(r, np.cos(lon), out=out[..., 0])
+    np.multiply(r, np.sin(lon), out=out[..., 1])
+    np.multiply(n * (1.0 - E2) + h, sin_lat, out=out[..., 2])
+    return out
 
 
 def ecef_to_geodetic(xyz_m):
