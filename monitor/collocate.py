@@ -35,7 +35,7 @@ TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)
 SPATIAL_RESPONSE = tuple((np.radians(r), c) for r, c in
                          ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065)))
 MIN_COVERAGE = 0.97
-BLOCK = 8192  # candidate pixels per block of the interval computation
+BLOCK = 4096  # candidate pixels per block of the interval computation
 BLOCK_PX = 4  # VIIRS pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
 PAD = 48  # margin of the j difference arrays, wider than any run beyond the grid (2h/s ~ 37)
 
