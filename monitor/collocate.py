@@ -15,6 +15,12 @@ edges). Each pixel is weighted by the solid angle it covers seen from CrIS,
 ``w = A_eff cos(view) / range^2``, where ``A_eff`` is the pixel footprint with the overlap between
 consecutive scans removed (divided by how many scans cover the pixel centre). The sum of the weights
 inside a cone over the cone's solid angle is its coverage: 1 when VIIRS fills it.
+
+Search. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans), a
+sphere holding its usable pixels. Around each FOV only the blocks whose sphere comes within the union
+of the perturbed cones are opened. A row/column window alone would take in whole stretches of the
+neighbouring scans (bow-tie overlap) that lie outside the cones; testing a block costs a sixteenth of
+testing its pixels.
 """
 
 from __future__ import annotations

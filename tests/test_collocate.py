@@ -5,6 +5,7 @@ import pytest
 
 from monitor import collocate
 from monitor.assess import AssessConfig, _cris_geometry, _load_swath, _SwathCache
+from monitor.geometry import wgs84
 from monitor.geometry.perturb import perturbation_grid
 from monitor.sdr import read_file
 from monitor.sdr.pairing import plan
@@ -12,13 +13,17 @@ from monitor.spectral import i5_band
 
 
 @pytest.fixture(scope="module")
-def scene(cases):
+def case_plan(cases):
     out, _, _ = cases.get()
-    case = plan([out])
-    g = case.cris[0]
+    return plan([out])
+
+
+@pytest.fixture(scope="module")
+def scene(case_plan):
+    g = case_plan.cris[0]
     (geo,) = read_file(g.geo, kinds=("cris_geo",))
     fg, valid, _ = _cris_geometry(geo)
-    swath = _load_swath(case.viirs[g.key], case.viirs_all, i5_band("j01"), _SwathCache())
+    swath = _load_swath(case_plan.viirs[g.key], case_plan.viirs_all, i5_band("j01"), _SwathCache())
     return fg, swath
 
 
@@ -81,3 +86,30 @@ def test_spatial_response_kernel_is_a_weighted_stack_of_top_hats(scene):
     assert np.all(np.isfinite(resp)) and np.all(np.abs(cov - 1) < 0.03)
     assert np.max(np.abs(resp - top)) > 0  # a different weighting of the same pixels
     assert AssessConfig(kernel="response").kernel == "response"
+
+
+def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):
+    """Pixels are searched in 4 x 4 blocks; a swath whose width is no multiple of 4 still has every
+    pixel of a cone that crosses its last, partial block column counted once."""
+    fg, swath = scene
+    idx = (1, 29, 4)
+    los = fg.sbf_to_ecef[idx] @ np.array([np.tan(fg.alpha_rad[idx]), np.tan(fg.beta_rad[idx]), 1.0])
+    los /= np.linalg.norm(los)
+    centre = fg.sat_ecef_m[idx] + wgs84.intersect_ellipsoid(fg.sat_ecef_m[idx], los) * los
+    row0, col0 = swath.nearest(centre[None])
+    ncol = int(col0[0]) + 4 * 5 + 3  # the cone reaches past the cut
+    assert ncol % collocate.BLOCK_PX
+    v = case_plan.viirs[case_plan.cris[0].key][int(row0[0]) // swath.pieces[0].radiance.shape[0]]
+    (vgeo,) = read_file(v.geo, kinds=("viirs_geo",))
+    (vsdr,) = read_file(v.sdr, kinds=("viirs_sdr",))
+    cut = collocate.build_swath(vgeo.lat_rad[:, :ncol], vgeo.lon_rad[:, :ncol], vsdr.bt_k[:, :ncol],
+                                vsdr.good[:, :ncol], i5_band("j01"))
+    assert cut.block_radius_m.shape[1] == -(-ncol // collocate.BLOCK_PX)
+    offsets = perturbation_grid(2, 900e-6)
+    mean, cover = collocate.cone_sums(cut, fg.sat_ecef_m[idx][None], fg.sbf_to_ecef[idx][None],
+                                      fg.alpha_rad[idx][None], fg.beta_rad[idx][None], offsets)
+    bm, bc = _brute(cut, fg.sat_ecef_m[idx], fg.sbf_to_ecef[idx], fg.alpha_rad[idx], fg.beta_rad[idx],
+                    offsets, collocate.TOP_HAT[0][0])
+    assert 0.05 < bc.min() and bc.max() < 0.95  # the cut runs through the cones
+    np.testing.assert_allclose(mean[0], bm, rtol=1e-6)
+    np.testing.assert_allclose(cover[0], bc, rtol=1e-6)
