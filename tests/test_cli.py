@@ -61,3 +61,22 @@ def test_corrupt_granule_is_skipped_and_recorded(cases, tmp_path, capsys):
 def test_simulate_cli_rejects_bad_profile(tmp_path, capsys):
     assert main(["simulate", "--out", str(tmp_path), "--profile", "nonsense", "--granules", "1"]) == 2
     assert "profile" in capsys.readouterr().err
+
+
+def test_bench_prints_every_stage_and_the_assessment_memory():
+    """`crisgeo bench` on a one-granule simulated case, in its own process so its memory is its own."""
+    import re
+    import subprocess
+    import sys
+    run = subprocess.run([sys.executable, "-c", "from monitor.cli import main; raise SystemExit(main("
+                          "['bench', '--granules', '1', '--workers', '1']))"],
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    out = run.stdout
+    assert "case: 1 CrIS granules, 1080 FOVs x 441 perturbations" in out
+    for stage in ("read", "geometry", "spectral", "collocation", "cost", "total"):
+        secs, rate = re.search(rf"^  {stage} +([0-9.]+) s +([0-9.]+|inf) FOVs/s", out, re.M).groups()
+        assert float(secs) > 0 or stage in ("spectral", "cost")
+    peak = float(re.search(r"^peak memory: ([0-9]+) MB$", out, re.M).group(1))
+    assert 100 < peak < 3000
+    assert "includes the simulation" not in out  # Linux resets the count after simulating
