@@ -68,7 +68,7 @@ class PixelArrays:
 
 @dataclass
 class SwathPiece(PixelArrays):
-    """One VIIRS granule prepared for collocation, with a KD-tree of its pixels on a 4 x 4 subgrid."""
+    """One VIIRS granule prepared for collocation, with a KD-tree of its pixel blocks' centres."""
 
     tree: cKDTree
     tree_rows: np.ndarray
@@ -89,12 +89,12 @@ class ViirsSwath(PixelArrays):
     def from_pieces(cls, pieces: list[SwathPiece]) -> "ViirsSwath":
         def cat(name):
             return np.concatenate([getattr(p, name) for p in pieces]) if len(pieces) > 1 else getattr(pieces[0], name)
-        return cls(cat("ecef_m"), cat("radiance"), cat("area_m2"), cat("block_centre_m"), cat("block_radius_m"),
-                   pieces[0].col_spacing_m,
-                   np.nanmean([p.advance_m for p in pieces], axis=0), pieces[0].det_step_m, list(pieces))
+        stacked = [cat(name) for name in ("ecef_m", "radiance", "area_m2", "block_centre_m", "block_radius_m")]
+        return cls(*stacked, pieces[0].col_spacing_m, np.nanmean([p.advance_m for p in pieces], axis=0),
+                   pieces[0].det_step_m, list(pieces))
 
     def nearest(self, points_m):
-        """(row, col) of the usable pixel (on a 4 x 4 subgrid) nearest each ECEF point."""
+        """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point."""
         best = np.full(len(points_m), np.inf)
         row = np.zeros(len(points_m), np.intp)
         col = np.zeros(len(points_m), np.intp)
@@ -217,11 +217,12 @@ def swath_piece(lat_rad, lon_rad, bt_k, good, band, before=None, after=None) -> 
     centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
     radius = np.empty(centre.shape[:2])
     for k in range(nscan):  # scan by scan: blocks never straddle two scans
-        sl, bl = slice(k * DETECTORS, (k + 1) * DETECTORS), slice(k * DETECTORS // BLOCK_PX, (k + 1) * DETECTORS // BLOCK_PX)
+        sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
+        bl = slice(k * DETECTORS // BLOCK_PX, (k + 1) * DETECTORS // BLOCK_PX)
         centre[bl], radius[bl] = _blocks(pos[sl], np.isfinite(radiance[sl]))
-    r_idx, c_idx = np.nonzero(np.isfinite(radiance[::4, ::4]))
-    r_idx, c_idx = r_idx * 4, c_idx * 4
-    tree = cKDTree(pos[r_idx, c_idx].astype(np.float64))
+    r_idx, c_idx = np.nonzero(np.isfinite(radius))
+    tree = cKDTree(centre[r_idx, c_idx])
+    r_idx, c_idx = r_idx * BLOCK_PX, c_idx * BLOCK_PX
     return SwathPiece(pos, radiance, area, centre, radius, _fill_nan(col_spacing), _fill_nan(advance),
                       _fill_nan(det_step), tree, r_idx, c_idx)
 

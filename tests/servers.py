@@ -52,20 +52,25 @@ def _wait(url: str, ok=(200, 204), timeout=30.0):
 
 
 @contextmanager
-def victoria_metrics(tmp: Path, port: int | None = None):
-    """VictoriaMetrics on 127.0.0.1; yields its base URL."""
-    exe = require("victoria-metrics")
-    port = port or free_port()
-    proc = subprocess.Popen([exe, f"-httpListenAddr=127.0.0.1:{port}", f"-storageDataPath={tmp}",
-                             "-retentionPeriod=100y", "-loggerLevel=ERROR"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+def _running(cmd: list, url: str, health: str):
+    """Run server *cmd*, wait until *url* + *health* answers, yield *url*; stop the server after."""
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        url = f"http://127.0.0.1:{port}"
-        _wait(url + "/health")
+        _wait(url + health)
         yield url
     finally:
         proc.terminate()
         proc.wait(timeout=30)
+
+
+@contextmanager
+def victoria_metrics(tmp: Path, port: int | None = None):
+    """VictoriaMetrics on 127.0.0.1; yields its base URL."""
+    exe = require("victoria-metrics")
+    port = port or free_port()
+    with _running([exe, f"-httpListenAddr=127.0.0.1:{port}", f"-storageDataPath={tmp}", "-retentionPeriod=100y",
+                   "-loggerLevel=ERROR"], f"http://127.0.0.1:{port}", "/health") as url:
+        yield url
 
 
 def vm_export(url: str, metric_regex: str) -> list[dict]:
@@ -98,14 +103,8 @@ bind-address = "127.0.0.1:{rpc}"
 [monitor]
   store-enabled = false
 """)
-    proc = subprocess.Popen([exe, "-config", str(conf)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        url = f"http://127.0.0.1:{http}"
-        _wait(url + "/ping")
+    with _running([exe, "-config", str(conf)], f"http://127.0.0.1:{http}", "/ping") as url:
         yield url
-    finally:
-        proc.terminate()
-        proc.wait(timeout=30)
 
 
 def influxql(url: str, db: str, q: str) -> list:
