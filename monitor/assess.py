@@ -6,9 +6,11 @@ Then per scan position k over all samples (equation 8):
 
     G(i, j, k) = STDEV(BT_VIIRS_ij - BT_CrIS),
 
-its minimum refined by a quadratic surface through the 3x3 neighbourhood of the grid minimum
-(Wang 2013), and a bootstrap over granules (over scans when there are fewer than 4 granules) for the
-uncertainty of each offset.
+its minimum refined between grid points by interpolating every sample's difference (:mod:`monitor.refine`;
+the quadratic surface of Wang 2013 through the 3x3 neighbourhood only where the grid minimum is too near
+the border for that), and its uncertainty: a bootstrap over scans within granules (the scatter) and a
+floor calibrated on simulated cases (what the estimator itself leaves, ``AssessConfig.sigma_floor_urad``;
+``benchmarks/acceptance.py`` measures it).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor import collocate
+from monitor import collocate, refine
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import inverse_geolocation
@@ -49,6 +51,7 @@ class AssessConfig:
     max_sigma_urad: float = 250.0  # ~0.55 perturbation step, 1.5 % of the FOV
     bootstrap: int = 100
     seed: int = 0
+    sigma_floor_urad: float = 5.0  # in quadrature with the bootstrap: the estimator's own error (calibrated)
 
     @property
     def offsets_rad(self) -> np.ndarray:
@@ -108,7 +111,8 @@ def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=N
         raise GranuleError(v.sdr, "BrightnessTemperature", f"shape {sdr.bt_k.shape} does not match the GEO "
                                                            f"{geo.lat_rad.shape}")
     with _stage(timings, "geometry"):
-        piece = collocate.swath_piece(geo.lat_rad, geo.lon_rad, sdr.bt_k, sdr.good, band, halo_before, halo_after)
+        piece = collocate.swath_piece(geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band,
+                                      halo_before, halo_after)
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))
     cache.pieces[v.key] = piece
@@ -253,6 +257,41 @@ def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
     return float(np.mean(it)), float(np.mean(ct)), jac
 
 
+def _scan_bootstrap_counts(rng, granule_of_unit, n_boot):
+    """Bootstrap counts (B, units): each granule's scans resampled with replacement within the granule."""
+    counts = np.zeros((n_boot, len(granule_of_unit)))
+    for g in np.unique(granule_of_unit):
+        members = np.flatnonzero(granule_of_unit == g)
+        counts[:, members] = rng.multinomial(len(members), np.full(len(members), 1.0 / len(members)), size=n_boot)
+    return counts
+
+
+def for_minimum(d, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
+    """Offsets (grid steps from the centre), bootstrap sigmas (steps) and flags of one FOR.
+
+    *d* (N, m, m) holds the samples' BT differences, *unit_ids* (N,) the scan each comes from and
+    *granule_of_unit* the granule of each scan. The cost surface is the standard deviation over samples;
+    its minimum is refined between grid points where the window fits (:mod:`monitor.refine`).
+    """
+    m = d.shape[1]
+    g = _stdev(d)
+    x, y, flags = find_minimum(g, cfg.flat_contrast)
+    i0, j0 = np.unravel_index(np.argmin(g), g.shape)
+    fine = FLAG_EDGE not in flags and FLAG_FLAT not in flags and refine.refinable(i0, j0, m)
+    if fine:
+        dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0))
+        x, y = i0 - (m - 1) // 2 + dx, j0 - (m - 1) // 2 + dy
+    sig = (np.nan, np.nan)
+    if cfg.bootstrap > 1 and len(granule_of_unit) >= 2:
+        counts = _scan_bootstrap_counts(rng, granule_of_unit, cfg.bootstrap)[:, unit_ids]
+        if fine:
+            est = refine.refined_minimum(refine.window_covariance(d, i0, j0, counts))
+        else:
+            est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in _stdev(d, counts)])
+        sig = tuple(np.nanstd(est, axis=0))
+    return g, x, y, sig, flags
+
+
 def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=None, satellite="") -> AssessmentResult:
     """The cost cube, per-FOR minimum, bootstrap uncertainty and km offsets of collocated *samples*."""
     offsets = cfg.offsets_rad
@@ -260,7 +299,6 @@ def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=N
     step_urad = cfg.step_rad * 1e6
     rng = np.random.default_rng(cfg.seed)
     cube = np.full((N_FOR, m, m), np.nan)
-    by_granule = len(samples) >= 4
     fors = []
     for k in range(N_FOR):
         diffs, units = [], []
@@ -268,29 +306,22 @@ def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=N
             use = s.usable[:, k]  # (nscan, 9)
             d = s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]
             diffs.append(d.astype(np.float64))
-            scan_idx = np.nonzero(use)[0]
-            units.append(np.full(len(d), g_i) if by_granule else g_i * 1000 + scan_idx)
+            units.append(g_i * 1000 + np.nonzero(use)[0])
         d = np.concatenate(diffs) if diffs else np.empty((0, m, m))
-        unit_ids = np.unique(np.concatenate(units), return_inverse=True)[1] if diffs else np.empty(0, int)
+        scan_keys, unit_ids = np.unique(np.concatenate(units), return_inverse=True) if diffs else (np.empty(0), [])
         n = len(d)
         flags = []
         if n < max(cfg.min_samples, 3):
             flags.append(FLAG_FEW_SAMPLES)
-        if n >= 3:
-            g = _stdev(d)
-            cube[k] = g
-            x, y, fl = find_minimum(g, cfg.flat_contrast)
-            flags += fl
-        else:
-            g = np.full((m, m), np.nan)
-            x = y = np.nan
+        x = y = np.nan
         sig_a = sig_b = np.nan
-        if n >= 3 and cfg.bootstrap > 1 and unit_ids.max() >= 1:
-            counts = rng.multinomial(unit_ids.max() + 1, np.full(unit_ids.max() + 1, 1.0 / (unit_ids.max() + 1)),
-                                     size=cfg.bootstrap)
-            gb = _stdev(d, counts[:, unit_ids].astype(float))
-            est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in gb])
-            sig_a, sig_b = np.nanstd(est, axis=0) * step_urad
+        g = np.full((m, m), np.nan)
+        if n >= 3:
+            g, x, y, (sig_a, sig_b), fl = for_minimum(d, unit_ids, scan_keys // 1000, cfg, rng)
+            cube[k] = g
+            flags += fl
+            sig_a, sig_b = np.hypot(sig_a * step_urad, cfg.sigma_floor_urad), np.hypot(sig_b * step_urad,
+                                                                                    cfg.sigma_floor_urad)
             if max(sig_a, sig_b) > cfg.max_sigma_urad:
                 flags.append(FLAG_UNCERTAIN)
         d_alpha, d_beta = x * step_urad, y * step_urad

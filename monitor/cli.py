@@ -51,6 +51,16 @@ def _ep(path, satellite=None):
         raise BadInput(str(exc)) from None
 
 
+def _residuals(path):
+    from monitor.mapping.residuals import ResidualError, load
+    if path is None:
+        return None
+    try:
+        return load(path)
+    except ResidualError as exc:
+        raise BadInput(str(exc)) from None
+
+
 def cmd_optimize(args) -> int:
     import json
 
@@ -80,10 +90,11 @@ def cmd_regeolocate(args) -> int:
     from monitor.mapping.regeolocate import regeolocate_file
     from monitor.sdr import GranuleError
     ep = _ep(args.ep)
+    residuals = _residuals(args.residuals)
     failed = 0
     for path in args.files:
         try:
-            out = regeolocate_file(ep, path, args.out)
+            out = regeolocate_file(ep, path, args.out, residuals)
             print(f"wrote {out}")
         except (GranuleError, ValueError, OSError) as exc:
             failed += 1
@@ -100,7 +111,7 @@ def cmd_geolocate(args) -> int:
     from monitor.sdr import GranuleError
     ep = _ep(args.ep)
     try:
-        rows = compare_with_files(ep, args.files)
+        rows = compare_with_files(ep, args.files, _residuals(args.residuals))
     except (GranuleError, ValueError) as exc:
         raise BadInput(str(exc)) from None
     if args.json:
@@ -333,7 +344,23 @@ def cmd_fingerprint(args) -> int:
         print(fpr.format_matches(matches))
         for p in problems:
             print(f"EP library: {p}")
+    if args.write_residuals:
+        _write_residuals(args, day, matches, library)
     return EXIT_OK
+
+
+def _write_residuals(args, day, matches, library):
+    from monitor.mapping.residuals import learn
+    if args.ep:
+        ep = _ep(args.ep)
+    elif matches:
+        ep = library[matches[0].name]
+    else:
+        raise BadInput("--write-residuals: no EP to learn against (give --ep or an --ep-library of this satellite)")
+    table = learn(day, ep)
+    table.write(args.write_residuals)
+    print(f"wrote residual table against EP {ep.version} ({len(day.granules)} granule(s)) to {args.write_residuals}",
+          file=sys.stderr if args.json else sys.stdout)
 
 
 def _geo_platform(files):
@@ -399,12 +426,14 @@ def build_parser() -> argparse.ArgumentParser:
     rg.add_argument("files", nargs="+")
     rg.add_argument("--ep", required=True)
     rg.add_argument("--out", required=True, help="output directory (never the input's)")
+    rg.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
     rg.set_defaults(func=cmd_regeolocate)
 
     gl = sub.add_parser("geolocate", help="compare an EP's geolocation with CrIS GEO files' own, per FOR")
     gl.add_argument("files", nargs="+")
     gl.add_argument("--ep", required=True)
     gl.add_argument("--json", action="store_true")
+    gl.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
     gl.set_defaults(func=cmd_geolocate)
 
     a = sub.add_parser("assess", help="assess CrIS geolocation against VIIRS I5 for the granules given")
@@ -456,6 +485,9 @@ def build_parser() -> argparse.ArgumentParser:
     fp.add_argument("--threshold-urad", type=float, default=10.0)
     fp.add_argument("--ep-library", action="append", metavar="PATH",
                     help="EP file or directory to identify the EP from (repeatable; default: the packaged real EPs)")
+    fp.add_argument("--write-residuals", metavar="FILE",
+                    help="write the per-FOR FOV-5 LOS residual against --ep (default: the best-matching EP)")
+    fp.add_argument("--ep", help="the EP the residual table is learned against (XML or YAML)")
     fp.set_defaults(func=cmd_fingerprint)
 
     rp = sub.add_parser("report", help="the self-contained HTML trend report (one page per satellite)")

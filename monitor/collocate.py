@@ -9,12 +9,18 @@ the test d . L_ij >= cos h for a pixel direction d is, for fixed i, a quadratic 
 t = tan B_j whose solution is one interval. So each pixel adds its value to one run of j per row i,
 and the 441 cone sums are prefix sums of these runs: exact, and 21 operations per pixel instead of 441.
 
+Pixels where they are. A terrain-corrected (GITCO) pixel is the 3-D point where its line of sight meets
+the terrain: (lat, lon, Height). Put at h = 0 instead, a pixel on terrain of height h seen from CrIS at
+view zenith z moves by about h sin(z) / range towards nadir (~0.5 mrad for 1 km at the scan edge), so
+every position below is the 3-D point; the ellipsoid product (GIMGO) has h = 0.
+
 Weights. CrIS sees the scene averaged over the solid angle of its FOV; VIIRS pixels do not sample
 that solid angle evenly (scan overlap towards the swath edge, footprint steps at the aggregation-zone
 edges). Each pixel is weighted by the solid angle it covers seen from CrIS,
-``w = A_eff cos(view) / range^2``, where ``A_eff`` is the pixel footprint with the overlap between
-consecutive scans removed (divided by how many scans cover the pixel centre). The sum of the weights
-inside a cone over the cone's solid angle is its coverage: 1 when VIIRS fills it.
+``w = |A . u| / range^2``, where ``A`` is the pixel's vector footprint (the cross product of the steps to
+its neighbours, so that a slope is foreshortened as seen along the unit direction ``u`` from CrIS) with
+the overlap between consecutive scans removed (divided by how many scans cover the pixel centre). The
+sum of the weights inside a cone over the cone's solid angle is its coverage: 1 when VIIRS fills it.
 
 Search. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans), a
 sphere holding its usable pixels. Around each FOV only the blocks whose sphere comes within the union
@@ -50,20 +56,22 @@ PAD = 48  # margin of the j difference arrays, wider than any run beyond the gri
 class PixelArrays:
     """VIIRS I5 pixels ready for collocation, rows of 32-detector scans.
 
-    ecef_m (rows, cols, 3) float32 (0.5 m resolution); radiance (rows, cols) I5 band radiance
-    mW/(m2 sr cm-1), NaN where unusable; area_m2 the pixel footprint with scan overlap removed.
-    block_centre_m (rows/4, cols/4, 3) and block_radius_m bound the usable pixels of each 4 x 4 block
-    (NaN where it has none); per-column spacings (m) size the search windows.
+    ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (rows, cols) I5 band
+    radiance mW/(m2 sr cm-1), NaN where unusable; area_vec_m2 (rows, cols, 3) float32 the vector footprint
+    with scan overlap removed. block_centre_m (rows/4, cols/4, 3) and block_radius_m bound the usable pixels
+    of each 4 x 4 block (NaN where it has none); per-column spacings (m) and the highest pixel
+    (max_height_m) size the search windows.
     """
 
     ecef_m: np.ndarray
     radiance: np.ndarray
-    area_m2: np.ndarray
+    area_vec_m2: np.ndarray
     block_centre_m: np.ndarray
     block_radius_m: np.ndarray
     col_spacing_m: np.ndarray
     advance_m: np.ndarray
     det_step_m: np.ndarray
+    max_height_m: float
 
 
 @dataclass
@@ -89,9 +97,9 @@ class ViirsSwath(PixelArrays):
     def from_pieces(cls, pieces: list[SwathPiece]) -> "ViirsSwath":
         def cat(name):
             return np.concatenate([getattr(p, name) for p in pieces]) if len(pieces) > 1 else getattr(pieces[0], name)
-        stacked = [cat(name) for name in ("ecef_m", "radiance", "area_m2", "block_centre_m", "block_radius_m")]
+        stacked = [cat(name) for name in ("ecef_m", "radiance", "area_vec_m2", "block_centre_m", "block_radius_m")]
         return cls(*stacked, pieces[0].col_spacing_m, np.nanmean([p.advance_m for p in pieces], axis=0),
-                   pieces[0].det_step_m, list(pieces))
+                   pieces[0].det_step_m, max(p.max_height_m for p in pieces), list(pieces))
 
     def nearest(self, points_m):
         """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point."""
@@ -178,13 +186,14 @@ def _scan_multiplicity(scan, ends, k):
     return mult
 
 
-def swath_piece(lat_rad, lon_rad, bt_k, good, band, before=None, after=None) -> SwathPiece:
+def swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band, before=None, after=None) -> SwathPiece:
     """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
 
-    *band* (:class:`monitor.spectral.I5Band`) turns pixel BT into band radiance. *before* and *after*
-    are optional (lat_rad, lon_rad) of the neighbouring granules' adjacent scan, so that the scan
-    overlap at the granule's first and last scan is counted as inside a continuous swath. Work goes
-    scan by scan: large temporaries are slow to allocate.
+    Pixels are the 3-D points (lat_rad, lon_rad, height_m) (height above the ellipsoid; zeros for the
+    ellipsoid product). *band* (:class:`monitor.spectral.I5Band`) turns pixel BT into band radiance.
+    *before* and *after* are optional (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent
+    scan, so that the scan overlap at the granule's first and last scan is counted as inside a continuous
+    swath. Work goes scan by scan: large temporaries are slow to allocate.
     """
     rows, cols = lat_rad.shape
     nscan = rows // DETECTORS
@@ -192,20 +201,22 @@ def swath_piece(lat_rad, lon_rad, bt_k, good, band, before=None, after=None) -> 
     radiance = np.empty((rows, cols), np.float32)
     for k in range(nscan):
         sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
-        pos[sl] = wgs84.geodetic_to_ecef(lat_rad[sl], lon_rad[sl], 0.0)
+        pos[sl] = wgs84.geodetic_to_ecef(lat_rad[sl], lon_rad[sl], height_m[sl])
         radiance[sl] = band.radiance_from_bt(np.where(good[sl], bt_k[sl], np.nan))
     scan = pos.reshape(nscan, DETECTORS, cols, 3)
     ends = {k: _scan_ends(scan[k]) for k in range(nscan)}
     for k, halo in ((-1, before), (nscan, after)):
         if halo is not None:
-            ends[k] = _scan_ends(wgs84.geodetic_to_ecef(*halo, 0.0))
-    area = np.empty((rows, cols), np.float32)
+            ends[k] = _scan_ends(wgs84.geodetic_to_ecef(*halo))
+    area = np.empty((rows, cols, 3), np.float32)
     for k in range(nscan):
         sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
         cross = np.cross(_half_diff(scan[k], axis=1), _half_diff(scan[k], axis=0))
-        area[sl] = np.linalg.norm(cross, axis=-1) / _scan_multiplicity(scan[k], ends, k)
-        bad = ~(np.isfinite(radiance[sl]) & np.isfinite(area[sl]))
+        area[sl] = cross / _scan_multiplicity(scan[k], ends, k)[..., None]
+        bad = ~(np.isfinite(radiance[sl]) & np.all(np.isfinite(area[sl]), axis=-1))
         radiance[sl][bad] = np.nan
+    located = np.isfinite(radiance)
+    max_height = float(np.max(height_m[located])) if located.any() else 0.0
 
     mid = scan[nscan // 2]
     col_spacing = np.nanmedian(np.linalg.norm(_half_diff(mid, axis=1), axis=-1), axis=0)
@@ -224,18 +235,12 @@ def swath_piece(lat_rad, lon_rad, bt_k, good, band, before=None, after=None) -> 
     tree = cKDTree(centre[r_idx, c_idx])
     r_idx, c_idx = r_idx * BLOCK_PX, c_idx * BLOCK_PX
     return SwathPiece(pos, radiance, area, centre, radius, _fill_nan(col_spacing), _fill_nan(advance),
-                      _fill_nan(det_step), tree, r_idx, c_idx)
+                      _fill_nan(det_step), max(max_height, 0.0), tree, r_idx, c_idx)
 
 
-def build_swath(lat_rad, lon_rad, bt_k, good, band) -> ViirsSwath:
+def build_swath(lat_rad, lon_rad, height_m, bt_k, good, band) -> ViirsSwath:
     """A :class:`ViirsSwath` from stacked rows of consecutive VIIRS scans (one piece)."""
-    return ViirsSwath.from_pieces([swath_piece(lat_rad, lon_rad, bt_k, good, band)])
-
-
-def _ellipsoid_normal(p):
-    """Geodetic up at points on the WGS84 ellipsoid: the normalised gradient (x/a^2, y/a^2, z/b^2)."""
-    g = np.asarray(p, np.float64) * np.array([1 / wgs84.A_M**2, 1 / wgs84.A_M**2, 1 / wgs84.B_M**2])
-    return g / np.linalg.norm(g, axis=-1, keepdims=True)
+    return ViirsSwath.from_pieces([swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band)])
 
 
 def _fill_nan(a):
@@ -245,9 +250,15 @@ def _fill_nan(a):
 
 
 def _window_half_sizes(swath: ViirsSwath, col0, range_m, cos_zen, rho):
-    """Row and column half-widths of the search window around each FOV centre pixel."""
-    d_track = rho * range_m
-    d_scan = rho * range_m / np.maximum(cos_zen, 0.2)
+    """Row and column half-widths of the search window around each FOV centre pixel.
+
+    The centre is the pixel nearest the LOS's ellipsoid point; pixels on terrain of height h meet the
+    LOS up to h tan(zenith) before it, so both widths grow by that relief displacement.
+    """
+    cz = np.maximum(cos_zen, 0.2)
+    relief = swath.max_height_m * np.sqrt(1.0 - cz * cz) / cz
+    d_track = rho * range_m + relief
+    d_scan = rho * range_m / cz + relief
     adv = swath.advance_m[col0]
     det = swath.det_step_m[col0]
     overlap = np.clip(1.0 - adv / (DETECTORS * det), 0.0, 1.0)
@@ -330,9 +341,8 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     dist2 = np.einsum("kx,kx->k", vec, vec)
     dist = np.sqrt(dist2)
     d /= dist[:, None]
-    up = _ellipsoid_normal(vec + sat_m[f_idx])
-    cos_view = -np.einsum("kx,kx->k", up, vec) / dist
-    weight = swath.area_m2.reshape(-1)[pix] * cos_view / dist2  # steradians seen from CrIS
+    area = swath.area_vec_m2.reshape(-1, 3)[pix]
+    weight = np.abs(np.einsum("kx,kx->k", area, vec)) / (dist2 * dist)  # steradians seen from CrIS
     value = swath.radiance.reshape(-1)[pix].astype(np.float64)
 
     tan_a = np.tan(offsets_rad[:, None] + alpha_rad[None, :])  # (m, F)

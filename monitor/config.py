@@ -14,8 +14,10 @@ from pathlib import Path
 
 import yaml
 
-SATELLITES = ("npp", "j01", "j02")
-NODD_BUCKETS = {"npp": "noaa-nesdis-snpp-pds", "j01": "noaa-nesdis-n20-pds", "j02": "noaa-nesdis-n21-pds"}
+from monitor.satellites import SATELLITES as _TABLE
+
+SATELLITES = tuple(_TABLE)
+NODD_BUCKETS = {s.short: s.bucket for s in _TABLE.values()}
 
 
 class ConfigError(ValueError):

@@ -31,14 +31,15 @@ def geodetic_to_ecef(lat_rad, lon_rad, h_m=0.0):
     return out
 
 
-def ecef_to_geodetic(xyz_m):
-    """Geodetic (lat_rad, lon_rad, h_m) of ECEF points (..., 3); Bowring's iteration, converged to < 1 mm."""
+def ecef_to_geodetic(xyz_m, iterations=5):
+    """Geodetic (lat_rad, lon_rad, h_m) of ECEF points (..., 3); Bowring's iteration, converged to < 1 mm
+    (5 iterations hold from the ground to orbit; 2 are enough within ~10 km of the ellipsoid)."""
     xyz = np.asarray(xyz_m, float)
     x, y, z = xyz[..., 0], xyz[..., 1], xyz[..., 2]
     lon = np.arctan2(y, x)
     p = np.hypot(x, y)
     lat = np.arctan2(z, p * (1.0 - E2))
-    for _ in range(5):
+    for _ in range(iterations):
         sin_lat = np.sin(lat)
         n = A_M / np.sqrt(1.0 - E2 * sin_lat**2)
         h = p * np.cos(lat) + z * sin_lat - A_M**2 / n

@@ -21,6 +21,7 @@ import numpy as np
 from monitor.geometry import instrument, wgs84
 from monitor.geometry.geolocate import GroundView, geolocate_fovs
 from monitor.geometry.instrument import EngineeringPacket
+from monitor.mapping.residuals import ResidualTable
 from monitor.sdr import read_file
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.products import PRODUCTS
@@ -33,12 +34,18 @@ _REWRITTEN = {"Latitude": ("lat_rad", np.degrees), "Longitude": ("lon_rad", np.d
               "SatelliteAzimuthAngle": ("azimuth_rad", np.degrees), "SatelliteRange": ("range_m", None)}
 
 
-def geolocate_granule(ep: EngineeringPacket, g: CrisGeoGranule) -> GroundView:
-    """Geolocation of every FOV of *g* with the LOS of *ep* and the granule's own ephemeris and attitude."""
+def geolocate_granule(ep: EngineeringPacket, g: CrisGeoGranule, residuals: ResidualTable | None = None) -> GroundView:
+    """Geolocation of every FOV of *g* with the LOS of *ep* (turned by the per-FOR *residuals*, if given)
+    and the granule's own ephemeris and attitude."""
     if g.meta.platform != ep.satellite:
         raise ValueError(f"{g.meta.path}: granule of {g.meta.platform}, EP {ep.version} of {ep.satellite}")
-    return geolocate_fovs(instrument.los_spacecraft(ep), g.for_time_us, g.mid_time_us, g.sc_position_m,
-                          g.sc_velocity_m_s, g.sc_attitude_rad)
+    if residuals is not None and residuals.satellite != ep.satellite:
+        raise ValueError(f"residual table of {residuals.satellite}, EP {ep.version} of {ep.satellite}")
+    los = instrument.los_spacecraft(ep)
+    if residuals is not None:
+        los = residuals.apply(los)
+    return geolocate_fovs(los, g.for_time_us, g.mid_time_us, g.sc_position_m, g.sc_velocity_m_s,
+                          g.sc_attitude_rad)
 
 
 def _geo_granules(path) -> list:
@@ -63,12 +70,13 @@ class ForDistance:
                 "max_m": self.max_m}
 
 
-def compare_with_files(ep: EngineeringPacket, paths) -> list[ForDistance]:
-    """Per-FOR statistics of the distance between *ep*'s geolocation and the files' latitude/longitude."""
+def compare_with_files(ep: EngineeringPacket, paths, residuals: ResidualTable | None = None) -> list[ForDistance]:
+    """Per-FOR statistics of the distance between *ep*'s geolocation (with *residuals*, if given) and the
+    files' latitude/longitude."""
     per_for = [[] for _ in range(instrument.N_FOR)]
     for path in paths:
         for g in _geo_granules(path):
-            view = geolocate_granule(ep, g)
+            view = geolocate_granule(ep, g, residuals)
             ref = wgs84.geodetic_to_ecef(g.lat_rad, g.lon_rad, 0.0)
             d = np.linalg.norm(view.ground_ecef_m - ref, axis=-1)
             for k in range(instrument.N_FOR):
@@ -85,8 +93,9 @@ def compare_with_files(ep: EngineeringPacket, paths) -> list[ForDistance]:
     return out
 
 
-def regeolocate_file(ep: EngineeringPacket, path, out_dir) -> Path:
-    """Write a copy of the GEO file *path* into *out_dir* with its geolocation computed from *ep*."""
+def regeolocate_file(ep: EngineeringPacket, path, out_dir, residuals: ResidualTable | None = None) -> Path:
+    """Write a copy of the GEO file *path* into *out_dir* with its geolocation computed from *ep* (and the
+    per-FOR *residuals*, if given)."""
     src = Path(path).resolve()
     dst_dir = Path(out_dir).resolve()
     if dst_dir == src.parent:
@@ -101,7 +110,7 @@ def regeolocate_file(ep: EngineeringPacket, path, out_dir) -> Path:
             group = h5[GEO.data_group]
             row = 0
             for k, g in enumerate(granules):
-                view = geolocate_granule(ep, g)
+                view = geolocate_granule(ep, g, residuals)
                 rows = slice(row, row + g.lat_rad.shape[0])
                 row = rows.stop
                 for dataset, (attr, convert) in _REWRITTEN.items():
@@ -113,7 +122,9 @@ def regeolocate_file(ep: EngineeringPacket, path, out_dir) -> Path:
                     dset[rows] = np.where(keep, old, new).astype(dset.dtype)
                 _update_bounds(h5, k, view)
             group.attrs["crisgeo_engineering_packet"] = json.dumps(
-                {"version": ep.version, "satellite": ep.satellite, "provenance": ep.provenance})
+                {"version": ep.version, "satellite": ep.satellite, "provenance": ep.provenance,
+                 "residuals": None if residuals is None else {"ep_version": residuals.ep_version,
+                                                              "granules": list(residuals.granules)}})
         tmp.replace(dst)
     except BaseException:
         tmp.unlink(missing_ok=True)

@@ -90,13 +90,17 @@ VIIRS_GEO_FIELDS = {
     "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC),
 }
 
+# Terrain-corrected geolocation: Latitude/Longitude/Height is the 3-D point where the pixel's line of sight
+# meets the terrain (formats.md 1.1 note); the ellipsoid product (GIMGO) puts its pixels at h = 0.
+VIIRS_TC_GEO_FIELDS = {**VIIRS_GEO_FIELDS, "height_m": Field("Height", per="row")}
+
 PRODUCTS = {p.prefix: p for p in (
     Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
     Product("SCRIF", "CrIS-FS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
     Product("GCRSO", "CrIS-SDR-GEO", "cris_geo", fields=CRIS_GEO_FIELDS),
     Product("SVI05", "VIIRS-I5-SDR", "viirs_sdr", rows_per_scan=32, scans_reserved=48, fields=VIIRS_SDR_FIELDS),
     Product("GITCO", "VIIRS-IMG-GEO-TC", "viirs_geo", rows_per_scan=32, scans_reserved=48,
-            fields=VIIRS_GEO_FIELDS),
+            fields=VIIRS_TC_GEO_FIELDS),
     Product("GIMGO", "VIIRS-IMG-GEO", "viirs_geo", rows_per_scan=32, scans_reserved=48, fields=VIIRS_GEO_FIELDS),
 )}
 

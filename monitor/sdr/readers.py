@@ -112,7 +112,12 @@ class ViirsSdrGranule:
 
 @dataclass
 class ViirsGeoGranule:
-    """VIIRS I-band geolocation (rows, 6400) and per-scan spacecraft state."""
+    """VIIRS I-band geolocation (rows, 6400) and per-scan spacecraft state.
+
+    Each pixel is the 3-D point (lat_rad, lon_rad, height_m): GITCO gives the terrain height where the
+    pixel's line of sight meets the terrain, GIMGO (ellipsoid geolocation) has no Height and its pixels
+    are at h = 0 (``height_m`` zeros).
+    """
 
     meta: GranuleMeta
     lat_rad: np.ndarray
@@ -122,6 +127,11 @@ class ViirsGeoGranule:
     sc_position_m: np.ndarray
     sc_velocity_m_s: np.ndarray
     sc_attitude_rad: np.ndarray
+    height_m: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.height_m is None:
+            self.height_m = np.zeros_like(self.lat_rad)
 
 
 _GRANULE_TYPES = {"cris_geo": CrisGeoGranule, "cris_sdr": CrisSdrGranule, "viirs_sdr": ViirsSdrGranule,
@@ -262,6 +272,24 @@ def _check_not_all_fill(path, product: Product, granule) -> None:
     if not np.any(np.isfinite(getattr(granule, key))):
         raise GranuleError(path, f"{product.data_group}/{product.fields[key].dataset}",
                            f"granule {granule.meta.granule_id or '?'} holds only fill values")
+    if product.kind == "viirs_geo" and "height_m" in product.fields:
+        _check_height(path, f"{product.data_group}/{product.fields['height_m'].dataset}",
+                      granule.lat_rad, granule.lon_rad, granule.height_m)
+
+
+def _check_height(path, name, lat_rad, lon_rad, height_m) -> None:
+    """A terrain-corrected pixel needs its height: fill only where the pixel itself is fill."""
+    located = np.isfinite(lat_rad) & np.isfinite(lon_rad)
+    missing = located & ~np.isfinite(height_m)
+    if missing.any():
+        r, c = np.argwhere(missing)[0]
+        raise GranuleError(path, name, f"fill or non-finite at {int(missing.sum())} geolocated pixel(s), "
+                                       f"first at row {r}, column {c}")
+    bad = located & ((height_m < -500.0) | (height_m > 9000.0))
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise GranuleError(path, name, f"terrain height {float(height_m[r, c]):.6g} m at row {r}, column {c} "
+                                       f"is outside -500..9000 m")
 
 
 def _open(path: Path) -> h5py.File:
@@ -324,14 +352,18 @@ def read_metadata(path) -> list[GranuleMeta]:
 
 
 def read_viirs_geo_scan(path, scan: int):
-    """(lat_rad, lon_rad) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the end)."""
+    """(lat_rad, lon_rad, height_m) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the
+    end); height_m is zero for the ellipsoid product."""
     path = Path(path)
     with _open(path) as h5:
         product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
         if product is None:
             raise GranuleError(path, "All_Data", "no VIIRS geolocation product")
         out = []
-        for key in ("lat_rad", "lon_rad"):
+        for key in ("lat_rad", "lon_rad", "height_m"):
+            if key not in product.fields:
+                out.append(np.zeros_like(out[0]))
+                continue
             f = product.fields[key]
             name = f"{product.data_group}/{f.dataset}"
             if name not in h5:
@@ -339,4 +371,6 @@ def read_viirs_geo_scan(path, scan: int):
             rows = h5[name].shape[0]
             start = (scan % (rows // product.rows_per_scan)) * product.rows_per_scan
             out.append(_clean(path, name, h5[name][start:start + product.rows_per_scan], f))
+        if "height_m" in product.fields:
+            _check_height(path, f"{product.data_group}/Height", *out)
         return tuple(out)

@@ -1,4 +1,12 @@
-"""Simulate a case: CrIS SCRIF + GCRSO and VIIRS SVI05 + GITCO granules with an injected LOS error."""
+"""Simulate a case: CrIS SCRIF + GCRSO and VIIRS SVI05 + GITCO granules with an injected LOS error.
+
+Where the case lies on the Earth is a pass of the satellite's own orbit (:data:`PASSES`: tropics by day
+on an ascending pass, by night on a descending one, 60-81 deg N or S; optionally nearest a longitude, e.g.
+180 deg to cross the antimeridian), or by default an ascending tropical pass at a random longitude.
+With terrain, VIIRS GITCO pixels are where each line of sight meets the terrain, with their Height (as
+IDPS writes them), CrIS radiances are averaged over the true cone on the terrain, and GCRSO stays on
+the h = 0 ellipsoid with the terrain height only reported (formats.md 2.5 item 8).
+"""
 
 from __future__ import annotations
 
@@ -11,14 +19,16 @@ import numpy as np
 
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
+from monitor.satellites import satellite as satellite_info
 from monitor.sdr import iet
 from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
 from monitor.simulate import instrument as ins
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
-from monitor.simulate.orbit import CircularOrbit
+from monitor.simulate.orbit import CircularOrbit, find_pass
 from monitor.simulate.profiles import load_profile
-from monitor.simulate.scene import Scene, spectra, transmittance
+from monitor.simulate.scene import MAX_HEIGHT_M, Scene, spectra, transmittance
+from monitor.simulate.terrain import intersect_terrain
 from monitor.spectral import i5_band, planck_radiance
 
 UTC = dt.timezone.utc
@@ -27,11 +37,14 @@ GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # formats.md 1.2
 CRIS_GRANULE_S = 32.0
 VIIRS_GRANULE_S = ins.VIIRS_SCANS * ins.VIIRS_SCAN_S
 ORBIT_PERIOD_S = 6080.0
-CONE_SAMPLES = 256
+CONE_SAMPLES = 512
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
 OBPT_U16, OBPT_F32 = 65533, -999.7
+# Named passes: (geocentric latitude of the first CrIS granule, ascending). A 14-granule case covers
+# ~27 deg of orbit: "arctic" runs from 60 deg N to the orbit's turning point at 81 deg N.
+PASSES = {"day": (-14.0, True), "night": (14.0, False), "arctic": (60.0, True), "antarctic": (-60.0, False)}
 
 DEFAULT_AUX = {
     "cris": ["CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops",
@@ -61,8 +74,15 @@ class SimulationSpec:
     cris_noise: float = 0.05  # mW/(m2 sr cm-1) per channel
     true_ep: EngineeringPacket | None = None  # with ground_ep: radiances from true_ep, GEO from ground_ep
     ground_ep: EngineeringPacket | None = None
+    terrain: bool = False  # ranges and plateaus of 1-4 km over land (land fraction 0.4 instead of 0.3)
+    orbit_pass: str | None = None  # a key of PASSES: the case starts at that pass after *start*
+    pass_lon_deg: float | None = None  # with orbit_pass: the pass nearest this longitude (16-day search)
 
     def __post_init__(self):
+        if self.orbit_pass is not None and self.orbit_pass not in PASSES:
+            raise ValueError(f"orbit pass {self.orbit_pass!r} is not one of {', '.join(PASSES)}")
+        if self.pass_lon_deg is not None and self.orbit_pass is None:
+            raise ValueError("a pass longitude needs an orbit pass")
         if (self.true_ep is None) != (self.ground_ep is None):
             raise ValueError("a simulation in EP terms needs both the true EP and the ground-processing EP")
         if self.true_ep is not None:
@@ -101,10 +121,16 @@ def _utc(unix_s: float) -> dt.datetime:
 
 
 def _sunflower_disk(n: int, radius: float):
-    k = np.arange(n) + 0.5
-    r = radius * np.sqrt(k / n)
+    """*n* (even) points evenly spread over a disk: a sunflower of n/2 points and its point reflection.
+
+    A sunflower alone is off-centre by ~2e-3 of its radius (17 urad for the CrIS cone with 256 points),
+    which biased the simulated CrIS truth cross-track; the reflected pairs put the centroid at zero.
+    """
+    k = np.arange(n // 2) + 0.5
+    r = radius * np.sqrt(k / (n // 2))
     phi = k * np.pi * (3.0 - np.sqrt(5.0))
-    return r * np.cos(phi), r * np.sin(phi)
+    x, y = r * np.cos(phi), r * np.sin(phi)
+    return np.concatenate([x, -x]), np.concatenate([y, -y])
 
 
 class Simulator:
@@ -112,10 +138,21 @@ class Simulator:
 
     def __init__(self, spec: SimulationSpec):
         self.spec = spec
-        self.t0 = _unix_s(spec.start)
+        sat = satellite_info(spec.satellite)
         rng = np.random.default_rng(spec.seed)
-        self.orbit = CircularOrbit(self.t0, u0_deg=-14.0 + rng.uniform(-3, 3), lon0_deg=rng.uniform(-180, 180))
-        self.scene = Scene(spec.seed)
+        night = False
+        if spec.orbit_pass is None:
+            self.t0 = _unix_s(spec.start)
+            self.orbit = CircularOrbit.through(self.t0, lon0_deg=rng.uniform(-180, 180),
+                                               u0_deg=-14.0 + rng.uniform(-3, 3), altitude_m=sat.altitude_m,
+                                               inclination_deg=sat.inclination_deg)
+        else:
+            lat, ascending = PASSES[spec.orbit_pass]
+            self.t0 = round(find_pass(sat, _unix_s(spec.start), lat, ascending, spec.pass_lon_deg), 1)
+            self.orbit = CircularOrbit.of(sat, self.t0)
+            night = not ascending  # the descending node of a 13:30 orbit is at 01:30 local time
+        self.scene = Scene(spec.seed, land_fraction=0.4 if spec.terrain else 0.3, terrain=spec.terrain,
+                           night=night)
         self.band = i5_band(spec.satellite)
         self.nu = cris_lw_wavenumbers_cm1()
         tau = transmittance(self.nu)
@@ -156,6 +193,7 @@ class Simulator:
         ground = sat + t[..., None] * geo_ecef
         lat, lon, _ = wgs84.ecef_to_geodetic(ground)
         zen, az, rng_m = wgs84.zenith_azimuth(ground, sat)
+        height = self.scene.height_m(lat, lon)  # reported only: GCRSO points are on the ellipsoid
         if spec.cris_sdr:
             radiance = self._cris_spectra(sat, true_ecef)
             radiance += self.rng.normal(0.0, spec.cris_noise, radiance.shape)
@@ -172,7 +210,7 @@ class Simulator:
         geo = {
             "FORTime": for_iet, "StartTime": start_iet, "MidTime": mid_iet,
             "Latitude": np.degrees(lat).astype(np.float32), "Longitude": np.degrees(lon).astype(np.float32),
-            "Height": np.zeros(lat.shape, np.float32),
+            "Height": height.astype(np.float32),
             "SatelliteRange": rng_m.astype(np.float32),
             "SatelliteZenithAngle": np.degrees(zen).astype(np.float32),
             "SatelliteAzimuthAngle": np.degrees(az).astype(np.float32),
@@ -202,6 +240,13 @@ class Simulator:
             names.append(name)
         return names
 
+    def _surface(self, origin, los):
+        """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is one."""
+        if not self.spec.terrain:
+            pts = origin + wgs84.intersect_ellipsoid(origin, los)[..., None] * los
+            return wgs84.ecef_to_geodetic(pts)
+        return intersect_terrain(origin, los, self.scene.height_m, MAX_HEIGHT_M)[1:]
+
     def _cris_spectra(self, sat, los_ecef):
         """LW spectra (nscan, 30, 9, 717) averaged over each true FOV cone on the scene, not the VIIRS grid."""
         x, y = _sunflower_disk(CONE_SAMPLES, np.tan(ins.CRIS_FOV_HALF_ANGLE_RAD))
@@ -210,9 +255,7 @@ class Simulator:
         e2 = np.cross(los_ecef, e1)
         dirs = frames.unit(los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :])
         origin = np.broadcast_to(sat[..., None, :], dirs.shape)
-        pts = origin + wgs84.intersect_ellipsoid(origin, dirs)[..., None] * dirs
-        lat, lon, _ = wgs84.ecef_to_geodetic(pts)
-        temp = self.scene.temperature_k(lat, lon).reshape(-1, CONE_SAMPLES)
+        temp = self.scene.temperature_k(*self._surface(origin, dirs)).reshape(-1, CONE_SAMPLES)
         nfov = temp.shape[0]
         pos = (np.clip(temp, T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (T_BINS_K[1] - T_BINS_K[0])
         b0 = np.floor(pos).astype(np.int64)
@@ -234,6 +277,7 @@ class Simulator:
         nrow = ins.VIIRS_SCANS * ins.VIIRS_DETECTORS
         lat_out = np.empty((nrow, ins.VIIRS_COLUMNS), np.float32)
         lon_out = np.empty_like(lat_out)
+        h_out = np.empty_like(lat_out)
         bt_dn = np.empty((nrow, ins.VIIRS_COLUMNS), np.uint16)
         rad_dn = np.empty_like(bt_dn)
         scan_start = g0 + np.arange(ins.VIIRS_SCANS) * ins.VIIRS_SCAN_S
@@ -244,14 +288,14 @@ class Simulator:
             r, _, m = self.state(tt)  # (n, 6400, 3), (n, 6400, 3, 3)
             los = np.einsum("scij,dcj->sdci", m, los_sbf)
             origin = np.broadcast_to(r[:, None], los.shape)
-            pts = origin + wgs84.intersect_ellipsoid(origin, los)[..., None] * los
-            lat, lon, _ = wgs84.ecef_to_geodetic(pts)
-            temp = self.scene.temperature_k(lat, lon)
+            lat, lon, h = self._surface(origin, los)
+            temp = self.scene.temperature_k(lat, lon, h)
             lrad = np.interp(temp, T_BINS_K, self.band_table)
             bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, temp.shape)
             rows = slice(s0 * 32, (s0 + lat.shape[0]) * 32)
             lat_out[rows] = np.degrees(lat).reshape(-1, ins.VIIRS_COLUMNS)
             lon_out[rows] = np.degrees(lon).reshape(-1, ins.VIIRS_COLUMNS)
+            h_out[rows] = h.reshape(-1, ins.VIIRS_COLUMNS)
             bt_dn[rows] = np.clip(np.round((bt - BT_OFFSET) / BT_SCALE), 0, 65527).reshape(-1, ins.VIIRS_COLUMNS)
             # W/(m2 sr um) from mW/(m2 sr cm-1): L_lambda = L_nu * nu^2 / 1e4 / 1e3
             lam = self.band.radiance_from_bt(bt) * cwv**2 * 1e-7
@@ -261,6 +305,7 @@ class Simulator:
         rad_dn[mask] = OBPT_U16
         lat_out[mask] = OBPT_F32
         lon_out[mask] = OBPT_F32
+        h_out[mask] = OBPT_F32
 
         start_iet = _iet_us(scan_start)
         mid_iet = start_iet + int(ins.VIIRS_EARTH_VIEW_S / 2 * 1e6)
@@ -277,7 +322,7 @@ class Simulator:
                     "SCVelocity": v_mid.astype(np.float32), "SCAttitude": att_mid.astype(np.float32),
                     "QF1_SCAN_VIIRSSDRGEO": np.zeros(ins.VIIRS_SCANS, np.uint8),
                     "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32)}
-        geo = {"Latitude": lat_out, "Longitude": lon_out, "Height": np.zeros_like(lat_out),
+        geo = {"Latitude": lat_out, "Longitude": lon_out, "Height": h_out,
                "QF2_VIIRSSDRGEO": np.zeros(lat_out.shape, np.uint8), **per_scan}
         sdr = {"BrightnessTemperature": bt_dn, "BrightnessTemperatureFactors": np.array([BT_SCALE, BT_OFFSET], np.float32),
                "Radiance": rad_dn, "RadianceFactors": np.array([RAD_SCALE, RAD_OFFSET], np.float32),
@@ -324,7 +369,8 @@ class Simulator:
 
 
 def simulate_case(out_dir, satellite="j01", granules=14, profile="paper", seed=0, start=None,
-                  spec: SimulationSpec | None = None, viirs: bool = True) -> dict:
+                  spec: SimulationSpec | None = None, viirs: bool = True, terrain: bool = False,
+                  orbit_pass: str | None = None, pass_lon_deg: float | None = None) -> dict:
     """Write a case's granules into *out_dir* and ``truth.json``; return the truth document."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -332,7 +378,8 @@ def simulate_case(out_dir, satellite="j01", granules=14, profile="paper", seed=0
         d_alpha, d_beta = load_profile(profile, seed)
         spec = SimulationSpec(satellite=satellite, granules=granules, d_alpha_urad=np.asarray(d_alpha, float),
                               d_beta_urad=np.asarray(d_beta, float), seed=seed,
-                              start=start or DEFAULT_START, profile=profile)
+                              start=start or DEFAULT_START, profile=profile, terrain=terrain,
+                              orbit_pass=orbit_pass, pass_lon_deg=pass_lon_deg)
     sim = Simulator(spec)
     files = []
     for k in range(spec.granules):
@@ -343,6 +390,8 @@ def simulate_case(out_dir, satellite="j01", granules=14, profile="paper", seed=0
     truth = {
         "satellite": spec.satellite, "profile": spec.profile, "seed": spec.seed,
         "start": spec.start.isoformat(), "granules": spec.granules, "files": sorted(files),
+        "first_granule_start": _utc(sim.t0).isoformat(), "orbit_pass": spec.orbit_pass,
+        "pass_lon_deg": spec.pass_lon_deg, "terrain": spec.terrain,
         "engineering_packets": None if spec.true_ep is None else
         {"true": spec.true_ep.version, "ground": spec.ground_ep.version},
         "fors": [{"for": k + 1, "d_alpha_urad": float(a), "d_beta_urad": float(b)}

@@ -1,35 +1,65 @@
-"""A circular sun-synchronous-like orbit: analytic ECI motion turned into ECEF by the Earth rotation angle."""
+"""Circular sun-synchronous orbits: analytic ECI motion turned into ECEF by the Earth rotation angle.
+
+Each satellite's orbit comes from :mod:`monitor.satellites` (altitude, inclination, local time of the
+ascending node, phase). :func:`find_pass` picks the start of a pass (ascending or descending through
+a latitude, optionally nearest a longitude) so that a simulated case can be put anywhere on the Earth:
+tropics by day or night, high latitudes, across the 180 deg meridian.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
 from monitor.geometry.wgs84 import A_M, GM_M3_S2, OMEGA_EARTH_RAD_S
+from monitor.satellites import NODAL_PERIOD_S, PHASE_EPOCH_UNIX_S, Satellite
 
 J2000_UNIX_S = 946728000.0  # 2000-01-01T12:00:00 UTC
+DAY_S = 86400.0
 
 
 def earth_rotation_angle(unix_s):
     """Earth rotation angle (rad) at UTC seconds since 1970 (UT1 taken as UTC; IERS 2010 eq. 5.15)."""
-    d = (np.asarray(unix_s, float) - J2000_UNIX_S) / 86400.0
+    d = (np.asarray(unix_s, float) - J2000_UNIX_S) / DAY_S
     return 2 * np.pi * ((0.7790572732640 + 0.00273781191135448 * d + d) % 1.0)
 
 
+def mean_sun_right_ascension(unix_s):
+    """Right ascension (rad) of the mean Sun: its mean longitude 280.460 + 0.9856474 deg/day from J2000
+    (the equation of time, < 4.5 deg, is left out: a sun-synchronous node follows the mean Sun)."""
+    d = (np.asarray(unix_s, float) - J2000_UNIX_S) / DAY_S
+    return np.radians((280.460 + 0.9856474 * d) % 360.0)
+
+
 class CircularOrbit:
-    """Circular orbit of *altitude_m* and *inclination_deg*; argument of latitude *u0_deg* at *t0_unix_s*.
+    """Circular orbit of *altitude_m* and *inclination_deg*: argument of latitude *u0_rad* and right
+    ascension of the ascending node *raan_rad* at *t0_unix_s* (UTC seconds since 1970)."""
 
-    The ascending node's right ascension is chosen so the sub-satellite point at t0 is at *lon0_deg*.
-    """
-
-    def __init__(self, t0_unix_s, altitude_m=828e3, inclination_deg=98.74, u0_deg=-14.0, lon0_deg=-160.0):
+    def __init__(self, t0_unix_s, altitude_m=828e3, inclination_deg=98.74, u0_rad=np.radians(-14.0),
+                 raan_rad=0.0):
         self.t0 = float(t0_unix_s)
         self.a = A_M + altitude_m
         self.n = np.sqrt(GM_M3_S2 / self.a**3)
         self.i = np.radians(inclination_deg)
-        self.u0 = np.radians(u0_deg)
-        x, y, _ = self._orbit_plane(self.u0, 0.0)
-        ra_of_point = np.arctan2(y, x)
-        self.raan = np.radians(lon0_deg) + earth_rotation_angle(self.t0) - ra_of_point
+        self.u0 = float(u0_rad)
+        self.raan = float(raan_rad)
+
+    @classmethod
+    def through(cls, t0_unix_s, lon0_deg=-160.0, u0_deg=-14.0, altitude_m=828e3, inclination_deg=98.74):
+        """The orbit whose sub-satellite point at *t0_unix_s* is at longitude *lon0_deg*, argument of
+        latitude *u0_deg*."""
+        orbit = cls(t0_unix_s, altitude_m, inclination_deg, np.radians(u0_deg), 0.0)
+        x, y, _ = orbit._orbit_plane(orbit.u0, 0.0)
+        orbit.raan = np.radians(lon0_deg) + earth_rotation_angle(orbit.t0) - np.arctan2(y, x)
+        return orbit
+
+    @classmethod
+    def of(cls, sat: Satellite, t0_unix_s):
+        """The satellite's own orbit at *t0_unix_s*: node from the local time of the ascending node,
+        argument of latitude from the phase."""
+        orbit = cls(t0_unix_s, sat.altitude_m, sat.inclination_deg)
+        orbit.u0 = float(_argument_of_latitude(sat, t0_unix_s))
+        orbit.raan = float(_node_right_ascension(sat, t0_unix_s))
+        return orbit
 
     def _orbit_plane(self, u, raan):
         ci, si = np.cos(self.i), np.sin(self.i)
@@ -56,3 +86,40 @@ class CircularOrbit:
         r_e = rot(r)
         v_e = rot(v) - np.cross([0.0, 0.0, OMEGA_EARTH_RAD_S], r_e)
         return r_e, v_e
+
+
+def _node_right_ascension(sat: Satellite, unix_s):
+    return mean_sun_right_ascension(unix_s) + np.radians((sat.ltan_h - 12.0) * 15.0)
+
+
+def _argument_of_latitude(sat: Satellite, unix_s):
+    """Mean argument of latitude (rad): the satellite's phase advancing with the shared orbit's period."""
+    return np.radians(sat.phase_deg) + 2 * np.pi * (np.asarray(unix_s, float) - PHASE_EPOCH_UNIX_S) / NODAL_PERIOD_S
+
+
+def find_pass(sat: Satellite, after_unix_s: float, lat_deg: float, ascending: bool = True,
+              lon_deg: float | None = None, days: int = 16, step_s: float = 5.0) -> float:
+    """UTC seconds of the satellite's sub-point crossing *lat_deg* (geocentric, northbound when
+    *ascending*) after *after_unix_s*; with *lon_deg*, the crossing nearest that longitude within
+    *days* (16: the JPSS repeat cycle, so every longitude comes within ~1 deg). ValueError if the
+    latitude is beyond the orbit's reach."""
+    if abs(np.sin(np.radians(lat_deg))) >= np.sin(np.radians(180.0 - sat.inclination_deg)):
+        raise ValueError(f"latitude {lat_deg} deg is beyond the reach of the {sat.name} orbit")
+    t = after_unix_s + np.arange(0.0, (days if lon_deg is not None else 1) * DAY_S, step_s)
+    u = _argument_of_latitude(sat, t)
+    i = np.radians(sat.inclination_deg)
+    lat = np.arcsin(np.sin(i) * np.sin(u))
+    northbound = np.cos(u) * np.sin(i) > 0
+    target = np.radians(lat_deg)
+    cross = np.flatnonzero((lat[:-1] - target) * (lat[1:] - target) <= 0)
+    cross = cross[northbound[cross] == ascending]
+    frac = (target - lat[cross]) / (lat[cross + 1] - lat[cross])
+    t_cross = t[cross] + frac * step_s
+    if lon_deg is None:
+        return float(t_cross[0])
+    raan = _node_right_ascension(sat, t_cross)
+    u_c = _argument_of_latitude(sat, t_cross)
+    ra = raan + np.arctan2(np.cos(i) * np.sin(u_c), np.cos(u_c))
+    lon = ra - earth_rotation_angle(t_cross)
+    miss = np.angle(np.exp(1j * (lon - np.radians(lon_deg))))
+    return float(t_cross[np.argmin(np.abs(miss))])

@@ -1,10 +1,21 @@
-"""A synthetic Earth in the thermal infrared: ocean, coastlines and broken cloud, deterministic by seed.
+"""A synthetic Earth in the thermal infrared: ocean, land, terrain and broken cloud, deterministic by seed.
 
-The scene is an emitting temperature T(lat, lon) (K): sea-surface temperature falling with latitude,
-land with its own temperature and texture, and clouds whose tops are colder, mixed by a cloud fraction
-with soft edges. Fields are periodic random fields on a 0.01 deg grid (period ~41 deg), so any orbit
-segment sees clouds at scales from ~2 km to hundreds of km. Spectra add a simple atmosphere:
-R(nu) = tau(nu) B(nu, T) + (1 - tau(nu)) B(nu, T_atm).
+The scene is an emitting temperature T(lat, lon, h) (K): sea-surface temperature falling with latitude,
+land warmer by day and colder by night with its own texture, colder with altitude (lapse rate), and
+clouds (more of them over high ground) whose tops are colder, mixed by a cloud fraction with soft edges.
+
+Fields live on the sphere, not on a latitude/longitude grid, so that nothing breaks at the 180 deg
+meridian or near the poles: each is a blend of three periodic random fields on the planes normal to
+the x, y and z axes ("triplanar"), weighted by the fourth power of the direction cosines and scaled to
+keep unit variance. The cloud field has 1.1 km cells (period ~2250 km), the land, terrain, cloud-top and
+texture fields 4.4 km cells, so an orbit segment sees clouds at scales from ~2 km to hundreds of km.
+
+Terrain (optional): ranges and plateaus of 1-4 km over land, rising from sea level over a coastal ramp
+of some tens of km. Its slopes stay below ``MAX_SLOPE`` (0.4, ~22 deg), so a line of sight from the
+satellite meets it once except on the steepest slopes seen at the very edge of the VIIRS swath (at view
+zenith z a ray can meet a slope s twice only when s > cot z; cot 68 deg = 0.4).
+
+Spectra add a simple atmosphere: R(nu) = tau(nu) B(nu, T) + (1 - tau(nu)) B(nu, T_atm).
 """
 
 from __future__ import annotations
@@ -13,9 +24,15 @@ import numpy as np
 
 from monitor.spectral import planck_radiance
 
-GRID_DEG = 0.01
-GRID_N = 4096
+EARTH_RADIUS_KM = 6371.0
+FINE_KM, FINE_N = 1.1, 2048
+COARSE_KM, COARSE_N = 4.4, 512
 T_ATM_K = 262.0
+LAPSE_K_PER_M = 6.5e-3
+LAND_DAY_K, LAND_NIGHT_K = 6.0, -5.0
+MAX_SLOPE = 0.4
+MAX_HEIGHT_M = 4000.0
+CLOUD_PER_M = 0.15e-3  # more cloud over high ground: the cloud field's threshold drops 0.15 per km
 
 
 def _random_field(rng, n, slope, low_cut):
@@ -29,48 +46,113 @@ def _random_field(rng, n, slope, low_cut):
     return ((f - f.mean()) / f.std()).astype(np.float32)
 
 
+def _unit_vectors(lat_rad, lon_rad):
+    lat = np.asarray(lat_rad, np.float64)
+    lon = np.asarray(lon_rad, np.float64)
+    c = np.cos(lat)
+    return c * np.cos(lon), c * np.sin(lon), np.sin(lat)
+
+
+class _Triplanar:
+    """Bilinear samples of stacked periodic fields (3 planes, n, n, channels) blended over the three planes."""
+
+    def __init__(self, fields, cell_km):
+        self.n = fields.shape[1]
+        self.flat = [np.ascontiguousarray(f.reshape(self.n * self.n, -1)) for f in fields]
+        self.scale = np.float32(EARTH_RADIUS_KM / cell_km)
+
+    def __call__(self, xyz):
+        x, y, z = (np.asarray(c, np.float32) for c in xyz)
+        w = [x**4, y**4, z**4]
+        norm = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+        out = None
+        for p, (u, v) in enumerate(((y, z), (z, x), (x, y))):
+            term = self._bilinear(p, u * self.scale, v * self.scale)
+            term *= (w[p] / norm)[..., None]
+            out = term if out is None else out + term
+        return out
+
+    def _bilinear(self, p, u, v):
+        n, mask = self.n, self.n - 1  # n is a power of two: modulo by mask
+        u0, v0 = np.floor(u), np.floor(v)
+        fu = (u - u0)[..., None]
+        fv = (v - v0)[..., None]
+        i0 = u0.astype(np.int32) & mask
+        j0 = v0.astype(np.int32) & mask
+        i1 = ((i0 + 1) & mask) * n
+        j1 = (j0 + 1) & mask
+        i0 *= n
+        f = self.flat[p]
+        a = f.take(i0 + j0, axis=0)
+        a += (f.take(i0 + j1, axis=0) - a) * fv
+        b = f.take(i1 + j0, axis=0)
+        b += (f.take(i1 + j1, axis=0) - b) * fv
+        a += (b - a) * fu
+        return a
+
+
 class Scene:
-    """Emitting temperature of the synthetic Earth; ``temperature_k(lat_rad, lon_rad)``."""
+    """Emitting temperature and terrain of the synthetic Earth.
 
-    def __init__(self, seed: int = 0, cloud_fraction: float = 0.45, land_fraction: float = 0.3):
+    ``temperature_k(lat_rad, lon_rad, height_m)`` and ``height_m(lat_rad, lon_rad)`` (zero without
+    *terrain*); *night* makes land colder than the sea instead of warmer.
+    """
+
+    def __init__(self, seed: int = 0, cloud_fraction: float = 0.45, land_fraction: float = 0.3,
+                 terrain: bool = False, night: bool = False):
         rng = np.random.default_rng(seed)
-        self.cloud = _random_field(rng, GRID_N, slope=3.2, low_cut=4)
-        small = GRID_N // 4
-        self.land = _random_field(rng, small, slope=3.6, low_cut=2)
-        self.top = _random_field(rng, small, slope=3.0, low_cut=2)
-        self.texture = _random_field(rng, small, slope=2.5, low_cut=2)
-        self.cloud_threshold = float(np.quantile(self.cloud[::8, ::8], 1.0 - cloud_fraction))
-        self.land_threshold = float(np.quantile(self.land[::4, ::4], 1.0 - land_fraction))
+        self.terrain = terrain
+        self.land_offset_k = LAND_NIGHT_K if night else LAND_DAY_K
+        self.cloud = _Triplanar(np.stack([_random_field(rng, FINE_N, 3.2, 4) for _ in range(3)])[..., None],
+                                FINE_KM)
+        # land, terrain relief and ridges (the shape of the Earth); cloud top and land texture
+        coarse = [[_random_field(rng, COARSE_N, s, 2) for s in (3.6, 4.0, 3.0, 3.0, 2.5)] for _ in range(3)]
+        self.shape = _Triplanar(np.stack([np.stack(c[:3], -1) for c in coarse]), COARSE_KM)
+        self.surface = _Triplanar(np.stack([np.stack(c[3:], -1) for c in coarse]), COARSE_KM)
+        probe = self.shape(_unit_vectors(*np.radians(np.meshgrid(np.linspace(-80, 80, 161),
+                                                                  np.linspace(-180, 180, 361)))))
+        self.cloud_threshold = float(np.quantile(self.cloud.flat[0][::61, 0], 1.0 - cloud_fraction))
+        self.land_threshold = float(np.quantile(probe[..., 0], 1.0 - land_fraction))
+        self.relief_gain = 1.0
+        if terrain:
+            self.relief_gain = min(1.0, MAX_SLOPE / self._max_slope())
 
-    @staticmethod
-    def _weights(n, lat_rad, lon_rad, cell_deg):
-        y = np.asarray(lat_rad, np.float64) * (180.0 / np.pi / cell_deg)
-        x = np.asarray(lon_rad, np.float64) * (180.0 / np.pi / cell_deg)
-        y0 = np.floor(y)
-        x0 = np.floor(x)
-        fy = (y - y0).astype(np.float32)
-        fx = (x - x0).astype(np.float32)
-        i0 = y0.astype(np.int64) % n
-        j0 = x0.astype(np.int64) % n
-        return i0 * n + j0, i0 * n + (j0 + 1) % n, ((i0 + 1) % n) * n + j0, ((i0 + 1) % n) * n + (j0 + 1) % n, fy, fx
 
-    @staticmethod
-    def _sample(field, w):
-        a, b, c, d, fy, fx = w
-        f = field.ravel()
-        return (f[a] * (1 - fx) + f[b] * fx) * (1 - fy) + (f[c] * (1 - fx) + f[d] * fx) * fy
+    def _height(self, land, relief, ridges):
+        """Terrain height (m): a coastal ramp times ranges (ridged noise) on plateaus (a squashed field)."""
+        coast = np.clip((land - self.land_threshold) / 1.0, 0.0, 1.0)
+        coast = coast * coast * (3 - 2 * coast)  # smoothstep: no cliff at the shore
+        plateau = 2200.0 + 1300.0 * np.tanh(1.2 * relief)
+        ridge = 700.0 * (1.0 - np.abs(np.tanh(ridges)))
+        return (coast * np.minimum(plateau + ridge, MAX_HEIGHT_M) * self.relief_gain).astype(np.float32)
 
-    def temperature_k(self, lat_rad, lon_rad):
-        """Emitting temperature (K) at geodetic *lat_rad*, *lon_rad*; float32, same shape."""
-        coarse = GRID_DEG * GRID_N / self.land.shape[0]
-        wc = self._weights(self.land.shape[0], lat_rad, lon_rad, coarse)
+    def _max_slope(self):
+        """Largest terrain slope on a 1 km probe grid over a few thousand km (the field is stationary)."""
+        step_rad = 1.0 / EARTH_RADIUS_KM
+        lat = np.arange(-0.15, 0.15, step_rad)
+        lat, lon = np.meshgrid(lat, np.arange(0.0, 0.3, step_rad), indexing="ij")
+        h = self._height(*np.moveaxis(self.shape(_unit_vectors(lat, lon)), -1, 0))
+        gy, gx = np.gradient(h, 1000.0)
+        return float(np.max(np.hypot(gx, gy)))
+
+    def height_m(self, lat_rad, lon_rad):
+        """Terrain height (m) above the ellipsoid at geodetic *lat_rad*, *lon_rad*; float32."""
+        if not self.terrain:
+            return np.zeros(np.shape(lat_rad), np.float32)
+        return self._height(*np.moveaxis(self.shape(_unit_vectors(lat_rad, lon_rad)), -1, 0))
+
+    def temperature_k(self, lat_rad, lon_rad, height_m=None):
+        """Emitting temperature (K) at geodetic *lat_rad*, *lon_rad* and terrain height *height_m*."""
+        xyz = _unit_vectors(lat_rad, lon_rad)
+        land = self.shape(xyz)[..., 0]
+        top, texture = np.moveaxis(self.surface(xyz), -1, 0)
+        h = np.zeros(np.shape(lat_rad), np.float32) if height_m is None else np.asarray(height_m, np.float32)
         sst = (301.0 - 12.0 * np.sin(np.asarray(lat_rad)) ** 2).astype(np.float32)
-        land_frac = np.clip((self._sample(self.land, wc) - self.land_threshold) / 0.05, 0.0, 1.0)
-        surface = sst + land_frac * (6.0 + 3.0 * self._sample(self.texture, wc))
-        top = 245.0 + 18.0 * self._sample(self.top, wc)
-        del wc
-        cover = np.clip((self._sample(self.cloud, self._weights(GRID_N, lat_rad, lon_rad, GRID_DEG))
-                         - self.cloud_threshold) / 0.6, 0.0, 1.0)
+        land_frac = np.clip((land - self.land_threshold) / 0.05, 0.0, 1.0)
+        surface = sst + land_frac * (self.land_offset_k + 3.0 * texture) - LAPSE_K_PER_M * h
+        top = 245.0 + 18.0 * top
+        cloud = self.cloud(xyz)[..., 0]
+        cover = np.clip((cloud - self.cloud_threshold + CLOUD_PER_M * h) / 0.6, 0.0, 1.0)
         return (surface * (1 - cover) + np.minimum(top, surface) * cover).astype(np.float32)
 
 

@@ -22,7 +22,7 @@ def test_perturbed_los_centre_is_the_original_and_axes_are_consistent():
 
 
 def test_offsets_in_km_at_nadir_and_edge():
-    orbit = CircularOrbit(1.7e9)
+    orbit = CircularOrbit.through(1.7e9)
     r, v = orbit.state_ecef(1.7e9)
     m = frames.sbf_to_ecef(r, v, np.zeros(3))
     h = np.linalg.norm(r) - 6378137.0

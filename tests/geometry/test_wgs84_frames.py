@@ -42,7 +42,7 @@ def _rot3(theta):
 
 def test_ocs_in_ecef_with_inertial_velocity_equals_eci_construction():
     """The ECEF shortcut of frames.ocs_axes_ecef gives the same LOS angles as building the OCS in ECI."""
-    orbit = CircularOrbit(1.7e9)
+    orbit = CircularOrbit.through(1.7e9)
     t = 1.7e9 + np.linspace(0, 600, 7)
     r_eci, v_eci = orbit.state_eci(t)
     r_ecef, v_ecef = orbit.state_ecef(t)
@@ -64,7 +64,7 @@ def test_ocs_in_ecef_with_inertial_velocity_equals_eci_construction():
 
 
 def test_ecef_velocity_alone_would_be_wrong():
-    orbit = CircularOrbit(1.7e9)
+    orbit = CircularOrbit.through(1.7e9)
     r, v = orbit.state_ecef(1.7e9)
     good = frames.ocs_axes_ecef(r, v)
     naive_y = frames.unit(np.cross(-wgs84.geodetic_up(r), v))

@@ -160,5 +160,48 @@ def test_viirs_files_scaled_and_bowtie_filled(cases):
     assert np.isnan(sdr.bt_k[0, :2016]).all() and np.isfinite(sdr.bt_k[0, 2016:4384]).all()
     assert np.isnan(geo.lat_rad[31, -2016:]).all() and np.isfinite(geo.lat_rad[15]).all()
     assert np.isnan(sdr.bt_k[2, :1280]).all() and np.isfinite(sdr.bt_k[2, 1280]).all()
-    lat, lon = read_viirs_geo_scan(next(out.glob("GITCO_*.h5")), -1)
+    lat, lon, height = read_viirs_geo_scan(next(out.glob("GITCO_*.h5")), -1)
     np.testing.assert_array_equal(lat, geo.lat_rad[-32:])
+    np.testing.assert_array_equal(height, geo.height_m[-32:])
+
+
+def _edit(path, dataset, edit):
+    with h5py.File(path, "r+") as h5:
+        d = h5[f"{PRODUCTS['GITCO'].data_group}/{dataset}"]
+        d[...] = edit(d[()])
+
+
+def test_gitco_height_is_read_and_checked(cases, tmp_path):
+    out, _, _ = cases.get()
+    src = next(out.glob("GITCO_*.h5"))
+    (geo,) = read_file(src)
+    assert geo.height_m.shape == geo.lat_rad.shape
+    assert np.array_equal(np.isnan(geo.height_m), np.isnan(geo.lat_rad))  # fill only where the pixel is fill
+    for dataset, edit, reason in (
+            ("Height", lambda h: np.where(np.arange(h.shape[1]) == 3000, np.float32(-999.3), h), "fill or non-finite"),
+            ("Height", lambda h: np.where(h > -999, np.float32(12000.0), h), "outside -500..9000 m")):
+        bad = _copy(src, tmp_path / src.name)
+        _edit(bad, dataset, edit)
+        with pytest.raises(GranuleError, match=f"{bad.name}: .*/Height: .*{reason}"):
+            read_file(bad)
+        bad.unlink()
+    bad = _copy(src, tmp_path / src.name)
+    with h5py.File(bad, "r+") as h5:
+        del h5[f"{PRODUCTS['GITCO'].data_group}/Height"]
+    with pytest.raises(GranuleError, match="Height: missing dataset"):
+        read_file(bad)
+
+
+def test_gimgo_pixels_are_on_the_ellipsoid(cases, tmp_path):
+    """The ellipsoid product has no Height: its pixels are at h = 0."""
+    out, _, _ = cases.get()
+    src = next(out.glob("GITCO_*.h5"))
+    with h5py.File(src, "r") as h5:
+        p = PRODUCTS["GITCO"]
+        data = {k: v[()] for k, v in h5[p.data_group].items() if k != "Height"}
+        attrs = _gran_attrs(h5, p.collection)
+    dst = tmp_path / src.name.replace("GITCO_", "GIMGO_")
+    write_file(dst, "j01", dt.datetime(2024, 6, 1, tzinfo=dt.timezone.utc),
+               [ProductData(PRODUCTS["GIMGO"], "VIIRS", "GEO", data, [attrs], {}, fills={}, compress=False)])
+    (geo,) = read_file(dst)
+    assert np.all(geo.height_m == 0) and read_viirs_geo_scan(dst, 0)[2].max() == 0

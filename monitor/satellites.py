@@ -1,0 +1,45 @@
+"""The JPSS satellites the monitor knows: one table, from which names, buckets and orbits are derived.
+
+Orbits (mean elements of a circular sun-synchronous orbit, ascending node at 13:30 local solar time):
+S-NPP mean altitude 838.8 km and inclination 98.67 deg (Lin et al. 2016, "Trending of SNPP ephemeris and
+its implications on VIIRS geometric performance", drag make-up and inclination maneuvers keep them);
+NOAA-21 833 km, 98.8 deg (NASA mission facts); NOAA-20 flies the same orbit. Phasing as flown since the
+NOAA-20 rephasing of April 2024: NOAA-21 a quarter orbit ahead of S-NPP, NOAA-20 directly opposite
+NOAA-21 (a quarter orbit behind S-NPP). The phase reference itself (S-NPP at the ascending node at
+``PHASE_EPOCH_UNIX_S``, advancing with the shared ``NODAL_PERIOD_S``) is illustrative: the simulator needs consistent, not operational, ephemerides.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Satellite:
+    """One satellite: file-name platform, IDPS platform name, long name, NODD bucket and mean orbit."""
+
+    short: str  # platform in JPSS file names: npp, j01, j02
+    idps: str  # HDF5 Platform_Short_Name
+    name: str  # the name people use
+    bucket: str  # NOAA Open Data Dissemination (NODD) bucket
+    altitude_m: float  # mean altitude above the equatorial radius
+    inclination_deg: float
+    ltan_h: float  # local solar time of the ascending node, hours
+    phase_deg: float  # mean argument of latitude ahead of S-NPP
+
+
+SATELLITES = {s.short: s for s in (
+    Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0),
+    Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0),
+    Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0),
+)}
+PHASE_EPOCH_UNIX_S = 1704067200.0  # 2024-01-01T00:00:00Z
+NODAL_PERIOD_S = 101.5 * 60.0  # the shared orbit's period (Lin et al. 2016): the phases keep their spacing
+
+
+def satellite(short: str) -> Satellite:
+    """The satellite of a file-name platform (npp, j01, j02); ValueError naming the known ones."""
+    try:
+        return SATELLITES[short]
+    except KeyError:
+        raise ValueError(f"unknown satellite {short!r} (known: {', '.join(SATELLITES)})") from None
