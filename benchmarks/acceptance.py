@@ -28,7 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from monitor.assess import AssessConfig, assess_paths
-from monitor.simulate.case import PASSES, simulate_case
+from monitor.simulate.case import simulate_case
+from monitor.simulate.orbit import PASSES
 
 BOUNDS = {14: (10.0, 25.0)}  # granules: (RMS, worst FOR) urad; smaller cases get SMALL_BOUNDS
 SMALL_BOUNDS = (12.0, 30.0)
@@ -110,14 +111,22 @@ def main() -> int:
     print(f"{'profile':<7} {'ground':<8} {'pass':<9} {'seed':>4} {'gran':>4} {'rms_a':>6} {'max_a':>6} {'rms_b':>6} "
           f"{'max_b':>6} {'flagged':>7} {'assess_s':>8}  verdict", flush=True)
     rows, failures = [], 0
+    done = {}
+    if args.rows and Path(args.rows).exists():  # resume: cases already in the rows file are not run again
+        for line in Path(args.rows).read_text().splitlines():
+            if line.strip():
+                r = json.loads(line)
+                done[(r["size"], r["ground"], r["pass"], r["profile"], r["seed"])] = r
     for size in args.sizes:
         for ground in args.ground:
             for pass_name in args.passes:
                 for profile in args.profiles:
                     for seed in args.seeds:
-                        row = run_case(root, size, profile, ground, pass_name, seed, args.workers, args.keep)
+                        row = done.get((size, ground, pass_name, profile, seed))
+                        if row is None:
+                            row = run_case(root, size, profile, ground, pass_name, seed, args.workers, args.keep)
                         rows.append(row)
-                        if args.rows:
+                        if args.rows and (size, ground, pass_name, profile, seed) not in done:
                             with open(args.rows, "a") as fh:
                                 fh.write(json.dumps(row) + "\n")
                         ok, line = verdict(row)

@@ -16,6 +16,7 @@ floor calibrated on simulated cases (what the estimator itself leaves, ``AssessC
 from __future__ import annotations
 
 import logging
+import os
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -367,10 +368,10 @@ def _collocate_run(cris: list, viirs: dict, viirs_all: list, satellite: str, cfg
 
 
 def _worker(args):
-    cris, viirs, viirs_all, satellite, cfg, stop_event = args
+    cris, viirs, viirs_all, satellite, cfg = args
     timings = {}
     samples, skipped = _collocate_run(cris, viirs, viirs_all, satellite, cfg, timings=timings,
-                                      should_stop=stop_event.is_set if stop_event is not None else None)
+                                      should_stop=_STOP.is_set if _STOP is not None else None)
     return samples, skipped, timings
 
 
@@ -404,14 +405,34 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
         return cost_and_offsets(samples, cfg, skipped, case.satellite)
 
 
+_STOP = None  # in a worker process: the event the parent sets to ask for a stop
+
+
+def _die_with_parent(stop_event):
+    """Worker initializer: die when the parent dies, even by SIGKILL (Linux parent-death signal), and keep
+    the stop event."""
+    global _STOP
+    _STOP = stop_event
+    try:
+        import ctypes
+        import signal
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the pool's own shutdown still applies
+        pass
+    if os.getppid() == 1:  # the parent died before the signal was armed
+        os._exit(1)
+
+
 def _in_processes(runs, case, cfg, should_stop):
-    """Collocate each run of granules in its own (spawned) process; a stop request is relayed to them."""
+    """Collocate each run of granules in its own (spawned) process; a stop request is relayed to them.
+
+    The workers hold no manager or server process of their own, and die with this process.
+    """
     import concurrent.futures as cf
     import multiprocessing as mp
     import threading
     ctx = mp.get_context("spawn")
-    manager = ctx.Manager() if should_stop is not None else None
-    event = manager.Event() if manager is not None else None
+    event = ctx.Event()
     done = threading.Event()
 
     def relay():
@@ -419,16 +440,15 @@ def _in_processes(runs, case, cfg, should_stop):
             if should_stop():
                 event.set()
                 return
-    if event is not None:
+    if should_stop is not None:
         threading.Thread(target=relay, daemon=True).start()
-    jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg, event) for r in runs]
+    jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg) for r in runs]
     try:
-        with cf.ProcessPoolExecutor(len(jobs), mp_context=ctx) as pool:
+        with cf.ProcessPoolExecutor(len(jobs), mp_context=ctx, initializer=_die_with_parent,
+                                    initargs=(event,)) as pool:
             return list(pool.map(_worker, jobs))
     finally:
         done.set()
-        if manager is not None:
-            manager.shutdown()
 
 
 def assess_paths(paths, cfg: AssessConfig | None = None, progress=None, workers: int = 1) -> AssessmentResult:

@@ -25,6 +25,7 @@ def _iso(text: str) -> dt.datetime:
 
 def cmd_simulate(args) -> int:
     from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
+    where = dict(terrain=args.terrain, orbit_pass=args.orbit_pass, pass_lon_deg=args.pass_lon)
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")
     try:
@@ -32,9 +33,9 @@ def cmd_simulate(args) -> int:
         if args.true_ep:
             spec = SimulationSpec(satellite=args.satellite, granules=args.granules, seed=args.seed,
                                   start=args.start or DEFAULT_START, profile="ep",
-                                  true_ep=_ep(args.true_ep), ground_ep=_ep(args.ground_ep))
+                                  true_ep=_ep(args.true_ep), ground_ep=_ep(args.ground_ep), **where)
         truth = simulate_case(args.out, satellite=args.satellite, granules=args.granules, profile=args.profile,
-                              seed=args.seed, start=args.start, spec=spec)
+                              seed=args.seed, start=args.start, spec=spec, **where)
     except ValueError as exc:
         raise BadInput(str(exc)) from None
     error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {args.profile}"
@@ -400,6 +401,7 @@ def cmd_bench(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from monitor.simulate.orbit import PASSES
     p = argparse.ArgumentParser(prog="crisgeo", description=__doc__)
     p.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     sub = p.add_subparsers(dest="command", required=True)
@@ -413,6 +415,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)")
     s.add_argument("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)")
     s.add_argument("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)")
+    s.add_argument("--terrain", action="store_true", help="1-4 km ranges and plateaus over 40 %% land")
+    s.add_argument("--pass", dest="orbit_pass", choices=sorted(PASSES),
+                   help="start at this pass of the satellite's orbit after --start (day: ascending tropics, "
+                        "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass")
+    s.add_argument("--pass-lon", type=float, help="with --pass: the pass nearest this longitude, deg (e.g. 180)")
     s.set_defaults(func=cmd_simulate)
 
     o = sub.add_parser("optimize", help="new scene-mirror angles (EP) from an assessment result (paper section 4)")

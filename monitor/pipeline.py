@@ -124,8 +124,16 @@ def publish_changes(cfg, store, satellite: str) -> None:
         store.queue_lines(target_name(p), satellite, change_lines(p.measurement, changes))
 
 
+def _failed(store, run_id, satellite, day, reason, timings) -> RunOutcome:
+    """Record a failed run and its ``run_failed`` event (the failure alert reads both)."""
+    store.finish_run(run_id, "failed", reason)
+    store.add_event("run_failed", satellite, f"{day}: {reason}")
+    return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings)
+
+
 def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, progress=None) -> RunOutcome:
-    """Process one satellite-day end to end; never raises for bad data, records every outcome."""
+    """Process one satellite-day end to end; never raises for a problem of the day's data or source: every
+    outcome is recorded (an unexpected exception too, as ``failed`` with its type and message)."""
     stop = should_stop or (lambda: False)
     run_id = store.begin_run(satellite, day)
     timings = {}
@@ -175,9 +183,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
             raise Stopped
         if not result.granules:
             reason = "no granule could be assessed: " + "; ".join(s["reason"] for s in result.skipped[:3])
-            store.finish_run(run_id, "failed", reason)
-            store.add_event("run_failed", satellite, f"{day}: {reason}")
-            return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings)
+            return _failed(store, run_id, satellite, day, reason, timings)
         lines = {target_name(p): result_lines(p.measurement, satellite, day, result.fors) for p in cfg.store.publish}
         store.save_day(run_id, satellite, day, result, decisions, lines)
         publish_changes(cfg, store, satellite)
@@ -186,10 +192,10 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         store.finish_run(run_id, "interrupted", "stop requested")
         return RunOutcome(satellite, day, "interrupted", "stop requested", run_id, timings=timings)
     except (SourceError, PlanError, OSError) as exc:
-        reason = f"{type(exc).__name__}: {exc}"
-        store.finish_run(run_id, "failed", reason)
-        store.add_event("run_failed", satellite, f"{day}: {reason}")
-        return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings)
+        return _failed(store, run_id, satellite, day, f"{type(exc).__name__}: {exc}", timings)
+    except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
+        LOG.exception("run %s %s failed unexpectedly", satellite, day)
+        return _failed(store, run_id, satellite, day, f"unexpected {type(exc).__name__}: {exc}"[:1000], timings)
     finally:
         t1 = time.perf_counter()
         if cfg.store.publish:

@@ -25,7 +25,7 @@ from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
 from monitor.simulate import instrument as ins
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
-from monitor.simulate.orbit import CircularOrbit, find_pass
+from monitor.simulate.orbit import PASSES, CircularOrbit, find_pass
 from monitor.simulate.profiles import load_profile
 from monitor.simulate.scene import MAX_HEIGHT_M, Scene, spectra, transmittance
 from monitor.simulate.terrain import intersect_terrain
@@ -42,9 +42,6 @@ T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
 OBPT_U16, OBPT_F32 = 65533, -999.7
-# Named passes: (geocentric latitude of the first CrIS granule, ascending). A 14-granule case covers
-# ~27 deg of orbit: "arctic" runs from 60 deg N to the orbit's turning point at 81 deg N.
-PASSES = {"day": (-14.0, True), "night": (14.0, False), "arctic": (60.0, True), "antarctic": (-60.0, False)}
 
 DEFAULT_AUX = {
     "cris": ["CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops",

@@ -13,6 +13,9 @@ import numpy as np
 from monitor.geometry.wgs84 import A_M, GM_M3_S2, OMEGA_EARTH_RAD_S
 from monitor.satellites import NODAL_PERIOD_S, PHASE_EPOCH_UNIX_S, Satellite
 
+# Named passes: (geocentric latitude of the first CrIS granule, ascending). A 14-granule case covers
+# ~27 deg of orbit: "arctic" runs from 60 deg N to the orbit's turning point at 81 deg N.
+PASSES = {"day": (-14.0, True), "night": (14.0, False), "arctic": (60.0, True), "antarctic": (-60.0, False)}
 J2000_UNIX_S = 946728000.0  # 2000-01-01T12:00:00 UTC
 DAY_S = 86400.0
 
