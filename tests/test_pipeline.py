@@ -67,3 +67,35 @@ def test_source_failure_is_a_failed_run_and_an_event(tmp_path):
     out = run_day(cfg, store, LocalSource(tmp_path / "missing"), "j01", DAY)
     assert out.status == "failed" and "no such directory" in out.reason
     assert store.events("run_failed")[0]["satellite"] == "j01"
+
+
+def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp_path, monkeypatch):
+    """Any exception inside a satellite-day stops at that day: the run is failed with its reason, the
+    failure alert fires, the catch-up goes on with the next day."""
+    import monitor.pipeline as pipeline
+    from monitor.service import Service
+    from monitor.simulate.case import simulate_case
+    data, _, _ = cases.get()
+    tree = tmp_path / "tree"
+    tree.mkdir()
+    for f in data.glob("*.h5"):
+        (tree / f.name).symlink_to(f)
+    simulate_case(tree / "next", granules=1, profile="paper", seed=2,
+                  start=dt.datetime(2024, 6, 2, 12, tzinfo=dt.timezone.utc))
+    log = tmp_path / "alerts.log"
+    cfg = make_config(tmp_path, tree, f"alerts: {{log: {log}}}\n")
+    real = pipeline.assess_plan
+
+    def poison(case, *args, **kw):
+        if case.cris[0].key.startswith("j01_d20240601"):
+            raise RuntimeError("poison granule")
+        return real(case, *args, **kw)
+    monkeypatch.setattr(pipeline, "assess_plan", poison)
+    outcomes = Service(cfg).catch_up("j01", today=DAY + dt.timedelta(days=2))
+    assert [(o.day, o.status) for o in outcomes][-2:] == [(DAY, "failed"), (DAY + dt.timedelta(days=1), "ok")]
+    assert outcomes[-2].reason == "unexpected RuntimeError: poison granule"
+    store = Store(cfg.store.sqlite)
+    assert {r["day"]: r["status"] for r in store.runs("j01")}[str(DAY)] == "failed"
+    assert any(e["kind"] == "run_failed" and "poison granule" in e["detail"] for e in store.events())
+    text = log.read_text()
+    assert "failure" in text and "poison granule" in text

@@ -14,7 +14,8 @@ PLATFORMS = {"npp": "NPP", "j01": "J01", "j02": "J02"}
 
 _PATTERN = re.compile(
     r"^(?P<products>[A-Z0-9]+(?:-[A-Z0-9]+)*)_(?P<platform>[a-z0-9]{3})_d(?P<date>\d{8})_t(?P<start>\d{7})"
-    r"_e(?P<end>\d{7})_b(?P<orbit>\d{5,})_c(?P<created>\d{20})_(?P<origin>[a-z0-9-]{4})_(?P<domain>[a-z_]+)\.h5$")
+    r"_e(?P<end>\d{7})_b(?P<orbit>\d{5,})_c(?P<created>\d{20})_(?P<origin>[a-z0-9-]{4})_(?P<domain>[a-z_]+)\.h5$",
+    re.ASCII)  # ASCII digits only: a key with other digits must not pass for a granule
 
 
 @dataclass(frozen=True)
@@ -43,13 +44,17 @@ def _clock(date: dt.date, hhmmsst: str) -> dt.datetime:
 
 
 def parse_name(name: str) -> JpssName | None:
-    """The parsed name, or None if *name* (a base name) is not a JPSS product file name."""
+    """The parsed name, or None if *name* (a base name) is not a JPSS product file name (an impossible
+    date or time included)."""
     m = _PATTERN.match(name)
     if not m:
         return None
-    date = dt.datetime.strptime(m["date"], "%Y%m%d").date()
-    start = _clock(date, m["start"])
-    end = _clock(date, m["end"])
+    try:
+        date = dt.datetime.strptime(m["date"], "%Y%m%d").date()
+        start = _clock(date, m["start"])
+        end = _clock(date, m["end"])
+    except ValueError:
+        return None
     if end < start:
         end += dt.timedelta(days=1)
     return JpssName(tuple(m["products"].split("-")), m["platform"], start, end, int(m["orbit"]),

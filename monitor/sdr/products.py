@@ -1,4 +1,4 @@
-"""The JPSS products the monitor reads, described as data (dataset paths, units, fill handling).
+"""The JPSS products the monitor reads, described as data (dataset paths, shapes, units, limits, fills).
 
 Layout facts: formats.md sections 1.2-1.8 (IDPS CDFCB layout, checked on real GCRSO files; satpy's
 ``viirs_sdr.yaml`` for the VIIRS names). Each field maps a Python name with its unit to a dataset of
@@ -6,9 +6,12 @@ Layout facts: formats.md sections 1.2-1.8 (IDPS CDFCB layout, checked on real GC
 
 * ``per``: what axis 0 counts: ``scan`` (CrIS arrays and VIIRS per-scan arrays) or ``row`` (VIIRS
   detector rows, ``rows_per_scan`` per scan).
-* ``kind``: ``float`` (the IDPS float fills -999.9 ... -999.2 become NaN), ``scaled`` (uint16 with fills >= 65528,
-  then ``value * scale + offset`` with one (scale, offset) pair per granule), ``time`` (int64 IET
-  microseconds) or ``flags`` (unsigned integers kept as they are).
+* ``dims``: the shape after axis 0 (every axis is checked).
+* ``kind``: ``float`` (float32/64; the IDPS float fills -999.9 ... -999.2 become NaN), ``scaled`` (uint16 with
+  fills >= 65528, then ``value * scale + offset`` with one (scale, offset) pair per granule), ``time`` (int64
+  IET microseconds) or ``flags`` (unsigned integers kept as they are).
+* ``limits``: the physical range of every value that is not a fill, in the file's unit after scaling;
+  ``norm``: the same for the length of a 3-vector (positions near the orbit radius).
 * ``to_si``: factor to the unit in the field's name (degrees -> radians, arcseconds -> radians).
 """
 
@@ -27,17 +30,27 @@ UINT16_FILL_MIN = 65528  # IDPS uint16 fills are 65528 ... 65535
 def is_float_fill(values) -> np.ndarray:
     """True where *values* hold one of the IDPS float fill codes (not merely a large negative number)."""
     v = np.asarray(values)
-    return (v > -999.95) & (v < -999.15) & (np.abs(v * 10 - np.round(v * 10)) < 1e-2)
+    with np.errstate(invalid="ignore", over="ignore"):
+        return (v > -999.95) & (v < -999.15) & (np.abs(v * 10 - np.round(v * 10)) < 1e-2)
 
 
 @dataclass(frozen=True)
 class Field:
+    """One dataset of a product: where it is, its shape after axis 0, its kind, unit and physical limits."""
+
     dataset: str
     per: str = "scan"
     kind: str = "float"
     to_si: float = 1.0
     factors: str | None = None
     required: bool = True
+    dims: tuple = ()
+    limits: tuple | None = None
+    norm: tuple | None = None
+
+
+DTYPES = {"float": "f", "scaled": "u", "time": "i", "flags": "u"}  # numpy kind of each field kind
+IET_LIMITS_US = (1.6e15, 2.8e15)  # IET of 2008 ... 2046: a time outside is not a JPSS observation time
 
 
 @dataclass(frozen=True)
@@ -54,45 +67,52 @@ class Product:
         return f"All_Data/{self.collection}_All"
 
 
+# CrIS long-wave grid: 717 channels from 648.75 cm-1 every 0.625 cm-1 (2 guard channels each end), NSR and FSR.
+CRIS_LW_FIRST_CM1 = 648.75
+CRIS_LW_STEP_CM1 = 0.625
+CRIS_LW_CHANNELS = 717
+FOV = (30, 9)  # CrIS: 30 fields of regard of 9 FOVs per scan
+VIIRS_COLUMNS = 6400  # I-band samples per row
 CRIS_GEO_FIELDS = {
-    "for_time_us": Field("FORTime", kind="time"),
-    "start_time_us": Field("StartTime", kind="time"),
-    "mid_time_us": Field("MidTime", kind="time"),
-    "lat_rad": Field("Latitude", to_si=DEG),
-    "lon_rad": Field("Longitude", to_si=DEG),
-    "height_m": Field("Height"),
-    "range_m": Field("SatelliteRange"),
-    "zenith_rad": Field("SatelliteZenithAngle", to_si=DEG),
-    "azimuth_rad": Field("SatelliteAzimuthAngle", to_si=DEG),
-    "sc_position_m": Field("SCPosition"),
-    "sc_velocity_m_s": Field("SCVelocity"),
-    "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC),
+    "for_time_us": Field("FORTime", kind="time", dims=(30,), limits=IET_LIMITS_US),
+    "start_time_us": Field("StartTime", kind="time", limits=IET_LIMITS_US),
+    "mid_time_us": Field("MidTime", kind="time", limits=IET_LIMITS_US),
+    "lat_rad": Field("Latitude", to_si=DEG, dims=FOV, limits=(-90.0, 90.0)),
+    "lon_rad": Field("Longitude", to_si=DEG, dims=FOV, limits=(-180.0, 180.0)),
+    "height_m": Field("Height", dims=FOV, limits=(-500.0, 9000.0)),
+    "range_m": Field("SatelliteRange", dims=FOV, limits=(7.0e5, 4.0e6)),
+    "zenith_rad": Field("SatelliteZenithAngle", to_si=DEG, dims=FOV, limits=(0.0, 90.0)),
+    "azimuth_rad": Field("SatelliteAzimuthAngle", to_si=DEG, dims=FOV, limits=(-180.0, 360.0)),
+    "sc_position_m": Field("SCPosition", dims=(3,), norm=(6.8e6, 7.8e6)),
+    "sc_velocity_m_s": Field("SCVelocity", dims=(3,), norm=(6.0e3, 8.5e3)),
+    "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC, dims=(3,), limits=(-3600.0, 3600.0)),
 }
 
 CRIS_SDR_FIELDS = {
-    "radiance_lw": Field("ES_RealLW"),  # mW/(m2 sr cm-1), unapodized
-    "qf3": Field("QF3_CRISSDR", kind="flags"),
+    "radiance_lw": Field("ES_RealLW", dims=FOV + (CRIS_LW_CHANNELS,), limits=(-200.0, 500.0)),  # mW/(m2 sr cm-1)
+    "qf3": Field("QF3_CRISSDR", kind="flags", dims=FOV + (3,)),
     "qf1_scan": Field("QF1_SCAN_CRISSDR", kind="flags", required=False),
 }
 
 VIIRS_SDR_FIELDS = {
-    "bt_k": Field("BrightnessTemperature", per="row", kind="scaled", factors="BrightnessTemperatureFactors"),
-    "qf1": Field("QF1_VIIRSIBANDSDR", per="row", kind="flags"),
+    "bt_k": Field("BrightnessTemperature", per="row", kind="scaled", factors="BrightnessTemperatureFactors",
+                  dims=(VIIRS_COLUMNS,), limits=(120.0, 380.0)),
+    "qf1": Field("QF1_VIIRSIBANDSDR", per="row", kind="flags", dims=(VIIRS_COLUMNS,)),
 }
 
 VIIRS_GEO_FIELDS = {
-    "lat_rad": Field("Latitude", per="row", to_si=DEG),
-    "lon_rad": Field("Longitude", per="row", to_si=DEG),
-    "start_time_us": Field("StartTime", kind="time"),
-    "mid_time_us": Field("MidTime", kind="time"),
-    "sc_position_m": Field("SCPosition"),
-    "sc_velocity_m_s": Field("SCVelocity"),
-    "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC),
+    "lat_rad": Field("Latitude", per="row", to_si=DEG, dims=(VIIRS_COLUMNS,), limits=(-90.0, 90.0)),
+    "lon_rad": Field("Longitude", per="row", to_si=DEG, dims=(VIIRS_COLUMNS,), limits=(-180.0, 180.0)),
+    "start_time_us": Field("StartTime", kind="time", limits=IET_LIMITS_US),
+    "mid_time_us": Field("MidTime", kind="time", limits=IET_LIMITS_US),
+    "sc_position_m": Field("SCPosition", dims=(3,), norm=(6.8e6, 7.8e6)),
+    "sc_velocity_m_s": Field("SCVelocity", dims=(3,), norm=(6.0e3, 8.5e3)),
+    "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC, dims=(3,), limits=(-3600.0, 3600.0)),
 }
 
 # Terrain-corrected geolocation: Latitude/Longitude/Height is the 3-D point where the pixel's line of sight
 # meets the terrain (formats.md 1.1 note); the ellipsoid product (GIMGO) puts its pixels at h = 0.
-VIIRS_TC_GEO_FIELDS = {**VIIRS_GEO_FIELDS, "height_m": Field("Height", per="row")}
+VIIRS_TC_GEO_FIELDS = {**VIIRS_GEO_FIELDS, "height_m": Field("Height", per="row", dims=(VIIRS_COLUMNS,))}
 
 PRODUCTS = {p.prefix: p for p in (
     Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
@@ -104,10 +124,6 @@ PRODUCTS = {p.prefix: p for p in (
     Product("GIMGO", "VIIRS-IMG-GEO", "viirs_geo", rows_per_scan=32, scans_reserved=48, fields=VIIRS_GEO_FIELDS),
 )}
 
-# CrIS long-wave grid: 717 channels from 648.75 cm-1 every 0.625 cm-1 (2 guard channels each end), NSR and FSR.
-CRIS_LW_FIRST_CM1 = 648.75
-CRIS_LW_STEP_CM1 = 0.625
-CRIS_LW_CHANNELS = 717
 
 
 def cris_lw_wavenumbers_cm1(nchan: int = CRIS_LW_CHANNELS) -> np.ndarray:

@@ -8,16 +8,19 @@ always reserves 48 scans). Every problem is raised as :class:`GranuleError` nami
 from __future__ import annotations
 
 import datetime as dt
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
 import numpy as np
 
+from monitor.satellites import SATELLITES
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.iet import iet_to_datetime
 from monitor.sdr.names import parse_name
-from monitor.sdr.products import PRODUCTS, is_float_fill, UINT16_FILL_MIN, Product, cris_lw_wavenumbers_cm1
+from monitor.sdr.products import (IET_LIMITS_US, PRODUCTS, UINT16_FILL_MIN, Product, cris_lw_wavenumbers_cm1,
+                                  is_float_fill)
 
 
 @dataclass(frozen=True)
@@ -156,31 +159,85 @@ def _when(date: str, time: str) -> dt.datetime:
     return dt.datetime.strptime(f"{date} {t}", "%Y%m%d %H%M%S.%f").replace(tzinfo=dt.timezone.utc)
 
 
+def _number(path, name, value, kind=int):
+    """One numeric attribute value, or GranuleError naming it (non-numeric, empty, non-finite)."""
+    try:
+        v = np.asarray(value).ravel()[0]
+        if isinstance(v, bytes):
+            v = v.decode("ascii")
+        out = kind(v)
+    except (IndexError, ValueError, TypeError, UnicodeDecodeError, OverflowError):
+        raise GranuleError(path, name, f"not a number: {_text(value)[:40]!r}") from None
+    if kind is float and not np.isfinite(out):
+        raise GranuleError(path, name, f"not finite: {out}")
+    return out
+
+
 def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform: str) -> GranuleMeta:
     name = f"Data_Products/{product.collection}/{product.collection}_Gran_{k}"
     if name not in h5:
         raise GranuleError(path, name, "missing granule metadata")
     a = h5[name].attrs
-    try:
-        start_iet = int(np.asarray(a["N_Beginning_Time_IET"]).ravel()[0])
-        end_iet = int(np.asarray(a["N_Ending_Time_IET"]).ravel()[0])
-        n_scans = int(np.asarray(a["N_Number_Of_Scans"]).ravel()[0])
-    except KeyError as exc:
-        raise GranuleError(path, f"{name}/{exc.args[0]}", "missing attribute") from None
+    for key in ("N_Beginning_Time_IET", "N_Ending_Time_IET", "N_Number_Of_Scans"):
+        if key not in a:
+            raise GranuleError(path, f"{name}/{key}", "missing attribute")
+    start_iet = _number(path, f"{name}/N_Beginning_Time_IET", a["N_Beginning_Time_IET"])
+    end_iet = _number(path, f"{name}/N_Ending_Time_IET", a["N_Ending_Time_IET"])
+    n_scans = _number(path, f"{name}/N_Number_Of_Scans", a["N_Number_Of_Scans"])
+    for key, value in (("N_Beginning_Time_IET", start_iet), ("N_Ending_Time_IET", end_iet)):
+        if not IET_LIMITS_US[0] <= value <= IET_LIMITS_US[1]:
+            raise GranuleError(path, f"{name}/{key}", f"{value} is not an IET time of the JPSS era")
+    if not 0 <= end_iet - start_iet <= 600_000_000:
+        raise GranuleError(path, f"{name}/N_Ending_Time_IET", f"{end_iet} is not within 10 min after the "
+                                                               f"beginning {start_iet}")
+    limit = product.scans_reserved or 64
+    if not 1 <= n_scans <= limit:
+        raise GranuleError(path, f"{name}/N_Number_Of_Scans", f"{n_scans} is not within 1..{limit}")
     try:
         start = _when(_text(a["Beginning_Date"]), _text(a["Beginning_Time"]))
         end = _when(_text(a["Ending_Date"]), _text(a["Ending_Time"]))
     except (KeyError, ValueError):
         start, end = iet_to_datetime(start_iet), iet_to_datetime(end_iet)
     asc = a.get("Ascending/Descending_Indicator")
+    orbit = a.get("N_Beginning_Orbit_Number")
+    granule_id = _text(a.get("N_Granule_ID", b""))
+    if granule_id and not granule_id.upper().startswith(platform.upper()):
+        raise GranuleError(path, f"{name}/N_Granule_ID", f"{granule_id!r} is not a granule of {platform}")
     return GranuleMeta(
         path=str(path), product=product.prefix, collection=product.collection, platform=platform,
-        granule_id=_text(a.get("N_Granule_ID", b"")), orbit=int(np.asarray(a.get("N_Beginning_Orbit_Number", 0)).ravel()[0]),
+        granule_id=granule_id, orbit=0 if orbit is None else _number(path, f"{name}/N_Beginning_Orbit_Number", orbit),
         start=start, end=end, start_iet_us=start_iet, end_iet_us=end_iet, n_scans=n_scans,
-        ascending=None if asc is None else int(np.asarray(asc).ravel()[0]) == 0,
+        ascending=None if asc is None else _number(path, f"{name}/Ascending/Descending_Indicator", asc) == 0,
         software_version=_text(a.get("N_Software_Version", b"")),
         algorithm_version=_text(a.get("N_Algorithm_Version", b"")),
         aux_files=_texts(a.get("N_Aux_Filename")), anc_files=_texts(a.get("N_Anc_Filename")))
+
+
+def _check_raw(path, name: str, raw: np.ndarray, f, rows: int) -> None:
+    """Dtype family and full shape of a dataset against the product table."""
+    kinds = {"float": "f", "scaled": "uf", "time": "i", "flags": "u"}[f.kind]
+    if raw.dtype.kind not in kinds or (raw.dtype.kind == "f" and raw.dtype.itemsize < 4):
+        raise GranuleError(path, name, f"dtype {raw.dtype} is not a {f.kind} dataset")
+    expected = (rows,) + tuple(f.dims)
+    if raw.shape != expected:
+        raise GranuleError(path, name, f"shape {raw.shape}, expected {expected}")
+
+
+def _check_values(path, name: str, data: np.ndarray, f) -> None:
+    """Physical limits of every value that is not a fill (file units, after scaling)."""
+    if f.limits is not None:
+        v = data[data > 0] if f.kind == "time" else data[np.isfinite(data)] if data.dtype.kind == "f" else data
+        if v.size:
+            lo, hi = v.min(), v.max()
+            if lo < f.limits[0] or hi > f.limits[1]:
+                bad = lo if lo < f.limits[0] else hi
+                raise GranuleError(path, name, f"value {bad:.6g} outside {f.limits[0]:g}..{f.limits[1]:g}")
+    if f.norm is not None:
+        n = np.linalg.norm(data, axis=-1)
+        n = n[np.isfinite(n)]
+        if n.size and (n.min() < f.norm[0] or n.max() > f.norm[1]):
+            bad = n.min() if n.min() < f.norm[0] else n.max()
+            raise GranuleError(path, name, f"vector length {bad:.6g} outside {f.norm[0]:g}..{f.norm[1]:g}")
 
 
 def _clean(path, dataset: str, raw: np.ndarray, f) -> np.ndarray:
@@ -189,21 +246,34 @@ def _clean(path, dataset: str, raw: np.ndarray, f) -> np.ndarray:
         wide = raw.dtype == np.float64 or (raw.ndim < 4 and f.per != "row")
         out = raw.astype(np.float64 if wide else np.float32)
         out[is_float_fill(raw)] = np.nan
-        return out * f.to_si if f.to_si != 1.0 else out
+        return out
     if f.kind == "scaled":
-        if raw.dtype.kind != "u":
-            out = raw.astype(np.float32)
-            out[is_float_fill(raw)] = np.nan
-            return out
         out = raw.astype(np.float32)
-        out[raw >= UINT16_FILL_MIN] = np.nan
+        out[is_float_fill(raw) if raw.dtype.kind == "f" else raw >= UINT16_FILL_MIN] = np.nan
         return out
     if f.kind == "time":
         return raw.astype(np.int64)
     return raw
 
 
-def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str, fields=None) -> list:
+def _factors(path, h5, group: str, f, n_gran: int) -> np.ndarray:
+    """(scale, offset) per granule: present, finite, scale > 0."""
+    name = f"{group}/{f.factors}"
+    if name not in h5:
+        raise GranuleError(path, name, "missing scale factors")
+    raw = np.asarray(h5[name][()])
+    if raw.dtype.kind not in "fiu" or raw.size < 2 * n_gran:
+        raise GranuleError(path, name, f"{raw.size} {raw.dtype} values for {n_gran} granule(s)")
+    fac = raw.astype(np.float64).ravel()[:2 * n_gran].reshape(-1, 2)
+    for k, (scale, offset) in enumerate(fac):
+        if is_float_fill(scale) or is_float_fill(offset):
+            raise GranuleError(path, name, f"fill value in factors of granule {k}")
+        if not (np.isfinite(scale) and np.isfinite(offset) and 0 < scale < 1e3 and abs(offset) < 1e6):
+            raise GranuleError(path, name, f"scale {scale:g}, offset {offset:g} of granule {k} are not usable")
+    return fac
+
+
+def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str) -> list:
     group = product.data_group
     if group not in h5:
         raise GranuleError(path, group, "missing product group")
@@ -211,13 +281,14 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
     aggr = f"Data_Products/{product.collection}/{product.collection}_Aggr"
     if aggr in h5:
         n_gran_attr = h5[aggr].attrs.get("AggregateNumberGranules")
-    n_gran = int(np.asarray(n_gran_attr).ravel()[0]) if n_gran_attr is not None else 1
+    n_gran = 1 if n_gran_attr is None else _number(path, f"{aggr}/AggregateNumberGranules", n_gran_attr)
+    if not 1 <= n_gran <= 1000:
+        raise GranuleError(path, f"{aggr}/AggregateNumberGranules", f"{n_gran} is not within 1..1000")
     metas = [_granule_meta(path, h5, product, k, platform) for k in range(n_gran)]
     scans = [product.scans_reserved or m.n_scans for m in metas]
     bounds = np.concatenate([[0], np.cumsum(scans)])
-    wanted = product.fields if fields is None else {k: product.fields[k] for k in fields}
     arrays = {}
-    for key, f in wanted.items():
+    for key, f in product.fields.items():
         name = f"{group}/{f.dataset}"
         if name not in h5:
             if f.required:
@@ -226,42 +297,54 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
             continue
         try:
             raw = h5[name][()]
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, TypeError, RuntimeError, KeyError) as exc:
             raise GranuleError(path, name, f"unreadable ({exc})") from None
         per = product.rows_per_scan if f.per == "row" else 1
-        if raw.ndim == 0 or raw.shape[0] != bounds[-1] * per:
-            raise GranuleError(path, name, f"axis 0 has {raw.shape[0] if raw.ndim else 0} entries, "
-                                           f"expected {bounds[-1] * per} for {n_gran} granule(s)")
+        if not isinstance(raw, np.ndarray) or raw.ndim == 0:
+            raise GranuleError(path, name, "not an array")
+        _check_raw(path, name, raw, f, int(bounds[-1] * per))
         data = _clean(path, name, raw, f)
-        if f.factors:
-            fac_name = f"{group}/{f.factors}"
-            if fac_name not in h5:
-                raise GranuleError(path, fac_name, "missing scale factors")
-            fac = np.asarray(h5[fac_name][()], np.float64).reshape(-1, 2)
-            if len(fac) < n_gran:
-                raise GranuleError(path, fac_name, f"{len(fac)} factor pairs for {n_gran} granules")
+        fac = _factors(path, h5, group, f, n_gran) if f.factors else None
         parts = []
         for k in range(n_gran):
             part = data[bounds[k] * per:bounds[k + 1] * per]
-            if f.factors:
-                scale, offset = fac[k]
-                if is_float_fill(scale) or is_float_fill(offset) or not np.isfinite(scale * offset):
-                    raise GranuleError(path, fac_name, f"fill value in factors of granule {k}")
-                part = (part * scale + offset).astype(np.float32)
-            parts.append(part)
+            if fac is not None:
+                part = (part * fac[k, 0] + fac[k, 1]).astype(np.float32)
+            _check_values(path, name, part, f)
+            parts.append(part * f.to_si if f.to_si != 1.0 else part)
         arrays[key] = parts
     out = []
     for k, meta in enumerate(metas):
         kwargs = {key: (v[k] if v is not None else None) for key, v in arrays.items()}
         if product.kind == "cris_sdr":
             kwargs["wavenumber_cm1"] = cris_lw_wavenumbers_cm1(kwargs["radiance_lw"].shape[-1])
-        if fields is not None:
-            out.append((meta, kwargs))
-            continue
         granule = _GRANULE_TYPES[product.kind](meta=meta, **kwargs)
         _check_not_all_fill(path, product, granule)
+        _check_times(path, product, granule)
         out.append(granule)
     return out
+
+
+def _check_times(path, product: Product, granule) -> None:
+    """Observation times increase and lie within the granule (10 s of margin: the IDPS granule bounds
+    are nominal)."""
+    t = getattr(granule, "for_time_us", None)
+    name = f"{product.data_group}/FORTime"
+    if t is None:
+        t = getattr(granule, "start_time_us", None)
+        name = f"{product.data_group}/StartTime"
+    if t is None:  # SDR files: their times are their GEO's
+        return
+    t = t.ravel()
+    t = t[t > 0]
+    lo, hi = granule.meta.start_iet_us - 10_000_000, granule.meta.end_iet_us + 10_000_000
+    if t.size and (t.min() < lo or t.max() > hi):
+        bad = t.min() if t.min() < lo else t.max()
+        raise GranuleError(path, name, f"time {bad} (IET us) outside the granule "
+                                       f"{granule.meta.start_iet_us}..{granule.meta.end_iet_us}")
+    if np.any(np.diff(t) <= 0):
+        i = int(np.argmax(np.diff(t) <= 0))
+        raise GranuleError(path, name, f"times do not increase: {t[i]} then {t[i + 1]}")
 
 
 _MAIN_FIELD = {"cris_geo": "lat_rad", "cris_sdr": "radiance_lw", "viirs_sdr": "bt_k", "viirs_geo": "lat_rad"}
@@ -299,14 +382,45 @@ def _open(path: Path) -> h5py.File:
         raise GranuleError(path, "(file)", f"not a readable HDF5 file ({exc})") from None
 
 
+@contextmanager
+def _reading(path):
+    """Errors h5py raises on corrupt metadata once a file is open become a GranuleError naming the file."""
+    try:
+        yield
+    except GranuleError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, OverflowError,
+            UnicodeDecodeError) as exc:
+        raise GranuleError(path, "(file)", f"corrupt or unreadable HDF5 structure "
+                                           f"({type(exc).__name__}: {exc})"[:300]) from None
+
+
 def _platform(path: Path, h5: h5py.File) -> str:
-    attr = h5.attrs.get("Platform_Short_Name")
-    if attr is not None:
-        return _text(attr).lower().replace("npp", "npp")
+    """The platform (npp, j01, j02) of the content; it must agree with the file name's."""
     parsed = parse_name(path.name)
-    if parsed is None:
-        raise GranuleError(path, "Platform_Short_Name", "missing and the file name is not a JPSS name")
-    return parsed.platform
+    attr = h5.attrs.get("Platform_Short_Name")
+    if attr is None:
+        if parsed is None:
+            raise GranuleError(path, "Platform_Short_Name", "missing and the file name is not a JPSS name")
+        return parsed.platform
+    platform = _text(attr).lower()
+    if parsed is not None and parsed.platform != platform:
+        raise GranuleError(path, "Platform_Short_Name", f"{_text(attr)!r} in a file named for {parsed.platform}")
+    if platform not in SATELLITES:
+        raise GranuleError(path, "Platform_Short_Name", f"{_text(attr)!r} is not one of "
+                                                        f"{', '.join(s.idps for s in SATELLITES.values())}")
+    return platform
+
+
+def _check_name_time(path: Path, metas) -> None:
+    """The file name's start time is its first granule's (to the tenth of a second; 60 s allowed)."""
+    parsed = parse_name(path.name)
+    if parsed is None or not metas:
+        return
+    first = min(m.start for m in metas)
+    if abs((first - parsed.start).total_seconds()) > 60:
+        raise GranuleError(path, "(file name)", f"start {parsed.start:%Y-%m-%d %H:%M:%S} but the first granule "
+                                                f"begins {first:%Y-%m-%d %H:%M:%S}")
 
 
 def products_in(path: Path, h5: h5py.File) -> list[Product]:
@@ -325,29 +439,34 @@ def products_in(path: Path, h5: h5py.File) -> list[Product]:
 
 
 def read_file(path, kinds=None) -> list:
-    """All granules of the supported products in *path* (optionally only those of *kinds*)."""
+    """All granules of the supported products in *path* (optionally only those of *kinds*), every field
+    checked against the product table; any problem is a :class:`GranuleError` naming file and field."""
     path = Path(path)
-    with _open(path) as h5:
+    with _open(path) as h5, _reading(path):
         platform = _platform(path, h5)
         out = []
         for product in products_in(path, h5):
             if kinds is None or product.kind in kinds:
                 out.extend(_product_granules(path, h5, product, platform))
+        _check_name_time(path, [g.meta for g in out])
         return out
 
 
 def read_metadata(path) -> list[GranuleMeta]:
     """Granule metadata of every product in *path*, without reading the arrays."""
     path = Path(path)
-    with _open(path) as h5:
+    with _open(path) as h5, _reading(path):
         platform = _platform(path, h5)
         metas = []
         for product in products_in(path, h5):
             aggr = f"Data_Products/{product.collection}/{product.collection}_Aggr"
             n = 1
             if aggr in h5 and "AggregateNumberGranules" in h5[aggr].attrs:
-                n = int(np.asarray(h5[aggr].attrs["AggregateNumberGranules"]).ravel()[0])
+                n = _number(path, f"{aggr}/AggregateNumberGranules", h5[aggr].attrs["AggregateNumberGranules"])
+                if not 1 <= n <= 1000:
+                    raise GranuleError(path, f"{aggr}/AggregateNumberGranules", f"{n} is not within 1..1000")
             metas.extend(_granule_meta(path, h5, product, k, platform) for k in range(n))
+        _check_name_time(path, metas)
         return metas
 
 
@@ -355,7 +474,7 @@ def read_viirs_geo_scan(path, scan: int):
     """(lat_rad, lon_rad, height_m) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the
     end); height_m is zero for the ellipsoid product."""
     path = Path(path)
-    with _open(path) as h5:
+    with _open(path) as h5, _reading(path):
         product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
         if product is None:
             raise GranuleError(path, "All_Data", "no VIIRS geolocation product")
@@ -369,8 +488,14 @@ def read_viirs_geo_scan(path, scan: int):
             if name not in h5:
                 raise GranuleError(path, name, "missing dataset")
             rows = h5[name].shape[0]
+            if rows < product.rows_per_scan:
+                raise GranuleError(path, name, f"{rows} rows, less than one scan")
             start = (scan % (rows // product.rows_per_scan)) * product.rows_per_scan
-            out.append(_clean(path, name, h5[name][start:start + product.rows_per_scan], f))
+            raw = h5[name][start:start + product.rows_per_scan]
+            _check_raw(path, name, raw, f, product.rows_per_scan)
+            data = _clean(path, name, raw, f)
+            _check_values(path, name, data, f)
+            out.append(data * f.to_si if f.to_si != 1.0 else data)
         if "height_m" in product.fields:
             _check_height(path, f"{product.data_group}/Height", *out)
         return tuple(out)
