@@ -19,8 +19,9 @@ that solid angle evenly (scan overlap towards the swath edge, footprint steps at
 edges). Each pixel is weighted by the solid angle it covers seen from CrIS,
 ``w = |A . u| / range^2``, where ``A`` is the pixel's vector footprint (the cross product of the steps to
 its neighbours, so that a slope is foreshortened as seen along the unit direction ``u`` from CrIS) with
-the overlap between consecutive scans removed (divided by how many scans cover the pixel centre). The
-sum of the weights inside a cone over the cone's solid angle is its coverage: 1 when VIIRS fills it.
+the overlap between consecutive scans removed (the part of a footprint that a neighbouring scan also
+covers counts half). The sum of the weights inside a cone over the cone's solid angle is its coverage:
+1 when VIIRS fills it.
 
 Search. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans), a
 sphere holding its usable pixels. Around each FOV only the blocks whose sphere comes within the union
@@ -167,23 +168,30 @@ def _scan_ends(scan):
     return p_first, p_last, step
 
 
-def _scan_multiplicity(scan, ends, k):
-    """How many scans cover each pixel centre of scan k (32, cols, 3): itself and any neighbour whose
-    first-to-last valid detector span (half a detector added each side) holds the pixel along track.
+def _scan_share(scan, ends, k):
+    """The share (0.5..1) of each pixel's footprint of scan k (32, cols, 3) that is its own: where a
+    neighbouring scan covers part of the footprint along track, that part is shared between two pixels.
 
-    *ends* maps scan index to :func:`_scan_ends` output and may hold the neighbouring granules' scans.
+    Along the track each pixel spans one detector step centred on it, each neighbour its first-to-last
+    valid detector span plus half a step each side; an overlap of a fraction f of the footprint leaves
+    the pixel 1 - f / 2. (Counting whole pixels in or out instead leaves ~1 % too much weight in stripes
+    at the scan edges near nadir, where the overlap is a fraction of a detector, and biases the in-track
+    minimum there.) *ends* maps scan index to :func:`_scan_ends` output and may hold the neighbouring
+    granules' scans.
     """
     p_first, p_last, step = ends[k]
     u = p_last - p_first
     u /= np.linalg.norm(u, axis=-1, keepdims=True)
     s_pix = np.einsum("dcx,cx->dc", scan - p_first.astype(np.float32), u.astype(np.float32))
-    mult = np.ones(scan.shape[:2], np.float32)
+    half = (step / 2).astype(np.float32)
+    share = np.ones(scan.shape[:2], np.float32)
     for n in (k - 1, k + 1):
         if n in ends:
-            lo = np.einsum("cx,cx->c", ends[n][0] - p_first, u) - step / 2
-            hi = np.einsum("cx,cx->c", ends[n][1] - p_first, u) + step / 2
-            mult += (s_pix >= lo) & (s_pix <= hi)
-    return mult
+            lo = (np.einsum("cx,cx->c", ends[n][0] - p_first, u) - ends[n][2] / 2).astype(np.float32)
+            hi = (np.einsum("cx,cx->c", ends[n][1] - p_first, u) + ends[n][2] / 2).astype(np.float32)
+            overlap = np.minimum(s_pix + half, hi) - np.maximum(s_pix - half, lo)
+            share -= np.clip(overlap / (2 * half), 0.0, 1.0) / 2
+    return share
 
 
 def swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band, before=None, after=None) -> SwathPiece:
@@ -212,7 +220,7 @@ def swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band, before=None, after
     for k in range(nscan):
         sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
         cross = np.cross(_half_diff(scan[k], axis=1), _half_diff(scan[k], axis=0))
-        area[sl] = cross / _scan_multiplicity(scan[k], ends, k)[..., None]
+        area[sl] = cross * _scan_share(scan[k], ends, k)[..., None]
         bad = ~(np.isfinite(radiance[sl]) & np.all(np.isfinite(area[sl]), axis=-1))
         radiance[sl][bad] = np.nan
     located = np.isfinite(radiance)

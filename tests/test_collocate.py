@@ -30,17 +30,15 @@ def scene(case_plan):
 def _brute(swath, sat, m, alpha, beta, offsets, half_angle):
     pos = swath.ecef_m.reshape(-1, 3).astype(float)
     rad = swath.radiance.reshape(-1)
-    area = swath.area_m2.reshape(-1)
+    area = swath.area_vec_m2.reshape(-1, 3).astype(float)
     ok = np.isfinite(rad)
     vec = pos[ok] - sat
     dist = np.linalg.norm(vec, axis=1)
     d = vec / dist[:, None]
     los0 = m @ np.array([np.tan(alpha), np.tan(beta), 1.0])
     near = d @ (los0 / np.linalg.norm(los0)) > np.cos(0.03)
-    d, dist, val, ar, p = d[near], dist[near], rad[ok][near], area[ok][near], pos[ok][near]
-    up = p / np.array([6378137.0**2, 6378137.0**2, 6356752.314245**2])
-    up /= np.linalg.norm(up, axis=1, keepdims=True)
-    w = ar * np.sum(-up * d, axis=1) / dist**2
+    d, dist, val, ar = d[near], dist[near], rad[ok][near], area[ok][near]
+    w = np.abs(np.sum(ar * d, axis=1)) / dist**2  # the footprint projected across the view, / range^2
     mean = np.empty((len(offsets), len(offsets)))
     cover = np.empty_like(mean)
     for i, da in enumerate(offsets):
@@ -63,8 +61,9 @@ def test_interval_method_equals_brute_force(scene, scan, for_, fov):
                     offsets, collocate.TOP_HAT[0][0])
     np.testing.assert_allclose(mean[0], bm, rtol=1e-6)
     np.testing.assert_allclose(cover[0], bc, rtol=1e-6)
-    # solid-angle weights fill the cone: coverage ~1 inside the swath
-    assert np.all(np.abs(bc - 1.0) < 0.03)
+    # solid-angle weights fill the cone: coverage 1 inside the swath, also at nadir (FOR 15), where the
+    # VIIRS scans overlap by a fraction of a detector (whole-pixel counting left ~1.2 % too much there)
+    assert np.all(np.abs(bc - 1.0) < 0.01)
 
 
 def test_fov_off_the_swath_has_no_coverage(scene):
@@ -102,8 +101,8 @@ def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):
     v = case_plan.viirs[case_plan.cris[0].key][int(row0[0]) // swath.pieces[0].radiance.shape[0]]
     (vgeo,) = read_file(v.geo, kinds=("viirs_geo",))
     (vsdr,) = read_file(v.sdr, kinds=("viirs_sdr",))
-    cut = collocate.build_swath(vgeo.lat_rad[:, :ncol], vgeo.lon_rad[:, :ncol], vsdr.bt_k[:, :ncol],
-                                vsdr.good[:, :ncol], i5_band("j01"))
+    cut = collocate.build_swath(vgeo.lat_rad[:, :ncol], vgeo.lon_rad[:, :ncol], vgeo.height_m[:, :ncol],
+                                vsdr.bt_k[:, :ncol], vsdr.good[:, :ncol], i5_band("j01"))
     assert cut.block_radius_m.shape[1] == -(-ncol // collocate.BLOCK_PX)
     offsets = perturbation_grid(2, 900e-6)
     mean, cover = collocate.cone_sums(cut, fg.sat_ecef_m[idx][None], fg.sbf_to_ecef[idx][None],

@@ -73,7 +73,47 @@ def test_wrong_axis0_is_reported(real_geo_files, tmp_path):
     with h5py.File(f, "r+") as h5:
         del h5["All_Data/CrIS-SDR-GEO_All/FORTime"]
         h5["All_Data/CrIS-SDR-GEO_All/FORTime"] = np.zeros((3, 30), np.int64)
-    with pytest.raises(GranuleError, match="axis 0 has 3 entries, expected 4"):
+    with pytest.raises(GranuleError, match=r"FORTime: shape \(3, 30\), expected \(4, 30\)"):
+        read_file(f)
+    with h5py.File(f, "r+") as h5:  # every axis is checked, not only the first
+        del h5["All_Data/CrIS-SDR-GEO_All/FORTime"]
+        h5["All_Data/CrIS-SDR-GEO_All/FORTime"] = np.zeros((4, 29), np.int64)
+    with pytest.raises(GranuleError, match=r"FORTime: shape \(4, 29\), expected \(4, 30\)"):
+        read_file(f)
+
+
+@pytest.mark.parametrize("dataset,value,reason", [
+    ("Latitude", 1e28, "value 1e\+28 outside -90..90"),
+    ("SatelliteRange", 10.0, "value 10 outside 700000..4e\+06"),
+    ("SCPosition", 7e9, "vector length .* outside"),
+])
+def test_out_of_range_values_are_refused(real_geo_files, tmp_path, dataset, value, reason):
+    f = _copy(real_geo_files[0], tmp_path / real_geo_files[0].name)
+    with h5py.File(f, "r+") as h5:
+        d = h5[f"All_Data/CrIS-SDR-GEO_All/{dataset}"]
+        a = d[()]
+        a.flat[5] = value
+        d[...] = a
+    with pytest.raises(GranuleError, match=f"{f.name}: All_Data/CrIS-SDR-GEO_All/{dataset}: {reason}"):
+        read_file(f)
+
+
+def test_times_and_platform_must_match_the_granule(real_geo_files, tmp_path):
+    f = _copy(real_geo_files[0], tmp_path / real_geo_files[0].name)
+    with h5py.File(f, "r+") as h5:
+        t = h5["All_Data/CrIS-SDR-GEO_All/FORTime"]
+        t[...] = t[()] - 3_600_000_000
+    with pytest.raises(GranuleError, match="FORTime: time .* outside the granule"):
+        read_file(f)
+    f = _copy(real_geo_files[1], tmp_path / real_geo_files[1].name)
+    with h5py.File(f, "r+") as h5:
+        h5.attrs["Platform_Short_Name"] = np.array([[b"NPP"]])
+    with pytest.raises(GranuleError, match="Platform_Short_Name: 'NPP' in a file named for j01"):
+        read_file(f)
+    f = _copy(real_geo_files[2], tmp_path / real_geo_files[2].name)
+    with h5py.File(f, "r+") as h5:
+        h5["Data_Products/CrIS-SDR-GEO/CrIS-SDR-GEO_Gran_0"].attrs["N_Number_Of_Scans"] = np.array([[b"four"]])
+    with pytest.raises(GranuleError, match="N_Number_Of_Scans: not a number: 'four'"):
         read_file(f)
 
 
