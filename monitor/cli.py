@@ -515,6 +515,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    from monitor.store.sqlite import StoreError
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
@@ -524,6 +525,9 @@ def main(argv=None) -> int:
     except BadInput as exc:
         print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except StoreError as exc:
+        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
+        return EXIT_FAIL
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:  # output piped into head and the like

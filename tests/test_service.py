@@ -145,3 +145,22 @@ def test_systemd_unit_verifies_without_any_warning(tmp_path):
     bad = tmp_path / "crisgeo-bad.service"
     bad.write_text(unit.read_text().replace("Restart=on-failure", "Restrat=on-failure"))
     assert "Unknown key" in _verify(bad).stderr  # the check above can fail
+
+
+@pytest.mark.skipif(shutil.which("systemd-analyze") is None, reason="systemd-analyze not installed")
+def test_systemd_unit_exposure_is_at_most_2(tmp_path):
+    """`systemd-analyze security` rates the unit's sandbox; 10 is unprotected, the shipped unit <= 2.0."""
+    import re
+    unit = tmp_path / "crisgeo.service"
+    unit.write_text((ROOT / "systemd" / "crisgeo.service").read_text())
+    r = subprocess.run(["systemd-analyze", "security", "--offline=true", "--no-pager", str(unit)],
+                       capture_output=True, text=True)
+    m = re.search(r"Overall exposure level for \S+: (\d+\.\d+)", r.stdout)
+    assert m, r.stdout + r.stderr
+    assert float(m.group(1)) <= 2.0, r.stdout
+    loose = tmp_path / "loose.service"
+    loose.write_text(unit.read_text().replace("SystemCallFilter=", "#SystemCallFilter=")
+                     .replace("PrivateUsers=yes", "").replace("ProtectProc=invisible", ""))
+    r = subprocess.run(["systemd-analyze", "security", "--offline=true", "--no-pager", str(loose)],
+                       capture_output=True, text=True)
+    assert float(re.search(r"Overall exposure level for \S+: (\d+\.\d+)", r.stdout).group(1)) > 2.0

@@ -74,18 +74,55 @@ def _num(v):
     return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
 
 
+class StoreError(RuntimeError):
+    """The store file cannot be used (corrupt, empty, not a crisgeo store, too new); one line, naming it."""
+
+
 class Store:
-    """The SQLite store. One connection per Store; use from one thread at a time."""
+    """The SQLite store. One connection per Store; use from one thread at a time.
+
+    A store is created only where no file exists (built under a temporary name, then renamed into place);
+    an existing file that is empty, corrupt or not a crisgeo store is refused with :class:`StoreError`,
+    never re-initialised: it holds the history and the alert state.
+    """
 
     def __init__(self, path):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.db = sqlite3.connect(self.path, timeout=30, isolation_level=None)
-        self.db.row_factory = sqlite3.Row
-        self.db.execute("PRAGMA journal_mode=WAL")
-        self.db.execute("PRAGMA synchronous=FULL")
-        self.db.execute("PRAGMA foreign_keys=ON")
+        if not self.path.exists():
+            self._create()
+        elif self.path.stat().st_size == 0:
+            raise StoreError(f"{self.path}: empty file, not a crisgeo store (restore it from a backup, or remove "
+                             f"it to start a new history)")
+        try:
+            self.db = self._connect(self.path)
+            tables = self.db.execute("SELECT COUNT(*) FROM sqlite_master").fetchone()[0]
+            if 0 < len(MIGRATIONS) < self.schema_version:
+                self._migrate()  # says it is newer than this program
+            if self.schema_version == 0 or tables == 0:
+                raise StoreError(f"{self.path}: not a crisgeo store (schema version {self.schema_version}, "
+                                 f"{tables} tables)")
+            self._migrate()
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(f"{self.path}: not a usable crisgeo store ({exc})") from None
+
+    @staticmethod
+    def _connect(path):
+        db = sqlite3.connect(path, timeout=30, isolation_level=None)
+        db.row_factory = sqlite3.Row
+        db.execute("PRAGMA journal_mode=WAL")
+        db.execute("PRAGMA synchronous=FULL")
+        db.execute("PRAGMA foreign_keys=ON")
+        return db
+
+    def _create(self):
+        tmp = self.path.with_name(self.path.name + ".new")
+        tmp.unlink(missing_ok=True)
+        self.db = self._connect(tmp)
         self._migrate()
+        self.db.execute("PRAGMA journal_mode=DELETE")  # fold the WAL in before the rename
+        self.db.close()
+        tmp.replace(self.path)
 
     def close(self):
         self.db.close()
@@ -98,7 +135,7 @@ class Store:
     def _migrate(self):
         version = self.schema_version
         if version > len(MIGRATIONS):
-            raise RuntimeError(f"{self.path}: schema version {version} is newer than this program "
+            raise StoreError(f"{self.path}: schema version {version} is newer than this program "
                                f"({len(MIGRATIONS)}); upgrade crisgeo")
         for v in range(version, len(MIGRATIONS)):
             with self.transaction():

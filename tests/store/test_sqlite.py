@@ -66,3 +66,37 @@ def test_outbox_delivery_bookkeeping(tmp_path):
     s.outbox_delivered([rows[0]["id"]])
     assert s.outbox_size("t") == 2
     assert s.done_days("j01") == {DAY}
+
+
+@pytest.mark.parametrize("content,reason", [(b"", "empty file, not a crisgeo store"),
+                                            (b"SQLite format 3\x00" + bytes(range(256)) * 20, "not a usable"),
+                                            (b"not a database at all" * 100, "not a usable")])
+def test_an_unusable_store_is_refused_and_left_as_it_is(tmp_path, content, reason):
+    from monitor.store.sqlite import StoreError
+    path = tmp_path / "store.sqlite"
+    path.write_bytes(content)
+    with pytest.raises(StoreError, match=f"{path}: {reason}"):
+        Store(path)
+    assert path.read_bytes() == content  # never re-initialised: the history may still be recovered
+
+
+def test_a_foreign_sqlite_file_is_refused(tmp_path):
+    from monitor.store.sqlite import StoreError
+    db = sqlite3.connect(tmp_path / "other.sqlite")
+    db.execute("CREATE TABLE t (x)")
+    db.close()
+    with pytest.raises(StoreError, match="not a crisgeo store"):
+        Store(tmp_path / "other.sqlite")
+
+
+def test_cli_reports_a_corrupt_store_in_one_line(tmp_path):
+    import subprocess
+    import sys
+    (tmp_path / "state").mkdir()
+    (tmp_path / "state" / "crisgeo.sqlite").write_bytes(b"garbage" * 500)
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "status", "--config", str(cfg)],
+                       capture_output=True, text=True)
+    assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "crisgeo.sqlite: not a usable crisgeo store" in r.stderr
