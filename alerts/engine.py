@@ -136,6 +136,8 @@ def deliver(store, settings, now: dt.datetime | None = None, channels=None) -> d
     channels = channels if channels is not None else make_channels(settings)
     counts = {"sent": 0, "retry": 0, "failed": 0}
     for d in state.due(now):
+        if not state.claim(d["id"], now):
+            continue  # another process is sending it
         ch = channels.get(d["channel"])
         if ch is None:
             state.mark(d["id"], "failed", now, f"channel {d['channel']} is no longer configured")

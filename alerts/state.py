@@ -83,8 +83,23 @@ class AlertState:
                         (channel, satellite, message["subject"], json.dumps(message), iso(now), iso(now)))
 
     def due(self, now: dt.datetime) -> list:
+        """Deliveries to try now: pending ones whose time has come, and claims whose lease ran out (a
+        sender that died mid-send)."""
         return [dict(r) for r in self.db.execute(
-            "SELECT * FROM deliveries WHERE status='pending' AND next_attempt <= ? ORDER BY id", (iso(now),))]
+            "SELECT * FROM deliveries WHERE status IN ('pending', 'sending') AND next_attempt <= ? ORDER BY id",
+            (iso(now),))]
+
+    def claim(self, delivery_id: int, now: dt.datetime, lease_s: float = 600.0) -> bool:
+        """Take a due delivery for sending, atomically: False when another sender has it (no double send).
+
+        The claim holds for *lease_s*; a sender that dies leaves it to be tried again after that.
+        """
+        with self.store.transaction():
+            cur = self.db.execute(
+                "UPDATE deliveries SET status='sending', next_attempt=? "
+                "WHERE id=? AND status IN ('pending', 'sending') AND next_attempt <= ?",
+                (iso(now + dt.timedelta(seconds=lease_s)), delivery_id, iso(now)))
+            return cur.rowcount == 1
 
     def deliveries(self, status: str | None = None) -> list:
         q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"

@@ -92,6 +92,7 @@ class PublishConfig:
 class StoreConfig:
     sqlite: Path
     publish: list = field(default_factory=list)
+    drain_minutes: float = 10.0  # the daemon sends what waits in the outbox this often, between daily runs
 
 
 @dataclass
@@ -239,8 +240,10 @@ def load_config(path) -> Config:
         raise ConfigError(f"assessment.kernel: {assessment.kernel!r} is not top-hat or response")
 
     st = _section(doc, "store")
-    _known(st, {"sqlite", "publish"}, "store.")
-    store = StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite"))))
+    _known(st, {"sqlite", "publish", "drain_minutes"}, "store.")
+    store = StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite"))),
+                        drain_minutes=_positive(_get(st, "drain_minutes", float, "store.", 10.0),
+                                                "store.drain_minutes"))
     for i, p in enumerate(_get(st, "publish", list, "store.", [])):
         where = f"store.publish[{i}]."
         if not isinstance(p, dict):

@@ -145,6 +145,19 @@ class Service:
             if own:
                 store.close()
 
+    def drain_outbox(self) -> dict:
+        """Send the time-series points waiting in the outbox (after an outage they need not wait for the
+        next daily run); returns {target: (sent, left)}."""
+        from monitor.store.timeseries import drain_outbox
+        store = self.store()
+        try:
+            report = drain_outbox(store, self.cfg.store.publish)
+            if any(sent for sent, _ in report.values()):
+                LOG.info("outbox: %s", report)
+            return report
+        finally:
+            store.close()
+
     def recover(self):
         """Mark runs left 'running' by a killed process as interrupted (call with the instance lock held)."""
         store = self.store()
@@ -179,22 +192,31 @@ class Service:
         self.catch_up(satellite)
 
     # -- daemon
-    def daemon(self):
+    def add_jobs(self, scheduler):
+        """The daemon's jobs: per satellite the daily run (catching up at start), the hourly alert
+        evaluation, and (with publishing) the outbox timer."""
         from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED
-        from apscheduler.schedulers.blocking import BlockingScheduler
         from apscheduler.triggers.cron import CronTrigger
+        sch = self.cfg.schedule
+        now = dt.datetime.now(UTC)
+        for sat in self.cfg.satellites:
+            trigger = CronTrigger(hour=sch.time_utc.hour, minute=sch.time_utc.minute, timezone=UTC)
+            scheduler.add_job(self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}",
+                              next_run_time=now)  # catch up at start, then daily
+        scheduler.add_job(self.check_alerts, "interval", hours=1, id="alerts", name="alert timer")
+        if self.cfg.store.publish:
+            scheduler.add_job(self.drain_outbox, "interval", minutes=self.cfg.store.drain_minutes, id="outbox",
+                              name="outbox timer")
+        scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
+
+    def daemon(self):
+        from apscheduler.schedulers.blocking import BlockingScheduler
         sch = self.cfg.schedule
         with InstanceLock(self.cfg.state_dir):
             self.recover()
             self.scheduler = BlockingScheduler(timezone=UTC, job_defaults={
                 "coalesce": True, "max_instances": 1, "misfire_grace_time": int(sch.misfire_grace_hours * 3600)})
-            now = dt.datetime.now(UTC)
-            for sat in self.cfg.satellites:
-                trigger = CronTrigger(hour=sch.time_utc.hour, minute=sch.time_utc.minute, timezone=UTC)
-                self.scheduler.add_job(self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}",
-                                       next_run_time=now)  # catch up at start, then daily
-            self.scheduler.add_job(self.check_alerts, "interval", hours=1, id="alerts", name="alert timer")
-            self.scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
+            self.add_jobs(self.scheduler)
             self.handle_signals()
             watchdog = self._start_watchdog()
             sd_notify("READY=1")

@@ -94,3 +94,45 @@ def test_slack_4xx_is_a_configuration_error_without_the_url(webhook, monkeypatch
         ch.send(MSG)
     assert "channel_not_found" in str(e.value) and "secret-token" not in str(e.value)
     assert len(webhook.received) == 1
+
+
+def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatch):
+    """Two processes' deliverers on one store (two connections, two threads) race for the same queued
+    message; the claim lets exactly one post it, even though the webhook answers slowly."""
+    import datetime as dt
+    import threading
+    import time
+
+    from alerts.engine import deliver
+    from alerts.settings import AlertSettings, RuleSettings
+    from alerts.state import AlertState
+    from monitor.store.sqlite import Store
+    monkeypatch.setenv("T_SLACK", webhook.url)
+    settings = AlertSettings(rules=RuleSettings(), slack=SlackSettings(webhook_env="T_SLACK", timeout_s=5))
+    path = tmp_path / "s.sqlite"
+    now = dt.datetime(2026, 1, 1, tzinfo=dt.timezone.utc)
+    store = Store(path)
+    AlertState(store).enqueue("slack", "j01", {"subject": "s", "text": "t", "blocks": []}, now)
+    store.close()
+    import requests
+    real_post = requests.post
+
+    def slow_post(*a, **kw):
+        time.sleep(0.5)  # both deliverers see the message as due before either has sent it
+        return real_post(*a, **kw)
+    monkeypatch.setattr(requests, "post", slow_post)
+    counts, start = [], threading.Barrier(2)
+
+    def run():
+        s = Store(path)
+        start.wait()
+        counts.append(deliver(s, settings, now=now))
+        s.close()
+    threads = [threading.Thread(target=run) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(webhook.received) == 1 and sorted(c["sent"] for c in counts) == [0, 1]
+    s = Store(path)
+    assert [d["status"] for d in AlertState(s).deliveries()] == ["sent"]

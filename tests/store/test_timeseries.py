@@ -93,3 +93,38 @@ def test_known_changes_reach_influxdb_for_annotations(tmp_path):
         assert drain_outbox(store, cfg.store.publish)[target_name(cfg.store.publish[0])] == (2, 0)
         (series,) = influxql(url, "crisgeo", 'SELECT "description", "instrument" FROM "cris_geolocation_change"')
         assert series["values"] == [[1716192000, "VIIRS-SDR-GEO-IMG-PARAM-LUT update", "viirs"]]
+
+
+def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
+    """Points that waited through an outage leave without a daily run: the daemon's outbox job sends them
+    as soon as the server is back."""
+    import time
+
+    from apscheduler.schedulers.background import BackgroundScheduler
+
+    from monitor.config import load_config
+    from monitor.service import Service
+    _, _, result = cases.get()
+    with victoria_metrics(tmp_path / "vm") as url:
+        cfg_file = tmp_path / "c.yaml"
+        cfg_file.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: "
+                            f"{tmp_path}}}\nstore: {{drain_minutes: 0.02, publish: [{{kind: influx2, url: '{url}', "
+                            f"bucket: crisgeo}}]}}\n")
+        service = Service(load_config(cfg_file))
+        store = service.store()
+        _queue(store, service.cfg.store.publish[0], result)
+        scheduler = BackgroundScheduler(timezone="UTC")
+        service.add_jobs(scheduler)
+        for job in scheduler.get_jobs():
+            if job.id != "outbox":  # no daily run, no alert evaluation: only the timer
+                job.remove()
+        scheduler.start()
+        try:
+            deadline = time.monotonic() + 30
+            while store.outbox_size(target_name(service.cfg.store.publish[0])) and time.monotonic() < deadline:
+                time.sleep(0.2)
+        finally:
+            scheduler.shutdown(wait=True)
+        assert store.outbox_size(target_name(service.cfg.store.publish[0])) == 0
+        assert len(vm_export(url, "cris_geolocation_d_beta_urad")) == 30
+        assert not store.runs("j01") or all(r["status"] != "ok" or r["day"] == str(DAY) for r in store.runs("j01"))
