@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor import collocate, refine
+from monitor.errors import AssessmentError
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import inverse_geolocation
@@ -377,7 +378,8 @@ def _worker(args):
 
 def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, should_stop=None,
                 timings=None, workers: int = 1) -> AssessmentResult:
-    """Assess every CrIS granule of *case*; granules that fail are skipped with their reason.
+    """Assess every CrIS granule of *case*; granules that fail are skipped with their reason. Fewer usable
+    FOVs in all than ``cfg.min_samples`` is an :class:`AssessmentError` naming the files.
 
     *progress* is called after each granule; *should_stop* is polled before each (a stop request
     skips the rest, recorded); *timings*, a dict, collects seconds per stage (summed over workers).
@@ -401,6 +403,12 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
         samples, k = _collocate_run(case.cris, case.viirs, case.viirs_all, case.satellite, cfg,
                                     progress, should_stop, timings)
         skipped += k
+    usable = sum(int(s.usable.sum()) for s in samples)
+    if usable < cfg.min_samples:
+        files = ", ".join(sorted({s.info["cris_geo"] for s in samples} | {str(k) for k, _ in skipped}))[:800]
+        why = "; ".join(f"{k}: {r}" for k, r in skipped[:3])
+        raise AssessmentError(f"too few usable FOVs to assess: {usable} (at least {cfg.min_samples}) in "
+                              f"{len(samples)} granule(s) [{files}]" + (f"; skipped: {why}" if why else ""))
     with _stage(timings, "cost"):
         return cost_and_offsets(samples, cfg, skipped, case.satellite)
 

@@ -142,17 +142,15 @@ def format_table(result) -> str:
 
 def cmd_assess(args) -> int:
     from monitor.assess import AssessConfig, assess_paths
+    from monitor.errors import DataError
     from monitor.sdr.pairing import PlanError
     if args.steps < 1 or args.step_urad <= 0:
         raise BadInput("--steps must be >= 1 and --step-urad > 0")
     cfg = AssessConfig(half_steps=args.steps, step_rad=args.step_urad * 1e-6, kernel=args.kernel)
     try:
         result = assess_paths(args.paths, cfg, workers=args.workers)
-    except PlanError as exc:
+    except (PlanError, DataError) as exc:
         raise BadInput(str(exc)) from None
-    if not result.granules:
-        reasons = "; ".join(f"{s['item']}: {s['reason']}" for s in result.skipped[:3])
-        raise BadInput(f"no CrIS granule could be assessed ({reasons})")
     print(format_table(result))
     if args.out:
         Path(args.out).write_text(result.to_json())

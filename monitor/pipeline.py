@@ -19,6 +19,7 @@ import numpy as np
 from monitor import fingerprint as fpr
 from monitor.mapping.engpkt import load_library
 from monitor.assess import AssessConfig, assess_plan
+from monitor.errors import DataError
 from monitor.scenes import select_scenes
 from monitor.sdr.pairing import PlanError, plan
 from monitor.sdr import GranuleError, read_file
@@ -181,9 +182,6 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         timings["assess"] = time.perf_counter() - t1
         if stop():
             raise Stopped
-        if not result.granules:
-            reason = "no granule could be assessed: " + "; ".join(s["reason"] for s in result.skipped[:3])
-            return _failed(store, run_id, satellite, day, reason, timings)
         lines = {target_name(p): result_lines(p.measurement, satellite, day, result.fors) for p in cfg.store.publish}
         store.save_day(run_id, satellite, day, result, decisions, lines)
         publish_changes(cfg, store, satellite)
@@ -191,7 +189,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
     except Stopped:
         store.finish_run(run_id, "interrupted", "stop requested")
         return RunOutcome(satellite, day, "interrupted", "stop requested", run_id, timings=timings)
-    except (SourceError, PlanError, OSError) as exc:
+    except (SourceError, PlanError, DataError, OSError) as exc:
         return _failed(store, run_id, satellite, day, f"{type(exc).__name__}: {exc}", timings)
     except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
         LOG.exception("run %s %s failed unexpectedly", satellite, day)

@@ -109,3 +109,27 @@ def test_workers_die_with_a_killed_parent(cases, tmp_path):
     alive = [k for k in kids if os.path.exists(f"/proc/{k}")
              and open(f"/proc/{k}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"]
     assert not alive, f"workers {alive} outlived their parent"
+
+
+def test_too_few_usable_fovs_is_an_error_naming_the_files(cases, tmp_path):
+    """VIIRS scale factors of 1e30 used to give a table of NaN with exit 0: now the granule is refused and
+    the assessment, left with nothing, exits 2 naming the files."""
+    import shutil
+    import subprocess
+    import sys
+
+    import h5py
+    out, _, _ = cases.get()
+    work = tmp_path / "data"
+    work.mkdir()
+    for f in out.glob("*.h5"):
+        if f.name.startswith("SVI05"):
+            shutil.copyfile(f, work / f.name)
+            with h5py.File(work / f.name, "r+") as h5:
+                h5["All_Data/VIIRS-I5-SDR_All/BrightnessTemperatureFactors"][0] = 1e30
+        else:
+            (work / f.name).symlink_to(f)
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "assess", str(work)], capture_output=True, text=True)
+    last = r.stderr.strip().splitlines()[-1]  # the log lines before it say which granule was skipped and why
+    assert r.returncode == 2 and last.startswith("crisgeo assess: too few usable FOVs to assess: 0"), r.stderr
+    assert "SVI05_j01" in last and "scale 1e+30" in last

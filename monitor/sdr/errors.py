@@ -1,7 +1,9 @@
 """The one error type of the readers: it names the file, the field and what is wrong with it."""
 
+from monitor.errors import DataError
 
-class GranuleError(ValueError):
+
+class GranuleError(DataError):
     """A granule that cannot be used. ``str()`` reads ``FILE: FIELD: REASON``."""
 
     def __init__(self, path, field, reason):
