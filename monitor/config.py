@@ -35,6 +35,11 @@ class SourceConfig:
     backoff_s: float = 1.5
     daily_budget_mb: float = 6000.0
     retention_days: int = 7
+    run_deadline_min: float = 180.0  # every request of one satellite-day's run ends by then
+    max_list_pages: int = 100  # per listing (a day of one product is ~3 pages of 1000 keys)
+    max_listed_keys: int = 20000
+    max_retry_after_s: float = 120.0  # a server asking to wait longer ends the attempt
+    min_rate_kb_s: float = 50.0  # a download slower than this on average is cut
     granules: int = 4
     profile: str = "paper"
     seed: int = 0
@@ -198,8 +203,11 @@ def load_config(path) -> Config:
     source = SourceConfig(kind=kind)
     if kind == "local":
         source.path = rel(_get(s, "path", str, "source.", required=True))
-    for key in ("timeout_s", "backoff_s", "daily_budget_mb"):
+    for key in ("timeout_s", "backoff_s", "daily_budget_mb", "run_deadline_min", "max_retry_after_s",
+                "min_rate_kb_s"):
         setattr(source, key, _positive(_get(s, key, float, "source.", getattr(source, key)), f"source.{key}"))
+    for key in ("max_list_pages", "max_listed_keys"):
+        setattr(source, key, _positive(_get(s, key, int, "source.", getattr(source, key)), f"source.{key}"))
     for key in ("retries", "retention_days", "granules", "seed"):
         setattr(source, key, _get(s, key, int, "source.", getattr(source, key)))
     source.profile = _get(s, "profile", str, "source.", source.profile)

@@ -119,16 +119,23 @@ def influxql(url: str, db: str, q: str) -> list:
 class S3Server:
     """A minimal S3-style server (path style: /<bucket>/<key>) over a directory of buckets.
 
-    ListObjectsV2 with ``page_size`` keys per page and continuation tokens; GET of objects. Faults:
-    ``drop_once`` names keys whose first download is cut half-way; ``extra_keys`` adds listed keys
-    that do not exist (e.g. a path-traversal attempt).
+    ListObjectsV2 with ``page_size`` keys per page, continuation tokens and MD5 ETags; GET of objects.
+    Faults, each off by default: ``drop_once`` (keys whose first download is cut half-way),
+    ``corrupt_once`` (keys whose first download has one byte changed), ``extra_keys`` (listed keys that do
+    not exist, with ``extra_sizes`` giving their <Size> text), ``endless_tokens`` (every page is truncated,
+    with a new token), ``repeat_token`` (every page is truncated, with the same token), ``slow_drip_s``
+    (downloads trickle 64 bytes per interval), ``retry_after`` (every request: 503 and this Retry-After),
+    ``lying_size`` (the listing says this many bytes), ``gzip`` (downloads are gzip-encoded), and
+    ``redirect_to`` (the next download answers 302 to this base URL).
     """
 
-    def __init__(self, root: Path, page_size: int = 3):
+    def __init__(self, root: Path, page_size: int = 3, host: str = "127.0.0.1"):
         self.root = Path(root)
         self.page_size = page_size
-        self.drop_once = set()
-        self.extra_keys = []
+        self.drop_once, self.corrupt_once = set(), set()
+        self.extra_keys, self.extra_sizes = [], {}
+        self.endless_tokens = self.repeat_token = self.gzip = False
+        self.slow_drip_s = self.retry_after = self.lying_size = self.redirect_to = None
         self.requests = []
         server = self
 
@@ -138,6 +145,12 @@ class S3Server:
 
             def do_GET(self):
                 server.requests.append(self.path)
+                if server.retry_after is not None:
+                    self.send_response(503)
+                    self.send_header("Retry-After", str(server.retry_after))
+                    self.send_header("Content-Length", "0")
+                    self.end_headers()
+                    return
                 parsed = urllib.parse.urlparse(self.path)
                 parts = parsed.path.lstrip("/").split("/", 1)
                 bucket = parts[0]
@@ -146,8 +159,9 @@ class S3Server:
                     return server._list(self, bucket, urllib.parse.parse_qs(parsed.query))
                 return server._get(self, bucket, key)
 
-        self.httpd = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
-        self.url = f"http://127.0.0.1:{self.httpd.server_address[1]}"
+        self.httpd = ThreadingHTTPServer((host, 0), Handler)
+        self.httpd.daemon_threads = True
+        self.url = f"http://{host}:{self.httpd.server_address[1]}"
         self.thread = threading.Thread(target=self.httpd.serve_forever, daemon=True)
 
     def __enter__(self):
@@ -159,18 +173,33 @@ class S3Server:
         self.httpd.server_close()
 
     def _list(self, h, bucket, q):
+        import hashlib
         prefix = q.get("prefix", [""])[0]
         base = self.root / bucket
         keys = sorted(str(p.relative_to(base)) for p in base.rglob("*") if p.is_file())
         keys = sorted(set(k for k in keys + self.extra_keys if k.startswith(prefix)))
-        start = int(base64.b64decode(q["continuation-token"][0]).decode()) if "continuation-token" in q else 0
+        token_in = q.get("continuation-token", [None])[0]
+        start = int(base64.b64decode(token_in).decode().split(":")[0]) if token_in and not self.repeat_token else 0
         page = keys[start:start + self.page_size]
-        more = start + self.page_size < len(keys)
-        items = "".join(
-            f"<Contents><Key>{escape(k)}</Key><Size>{(base / k).stat().st_size if (base / k).is_file() else 10}"
-            f"</Size></Contents>" for k in page)
-        token = (f"<NextContinuationToken>{base64.b64encode(str(start + self.page_size).encode()).decode()}"
-                 f"</NextContinuationToken>" if more else "")
+        more = start + self.page_size < len(keys) or self.endless_tokens or self.repeat_token
+
+        def size(k):
+            if k in self.extra_sizes:
+                return self.extra_sizes[k]
+            if self.lying_size is not None:
+                return str(self.lying_size)
+            return str((base / k).stat().st_size) if (base / k).is_file() else "10"
+
+        def etag(k):
+            return f"<ETag>&quot;{hashlib.md5((base / k).read_bytes()).hexdigest()}&quot;</ETag>" \
+                if (base / k).is_file() else ""
+        items = "".join(f"<Contents><Key>{escape(k)}</Key><Size>{escape(size(k))}</Size>{etag(k)}</Contents>"
+                        for k in page)
+        nxt = start + self.page_size if start + self.page_size < len(keys) else 0
+        token = base64.b64encode(f"{0 if self.repeat_token else nxt}:{len(self.requests)}".encode()).decode()
+        if self.repeat_token:
+            token = "c2FtZQ=="
+        token = f"<NextContinuationToken>{token}</NextContinuationToken>" if more else ""
         body = (f'<?xml version="1.0" encoding="UTF-8"?><ListBucketResult xmlns="http://s3.amazonaws.com/doc/2006-03-01/">'
                 f"<Name>{bucket}</Name><Prefix>{escape(prefix)}</Prefix><KeyCount>{len(page)}</KeyCount>"
                 f"<IsTruncated>{'true' if more else 'false'}</IsTruncated>{token}{items}</ListBucketResult>").encode()
@@ -181,6 +210,13 @@ class S3Server:
         h.wfile.write(body)
 
     def _get(self, h, bucket, key):
+        if self.redirect_to is not None:
+            target, self.redirect_to = self.redirect_to, None  # once
+            h.send_response(302)
+            h.send_header("Location", f"{target}/{bucket}/{key}")
+            h.send_header("Content-Length", "0")
+            h.end_headers()
+            return
         path = (self.root / bucket / key).resolve()
         if not path.is_file() or self.root.resolve() not in path.parents:
             h.send_response(404)
@@ -188,13 +224,30 @@ class S3Server:
             h.end_headers()
             return
         data = path.read_bytes()
+        if key in self.corrupt_once:
+            self.corrupt_once.discard(key)
+            data = data[:100] + bytes([data[100] ^ 0xFF]) + data[101:]
+        if self.gzip:
+            import gzip
+            data = gzip.compress(data)
         h.send_response(200)
+        if self.gzip:
+            h.send_header("Content-Encoding", "gzip")
         h.send_header("Content-Length", str(len(data)))
         h.end_headers()
-        if key in self.drop_once:
-            self.drop_once.discard(key)
-            h.wfile.write(data[: len(data) // 2])
-            h.wfile.flush()
-            h.connection.shutdown(socket.SHUT_RDWR)
-            return
-        h.wfile.write(data)
+        try:
+            if key in self.drop_once:
+                self.drop_once.discard(key)
+                h.wfile.write(data[: len(data) // 2])
+                h.wfile.flush()
+                h.connection.shutdown(socket.SHUT_RDWR)
+                return
+            if self.slow_drip_s is not None:
+                for i in range(0, len(data), 64):
+                    h.wfile.write(data[i:i + 64])
+                    h.wfile.flush()
+                    time.sleep(self.slow_drip_s)
+                return
+            h.wfile.write(data)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # the client gave up, as it should

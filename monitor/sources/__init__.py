@@ -29,24 +29,28 @@ class BudgetExceeded(SourceError):
 
 @dataclass(frozen=True)
 class ListedFile:
-    """A granule file a source can fetch: its name, size in bytes (None if unknown) and location."""
+    """A granule file a source can fetch: its name, size in bytes (None if unknown), location and, where the
+    listing gives one, the MD5 of its content (hex)."""
 
     name: str
     size: int | None
     location: str
     parsed: JpssName
+    md5: str | None = None
 
     @property
     def product(self) -> str:
         return self.parsed.products[0]
 
 
-def listed(name: str, size, location: str) -> ListedFile | None:
-    """A :class:`ListedFile` for a safe JPSS file name, or None for anything else (path parts, odd names)."""
-    if "/" in name or "\\" in name or name.startswith("."):
+def listed(name: str, size, location: str, md5: str | None = None) -> ListedFile | None:
+    """A :class:`ListedFile` for a safe JPSS file name, or None for anything else (path parts, dot
+    segments, non-ASCII, odd names)."""
+    if not name.isascii() or "/" in name or "\\" in name or name.startswith(".") or \
+            any(part in (".", "..") for part in location.split("/")):
         return None
     parsed = parse_name(name)
-    return None if parsed is None else ListedFile(name, size, location, parsed)
+    return None if parsed is None else ListedFile(name, size, location, parsed, md5)
 
 
 def on_day(f: ListedFile, day: dt.date) -> bool:

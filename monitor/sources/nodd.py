@@ -3,22 +3,36 @@
 Keys are ``<product folder>/YYYY/MM/DD/<file>``, e.g. ``CrIS-SDR-GEO/2024/06/01/GCRSO_j01_...h5``
 (operations.md 1.2). Listings are narrowed with a file-name prefix and followed through continuation
 tokens (a day holds more than the 1000 keys of one page). Downloads go to ``<name>.part`` and are
-renamed only when complete and of the listed size; a dropped connection is retried with backoff. A
-per-day byte budget bounds what one run may download, and cached files older than the retention go.
+renamed only when complete, of the listed size and, where the listing's ETag is a plain MD5, of that
+digest. A per-day byte budget bounds what one run may download, and cached files older than the
+retention go.
+
+Everything a server says is bounded, so that no listing or download hangs or grows without end: a run
+deadline (``source.run_deadline_min``) for all requests of a run; at most ``max_list_pages`` pages and
+``max_listed_keys`` keys per listing, and a continuation token seen twice is an error; Retry-After is
+honoured up to ``max_retry_after_s`` (a longer one ends the attempt); a download must keep up
+``min_rate_kb_s`` and may not bring more bytes than listed (Content-Length is checked first); a
+compressed response is refused (granules are stored as they are, never transparently decoded).
+Redirects are followed only on the endpoint's own host. Listed keys must be plain ASCII JPSS names in
+the day folder asked for (no dot segments). There is one retry layer, here: connection errors, 429
+and 5xx, ``retries`` times with exponential backoff.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import email.utils
+import hashlib
 import logging
 import os
+import re
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from urllib.parse import urljoin, urlsplit
 
 import requests
-from requests.adapters import HTTPAdapter
-from urllib3.util.retry import Retry
+import urllib3
 
 from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed
 
@@ -27,20 +41,37 @@ S3_NS = "{http://s3.amazonaws.com/doc/2006-03-01/}"
 FOLDERS = {"SCRIF": "CrIS-FS-SDR", "SCRIS": "CrIS-SDR", "GCRSO": "CrIS-SDR-GEO", "SVI05": "VIIRS-I5-SDR",
            "GITCO": "VIIRS-IMG-GEO-TC", "GIMGO": "VIIRS-IMG-GEO"}
 CRIS = ("SCRIF", "SCRIS", "GCRSO")
+MAX_LISTING_PAGE_BYTES = 8 << 20  # a page of 1000 keys is ~0.3 MB
+RETRYABLE = (429, 500, 502, 503, 504)
+REDIRECTS = (301, 302, 303, 307, 308)
+_DIGITS = re.compile(r"[0-9]{1,15}", re.ASCII)
+_MD5 = re.compile(r'"?([0-9a-fA-F]{32})"?', re.ASCII)
+
+
+def _retry_after_s(value: str | None) -> float | None:
+    """Seconds from a Retry-After header (delta seconds or an HTTP date), None when absent or unreadable."""
+    if not value:
+        return None
+    if _DIGITS.fullmatch(value.strip()):
+        return float(value.strip())
+    try:
+        when = email.utils.parsedate_to_datetime(value)
+    except (TypeError, ValueError):
+        return None
+    return max(0.0, (when - dt.datetime.now(dt.timezone.utc)).total_seconds()) if when.tzinfo else None
 
 
 class NoddSource:
     """Granules of the NODD bucket of each satellite, cached under *cache_dir*."""
 
-    def __init__(self, cfg, cache_dir: Path):
+    def __init__(self, cfg, cache_dir: Path, sleep=time.sleep):
         self.cfg = cfg
         self.cache_dir = Path(cache_dir)
-        self.session = requests.Session()
-        retry = Retry(total=cfg.retries, backoff_factor=cfg.backoff_s, status_forcelist=(429, 500, 502, 503, 504),
-                      allowed_methods=("GET", "HEAD"), respect_retry_after_header=True)
-        self.session.mount("http://", HTTPAdapter(max_retries=retry))
-        self.session.mount("https://", HTTPAdapter(max_retries=retry))
+        self.session = requests.Session()  # no urllib3 Retry: the one retry layer is _get
+        self.session.headers["Accept-Encoding"] = "identity"
         self.spent_bytes = 0
+        self.deadline = None
+        self.sleep = sleep
 
     def _base(self, satellite: str) -> str:
         bucket = self.cfg.buckets.get(satellite)
@@ -49,45 +80,110 @@ class NoddSource:
         return self.cfg.endpoint.format(bucket=bucket).rstrip("/")
 
     def start_day(self):
-        """Reset the day's budget and apply the cache retention."""
+        """Start a run: reset the day's budget and the run deadline, apply the cache retention."""
         self.spent_bytes = 0
+        self.deadline = time.monotonic() + self.cfg.run_deadline_min * 60
         self.cache_dir.mkdir(parents=True, exist_ok=True)
         cutoff = time.time() - self.cfg.retention_days * 86400
         for p in self.cache_dir.rglob("*"):
             if p.is_file() and (p.suffix == ".part" or p.stat().st_mtime < cutoff):
                 p.unlink(missing_ok=True)
 
+    def _left_s(self, what: str) -> float:
+        if self.deadline is None:
+            self.deadline = time.monotonic() + self.cfg.run_deadline_min * 60
+        left = self.deadline - time.monotonic()
+        if left <= 0:
+            raise SourceError(f"{what}: the run deadline of {self.cfg.run_deadline_min:g} min has passed")
+        return left
+
+    def _get(self, url: str, what: str, params=None, stream=False) -> requests.Response:
+        """GET *url* with the one retry layer; the response is 200 (the caller closes it)."""
+        last = "no attempt"
+        for attempt in range(self.cfg.retries + 1):
+            wait = self.cfg.backoff_s * 2 ** attempt
+            try:
+                r = self.session.get(url, params=params, stream=stream, allow_redirects=False,
+                                     timeout=min(self.cfg.timeout_s, self._left_s(what)))
+            except requests.RequestException as exc:
+                last = type(exc).__name__
+            else:
+                if r.status_code == 200:
+                    return r
+                r.close()
+                if r.status_code in REDIRECTS:
+                    target = urljoin(r.url, r.headers.get("Location", ""))
+                    here, there = urlsplit(r.url), urlsplit(target)
+                    if (there.scheme, there.netloc) != (here.scheme, here.netloc):
+                        raise SourceError(f"{what}: redirect to {there.scheme}://{there.netloc} refused "
+                                          f"(only {here.netloc} is trusted)")
+                    url, params, last = target, None, f"redirect to {there.path}"
+                    continue
+                if r.status_code not in RETRYABLE:
+                    raise SourceError(f"{what}: HTTP {r.status_code}")
+                last = f"HTTP {r.status_code}"
+                asked = _retry_after_s(r.headers.get("Retry-After"))
+                if asked is not None:
+                    if asked > self.cfg.max_retry_after_s:
+                        raise SourceError(f"{what}: HTTP {r.status_code} with Retry-After {asked:.0f} s, more than "
+                                          f"the {self.cfg.max_retry_after_s:g} s allowed")
+                    wait = max(wait, asked)
+            if attempt < self.cfg.retries:
+                LOG.warning("%s: %s, retrying in %.1f s", what, last, wait)
+                self.sleep(min(wait, self._left_s(what)))
+        raise SourceError(f"{what}: {last} after {self.cfg.retries + 1} attempts")
+
     def list_prefix(self, satellite: str, prefix: str) -> list[ListedFile]:
-        """Every object under *prefix*, following continuation tokens."""
-        out, token = [], None
+        """Every object under *prefix* (``folder/YYYY/MM/DD/name-prefix``), following continuation tokens."""
+        out, token, seen = [], None, set()
         base = self._base(satellite)
-        while True:
+        folder = prefix.rsplit("/", 1)[0] + "/"
+        what = f"listing {prefix}"
+        for _ in range(self.cfg.max_list_pages):
             params = {"list-type": "2", "prefix": prefix, "max-keys": "1000"}
             if token:
                 params["continuation-token"] = token
+            r = self._get(base + "/", what, params, stream=True)
             try:
-                r = self.session.get(base + "/", params=params, timeout=self.cfg.timeout_s)
-            except requests.RequestException as exc:
-                raise SourceError(f"listing {prefix}: {type(exc).__name__}") from None
-            if r.status_code != 200:
-                raise SourceError(f"listing {prefix}: HTTP {r.status_code}")
+                body = r.raw.read(MAX_LISTING_PAGE_BYTES + 1, decode_content=True)
+            except (requests.RequestException, urllib3.exceptions.HTTPError, OSError, ValueError) as exc:
+                raise SourceError(f"{what}: {type(exc).__name__} while reading") from None
+            finally:
+                r.close()
+            if len(body) > MAX_LISTING_PAGE_BYTES:
+                raise SourceError(f"{what}: a page of more than {MAX_LISTING_PAGE_BYTES >> 20} MB")
             try:
-                root = ET.fromstring(r.content)
+                root = ET.fromstring(body)
             except ET.ParseError as exc:
-                raise SourceError(f"listing {prefix}: invalid XML ({exc})") from None
+                raise SourceError(f"{what}: invalid XML ({exc})") from None
             for c in root.iter(f"{S3_NS}Contents"):
-                key = c.findtext(f"{S3_NS}Key") or ""
-                size = c.findtext(f"{S3_NS}Size")
-                f = listed(key.rsplit("/", 1)[-1], int(size) if size and size.isdigit() else None, key)
-                if f is None or not key.startswith(prefix):
-                    LOG.warning("ignoring listed key %r: not a JPSS granule under %s", key, prefix)
-                    continue
-                out.append(f)
-            if (root.findtext(f"{S3_NS}IsTruncated") or "").lower() != "true":
+                f = self._listed(c, folder, prefix)
+                if f is not None:
+                    out.append(f)
+            if len(out) > self.cfg.max_listed_keys:
+                raise SourceError(f"{what}: more than {self.cfg.max_listed_keys} keys")
+            if (root.findtext(f"{S3_NS}IsTruncated") or "").strip().lower() != "true":
                 return out
             token = root.findtext(f"{S3_NS}NextContinuationToken")
             if not token:
-                raise SourceError(f"listing {prefix}: truncated without a continuation token")
+                raise SourceError(f"{what}: truncated without a continuation token")
+            if token in seen:
+                raise SourceError(f"{what}: the continuation token {token[:40]!r} came back")
+            seen.add(token)
+        raise SourceError(f"{what}: more than {self.cfg.max_list_pages} pages")
+
+    @staticmethod
+    def _listed(c, folder: str, prefix: str) -> ListedFile | None:
+        key = c.findtext(f"{S3_NS}Key") or ""
+        size = (c.findtext(f"{S3_NS}Size") or "").strip()
+        etag = _MD5.fullmatch((c.findtext(f"{S3_NS}ETag") or "").strip())
+        name = key[len(folder):]
+        ok = key.isascii() and key.startswith(prefix) and "/" not in name and _DIGITS.fullmatch(size)
+        f = listed(name, int(size), key, etag.group(1).lower() if etag else None) if ok else None
+        if f is None:
+            LOG.warning("ignoring listed key %r (size %r): not a plain JPSS granule name under %s", key[:200],
+                        size[:20], folder)
+        return f
 
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
         out = []
@@ -114,29 +210,61 @@ class NoddSource:
         url = f"{self._base(f.parsed.platform)}/{f.location}"
         last = None
         for attempt in range(self.cfg.retries + 1):
-            if attempt:
-                time.sleep(min(self.cfg.backoff_s * 2 ** (attempt - 1), 60.0))
             try:
-                with self.session.get(url, stream=True, timeout=self.cfg.timeout_s) as r:
-                    if r.status_code != 200:
-                        raise SourceError(f"{f.name}: HTTP {r.status_code}")
-                    n = 0
-                    with open(part, "wb") as out:
-                        for chunk in r.iter_content(1 << 20):
-                            out.write(chunk)
-                            n += len(chunk)
-                        out.flush()
-                        os.fsync(out.fileno())
-                self.spent_bytes += n
-                if f.size is not None and n != f.size:
-                    raise SourceError(f"{f.name}: got {n} bytes, the listing says {f.size}")
-                os.replace(part, target)
-                return target
-            except (requests.RequestException, SourceError) as exc:
+                n = self._download(url, f, part)
+            except SourceError as exc:
                 last = exc
-                LOG.warning("download of %s failed (attempt %d): %s", f.name, attempt + 1, exc)
                 part.unlink(missing_ok=True)
-        raise SourceError(f"{f.name}: download failed after {self.cfg.retries + 1} attempts ({last})")
+                if attempt < self.cfg.retries and "refused" not in str(exc) and "deadline" not in str(exc):
+                    LOG.warning("download of %s failed (attempt %d): %s", f.name, attempt + 1, exc)
+                    self.sleep(min(self.cfg.backoff_s * 2 ** attempt, self._left_s(f.name)))
+                    continue
+                break
+            self.spent_bytes += n
+            os.replace(part, target)
+            return target
+        raise SourceError(f"{f.name}: download failed ({last})")
+
+    def _download(self, url: str, f: ListedFile, part: Path) -> int:
+        """One download into *part*: bounded in bytes and time, checked against the listing."""
+        r = self._get(url, f.name, stream=True)
+        try:
+            encoding = r.headers.get("Content-Encoding", "identity").strip().lower()
+            if encoding not in ("", "identity"):
+                raise SourceError(f"{f.name}: compressed response (Content-Encoding {encoding[:20]}) refused")
+            length = r.headers.get("Content-Length")
+            if f.size is not None and length is not None and length.strip() != str(f.size):
+                raise SourceError(f"{f.name}: Content-Length {length[:20]}, the listing says {f.size}")
+            slowest = time.monotonic() + 30.0 + (f.size or 0) / (self.cfg.min_rate_kb_s * 1e3)
+            md5 = hashlib.md5() if f.md5 else None
+            n = 0
+            with open(part, "wb") as out:
+                while True:
+                    try:
+                        chunk = r.raw.read1(1 << 20, decode_content=False)
+                    except (requests.RequestException, urllib3.exceptions.HTTPError, OSError, ValueError) as exc:
+                        raise SourceError(f"{f.name}: {type(exc).__name__} after {n} bytes") from None
+                    if not chunk:
+                        break
+                    n += len(chunk)
+                    if f.size is not None and n > f.size:
+                        raise SourceError(f"{f.name}: more than the {f.size} bytes listed")
+                    if time.monotonic() > slowest:
+                        raise SourceError(f"{f.name}: slower than {self.cfg.min_rate_kb_s:g} kB/s "
+                                          f"({n} bytes received)")
+                    self._left_s(f.name)
+                    out.write(chunk)
+                    if md5 is not None:
+                        md5.update(chunk)
+                out.flush()
+                os.fsync(out.fileno())
+        finally:
+            r.close()
+        if f.size is not None and n != f.size:
+            raise SourceError(f"{f.name}: got {n} bytes, the listing says {f.size}")
+        if md5 is not None and md5.hexdigest() != f.md5:
+            raise SourceError(f"{f.name}: MD5 {md5.hexdigest()} differs from the listing's ETag {f.md5}")
+        return n
 
 
 def _newest_per_granule(files: list[ListedFile]) -> list[ListedFile]:

@@ -36,7 +36,8 @@ def bucket(cases, tmp_path_factory):
 
 
 def _source(url, tmp_path, **kw):
-    cfg = SourceConfig(kind="nodd", endpoint=url + "/{bucket}", retries=2, backoff_s=0.01, timeout_s=10, **kw)
+    cfg = SourceConfig(kind="nodd", endpoint=url + "/{bucket}", **{"retries": 2, "backoff_s": 0.01, "timeout_s": 10,
+                                                                   **kw})
     return NoddSource(cfg, tmp_path / "cache")
 
 
@@ -101,3 +102,110 @@ def test_unreachable_server_is_a_source_error(tmp_path):
     src = _source("http://127.0.0.1:9", tmp_path)
     with pytest.raises(SourceError, match="listing"):
         src.list_day("j01", DAY, ("GCRSO",))
+
+
+# -- a hostile server: every fault ends within its bound, with a reason, and nothing grows without end
+
+
+def _timed(fn):
+    import tracemalloc
+    tracemalloc.start()
+    t0 = time.monotonic()
+    try:
+        fn()
+    except SourceError as exc:
+        return time.monotonic() - t0, tracemalloc.get_traced_memory()[1], str(exc)
+    finally:
+        tracemalloc.stop()
+    pytest.fail("no SourceError")
+
+
+def test_endless_and_repeated_continuation_tokens_end(bucket, tmp_path):
+    with S3Server(bucket, page_size=1) as s3:
+        s3.endless_tokens = True
+        secs, peak, why = _timed(lambda: _source(s3.url, tmp_path, max_list_pages=20).list_day("j01", DAY, ("GCRSO",)))
+        assert "more than 20 pages" in why and secs < 10 and peak < 20e6
+        assert sum("continuation-token" in r for r in s3.requests) == 19
+    with S3Server(bucket, page_size=1) as s3:
+        s3.repeat_token = True
+        secs, _, why = _timed(lambda: _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",)))
+        assert "continuation token 'c2FtZQ==' came back" in why and len(s3.requests) == 2
+
+
+def test_a_huge_retry_after_is_not_waited_for(bucket, tmp_path):
+    with S3Server(bucket) as s3:
+        s3.retry_after = 3600
+        secs, _, why = _timed(lambda: _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",)))
+        assert "Retry-After 3600 s, more than the 120 s allowed" in why and secs < 5 and len(s3.requests) == 1
+
+
+def test_a_slow_drip_download_is_cut(bucket, tmp_path):
+    with S3Server(bucket) as s3:
+        src = _source(s3.url, tmp_path, min_rate_kb_s=1000.0, retries=0)
+        f = src.list_day("j01", DAY, ("SCRIF",))[0]
+        s3.slow_drip_s = 0.05
+        secs, peak, why = _timed(lambda: src.fetch(f))
+        assert "slower than 1000 kB/s" in why and secs < 45 and peak < 20e6
+        assert not list((tmp_path / "cache").rglob("*.h5*"))  # no partial granule left
+
+
+def test_the_run_deadline_ends_everything(bucket, tmp_path):
+    with S3Server(bucket) as s3:
+        src = _source(s3.url, tmp_path, run_deadline_min=0.02, retries=0)
+        f = src.list_day("j01", DAY, ("SCRIF",))[0]
+        s3.slow_drip_s = 0.05
+        secs, _, why = _timed(lambda: src.fetch(f))
+        assert "run deadline of 0.02 min has passed" in why and secs < 5
+
+
+def test_a_lying_size_and_a_gzip_response_are_refused(bucket, tmp_path):
+    with S3Server(bucket) as s3:
+        s3.lying_size = 1000
+        src = _source(s3.url, tmp_path)
+        f = src.list_day("j01", DAY, ("SCRIF",))[0]
+        secs, peak, why = _timed(lambda: src.fetch(f))
+        assert "Content-Length" in why and "listing says 1000" in why and peak < 20e6  # the server's copy too
+    with S3Server(bucket) as s3:
+        src = _source(s3.url, tmp_path)
+        f = src.list_day("j01", DAY, ("GCRSO",))[0]
+        s3.gzip = True
+        secs, _, why = _timed(lambda: src.fetch(f))
+        assert "compressed response (Content-Encoding gzip) refused" in why
+    assert not list((tmp_path / "cache").rglob("*.h5*"))
+
+
+def test_md5_against_the_etag(bucket, tmp_path):
+    with S3Server(bucket) as s3:
+        src = _source(s3.url, tmp_path, retries=0)
+        f = src.list_day("j01", DAY, ("GCRSO",))[0]
+        assert f.md5 is not None and len(f.md5) == 32
+        s3.corrupt_once.add(f.location)
+        secs, _, why = _timed(lambda: src.fetch(f))
+        assert "MD5" in why and "differs from the listing's ETag" in why
+        assert src.fetch(f).read_bytes() == (bucket / "noaa-nesdis-n20-pds" / f.location).read_bytes()
+
+
+def test_odd_keys_never_shadow_the_granule(bucket, tmp_path):
+    folder = "CrIS-SDR-GEO/2024/06/01/"
+    with S3Server(bucket) as s3:
+        genuine = _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",))
+        g = next(f.name for f in genuine if "_c2024" in f.name)
+        newer = g.replace("_c2024", "_c2099")
+        s3.extra_keys = [folder + "./" + newer, folder + "sub/../" + newer, folder + newer.replace("_t12", "_t\u0661\u0662"),
+                         folder + g.replace("_t1200", "_t1299").replace("_e1200", "_e1299"),
+                         folder + newer.replace("_c2099", "_c2098")]
+        s3.extra_sizes = {folder + newer.replace("_c2099", "_c2098"): "\u00b2"}
+        files = _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",))
+    assert sorted(f.name for f in files) == sorted(f.name for f in genuine)
+
+
+def test_a_redirect_to_another_host_is_refused(bucket, tmp_path):
+    with S3Server(bucket, host="127.0.0.2") as other, S3Server(bucket) as s3:
+        src = _source(s3.url, tmp_path)
+        f = src.list_day("j01", DAY, ("GCRSO",))[0]
+        s3.redirect_to = other.url
+        secs, _, why = _timed(lambda: src.fetch(f))
+        assert "redirect to http://127.0.0.2" in why and "refused" in why
+        assert other.requests == []
+        s3.redirect_to = s3.url  # on the same host a redirect is followed
+        assert src.fetch(f).stat().st_size == f.size
