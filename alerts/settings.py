@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,58 +50,94 @@ class AlertSettings:
         return [n for n in ("log", "email", "slack") if getattr(self, n)]
 
 
-def _typed(doc, key, typ, where, default):
+RULE_LIMITS = {  # the accepted range of each rule setting, in its unit
+    "spec_km": (0.01, 100.0), "min_jump_km": (0.001, 100.0), "jump_z": (1.0, 100.0), "jump_z_at_change": (1.0, 100.0),
+    "pre_days": (2, 365), "min_pre_days": (2, 365), "min_post_days": (1, 365), "post_days": (1, 365),
+    "blind_window_days": (1, 365), "change_window_days": (1, 3650), "attribution_days": (0, 365),
+    "active_days": (1, 3650), "stale_hours": (1.0, 8760.0), "repeat_hours": (0.1, 8760.0),
+}
+
+
+def _typed(doc, key, typ, where, default, limits=None):
     v = doc.get(key, default)
     if v is None:
         return None
     if typ is float and isinstance(v, int) and not isinstance(v, bool):
         v = float(v)
-    if not isinstance(v, typ):
-        raise AlertConfigError(f"{where}{key}: expected {typ.__name__}, got {v!r}")
+    if not isinstance(v, typ) or (typ in (int, float) and isinstance(v, bool)):
+        raise AlertConfigError(f"{where}{key}: expected {typ.__name__}, got {str(v)[:60]!r}")
+    if typ is float and not math.isfinite(v):
+        raise AlertConfigError(f"{where}{key}: {v} is not a finite number")
+    if limits is not None and not limits[0] <= v <= limits[1]:
+        raise AlertConfigError(f"{where}{key}: {v} is not within {limits[0]:g}..{limits[1]:g}")
     return v
+
+
+def _mapping(doc, key):
+    v = doc.get(key)
+    if not isinstance(v, dict):
+        raise AlertConfigError(f"alerts.{key}: expected a mapping, got {str(v)[:60]!r}")
+    return v
+
+
+def _only(doc, allowed, where):
+    unknown = sorted(set(map(str, doc)) - set(allowed))
+    if unknown:
+        raise AlertConfigError(f"{where}{unknown[0]}: unknown key")
 
 
 def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=None) -> AlertSettings:
     """Parse the alerts section *doc*; relative paths are relative to *base* (the config file's folder)."""
     doc = doc or {}
+    if not isinstance(doc, dict):
+        raise AlertConfigError("alerts: expected a mapping")
     rules = RuleSettings()
-    for key in ("spec_km", "min_jump_km", "stale_hours", "repeat_hours", "jump_z", "jump_z_at_change"):
-        setattr(rules, key, _typed(doc, key, float, "alerts.", getattr(rules, key)))
-    for key in ("pre_days", "min_pre_days", "min_post_days", "post_days", "blind_window_days", "attribution_days",
-                "active_days", "change_window_days"):
-        setattr(rules, key, _typed(doc, key, int, "alerts.", getattr(rules, key)))
-    allowed = set(RuleSettings.__dataclass_fields__) | {"log", "email", "slack", "events_file"}
-    unknown = sorted(set(doc) - allowed)
-    if unknown:
-        raise AlertConfigError(f"alerts.{unknown[0]}: unknown key")
+    for key, limits in RULE_LIMITS.items():
+        typ = float if isinstance(getattr(rules, key), float) else int
+        setattr(rules, key, _typed(doc, key, typ, "alerts.", getattr(rules, key), limits))
+    if rules.min_pre_days > rules.pre_days:
+        raise AlertConfigError(f"alerts.min_pre_days: {rules.min_pre_days} is more than alerts.pre_days "
+                               f"({rules.pre_days})")
+    _only(doc, set(RuleSettings.__dataclass_fields__) | {"log", "email", "slack", "events_file"}, "alerts.")
 
-    def path(p):
-        p = Path(os.path.expandvars(str(p))).expanduser()
+    def path(key, d=doc, where="alerts."):
+        p = _typed(d, key, str, where, None)
+        if p is None or p == "":
+            return None
+        p = Path(os.path.expandvars(p)).expanduser()
         return p if p.is_absolute() else base / p
 
     s = AlertSettings(rules=rules, report_dir=report_dir, dashboard_url=dashboard_url)
-    if doc.get("log"):
-        s.log = path(doc["log"])
-    if doc.get("events_file"):
-        s.events_file = path(doc["events_file"])
+    s.log = path("log")
+    s.events_file = path("events_file")
     if doc.get("email"):
-        e = doc["email"]
-        if not isinstance(e, dict) or not e.get("host"):
+        e = _mapping(doc, "email")
+        w = "alerts.email."
+        _only(e, {"host", "port", "from", "to", "starttls", "username_env", "password_env", "cafile", "timeout_s"}, w)
+        if not e.get("host") or not isinstance(e["host"], str):
             raise AlertConfigError("alerts.email.host: missing")
         to = e.get("to") or []
-        if not isinstance(to, list) or not to:
+        if not isinstance(to, list) or not to or not all(isinstance(a, str) and "@" in a for a in to):
             raise AlertConfigError("alerts.email.to: a list of addresses is needed")
-        s.email = EmailSettings(host=e["host"], port=int(e.get("port", 587)), sender=e.get("from", "crisgeo@localhost"),
-                                to=list(to), starttls=bool(e.get("starttls", True)),
-                                username_env=e.get("username_env"), password_env=e.get("password_env"),
-                                cafile=str(path(e["cafile"])) if e.get("cafile") else None,
-                                timeout_s=float(e.get("timeout_s", 30.0)))
+        sender = _typed(e, "from", str, w, "crisgeo@localhost")
+        if "@" not in sender:
+            raise AlertConfigError(f"alerts.email.from: {sender!r} is not an address")
+        s.email = EmailSettings(host=e["host"], port=_typed(e, "port", int, w, 587, (1, 65535)), sender=sender,
+                                to=list(to), starttls=_typed(e, "starttls", bool, w, True),
+                                username_env=_typed(e, "username_env", str, w, None),
+                                password_env=_typed(e, "password_env", str, w, None),
+                                cafile=str(path("cafile", e, w)) if e.get("cafile") else None,
+                                timeout_s=_typed(e, "timeout_s", float, w, 30.0, (0.1, 600.0)))
     if doc.get("slack"):
-        sl = doc["slack"]
-        if not isinstance(sl, dict) or not sl.get("webhook_env"):
+        sl = _mapping(doc, "slack")
+        w = "alerts.slack."
+        _only(sl, {"webhook_env", "retries", "max_wait_s", "timeout_s"}, w)
+        if not sl.get("webhook_env"):
             raise AlertConfigError("alerts.slack.webhook_env: missing (the name of the variable holding the URL)")
-        s.slack = SlackSettings(webhook_env=sl["webhook_env"], retries=int(sl.get("retries", 3)),
-                                max_wait_s=float(sl.get("max_wait_s", 30.0)), timeout_s=float(sl.get("timeout_s", 15.0)))
+        s.slack = SlackSettings(webhook_env=_typed(sl, "webhook_env", str, w, None),
+                                retries=_typed(sl, "retries", int, w, 3, (0, 20)),
+                                max_wait_s=_typed(sl, "max_wait_s", float, w, 30.0, (0.0, 3600.0)),
+                                timeout_s=_typed(sl, "timeout_s", float, w, 15.0, (0.1, 600.0)))
     return s
 
 

@@ -166,6 +166,16 @@ def _load(args):
         raise BadInput(f"{args.config}: {exc}") from None
 
 
+def cmd_check_config(args) -> int:
+    import yaml
+
+    from monitor.config import effective
+    cfg = _load(args)
+    print(f"# {args.config}: valid")
+    print(yaml.safe_dump(effective(cfg), sort_keys=False, default_flow_style=False), end="")
+    return EXIT_OK
+
+
 def _day(text: str) -> dt.date:
     try:
         return dt.date.fromisoformat(text)
@@ -457,6 +467,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD")
     r.set_defaults(func=cmd_run)
 
+    cc = sub.add_parser("check-config", help="validate a configuration; print it with its defaults, secrets masked")
+    cc.add_argument("--config", required=True)
+    cc.set_defaults(func=cmd_check_config)
+
     d = sub.add_parser("daemon", help="the long-running service (systemd)")
     d.add_argument("--config", required=True)
     d.set_defaults(func=cmd_daemon)
@@ -518,6 +532,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    logging.getLogger("urllib3").setLevel(logging.WARNING)  # its debug lines carry request paths (webhooks)
     try:
         return args.func(args)
     except BadInput as exc:

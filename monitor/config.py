@@ -7,12 +7,15 @@ value is a secret end in ``_env`` and hold the *name* of an environment variable
 from __future__ import annotations
 
 import datetime as dt
+import math
 import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
+import yaml.events
+from urllib.parse import urlsplit, urlunsplit
 
 from monitor.satellites import SATELLITES as _TABLE
 
@@ -114,6 +117,7 @@ class Config:
     fingerprint: FingerprintConfig = field(default_factory=FingerprintConfig)
     report_dir: Path | None = None
     dashboard_url: str | None = None
+    alert_settings: object = None  # alerts.settings.AlertSettings, parsed and validated with the rest
 
     @property
     def cache_dir(self) -> Path:
@@ -129,7 +133,16 @@ def _get(doc: dict, key: str, typ, where: str, default=None, required=False):
     if typ is float and isinstance(value, int) and not isinstance(value, bool):
         value = float(value)
     if not isinstance(value, typ) or (typ in (int, float) and isinstance(value, bool)):
-        raise ConfigError(f"{where}{key}: expected {typ.__name__}, got {type(value).__name__} {value!r}")
+        raise ConfigError(f"{where}{key}: expected {typ.__name__}, got {type(value).__name__} {str(value)[:60]!r}")
+    if typ is float and not math.isfinite(value):
+        raise ConfigError(f"{where}{key}: {value} is not a finite number")
+    return value
+
+
+def _within(value, lo, hi, where):
+    """*value* within lo..hi (inclusive), or a ConfigError naming the key."""
+    if not lo <= value <= hi:
+        raise ConfigError(f"{where}: {value} is not within {lo:g}..{hi:g}")
     return value
 
 
@@ -167,18 +180,93 @@ def _no_inline_secrets(doc, where=""):
             _no_inline_secrets(v, f"{where[:-1]}[{i}].")
 
 
-def load_config(path) -> Config:
-    """Load and validate the YAML configuration at *path*; relative paths are relative to the file."""
-    path = Path(path)
+MAX_CONFIG_BYTES = 1 << 20
+ENV_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}", re.ASCII)
+
+
+class _Loader(yaml.SafeLoader):
+    """Safe YAML without anchors and aliases: a configuration needs none, and aliases nest into bombs."""
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.events.AliasEvent):
+            mark = self.peek_event().start_mark
+            raise ConfigError(f"line {mark.line + 1}: YAML aliases (*name) are not allowed in the configuration")
+        event = self.peek_event()
+        if getattr(event, "anchor", None):
+            raise ConfigError(f"line {event.start_mark.line + 1}: YAML anchors (&name) are not allowed in the "
+                              f"configuration")
+        return super().compose_node(parent, index)
+
+
+def read_yaml(path: Path):
+    """The YAML document at *path*: at most 1 MiB, safe types only, no anchors or aliases."""
     try:
-        doc = yaml.safe_load(path.read_text())
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_CONFIG_BYTES + 1)
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read ({exc.strerror})") from None
+    if len(raw) > MAX_CONFIG_BYTES:
+        raise ConfigError(f"{path}: larger than {MAX_CONFIG_BYTES >> 20} MiB")
+    try:
+        return yaml.load(raw.decode("utf-8"), Loader=_Loader)  # noqa: S506 - _Loader is a SafeLoader
+    except UnicodeDecodeError:
+        raise ConfigError(f"{path}: not UTF-8 text") from None
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: {exc}") from None
     except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML ({exc})") from None
+        raise ConfigError(f"{path}: not valid YAML ({str(exc)[:300]})") from None
+
+
+def check_url(url: str, where: str, placeholder: str | None = None) -> str:
+    """An http(s) URL without credentials in it (secrets come from *_env variables)."""
+    try:
+        parts = urlsplit(url)
+    except ValueError:
+        raise ConfigError(f"{where}: {url!r} is not a URL") from None
+    if parts.scheme not in ("http", "https") or not parts.netloc:
+        raise ConfigError(f"{where}: {redact_url(url)!r} is not an http(s) URL")
+    if parts.username or parts.password or "@" in parts.netloc:
+        raise ConfigError(f"{where}: credentials may not be written in a URL; name environment variables "
+                          f"with the *_env keys")
+    if placeholder and placeholder not in url:
+        raise ConfigError(f"{where}: {url!r} has no {placeholder} placeholder")
+    return url
+
+
+def redact_url(url: str) -> str:
+    """*url* with any user:password and query string masked, for logs and messages."""
+    try:
+        p = urlsplit(str(url))
+    except ValueError:
+        return "<unparsable URL>"
+    netloc = p.netloc.rsplit("@", 1)[-1]
+    if "@" in p.netloc:
+        netloc = "***@" + netloc
+    return urlunsplit((p.scheme, netloc, p.path, "***" if p.query else "", ""))
+
+
+def _env_names(doc, where=""):
+    """Every *_env value names an environment variable: an identifier, not a secret pasted in."""
+    if isinstance(doc, dict):
+        for k, v in doc.items():
+            if str(k).endswith("_env") and v is not None and not (isinstance(v, str) and ENV_NAME.fullmatch(v)):
+                raise ConfigError(f"{where}{k}: {'a value' if isinstance(v, str) else repr(v)} is not the name "
+                                  f"of an environment variable")
+            _env_names(v, f"{where}{k}.")
+    elif isinstance(doc, list):
+        for i, v in enumerate(doc):
+            _env_names(v, f"{where[:-1]}[{i}].")
+
+
+def load_config(path) -> Config:
+    """Load and validate the YAML configuration at *path*, the alerts section included; relative paths are
+    relative to the file. Any problem is a :class:`ConfigError` naming the key."""
+    path = Path(path)
+    doc = read_yaml(path)
     if not isinstance(doc, dict):
         raise ConfigError(f"{path}: expected a mapping at the top level")
     _no_inline_secrets(doc)
+    _env_names(doc)
     _known(doc, {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts",
                  "fingerprint", "report_dir", "dashboard_url"}, "")
     base = path.resolve().parent
@@ -214,9 +302,10 @@ def load_config(path) -> Config:
     source.endpoint = _get(s, "endpoint", str, "source.", source.endpoint)
     buckets = _get(s, "buckets", dict, "source.", None)
     if buckets:
-        source.buckets.update({str(k): str(v) for k, v in buckets.items()})
-    if source.granules < 1 or source.retries < 0 or source.retention_days < 0:
-        raise ConfigError("source.granules must be >= 1, source.retries and source.retention_days >= 0")
+        for k, v in buckets.items():
+            if not isinstance(v, str):
+                raise ConfigError(f"source.buckets.{k}: expected a bucket name, got {v!r}")
+        source.buckets.update({str(k): v for k, v in buckets.items()})
 
     sc = _section(doc, "schedule")
     _known(sc, {"time_utc", "catch_up_days", "misfire_grace_hours", "lag_days"}, "schedule.")
@@ -260,9 +349,7 @@ def load_config(path) -> Config:
         pk = _get(p, "kind", str, where, required=True)
         if pk not in ("influx2", "influx1"):
             raise ConfigError(f"{where}kind: {pk!r} is not influx2 or influx1")
-        url = _get(p, "url", str, where, required=True)
-        if not re.match(r"https?://", url):
-            raise ConfigError(f"{where}url: {url!r} is not an http(s) URL")
+        url = check_url(_get(p, "url", str, where, required=True), f"{where}url")
         pc = PublishConfig(kind=pk, url=url.rstrip("/"))
         for key in ("measurement", "bucket", "org", "database", "token_env", "username_env", "password_env"):
             setattr(pc, key, _get(p, key, str, where, getattr(pc, key)))
@@ -281,8 +368,80 @@ def load_config(path) -> Config:
                                               "fingerprint.threshold_urad"),
                                     tuple(rel(x) for x in library))
     alerts = _section(doc, "alerts")
-    report_dir = doc.get("report_dir")
-    return Config(path=path, satellites=list(sats), state_dir=state_dir, source=source, schedule=schedule,
-                  scenes=scenes, assessment=assessment, store=store, alerts=alerts, fingerprint=fingerprint,
-                  report_dir=rel(report_dir) if report_dir else None,
-                  dashboard_url=_get(doc, "dashboard_url", str, "", None))
+    report_dir = _get(doc, "report_dir", str, "", None)
+    dashboard_url = _get(doc, "dashboard_url", str, "", None)
+    if dashboard_url:
+        check_url(dashboard_url, "dashboard_url")
+    cfg = Config(path=path, satellites=list(sats), state_dir=state_dir, source=source, schedule=schedule,
+                 scenes=scenes, assessment=assessment, store=store, alerts=alerts, fingerprint=fingerprint,
+                 report_dir=rel(report_dir) if report_dir else None, dashboard_url=dashboard_url)
+    _check_limits(cfg)
+    from alerts.settings import AlertConfigError, load_alert_settings
+    try:
+        cfg.alert_settings = load_alert_settings(alerts, base, cfg.report_dir, cfg.dashboard_url)
+    except AlertConfigError as exc:
+        raise ConfigError(str(exc)) from None
+    return cfg
+
+
+# The accepted range of every bounded number: (lowest, highest), in the key's unit.
+LIMITS = {
+    "source.timeout_s": (0.1, 3600), "source.retries": (0, 20), "source.backoff_s": (0.01, 600),
+    "source.daily_budget_mb": (1, 1e6), "source.retention_days": (0, 3650), "source.run_deadline_min": (1, 1440),
+    "source.max_list_pages": (1, 10000), "source.max_listed_keys": (1, 10**6), "source.max_retry_after_s": (1, 3600),
+    "source.min_rate_kb_s": (1, 1e6), "source.granules": (1, 100), "source.seed": (0, 2**31 - 1),
+    "schedule.catch_up_days": (1, 366), "schedule.lag_days": (0, 30), "schedule.misfire_grace_hours": (0.01, 72),
+    "scenes.candidates": (1, 1000), "scenes.keep": (1, 200), "scenes.min_inhomogeneity_k": (0, 50),
+    "assessment.half_steps": (1, 40), "assessment.step_urad": (10, 5000), "assessment.workers": (1, 64),
+    "store.drain_minutes": (0.01, 1440),
+    "fingerprint.granules": (1, 2000), "fingerprint.threshold_urad": (0.1, 10000),
+}
+BUCKET = re.compile(r"[a-z0-9][a-z0-9.-]{1,61}[a-z0-9]", re.ASCII)
+
+
+def _check_limits(cfg: Config) -> None:
+    for key, (lo, hi) in LIMITS.items():
+        section, name = key.split(".")
+        _within(getattr(getattr(cfg, section), name), lo, hi, key)
+    if cfg.scenes.keep > cfg.scenes.candidates:
+        raise ConfigError(f"scenes.keep: {cfg.scenes.keep} is more than scenes.candidates ({cfg.scenes.candidates})")
+    if len(set(cfg.satellites)) != len(cfg.satellites):
+        raise ConfigError("satellites: a satellite is listed twice")
+    check_url(cfg.source.endpoint, "source.endpoint", "{bucket}")
+    for sat, bucket in cfg.source.buckets.items():
+        if sat not in SATELLITES:
+            raise ConfigError(f"source.buckets.{sat}: not one of {', '.join(SATELLITES)}")
+        if not BUCKET.fullmatch(bucket):
+            raise ConfigError(f"source.buckets.{sat}: {bucket!r} is not a bucket name")
+    for i, p in enumerate(cfg.store.publish):
+        _within(p.timeout_s, 0.1, 600, f"store.publish[{i}].timeout_s")
+
+
+def effective(cfg: Config) -> dict:
+    """The configuration as loaded (defaults filled in), for ``crisgeo check-config``: no secret values,
+    only the names of the variables that hold them and whether each is set."""
+    import dataclasses
+
+    def plain(v, key=""):
+        if dataclasses.is_dataclass(v):
+            return {f.name: plain(getattr(v, f.name), f.name) for f in dataclasses.fields(v)
+                    if f.name not in ("path", "alerts", "report_dir", "dashboard_url") or v is not cfg}
+        if isinstance(v, dict):
+            return {str(k): plain(x, str(k)) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [plain(x, key) for x in v]
+        if isinstance(v, Path):
+            return str(v)
+        if isinstance(v, dt.time):
+            return v.strftime("%H:%M")
+        if key.endswith("_env") and v:
+            return f"{v} ({'set' if os.environ.get(v) else 'not set'})"
+        if key in ("url", "endpoint", "dashboard_url") and isinstance(v, str):
+            return redact_url(v)
+        return v
+    out = plain(cfg)
+    out["alerts"] = plain(cfg.alert_settings)
+    out.pop("alert_settings", None)
+    out["report_dir"] = str(cfg.report_dir) if cfg.report_dir else None
+    out["dashboard_url"] = redact_url(cfg.dashboard_url) if cfg.dashboard_url else None
+    return out

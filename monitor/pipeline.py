@@ -114,11 +114,9 @@ def publish_changes(cfg, store, satellite: str) -> None:
     if not cfg.store.publish:
         return
     from alerts.changes import all_changes
-    from alerts.settings import AlertConfigError, load_alert_settings
     try:
-        calendar = load_alert_settings(cfg.alerts, cfg.path.resolve().parent).events_file
-        changes = all_changes(store, satellite, calendar)
-    except (AlertConfigError, ValueError, OSError) as exc:
+        changes = all_changes(store, satellite, cfg.alert_settings.events_file)
+    except (ValueError, OSError) as exc:
         LOG.warning("changes not published: %s", exc)
         return
     for p in cfg.store.publish:

@@ -108,9 +108,8 @@ class Service:
             store.close()
 
     def alert_settings(self):
-        from alerts.settings import load_alert_settings
-        return load_alert_settings(self.cfg.alerts, self.cfg.path.resolve().parent, self.cfg.report_dir,
-                                   self.cfg.dashboard_url)
+        """The alerts section, validated with the rest of the configuration at load."""
+        return self.cfg.alert_settings
 
     def _after_run(self, store, outcome):
         """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the

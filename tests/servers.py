@@ -64,12 +64,12 @@ def _running(cmd: list, url: str, health: str):
 
 
 @contextmanager
-def victoria_metrics(tmp: Path, port: int | None = None):
-    """VictoriaMetrics on 127.0.0.1; yields its base URL."""
+def victoria_metrics(tmp: Path, port: int | None = None, flags=()):
+    """VictoriaMetrics on 127.0.0.1 (with extra command-line *flags*); yields its base URL."""
     exe = require("victoria-metrics")
     port = port or free_port()
     with _running([exe, f"-httpListenAddr=127.0.0.1:{port}", f"-storageDataPath={tmp}", "-retentionPeriod=100y",
-                   "-loggerLevel=ERROR"], f"http://127.0.0.1:{port}", "/health") as url:
+                   "-loggerLevel=ERROR", *flags], f"http://127.0.0.1:{port}", "/health") as url:
         yield url
 
 

@@ -54,8 +54,7 @@ class ReportOptions:
 
 def options_from_config(cfg, satellites=None, since=None, until=None) -> ReportOptions:
     """Report options of a service configuration: the spec of its alert rules, its events calendar."""
-    from alerts.settings import load_alert_settings
-    settings = load_alert_settings(cfg.alerts, cfg.path.resolve().parent)
+    settings = cfg.alert_settings
     return ReportOptions(spec_km=settings.rules.spec_km, since=since, until=until, calendar=settings.events_file,
                          satellites=list(satellites or cfg.satellites))
 

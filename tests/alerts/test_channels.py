@@ -136,3 +136,28 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     assert len(webhook.received) == 1 and sorted(c["sent"] for c in counts) == [0, 1]
     s = Store(path)
     assert [d["status"] for d in AlertState(s).deliveries()] == ["sent"]
+
+
+def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
+    """`crisgeo -v` logs at debug level; urllib3's request lines (which carry the webhook's secret path)
+    are kept out."""
+    import datetime as dt
+    import os
+    import subprocess
+    import sys
+
+    from alerts.state import AlertState
+    from monitor.store.sqlite import Store
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+                   f"alerts: {{slack: {{webhook_env: T_SLACK}}}}\n")
+    (tmp_path / "state").mkdir()
+    store = Store(tmp_path / "state" / "crisgeo.sqlite")
+    AlertState(store).enqueue("slack", "j01", {"subject": "s", "text": "t", "blocks": []},
+                              dt.datetime.now(dt.timezone.utc) - dt.timedelta(minutes=1))
+    store.close()
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "-v", "alerts", "evaluate", "--config", str(cfg)],
+                       capture_output=True, text=True, env={**os.environ, "T_SLACK": webhook.url})
+    assert r.returncode == 0, r.stderr
+    assert len(webhook.received) >= 1  # it was sent
+    assert "secret-token" not in r.stderr + r.stdout and "DEBUG" in r.stderr

@@ -83,8 +83,8 @@ def test_wrong_axis0_is_reported(real_geo_files, tmp_path):
 
 
 @pytest.mark.parametrize("dataset,value,reason", [
-    ("Latitude", 1e28, "value 1e\+28 outside -90..90"),
-    ("SatelliteRange", 10.0, "value 10 outside 700000..4e\+06"),
+    ("Latitude", 1e28, r"value 1e\+28 outside -90..90"),
+    ("SatelliteRange", 10.0, r"value 10 outside 700000..4e\+06"),
     ("SCPosition", 7e9, "vector length .* outside"),
 ])
 def test_out_of_range_values_are_refused(real_geo_files, tmp_path, dataset, value, reason):

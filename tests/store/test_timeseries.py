@@ -128,3 +128,21 @@ def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
         assert store.outbox_size(target_name(service.cfg.store.publish[0])) == 0
         assert len(vm_export(url, "cris_geolocation_d_beta_urad")) == 30
         assert not store.runs("j01") or all(r["status"] != "ok" or r["day"] == str(DAY) for r in store.runs("j01"))
+
+
+def test_a_rerun_day_keeps_one_value_per_series_with_dedup(cases, tmp_path):
+    """Re-running a day queues the same points again (same series, same timestamps). InfluxDB overwrites
+    a point with the same series and time; VictoriaMetrics keeps one only with deduplication on
+    (``-dedup.minScrapeInterval``, README), which this test starts it with."""
+    _, _, result = cases.get()
+    with victoria_metrics(tmp_path / "vm", flags=["-dedup.minScrapeInterval=1ms"]) as url:
+        cfg = PublishConfig(kind="influx2", url=url, bucket="crisgeo")
+        store = Store(tmp_path / "s.sqlite")
+        first = []
+        for _ in range(2):  # the day, then the same day again
+            _queue(store, cfg, result)
+            first.append(list(r["line"] for r in store.outbox(target_name(cfg), 100)))
+            assert drain_outbox(store, [cfg]) == {target_name(cfg): (30, 0)}
+        assert first[0] == first[1]  # the same series and timestamps
+        series = vm_export(url, "cris_geolocation_d_alpha_urad")
+        assert len(series) == 30 and all(len(s["values"]) == 1 for s in series)
