@@ -355,6 +355,12 @@ def _check_not_all_fill(path, product: Product, granule) -> None:
     if not np.any(np.isfinite(getattr(granule, key))):
         raise GranuleError(path, f"{product.data_group}/{product.fields[key].dataset}",
                            f"granule {granule.meta.granule_id or '?'} holds only fill values")
+    if product.kind in ("viirs_geo", "cris_geo"):
+        lat_ok, lon_ok = np.isfinite(granule.lat_rad), np.isfinite(granule.lon_rad)
+        if np.any(lat_ok != lon_ok):
+            n = int(np.sum(lat_ok != lon_ok))
+            raise GranuleError(path, f"{product.data_group}/Longitude", f"fill at {n} pixel(s) where Latitude is set, "
+                                                                       f"or set where it is fill")
     if product.kind == "viirs_geo" and "height_m" in product.fields:
         _check_height(path, f"{product.data_group}/{product.fields['height_m'].dataset}",
                       granule.lat_rad, granule.lon_rad, granule.height_m)

@@ -245,3 +245,13 @@ def test_gimgo_pixels_are_on_the_ellipsoid(cases, tmp_path):
                [ProductData(PRODUCTS["GIMGO"], "VIIRS", "GEO", data, [attrs], {}, fills={}, compress=False)])
     (geo,) = read_file(dst)
     assert np.all(geo.height_m == 0) and read_viirs_geo_scan(dst, 0)[2].max() == 0
+
+
+def test_longitudes_all_fill_under_set_latitudes_are_refused(cases, tmp_path):
+    """A VIIRS GEO whose longitudes are all NaN used to end the assessment with a numpy ValueError."""
+    out, _, _ = cases.get()
+    src = next(out.glob("GITCO_*.h5"))
+    bad = _copy(src, tmp_path / src.name)
+    _edit(bad, "Longitude", lambda a: np.full_like(a, np.nan))
+    with pytest.raises(GranuleError, match=f"{bad.name}: .*/Longitude: fill at .* where Latitude is set"):
+        read_file(bad)
