@@ -209,3 +209,12 @@ def test_a_redirect_to_another_host_is_refused(bucket, tmp_path):
         assert other.requests == []
         s3.redirect_to = s3.url  # on the same host a redirect is followed
         assert src.fetch(f).stat().st_size == f.size
+
+
+def test_one_retry_layer(bucket, tmp_path):
+    """503s are retried `retries` times by the source alone (no urllib3 Retry nested inside: that made up
+    to 36 attempts per file)."""
+    with S3Server(bucket) as s3:
+        s3.retry_after = 0
+        secs, _, why = _timed(lambda: _source(s3.url, tmp_path, retries=3).list_day("j01", DAY, ("GCRSO",)))
+        assert "HTTP 503 after 4 attempts" in why and len(s3.requests) == 4
