@@ -52,12 +52,17 @@ def _ep(path, satellite=None):
         raise BadInput(str(exc)) from None
 
 
-def _residuals(path):
-    from monitor.mapping.residuals import ResidualError, load
-    if path is None:
+def _residuals(args):
+    """The residual table of --residuals FILE, or each granule's own against --own-residuals EP."""
+    from monitor.mapping.residuals import OwnResiduals, ResidualError, load
+    if args.residuals and args.own_residuals:
+        raise BadInput("--residuals and --own-residuals exclude each other")
+    if args.own_residuals:
+        return OwnResiduals(_ep(args.own_residuals))
+    if args.residuals is None:
         return None
     try:
-        return load(path)
+        return load(args.residuals)
     except ResidualError as exc:
         raise BadInput(str(exc)) from None
 
@@ -91,7 +96,7 @@ def cmd_regeolocate(args) -> int:
     from monitor.mapping.regeolocate import regeolocate_file
     from monitor.sdr import GranuleError
     ep = _ep(args.ep)
-    residuals = _residuals(args.residuals)
+    residuals = _residuals(args)
     failed = 0
     for path in args.files:
         try:
@@ -112,7 +117,7 @@ def cmd_geolocate(args) -> int:
     from monitor.sdr import GranuleError
     ep = _ep(args.ep)
     try:
-        rows = compare_with_files(ep, args.files, _residuals(args.residuals))
+        rows = compare_with_files(ep, args.files, _residuals(args))
     except (GranuleError, ValueError) as exc:
         raise BadInput(str(exc)) from None
     if args.json:
@@ -442,6 +447,8 @@ def build_parser() -> argparse.ArgumentParser:
     rg.add_argument("--ep", required=True)
     rg.add_argument("--out", required=True, help="output directory (never the input's)")
     rg.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
+    rg.add_argument("--own-residuals", metavar="EP_IN_FORCE",
+                    help="learn each granule's residual from itself, against the EP it was made with")
     rg.set_defaults(func=cmd_regeolocate)
 
     gl = sub.add_parser("geolocate", help="compare an EP's geolocation with CrIS GEO files' own, per FOR")
@@ -449,6 +456,8 @@ def build_parser() -> argparse.ArgumentParser:
     gl.add_argument("--ep", required=True)
     gl.add_argument("--json", action="store_true")
     gl.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
+    gl.add_argument("--own-residuals", metavar="EP_IN_FORCE",
+                    help="learn each granule's residual from itself, against the EP it was made with")
     gl.set_defaults(func=cmd_geolocate)
 
     a = sub.add_parser("assess", help="assess CrIS geolocation against VIIRS I5 for the granules given")

@@ -21,7 +21,7 @@ import numpy as np
 from monitor.geometry import instrument, wgs84
 from monitor.geometry.geolocate import GroundView, geolocate_fovs
 from monitor.geometry.instrument import EngineeringPacket
-from monitor.mapping.residuals import ResidualTable
+from monitor.mapping.residuals import OwnResiduals, ResidualTable
 from monitor.sdr import read_file
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.products import PRODUCTS
@@ -34,7 +34,7 @@ _REWRITTEN = {"Latitude": ("lat_rad", np.degrees), "Longitude": ("lon_rad", np.d
               "SatelliteAzimuthAngle": ("azimuth_rad", np.degrees), "SatelliteRange": ("range_m", None)}
 
 
-def geolocate_granule(ep: EngineeringPacket, g: CrisGeoGranule, residuals: ResidualTable | None = None) -> GroundView:
+def geolocate_granule(ep: EngineeringPacket, g: CrisGeoGranule, residuals: ResidualTable | OwnResiduals | None = None) -> GroundView:
     """Geolocation of every FOV of *g* with the LOS of *ep* (turned by the per-FOR *residuals*, if given)
     and the granule's own ephemeris and attitude."""
     if g.meta.platform != ep.satellite:
@@ -43,7 +43,7 @@ def geolocate_granule(ep: EngineeringPacket, g: CrisGeoGranule, residuals: Resid
         raise ValueError(f"residual table of {residuals.satellite}, EP {ep.version} of {ep.satellite}")
     los = instrument.los_spacecraft(ep)
     if residuals is not None:
-        los = residuals.apply(los)
+        los = residuals.table_for(g).apply(los)
     return geolocate_fovs(los, g.for_time_us, g.mid_time_us, g.sc_position_m, g.sc_velocity_m_s,
                           g.sc_attitude_rad)
 
@@ -70,7 +70,7 @@ class ForDistance:
                 "max_m": self.max_m}
 
 
-def compare_with_files(ep: EngineeringPacket, paths, residuals: ResidualTable | None = None) -> list[ForDistance]:
+def compare_with_files(ep: EngineeringPacket, paths, residuals: ResidualTable | OwnResiduals | None = None) -> list[ForDistance]:
     """Per-FOR statistics of the distance between *ep*'s geolocation (with *residuals*, if given) and the
     files' latitude/longitude."""
     per_for = [[] for _ in range(instrument.N_FOR)]
@@ -93,7 +93,7 @@ def compare_with_files(ep: EngineeringPacket, paths, residuals: ResidualTable | 
     return out
 
 
-def regeolocate_file(ep: EngineeringPacket, path, out_dir, residuals: ResidualTable | None = None) -> Path:
+def regeolocate_file(ep: EngineeringPacket, path, out_dir, residuals: ResidualTable | OwnResiduals | None = None) -> Path:
     """Write a copy of the GEO file *path* into *out_dir* with its geolocation computed from *ep* (and the
     per-FOR *residuals*, if given)."""
     src = Path(path).resolve()
@@ -123,8 +123,9 @@ def regeolocate_file(ep: EngineeringPacket, path, out_dir, residuals: ResidualTa
                 _update_bounds(h5, k, view)
             group.attrs["crisgeo_engineering_packet"] = json.dumps(
                 {"version": ep.version, "satellite": ep.satellite, "provenance": ep.provenance,
-                 "residuals": None if residuals is None else {"ep_version": residuals.ep_version,
-                                                              "granules": list(residuals.granules)}})
+                 "residuals": None if residuals is None else
+                 {"own_against": residuals.ep_in_force.version} if isinstance(residuals, OwnResiduals) else
+                 {"ep_version": residuals.ep_version, "granules": list(residuals.granules)}})
         tmp.replace(dst)
     except BaseException:
         tmp.unlink(missing_ok=True)

@@ -76,3 +76,16 @@ def test_bad_tables_name_file_and_field(real_geo_files, v115, tmp_path, edit, fi
     path.write_text("{not json")
     with pytest.raises(residuals.ResidualError, match="bad.json: \\(file\\): not JSON"):
         residuals.load(path)
+
+
+def test_own_residuals_reproduce_the_operational_geolocation(real_geo_files, v115, tmp_path):
+    """Learned from the granule being regeolocated (against the EP it was made with), the residual carries
+    that minute's servo corrections: median 2 m, p99 <= 16 m at every FOR on granules 6-10."""
+    rows = compare_with_files(v115, real_geo_files[5:], residuals.OwnResiduals(v115))
+    assert np.median([r.median_m for r in rows]) < 4 and max(r.p99_m for r in rows) < 20
+    run = subprocess.run([sys.executable, "-m", "monitor.cli", "regeolocate", "--ep", str(V115), "--own-residuals",
+                          str(V115), "--out", str(tmp_path), str(real_geo_files[6])], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    (g,) = read_file(tmp_path / real_geo_files[6].name)
+    (orig,) = read_file(real_geo_files[6])
+    assert np.nanmax(np.abs(g.lat_rad - orig.lat_rad)) * 6.4e6 < 40  # metres, at most
