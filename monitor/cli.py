@@ -1,4 +1,11 @@
-"""The ``crisgeo`` command line. Exit status: 0 success, 2 bad input (one line on stderr), 1 failure."""
+"""The ``crisgeo`` command line.
+
+Exit status: 0 success; 1 failure (a run failed, the store is unusable); 2 bad input (one line on stderr:
+arguments, configuration, data); 75 another instance holds the state directory (try again later). ``crisgeo
+status`` follows the Nagios plugin convention instead: 0 OK, 1 WARNING (a warning alert fires), 2 CRITICAL
+(a critical alert fires or the last run of a satellite failed), 3 UNKNOWN (no usable configuration or store).
+The configuration is ``--config``, else ``$CRISGEO_CONFIG``, else ``/etc/crisgeo/monitor.yaml``.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +16,9 @@ import sys
 from pathlib import Path
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
+EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
+NAGIOS_OK, NAGIOS_WARNING, NAGIOS_CRITICAL, NAGIOS_UNKNOWN = 0, 1, 2, 3
+DEFAULT_CONFIG = "/etc/crisgeo/monitor.yaml"
 
 
 class BadInput(Exception):
@@ -164,11 +174,15 @@ def cmd_assess(args) -> int:
 
 
 def _load(args):
+    import os
+
     from monitor.config import ConfigError, load_config
+    args.config = args.config or os.environ.get("CRISGEO_CONFIG") or DEFAULT_CONFIG
     try:
         return load_config(args.config)
     except ConfigError as exc:
-        raise BadInput(f"{args.config}: {exc}") from None
+        msg = str(exc)
+        raise BadInput(msg if msg.startswith(str(args.config)) else f"{args.config}: {msg}") from None
 
 
 def cmd_check_config(args) -> int:
@@ -207,7 +221,8 @@ def cmd_run(args) -> int:
             for sat in sats:
                 outcomes += [service.run(sat, args.date)] if args.date else service.catch_up(sat)
     except AlreadyRunning as exc:
-        raise BadInput(str(exc)) from None
+        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
+        return EXIT_ALREADY_RUNNING
     finally:
         if bar is not None:
             bar.close()
@@ -228,36 +243,74 @@ def cmd_daemon(args) -> int:
     try:
         Service(cfg).daemon()
     except AlreadyRunning as exc:
-        raise BadInput(str(exc)) from None
+        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
+        return EXIT_ALREADY_RUNNING
     return EXIT_OK
+
+
+def status_report(cfg, store) -> dict:
+    """What ``crisgeo status`` shows, as data: per satellite the last run, the latest per-FOR offsets and
+    the alerts firing; the next run; the outbox size; and the Nagios state of it all."""
+    from alerts.state import AlertState
+    from monitor.service import next_run
+    runs = {r["satellite"]: r for r in store.last_runs()}
+    firing = AlertState(store).firing()
+    sats = {}
+    for sat in cfg.satellites:
+        r = runs.get(sat)
+        day = store.latest_day(sat)
+        sats[sat] = {
+            "last_run": None if r is None else {k: r[k] for k in ("day", "status", "finished", "reason")},
+            "latest_day": None if day is None else str(day),
+            "fors": [] if day is None else [f.to_dict() for f in store.day_result(sat, day)],
+            "alerts": [{k: a[k] for k in ("rule", "severity", "summary", "started")}
+                       for a in firing if a["satellite"] == sat]}
+    critical = any(a["severity"] == "critical" for a in firing) or \
+        any(s["last_run"] and s["last_run"]["status"] == "failed" for s in sats.values())
+    state = NAGIOS_CRITICAL if critical else NAGIOS_WARNING if firing else NAGIOS_OK
+    return {"state": ["OK", "WARNING", "CRITICAL"][state], "exit": state, "satellites": sats,
+            "next_run_utc": f"{next_run(cfg.schedule):%Y-%m-%dT%H:%MZ}", "outbox": store.outbox_size()}
 
 
 def cmd_status(args) -> int:
-    from monitor.service import next_run
-    from monitor.store.sqlite import Store
-    cfg = _load(args)
-    store = Store(cfg.store.sqlite)
+    import json
+
+    from monitor.config import ConfigError, load_config
+    from monitor.store.sqlite import Store, StoreError
     try:
-        runs = {r["satellite"]: r for r in store.last_runs()}
-        for sat in cfg.satellites:
-            r = runs.get(sat)
-            if r is None:
-                print(f"{sat}: no run yet")
-                continue
-            print(f"{sat}: last run {r['day']} {r['status']} (finished {r['finished'] or '-'})"
-                  + (f": {r['reason']}" if r["reason"] else ""))
-            day = store.latest_day(sat)
-            if day is not None:
-                print(f"  latest results: {day}")
-                print(f"  {'FOR':>3} {'d_alpha':>8} {'d_beta':>8} {'in-trk':>7} {'x-trk':>7} {'total':>6}  flags")
-                for f in store.day_result(sat, day):
-                    print(f"  {f.for_index:>3} {f.d_alpha_urad:8.0f} {f.d_beta_urad:8.0f} {f.in_track_km:7.3f} "
-                          f"{f.cross_track_km:7.3f} {f.total_km:6.3f}  {','.join(f.flags)}")
-        print(f"next scheduled run: {next_run(cfg.schedule):%Y-%m-%d %H:%M} UTC")
-        print(f"outbox: {store.outbox_size()} point(s) waiting")
+        cfg = _load(args)
+        store = Store(cfg.store.sqlite)
+    except (BadInput, ConfigError, StoreError) as exc:
+        if args.json:
+            print(json.dumps({"state": "UNKNOWN", "exit": NAGIOS_UNKNOWN, "error": str(exc)}))
+        print(f"crisgeo status: UNKNOWN: {exc}", file=sys.stderr)
+        return NAGIOS_UNKNOWN
+    try:
+        rep = status_report(cfg, store)
     finally:
         store.close()
-    return EXIT_OK
+    if args.json:
+        print(json.dumps(rep, indent=1, default=str))
+        return rep["exit"]
+    print(f"crisgeo status: {rep['state']}")
+    for sat, s in rep["satellites"].items():
+        r = s["last_run"]
+        if r is None:
+            print(f"{sat}: no run yet")
+            continue
+        print(f"{sat}: last run {r['day']} {r['status']} (finished {r['finished'] or '-'})"
+              + (f": {r['reason']}" if r["reason"] else ""))
+        for a in s["alerts"]:
+            print(f"  {a['severity']} {a['rule']}: {a['summary']} (since {a['started']})")
+        if s["latest_day"]:
+            print(f"  latest results: {s['latest_day']}")
+            print(f"  {'FOR':>3} {'d_alpha':>8} {'d_beta':>8} {'in-trk':>7} {'x-trk':>7} {'total':>6}  flags")
+            for f in s["fors"]:
+                print(f"  {f['for']:>3} {f['d_alpha_urad']:8.0f} {f['d_beta_urad']:8.0f} {f['in_track_km']:7.3f} "
+                      f"{f['cross_track_km']:7.3f} {f['total_km']:6.3f}  {','.join(f['flags'])}")
+    print(f"next scheduled run: {rep['next_run_utc'].replace('T', ' ').replace('Z', '')} UTC")
+    print(f"outbox: {rep['outbox']} point(s) waiting")
+    return rep["exit"]
 
 
 def cmd_alerts(args) -> int:
@@ -413,11 +466,25 @@ def cmd_bench(args) -> int:
     return run_bench(args)
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("crisgeo-monitor")
+    except PackageNotFoundError:
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     from monitor.simulate.orbit import PASSES
-    p = argparse.ArgumentParser(prog="crisgeo", description=__doc__)
+    p = argparse.ArgumentParser(prog="crisgeo", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    p.add_argument("--version", action="version", version=f"crisgeo {_version()}")
+    common = argparse.ArgumentParser(add_help=False)  # -v after the subcommand too
+    common.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="debug logging")
     sub = p.add_subparsers(dest="command", required=True)
+    add_parser = sub.add_parser
+    sub.add_parser = lambda *a, **kw: add_parser(*a, parents=[common], **kw)
 
     s = sub.add_parser("simulate", help="write simulated CrIS/VIIRS granules with an injected LOS error")
     s.add_argument("--out", required=True, help="output directory")
@@ -471,26 +538,27 @@ def build_parser() -> argparse.ArgumentParser:
     a.set_defaults(func=cmd_assess)
 
     r = sub.add_parser("run", help="one run of the daily job (the missed days, or --date), then exit")
-    r.add_argument("--config", required=True)
+    r.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     r.add_argument("--satellite", choices=("npp", "j01", "j02"))
     r.add_argument("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD")
     r.set_defaults(func=cmd_run)
 
     cc = sub.add_parser("check-config", help="validate a configuration; print it with its defaults, secrets masked")
-    cc.add_argument("--config", required=True)
+    cc.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     cc.set_defaults(func=cmd_check_config)
 
     d = sub.add_parser("daemon", help="the long-running service (systemd)")
-    d.add_argument("--config", required=True)
+    d.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     d.set_defaults(func=cmd_daemon)
 
     st = sub.add_parser("status", help="last run per satellite, latest per-FOR table, next run, outbox size")
-    st.add_argument("--config", required=True)
+    st.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+    st.add_argument("--json", action="store_true", help="machine-readable status")
     st.set_defaults(func=cmd_status)
 
     al = sub.add_parser("alerts", help="list firing, silenced and resolved alerts; silence; evaluate now")
     al.add_argument("action", choices=("list", "silence", "evaluate"), nargs="?", default="list")
-    al.add_argument("--config", required=True)
+    al.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     al.add_argument("--rule", choices=("spec", "jump", "stale", "failure", "processing"))
     al.add_argument("--satellite", choices=("npp", "j01", "j02"))
     al.add_argument("--until", type=_iso, help="end of the silence (ISO 8601, UTC)")
@@ -499,7 +567,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     ev = sub.add_parser("events", help="list the known changes, or add one to the events calendar")
     ev.add_argument("action", choices=("list", "add"), nargs="?", default="list")
-    ev.add_argument("--config", required=True)
+    ev.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     ev.add_argument("--satellite", choices=("npp", "j01", "j02"))
     ev.add_argument("--time", type=_iso)
     ev.add_argument("--instrument", choices=("cris", "viirs", "common"))
@@ -519,7 +587,7 @@ def build_parser() -> argparse.ArgumentParser:
     fp.set_defaults(func=cmd_fingerprint)
 
     rp = sub.add_parser("report", help="the self-contained HTML trend report (one page per satellite)")
-    rp.add_argument("--config", required=True)
+    rp.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     rp.add_argument("--out", help="output directory (default: report_dir of the configuration)")
     rp.add_argument("--satellite", choices=("npp", "j01", "j02"))
     rp.add_argument("--since", type=_day, help="first day shown, YYYY-MM-DD")
@@ -542,6 +610,7 @@ def main(argv=None) -> int:
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     logging.getLogger("urllib3").setLevel(logging.WARNING)  # its debug lines carry request paths (webhooks)
+    logging.getLogger("h5py").setLevel(logging.INFO)
     try:
         return args.func(args)
     except BadInput as exc:

@@ -69,8 +69,14 @@ class InstanceLock:
         try:
             fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
+            self.fh.seek(0)
+            holder = self.fh.read().strip()[:20] or "?"
             self.fh.close()
-            raise AlreadyRunning(f"{self.path}: another crisgeo process is running on this state directory") from None
+            raise AlreadyRunning(
+                f"{self.path}: another crisgeo process (pid {holder}) is running on this state directory. The "
+                f"daemon assesses the missed days of its catch-up window itself at its next daily run; to redo "
+                f"a day now, stop it (systemctl stop crisgeo), run 'crisgeo run --date YYYY-MM-DD', and start "
+                f"it again") from None
         self.fh.seek(0)
         self.fh.truncate()
         self.fh.write(str(os.getpid()))

@@ -80,3 +80,48 @@ def test_bench_prints_every_stage_and_the_assessment_memory():
     peak = float(re.search(r"^peak memory: ([0-9]+) MB$", out, re.M).group(1))
     assert 100 < peak < 3000
     assert "includes the simulation" not in out  # Linux resets the count after simulating
+
+
+def test_version_and_verbose_after_the_subcommand(capsys):
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "--version"], capture_output=True, text=True)
+    assert r.returncode == 0 and r.stdout.startswith("crisgeo ")
+    from monitor.cli import build_parser
+    args = build_parser().parse_args(["status", "-v", "--config", "x.yaml"])
+    assert args.verbose is True and args.command == "status"
+    assert build_parser().parse_args(["-v", "status"]).verbose is True
+    assert build_parser().parse_args(["status"]).verbose is False
+
+
+def _status_config(tmp_path):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
+    return cfg
+
+
+def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
+    import datetime as dt
+
+    from alerts.rules import Finding
+    from alerts.state import AlertState
+    from monitor.store.sqlite import Store
+    cfg = _status_config(tmp_path)
+    monkeypatch.setenv("CRISGEO_CONFIG", str(cfg))  # the default when --config is not given
+    assert main(["status", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["state"] == "OK" and doc["satellites"]["j01"]["last_run"] is None and doc["outbox"] == 0
+    store = Store(tmp_path / "state" / "crisgeo.sqlite")
+    now = dt.datetime.now(dt.timezone.utc)
+    AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), "firing", now, True)
+    assert main(["status", "--json"]) == 1 and json.loads(capsys.readouterr().out)["state"] == "WARNING"
+    run = store.begin_run("j01", dt.date(2024, 6, 1))
+    store.finish_run(run, "failed", "HTTP 503")
+    assert main(["status"]) == 2
+    out = capsys.readouterr().out
+    assert "crisgeo status: CRITICAL" in out and "failed" in out and "warning jump" in out
+    store.close()
+    (tmp_path / "state" / "crisgeo.sqlite").write_bytes(b"garbage" * 100)
+    assert main(["status", "--json"]) == 3 and json.loads(capsys.readouterr().out)["state"] == "UNKNOWN"
+    monkeypatch.setenv("CRISGEO_CONFIG", str(tmp_path / "missing.yaml"))
+    assert main(["status"]) == 3 and "missing.yaml: cannot read" in capsys.readouterr().err

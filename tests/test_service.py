@@ -110,7 +110,7 @@ def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
         assert _wait_for(lambda: _status(tmp_path / "state" / "crisgeo.sqlite").count("no_data") == 2, 60)
         # a second instance on the same state directory is refused
         r = subprocess.run(CRISGEO + ["run", "--config", str(cfg)], capture_output=True, text=True, cwd=ROOT)
-        assert r.returncode == 2 and "another crisgeo process" in r.stderr
+        assert r.returncode == 75 and "another crisgeo process (pid" in r.stderr and "systemctl stop" in r.stderr
         p.send_signal(signal.SIGTERM)
         assert p.wait(timeout=20) == 0
         while "STOPPING=1" not in got:
