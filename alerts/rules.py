@@ -217,7 +217,7 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
 def failure_finding(store, satellite: str) -> Finding | None:
     """The latest run failed, or the scheduler reported a failed or missed job since the last good run."""
     runs = store.runs(satellite)
-    last_ok = max((r["id"] for r in runs if r["status"] in ("ok", "no_data")), default=0)
+    last_ok = max((r["id"] for r in runs if r["status"] in ("ok", "no_data", "no_data_final")), default=0)
     failed = [r for r in runs if r["id"] > last_ok and r["status"] == "failed"]
     last_ok_time = next((r["finished"] for r in runs if r["id"] == last_ok), "")
     jobs = [e for e in store.events() if e["kind"] in ("job_error", "job_missed", "job_skipped")

@@ -54,6 +54,7 @@ class ScheduleConfig:
     catch_up_days: int = 7
     misfire_grace_hours: float = 6.0
     lag_days: int = 1  # assess the day that ended this many days ago
+    no_data_retry_days: int = 3  # a day found empty is tried again this many days, then recorded as final
 
 
 @dataclass
@@ -308,7 +309,7 @@ def load_config(path) -> Config:
         source.buckets.update({str(k): v for k, v in buckets.items()})
 
     sc = _section(doc, "schedule")
-    _known(sc, {"time_utc", "catch_up_days", "misfire_grace_hours", "lag_days"}, "schedule.")
+    _known(sc, {"time_utc", "catch_up_days", "misfire_grace_hours", "lag_days", "no_data_retry_days"}, "schedule.")
     schedule = ScheduleConfig()
     t = _get(sc, "time_utc", str, "schedule.", "03:30")
     m = re.fullmatch(r"(\d{1,2}):(\d{2})", t)
@@ -316,7 +317,8 @@ def load_config(path) -> Config:
         raise ConfigError(f"schedule.time_utc: {t!r} is not HH:MM")
     schedule.time_utc = dt.time(int(m[1]), int(m[2]))
     schedule.catch_up_days = _get(sc, "catch_up_days", int, "schedule.", 7)
-    schedule.lag_days = _get(sc, "lag_days", int, "schedule.", 1)
+    schedule.lag_days = _get(sc, "lag_days", int, "schedule.", schedule.lag_days)
+    schedule.no_data_retry_days = _get(sc, "no_data_retry_days", int, "schedule.", schedule.no_data_retry_days)
     schedule.misfire_grace_hours = _positive(_get(sc, "misfire_grace_hours", float, "schedule.", 6.0),
                                              "schedule.misfire_grace_hours")
 
@@ -390,7 +392,7 @@ LIMITS = {
     "source.daily_budget_mb": (1, 1e6), "source.retention_days": (0, 3650), "source.run_deadline_min": (1, 1440),
     "source.max_list_pages": (1, 10000), "source.max_listed_keys": (1, 10**6), "source.max_retry_after_s": (1, 3600),
     "source.min_rate_kb_s": (1, 1e6), "source.granules": (1, 100), "source.seed": (0, 2**31 - 1),
-    "schedule.catch_up_days": (1, 366), "schedule.lag_days": (0, 30), "schedule.misfire_grace_hours": (0.01, 72),
+    "schedule.catch_up_days": (1, 366), "schedule.lag_days": (0, 30), "schedule.no_data_retry_days": (0, 366), "schedule.misfire_grace_hours": (0.01, 72),
     "scenes.candidates": (1, 1000), "scenes.keep": (1, 200), "scenes.min_inhomogeneity_k": (0, 50),
     "assessment.half_steps": (1, 40), "assessment.step_urad": (10, 5000), "assessment.workers": (1, 64),
     "store.drain_minutes": (0.01, 1440),

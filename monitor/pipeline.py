@@ -44,12 +44,32 @@ class RunOutcome:
     timings: dict = field(default_factory=dict)
 
 
-def days_to_run(store, satellite: str, today: dt.date, catch_up_days: int, lag_days: int = 1) -> list[dt.date]:
-    """The days of the catch-up window (ending *lag_days* before *today*) without a completed run, oldest first."""
-    done = store.done_days(satellite)
+def days_to_run(store, satellite: str, today: dt.date, catch_up_days: int, lag_days: int = 1,
+                no_data_retry_days: int = 3) -> list[dt.date]:
+    """The days of the catch-up window (ending *lag_days* before *today*) without a completed run, oldest
+    first. A day found empty (archive outage, late ingest) is tried again for *no_data_retry_days* after
+    it became due; then its empty listing is final."""
+    done = store.done_days(satellite, no_data_horizon(today, lag_days, no_data_retry_days))
     last = today - dt.timedelta(days=lag_days)
     window = [last - dt.timedelta(days=k) for k in range(max(catch_up_days, 1))]
     return sorted(d for d in window if d not in done)
+
+
+def no_data_horizon(today: dt.date, lag_days: int, no_data_retry_days: int) -> dt.date:
+    """Days before this one that were found empty are not tried again (their no_data is final)."""
+    return today - dt.timedelta(days=lag_days + no_data_retry_days)
+
+
+def _no_data(cfg, store, run_id, satellite, day, reason, timings, summary=None) -> RunOutcome:
+    """Record an empty day: ``no_data`` while it may still fill (tried again at the next runs),
+    ``no_data_final`` once past the retry horizon."""
+    s = cfg.schedule
+    final = day < no_data_horizon(dt.datetime.now(dt.timezone.utc).date(), s.lag_days, s.no_data_retry_days)
+    status = "no_data_final" if final else "no_data"
+    if not final:
+        reason += f" (tried again for {s.no_data_retry_days} day(s) after it is due)"
+    store.finish_run(run_id, status, reason, summary=summary)
+    return RunOutcome(satellite, day, status, reason, run_id, timings=timings)
 
 
 def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -> dict | None:
@@ -142,9 +162,8 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
         timings["list"] = time.perf_counter() - t0
         if not any(f.product in ("GCRSO",) for f in listing):
-            reason = f"no CrIS GEO granule of {satellite} on {day} in the source"
-            store.finish_run(run_id, "no_data", reason)
-            return RunOutcome(satellite, day, "no_data", reason, run_id, timings=timings)
+            return _no_data(cfg, store, run_id, satellite, day, f"no CrIS GEO granule of {satellite} on {day} in "
+                                                                  f"the source", timings)
         if stop():
             raise Stopped
         t1 = time.perf_counter()
@@ -156,8 +175,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         timings["select"] = time.perf_counter() - t1
         if not chosen:
             reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in decisions}))[:500]
-            store.finish_run(run_id, "no_data", reason, summary={"selection": decisions[:50]})
-            return RunOutcome(satellite, day, "no_data", reason, run_id, timings=timings)
+            return _no_data(cfg, store, run_id, satellite, day, reason, timings, {"selection": decisions[:50]})
         t1 = time.perf_counter()
         paths, fetch_skipped = [], []
         for c in chosen:

@@ -183,7 +183,8 @@ class Service:
         today = today or dt.datetime.now(UTC).date()
         store = self.store()
         try:
-            days = days_to_run(store, satellite, today, self.cfg.schedule.catch_up_days, self.cfg.schedule.lag_days)
+            sch = self.cfg.schedule
+            days = days_to_run(store, satellite, today, sch.catch_up_days, sch.lag_days, sch.no_data_retry_days)
         finally:
             store.close()
         outcomes = []

@@ -42,10 +42,25 @@ def test_a_day_without_data_is_recorded(cases, tmp_path):
     cfg = make_config(tmp_path, data)
     store = Store(cfg.store.sqlite)
     out = run_day(cfg, store, LocalSource(data), "j01", DAY + dt.timedelta(days=3))
-    assert out.status == "no_data" and "no CrIS GEO granule" in out.reason
-    assert store.runs()[0]["status"] == "no_data"
+    assert out.status == "no_data_final" and "no CrIS GEO granule" in out.reason  # long past its retry horizon
+    assert store.runs()[0]["status"] == "no_data_final"
     assert DAY + dt.timedelta(days=3) in store.done_days("j01")
     assert days_to_run(store, "j01", DAY + dt.timedelta(days=5), 4) == [DAY + dt.timedelta(days=k) for k in (1, 2, 4)]
+
+
+def test_an_empty_day_is_tried_again_until_its_horizon(cases, tmp_path):
+    """An archive outage or late ingest: the day is retried at each run for schedule.no_data_retry_days
+    (3) after it is due, and only then recorded as final."""
+    data, _, _ = cases.get()
+    cfg = make_config(tmp_path, data)
+    store = Store(cfg.store.sqlite)
+    today = dt.datetime.now(dt.timezone.utc).date()
+    yesterday = today - dt.timedelta(days=1)
+    out = run_day(cfg, store, LocalSource(data), "j01", yesterday)
+    assert out.status == "no_data" and "tried again for 3 day(s)" in out.reason
+    for later in range(4):  # due on today; tried again on the next three days
+        assert yesterday in days_to_run(store, "j01", today + dt.timedelta(days=later), 7, 1, 3), later
+    assert yesterday not in days_to_run(store, "j01", today + dt.timedelta(days=4), 7, 1, 3)
 
 
 def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_path):

@@ -169,11 +169,17 @@ class Store:
                                   "reason='process ended during the run' WHERE status='running'", (now_iso(),))
             return cur.rowcount
 
-    def done_days(self, satellite: str) -> set:
-        """Days with a completed run (results stored, or recorded as having no data)."""
-        rows = self.db.execute("SELECT DISTINCT day FROM runs WHERE satellite=? AND status IN ('ok', 'no_data')",
-                               (satellite,))
-        return {dt.date.fromisoformat(r[0]) for r in rows}
+    def done_days(self, satellite: str, no_data_final_before: dt.date | None = None) -> set:
+        """Days with a completed run: results stored, or no data for good. A plain ``no_data`` day counts
+        as done only before *no_data_final_before* (None: always); later ones are tried again."""
+        rows = self.db.execute("SELECT DISTINCT day, status FROM runs WHERE satellite=? "
+                               "AND status IN ('ok', 'no_data', 'no_data_final')", (satellite,))
+        out = set()
+        for day, status in rows:
+            d = dt.date.fromisoformat(day)
+            if status != "no_data" or no_data_final_before is None or d < no_data_final_before:
+                out.add(d)
+        return out
 
     def last_runs(self) -> list:
         return [dict(r) for r in self.db.execute(
