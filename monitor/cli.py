@@ -466,6 +466,32 @@ def cmd_bench(args) -> int:
     return run_bench(args)
 
 
+class JsonFormatter(logging.Formatter):
+    """One JSON object per line: time (UTC, ISO 8601), level, logger, message (and the exception)."""
+
+    def format(self, record):
+        import json
+        doc = {"time": dt.datetime.fromtimestamp(record.created, dt.timezone.utc).isoformat(timespec="milliseconds"),
+               "level": record.levelname, "logger": record.name, "message": record.getMessage()}
+        if record.exc_info:
+            doc["exception"] = self.formatException(record.exc_info)
+        return json.dumps(doc)
+
+
+def setup_logging(verbose: bool, log_format: str) -> None:
+    """Text with a timestamp on a terminal or in a file; without one under systemd, whose journal stamps
+    every line itself (it sets JOURNAL_STREAM); or JSON lines."""
+    import os
+    handler = logging.StreamHandler()
+    if log_format == "json":
+        handler.setFormatter(JsonFormatter())
+    elif os.environ.get("JOURNAL_STREAM"):
+        handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    else:
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    logging.basicConfig(level=logging.DEBUG if verbose else logging.INFO, handlers=[handler])
+
+
 def _version() -> str:
     from importlib.metadata import PackageNotFoundError, version
     try:
@@ -480,8 +506,12 @@ def build_parser() -> argparse.ArgumentParser:
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     p.add_argument("--version", action="version", version=f"crisgeo {_version()}")
-    common = argparse.ArgumentParser(add_help=False)  # -v after the subcommand too
+    p.add_argument("--log-format", choices=("text", "json"), default="text",
+                   help="text (no timestamp under systemd: the journal adds one) or JSON lines")
+    common = argparse.ArgumentParser(add_help=False)  # -v and --log-format after the subcommand too
     common.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="debug logging")
+    common.add_argument("--log-format", choices=("text", "json"), default=argparse.SUPPRESS,
+                        help="text or JSON lines")
     sub = p.add_subparsers(dest="command", required=True)
     add_parser = sub.add_parser
     sub.add_parser = lambda *a, **kw: add_parser(*a, parents=[common], **kw)
@@ -607,8 +637,7 @@ def main(argv=None) -> int:
     from monitor.store.sqlite import StoreError
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
-                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    setup_logging(args.verbose, args.log_format)
     logging.getLogger("urllib3").setLevel(logging.WARNING)  # its debug lines carry request paths (webhooks)
     logging.getLogger("h5py").setLevel(logging.INFO)
     try:

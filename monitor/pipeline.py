@@ -42,6 +42,22 @@ class RunOutcome:
     run_id: int | None = None
     result: object = None
     timings: dict = field(default_factory=dict)
+    counts: dict = field(default_factory=dict)  # granules listed, selected, assessed; MB downloaded
+
+    def summary(self) -> str:
+        """The one line a run leaves in the log."""
+        c, t = self.counts, self.timings
+        parts = [f"run {self.satellite} {self.day}: {self.status}" + (f" ({self.reason})" if self.reason else "")]
+        if c:
+            parts.append(f"granules listed {c.get('listed', 0)}, selected {c.get('selected', 0)}, "
+                         f"assessed {c.get('assessed', 0)}; {c.get('mb', 0.0):.0f} MB downloaded")
+        if self.result is not None:
+            ok = [f for f in self.result.fors if f.reliable]
+            worst = max((f.total_km for f in ok), default=float("nan"))
+            parts.append(f"reliable FORs {len(ok)}/{len(self.result.fors)}, worst {worst:.2f} km")
+        if t:
+            parts.append("stages " + ", ".join(f"{k} {v:.1f} s" for k, v in t.items()))
+        return "; ".join(parts)
 
 
 def days_to_run(store, satellite: str, today: dt.date, catch_up_days: int, lag_days: int = 1,
@@ -60,7 +76,7 @@ def no_data_horizon(today: dt.date, lag_days: int, no_data_retry_days: int) -> d
     return today - dt.timedelta(days=lag_days + no_data_retry_days)
 
 
-def _no_data(cfg, store, run_id, satellite, day, reason, timings, summary=None) -> RunOutcome:
+def _no_data(cfg, store, run_id, satellite, day, reason, timings, summary=None, counts=None) -> RunOutcome:
     """Record an empty day: ``no_data`` while it may still fill (tried again at the next runs),
     ``no_data_final`` once past the retry horizon."""
     s = cfg.schedule
@@ -69,7 +85,7 @@ def _no_data(cfg, store, run_id, satellite, day, reason, timings, summary=None) 
     if not final:
         reason += f" (tried again for {s.no_data_retry_days} day(s) after it is due)"
     store.finish_run(run_id, status, reason, summary=summary)
-    return RunOutcome(satellite, day, status, reason, run_id, timings=timings)
+    return RunOutcome(satellite, day, status, reason, run_id, timings=timings, counts=counts or {})
 
 
 def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -> dict | None:
@@ -143,11 +159,11 @@ def publish_changes(cfg, store, satellite: str) -> None:
         store.queue_lines(target_name(p), satellite, change_lines(p.measurement, changes))
 
 
-def _failed(store, run_id, satellite, day, reason, timings) -> RunOutcome:
+def _failed(store, run_id, satellite, day, reason, timings, counts=None) -> RunOutcome:
     """Record a failed run and its ``run_failed`` event (the failure alert reads both)."""
     store.finish_run(run_id, "failed", reason)
     store.add_event("run_failed", satellite, f"{day}: {reason}")
-    return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings)
+    return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings, counts=counts or {})
 
 
 def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, progress=None) -> RunOutcome:
@@ -156,14 +172,16 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
     stop = should_stop or (lambda: False)
     run_id = store.begin_run(satellite, day)
     timings = {}
+    counts = {"listed": 0, "selected": 0, "assessed": 0, "mb": 0.0}
     t0 = time.perf_counter()
     try:
         source.start_day()
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
         timings["list"] = time.perf_counter() - t0
+        counts["listed"] = len(listing)
         if not any(f.product in ("GCRSO",) for f in listing):
             return _no_data(cfg, store, run_id, satellite, day, f"no CrIS GEO granule of {satellite} on {day} in "
-                                                                  f"the source", timings)
+                                                                  f"the source", timings, counts=counts)
         if stop():
             raise Stopped
         t1 = time.perf_counter()
@@ -173,9 +191,11 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         chosen, decisions = select_scenes(listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep,
                                           cfg.scenes.min_inhomogeneity_k)
         timings["select"] = time.perf_counter() - t1
+        counts["selected"] = len(chosen)
         if not chosen:
             reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in decisions}))[:500]
-            return _no_data(cfg, store, run_id, satellite, day, reason, timings, {"selection": decisions[:50]})
+            return _no_data(cfg, store, run_id, satellite, day, reason, timings, {"selection": decisions[:50]},
+                            counts)
         t1 = time.perf_counter()
         paths, fetch_skipped = [], []
         for c in chosen:
@@ -188,6 +208,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
                 except (SourceError, BudgetExceeded) as exc:
                     fetch_skipped.append((vs.name, str(exc)))
         timings["fetch"] = time.perf_counter() - t1
+        counts["mb"] = getattr(source, "spent_bytes", 0) / 1e6
         t1 = time.perf_counter()
         case = plan(sorted(set(paths)))
         case.skipped += fetch_skipped
@@ -196,20 +217,22 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
                                                 kernel=a.kernel), progress=progress, should_stop=stop,
                              workers=a.workers)
         timings["assess"] = time.perf_counter() - t1
+        counts["assessed"] = len(result.granules)
         if stop():
             raise Stopped
         lines = {target_name(p): result_lines(p.measurement, satellite, day, result.fors) for p in cfg.store.publish}
         store.save_day(run_id, satellite, day, result, decisions, lines)
         publish_changes(cfg, store, satellite)
-        return RunOutcome(satellite, day, "ok", None, run_id, result, timings)
+        return RunOutcome(satellite, day, "ok", None, run_id, result, timings, counts)
     except Stopped:
         store.finish_run(run_id, "interrupted", "stop requested")
-        return RunOutcome(satellite, day, "interrupted", "stop requested", run_id, timings=timings)
+        return RunOutcome(satellite, day, "interrupted", "stop requested", run_id, timings=timings, counts=counts)
     except (SourceError, PlanError, DataError, OSError) as exc:
-        return _failed(store, run_id, satellite, day, f"{type(exc).__name__}: {exc}", timings)
+        return _failed(store, run_id, satellite, day, f"{type(exc).__name__}: {exc}", timings, counts)
     except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
         LOG.exception("run %s %s failed unexpectedly", satellite, day)
-        return _failed(store, run_id, satellite, day, f"unexpected {type(exc).__name__}: {exc}"[:1000], timings)
+        return _failed(store, run_id, satellite, day, f"unexpected {type(exc).__name__}: {exc}"[:1000], timings,
+                       counts)
     finally:
         t1 = time.perf_counter()
         if cfg.store.publish:

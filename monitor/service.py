@@ -107,7 +107,7 @@ class Service:
             LOG.info("run %s %s", satellite, day)
             sd_notify(f"STATUS=assessing {satellite} {day}")
             out = run_day(self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress)
-            LOG.info("run %s %s: %s%s", satellite, day, out.status, f" ({out.reason})" if out.reason else "")
+            LOG.info("%s", out.summary())
             self._after_run(store, out)
             return out
         finally:

@@ -125,3 +125,35 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     assert main(["status", "--json"]) == 3 and json.loads(capsys.readouterr().out)["state"] == "UNKNOWN"
     monkeypatch.setenv("CRISGEO_CONFIG", str(tmp_path / "missing.yaml"))
     assert main(["status"]) == 3 and "missing.yaml: cannot read" in capsys.readouterr().err
+
+
+def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
+    import os
+    import subprocess
+    import sys
+    data, _, _ = cases.get()
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
+                   f"assessment: {{workers: 1}}\n")
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "run", "--config", str(cfg), "--date", "2024-06-01",
+                        "--log-format", "json"], capture_output=True, text=True,
+                       env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"})
+    assert r.returncode == 0, r.stderr
+    lines = [json.loads(line) for line in r.stderr.splitlines() if line.startswith("{")]
+    assert lines and all({"time", "level", "logger", "message"} <= set(d) for d in lines)
+    (summary,) = [d["message"] for d in lines if d["message"].startswith("run j01 2024-06-01: ok")]
+    assert "granules listed 6, selected 2, assessed 2" in summary and "reliable FORs" in summary
+    assert "worst" in summary and "stages list" in summary
+
+
+def test_under_systemd_lines_carry_no_second_timestamp(tmp_path):
+    import os
+    import subprocess
+    import sys
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "run", "--config", str(cfg), "--date", "2024-06-01"],
+                       capture_output=True, text=True, env={**os.environ, "JOURNAL_STREAM": "8:1234"})
+    assert r.returncode == 0, r.stderr
+    log = [line for line in r.stderr.splitlines() if line.strip()]
+    assert log and all(line.split()[0] in ("INFO", "WARNING", "ERROR", "DEBUG") for line in log), log
