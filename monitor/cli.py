@@ -195,6 +195,24 @@ def cmd_check_config(args) -> int:
     return EXIT_OK
 
 
+def cmd_export(args) -> int:
+    from monitor.export import export
+    from monitor.store.sqlite import Store
+    cfg = _load(args)
+    sats = [args.satellite] if args.satellite else cfg.satellites
+    if len(sats) > 1:
+        raise BadInput(f"--satellite: one of {', '.join(sats)} (a file holds one satellite)")
+    store = Store(cfg.store.sqlite)
+    try:
+        path = export(store, sats[0], args.out, args.format, args.since, args.until)
+    except ImportError as exc:
+        raise BadInput(f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})") from None
+    finally:
+        store.close()
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
 def _day(text: str) -> dt.date:
     try:
         return dt.date.fromisoformat(text)
@@ -572,6 +590,15 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--satellite", choices=("npp", "j01", "j02"))
     r.add_argument("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD")
     r.set_defaults(func=cmd_run)
+
+    ex = sub.add_parser("export", help="per-FOR results as CF NetCDF (xarray) or CSV")
+    ex.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+    ex.add_argument("--format", choices=("netcdf", "csv"), default="netcdf")
+    ex.add_argument("--out", required=True)
+    ex.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    ex.add_argument("--since", type=_day, help="first day, YYYY-MM-DD")
+    ex.add_argument("--until", type=_day, help="last day, YYYY-MM-DD")
+    ex.set_defaults(func=cmd_export)
 
     cc = sub.add_parser("check-config", help="validate a configuration; print it with its defaults, secrets masked")
     cc.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")

@@ -247,6 +247,11 @@ class Store:
         r = self.db.execute("SELECT MAX(day) FROM results WHERE satellite=?", (satellite,)).fetchone()[0]
         return dt.date.fromisoformat(r) if r else None
 
+    def to_xarray(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
+        """The per-FOR results of *satellite* as a CF-style xarray Dataset (:mod:`monitor.export`)."""
+        from monitor.export import to_xarray
+        return to_xarray(self, satellite, since, until)
+
     def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> list:
         q = "SELECT * FROM results WHERE satellite=?"
         args = [satellite]

@@ -1,0 +1,87 @@
+"""Results as data for scientists: the store's per-FOR offsets as a CF-style xarray Dataset, NetCDF or CSV.
+
+Dimensions ``time`` (the assessed day, 00:00 UTC) x ``for`` (scan position 1..30); one variable per stored
+quantity with its unit and long name, the reliability flags as a CF bit mask (``flag_masks`` and
+``flag_meanings``), and global attributes for the satellite, the method and the software version.
+xarray and h5netcdf are an optional extra: ``pip install 'crisgeo-monitor[export]'``.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from pathlib import Path
+
+import numpy as np
+
+from monitor.result import N_FOR, RELIABILITY_FLAGS
+from monitor.satellites import satellite as satellite_info
+
+# variable: (unit, long name); the store's column names
+VARIABLES = {
+    "d_alpha_urad": ("urad", "in-track LOS offset (turn of the CrIS LOS that best matches VIIRS I5)"),
+    "d_beta_urad": ("urad", "cross-track LOS offset"),
+    "sigma_alpha_urad": ("urad", "uncertainty (1 sigma) of the in-track offset"),
+    "sigma_beta_urad": ("urad", "uncertainty (1 sigma) of the cross-track offset"),
+    "in_track_km": ("km", "in-track geolocation error on the ground"),
+    "cross_track_km": ("km", "cross-track geolocation error on the ground"),
+    "total_km": ("km", "total geolocation error on the ground"),
+    "sigma_in_track_km": ("km", "uncertainty (1 sigma) of the in-track error"),
+    "sigma_cross_track_km": ("km", "uncertainty (1 sigma) of the cross-track error"),
+    "cost_min_k": ("K", "minimum of the cost STDEV(BT_VIIRS - BT_CrIS) over the perturbations"),
+    "cost_zero_k": ("K", "cost STDEV(BT_VIIRS - BT_CrIS) of the unperturbed LOS"),
+}
+FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
+
+
+def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
+    """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset."""
+    import xarray as xr
+
+    from monitor import __version__
+    rows = store.series(satellite, since, until)
+    days = sorted({r["day"] for r in rows})
+    index = {d: i for i, d in enumerate(days)}
+    shape = (len(days), N_FOR)
+    data = {k: np.full(shape, np.nan) for k in VARIABLES}
+    n_samples = np.zeros(shape, np.int32)
+    flags = np.zeros(shape, np.int8)
+    for r in rows:
+        i, k = index[r["day"]], r["for_index"] - 1
+        for name in VARIABLES:
+            data[name][i, k] = np.nan if r[name] is None else r[name]
+        n_samples[i, k] = r["n_samples"] or 0
+        flags[i, k] = sum(FLAG_BITS[f] for f in json.loads(r["flags"] or "[]") if f in FLAG_BITS)
+    coords = {"time": np.array([np.datetime64(d, "ns") for d in days], dtype="datetime64[ns]"),
+              "for": np.arange(1, N_FOR + 1, dtype=np.int16)}
+    ds = xr.Dataset({name: (("time", "for"), data[name], {"units": unit, "long_name": long})
+                     for name, (unit, long) in VARIABLES.items()}, coords=coords)
+    ds["n_samples"] = (("time", "for"), n_samples, {"units": "1", "long_name": "CrIS FOVs in the cost function"})
+    ds["flags"] = (("time", "for"), flags, {
+        "long_name": "reliability flags (any set: not reliable)", "flag_masks": np.array(list(FLAG_BITS.values()),
+                                                                                       np.int8),
+        "flag_meanings": " ".join(FLAG_BITS)})
+    ds["for"].attrs.update(long_name="CrIS field of regard (scan position)", units="1")
+    ds["time"].attrs.update(long_name="assessed day (00:00 UTC)")
+    info = satellite_info(satellite)
+    ds.attrs.update(Conventions="CF-1.8", title=f"CrIS geolocation assessed against VIIRS I5, {info.name}",
+                    satellite=satellite, platform=info.name,
+                    method="LOS perturbation assessment, Wang et al. 2017, JGR 122:519",
+                    source=f"crisgeo-monitor {__version__}",
+                    history=f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ} exported from {store.path.name}")
+    return ds
+
+
+def export(store, satellite: str, out, fmt: str, since=None, until=None) -> Path:
+    """Write the results of *satellite* to *out* as ``netcdf`` or ``csv``; returns the path."""
+    out = Path(out)
+    ds = to_xarray(store, satellite, since, until)
+    tmp = out.with_name(out.name + ".part")
+    if fmt == "netcdf":
+        ds.to_netcdf(tmp, engine="h5netcdf")
+    elif fmt == "csv":
+        ds.to_dataframe().reset_index().to_csv(tmp, index=False)
+    else:
+        raise ValueError(f"export format {fmt!r} is not netcdf or csv")
+    tmp.replace(out)
+    return out
