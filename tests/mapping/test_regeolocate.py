@@ -50,7 +50,8 @@ def test_fills_are_kept_and_inputs_refused_in_place(ep_geo_case, nominal_ep, tmp
     src.parent.mkdir()
     src.write_bytes(_geo_files(case)[0].read_bytes())
     with h5py.File(src, "r+") as h5:
-        h5["All_Data/CrIS-SDR-GEO_All/Latitude"][1, 3, :] = -999.3
+        h5["All_Data/CrIS-SDR-GEO_All/Latitude"][1, 3, :] = -999.3  # IDPS fills a FOV's position whole
+        h5["All_Data/CrIS-SDR-GEO_All/Longitude"][1, 3, :] = -999.3
     out = regeolocate_file(nominal_ep, src, tmp_path / "out")
     with h5py.File(out) as h5:
         lat = h5["All_Data/CrIS-SDR-GEO_All/Latitude"][()]

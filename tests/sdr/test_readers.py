@@ -58,8 +58,8 @@ def test_missing_dataset_is_named(real_geo_files, tmp_path):
 def test_all_fill_granule_is_rejected_and_partial_fill_masked(real_geo_files, tmp_path):
     f = _copy(real_geo_files[0], tmp_path / real_geo_files[0].name)
     with h5py.File(f, "r+") as h5:
-        lat = h5["All_Data/CrIS-SDR-GEO_All/Latitude"]
-        lat[1, 5, :] = -999.3
+        for name in ("Latitude", "Longitude"):
+            h5[f"All_Data/CrIS-SDR-GEO_All/{name}"][1, 5, :] = -999.3
     (g,) = read_file(f)
     assert np.isnan(g.lat_rad[1, 5]).all() and not g.valid[1, 5].any() and g.valid[0].all()
     with h5py.File(f, "r+") as h5:
