@@ -169,16 +169,21 @@ def _section(doc, key):
 SECRET_WORDS = re.compile(r"(token|password|secret|webhook)$", re.I)
 
 
-def _no_inline_secrets(doc, where=""):
+def _check_secrets(doc, where=""):
+    """No secret written in the file (a key named like one), and every *_env value the name of an
+    environment variable (an identifier, not a secret pasted in)."""
     if isinstance(doc, dict):
         for k, v in doc.items():
             if SECRET_WORDS.search(str(k)) and v not in (None, ""):
                 raise ConfigError(f"{where}{k}: secrets may not be written in the file; "
                                   f"name an environment variable with {k}_env")
-            _no_inline_secrets(v, f"{where}{k}.")
+            if str(k).endswith("_env") and v is not None and not (isinstance(v, str) and ENV_NAME.fullmatch(v)):
+                raise ConfigError(f"{where}{k}: {'a value' if isinstance(v, str) else repr(v)} is not the name "
+                                  f"of an environment variable")
+            _check_secrets(v, f"{where}{k}.")
     elif isinstance(doc, list):
         for i, v in enumerate(doc):
-            _no_inline_secrets(v, f"{where[:-1]}[{i}].")
+            _check_secrets(v, f"{where[:-1]}[{i}].")
 
 
 MAX_CONFIG_BYTES = 1 << 20
@@ -246,19 +251,6 @@ def redact_url(url: str) -> str:
     return urlunsplit((p.scheme, netloc, p.path, "***" if p.query else "", ""))
 
 
-def _env_names(doc, where=""):
-    """Every *_env value names an environment variable: an identifier, not a secret pasted in."""
-    if isinstance(doc, dict):
-        for k, v in doc.items():
-            if str(k).endswith("_env") and v is not None and not (isinstance(v, str) and ENV_NAME.fullmatch(v)):
-                raise ConfigError(f"{where}{k}: {'a value' if isinstance(v, str) else repr(v)} is not the name "
-                                  f"of an environment variable")
-            _env_names(v, f"{where}{k}.")
-    elif isinstance(doc, list):
-        for i, v in enumerate(doc):
-            _env_names(v, f"{where[:-1]}[{i}].")
-
-
 def load_config(path) -> Config:
     """Load and validate the YAML configuration at *path*, the alerts section included; relative paths are
     relative to the file. Any problem is a :class:`ConfigError` naming the key."""
@@ -266,8 +258,7 @@ def load_config(path) -> Config:
     doc = read_yaml(path)
     if not isinstance(doc, dict):
         raise ConfigError(f"{path}: expected a mapping at the top level")
-    _no_inline_secrets(doc)
-    _env_names(doc)
+    _check_secrets(doc)
     _known(doc, {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts",
                  "fingerprint", "report_dir", "dashboard_url"}, "")
     base = path.resolve().parent

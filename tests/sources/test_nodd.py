@@ -139,23 +139,19 @@ def test_a_huge_retry_after_is_not_waited_for(bucket, tmp_path):
         assert "Retry-After 3600 s, more than the 120 s allowed" in why and secs < 5 and len(s3.requests) == 1
 
 
-def test_a_slow_drip_download_is_cut(bucket, tmp_path):
+@pytest.mark.parametrize("bound,reason,limit_s", [
+    ({"min_rate_kb_s": 1000.0}, "slower than 1000 kB/s", 45),
+    ({"run_deadline_min": 0.02}, "run deadline of 0.02 min has passed", 5),
+])
+def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s):
+    """By the minimum rate of each download, or by the run deadline, whichever comes first."""
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path, min_rate_kb_s=1000.0, retries=0)
+        src = _source(s3.url, tmp_path, retries=0, **bound)
         f = src.list_day("j01", DAY, ("SCRIF",))[0]
         s3.slow_drip_s = 0.05
         secs, peak, why = _timed(lambda: src.fetch(f))
-        assert "slower than 1000 kB/s" in why and secs < 45 and peak < 20e6
+        assert reason in why and secs < limit_s and peak < 20e6
         assert not list((tmp_path / "cache").rglob("*.h5*"))  # no partial granule left
-
-
-def test_the_run_deadline_ends_everything(bucket, tmp_path):
-    with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path, run_deadline_min=0.02, retries=0)
-        f = src.list_day("j01", DAY, ("SCRIF",))[0]
-        s3.slow_drip_s = 0.05
-        secs, _, why = _timed(lambda: src.fetch(f))
-        assert "run deadline of 0.02 min has passed" in why and secs < 5
 
 
 def test_a_lying_size_and_a_gzip_response_are_refused(bucket, tmp_path):
