@@ -147,10 +147,12 @@ def _within(value, lo, hi, where):
     return value
 
 
-def _positive(value, where):
-    if value <= 0:
-        raise ConfigError(f"{where}: must be > 0, got {value}")
-    return value
+def _fill(obj, doc: dict, where: str, **types):
+    """Set each named field of the section dataclass *obj* from *doc*, checking its type; the default is
+    the dataclass's own (one default per key). Ranges are checked afterwards (:data:`LIMITS`)."""
+    for name, typ in types.items():
+        setattr(obj, name, _get(doc, name, typ, where, getattr(obj, name)))
+    return obj
 
 
 def _known(doc: dict, allowed: set, where: str):
@@ -283,15 +285,9 @@ def load_config(path) -> Config:
     source = SourceConfig(kind=kind)
     if kind == "local":
         source.path = rel(_get(s, "path", str, "source.", required=True))
-    for key in ("timeout_s", "backoff_s", "daily_budget_mb", "run_deadline_min", "max_retry_after_s",
-                "min_rate_kb_s"):
-        setattr(source, key, _positive(_get(s, key, float, "source.", getattr(source, key)), f"source.{key}"))
-    for key in ("max_list_pages", "max_listed_keys"):
-        setattr(source, key, _positive(_get(s, key, int, "source.", getattr(source, key)), f"source.{key}"))
-    for key in ("retries", "retention_days", "granules", "seed"):
-        setattr(source, key, _get(s, key, int, "source.", getattr(source, key)))
-    source.profile = _get(s, "profile", str, "source.", source.profile)
-    source.endpoint = _get(s, "endpoint", str, "source.", source.endpoint)
+    _fill(source, s, "source.", timeout_s=float, backoff_s=float, daily_budget_mb=float, run_deadline_min=float,
+          max_retry_after_s=float, min_rate_kb_s=float, max_list_pages=int, max_listed_keys=int, retries=int,
+          retention_days=int, granules=int, seed=int, profile=str, endpoint=str)
     buckets = _get(s, "buckets", dict, "source.", None)
     if buckets:
         for k, v in buckets.items():
@@ -300,40 +296,29 @@ def load_config(path) -> Config:
         source.buckets.update({str(k): v for k, v in buckets.items()})
 
     sc = _section(doc, "schedule")
-    _known(sc, {"time_utc", "catch_up_days", "misfire_grace_hours", "lag_days", "no_data_retry_days"}, "schedule.")
-    schedule = ScheduleConfig()
-    t = _get(sc, "time_utc", str, "schedule.", "03:30")
-    m = re.fullmatch(r"(\d{1,2}):(\d{2})", t)
+    _known(sc, set(ScheduleConfig.__dataclass_fields__), "schedule.")
+    schedule = _fill(ScheduleConfig(), sc, "schedule.", catch_up_days=int, lag_days=int, no_data_retry_days=int,
+                     misfire_grace_hours=float)
+    t = _get(sc, "time_utc", str, "schedule.", schedule.time_utc.strftime("%H:%M"))
+    m = re.fullmatch(r"(\d{1,2}):(\d{2})", t, re.ASCII)
     if not m or int(m[1]) > 23 or int(m[2]) > 59:
         raise ConfigError(f"schedule.time_utc: {t!r} is not HH:MM")
     schedule.time_utc = dt.time(int(m[1]), int(m[2]))
-    schedule.catch_up_days = _get(sc, "catch_up_days", int, "schedule.", 7)
-    schedule.lag_days = _get(sc, "lag_days", int, "schedule.", schedule.lag_days)
-    schedule.no_data_retry_days = _get(sc, "no_data_retry_days", int, "schedule.", schedule.no_data_retry_days)
-    schedule.misfire_grace_hours = _positive(_get(sc, "misfire_grace_hours", float, "schedule.", 6.0),
-                                             "schedule.misfire_grace_hours")
 
     se = _section(doc, "scenes")
-    _known(se, {"candidates", "keep", "min_inhomogeneity_k"}, "scenes.")
-    scenes = SceneConfig(_positive(_get(se, "candidates", int, "scenes.", 40), "scenes.candidates"),
-                         _positive(_get(se, "keep", int, "scenes.", 14), "scenes.keep"),
-                         _get(se, "min_inhomogeneity_k", float, "scenes.", 0.5))
+    _known(se, set(SceneConfig.__dataclass_fields__), "scenes.")
+    scenes = _fill(SceneConfig(), se, "scenes.", candidates=int, keep=int, min_inhomogeneity_k=float)
 
     a = _section(doc, "assessment")
     _known(a, set(AssessmentConfig.__dataclass_fields__), "assessment.")
-    assessment = AssessmentConfig(_positive(_get(a, "half_steps", int, "assessment.", 10), "assessment.half_steps"),
-                                  _positive(_get(a, "step_urad", float, "assessment.", AssessmentConfig.step_urad),
-                                            "assessment.step_urad"),
-                                  _get(a, "kernel", str, "assessment.", "top-hat"),
-                                  _positive(_get(a, "workers", int, "assessment.", 2), "assessment.workers"))
+    assessment = _fill(AssessmentConfig(), a, "assessment.", half_steps=int, step_urad=float, kernel=str, workers=int)
     if assessment.kernel not in ("top-hat", "response"):
         raise ConfigError(f"assessment.kernel: {assessment.kernel!r} is not top-hat or response")
 
     st = _section(doc, "store")
     _known(st, {"sqlite", "publish", "drain_minutes"}, "store.")
-    store = StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite"))),
-                        drain_minutes=_positive(_get(st, "drain_minutes", float, "store.", 10.0),
-                                                "store.drain_minutes"))
+    store = _fill(StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite")))), st,
+                  "store.", drain_minutes=float)
     for i, p in enumerate(_get(st, "publish", list, "store.", [])):
         where = f"store.publish[{i}]."
         if not isinstance(p, dict):
@@ -343,23 +328,19 @@ def load_config(path) -> Config:
         if pk not in ("influx2", "influx1"):
             raise ConfigError(f"{where}kind: {pk!r} is not influx2 or influx1")
         url = check_url(_get(p, "url", str, where, required=True), f"{where}url")
-        pc = PublishConfig(kind=pk, url=url.rstrip("/"))
-        for key in ("measurement", "bucket", "org", "database", "token_env", "username_env", "password_env"):
-            setattr(pc, key, _get(p, key, str, where, getattr(pc, key)))
-        pc.timeout_s = _positive(_get(p, "timeout_s", float, where, 30.0), f"{where}timeout_s")
-        store.publish.append(pc)
+        store.publish.append(_fill(PublishConfig(kind=pk, url=url.rstrip("/")), p, where, measurement=str, bucket=str,
+                                   org=str, database=str, token_env=str, username_env=str, password_env=str,
+                                   timeout_s=float))
 
     fp = _section(doc, "fingerprint")
-    _known(fp, {"granules", "threshold_urad", "ep_library"}, "fingerprint.")
+    _known(fp, set(FingerprintConfig.__dataclass_fields__), "fingerprint.")
     library = fp.get("ep_library") or []
     if isinstance(library, str):
         library = [library]
     if not isinstance(library, list) or not all(isinstance(x, str) for x in library):
         raise ConfigError(f"fingerprint.ep_library: expected a list of paths, got {library!r}")
-    fingerprint = FingerprintConfig(_positive(_get(fp, "granules", int, "fingerprint.", 100), "fingerprint.granules"),
-                                    _positive(_get(fp, "threshold_urad", float, "fingerprint.", 10.0),
-                                              "fingerprint.threshold_urad"),
-                                    tuple(rel(x) for x in library))
+    fingerprint = _fill(FingerprintConfig(ep_library=tuple(rel(x) for x in library)), fp, "fingerprint.",
+                        granules=int, threshold_urad=float)
     alerts = _section(doc, "alerts")
     report_dir = _get(doc, "report_dir", str, "", None)
     dashboard_url = _get(doc, "dashboard_url", str, "", None)

@@ -29,7 +29,7 @@ BASE = "satellites: [j01]\nstate_dir: s\nsource: {kind: simulated}\n"
     ("state_dir: s\nsource: {kind: simulated}\n", "satellites: missing"),
     ("satellites: [j05]\nstate_dir: s\nsource: {kind: simulated}\n", "satellites[0]: 'j05' is not one of"),
     (BASE + "schedule: {time_utc: '25:00'}\n", "schedule.time_utc: '25:00' is not HH:MM"),
-    (BASE + "scenes: {keep: 0}\n", "scenes.keep: must be > 0"),
+    (BASE + "scenes: {keep: 0}\n", "scenes.keep: 0 is not within 1..200"),
     (BASE + "scenes: {keep: ten}\n", "scenes.keep: expected int, got str"),
     (BASE + "store: {publish: [{kind: influx2, url: 'localhost:8086'}]}\n", "store.publish[0].url"),
     (BASE + "store: {publish: [{kind: influx2, url: 'http://h', token: abc}]}\n", "secrets may not be written"),
