@@ -519,6 +519,7 @@ def _version() -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from monitor.satellites import SATELLITES
     from monitor.simulate.orbit import PASSES
     p = argparse.ArgumentParser(prog="crisgeo", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -536,7 +537,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("simulate", help="write simulated CrIS/VIIRS granules with an injected LOS error")
     s.add_argument("--out", required=True, help="output directory")
-    s.add_argument("--satellite", choices=("npp", "j01", "j02"), default="j01")
+    s.add_argument("--satellite", choices=tuple(SATELLITES), default="j01")
     s.add_argument("--granules", type=int, default=14, help="consecutive CrIS granules (default 14, as the paper)")
     s.add_argument("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file")
     s.add_argument("--seed", type=int, default=0)
@@ -587,7 +588,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("run", help="one run of the daily job (the missed days, or --date), then exit")
     r.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    r.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    r.add_argument("--satellite", choices=tuple(SATELLITES))
     r.add_argument("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD")
     r.set_defaults(func=cmd_run)
 
@@ -595,7 +596,7 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     ex.add_argument("--format", choices=("netcdf", "csv"), default="netcdf")
     ex.add_argument("--out", required=True)
-    ex.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    ex.add_argument("--satellite", choices=tuple(SATELLITES))
     ex.add_argument("--since", type=_day, help="first day, YYYY-MM-DD")
     ex.add_argument("--until", type=_day, help="last day, YYYY-MM-DD")
     ex.set_defaults(func=cmd_export)
@@ -617,7 +618,7 @@ def build_parser() -> argparse.ArgumentParser:
     al.add_argument("action", choices=("list", "silence", "evaluate"), nargs="?", default="list")
     al.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     al.add_argument("--rule", choices=("spec", "jump", "stale", "failure", "processing"))
-    al.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    al.add_argument("--satellite", choices=tuple(SATELLITES))
     al.add_argument("--until", type=_iso, help="end of the silence (ISO 8601, UTC)")
     al.add_argument("--reason", default="")
     al.set_defaults(func=cmd_alerts)
@@ -625,7 +626,7 @@ def build_parser() -> argparse.ArgumentParser:
     ev = sub.add_parser("events", help="list the known changes, or add one to the events calendar")
     ev.add_argument("action", choices=("list", "add"), nargs="?", default="list")
     ev.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    ev.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    ev.add_argument("--satellite", choices=tuple(SATELLITES))
     ev.add_argument("--time", type=_iso)
     ev.add_argument("--instrument", choices=("cris", "viirs", "common"))
     ev.add_argument("--kind", default="change", help="ep_upload, lut_change, software, ...")
@@ -646,7 +647,7 @@ def build_parser() -> argparse.ArgumentParser:
     rp = sub.add_parser("report", help="the self-contained HTML trend report (one page per satellite)")
     rp.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
     rp.add_argument("--out", help="output directory (default: report_dir of the configuration)")
-    rp.add_argument("--satellite", choices=("npp", "j01", "j02"))
+    rp.add_argument("--satellite", choices=tuple(SATELLITES))
     rp.add_argument("--since", type=_day, help="first day shown, YYYY-MM-DD")
     rp.add_argument("--until", type=_day, help="last day shown, YYYY-MM-DD")
     rp.set_defaults(func=cmd_report)

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from monitor.satellites import SATELLITES
 from monitor.geometry.instrument import N_FOR, N_FOV, URAD, EngineeringPacket
 
 
@@ -156,8 +157,8 @@ def load_ep(path, satellite: str | None = None) -> EngineeringPacket:
     kw["sc_to_sbf_rad"] = np.asarray([_numbers(path, f"{group}/{p}", src.get(f"{group}/{p}"), None)
                                       for p in parts]) * URAD
     sat = satellite or doc.get("satellite")
-    if sat not in ("npp", "j01", "j02"):
-        raise EngPktError(path, "satellite", f"{sat!r}, expected npp, j01 or j02")
+    if sat not in SATELLITES:
+        raise EngPktError(path, "satellite", f"{sat!r}, expected one of {', '.join(SATELLITES)}")
     return _build(path, kw, sat, str(doc.get("version", path.stem)), dict(doc.get("provenance") or {}))
 
 

@@ -10,8 +10,6 @@ import datetime as dt
 import re
 from dataclasses import dataclass
 
-PLATFORMS = {"npp": "NPP", "j01": "J01", "j02": "J02"}
-
 _PATTERN = re.compile(
     r"^(?P<products>[A-Z0-9]+(?:-[A-Z0-9]+)*)_(?P<platform>[a-z0-9]{3})_d(?P<date>\d{8})_t(?P<start>\d{7})"
     r"_e(?P<end>\d{7})_b(?P<orbit>\d{5,})_c(?P<created>\d{20})_(?P<origin>[a-z0-9-]{4})_(?P<domain>[a-z_]+)\.h5$",
