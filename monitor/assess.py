@@ -404,7 +404,8 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
                                     progress, should_stop, timings)
         skipped += k
     usable = sum(int(s.usable.sum()) for s in samples)
-    if usable < cfg.min_samples:
+    stopped = should_stop is not None and should_stop()  # the caller records an interruption, not bad data
+    if usable < cfg.min_samples and not stopped:
         files = ", ".join(sorted({s.info["cris_geo"] for s in samples} | {str(k) for k, _ in skipped}))[:800]
         why = "; ".join(f"{k}: {r}" for k, r in skipped[:3])
         raise AssessmentError(f"too few usable FOVs to assess: {usable} (at least {cfg.min_samples}) in "

@@ -96,7 +96,10 @@ def test_cli_reports_a_corrupt_store_in_one_line(tmp_path):
     (tmp_path / "state" / "crisgeo.sqlite").write_bytes(b"garbage" * 500)
     cfg = tmp_path / "c.yaml"
     cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "status", "--config", str(cfg)],
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "alerts", "list", "--config", str(cfg)],
                        capture_output=True, text=True)
     assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "crisgeo.sqlite: not a usable crisgeo store" in r.stderr
+    r = subprocess.run([sys.executable, "-m", "monitor.cli", "status", "--config", str(cfg)],
+                       capture_output=True, text=True)
+    assert r.returncode == 3 and "UNKNOWN" in r.stderr  # status speaks Nagios
