@@ -293,7 +293,7 @@ def status_report(cfg, store) -> dict:
 def cmd_status(args) -> int:
     import json
 
-    from monitor.config import ConfigError, load_config
+    from monitor.config import ConfigError
     from monitor.store.sqlite import Store, StoreError
     try:
         cfg = _load(args)

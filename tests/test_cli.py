@@ -1,6 +1,5 @@
 import json
 
-import pytest
 
 from monitor.cli import main
 from tests.conftest import tree_with_truncated

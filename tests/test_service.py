@@ -1,6 +1,5 @@
 """The service as a process: SIGKILL mid-run, SIGTERM mid-run, the daemon under a fake systemd, the unit."""
 
-import datetime as dt
 import os
 import shutil
 import signal

@@ -34,11 +34,10 @@ def mean_sun_right_ascension(unix_s):
 
 
 class CircularOrbit:
-    """Circular orbit of *altitude_m* and *inclination_deg*: argument of latitude *u0_rad* and right
-    ascension of the ascending node *raan_rad* at *t0_unix_s* (UTC seconds since 1970)."""
+    """Circular orbit of *altitude_m* and *inclination_deg*: argument of latitude *u0_rad* (default -14 deg)
+    and right ascension of the ascending node *raan_rad* at *t0_unix_s* (UTC seconds since 1970)."""
 
-    def __init__(self, t0_unix_s, altitude_m=828e3, inclination_deg=98.74, u0_rad=np.radians(-14.0),
-                 raan_rad=0.0):
+    def __init__(self, t0_unix_s, altitude_m=828e3, inclination_deg=98.74, u0_rad=-0.2443461, raan_rad=0.0):
         self.t0 = float(t0_unix_s)
         self.a = A_M + altitude_m
         self.n = np.sqrt(GM_M3_S2 / self.a**3)

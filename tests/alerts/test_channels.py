@@ -1,5 +1,4 @@
 import email
-import smtplib
 
 import pytest
 
