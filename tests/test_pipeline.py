@@ -113,3 +113,12 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
     assert any(e["kind"] == "run_failed" and "poison granule" in e["detail"] for e in store.events())
     text = log.read_text()
     assert "failure" in text and "poison granule" in text
+
+
+def test_a_local_tree_under_a_relative_path_is_listed(cases, tmp_path):
+    """The demo's state lives at configs/../demo-state: a '..' in the root is not a dot segment of a key."""
+    data, _, _ = cases.get()
+    (tmp_path / "a").mkdir()
+    (tmp_path / "tree").symlink_to(data)
+    files = LocalSource(tmp_path / "a" / ".." / "tree").list_day("j01", DAY, ("GCRSO", "SCRIF"))
+    assert len(files) == 4

@@ -44,10 +44,9 @@ class ListedFile:
 
 
 def listed(name: str, size, location: str, md5: str | None = None) -> ListedFile | None:
-    """A :class:`ListedFile` for a safe JPSS file name, or None for anything else (path parts, dot
-    segments, non-ASCII, odd names)."""
-    if not name.isascii() or "/" in name or "\\" in name or name.startswith(".") or \
-            any(part in (".", "..") for part in location.split("/")):
+    """A :class:`ListedFile` for a safe JPSS file name (a base name, so no dot segment can slip in), or
+    None for anything else (path parts, non-ASCII, odd names)."""
+    if not name.isascii() or "/" in name or "\\" in name or name.startswith("."):
         return None
     parsed = parse_name(name)
     return None if parsed is None else ListedFile(name, size, location, parsed, md5)
