@@ -9,7 +9,9 @@ Calibration of the reported sigma (the bootstrap over scans within granules plus
 ``AssessConfig.sigma_floor_urad`` in quadrature): over all cases, the share of FOR-directions whose
 |error| <= 2 sigma (target >= 90 %) and, per case, the median sigma over the RMS error (target <= 3).
 It also prints the floor that would give 90 % coverage with the bootstrap part as measured.
-Slow (~2-4 min per 14-granule case); not part of the test suite.
+Slow (~2-5 min per 14-granule case); not part of the test suite. ``--rows FILE`` appends one JSON line per
+case and resumes from the cases already in the file; ``benchmarks/results/acceptance_2026-11-22.jsonl`` holds
+the 25 cases of 2026-11-22 (print their tables with ``--from-rows``).
 
     .venv/bin/python benchmarks/acceptance.py [--sizes 14 6] [--seeds 1 2] [--profiles paper random zero]
         [--ground flat terrain] [--passes day night] [--keep DIR] [--rows FILE]
