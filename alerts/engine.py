@@ -71,8 +71,10 @@ def build_message(store, satellite: str, items: list, settings) -> dict:
     if trend:
         text += ["trend (last days):"] + [f"  {t}" for t in trend]
     where = []
-    if settings.report_dir:
-        where.append(f"report: {settings.report_dir / satellite / 'index.html'}")
+    if settings.report_url:
+        where.append(f"report: {settings.report_url.rstrip('/')}/{satellite}/")
+    elif settings.report_dir:
+        where.append(f"report: {settings.report_dir / satellite / 'index.html'} (on the server; set report_url)")
     if settings.dashboard_url:
         where.append(f"dashboard: {settings.dashboard_url}")
     text += where

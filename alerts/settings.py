@@ -44,6 +44,7 @@ class AlertSettings:
     events_file: Path | None = None
     report_dir: Path | None = None
     dashboard_url: str | None = None
+    report_url: str | None = None  # where readers of the messages open report_dir (e.g. behind a proxy)
 
     @property
     def channels(self) -> list[str]:
@@ -86,7 +87,7 @@ def _only(doc, allowed, where):
         raise AlertConfigError(f"{where}{unknown[0]}: unknown key")
 
 
-def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=None) -> AlertSettings:
+def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=None, report_url=None) -> AlertSettings:
     """Parse the alerts section *doc*; relative paths are relative to *base* (the config file's folder)."""
     doc = doc or {}
     if not isinstance(doc, dict):
@@ -107,7 +108,7 @@ def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=No
         p = Path(os.path.expandvars(p)).expanduser()
         return p if p.is_absolute() else base / p
 
-    s = AlertSettings(rules=rules, report_dir=report_dir, dashboard_url=dashboard_url)
+    s = AlertSettings(rules=rules, report_dir=report_dir, dashboard_url=dashboard_url, report_url=report_url)
     s.log = path("log")
     s.events_file = path("events_file")
     if doc.get("email"):

@@ -5,7 +5,12 @@ The science lives in ``monitor.sdr`` (files), ``monitor.geometry`` (frames), ``m
 object, :class:`monitor.result.AssessmentResult`.
 """
 
-__version__ = "0.1.0"
+from importlib.metadata import PackageNotFoundError, version as _dist_version
+
+try:
+    __version__ = _dist_version("crisgeo-monitor")  # the one version: pyproject.toml's
+except PackageNotFoundError:  # a source tree that was never installed
+    __version__ = "0+unknown"
 
 __all__ = ["AssessmentResult", "assess_paths", "open_store", "__version__"]
 

@@ -15,6 +15,8 @@ import logging
 import sys
 from pathlib import Path
 
+from monitor import __version__
+
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
 NAGIOS_OK, NAGIOS_WARNING, NAGIOS_CRITICAL, NAGIOS_UNKNOWN = 0, 1, 2, 3
@@ -258,11 +260,20 @@ def cmd_run(args) -> int:
 def cmd_daemon(args) -> int:
     from monitor.service import AlreadyRunning, Service
     cfg = _load(args)
+    if args.listen is not None:
+        from monitor.config import ConfigError, check_listen
+        try:
+            check_listen(args.listen, "--listen")
+        except ConfigError as exc:
+            raise BadInput(str(exc)) from None
     try:
-        Service(cfg).daemon()
+        Service(cfg).daemon(args.listen)
     except AlreadyRunning as exc:
         print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
         return EXIT_ALREADY_RUNNING
+    except OSError as exc:  # the endpoint's port is taken or not allowed
+        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
+        return EXIT_FAIL
     return EXIT_OK
 
 
@@ -510,21 +521,13 @@ def setup_logging(verbose: bool, log_format: str) -> None:
     logging.basicConfig(level=logging.DEBUG if verbose else logging.INFO, handlers=[handler])
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("crisgeo-monitor")
-    except PackageNotFoundError:
-        return "unknown (not installed)"
-
-
 def build_parser() -> argparse.ArgumentParser:
     from monitor.satellites import SATELLITES
     from monitor.simulate.orbit import PASSES
     p = argparse.ArgumentParser(prog="crisgeo", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("-v", "--verbose", action="store_true", help="debug logging")
-    p.add_argument("--version", action="version", version=f"crisgeo {_version()}")
+    p.add_argument("--version", action="version", version=f"crisgeo {__version__}")
     p.add_argument("--log-format", choices=("text", "json"), default="text",
                    help="text (no timestamp under systemd: the journal adds one) or JSON lines")
     common = argparse.ArgumentParser(add_help=False)  # -v and --log-format after the subcommand too
@@ -607,6 +610,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("daemon", help="the long-running service (systemd)")
     d.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+    d.add_argument("--listen", metavar="HOST:PORT", help="serve /metrics, /healthz, /report/ here (overrides "
+                   "http.listen; off: no endpoint)")
     d.set_defaults(func=cmd_daemon)
 
     st = sub.add_parser("status", help="last run per satellite, latest per-FOR table, next run, outbox size")

@@ -55,6 +55,7 @@ class ScheduleConfig:
     misfire_grace_hours: float = 6.0
     lag_days: int = 1  # assess the day that ended this many days ago
     no_data_retry_days: int = 3  # a day found empty is tried again this many days, then recorded as final
+    run_budget_min: float = 240.0  # a satellite-day run longer than this makes the daemon unhealthy
 
 
 @dataclass
@@ -98,6 +99,11 @@ class PublishConfig:
 
 
 @dataclass
+class HttpConfig:
+    listen: str = "127.0.0.1:9782"  # HOST:PORT of /metrics, /healthz, /report/ ("off": none; port 0: any free)
+
+
+@dataclass
 class StoreConfig:
     sqlite: Path
     publish: list = field(default_factory=list)
@@ -116,7 +122,9 @@ class Config:
     store: StoreConfig
     alerts: dict = field(default_factory=dict)
     fingerprint: FingerprintConfig = field(default_factory=FingerprintConfig)
+    http: HttpConfig = field(default_factory=HttpConfig)
     report_dir: Path | None = None
+    report_url: str | None = None
     dashboard_url: str | None = None
     alert_settings: object = None  # alerts.settings.AlertSettings, parsed and validated with the rest
 
@@ -241,6 +249,18 @@ def check_url(url: str, where: str, placeholder: str | None = None) -> str:
     return url
 
 
+def check_listen(text: str, where: str) -> str:
+    """``off`` or ``HOST:PORT`` (the daemon's HTTP endpoint)."""
+    if text == "off":
+        return text
+    from monitor.endpoint import parse_listen
+    try:
+        parse_listen(text)
+    except ValueError as exc:
+        raise ConfigError(f"{where}: {exc} (or off)") from None
+    return text
+
+
 def redact_url(url: str) -> str:
     """*url* with any user:password and query string masked, for logs and messages."""
     try:
@@ -262,7 +282,7 @@ def load_config(path) -> Config:
         raise ConfigError(f"{path}: expected a mapping at the top level")
     _check_secrets(doc)
     _known(doc, {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts",
-                 "fingerprint", "report_dir", "dashboard_url"}, "")
+                 "fingerprint", "http", "report_dir", "report_url", "dashboard_url"}, "")
     base = path.resolve().parent
 
     def rel(p):
@@ -298,7 +318,7 @@ def load_config(path) -> Config:
     sc = _section(doc, "schedule")
     _known(sc, set(ScheduleConfig.__dataclass_fields__), "schedule.")
     schedule = _fill(ScheduleConfig(), sc, "schedule.", catch_up_days=int, lag_days=int, no_data_retry_days=int,
-                     misfire_grace_hours=float)
+                     misfire_grace_hours=float, run_budget_min=float)
     t = _get(sc, "time_utc", str, "schedule.", schedule.time_utc.strftime("%H:%M"))
     m = re.fullmatch(r"(\d{1,2}):(\d{2})", t, re.ASCII)
     if not m or int(m[1]) > 23 or int(m[2]) > 59:
@@ -341,18 +361,24 @@ def load_config(path) -> Config:
         raise ConfigError(f"fingerprint.ep_library: expected a list of paths, got {library!r}")
     fingerprint = _fill(FingerprintConfig(ep_library=tuple(rel(x) for x in library)), fp, "fingerprint.",
                         granules=int, threshold_urad=float)
+    h = _section(doc, "http")
+    _known(h, set(HttpConfig.__dataclass_fields__), "http.")
+    http = _fill(HttpConfig(), h, "http.", listen=str)
+    check_listen(http.listen, "http.listen")
     alerts = _section(doc, "alerts")
     report_dir = _get(doc, "report_dir", str, "", None)
-    dashboard_url = _get(doc, "dashboard_url", str, "", None)
-    if dashboard_url:
-        check_url(dashboard_url, "dashboard_url")
+    report_url, dashboard_url = (_get(doc, k, str, "", None) for k in ("report_url", "dashboard_url"))
+    for key, url in (("report_url", report_url), ("dashboard_url", dashboard_url)):
+        if url:
+            check_url(url, key)
     cfg = Config(path=path, satellites=list(sats), state_dir=state_dir, source=source, schedule=schedule,
-                 scenes=scenes, assessment=assessment, store=store, alerts=alerts, fingerprint=fingerprint,
-                 report_dir=rel(report_dir) if report_dir else None, dashboard_url=dashboard_url)
+                 scenes=scenes, assessment=assessment, store=store, alerts=alerts, fingerprint=fingerprint, http=http,
+                 report_dir=rel(report_dir) if report_dir else None, report_url=report_url,
+                 dashboard_url=dashboard_url)
     _check_limits(cfg)
     from alerts.settings import AlertConfigError, load_alert_settings
     try:
-        cfg.alert_settings = load_alert_settings(alerts, base, cfg.report_dir, cfg.dashboard_url)
+        cfg.alert_settings = load_alert_settings(alerts, base, cfg.report_dir, cfg.dashboard_url, cfg.report_url)
     except AlertConfigError as exc:
         raise ConfigError(str(exc)) from None
     return cfg
@@ -365,6 +391,7 @@ LIMITS = {
     "source.max_list_pages": (1, 10000), "source.max_listed_keys": (1, 10**6), "source.max_retry_after_s": (1, 3600),
     "source.min_rate_kb_s": (1, 1e6), "source.granules": (1, 100), "source.seed": (0, 2**31 - 1),
     "schedule.catch_up_days": (1, 366), "schedule.lag_days": (0, 30), "schedule.no_data_retry_days": (0, 366), "schedule.misfire_grace_hours": (0.01, 72),
+    "schedule.run_budget_min": (0.01, 10080),
     "scenes.candidates": (1, 1000), "scenes.keep": (1, 200), "scenes.min_inhomogeneity_k": (0, 50),
     "assessment.half_steps": (1, 40), "assessment.step_urad": (10, 5000), "assessment.workers": (1, 64),
     "store.drain_minutes": (0.01, 1440),
@@ -399,7 +426,7 @@ def effective(cfg: Config) -> dict:
     def plain(v, key=""):
         if dataclasses.is_dataclass(v):
             return {f.name: plain(getattr(v, f.name), f.name) for f in dataclasses.fields(v)
-                    if f.name not in ("path", "alerts", "report_dir", "dashboard_url") or v is not cfg}
+                    if f.name not in ("path", "alerts", "report_dir", "report_url", "dashboard_url") or v is not cfg}
         if isinstance(v, dict):
             return {str(k): plain(x, str(k)) for k, x in v.items()}
         if isinstance(v, (list, tuple)):
@@ -417,5 +444,6 @@ def effective(cfg: Config) -> dict:
     out["alerts"] = plain(cfg.alert_settings)
     out.pop("alert_settings", None)
     out["report_dir"] = str(cfg.report_dir) if cfg.report_dir else None
-    out["dashboard_url"] = redact_url(cfg.dashboard_url) if cfg.dashboard_url else None
+    for key in ("report_url", "dashboard_url"):
+        out[key] = redact_url(getattr(cfg, key)) if getattr(cfg, key) else None
     return out

@@ -42,7 +42,7 @@ class RunOutcome:
     run_id: int | None = None
     result: object = None
     timings: dict = field(default_factory=dict)
-    counts: dict = field(default_factory=dict)  # granules listed, selected, assessed; MB downloaded
+    counts: dict = field(default_factory=dict)  # granules listed, selected, assessed; files, bytes downloaded
 
     def summary(self) -> str:
         """The one line a run leaves in the log."""
@@ -50,7 +50,8 @@ class RunOutcome:
         parts = [f"run {self.satellite} {self.day}: {self.status}" + (f" ({self.reason})" if self.reason else "")]
         if c:
             parts.append(f"granules listed {c.get('listed', 0)}, selected {c.get('selected', 0)}, "
-                         f"assessed {c.get('assessed', 0)}; {c.get('mb', 0.0):.0f} MB downloaded")
+                         f"assessed {c.get('assessed', 0)}; {c.get('downloaded', 0)} files, "
+                         f"{c.get('bytes', 0) / 1e6:.0f} MB downloaded")
         if self.result is not None:
             ok = [f for f in self.result.fors if f.reliable]
             worst = max((f.total_km for f in ok), default=float("nan"))
@@ -172,7 +173,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
     stop = should_stop or (lambda: False)
     run_id = store.begin_run(satellite, day)
     timings = {}
-    counts = {"listed": 0, "selected": 0, "assessed": 0, "mb": 0.0}
+    counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}
     t0 = time.perf_counter()
     try:
         source.start_day()
@@ -208,7 +209,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
                 except (SourceError, BudgetExceeded) as exc:
                     fetch_skipped.append((vs.name, str(exc)))
         timings["fetch"] = time.perf_counter() - t1
-        counts["mb"] = getattr(source, "spent_bytes", 0) / 1e6
+        counts["downloaded"], counts["bytes"] = source.downloaded_files, source.spent_bytes
         t1 = time.perf_counter()
         case = plan(sorted(set(paths)))
         case.skipped += fetch_skipped

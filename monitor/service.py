@@ -5,7 +5,10 @@
 * SIGTERM/SIGINT set a stop event that the run polls between steps and granules, then the scheduler
   shuts down; a run cut short is recorded as interrupted and redone at the next start.
 * A single-instance lock (flock on the state directory) keeps a second copy from running.
-* sd_notify READY/STATUS/WATCHDOG/STOPPING over $NOTIFY_SOCKET, when systemd provides one.
+* sd_notify READY/STATUS/WATCHDOG/STOPPING over $NOTIFY_SOCKET, when systemd provides one; the watchdog
+  is fed only while :mod:`monitor.health` holds (every run within ``schedule.run_budget_min``, the
+  scheduler's heartbeat recent), so a wedged run or a stalled scheduler ends in a restart.
+* One HTTP endpoint (``http.listen``): /metrics, /healthz, /report/ (:mod:`monitor.endpoint`).
 * A job that fails or is missed becomes an event in the store, which the alerting layer reads.
 """
 
@@ -20,12 +23,15 @@ import socket
 import threading
 from pathlib import Path
 
+from monitor.health import Health
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources import make_source
 from monitor.store.sqlite import Store
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
+HEARTBEAT_S = 30.0  # the scheduler's heartbeat job runs this often
+STALL_S = 300.0  # ... and the scheduler counts as stalled when it has not run for this long
 
 
 def sd_notify(message: str) -> bool:
@@ -97,6 +103,8 @@ class Service:
         self.progress = progress
         self.source = make_source(cfg)
         self.scheduler = None
+        self.health = Health(STALL_S)
+        self.metrics = None  # monitor.metrics.ServiceMetrics, while the daemon serves /metrics
 
     def store(self) -> Store:
         return Store(self.cfg.store.sqlite)
@@ -106,8 +114,11 @@ class Service:
         try:
             LOG.info("run %s %s", satellite, day)
             sd_notify(f"STATUS=assessing {satellite} {day}")
-            out = run_day(self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress)
+            with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
+                out = run_day(self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress)
             LOG.info("%s", out.summary())
+            if self.metrics is not None:
+                self.metrics.record(out)
             self._after_run(store, out)
             return out
         finally:
@@ -210,15 +221,30 @@ class Service:
             scheduler.add_job(self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}",
                               next_run_time=now)  # catch up at start, then daily
         scheduler.add_job(self.check_alerts, "interval", hours=1, id="alerts", name="alert timer")
+        scheduler.add_job(self.health.beat, "interval", seconds=HEARTBEAT_S, id="heartbeat", name="heartbeat",
+                          next_run_time=now)
         if self.cfg.store.publish:
             scheduler.add_job(self.drain_outbox, "interval", minutes=self.cfg.store.drain_minutes, id="outbox",
                               name="outbox timer")
         scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
 
-    def daemon(self):
+    def start_endpoint(self, listen: str):
+        """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
+        if listen == "off":
+            return None
+        from monitor.endpoint import Endpoint, parse_listen
+        from monitor.metrics import ServiceMetrics
+        from monitor import __version__
+        self.metrics = ServiceMetrics(self.store, self.cfg.satellites, self.health, __version__)
+        report = self.cfg.report_dir if self.cfg.report_dir else None
+        return Endpoint(*parse_listen(listen), self.metrics, self.health, report).start()
+
+    def daemon(self, listen: str | None = None):
+        """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``."""
         from apscheduler.schedulers.blocking import BlockingScheduler
         sch = self.cfg.schedule
         with InstanceLock(self.cfg.state_dir):
+            endpoint = self.start_endpoint(listen or self.cfg.http.listen)
             self.recover()
             self.scheduler = BlockingScheduler(timezone=UTC, job_defaults={
                 "coalesce": True, "max_instances": 1, "misfire_grace_time": int(sch.misfire_grace_hours * 3600)})
@@ -235,6 +261,8 @@ class Service:
                 self.stop_event.set()
                 if watchdog is not None:
                     watchdog.join(timeout=5)
+                if endpoint is not None:
+                    endpoint.stop()
                 LOG.info("crisgeo daemon stopped")
 
     def _on_signal(self, signum, frame):
@@ -263,10 +291,19 @@ class Service:
         interval = int(usec) / 1e6 / 2
 
         def ping():
+            reported = set()  # what is wrong, by source (a job, the scheduler): said once, not every ping
             while not self.stop_event.wait(interval):
                 sched = self.scheduler
-                if sched is not None and sched.running:
+                problems = self.health.problems() if sched is not None and sched.running else ["scheduler: not running"]
+                sources = {p.split(":", 1)[0] for p in problems}
+                if not problems:
+                    if reported:
+                        LOG.info("healthy again; the watchdog is fed")
                     sd_notify("WATCHDOG=1")
+                elif sources != reported:
+                    LOG.error("unhealthy, the watchdog is no longer fed: %s", "; ".join(problems))
+                    sd_notify("STATUS=unhealthy: " + "; ".join(problems)[:200])
+                reported = sources
         t = threading.Thread(target=ping, name="watchdog", daemon=True)
         t.start()
         return t

@@ -39,6 +39,19 @@ def require(binary: str) -> str:
     return path
 
 
+def chromium_driver(tmp_path):
+    """Headless Chromium under Selenium, keeping the browser console log (read it with get_log)."""
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    options = webdriver.ChromeOptions()
+    options.binary_location = require("chromium")
+    for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1280,2400",
+                f"--user-data-dir={tmp_path / 'chrome-profile'}"):
+        options.add_argument(arg)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    return webdriver.Chrome(service=Service(require("chromedriver")), options=options)
+
+
 def _wait(url: str, ok=(200, 204), timeout=30.0):
     t0 = time.time()
     while time.time() - t0 < timeout:

@@ -71,6 +71,7 @@ def _write(path: Path, text: str) -> None:
 
 def _page(title: str, body: str) -> str:
     return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{_e(title)}</title>"
+            "<link rel=\"icon\" href=\"data:,\">"  # no favicon request (a 404 in the browser console)
             f"<style>{CSS}</style></head><body>\n{body}\n</body></html>\n")
 
 
@@ -134,8 +135,6 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     """Write ``out/<satellite>/`` and return a summary for the index."""
     sat_dir = out / satellite
     sat_dir.mkdir(parents=True, exist_ok=True)
-    for old in sat_dir.glob("*.png"):
-        old.unlink()
     name = f"{SAT_NAMES.get(satellite, satellite)} ({satellite})"
     rows = store.series(satellite, opts.since, opts.until)
     changes = [c for c in all_changes(store, satellite, opts.calendar)
@@ -152,6 +151,7 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
         parts.append("<h2>Active alerts</h2>" + _alerts_table(firing))
         parts.append("<h2>Known changes</h2>" + _changes_table(changes))
         _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))
+        _drop_figures_except(sat_dir, set())
         return summary
     days, arrays = _series_arrays(rows)
     latest = days[-1]
@@ -178,12 +178,14 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
                       opts.spec_km, marks, alert_days, span)
     stored = store.cost_cube(satellite, latest)
     cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
+    figures = {"latest_km.png", "latest_urad.png", "heatmap.png", "trend.png"}
     if stored is not None and worst is not None:
         cube, step = stored
         runs = [r for r in store.runs(satellite) if r["day"] == latest.isoformat() and r["status"] == "ok"]
         plots.cost_contour(sat_dir / "cost.png", np.asarray(cube[worst.for_index - 1], float), worst.for_index, step,
                            worst.d_alpha_urad, worst.d_beta_urad, f"{title}: worst FOR {worst.for_index}, "
                            f"{worst.total_km:.2f} km" + (f" (run {runs[-1]['id']})" if runs else ""))
+        figures.add("cost.png")
         cost_html = (_img("cost.png", f"cost surface of FOR {worst.for_index}") +
                      f"<p class=note>G_min {worst.cost_min_k:.3f} K against {worst.cost_zero_k:.3f} K as geolocated; "
                      "a sharp, closed minimum is a trustworthy result, a flat or open one is flagged.</p>")
@@ -205,7 +207,16 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
         f"<p class=note>Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} UTC by crisgeo report.</p>",
     ]
     _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))
+    _drop_figures_except(sat_dir, figures)
     return summary
+
+
+def _drop_figures_except(sat_dir: Path, keep: set) -> None:
+    """Remove figures of an earlier report that this one no longer shows. Figures are replaced in place,
+    never removed first, so a page being read while the report is rewritten keeps its images."""
+    for old in sat_dir.glob("*.png"):
+        if old.name not in keep:
+            old.unlink(missing_ok=True)
 
 
 def build_report(store, out_dir, opts: ReportOptions) -> Path:

@@ -6,6 +6,7 @@ Every function takes plain arrays and writes one PNG; none reads the store.
 from __future__ import annotations
 
 import datetime as dt
+import os
 from pathlib import Path
 
 import matplotlib
@@ -22,8 +23,12 @@ CHANGE_COLOURS = {"cris": "tab:purple", "viirs": "tab:green", "common": "tab:bro
 
 
 def _save(fig, path: Path) -> Path:
-    fig.savefig(path, dpi=DPI)
+    """Write the figure as PNG through a temporary name: the served report never shows half an image."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.part")
+    fig.savefig(tmp, dpi=DPI, format="png")
     plt.close(fig)
+    os.replace(tmp, path)
     return path
 
 

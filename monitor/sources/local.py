@@ -12,7 +12,10 @@ LOG = logging.getLogger(__name__)
 
 
 class LocalSource:
-    """Granule files anywhere below *root*; fetching returns the file itself."""
+    """Granule files anywhere below *root*; fetching returns the file itself (nothing is downloaded)."""
+
+    spent_bytes = 0
+    downloaded_files = 0
 
     def __init__(self, root):
         self.root = Path(root)

@@ -69,7 +69,8 @@ class NoddSource:
         self.cache_dir = Path(cache_dir)
         self.session = requests.Session()  # no urllib3 Retry: the one retry layer is _get
         self.session.headers["Accept-Encoding"] = "identity"
-        self.spent_bytes = 0
+        self.spent_bytes = 0  # downloaded in this run (cache hits are free)
+        self.downloaded_files = 0
         self.deadline = None
         self.sleep = sleep
 
@@ -82,6 +83,7 @@ class NoddSource:
     def start_day(self):
         """Start a run: reset the day's budget and the run deadline, apply the cache retention."""
         self.spent_bytes = 0
+        self.downloaded_files = 0
         self.deadline = time.monotonic() + self.cfg.run_deadline_min * 60
         self.cache_dir.mkdir(parents=True, exist_ok=True)
         cutoff = time.time() - self.cfg.retention_days * 86400
@@ -221,6 +223,7 @@ class NoddSource:
                     continue
                 break
             self.spent_bytes += n
+            self.downloaded_files += 1
             os.replace(part, target)
             return target
         raise SourceError(f"{f.name}: download failed ({last})")

@@ -186,6 +186,20 @@ class Store:
             "SELECT r.* FROM runs r JOIN (SELECT satellite, MAX(id) AS id FROM runs GROUP BY satellite) m "
             "ON r.id = m.id ORDER BY r.satellite")]
 
+    def run_counts(self) -> dict:
+        """{(satellite, status): number of runs} over the whole ledger."""
+        return {(r[0], r[1]): r[2] for r in self.db.execute(
+            "SELECT satellite, status, COUNT(*) FROM runs GROUP BY satellite, status")}
+
+    def last_success(self) -> dict:
+        """{satellite: finish time (aware UTC datetime) of its latest ok run}."""
+        return {r[0]: dt.datetime.fromisoformat(r[1]) for r in self.db.execute(
+            "SELECT satellite, MAX(finished) FROM runs WHERE status='ok' AND finished IS NOT NULL GROUP BY satellite")}
+
+    def outbox_sizes(self) -> dict:
+        """{target: points waiting}."""
+        return dict(self.db.execute("SELECT target, COUNT(*) FROM outbox GROUP BY target").fetchall())
+
     def runs(self, satellite: str | None = None) -> list:
         q = "SELECT * FROM runs" + (" WHERE satellite=?" if satellite else "") + " ORDER BY id"
         return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]

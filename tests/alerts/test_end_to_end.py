@@ -2,6 +2,7 @@
 
 import datetime as dt
 import email
+import json
 from email import policy
 
 import pytest
@@ -39,6 +40,7 @@ source: {{kind: local, path: {two_days}}}
 assessment: {{workers: 1}}
 dashboard_url: http://grafana.test/d/crisgeo
 report_dir: {tmp_path / 'report'}
+report_url: https://crisgeo.test/report/
 alerts:
   log: {tmp_path / 'alerts.log'}
   email: {{host: localhost, port: {port}, from: crisgeo@test, to: [sdr@test], cafile: {cafile},
@@ -54,7 +56,9 @@ alerts:
     for k in (27, 28, 29, 30):
         assert f"FOR {k}:" in body
     assert "FOR 15:" not in body and "http://grafana.test/d/crisgeo" in body and "granule pair(s)" in body
+    assert "report: https://crisgeo.test/report/j01/" in body and str(tmp_path) not in body
     assert "FOR 30" in webhook.received[0]["text"]
+    assert "https://crisgeo.test/report/j01/" in json.dumps(webhook.received[0])
     # the report was regenerated before the message left: it shows the alert, the e-mail carries its plot
     assert "FOR 30" in (tmp_path / "report" / "j01" / "index.html").read_text()
     assert [p.get_filename() for p in m.iter_attachments()] == ["trend.png"]

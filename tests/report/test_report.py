@@ -14,7 +14,7 @@ from monitor.cli import main
 from monitor.report.html import ReportOptions, build_report
 from monitor.simulate.history import fill_store
 from monitor.store.sqlite import Store
-from tests.servers import require
+from tests.servers import chromium_driver
 
 SATS = ["npp", "j01", "j02"]
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -75,22 +75,10 @@ def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
     assert main(["report", "--config", str(cfg), "--since", "2025-03-31", "--until", "2025-03-01"]) == 2
 
 
-def _chromium_driver(tmp_path):
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-    options = webdriver.ChromeOptions()
-    options.binary_location = require("chromium")
-    for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1280,2400",
-                f"--user-data-dir={tmp_path / 'chrome-profile'}"):
-        options.add_argument(arg)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service(require("chromedriver")), options=options)
-
-
 def test_report_in_headless_chromium(store, tmp_path):
     days = fill_store(store, SATS, dt.date(2025, 6, 1), 120, step_day=90)
     build_report(store, tmp_path / "rep", ReportOptions(satellites=SATS, calendar=_calendar(tmp_path, days[90])))
-    driver = _chromium_driver(tmp_path)
+    driver = chromium_driver(tmp_path)
     try:
         for page in ["index.html"] + [f"{s}/index.html" for s in SATS]:
             driver.get((tmp_path / "rep" / page).as_uri())

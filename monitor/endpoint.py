@@ -1,0 +1,121 @@
+"""The daemon's one HTTP endpoint (``http.listen``, loopback by default): metrics, health, the report.
+
+    GET /metrics    Prometheus text format (:mod:`monitor.metrics`)
+    GET /healthz    200 {"status": "ok", ...} or 503 {"status": "unhealthy", "problems": [...]}
+    GET /report/    the HTML report, read-only (files under ``report_dir``; no listings, no dotfiles such as
+                    the temporary ``.name.part`` of a file being rewritten, nothing outside)
+
+Only GET and HEAD; any other path is 404. A stdlib threading server on its own daemon thread: a slow
+client cannot hold up the scheduler, and a scrape opens its own connection to the store.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import socket
+import threading
+from functools import partial
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+
+from prometheus_client import CONTENT_TYPE_LATEST, generate_latest
+
+LOG = logging.getLogger(__name__)
+
+
+def parse_listen(text: str) -> tuple[str, int]:
+    """``HOST:PORT`` (``[::1]:PORT`` for IPv6) as (host, port); ValueError naming the value otherwise."""
+    host, sep, port = str(text).rpartition(":")
+    host = host[1:-1] if host.startswith("[") and host.endswith("]") else host
+    if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
+        raise ValueError(f"{text!r} is not HOST:PORT")
+    return host, int(port)
+
+
+class _Handler(SimpleHTTPRequestHandler):
+    server_version = "crisgeo"
+    sys_version = ""
+
+    def __init__(self, *args, endpoint=None, **kwargs):
+        self.endpoint = endpoint
+        super().__init__(*args, **kwargs)
+
+    def do_GET(self):  # noqa: N802 - http.server's naming
+        self._route(head=False)
+
+    def do_HEAD(self):  # noqa: N802
+        self._route(head=True)
+
+    def _route(self, head: bool):
+        path = self.path.split("?", 1)[0]
+        if path == "/metrics":
+            self._send(200, generate_latest(self.endpoint.metrics.registry), CONTENT_TYPE_LATEST, head)
+        elif path == "/healthz":
+            problems = self.endpoint.health.problems()
+            body = {"status": "unhealthy" if problems else "ok", "problems": problems,
+                    "running": self.endpoint.health.running()}
+            self._send(503 if problems else 200, json.dumps(body).encode(), "application/json", head)
+        elif path == "/report":
+            self.send_response(301)
+            self.send_header("Location", "/report/")
+            self.send_header("Content-Length", "0")
+            self.end_headers()
+        elif path.startswith("/report/") and self.directory is not None and "/." not in path:
+            self.path = self.path[len("/report"):]
+            super().do_HEAD() if head else super().do_GET()
+        else:
+            self._send(404, b"not found\n", "text/plain", head)
+
+    def list_directory(self, path):
+        self.send_error(404, "no listing")
+        return None
+
+    def _send(self, code: int, body: bytes, ctype: str, head: bool):
+        self.send_response(code)
+        self.send_header("Content-Type", ctype)
+        self.send_header("Content-Length", str(len(body)))
+        self.send_header("Cache-Control", "no-store")
+        self.end_headers()
+        if not head:
+            self.wfile.write(body)
+
+    def log_message(self, fmt, *args):
+        LOG.debug("%s %s", self.address_string(), fmt % args)
+
+
+class _V6Server(ThreadingHTTPServer):
+    address_family = socket.AF_INET6
+
+
+class Endpoint:
+    """Serves *metrics* (:class:`monitor.metrics.ServiceMetrics`), *health* (:class:`monitor.health.Health`)
+    and the files under *report_dir* on (host, port); port 0 takes a free one (see :attr:`address`)."""
+
+    def __init__(self, host: str, port: int, metrics, health, report_dir: Path | None):
+        self.metrics = metrics
+        self.health = health
+        directory = str(report_dir) if report_dir else None
+        handler = partial(_Handler, endpoint=self, directory=directory)
+        server_cls = _V6Server if ":" in host else ThreadingHTTPServer
+        try:
+            self.server = server_cls((host, port), handler)
+        except OSError as exc:
+            raise OSError(f"http.listen {host}:{port}: cannot listen ({exc.strerror or exc})") from None
+        self.server.daemon_threads = True
+        self.thread = threading.Thread(target=self.server.serve_forever, name="http", daemon=True)
+
+    @property
+    def address(self) -> str:
+        host, port = self.server.server_address[:2]
+        return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
+
+    def start(self) -> "Endpoint":
+        self.thread.start()
+        LOG.info("serving /metrics, /healthz and /report/ on http://%s/", self.address)
+        return self
+
+    def stop(self) -> None:
+        self.server.shutdown()
+        self.server.server_close()
+        self.thread.join(timeout=5)
