@@ -169,23 +169,30 @@ def evaluate_and_deliver(store, settings, satellites, now=None) -> dict:
     return counts
 
 
-def fmt_alerts(store, now: dt.datetime) -> str:
-    """The ``crisgeo alerts list`` view: firing, silenced, recently resolved."""
+def alerts_view(store, now: dt.datetime) -> dict:
+    """What ``crisgeo alerts list`` shows, as data: the alerts (firing, silenced, resolved in the last 7
+    days), the silences in force and the number of messages waiting for delivery."""
     state = AlertState(store)
-    rows = state.all()
-    lines = []
-    for r in rows:
+    alerts = []
+    for r in state.all():
         if r["status"] == "resolved" and r["resolved"] and \
                 now - dt.datetime.fromisoformat(r["resolved"]) > dt.timedelta(days=7):
             continue
         quiet = state.silenced(r["rule"], r["satellite"], now)
-        status = "silenced" if quiet and r["status"] == "firing" else r["status"]
-        lines.append(f"{status:<9} {r['severity'] or '':<8} {r['fingerprint']:<28} since {r['started']}"
-                     + (f" resolved {r['resolved']}" if r["status"] == "resolved" else "") + f"  {r['summary']}")
-    for s in state.silences(now):
-        lines.append(f"silence   rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: {s['reason']}")
-    pending = state.deliveries("pending")
-    lines.append(f"{len(pending)} message(s) waiting for delivery")
-    return "\n".join(lines) if rows or pending else "no alerts"
+        alerts.append({"status": "silenced" if quiet and r["status"] == "firing" else r["status"],
+                       "severity": r["severity"], "rule": r["rule"], "satellite": r["satellite"],
+                       "fingerprint": r["fingerprint"], "started": r["started"], "resolved": r["resolved"],
+                       "summary": r["summary"], "lines": json.loads(r["lines"] or "[]")})
+    silences = [{k: s[k] for k in ("rule", "satellite", "until", "reason")} for s in state.silences(now)]
+    return {"alerts": alerts, "silences": silences, "pending_deliveries": len(state.deliveries("pending"))}
 
 
+def fmt_alerts(view: dict) -> str:
+    """The text of ``crisgeo alerts list`` from :func:`alerts_view`."""
+    lines = [f"{a['status']:<9} {a['severity'] or '':<8} {a['fingerprint']:<28} since {a['started']}"
+             + (f" resolved {a['resolved']}" if a["status"] == "resolved" else "") + f"  {a['summary']}"
+             for a in view["alerts"]]
+    lines += [f"silence   rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: {s['reason']}"
+              for s in view["silences"]]
+    lines.append(f"{view['pending_deliveries']} message(s) waiting for delivery")
+    return "\n".join(lines) if view["alerts"] or view["pending_deliveries"] else "no alerts"

@@ -371,7 +371,8 @@ def _collocate_run(cris: list, viirs: dict, viirs_all: list, satellite: str, cfg
 def _worker(args):
     cris, viirs, viirs_all, satellite, cfg = args
     timings = {}
-    samples, skipped = _collocate_run(cris, viirs, viirs_all, satellite, cfg, timings=timings,
+    done = (lambda g: _DONE.put(g.key)) if _DONE is not None else None
+    samples, skipped = _collocate_run(cris, viirs, viirs_all, satellite, cfg, progress=done, timings=timings,
                                       should_stop=_STOP.is_set if _STOP is not None else None)
     return samples, skipped, timings
 
@@ -391,14 +392,12 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
     if workers > 1 and len(case.cris) > 1:
         runs = [list(r) for r in np.array_split(np.array(case.cris, dtype=object), min(workers, len(case.cris)))]
         samples = []
-        for run, (s, k, t) in zip(runs, _in_processes(runs, case, cfg, should_stop)):
+        for s, k, t in _in_processes(runs, case, cfg, should_stop, progress):
             samples += s
             skipped += k
             for name, sec in t.items():
                 if timings is not None:
                     timings[name] = timings.get(name, 0.0) + sec
-            for g in run if progress is not None else ():
-                progress(g)
     else:
         samples, k = _collocate_run(case.cris, case.viirs, case.viirs_all, case.satellite, cfg,
                                     progress, should_stop, timings)
@@ -415,13 +414,14 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
 
 
 _STOP = None  # in a worker process: the event the parent sets to ask for a stop
+_DONE = None  # ... and the queue it tells each finished granule (its key) for the parent's progress
 
 
-def _die_with_parent(stop_event):
+def _die_with_parent(stop_event, done_queue):
     """Worker initializer: die when the parent dies, even by SIGKILL (Linux parent-death signal), and keep
-    the stop event."""
-    global _STOP
-    _STOP = stop_event
+    the stop event and the progress queue."""
+    global _STOP, _DONE
+    _STOP, _DONE = stop_event, done_queue
     try:
         import ctypes
         import signal
@@ -432,32 +432,49 @@ def _die_with_parent(stop_event):
         os._exit(1)
 
 
-def _in_processes(runs, case, cfg, should_stop):
-    """Collocate each run of granules in its own (spawned) process; a stop request is relayed to them.
+def _in_processes(runs, case, cfg, should_stop, progress=None):
+    """Collocate each run of granules in its own (spawned) process; a stop request is relayed to them,
+    and *progress* is called here as each granule finishes there.
 
     The workers hold no manager or server process of their own, and die with this process.
     """
     import concurrent.futures as cf
     import multiprocessing as mp
+    import queue
     import threading
     ctx = mp.get_context("spawn")
     event = ctx.Event()
+    finished = ctx.Queue() if progress is not None else None
     done = threading.Event()
+    granules = {g.key: g for r in runs for g in r}
 
     def relay():
-        while not done.wait(0.2):
-            if should_stop():
+        while not done.is_set():
+            if should_stop is not None and should_stop():
                 event.set()
-                return
-    if should_stop is not None:
-        threading.Thread(target=relay, daemon=True).start()
+            if progress is None:
+                done.wait(0.2)
+                continue
+            try:
+                progress(granules[finished.get(timeout=0.2)])
+            except queue.Empty:
+                pass
+    relay_thread = threading.Thread(target=relay, daemon=True)
+    relay_thread.start()
     jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg) for r in runs]
     try:
         with cf.ProcessPoolExecutor(len(jobs), mp_context=ctx, initializer=_die_with_parent,
-                                    initargs=(event,)) as pool:
+                                    initargs=(event, finished)) as pool:
             return list(pool.map(_worker, jobs))
     finally:
         done.set()
+        relay_thread.join(timeout=5)
+        if progress is not None:  # granules whose report was still on its way
+            while True:
+                try:
+                    progress(granules[finished.get(timeout=0.05)])
+                except queue.Empty:
+                    break
 
 
 def assess_paths(paths, cfg: AssessConfig | None = None, progress=None, workers: int = 1) -> AssessmentResult:

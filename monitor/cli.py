@@ -343,7 +343,7 @@ def cmd_status(args) -> int:
 
 
 def cmd_alerts(args) -> int:
-    from alerts.engine import evaluate_and_deliver, fmt_alerts
+    from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts
     from alerts.settings import AlertConfigError
     from alerts.state import AlertState
     from monitor.service import Service
@@ -366,8 +366,11 @@ def cmd_alerts(args) -> int:
             print(f"silenced rule={args.rule or '*'} satellite={args.satellite or '*'} until {args.until:%Y-%m-%d %H:%M} UTC")
         elif args.action == "evaluate":
             print(evaluate_and_deliver(store, settings, cfg.satellites, now))
+        elif args.json:
+            import json
+            print(json.dumps(alerts_view(store, now), indent=1))
         else:
-            print(fmt_alerts(store, now))
+            print(fmt_alerts(alerts_view(store, now)))
     finally:
         store.close()
     return EXIT_OK
@@ -626,6 +629,7 @@ def build_parser() -> argparse.ArgumentParser:
     al.add_argument("--satellite", choices=tuple(SATELLITES))
     al.add_argument("--until", type=_iso, help="end of the silence (ISO 8601, UTC)")
     al.add_argument("--reason", default="")
+    al.add_argument("--json", action="store_true", help="list as JSON")
     al.set_defaults(func=cmd_alerts)
 
     ev = sub.add_parser("events", help="list the known changes, or add one to the events calendar")

@@ -29,6 +29,23 @@ from monitor.store.timeseries import change_lines, drain_outbox, result_lines, t
 LOG = logging.getLogger(__name__)
 
 
+class ProgressLines:
+    """Progress of a long stage as log lines, for logs and the journal where no bar can be drawn: one
+    line at most every *every_s* seconds, and one at the end. Call it once per item done."""
+
+    def __init__(self, what: str, total: int, every_s: float = 30.0):
+        self.what, self.total, self.every_s = what, total, every_s
+        self.done = 0
+        self.t0 = self.last = time.monotonic()
+
+    def __call__(self, _item=None):
+        self.done += 1
+        now = time.monotonic()
+        if self.done >= self.total or now - self.last >= self.every_s:
+            self.last = now
+            LOG.info("%s: %d/%d after %.0f s", self.what, self.done, self.total, now - self.t0)
+
+
 class Stopped(Exception):
     """A stop was requested between two steps of a run."""
 
@@ -199,6 +216,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
                             counts)
         t1 = time.perf_counter()
         paths, fetch_skipped = [], []
+        fetched = ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
         for c in chosen:
             if stop():
                 raise Stopped
@@ -208,12 +226,14 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
                     paths += [source.fetch(vs), source.fetch(vg)]
                 except (SourceError, BudgetExceeded) as exc:
                     fetch_skipped.append((vs.name, str(exc)))
+            fetched()
         timings["fetch"] = time.perf_counter() - t1
         counts["downloaded"], counts["bytes"] = source.downloaded_files, source.spent_bytes
         t1 = time.perf_counter()
         case = plan(sorted(set(paths)))
         case.skipped += fetch_skipped
         a = cfg.assessment
+        progress = progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris))
         result = assess_plan(case, AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6,
                                                 kernel=a.kernel), progress=progress, should_stop=stop,
                              workers=a.workers)

@@ -114,6 +114,16 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     now = dt.datetime.now(dt.timezone.utc)
     AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), "firing", now, True)
     assert main(["status", "--json"]) == 1 and json.loads(capsys.readouterr().out)["state"] == "WARNING"
+    assert main(["alerts", "list", "--json"]) == 0
+    (alert,) = json.loads(capsys.readouterr().out)["alerts"]
+    assert (alert["status"], alert["rule"], alert["satellite"], alert["severity"]) == ("firing", "jump", "j01", "warning")
+    assert main(["alerts", "silence", "--rule", "jump", "--until", (now + dt.timedelta(hours=2)).isoformat(),
+                 "--reason", "known step"]) == 0
+    capsys.readouterr()
+    assert main(["alerts", "list", "--json"]) == 0
+    view = json.loads(capsys.readouterr().out)
+    assert view["alerts"][0]["status"] == "silenced" and view["silences"][0]["reason"] == "known step"
+    assert main(["alerts"]) == 0 and "silenced  warning" in capsys.readouterr().out
     run = store.begin_run("j01", dt.date(2024, 6, 1))
     store.finish_run(run, "failed", "HTTP 503")
     assert main(["status"]) == 2
@@ -133,7 +143,7 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
     data, _, _ = cases.get()
     cfg = tmp_path / "c.yaml"
     cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
-                   f"assessment: {{workers: 1}}\n")
+                   f"assessment: {{workers: 2}}\n")
     r = subprocess.run([sys.executable, "-m", "monitor.cli", "run", "--config", str(cfg), "--date", "2024-06-01",
                         "--log-format", "json"], capture_output=True, text=True,
                        env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"})
@@ -143,6 +153,10 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
     (summary,) = [d["message"] for d in lines if d["message"].startswith("run j01 2024-06-01: ok")]
     assert "granules listed 6, selected 2, assessed 2" in summary and "reliable FORs" in summary
     assert "worst" in summary and "stages list" in summary
+    # not on a terminal: progress as log lines, the granules as the worker processes finish them
+    progress = [d["message"] for d in lines if " after " in d["message"]]
+    assert any(m.startswith("j01 2024-06-01: fetched scenes: 2/2") for m in progress), progress
+    assert any(m.startswith("j01 2024-06-01: assessed granules: 2/2") for m in progress), progress
 
 
 def test_under_systemd_lines_carry_no_second_timestamp(tmp_path):
