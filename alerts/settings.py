@@ -51,6 +51,11 @@ class AlertSettings:
         return [n for n in ("log", "email", "slack") if getattr(self, n)]
 
 
+# the keys of the alerts section; email "from" is EmailSettings.sender
+ALERT_KEYS = set(RuleSettings.__dataclass_fields__) | {"log", "email", "slack", "events_file"}
+EMAIL_KEYS = {"host", "port", "from", "to", "starttls", "username_env", "password_env", "cafile", "timeout_s"}
+SLACK_KEYS = set(SlackSettings.__dataclass_fields__)
+
 RULE_LIMITS = {  # the accepted range of each rule setting, in its unit
     "spec_km": (0.01, 100.0), "min_jump_km": (0.001, 100.0), "jump_z": (1.0, 100.0), "jump_z_at_change": (1.0, 100.0),
     "pre_days": (2, 365), "min_pre_days": (2, 365), "min_post_days": (1, 365), "post_days": (1, 365),
@@ -69,6 +74,8 @@ def _typed(doc, key, typ, where, default, limits=None):
         raise AlertConfigError(f"{where}{key}: expected {typ.__name__}, got {str(v)[:60]!r}")
     if typ is float and not math.isfinite(v):
         raise AlertConfigError(f"{where}{key}: {v} is not a finite number")
+    if typ is str and "\x00" in v:
+        raise AlertConfigError(f"{where}{key}: contains a NUL character")
     if limits is not None and not limits[0] <= v <= limits[1]:
         raise AlertConfigError(f"{where}{key}: {v} is not within {limits[0]:g}..{limits[1]:g}")
     return v
@@ -99,7 +106,7 @@ def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=No
     if rules.min_pre_days > rules.pre_days:
         raise AlertConfigError(f"alerts.min_pre_days: {rules.min_pre_days} is more than alerts.pre_days "
                                f"({rules.pre_days})")
-    _only(doc, set(RuleSettings.__dataclass_fields__) | {"log", "email", "slack", "events_file"}, "alerts.")
+    _only(doc, ALERT_KEYS, "alerts.")
 
     def path(key, d=doc, where="alerts."):
         p = _typed(d, key, str, where, None)
@@ -114,31 +121,33 @@ def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=No
     if doc.get("email"):
         e = _mapping(doc, "email")
         w = "alerts.email."
-        _only(e, {"host", "port", "from", "to", "starttls", "username_env", "password_env", "cafile", "timeout_s"}, w)
-        if not e.get("host") or not isinstance(e["host"], str):
+        _only(e, EMAIL_KEYS, w)
+        if not _typed(e, "host", str, w, None):
             raise AlertConfigError("alerts.email.host: missing")
         to = e.get("to") or []
         if not isinstance(to, list) or not to or not all(isinstance(a, str) and "@" in a for a in to):
             raise AlertConfigError("alerts.email.to: a list of addresses is needed")
-        sender = _typed(e, "from", str, w, "crisgeo@localhost")
+        d = EmailSettings(host=e["host"], to=list(to))  # the defaults, once
+        sender = _typed(e, "from", str, w, d.sender)
         if "@" not in sender:
             raise AlertConfigError(f"alerts.email.from: {sender!r} is not an address")
-        s.email = EmailSettings(host=e["host"], port=_typed(e, "port", int, w, 587, (1, 65535)), sender=sender,
-                                to=list(to), starttls=_typed(e, "starttls", bool, w, True),
-                                username_env=_typed(e, "username_env", str, w, None),
-                                password_env=_typed(e, "password_env", str, w, None),
+        s.email = EmailSettings(host=e["host"], port=_typed(e, "port", int, w, d.port, (1, 65535)), sender=sender,
+                                to=list(to), starttls=_typed(e, "starttls", bool, w, d.starttls),
+                                username_env=_typed(e, "username_env", str, w, d.username_env),
+                                password_env=_typed(e, "password_env", str, w, d.password_env),
                                 cafile=str(path("cafile", e, w)) if e.get("cafile") else None,
-                                timeout_s=_typed(e, "timeout_s", float, w, 30.0, (0.1, 600.0)))
+                                timeout_s=_typed(e, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)))
     if doc.get("slack"):
         sl = _mapping(doc, "slack")
         w = "alerts.slack."
-        _only(sl, {"webhook_env", "retries", "max_wait_s", "timeout_s"}, w)
+        _only(sl, SLACK_KEYS, w)
         if not sl.get("webhook_env"):
             raise AlertConfigError("alerts.slack.webhook_env: missing (the name of the variable holding the URL)")
+        d = SlackSettings(webhook_env=sl["webhook_env"])
         s.slack = SlackSettings(webhook_env=_typed(sl, "webhook_env", str, w, None),
-                                retries=_typed(sl, "retries", int, w, 3, (0, 20)),
-                                max_wait_s=_typed(sl, "max_wait_s", float, w, 30.0, (0.0, 3600.0)),
-                                timeout_s=_typed(sl, "timeout_s", float, w, 15.0, (0.1, 600.0)))
+                                retries=_typed(sl, "retries", int, w, d.retries, (0, 20)),
+                                max_wait_s=_typed(sl, "max_wait_s", float, w, d.max_wait_s, (0.0, 3600.0)),
+                                timeout_s=_typed(sl, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)))
     return s
 
 

@@ -187,10 +187,24 @@ def _load(args):
         raise BadInput(msg if msg.startswith(str(args.config)) else f"{args.config}: {msg}") from None
 
 
+def cmd_install_files(args) -> int:
+    from monitor.install import install_files, kept_files
+    kept = [] if args.force else kept_files(args.dest)
+    for path in install_files(args.dest, args.force):
+        print(f"wrote {path}")
+    for path in kept:
+        print(f"kept  {path} (exists; --force replaces it)")
+    return EXIT_OK
+
+
 def cmd_check_config(args) -> int:
     import yaml
 
     from monitor.config import effective
+    if args.reference:
+        from monitor.config_reference import reference
+        print(reference(), end="")
+        return EXIT_OK
     cfg = _load(args)
     print(f"# {args.config}: valid")
     print(yaml.safe_dump(effective(cfg), sort_keys=False, default_flow_style=False), end="")
@@ -609,7 +623,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     cc = sub.add_parser("check-config", help="validate a configuration; print it with its defaults, secrets masked")
     cc.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+    cc.add_argument("--reference", action="store_true", help="print the reference of every key (Markdown) instead")
     cc.set_defaults(func=cmd_check_config)
+
+    inst = sub.add_parser("install-files", help="copy the shipped configs, Grafana and Prometheus files, EP files, "
+                          "systemd unit and docs into a directory")
+    inst.add_argument("dest", type=Path, help="target directory, e.g. /opt/crisgeo/share")
+    inst.add_argument("--force", action="store_true", help="replace files that exist")
+    inst.set_defaults(func=cmd_install_files)
 
     d = sub.add_parser("daemon", help="the long-running service (systemd)")
     d.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")

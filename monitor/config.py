@@ -133,6 +133,13 @@ class Config:
         return self.state_dir / "cache"
 
 
+TOP_KEYS = {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts", "fingerprint",
+            "http", "report_dir", "report_url", "dashboard_url"}
+SECTIONS = {"source": SourceConfig, "schedule": ScheduleConfig, "scenes": SceneConfig,
+            "assessment": AssessmentConfig, "fingerprint": FingerprintConfig, "http": HttpConfig}
+STORE_KEYS = {"sqlite", "publish", "drain_minutes"}
+
+
 def _get(doc: dict, key: str, typ, where: str, default=None, required=False):
     if key not in doc or doc[key] is None:
         if required:
@@ -145,6 +152,8 @@ def _get(doc: dict, key: str, typ, where: str, default=None, required=False):
         raise ConfigError(f"{where}{key}: expected {typ.__name__}, got {type(value).__name__} {str(value)[:60]!r}")
     if typ is float and not math.isfinite(value):
         raise ConfigError(f"{where}{key}: {value} is not a finite number")
+    if typ is str and "\x00" in value:
+        raise ConfigError(f"{where}{key}: contains a NUL character")
     return value
 
 
@@ -281,8 +290,7 @@ def load_config(path) -> Config:
     if not isinstance(doc, dict):
         raise ConfigError(f"{path}: expected a mapping at the top level")
     _check_secrets(doc)
-    _known(doc, {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts",
-                 "fingerprint", "http", "report_dir", "report_url", "dashboard_url"}, "")
+    _known(doc, TOP_KEYS, "")
     base = path.resolve().parent
 
     def rel(p):
@@ -336,7 +344,7 @@ def load_config(path) -> Config:
         raise ConfigError(f"assessment.kernel: {assessment.kernel!r} is not top-hat or response")
 
     st = _section(doc, "store")
-    _known(st, {"sqlite", "publish", "drain_minutes"}, "store.")
+    _known(st, STORE_KEYS, "store.")
     store = _fill(StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite")))), st,
                   "store.", drain_minutes=float)
     for i, p in enumerate(_get(st, "publish", list, "store.", [])):
@@ -357,7 +365,7 @@ def load_config(path) -> Config:
     library = fp.get("ep_library") or []
     if isinstance(library, str):
         library = [library]
-    if not isinstance(library, list) or not all(isinstance(x, str) for x in library):
+    if not isinstance(library, list) or not all(isinstance(x, str) and "\x00" not in x for x in library):
         raise ConfigError(f"fingerprint.ep_library: expected a list of paths, got {library!r}")
     fingerprint = _fill(FingerprintConfig(ep_library=tuple(rel(x) for x in library)), fp, "fingerprint.",
                         granules=int, threshold_urad=float)
