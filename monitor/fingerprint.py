@@ -8,7 +8,7 @@ no VIIRS data needed.
 
 On the real NOAA-20 granules of 2018-10-22 the FOV-5 angles scatter from scan to scan by <= 2 urad
 in-track but 1.5-9.5 urad cross-track depending on the FOR (largest at FOR 1, 11, 21: scene-mirror
-servo errors, formats.md 2.5), and the cross-track angle of those FORs drifts by ~20 urad within five
+servo errors, docs/jpss-formats.md 2.3), and the cross-track angle of those FORs drifts by ~20 urad within five
 minutes. The step threshold of each FOR and direction is therefore set from the measured scatter:
 max(10 urad, 4 x the scan-to-scan standard deviation).
 """
@@ -170,7 +170,7 @@ def identify_ep(day: DayPrint, library: dict, satellite: str | None = None) -> l
 
     Each EP's model FOV-5 angles (equations 14-18 and the mounting) are compared with the fingerprint's
     per-FOR medians. With *satellite*, EPs of other satellites are left out. On real NOAA-20 data the
-    right EP leaves ~30 urad (the servo and in-track residuals of formats.md 2.5); a wrong one, hundreds.
+    right EP leaves ~30 urad (the servo and in-track residuals of docs/jpss-formats.md 2.3); a wrong one, hundreds.
     """
     matches = []
     for name, ep in library.items():

@@ -10,7 +10,7 @@ Frames (Wang et al. 2017, table 1 and section 2.2):
 
 The paper goes OCS <- ECI <- ECEF with NOVAS. Because one ECEF->ECI rotation applied to both the LOS
 and the OCS axes leaves every dot product unchanged, the OCS axes are built here directly in ECEF with
-the *inertial* velocity expressed in ECEF, v_ecef + omega x r (science.md; ``tests/geometry`` checks
+the *inertial* velocity expressed in ECEF, v_ecef + omega x r (docs/science.md; ``tests/geometry`` checks
 the equivalence against an explicit ECI computation).
 """
 
@@ -72,7 +72,7 @@ def sbf_to_ocs(roll_rad, pitch_rad, yaw_rad):
     """Rotation (..., 3, 3) taking an SBF vector to the OCS for the given attitude.
 
     Yaw-roll-pitch (3-1-2): the orbit-to-body matrix is A = P(-pitch) R(-roll) Y(-yaw), so body to
-    orbit is A^T = Y(yaw) R(roll) P(pitch) (the convention that reproduces IDPS GCRSO, formats.md 2.5).
+    orbit is A^T = Y(yaw) R(roll) P(pitch) (the convention that reproduces IDPS GCRSO, docs/jpss-formats.md 2.3).
     """
     return rot_z(yaw_rad) @ rot_x(roll_rad) @ rot_y(pitch_rad)
 

@@ -1,7 +1,7 @@
 """Short-arc propagation of the spacecraft state in the rotating ECEF frame (two-body + J2).
 
 IDPS gives SCPosition/SCVelocity at each scan's MidTime; a FOR is up to ~3 s away. A straight line
-r + v dt is ~30 m off at the scan ends (formats.md 2.5), so the state is integrated with RK4.
+r + v dt is ~30 m off at the scan ends (docs/jpss-formats.md 2.3), so the state is integrated with RK4.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """IDPS Epoch Time (IET): microseconds since 1958-01-01T00:00:00 counting TAI seconds.
 
 Converting to UTC needs the leap seconds (TAI - UTC); treating IET as naive UTC is wrong by 34-37 s
-(formats.md 1.6). Times before 1972 are outside JPSS and not supported.
+(docs/jpss-formats.md 1.6). Times before 1972 are outside JPSS and not supported.
 """
 
 from __future__ import annotations

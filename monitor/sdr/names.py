@@ -1,7 +1,7 @@
 """JPSS file names: ``{PRODIDS}_{plat}_d{YYYYMMDD}_t{HHMMSSS}_e{HHMMSSS}_b{orbit}_c{created}_{origin}_{domain}.h5``.
 
 The t/e fields are HHMMSS plus tenths of a second; the end may roll past midnight. An SDR and its GEO
-file differ only in the creation time, so granules are paired on ``plat_d_t_e_b`` (formats.md 1.1).
+file differ only in the creation time, so granules are paired on ``plat_d_t_e_b`` (docs/jpss-formats.md 1.1).
 """
 
 from __future__ import annotations

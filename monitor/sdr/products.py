@@ -1,6 +1,6 @@
 """The JPSS products the monitor reads, described as data (dataset paths, shapes, units, limits, fills).
 
-Layout facts: formats.md sections 1.2-1.8 (IDPS CDFCB layout, checked on real GCRSO files; satpy's
+Layout facts: docs/jpss-formats.md sections 1.2-1.8 (IDPS CDFCB layout, checked on real GCRSO files; satpy's
 ``viirs_sdr.yaml`` for the VIIRS names). Each field maps a Python name with its unit to a dataset of
 ``/All_Data/<collection>_All``:
 
@@ -111,7 +111,7 @@ VIIRS_GEO_FIELDS = {
 }
 
 # Terrain-corrected geolocation: Latitude/Longitude/Height is the 3-D point where the pixel's line of sight
-# meets the terrain (formats.md 1.1 note); the ellipsoid product (GIMGO) puts its pixels at h = 0.
+# meets the terrain (docs/jpss-formats.md 1.8); the ellipsoid product (GIMGO) puts its pixels at h = 0.
 VIIRS_TC_GEO_FIELDS = {**VIIRS_GEO_FIELDS, "height_m": Field("Height", per="row", dims=(VIIRS_COLUMNS,))}
 
 PRODUCTS = {p.prefix: p for p in (

@@ -2,5 +2,5 @@
 
 Radiances come from the true lines of sight over a synthetic inhomogeneous Earth (clouds over ocean,
 coastlines); the CrIS GEO is computed from the erroneous ones. The CrIS truth is the scene integrated
-over the true FOV cone, independently of the VIIRS pixel grid (no "inverse crime", science.md).
+over the true FOV cone, independently of the VIIRS pixel grid (no "inverse crime", docs/science.md).
 """

@@ -5,7 +5,7 @@ on an ascending pass, by night on a descending one, 60-81 deg N or S; optionally
 180 deg to cross the antimeridian), or by default an ascending tropical pass at a random longitude.
 With terrain, VIIRS GITCO pixels are where each line of sight meets the terrain, with their Height (as
 IDPS writes them), CrIS radiances are averaged over the true cone on the terrain, and GCRSO stays on
-the h = 0 ellipsoid with the terrain height only reported (formats.md 2.5 item 8).
+the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 2.3 item 8).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from monitor.spectral import i5_band, planck_radiance
 
 UTC = dt.timezone.utc
 DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)
-GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # formats.md 1.2
+GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # docs/jpss-formats.md 1.2
 CRIS_GRANULE_S = 32.0
 VIIRS_GRANULE_S = ins.VIIRS_SCANS * ins.VIIRS_SCAN_S
 ORBIT_PERIOD_S = 6080.0

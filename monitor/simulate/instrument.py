@@ -13,7 +13,7 @@ from monitor.geometry.frames import rot_x, unit
 CRIS_N_FOR = 30
 CRIS_N_FOV = 9
 CRIS_FOR_STEP_RAD = np.radians(3.3333)
-CRIS_FOV_SPACING_RAD = 19.1e-3  # FOV centre spacing, ~1.1 deg (EP offsets, formats.md 2.1)
+CRIS_FOV_SPACING_RAD = 19.1e-3  # FOV centre spacing, ~1.1 deg (EP offsets, docs/jpss-formats.md 2.1)
 CRIS_FOV_HALF_ANGLE_RAD = 16807.5e-6 / 2
 CRIS_FOR_DT_US = 200_000
 CRIS_SCAN_US = 8_000_000
@@ -70,7 +70,7 @@ def viirs_column_geometry():
 
 
 def viirs_bowtie_deleted() -> np.ndarray:
-    """(32, 6400) mask of on-board bow-tie deleted I-band pixels (formats.md 3)."""
+    """(32, 6400) mask of on-board bow-tie deleted I-band pixels (docs/jpss-formats.md 3)."""
     mask = np.zeros((VIIRS_DETECTORS, VIIRS_COLUMNS), bool)
     for rows, n in (((0, 1, 30, 31), 2016), ((2, 3, 28, 29), 1280)):
         for r in rows:

@@ -1,6 +1,6 @@
 """Write HDF5 files in the IDPS layout: 1024-byte XML user block, 2-D string attributes,
 ``/All_Data/<coll>_All`` datasets and ``/Data_Products/<coll>`` with ``_Aggr`` object references and
-``_Gran_k`` region references (formats.md 1.2, checked against real GCRSO files)."""
+``_Gran_k`` region references (docs/jpss-formats.md 1.2, checked against real GCRSO files)."""
 
 from __future__ import annotations
 

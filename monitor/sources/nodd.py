@@ -1,7 +1,7 @@
 """NOAA Open Data Dissemination (NODD) buckets over plain HTTPS: anonymous ListObjectsV2 and GET.
 
 Keys are ``<product folder>/YYYY/MM/DD/<file>``, e.g. ``CrIS-SDR-GEO/2024/06/01/GCRSO_j01_...h5``
-(operations.md 1.2). Listings are narrowed with a file-name prefix and followed through continuation
+(docs/archive.md). Listings are narrowed with a file-name prefix and followed through continuation
 tokens (a day holds more than the 1000 keys of one page). Downloads go to ``<name>.part`` and are
 renamed only when complete, of the listed size and, where the listing's ETag is a plain MD5, of that
 digest. A per-day byte budget bounds what one run may download, and cached files older than the

@@ -31,7 +31,7 @@ def test_v115_reproduces_real_noaa20_gcrso_per_for(v115, real_geo_files):
     d = _distances(v115, real_geo_files)
     p99 = np.percentile(d.reshape(-1, 30, 9).transpose(1, 0, 2).reshape(30, -1), 99, axis=1)
     assert np.median(d) < 40.0
-    # FOR 1-3 carry the scene-mirror servo residuals that GCRSO does not record (formats.md 2.5)
+    # FOR 1-3 carry the scene-mirror servo residuals that GCRSO does not record (docs/jpss-formats.md 2.3)
     assert np.all(p99[3:] < 100.0), p99.round(1)
     assert np.all(p99[:3] < 150.0), p99.round(1)
 

@@ -22,7 +22,7 @@ def test_real_noaa20_fingerprint_is_v115(real_geo_files):
     ranked = fpr.identify_ep(day, library)
     assert ranked[0].version == "V115" and ranked[0].rms_urad < 40.0
     assert ranked[1].rms_urad > 10 * ranked[0].rms_urad
-    # the known residual of the real processing: ~+28 urad in-track at every FOR (formats.md 2.5)
+    # the known residual of the real processing: ~+28 urad in-track at every FOR (docs/jpss-formats.md 2.3)
     assert np.all(np.abs(ranked[0].d_alpha_urad - 28.0) < 5.0)
     assert [m.version for m in fpr.identify_ep(day, library, "j01")] == ["V115"]
 
