@@ -18,11 +18,12 @@ from monitor import config as C
 
 MEANING = {
     "satellites": "Satellites to monitor, short names (npp, j01, j02). Required.",
-    "state_dir": "Directory of the service's state: store, download cache, simulated granules, lock. Required; "
-                 "relative paths in the file are relative to the file.",
-    "report_dir": "Where the HTML report is regenerated after every run (and served under /report/). None: no report.",
-    "report_url": "The address at which readers open report_dir (e.g. behind a reverse proxy); messages link "
-                  "REPORT_URL/SATELLITE/. Without it they name the path on the server.",
+    "state_dir": "Directory of the service's state: store, download cache, simulated granules, lock. "
+                 "Required; relative paths in the file are relative to the file.",
+    "report_dir": "Where the HTML report is regenerated after every run (and served under /report/). None: "
+                  "no report.",
+    "report_url": "The address at which readers open report_dir (e.g. behind a reverse proxy); messages link"
+                  " REPORT_URL/SATELLITE/. Without it they name the path on the server.",
     "dashboard_url": "Link to the Grafana dashboard, added to every message.",
     "source.kind": "Where granules come from: nodd (NOAA's archive on S3), local (a directory tree) or "
                    "simulated (the offline demo). Required.",
@@ -32,9 +33,12 @@ MEANING = {
     "source.timeout_s": "Timeout of one HTTP request.",
     "source.retries": "Retries of a failed request (backoff doubling from backoff_s).",
     "source.backoff_s": "First wait between retries.",
-    "source.daily_budget_mb": "Most bytes downloaded in one satellite-day run; further files are skipped with the reason.",
-    "source.retention_days": "Downloaded files older than this are removed from the cache at the start of a run.",
-    "source.run_deadline_min": "Every request of one satellite-day run ends by this time after the run started.",
+    "source.daily_budget_mb": "Most bytes downloaded in one satellite-day run; further files are skipped "
+                              "with the reason.",
+    "source.retention_days": "Downloaded files older than this are removed from the cache at the start of a "
+                             "run.",
+    "source.run_deadline_min": "Every request of one satellite-day run ends by this time after the run "
+                               "started.",
     "source.max_list_pages": "Most pages of one listing (a day of one product is ~3 pages of 1000 keys).",
     "source.max_listed_keys": "Most keys of one listing.",
     "source.max_retry_after_s": "A server asking to wait longer than this (Retry-After) ends the attempt.",
@@ -43,30 +47,35 @@ MEANING = {
     "source.profile": "Error profile injected by the simulator (paper, random, zero; kind simulated).",
     "source.seed": "Seed of the simulator (kind simulated).",
     "schedule.time_utc": "Time of the daily run, HH:MM UTC.",
-    "schedule.catch_up_days": "Days back (ending lag_days ago) that are assessed when they have no completed run.",
+    "schedule.catch_up_days": "Days back (ending lag_days ago) that are assessed when they have no completed"
+                              " run.",
     "schedule.misfire_grace_hours": "A daily run missed by less than this (e.g. host asleep) still runs.",
     "schedule.lag_days": "The daily run assesses the day that ended this many days ago (archive latency).",
-    "schedule.no_data_retry_days": "A day found empty is tried again for this many days after it is due, then "
-                                   "recorded as no_data_final.",
-    "schedule.run_budget_min": "A satellite-day run longer than this makes /healthz unhealthy and stops feeding the "
-                               "systemd watchdog (a restart follows). Keep it above source.run_deadline_min.",
+    "schedule.no_data_retry_days": "A day found empty is tried again for this many days after it is due, "
+                                   "then recorded as no_data_final.",
+    "schedule.run_budget_min": "A satellite-day run longer than this makes /healthz unhealthy and stops "
+                               "feeding the systemd watchdog (a restart follows). Keep it above "
+                               "source.run_deadline_min.",
     "scenes.candidates": "CrIS granules of the day scored for inhomogeneity (spread over the day).",
     "scenes.keep": "Most inhomogeneous granules assessed (the paper uses 14).",
     "scenes.min_inhomogeneity_k": "A granule whose VIIRS-BT spread is below this is not used.",
-    "assessment.half_steps": "Perturbations on each side of zero per direction: the grid is (2n+1)^2 (21 x 21).",
+    "assessment.half_steps": "Perturbations on each side of zero per direction: the grid is (2n+1)^2 (21 x "
+                             "21).",
     "assessment.step_urad": "Perturbation step (375 m at nadir from 833 km).",
     "assessment.kernel": "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response).",
     "assessment.workers": "Processes collocating granules in parallel.",
     "fingerprint.granules": "GEO granules per day sampled (spread over the day) for the LOS fingerprint.",
-    "fingerprint.threshold_urad": "A FOR whose fingerprint angle moves more than this is a processing change.",
-    "fingerprint.ep_library": "EP files or directories to identify the EP in use from; empty: the packaged real EPs.",
-    "http.listen": "HOST:PORT of /metrics, /healthz and /report/ (loopback by default; port 0: any free port; off: "
-                   "no endpoint). crisgeo daemon --listen overrides it.",
+    "fingerprint.threshold_urad": "A FOR whose fingerprint angle moves more than this is a processing "
+                                  "change.",
+    "fingerprint.ep_library": "EP files or directories to identify the EP in use from; empty: the packaged "
+                              "real EPs.",
+    "http.listen": "HOST:PORT of /metrics, /healthz and /report/ (loopback by default; port 0: any free "
+                   "port; off: no endpoint). crisgeo daemon --listen overrides it.",
     "store.sqlite": "The SQLite store (history, alert state, outbox). Default: state_dir/crisgeo.sqlite.",
     "store.drain_minutes": "The daemon sends the time-series points waiting in the outbox this often.",
     "store.publish": "Time-series databases the results are written to (list of the mappings below).",
-    "store.publish[].kind": "influx2 (InfluxDB 2 API: token) or influx1 (InfluxDB 1 / VictoriaMetrics: user, "
-                            "password). Required.",
+    "store.publish[].kind": "influx2 (InfluxDB 2 API: token) or influx1 (InfluxDB 1 / VictoriaMetrics: user,"
+                            " password). Required.",
     "store.publish[].url": "Base URL of the database (no credentials in it). Required.",
     "store.publish[].measurement": "Measurement name of the points.",
     "store.publish[].bucket": "Bucket (influx2).",
@@ -76,11 +85,11 @@ MEANING = {
     "store.publish[].username_env": "Environment variable holding the user name (influx1).",
     "store.publish[].password_env": "Environment variable holding the password (influx1).",
     "store.publish[].timeout_s": "Timeout of one write.",
-    "alerts.spec_km": "Specification of the geolocation error on the ground; a reliable FOR beyond it fires the spec "
-                      "rule (critical when value - 2 sigma is beyond it).",
+    "alerts.spec_km": "Specification of the geolocation error on the ground; a reliable FOR beyond it fires "
+                      "the spec rule (critical when value - 2 sigma is beyond it).",
     "alerts.min_jump_km": "Smallest step (median after minus median before) that counts as a jump.",
-    "alerts.jump_z": "Step size in units of its standard error that counts as a jump, on any day of the recent "
-                     "window (blind search).",
+    "alerts.jump_z": "Step size in units of its standard error that counts as a jump, on any day of the "
+                     "recent window (blind search).",
     "alerts.jump_z_at_change": "The same at the date of a known change (events calendar, fingerprint).",
     "alerts.pre_days": "Days before a candidate step that form the reference.",
     "alerts.min_pre_days": "Fewest assessed days before a step for the test to run.",
@@ -93,7 +102,8 @@ MEANING = {
     "alerts.stale_hours": "No completed run for this long fires the stale rule.",
     "alerts.repeat_hours": "A firing alert is notified again after this long.",
     "alerts.log": "File the alert messages are appended to (a channel that cannot fail).",
-    "alerts.events_file": "The events calendar (EP uploads, LUT changes) used to attribute jumps and annotate plots.",
+    "alerts.events_file": "The events calendar (EP uploads, LUT changes) used to attribute jumps and "
+                          "annotate plots.",
     "alerts.email": "E-mail channel (mapping below); absent: none.",
     "alerts.email.host": "SMTP server. Required.",
     "alerts.email.port": "SMTP port.",
@@ -111,13 +121,36 @@ MEANING = {
     "alerts.slack.timeout_s": "Timeout of one request.",
 }
 
-UNITS = (("_kb_s", "kB/s"), ("_urad", "µrad"), ("_km", "km"), ("_k", "K"), ("_mb", "MB"), ("_min", "min"),
-         ("_minutes", "min"), ("_hours", "h"), ("_days", "days"), ("_s", "s"))
-REQUIRED = {"satellites", "state_dir", "source.kind", "store.publish[].kind", "store.publish[].url",
-            "alerts.email.host", "alerts.email.to", "alerts.slack.webhook_env"}
-_ALERT_LIMITS = {"alerts.email.port": (1, 65535), "alerts.email.timeout_s": (0.1, 600.0),
-                 "alerts.slack.retries": (0, 20), "alerts.slack.max_wait_s": (0.0, 3600.0),
-                 "alerts.slack.timeout_s": (0.1, 600.0), "store.publish[].timeout_s": (0.1, 600)}
+UNITS = (
+    ("_kb_s", "kB/s"),
+    ("_urad", "µrad"),
+    ("_km", "km"),
+    ("_k", "K"),
+    ("_mb", "MB"),
+    ("_min", "min"),
+    ("_minutes", "min"),
+    ("_hours", "h"),
+    ("_days", "days"),
+    ("_s", "s"),
+)
+REQUIRED = {
+    "satellites",
+    "state_dir",
+    "source.kind",
+    "store.publish[].kind",
+    "store.publish[].url",
+    "alerts.email.host",
+    "alerts.email.to",
+    "alerts.slack.webhook_env",
+}
+_ALERT_LIMITS = {
+    "alerts.email.port": (1, 65535),
+    "alerts.email.timeout_s": (0.1, 600.0),
+    "alerts.slack.retries": (0, 20),
+    "alerts.slack.max_wait_s": (0.0, 3600.0),
+    "alerts.slack.timeout_s": (0.1, 600.0),
+    "store.publish[].timeout_s": (0.1, 600),
+}
 
 
 def _default(cls, name):
@@ -135,10 +168,14 @@ def model_keys() -> dict:
     for section, cls in C.SECTIONS.items():
         keys.update({f"{section}.{name}": _default(cls, name) for name in cls.__dataclass_fields__})
     keys.update({f"store.{k}": _default(C.StoreConfig, k) if k != "sqlite" else None for k in C.STORE_KEYS})
-    keys.update({f"store.publish[].{k}": _default(C.PublishConfig, k) for k in C.PublishConfig.__dataclass_fields__})
+    keys.update(
+        {f"store.publish[].{k}": _default(C.PublishConfig, k) for k in C.PublishConfig.__dataclass_fields__}
+    )
     for k in ALERT_KEYS:
         keys[f"alerts.{k}"] = _default(RuleSettings, k) if k in RuleSettings.__dataclass_fields__ else None
-    keys.update({f"alerts.email.{k}": _default(EmailSettings, "sender" if k == "from" else k) for k in EMAIL_KEYS})
+    keys.update(
+        {f"alerts.email.{k}": _default(EmailSettings, "sender" if k == "from" else k) for k in EMAIL_KEYS}
+    )
     keys.update({f"alerts.slack.{k}": _default(SlackSettings, k) for k in SLACK_KEYS})
     return keys
 
@@ -175,12 +212,17 @@ def reference() -> str:
     keys = model_keys()
     order = ["", "source", "schedule", "scenes", "assessment", "fingerprint", "http", "store", "alerts"]
     rank = lambda k: (order.index(k.split(".")[0]) if "." in k else 0, k.count("."), k)  # noqa: E731
-    lines = ["# Configuration reference", "",
-             "Generated by `crisgeo check-config --reference` from the configuration model; "
-             "`crisgeo check-config --config FILE` validates a file and prints it with every default filled in.",
-             "Relative paths are relative to the configuration file. Keys ending in `_env` name an environment "
-             "variable holding a secret; secrets are never written in the file.", "",
-             "| key | default | unit | range | meaning |", "|---|---|---|---|---|"]
+    lines = [
+        "# Configuration reference",
+        "",
+        "Generated by `crisgeo check-config --reference` from the configuration model; "
+        "`crisgeo check-config --config FILE` validates a file and prints it with every default filled in.",
+        "Relative paths are relative to the configuration file. Keys ending in `_env` name an environment "
+        "variable holding a secret; secrets are never written in the file.",
+        "",
+        "| key | default | unit | range | meaning |",
+        "|---|---|---|---|---|",
+    ]
     for key in sorted(keys, key=rank):
         default = "(required)" if key in REQUIRED else _show(keys[key])
         lines.append(f"| `{key}` | {default} | {_unit(key)} | {_range(key)} | {MEANING[key]} |")

@@ -53,8 +53,11 @@ class _Handler(SimpleHTTPRequestHandler):
             self._send(200, generate_latest(self.endpoint.metrics.registry), CONTENT_TYPE_LATEST, head)
         elif path == "/healthz":
             problems = self.endpoint.health.problems()
-            body = {"status": "unhealthy" if problems else "ok", "problems": problems,
-                    "running": self.endpoint.health.running()}
+            body = {
+                "status": "unhealthy" if problems else "ok",
+                "problems": problems,
+                "running": self.endpoint.health.running(),
+            }
             self._send(503 if problems else 200, json.dumps(body).encode(), "application/json", head)
         elif path == "/report":
             self.send_response(301)
@@ -62,7 +65,7 @@ class _Handler(SimpleHTTPRequestHandler):
             self.send_header("Content-Length", "0")
             self.end_headers()
         elif path.startswith("/report/") and self.directory is not None and "/." not in path:
-            self.path = self.path[len("/report"):]
+            self.path = self.path[len("/report") :]
             super().do_HEAD() if head else super().do_GET()
         else:
             self._send(404, b"not found\n", "text/plain", head)

@@ -49,8 +49,11 @@ class Health:
         with self._lock:
             jobs = list(self._jobs.values())
             silent = now - self._beat
-        out = [f"{name}: running for {now - t0:.0f} s, over its budget of {budget:.0f} s"
-               for name, t0, budget in jobs if now - t0 > budget]
+        out = [
+            f"{name}: running for {now - t0:.0f} s, over its budget of {budget:.0f} s"
+            for name, t0, budget in jobs
+            if now - t0 > budget
+        ]
         if silent > self.stall_s:
             out.append(f"scheduler: no heartbeat for {silent:.0f} s (stalled after {self.stall_s:.0f} s)")
         return out
@@ -59,4 +62,6 @@ class Health:
         """The jobs in flight: name, seconds running, budget."""
         now = self.clock()
         with self._lock:
-            return [{"job": n, "running_s": round(now - t0, 1), "budget_s": b} for n, t0, b in self._jobs.values()]
+            return [
+                {"job": n, "running_s": round(now - t0, 1), "budget_s": b} for n, t0, b in self._jobs.values()
+            ]

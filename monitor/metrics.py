@@ -12,7 +12,7 @@ at each scrape, so it survives restarts and agrees with ``crisgeo status``; what
     crisgeo_outbox_points{target}                         time-series points waiting to be sent
     crisgeo_alerts_firing{satellite,rule,severity}        alerts firing now
     crisgeo_for_offset_urad{satellite,for,direction}      latest day's LOS offset (alpha, beta)
-    crisgeo_for_offset_km{satellite,for,direction}        latest day's offset on the ground (in_track, cross_track, total)
+    crisgeo_for_offset_km{satellite,for,direction}        latest day's offset in km (in/cross-track, total)
     crisgeo_for_reliable{satellite,for}                   1 when the FOR carries no reliability flag
     crisgeo_latest_day_timestamp_seconds{satellite}       00:00 UTC of the latest assessed day
     crisgeo_healthy                                       1 when /healthz is ok
@@ -40,6 +40,7 @@ class _StoreCollector:
 
     def collect(self):
         from alerts.state import AlertState
+
         store = self.open_store()
         try:
             success = store.last_success()
@@ -50,22 +51,30 @@ class _StoreCollector:
             fors = {s: store.day_result(s, d) for s, d in latest.items() if d is not None}
         finally:
             store.close()
-        g = GaugeMetricFamily("crisgeo_last_success_timestamp_seconds",
-                              "End of the latest successful run (Unix time)", labels=["satellite"])
+        g = GaugeMetricFamily(
+            "crisgeo_last_success_timestamp_seconds",
+            "End of the latest successful run (Unix time)",
+            labels=["satellite"],
+        )
         for sat, t in success.items():
             g.add_metric([sat], t.timestamp())
         yield g
-        c = CounterMetricFamily("crisgeo_runs", "Runs in the ledger by outcome", labels=["satellite", "outcome"])
+        c = CounterMetricFamily(
+            "crisgeo_runs", "Runs in the ledger by outcome", labels=["satellite", "outcome"]
+        )
         for sat in self.satellites:
             for outcome in OUTCOMES:
                 c.add_metric([sat, outcome], counts.get((sat, outcome), 0))
         yield c
-        g = GaugeMetricFamily("crisgeo_outbox_points", "Time-series points waiting to be sent", labels=["target"])
+        g = GaugeMetricFamily(
+            "crisgeo_outbox_points", "Time-series points waiting to be sent", labels=["target"]
+        )
         for target, n in outbox.items():
             g.add_metric([target], n)
         yield g
-        g = GaugeMetricFamily("crisgeo_alerts_firing", "Alerts firing now",
-                              labels=["satellite", "rule", "severity"])
+        g = GaugeMetricFamily(
+            "crisgeo_alerts_firing", "Alerts firing now", labels=["satellite", "rule", "severity"]
+        )
         per = {}
         for a in firing:
             key = (a["satellite"], a["rule"], a["severity"] or "")
@@ -74,18 +83,32 @@ class _StoreCollector:
             g.add_metric(list(key), n)
         yield g
         yield from self._offsets(latest, fors)
-        yield GaugeMetricFamily("crisgeo_healthy", "1 when /healthz is ok", value=0 if self.health.problems() else 1)
+        yield GaugeMetricFamily(
+            "crisgeo_healthy", "1 when /healthz is ok", value=0 if self.health.problems() else 1
+        )
 
     @staticmethod
     def _offsets(latest, fors):
-        day = GaugeMetricFamily("crisgeo_latest_day_timestamp_seconds", "00:00 UTC of the latest assessed day",
-                                labels=["satellite"])
-        urad = GaugeMetricFamily("crisgeo_for_offset_urad", "Latest LOS offset per FOR (spacecraft frame)",
-                                 labels=["satellite", "for", "direction"])
-        km = GaugeMetricFamily("crisgeo_for_offset_km", "Latest offset per FOR on the ground",
-                               labels=["satellite", "for", "direction"])
-        ok = GaugeMetricFamily("crisgeo_for_reliable", "1 when the FOR's latest offset carries no reliability flag",
-                               labels=["satellite", "for"])
+        day = GaugeMetricFamily(
+            "crisgeo_latest_day_timestamp_seconds",
+            "00:00 UTC of the latest assessed day",
+            labels=["satellite"],
+        )
+        urad = GaugeMetricFamily(
+            "crisgeo_for_offset_urad",
+            "Latest LOS offset per FOR (spacecraft frame)",
+            labels=["satellite", "for", "direction"],
+        )
+        km = GaugeMetricFamily(
+            "crisgeo_for_offset_km",
+            "Latest offset per FOR on the ground",
+            labels=["satellite", "for", "direction"],
+        )
+        ok = GaugeMetricFamily(
+            "crisgeo_for_reliable",
+            "1 when the FOR's latest offset carries no reliability flag",
+            labels=["satellite", "for"],
+        )
         for sat, d in latest.items():
             if d is None:
                 continue
@@ -95,8 +118,11 @@ class _StoreCollector:
                 for direction, v in (("alpha", f.d_alpha_urad), ("beta", f.d_beta_urad)):
                     if math.isfinite(v):
                         urad.add_metric([sat, k, direction], v)
-                for direction, v in (("in_track", f.in_track_km), ("cross_track", f.cross_track_km),
-                                     ("total", f.total_km)):
+                for direction, v in (
+                    ("in_track", f.in_track_km),
+                    ("cross_track", f.cross_track_km),
+                    ("total", f.total_km),
+                ):
                     if math.isfinite(v):
                         km.add_metric([sat, k, direction], v)
                 ok.add_metric([sat, k], 1 if f.reliable else 0)
@@ -109,13 +135,27 @@ class ServiceMetrics:
     def __init__(self, open_store, satellites, health, version: str):
         self.registry = CollectorRegistry()
         self.registry.register(_StoreCollector(open_store, satellites, health))
-        self.duration = Gauge("crisgeo_run_duration_seconds", "Wall time of each stage of the latest run",
-                              ["satellite", "stage"], registry=self.registry)
-        self.granules = Counter("crisgeo_downloaded_granules", "Files downloaded by this process",
-                                ["satellite"], registry=self.registry)
-        self.bytes = Counter("crisgeo_downloaded_bytes", "Bytes downloaded by this process", ["satellite"],
-                             registry=self.registry)
-        Gauge("crisgeo_build_info", "The running version", ["version"], registry=self.registry).labels(version).set(1)
+        self.duration = Gauge(
+            "crisgeo_run_duration_seconds",
+            "Wall time of each stage of the latest run",
+            ["satellite", "stage"],
+            registry=self.registry,
+        )
+        self.granules = Counter(
+            "crisgeo_downloaded_granules",
+            "Files downloaded by this process",
+            ["satellite"],
+            registry=self.registry,
+        )
+        self.bytes = Counter(
+            "crisgeo_downloaded_bytes",
+            "Bytes downloaded by this process",
+            ["satellite"],
+            registry=self.registry,
+        )
+        Gauge("crisgeo_build_info", "The running version", ["version"], registry=self.registry).labels(
+            version
+        ).set(1)
         for sat in satellites:
             self.granules.labels(sat)
             self.bytes.labels(sat)

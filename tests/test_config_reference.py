@@ -16,7 +16,9 @@ def test_every_key_of_the_model_has_a_meaning_and_nothing_else_does():
 
 
 def test_the_shipped_reference_is_the_generated_one():
-    assert DOC.read_text() == reference(), "regenerate: crisgeo check-config --reference > docs/configuration.md"
+    assert DOC.read_text() == reference(), (
+        "regenerate: crisgeo check-config --reference > docs/configuration.md"
+    )
     for key in model_keys():
         assert f"| `{key}` |" in DOC.read_text()
 
@@ -26,8 +28,15 @@ def test_every_documented_key_is_one_the_loader_knows(tmp_path, key):
     """A key named in the reference is known to the loader (an unknown key is refused as such), so the
     model's key list and the loader agree; a NUL character in a value is refused whatever the key."""
     *sections, name = key.split(".")
-    doc = {"satellites": ["j01"], "state_dir": "s", "source": {"kind": "local" if key == "source.path" else "simulated"},
-           "alerts": {"email": {"host": "smtp.example.org", "to": ["sdr@example.org"]}, "slack": {"webhook_env": "HOOK"}}}
+    doc = {
+        "satellites": ["j01"],
+        "state_dir": "s",
+        "source": {"kind": "local" if key == "source.path" else "simulated"},
+        "alerts": {
+            "email": {"host": "smtp.example.org", "to": ["sdr@example.org"]},
+            "slack": {"webhook_env": "HOOK"},
+        },
+    }
     node = doc
     for s in sections:
         node = node.setdefault(s, {})

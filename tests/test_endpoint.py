@@ -50,8 +50,13 @@ def _get(url, **kw):
 def _daemon(cfg, port, notify_path, tmp_path):
     env = dict(os.environ, NOTIFY_SOCKET=notify_path, WATCHDOG_USEC="400000")
     log = open(tmp_path / "daemon.log", "w")
-    return subprocess.Popen(CRISGEO + ["daemon", "--config", str(cfg), "--listen", f"127.0.0.1:{port}"], env=env,
-                            cwd=ROOT, stdout=log, stderr=log)
+    return subprocess.Popen(
+        CRISGEO + ["daemon", "--config", str(cfg), "--listen", f"127.0.0.1:{port}"],
+        env=env,
+        cwd=ROOT,
+        stdout=log,
+        stderr=log,
+    )
 
 
 def _stop(proc):
@@ -69,11 +74,18 @@ def served(cases, tmp_path_factory):
     data, _, _ = cases.get()
     tmp = tmp_path_factory.mktemp("served")
     cfg = tmp / "c.yaml"
-    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp / 'state'}\nsource: {{kind: local, path: {data}}}\n"
-                   f"assessment: {{workers: 1}}\nschedule: {{catch_up_days: 1}}\nreport_dir: {tmp / 'report'}\n"
-                   f"report_url: https://crisgeo.example.org/report/\n")
-    r = subprocess.run(CRISGEO + ["run", "--config", str(cfg), "--date", DAY], capture_output=True, text=True,
-                       cwd=ROOT, timeout=600)
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp / 'state'}\nsource: {{kind: local, path: {data}}}\n"
+        f"assessment: {{workers: 1}}\nschedule: {{catch_up_days: 1}}\nreport_dir: {tmp / 'report'}\n"
+        f"report_url: https://crisgeo.example.org/report/\n"
+    )
+    r = subprocess.run(
+        CRISGEO + ["run", "--config", str(cfg), "--date", DAY],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=600,
+    )
     assert r.returncode == 0, r.stderr
     (tmp / "report" / "empty").mkdir()
     sock, notify = _notify_socket(tmp)
@@ -97,8 +109,11 @@ def _families(url):
 
 
 def _samples(fam, name=None, **labels):
-    return [s for s in fam.samples if (name is None or s.name == name)
-            and all(s.labels.get(k) == v for k, v in labels.items())]
+    return [
+        s
+        for s in fam.samples
+        if (name is None or s.name == name) and all(s.labels.get(k) == v for k, v in labels.items())
+    ]
 
 
 def test_metrics_after_a_run(served):
@@ -108,24 +123,38 @@ def test_metrics_after_a_run(served):
     fams = _families(url)
     (last,) = _samples(fams["crisgeo_last_success_timestamp_seconds"], satellite="j01")
     assert abs(last.value - time.time()) < 3600
-    runs = {s.labels["outcome"]: s.value for s in _samples(fams["crisgeo_runs"], "crisgeo_runs_total", satellite="j01")}
+    runs = {
+        s.labels["outcome"]: s.value
+        for s in _samples(fams["crisgeo_runs"], "crisgeo_runs_total", satellite="j01")
+    }
     assert runs["ok"] == 1 and runs["no_data"] >= 1 and runs["failed"] == 0
     stages = {s.labels["stage"] for s in _samples(fams["crisgeo_run_duration_seconds"], satellite="j01")}
     assert "list" in stages
-    assert _samples(fams["crisgeo_downloaded_granules"], "crisgeo_downloaded_granules_total", satellite="j01")[0].value == 0
+    assert (
+        _samples(fams["crisgeo_downloaded_granules"], "crisgeo_downloaded_granules_total", satellite="j01")[
+            0
+        ].value
+        == 0
+    )
     assert _samples(fams["crisgeo_downloaded_bytes"], "crisgeo_downloaded_bytes_total", satellite="j01")
     assert fams["crisgeo_outbox_points"].type == "gauge"
     assert fams["crisgeo_alerts_firing"].type == "gauge"
-    assert all({"satellite", "rule", "severity"} == set(s.labels) for s in fams["crisgeo_alerts_firing"].samples)
+    assert all(
+        {"satellite", "rule", "severity"} == set(s.labels) for s in fams["crisgeo_alerts_firing"].samples
+    )
     store = Store(db)
     fors = store.day_result("j01", store.latest_day("j01"))
     store.close()
-    alpha = {int(s.labels["for"]): s.value for s in _samples(fams["crisgeo_for_offset_urad"], satellite="j01",
-                                                               direction="alpha")}
+    alpha = {
+        int(s.labels["for"]): s.value
+        for s in _samples(fams["crisgeo_for_offset_urad"], satellite="j01", direction="alpha")
+    }
     assert sorted(alpha) == list(range(1, 31))
     assert all(abs(alpha[f.for_index] - f.d_alpha_urad) < 1e-6 for f in fors)
     assert len(_samples(fams["crisgeo_for_offset_km"], satellite="j01", direction="total")) == 30
-    reliable = {int(s.labels["for"]): s.value for s in _samples(fams["crisgeo_for_reliable"], satellite="j01")}
+    reliable = {
+        int(s.labels["for"]): s.value for s in _samples(fams["crisgeo_for_reliable"], satellite="j01")
+    }
     assert all(reliable[f.for_index] == (1 if f.reliable else 0) for f in fors)
     assert fams["crisgeo_healthy"].samples[0].value == 1
     assert _samples(fams["crisgeo_build_info"])[0].labels["version"]
@@ -149,15 +178,22 @@ def test_report_served_read_only(served, tmp_path):
     image = plt.imread(io.BytesIO(png.content), format="png")
     assert image.ndim == 3 and image.shape[0] > 100 and image.shape[1] > 100
     (Path(served[1]).parents[1] / "report" / ".trend.png.part").write_bytes(b"half")
-    for bad in ("/report/../c.yaml", "/report/%2e%2e/c.yaml", "/report/empty/", "/report/.trend.png.part", "/c.yaml",
-                "/"):
+    for bad in (
+        "/report/../c.yaml",
+        "/report/%2e%2e/c.yaml",
+        "/report/empty/",
+        "/report/.trend.png.part",
+        "/c.yaml",
+        "/",
+    ):
         assert requests.get(url + bad, timeout=10).status_code == 404, bad
     assert requests.post(url + "/metrics", timeout=10).status_code == 501
     driver = chromium_driver(tmp_path)
     try:
         driver.get(url + "/report/j01/")
         images = driver.execute_script(
-            "return Array.from(document.images).map(i => [i.src, i.complete, i.naturalWidth]);")
+            "return Array.from(document.images).map(i => [i.src, i.complete, i.naturalWidth]);"
+        )
         assert images and all(ok and width > 0 for _, ok, width in images), images
         assert not [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
     finally:
@@ -166,8 +202,10 @@ def test_report_served_read_only(served, tmp_path):
 
 def test_a_run_over_its_budget_makes_the_daemon_unhealthy_and_starves_the_watchdog(tmp_path):
     cfg = tmp_path / "c.yaml"
-    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: simulated, granules: 1}}\n"
-                   f"assessment: {{workers: 1}}\nschedule: {{catch_up_days: 3, run_budget_min: 0.01}}\n")
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: simulated, granules: 1}}\n"
+        f"assessment: {{workers: 1}}\nschedule: {{catch_up_days: 3, run_budget_min: 0.01}}\n"
+    )
     sock, notify = _notify_socket(tmp_path)
     port = free_port()
     proc = _daemon(cfg, port, notify, tmp_path)
@@ -205,16 +243,26 @@ def test_a_run_over_its_budget_makes_the_daemon_unhealthy_and_starves_the_watchd
 def test_listen_is_checked(tmp_path):
     cfg = tmp_path / "c.yaml"
     cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: simulated}}\n")
-    r = subprocess.run(CRISGEO + ["daemon", "--config", str(cfg), "--listen", "nonsense"], capture_output=True,
-                       text=True, cwd=ROOT, timeout=60)
+    r = subprocess.run(
+        CRISGEO + ["daemon", "--config", str(cfg), "--listen", "nonsense"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=60,
+    )
     assert r.returncode == 2 and "--listen: 'nonsense' is not HOST:PORT" in r.stderr
     taken = socket.socket()
     taken.bind(("127.0.0.1", 0))
     taken.listen()
     port = taken.getsockname()[1]
     try:
-        r = subprocess.run(CRISGEO + ["daemon", "--config", str(cfg), "--listen", f"127.0.0.1:{port}"],
-                           capture_output=True, text=True, cwd=ROOT, timeout=60)
+        r = subprocess.run(
+            CRISGEO + ["daemon", "--config", str(cfg), "--listen", f"127.0.0.1:{port}"],
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+            timeout=60,
+        )
     finally:
         taken.close()
     assert r.returncode == 1 and f"http.listen 127.0.0.1:{port}: cannot listen" in r.stderr, r.stderr

@@ -18,6 +18,9 @@ def test_rules_check():
 def test_rules_fire_as_documented(tmp_path):
     spec = (Path(__file__).parent / "rules_test.yml").read_text().replace("RULES", str(RULES))
     (tmp_path / "rules_test.yml").write_text(spec)
-    r = subprocess.run([require("promtool"), "test", "rules", str(tmp_path / "rules_test.yml")], capture_output=True,
-                       text=True)
+    r = subprocess.run(
+        [require("promtool"), "test", "rules", str(tmp_path / "rules_test.yml")],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 0 and "SUCCESS" in r.stdout, r.stdout + r.stderr
