@@ -12,11 +12,15 @@ import html
 import json
 import logging
 
-
 from alerts.changes import all_changes
 from alerts.channels import Permanent, Transient, make_channels
-from alerts.rules import (failure_finding, jump_findings, processing_change_findings, spec_finding,
-                          stale_finding)
+from alerts.rules import (
+    failure_finding,
+    jump_findings,
+    processing_change_findings,
+    spec_finding,
+    stale_finding,
+)
 from alerts.state import AlertState
 
 LOG = logging.getLogger(__name__)

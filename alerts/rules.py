@@ -14,11 +14,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from alerts.changes import preceding_change
+from monitor.constants import N_FOR
+from monitor.result import RELIABILITY_FLAGS
 
 UTC = dt.timezone.utc
-N_FOR = 30
 COMPONENTS = (("in_track_km", "in-track"), ("cross_track_km", "cross-track"))
-GROUPS = {"FOR 1-10": range(0, 10), "FOR 11-20": range(10, 20), "FOR 21-30": range(20, 30), "all FORs": range(30)}
+GROUPS = {"FOR 1-10": range(0, 10), "FOR 11-20": range(10, 20), "FOR 21-30": range(20, N_FOR),
+          "all FORs": range(N_FOR)}
 
 
 @dataclass
@@ -99,7 +101,7 @@ def _series(store, satellite: str):
     index = {d: i for i, d in enumerate(days)}
     values = {c: np.full((len(days), N_FOR), np.nan) for c, _ in COMPONENTS}
     for r in rows:
-        if any(f in json.loads(r["flags"] or "[]") for f in ("few_samples", "edge", "flat", "uncertain")):
+        if any(f in json.loads(r["flags"] or "[]") for f in RELIABILITY_FLAGS):
             continue
         for c, _ in COMPONENTS:
             if r[c] is not None:

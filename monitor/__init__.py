@@ -5,7 +5,8 @@ The science lives in ``monitor.sdr`` (files), ``monitor.geometry`` (frames), ``m
 object, :class:`monitor.result.AssessmentResult`.
 """
 
-from importlib.metadata import PackageNotFoundError, version as _dist_version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _dist_version
 
 try:
     __version__ = _dist_version("crisgeo-monitor")  # the one version: pyproject.toml's

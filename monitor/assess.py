@@ -24,13 +24,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor import collocate, refine
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR
 from monitor.errors import AssessmentError
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import inverse_geolocation
-from monitor.geometry.perturb import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, perturbation_grid
-from monitor.result import (FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, N_FOR, AssessmentResult,
-                            ForOffset)
+from monitor.geometry.perturb import perturbation_grid
+from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult, ForOffset
 from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_viirs_geo_scan

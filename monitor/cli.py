@@ -539,6 +539,7 @@ def setup_logging(verbose: bool, log_format: str) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
     from monitor.satellites import SATELLITES
     from monitor.simulate.orbit import PASSES
     p = argparse.ArgumentParser(prog="crisgeo", description=__doc__,
@@ -599,8 +600,9 @@ def build_parser() -> argparse.ArgumentParser:
     a = sub.add_parser("assess", help="assess CrIS geolocation against VIIRS I5 for the granules given")
     a.add_argument("paths", nargs="+", help="granule files or directories")
     a.add_argument("--out", help="write the result JSON here")
-    a.add_argument("--steps", type=int, default=10, help="perturbation steps each side of zero (grid 2n+1)")
-    a.add_argument("--step-urad", type=float, default=375.0 / 833000.0 * 1e6, help="perturbation step, urad")
+    a.add_argument("--steps", type=int, default=DEFAULT_HALF_STEPS,
+                   help="perturbation steps each side of zero (grid 2n+1)")
+    a.add_argument("--step-urad", type=float, default=DEFAULT_STEP_URAD, help="perturbation step, urad")
     a.add_argument("--kernel", choices=("top-hat", "response"), default="top-hat",
                    help="FOV weighting: top-hat cone or the CrIS spatial response")
     a.add_argument("--workers", type=int, default=1, help="worker processes over granules")

@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from monitor.constants import FOV_DIAMETER_RAD
 from monitor.geometry import wgs84
-from monitor.geometry.perturb import FOV_DIAMETER_RAD
 
 DETECTORS = 32
 TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)

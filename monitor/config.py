@@ -12,11 +12,12 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from urllib.parse import urlsplit, urlunsplit
 
 import yaml
 import yaml.events
-from urllib.parse import urlsplit, urlunsplit
 
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
 from monitor.satellites import SATELLITES as _TABLE
 
 SATELLITES = tuple(_TABLE)
@@ -74,8 +75,8 @@ class FingerprintConfig:
 
 @dataclass
 class AssessmentConfig:
-    half_steps: int = 10
-    step_urad: float = 375.0 / 833000.0 * 1e6
+    half_steps: int = DEFAULT_HALF_STEPS
+    step_urad: float = DEFAULT_STEP_URAD
     kernel: str = "top-hat"
     workers: int = 2
 

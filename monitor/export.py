@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.result import N_FOR, RELIABILITY_FLAGS
+from monitor.constants import N_FOR
+from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import satellite as satellite_info
 
 # variable: (unit, long name); the store's column names

@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.geometry.instrument import FOV5, URAD, fov5_angles
+from monitor.constants import URAD
+from monitor.geometry.instrument import FOV5, fov5_angles
 from monitor.geometry.inverse import inverse_geolocation
-
 
 
 @dataclass

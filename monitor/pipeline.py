@@ -8,21 +8,20 @@ ok or no_data run within the catch-up window are redone, oldest first.
 from __future__ import annotations
 
 import datetime as dt
+import json
 import logging
 import time
 from dataclasses import dataclass, field
 
-import json
-
 import numpy as np
 
 from monitor import fingerprint as fpr
-from monitor.mapping.engpkt import load_library
 from monitor.assess import AssessConfig, assess_plan
 from monitor.errors import DataError
+from monitor.mapping.engpkt import load_library
 from monitor.scenes import select_scenes
-from monitor.sdr.pairing import PlanError, plan
 from monitor.sdr import GranuleError, read_file
+from monitor.sdr.pairing import PlanError, plan
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 

@@ -7,8 +7,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-FOV_SIZE_URAD = 16807.5
-N_FOR = 30
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DIAMETER_URAD
 
 FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
 FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
@@ -42,11 +41,11 @@ class ForOffset:
 
     @property
     def d_alpha_pct_fov(self) -> float:
-        return 100.0 * self.d_alpha_urad / FOV_SIZE_URAD
+        return 100.0 * self.d_alpha_urad / FOV_DIAMETER_URAD
 
     @property
     def d_beta_pct_fov(self) -> float:
-        return 100.0 * self.d_beta_urad / FOV_SIZE_URAD
+        return 100.0 * self.d_beta_urad / FOV_DIAMETER_URAD
 
     @property
     def reliable(self) -> bool:
@@ -79,8 +78,8 @@ class AssessmentResult:
     fors: list
     granules: list = field(default_factory=list)
     skipped: list = field(default_factory=list)
-    half_steps: int = 10
-    step_urad: float = 375.0 / 833000.0 * 1e6
+    half_steps: int = DEFAULT_HALF_STEPS
+    step_urad: float = DEFAULT_STEP_URAD
     cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
 
     def to_dict(self, with_cube: bool = False) -> dict:
@@ -100,8 +99,8 @@ class AssessmentResult:
         cube = d.get("cost_cube_k")
         return cls(satellite=d["satellite"], start=d["start"], end=d["end"],
                    fors=[ForOffset.from_dict(f) for f in d["fors"]], granules=d.get("granules", []),
-                   skipped=d.get("skipped", []), half_steps=int(d.get("half_steps", 10)),
-                   step_urad=float(d.get("step_urad", 375.0 / 833000.0 * 1e6)),
+                   skipped=d.get("skipped", []), half_steps=int(d.get("half_steps", DEFAULT_HALF_STEPS)),
+                   step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),
                    cost_cube_k=None if cube is None else np.asarray(cube, float))
 
     @classmethod

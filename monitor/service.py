@@ -232,9 +232,9 @@ class Service:
         """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
         if listen == "off":
             return None
+        from monitor import __version__
         from monitor.endpoint import Endpoint, parse_listen
         from monitor.metrics import ServiceMetrics
-        from monitor import __version__
         self.metrics = ServiceMetrics(self.store, self.cfg.satellites, self.health, __version__)
         report = self.cfg.report_dir if self.cfg.report_dir else None
         return Endpoint(*parse_listen(listen), self.metrics, self.health, report).start()

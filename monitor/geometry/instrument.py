@@ -25,12 +25,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from monitor.constants import N_FOR, N_FOV
 from monitor.geometry.frames import los_angles, los_from_angles, rot_x, rot_y, rot_z, unit
 
-N_FOR = 30
-N_FOV = 9
 FOV5 = 4  # index of the central FOV, whose LOS defines the FOR's pointing (section 4.1)
-URAD = 1e-6  # radians per microradian (EP files and reports hold urad)
 _MIRROR_NORMAL_0 = np.array([-1.0, 0.0, 1.0]) / np.sqrt(2.0)
 
 

@@ -4,11 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD
 from monitor.geometry.frames import los_from_angles
-
-DEFAULT_HALF_STEPS = 10
-DEFAULT_STEP_RAD = 375.0 / 833000.0  # one VIIRS I-band pixel seen from 833 km, ~450 urad
-FOV_DIAMETER_RAD = 16807.5e-6  # CrIS FOV size (0.963 deg)
 
 
 def perturbation_grid(n=DEFAULT_HALF_STEPS, step_rad=DEFAULT_STEP_RAD):

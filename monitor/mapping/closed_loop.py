@@ -14,13 +14,13 @@ from pathlib import Path
 import numpy as np
 
 from monitor.assess import AssessConfig, assess_paths
-from monitor.geometry.instrument import URAD, EngineeringPacket
+from monitor.constants import URAD
+from monitor.geometry.instrument import EngineeringPacket
 from monitor.mapping.optimize import Optimization, optimize
 from monitor.mapping.regeolocate import regeolocate_file
 from monitor.result import AssessmentResult
 from monitor.sdr.names import parse_name
 from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
-
 
 
 @dataclass

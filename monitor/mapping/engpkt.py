@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from monitor.constants import N_FOR, N_FOV, URAD
+from monitor.geometry.instrument import EngineeringPacket
 from monitor.satellites import SATELLITES
-from monitor.geometry.instrument import N_FOR, N_FOV, URAD, EngineeringPacket
-
 
 # (model field, path in the EP, number of values); a triple/pair path lists its components.
 _ANGLES = (

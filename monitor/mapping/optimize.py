@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from monitor.geometry.instrument import N_FOR, URAD, EngineeringPacket, corrected_ssm_angles
+from monitor.constants import N_FOR, URAD
+from monitor.geometry.instrument import EngineeringPacket, corrected_ssm_angles
 from monitor.result import AssessmentResult
-
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from monitor.constants import N_FOR
 from monitor.geometry import instrument, wgs84
 from monitor.geometry.geolocate import GroundView, geolocate_fovs
 from monitor.geometry.instrument import EngineeringPacket
@@ -73,13 +74,13 @@ class ForDistance:
 def compare_with_files(ep: EngineeringPacket, paths, residuals: ResidualTable | OwnResiduals | None = None) -> list[ForDistance]:
     """Per-FOR statistics of the distance between *ep*'s geolocation (with *residuals*, if given) and the
     files' latitude/longitude."""
-    per_for = [[] for _ in range(instrument.N_FOR)]
+    per_for = [[] for _ in range(N_FOR)]
     for path in paths:
         for g in _geo_granules(path):
             view = geolocate_granule(ep, g, residuals)
             ref = wgs84.geodetic_to_ecef(g.lat_rad, g.lon_rad, 0.0)
             d = np.linalg.norm(view.ground_ecef_m - ref, axis=-1)
-            for k in range(instrument.N_FOR):
+            for k in range(N_FOR):
                 col = d[:, k].ravel()
                 per_for[k].append(col[np.isfinite(col)])
     out = []

@@ -24,8 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
+from monitor.constants import N_FOR, URAD
 from monitor.geometry.frames import los_angles, los_from_angles
-from monitor.geometry.instrument import N_FOR, URAD, EngineeringPacket, fov5_angles
+from monitor.geometry.instrument import EngineeringPacket, fov5_angles
 
 
 class ResidualError(ValueError):

@@ -27,6 +27,7 @@ import numpy as np
 
 from alerts.changes import all_changes
 from alerts.state import AlertState
+from monitor.constants import N_FOR
 from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 
@@ -84,7 +85,7 @@ def _series_arrays(rows):
     days = sorted({r["day"] for r in rows})
     index = {d: i for i, d in enumerate(days)}
     names = ("in_track_km", "cross_track_km", "total_km")
-    out = {n: np.full((len(days), 30), np.nan) for n in names}
+    out = {n: np.full((len(days), N_FOR), np.nan) for n in names}
     for r in rows:
         for n in names:
             if r[n] is not None:

@@ -16,8 +16,9 @@ import matplotlib.dates as mdates  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-FOV_SIZE_URAD = 16807.5
-FORS = np.arange(1, 31)
+from monitor.constants import FOV_DIAMETER_URAD, N_FOR  # noqa: E402
+
+FORS = np.arange(1, N_FOR + 1)
 DPI = 90
 CHANGE_COLOURS = {"cris": "tab:purple", "viirs": "tab:green", "common": "tab:brown"}
 
@@ -68,8 +69,8 @@ def latest_urad(path, d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_ur
         ax.set_xlabel("FOR (scan position)")
         ax.set_xlim(0, 31)
         ax.grid(alpha=0.3)
-        pct = ax.secondary_yaxis("right", functions=(lambda u: 100 * u / FOV_SIZE_URAD,
-                                                     lambda p: p * FOV_SIZE_URAD / 100))
+        pct = ax.secondary_yaxis("right", functions=(lambda u: 100 * u / FOV_DIAMETER_URAD,
+                                                     lambda p: p * FOV_DIAMETER_URAD / 100))
         pct.set_ylabel("% of FOV")
     fig.suptitle(title, fontsize=10)
     return _save(fig, Path(path))

@@ -21,6 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from monitor.constants import N_FOR, N_FOV
+
 DEG = np.pi / 180.0
 ARCSEC = np.pi / (180.0 * 3600.0)
 FLOAT_FILLS = (-999.9, -999.8, -999.7, -999.6, -999.5, -999.4, -999.3, -999.2)  # IDPS float fills (NA ... SOUB)
@@ -71,10 +73,10 @@ class Product:
 CRIS_LW_FIRST_CM1 = 648.75
 CRIS_LW_STEP_CM1 = 0.625
 CRIS_LW_CHANNELS = 717
-FOV = (30, 9)  # CrIS: 30 fields of regard of 9 FOVs per scan
+FOV = (N_FOR, N_FOV)  # CrIS: 30 fields of regard of 9 FOVs per scan
 VIIRS_COLUMNS = 6400  # I-band samples per row
 CRIS_GEO_FIELDS = {
-    "for_time_us": Field("FORTime", kind="time", dims=(30,), limits=IET_LIMITS_US),
+    "for_time_us": Field("FORTime", kind="time", dims=(N_FOR,), limits=IET_LIMITS_US),
     "start_time_us": Field("StartTime", kind="time", limits=IET_LIMITS_US),
     "mid_time_us": Field("MidTime", kind="time", limits=IET_LIMITS_US),
     "lat_rad": Field("Latitude", to_si=DEG, dims=FOV, limits=(-90.0, 90.0)),

@@ -19,8 +19,14 @@ from monitor.satellites import SATELLITES
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.iet import iet_to_datetime
 from monitor.sdr.names import parse_name
-from monitor.sdr.products import (IET_LIMITS_US, PRODUCTS, UINT16_FILL_MIN, Product, cris_lw_wavenumbers_cm1,
-                                  is_float_fill)
+from monitor.sdr.products import (
+    IET_LIMITS_US,
+    PRODUCTS,
+    UINT16_FILL_MIN,
+    Product,
+    cris_lw_wavenumbers_cm1,
+    is_float_fill,
+)
 
 
 @dataclass(frozen=True)

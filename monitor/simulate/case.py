@@ -181,7 +181,7 @@ class Simulator:
         spec = self.spec
         g0 = self.t0 + k * CRIS_GRANULE_S
         scan_start = g0 + np.arange(4) * ins.CRIS_SCAN_US * 1e-6
-        for_unix = scan_start[:, None] + np.arange(ins.CRIS_N_FOR) * ins.CRIS_FOR_DT_US * 1e-6
+        for_unix = scan_start[:, None] + np.arange(ins.N_FOR) * ins.CRIS_FOR_DT_US * 1e-6
         r, v, m = self.state(for_unix)  # (4, 30, ...)
         true_ecef = np.einsum("skij,kfj->skfi", m, self.los_true)
         geo_ecef = np.einsum("skij,kfj->skfi", m, self.los_geo)

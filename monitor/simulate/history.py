@@ -10,6 +10,7 @@ import datetime as dt
 
 import numpy as np
 
+from monitor.constants import N_FOR
 from monitor.result import FLAG_FLAT, AssessmentResult, ForOffset
 from monitor.simulate.profiles import paper_profile
 
@@ -19,12 +20,12 @@ KM_PER_URAD = 0.00083  # at nadir; enough for a picture
 def day_result(satellite: str, day: dt.date, rng, step_urad: float = 0.0, with_cube: bool = True) -> AssessmentResult:
     """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR 21-30."""
     d_alpha, d_beta = paper_profile()
-    d_alpha = 0.3 * d_alpha + rng.normal(0, 15, 30)
-    d_beta = 0.3 * d_beta + rng.normal(0, 15, 30) + np.where(np.arange(30) >= 20, step_urad, 0.0)
-    scan = np.abs(np.linspace(-48.3, 48.3, 30))
+    d_alpha = 0.3 * d_alpha + rng.normal(0, 15, N_FOR)
+    d_beta = 0.3 * d_beta + rng.normal(0, 15, N_FOR) + np.where(np.arange(N_FOR) >= 20, step_urad, 0.0)
+    scan = np.abs(np.linspace(-48.3, 48.3, N_FOR))
     stretch = 1.0 / np.cos(np.radians(scan)) ** 2
     fors = []
-    for k in range(30):
+    for k in range(N_FOR):
         it, ct = d_alpha[k] * KM_PER_URAD, d_beta[k] * KM_PER_URAD * stretch[k]
         fors.append(ForOffset(k + 1, float(d_alpha[k]), float(d_beta[k]), 12.0, 14.0, float(it), float(ct),
                               float(np.hypot(it, ct)), 0.01, 0.012 * stretch[k], 500, 0.8, 1.2,

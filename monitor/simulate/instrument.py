@@ -8,13 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from monitor.constants import DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, N_FOV
 from monitor.geometry.frames import rot_x, unit
 
-CRIS_N_FOR = 30
-CRIS_N_FOV = 9
 CRIS_FOR_STEP_RAD = np.radians(3.3333)
 CRIS_FOV_SPACING_RAD = 19.1e-3  # FOV centre spacing, ~1.1 deg (EP offsets, docs/jpss-formats.md 2.1)
-CRIS_FOV_HALF_ANGLE_RAD = 16807.5e-6 / 2
+CRIS_FOV_HALF_ANGLE_RAD = FOV_DIAMETER_RAD / 2
 CRIS_FOR_DT_US = 200_000
 CRIS_SCAN_US = 8_000_000
 CRIS_MID_OFFSET_US = 2_899_989
@@ -26,18 +25,18 @@ VIIRS_SCAN_S = 1.7864
 VIIRS_ZONE_COLUMNS = (1280, 736, 2368, 736, 1280)  # aggregation zones, output columns (VcstGeoParameters.h)
 VIIRS_ZONE_AGGREGATION = (1, 2, 3, 2, 1)
 VIIRS_NATIVE_RAD = 155.2e-6  # along-scan native sample; 12608 samples span +-56 deg
-VIIRS_DETECTOR_RAD = 375.0 / 833000.0
+VIIRS_DETECTOR_RAD = DEFAULT_STEP_RAD  # one I-band pixel seen from 833 km
 VIIRS_EARTH_VIEW_S = 0.556  # the 112 deg Earth-view sector of the 1.7864 s rotation
 
 
 def cris_scan_angles_rad() -> np.ndarray:
     """Scan angle of FOR 1..30 (rad), -48.33 deg to +48.33 deg."""
-    return (np.arange(CRIS_N_FOR) - (CRIS_N_FOR - 1) / 2) * CRIS_FOR_STEP_RAD
+    return (np.arange(N_FOR) - (N_FOR - 1) / 2) * CRIS_FOR_STEP_RAD
 
 
 def cris_fov_offsets_rad():
     """(in_track, cross_track) offsets (rad) of FOV 1..9 at nadir: FOV 7-9 ahead, FOV 1, 4, 7 on the left."""
-    f = np.arange(CRIS_N_FOV)
+    f = np.arange(N_FOV)
     return (f // 3 - 1) * CRIS_FOV_SPACING_RAD, (f % 3 - 1) * CRIS_FOV_SPACING_RAD
 
 

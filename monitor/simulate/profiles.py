@@ -8,8 +8,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-FOV_URAD = 16807.5
-N_FOR = 30
+from monitor.constants import FOV_DIAMETER_URAD, N_FOR
 
 
 def paper_profile():
@@ -20,7 +19,7 @@ def paper_profile():
     """
     k = np.arange(1, N_FOR + 1)
     d_beta = 1750.0 * np.clip((k - 10) / 20.0, 0.0, None) ** 2
-    d_alpha = FOV_URAD * np.interp(k, [1, N_FOR], [0.051, -0.03])
+    d_alpha = FOV_DIAMETER_URAD * np.interp(k, [1, N_FOR], [0.051, -0.03])
     return d_alpha, d_beta
 
 

@@ -1,0 +1,17 @@
+"""The instrument constants, in one place: CrIS scan and FOV, the VIIRS I-band pixel, the paper's grid.
+
+Everything else derives from these (never retype 30 or 16807.5).
+"""
+
+URAD = 1e-6  # radians per microradian (EP files and reports hold urad)
+
+N_FOR = 30  # CrIS fields of regard (scan positions) per scan
+N_FOV = 9  # CrIS fields of view per FOR (3 x 3)
+FOV_DIAMETER_URAD = 16807.5  # CrIS FOV size, 0.963 deg (Wang et al. 2017; the EP files carry 16808)
+FOV_DIAMETER_RAD = FOV_DIAMETER_URAD * URAD
+
+VIIRS_I_PIXEL_M = 375.0  # VIIRS I-band pixel at nadir
+REFERENCE_ALTITUDE_M = 833000.0  # the JPSS orbit altitude the paper's grid step is defined at
+DEFAULT_STEP_RAD = VIIRS_I_PIXEL_M / REFERENCE_ALTITUDE_M  # one I-band pixel seen from 833 km, ~450 urad
+DEFAULT_STEP_URAD = DEFAULT_STEP_RAD / URAD
+DEFAULT_HALF_STEPS = 10  # perturbations on each side of zero: a 21 x 21 grid
