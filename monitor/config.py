@@ -18,10 +18,9 @@ import yaml
 import yaml.events
 
 from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
-from monitor.satellites import SATELLITES as _TABLE
+from monitor.satellites import SATELLITES
 
-SATELLITES = tuple(_TABLE)
-NODD_BUCKETS = {s.short: s.bucket for s in _TABLE.values()}
+NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
 
 
 class ConfigError(ValueError):

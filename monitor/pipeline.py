@@ -22,6 +22,7 @@ from monitor.mapping.engpkt import load_library
 from monitor.scenes import select_scenes
 from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import PlanError, plan
+from monitor.sdr.products import CRIS_GEO
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
@@ -111,7 +112,7 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
     A step against the previous day, or within the day, becomes a ``change:cris`` event (used for jump
     attribution and notified by the alerts). Problems are logged, never fatal to the run.
     """
-    geos = sorted((f for f in listing if f.product == "GCRSO" and f.parsed.start.date() == day),
+    geos = sorted((f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
                   key=lambda f: f.parsed.start)
     if not geos:
         return None
@@ -196,7 +197,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
         timings["list"] = time.perf_counter() - t0
         counts["listed"] = len(listing)
-        if not any(f.product in ("GCRSO",) for f in listing):
+        if not any(f.product in CRIS_GEO for f in listing):
             return _no_data(cfg, store, run_id, satellite, day, f"no CrIS GEO granule of {satellite} on {day} in "
                                                                   f"the source", timings, counts=counts)
         if stop():

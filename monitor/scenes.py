@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from monitor.sdr import GranuleError, read_file
-from monitor.sources import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR, BudgetExceeded, SourceError
+from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
+from monitor.sources import BudgetExceeded, SourceError
 from monitor.spectral import i5_band
 
 LOG = logging.getLogger(__name__)

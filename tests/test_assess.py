@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from tests.conftest import truth_arrays
 from monitor.assess import AssessConfig, find_minimum
 from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult
+from tests.conftest import truth_arrays
 
 
 def _bowl(x0, y0, m=21, skew=0.3):
@@ -62,9 +62,8 @@ def test_result_fields_and_km(cases):
 
 
 def test_too_few_samples_are_flagged(cases):
-    from monitor.assess import cost_and_offsets
+    from monitor.assess import _collocate_run, cost_and_offsets
     from monitor.sdr.pairing import plan
-    from monitor.assess import _collocate_run
     out, _, _ = cases.get("paper", 1)
     case = plan([out])
     samples, _ = _collocate_run(case.cris[:1], case.viirs, case.viirs_all, "j01", AssessConfig())

@@ -1,9 +1,8 @@
 import json
 
-
 from monitor.cli import main
-from tests.conftest import tree_with_truncated
 from monitor.simulate.case import simulate_case
+from tests.conftest import tree_with_truncated
 
 
 def test_assess_writes_the_contract_json(cases, tmp_path, capsys):

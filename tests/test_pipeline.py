@@ -2,7 +2,6 @@
 
 import datetime as dt
 
-
 from monitor.config import load_config
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources.local import LocalSource

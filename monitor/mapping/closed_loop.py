@@ -20,6 +20,7 @@ from monitor.mapping.optimize import Optimization, optimize
 from monitor.mapping.regeolocate import regeolocate_file
 from monitor.result import AssessmentResult
 from monitor.sdr.names import parse_name
+from monitor.sdr.products import CRIS_GEO
 from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
 
 
@@ -80,7 +81,7 @@ def run_closed_loop(work_dir, true_ep: EngineeringPacket, ground_ep: Engineering
     regeo.mkdir(parents=True, exist_ok=True)
     for name in truth["files"]:
         parsed = parse_name(name)
-        if parsed is not None and parsed.products == ("GCRSO",):
+        if parsed is not None and parsed.products == CRIS_GEO:
             regeolocate_file(opt.ep, case / name, regeo)
         else:
             _link_or_copy(case / name, regeo / name)

@@ -30,9 +30,9 @@ from alerts.state import AlertState
 from monitor.constants import N_FOR
 from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
+from monitor.satellites import SATELLITES
 
 UTC = dt.timezone.utc
-SAT_NAMES = {"npp": "S-NPP", "j01": "NOAA-20", "j02": "NOAA-21"}
 CSS = """
 body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:1.5em auto;max-width:1100px;color:#222}
 h1{font-size:1.5em}h2{font-size:1.15em;margin-top:1.6em;border-bottom:1px solid #ccc}
@@ -136,7 +136,7 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     """Write ``out/<satellite>/`` and return a summary for the index."""
     sat_dir = out / satellite
     sat_dir.mkdir(parents=True, exist_ok=True)
-    name = f"{SAT_NAMES.get(satellite, satellite)} ({satellite})"
+    name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
     rows = store.series(satellite, opts.since, opts.until)
     changes = [c for c in all_changes(store, satellite, opts.calendar)
                if (opts.since is None or c.time.date() >= opts.since) and (opts.until is None or c.time.date() <= opts.until)]

@@ -13,12 +13,9 @@ from pathlib import Path
 
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.names import parse_name
+from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
 from monitor.sdr.readers import GranuleMeta, read_metadata
 
-CRIS_SDR = ("SCRIF", "SCRIS")
-CRIS_GEO = ("GCRSO",)
-VIIRS_SDR = ("SVI05",)
-VIIRS_GEO = ("GIMGO", "GITCO")  # ellipsoid geolocation first, as Wang's code; NODD has only GITCO
 COVER_MARGIN = dt.timedelta(seconds=10)
 CONTIGUOUS = dt.timedelta(seconds=5)  # VIIRS granules this close in time form one continuous swath
 

@@ -116,15 +116,26 @@ VIIRS_GEO_FIELDS = {
 # meets the terrain (docs/jpss-formats.md 1.8); the ellipsoid product (GIMGO) puts its pixels at h = 0.
 VIIRS_TC_GEO_FIELDS = {**VIIRS_GEO_FIELDS, "height_m": Field("Height", per="row", dims=(VIIRS_COLUMNS,))}
 
+# The product table. Within a kind the first listed is preferred (full spectral resolution; terrain-corrected
+# geolocation, the only one NOAA's archive carries). The collection is also the product's NODD folder.
 PRODUCTS = {p.prefix: p for p in (
-    Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
     Product("SCRIF", "CrIS-FS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
+    Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
     Product("GCRSO", "CrIS-SDR-GEO", "cris_geo", fields=CRIS_GEO_FIELDS),
     Product("SVI05", "VIIRS-I5-SDR", "viirs_sdr", rows_per_scan=32, scans_reserved=48, fields=VIIRS_SDR_FIELDS),
     Product("GITCO", "VIIRS-IMG-GEO-TC", "viirs_geo", rows_per_scan=32, scans_reserved=48,
             fields=VIIRS_TC_GEO_FIELDS),
     Product("GIMGO", "VIIRS-IMG-GEO", "viirs_geo", rows_per_scan=32, scans_reserved=48, fields=VIIRS_GEO_FIELDS),
 )}
+
+
+def prefixes(kind: str) -> tuple:
+    """The prefixes of the products of *kind* (cris_sdr, cris_geo, viirs_sdr, viirs_geo), preferred first."""
+    return tuple(p.prefix for p in PRODUCTS.values() if p.kind == kind)
+
+
+CRIS_SDR, CRIS_GEO, VIIRS_SDR, VIIRS_GEO = (prefixes(k) for k in ("cris_sdr", "cris_geo", "viirs_sdr", "viirs_geo"))
+CRIS_PRODUCTS = CRIS_SDR + CRIS_GEO
 
 
 

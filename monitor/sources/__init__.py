@@ -11,12 +11,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from monitor.sdr.names import JpssName, parse_name
+from monitor.sdr.products import PRODUCTS
 
-CRIS_SDR = ("SCRIF", "SCRIS")
-CRIS_GEO = ("GCRSO",)
-VIIRS_SDR = ("SVI05",)
-VIIRS_GEO = ("GITCO", "GIMGO")
-ALL_PRODUCTS = CRIS_SDR + CRIS_GEO + VIIRS_SDR + VIIRS_GEO
+ALL_PRODUCTS = tuple(PRODUCTS)
 
 
 class SourceError(RuntimeError):

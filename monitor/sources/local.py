@@ -6,6 +6,7 @@ import datetime as dt
 import logging
 from pathlib import Path
 
+from monitor.sdr.products import CRIS_PRODUCTS
 from monitor.sources import ListedFile, listed, on_day
 
 LOG = logging.getLogger(__name__)
@@ -29,7 +30,7 @@ class LocalSource:
             if f is not None and f.parsed.platform == satellite and f.product in products \
                     and abs((f.parsed.start.date() - day).days) <= 1:
                 out.append(f)
-        return [f for f in out if on_day(f, day) or f.product not in ("SCRIF", "SCRIS", "GCRSO")]
+        return [f for f in out if on_day(f, day) or f.product not in CRIS_PRODUCTS]
 
     def fetch(self, f: ListedFile) -> Path:
         return Path(f.location)

@@ -34,13 +34,11 @@ from urllib.parse import urljoin, urlsplit
 import requests
 import urllib3
 
+from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
 from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed
 
 LOG = logging.getLogger(__name__)
 S3_NS = "{http://s3.amazonaws.com/doc/2006-03-01/}"
-FOLDERS = {"SCRIF": "CrIS-FS-SDR", "SCRIS": "CrIS-SDR", "GCRSO": "CrIS-SDR-GEO", "SVI05": "VIIRS-I5-SDR",
-           "GITCO": "VIIRS-IMG-GEO-TC", "GIMGO": "VIIRS-IMG-GEO"}
-CRIS = ("SCRIF", "SCRIS", "GCRSO")
 MAX_LISTING_PAGE_BYTES = 8 << 20  # a page of 1000 keys is ~0.3 MB
 RETRYABLE = (429, 500, 502, 503, 504)
 REDIRECTS = (301, 302, 303, 307, 308)
@@ -190,9 +188,9 @@ class NoddSource:
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
         out = []
         for product in products:
-            folder = FOLDERS[product]
+            folder = PRODUCTS[product].collection  # the NODD folder is the collection name
             prefixes = [(day, f"{product}_{satellite}_d{day:%Y%m%d}")]
-            if product not in CRIS:  # VIIRS granules spanning midnight cover the day's first/last CrIS
+            if product not in CRIS_PRODUCTS:  # VIIRS granules spanning midnight cover the day's first/last CrIS
                 prev, nxt = day - dt.timedelta(days=1), day + dt.timedelta(days=1)
                 prefixes += [(prev, f"{product}_{satellite}_d{prev:%Y%m%d}_t23"),
                              (nxt, f"{product}_{satellite}_d{nxt:%Y%m%d}_t00")]

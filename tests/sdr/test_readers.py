@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from monitor.sdr import GranuleError, read_file
-from monitor.sdr.readers import read_metadata, read_viirs_geo_scan
 from monitor.sdr.products import PRODUCTS
+from monitor.sdr.readers import read_metadata, read_viirs_geo_scan
 from monitor.simulate.case import simulate_case
 from monitor.simulate.jpss_h5 import ProductData, write_file
 
