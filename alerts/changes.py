@@ -124,10 +124,10 @@ def stored_changes(store, satellite: str) -> list[Change]:
     """Change events the service itself recorded (``events`` rows of kind ``change:<instrument>``)."""
     out = []
     for e in store.events():
-        if e["kind"].startswith("change:") and e["satellite"] == satellite:
-            detail = json.loads(e["detail"])
-            out.append(Change(_when(detail["time"]), satellite, e["kind"].split(":", 1)[1], detail.get("kind", "change"),
-                              detail.get("description", ""), detail.get("origin", "service")))
+        if e.kind.is_change and e.satellite == satellite and "time" in e.detail:
+            d = e.detail
+            out.append(Change(_when(d["time"]), satellite, e.kind.value.split(":", 1)[1], d.get("kind", "change"),
+                              d.get("description", ""), d.get("origin", "service")))
     return out
 
 

@@ -21,7 +21,7 @@ from alerts.rules import (
     spec_finding,
     stale_finding,
 )
-from alerts.state import AlertState
+from monitor.store.alerts import AlertState
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc

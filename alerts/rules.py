@@ -16,6 +16,7 @@ import numpy as np
 from alerts.changes import preceding_change
 from monitor.constants import N_FOR
 from monitor.result import RELIABILITY_FLAGS
+from monitor.store.sqlite import SCHEDULER_KINDS, EventKind
 
 UTC = dt.timezone.utc
 COMPONENTS = (("in_track_km", "in-track"), ("cross_track_km", "cross-track"))
@@ -222,21 +223,23 @@ def failure_finding(store, satellite: str) -> Finding | None:
     last_ok = max((r["id"] for r in runs if r["status"] in ("ok", "no_data", "no_data_final")), default=0)
     failed = [r for r in runs if r["id"] > last_ok and r["status"] == "failed"]
     last_ok_time = next((r["finished"] for r in runs if r["id"] == last_ok), "")
-    jobs = [e for e in store.events() if e["kind"] in ("job_error", "job_missed", "job_skipped")
-            and e["satellite"] == satellite and e["time"] > (last_ok_time or "")]
+    jobs = [e for e in store.events() if e.kind in SCHEDULER_KINDS
+            and e.satellite == satellite and e.time > (last_ok_time or "")]
     if not failed and not jobs:
         return None
-    lines = [f"run {r['day']}: {r['reason']}" for r in failed] + [f"scheduler: {e['detail']}" for e in jobs]
+    lines = [f"run {r['day']}: {r['reason']}" for r in failed] + \
+        [f"scheduler: {e.detail.get('job')}: {e.detail.get('error', e.detail.get('text'))} "
+         f"(scheduled {e.detail.get('scheduled', '?')})" for e in jobs]
     return Finding("failure", satellite, "critical", f"{satellite}: {len(lines)} failed or missed run(s)", lines)
 
 
 def processing_change_findings(store, satellite: str, s: RuleSettings, today: dt.date) -> list[Finding]:
     """CrIS geolocation processing changes found by the LOS fingerprint in the last ``active_days``."""
     out = []
-    for e in store.events():
-        if e["kind"] != "change:cris" or e["satellite"] != satellite:
+    for e in store.events(EventKind.CHANGE_CRIS):
+        if e.satellite != satellite:
             continue
-        d = json.loads(e["detail"])
+        d = e.detail
         if d.get("origin") != "fingerprint":
             continue
         when = dt.datetime.fromisoformat(d["time"])

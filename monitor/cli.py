@@ -294,8 +294,8 @@ def cmd_daemon(args) -> int:
 def status_report(cfg, store) -> dict:
     """What ``crisgeo status`` shows, as data: per satellite the last run, the latest per-FOR offsets and
     the alerts firing; the next run; the outbox size; and the Nagios state of it all."""
-    from alerts.state import AlertState
     from monitor.service import next_run
+    from monitor.store.alerts import AlertState
     runs = {r["satellite"]: r for r in store.last_runs()}
     firing = AlertState(store).firing()
     sats = {}
@@ -359,8 +359,8 @@ def cmd_status(args) -> int:
 def cmd_alerts(args) -> int:
     from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts
     from alerts.settings import AlertConfigError
-    from alerts.state import AlertState
     from monitor.service import Service
+    from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
     cfg = _load(args)
     service = Service(cfg)

@@ -39,7 +39,7 @@ class _StoreCollector:
         self.health = health
 
     def collect(self):
-        from alerts.state import AlertState
+        from monitor.store.alerts import AlertState
 
         store = self.open_store()
         try:

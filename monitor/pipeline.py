@@ -8,7 +8,6 @@ ok or no_data run within the catch-up window are redone, oldest first.
 from __future__ import annotations
 
 import datetime as dt
-import json
 import logging
 import time
 from dataclasses import dataclass, field
@@ -24,6 +23,7 @@ from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import PlanError, plan
 from monitor.sdr.products import CRIS_GEO
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
+from monitor.store.sqlite import EventKind
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
 LOG = logging.getLogger(__name__)
@@ -156,8 +156,8 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
         body["change"] = {"time": change["time"], "granule": change["granule"], "fors": change["fors"],
                           "d_alpha_urad": np.round(change["da"], 1).tolist(),
                           "d_beta_urad": np.round(change["db"], 1).tolist()}
-        store.add_event("change:cris", satellite, json.dumps({"time": change["time"], "kind": "processing_change",
-                                                              "description": desc, "origin": "fingerprint"}))
+        store.add_event(EventKind.CHANGE_CRIS, satellite, {"time": change["time"], "kind": "processing_change",
+                                                           "description": desc, "origin": "fingerprint"})
         LOG.warning("%s %s: %s", satellite, day, desc)
     store.save_fingerprint(satellite, day, body)
     return body
@@ -180,7 +180,7 @@ def publish_changes(cfg, store, satellite: str) -> None:
 def _failed(store, run_id, satellite, day, reason, timings, counts=None) -> RunOutcome:
     """Record a failed run and its ``run_failed`` event (the failure alert reads both)."""
     store.finish_run(run_id, "failed", reason)
-    store.add_event("run_failed", satellite, f"{day}: {reason}")
+    store.add_event(EventKind.RUN_FAILED, satellite, {"day": day.isoformat(), "reason": reason})
     return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings, counts=counts or {})
 
 

@@ -274,15 +274,16 @@ class Service:
 
     def _job_event(self, event):
         from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MISSED
-        kind = {EVENT_JOB_ERROR: "job_error", EVENT_JOB_MISSED: "job_missed"}.get(event.code, "job_skipped")
-        detail = f"{event.job_id}: {getattr(event, 'exception', None) or kind} (scheduled {event.scheduled_run_time})"
-        LOG.error("scheduler: %s", detail)
-        store = self.store()
-        try:
+
+        from monitor.store.sqlite import EventKind
+        kind = {EVENT_JOB_ERROR: EventKind.JOB_ERROR, EVENT_JOB_MISSED: EventKind.JOB_MISSED}.get(
+            event.code, EventKind.JOB_SKIPPED)
+        detail = {"job": event.job_id, "error": str(getattr(event, "exception", None) or kind.value),
+                  "scheduled": str(event.scheduled_run_time)}
+        LOG.error("scheduler: %s: %s (scheduled %s)", detail["job"], detail["error"], detail["scheduled"])
+        with self.store() as store:
             store.add_event(kind, event.job_id.split("-", 1)[-1], detail)
             self.check_alerts(store)
-        finally:
-            store.close()
 
     def _start_watchdog(self):
         usec = os.environ.get("WATCHDOG_USEC")

@@ -102,7 +102,7 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     import datetime as dt
 
     from alerts.rules import Finding
-    from alerts.state import AlertState
+    from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
     cfg = _status_config(tmp_path)
     monkeypatch.setenv("CRISGEO_CONFIG", str(cfg))  # the default when --config is not given

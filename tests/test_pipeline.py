@@ -5,7 +5,7 @@ import datetime as dt
 from monitor.config import load_config
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources.local import LocalSource
-from monitor.store.sqlite import Store
+from monitor.store.sqlite import EventKind, Store
 from tests.conftest import tree_with_truncated
 
 DAY = dt.date(2024, 6, 1)
@@ -79,7 +79,8 @@ def test_source_failure_is_a_failed_run_and_an_event(tmp_path):
     store = Store(cfg.store.sqlite)
     out = run_day(cfg, store, LocalSource(tmp_path / "missing"), "j01", DAY)
     assert out.status == "failed" and "no such directory" in out.reason
-    assert store.events("run_failed")[0]["satellite"] == "j01"
+    (event,) = store.events(EventKind.RUN_FAILED)
+    assert event.satellite == "j01" and event.detail == {"day": DAY.isoformat(), "reason": out.reason}
 
 
 def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp_path, monkeypatch):
@@ -109,7 +110,7 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
     assert outcomes[-2].reason == "unexpected RuntimeError: poison granule"
     store = Store(cfg.store.sqlite)
     assert {r["day"]: r["status"] for r in store.runs("j01")}[str(DAY)] == "failed"
-    assert any(e["kind"] == "run_failed" and "poison granule" in e["detail"] for e in store.events())
+    assert any(e.kind == EventKind.RUN_FAILED and "poison granule" in e.detail["reason"] for e in store.events())
     text = log.read_text()
     assert "failure" in text and "poison granule" in text
 

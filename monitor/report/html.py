@@ -26,11 +26,11 @@ from pathlib import Path
 import numpy as np
 
 from alerts.changes import all_changes
-from alerts.state import AlertState
 from monitor.constants import N_FOR
 from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
+from monitor.store.alerts import AlertState
 
 UTC = dt.timezone.utc
 CSS = """

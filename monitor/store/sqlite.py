@@ -2,15 +2,18 @@
 
 It holds the runs (the ledger of processed days), the per-FOR results with their flags, the granules
 used with their metadata (aux file lists, software versions), the scene-selection decisions, the cost
-cubes, service events, and the outbox of time-series points still to publish. A day's results are
+cubes, service events, the alert state, silences and delivery queue (:mod:`monitor.store.alerts`), and the
+outbox of time-series points still to publish. All of the service's SQL lives in this package. A day's results are
 replaced in one transaction, so a re-run never duplicates and a crash never leaves half a day.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import enum
 import json
 import sqlite3
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -59,6 +62,20 @@ MIGRATIONS = [
         satellite TEXT NOT NULL, day TEXT NOT NULL, computed TEXT NOT NULL, body TEXT NOT NULL,
         PRIMARY KEY (satellite, day));
     """,
+    # 3: the alert tables (monitor/store/alerts.py), until now created by the alert state itself: IF NOT
+    # EXISTS keeps the rows of stores that have them; alert_meta, their own version table, goes
+    """
+    CREATE TABLE IF NOT EXISTS alert_state (
+        fingerprint TEXT PRIMARY KEY, rule TEXT NOT NULL, satellite TEXT NOT NULL, grp TEXT, severity TEXT,
+        status TEXT NOT NULL, started TEXT, last_notified TEXT, resolved TEXT, summary TEXT, lines TEXT);
+    CREATE TABLE IF NOT EXISTS silences (
+        id INTEGER PRIMARY KEY, rule TEXT, satellite TEXT, until TEXT NOT NULL, reason TEXT NOT NULL, created TEXT);
+    CREATE TABLE IF NOT EXISTS deliveries (
+        id INTEGER PRIMARY KEY, channel TEXT NOT NULL, satellite TEXT, subject TEXT NOT NULL, body TEXT NOT NULL,
+        created TEXT NOT NULL, status TEXT NOT NULL, attempts INTEGER DEFAULT 0, next_attempt TEXT,
+        last_error TEXT, sent TEXT);
+    DROP TABLE IF EXISTS alert_meta;
+    """,
 ]
 
 RESULT_FIELDS = ("d_alpha_urad", "d_beta_urad", "sigma_alpha_urad", "sigma_beta_urad", "in_track_km",
@@ -72,6 +89,46 @@ def now_iso() -> str:
 
 def _num(v):
     return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
+
+
+class EventKind(str, enum.Enum):
+    """What an ``events`` row records."""
+
+    RUN_FAILED = "run_failed"  # detail: day, reason
+    JOB_ERROR = "job_error"  # detail: job, error, scheduled (a scheduler job raised)
+    JOB_MISSED = "job_missed"  # ... was missed (the host was down past the misfire grace)
+    JOB_SKIPPED = "job_skipped"  # ... was skipped (the previous instance still ran)
+    CHANGE_CRIS = "change:cris"  # detail: time, kind, description, origin (a CrIS processing change)
+    CHANGE_VIIRS = "change:viirs"  # the same for VIIRS
+
+    @property
+    def is_change(self) -> bool:
+        return self.value.startswith("change:")
+
+
+SCHEDULER_KINDS = (EventKind.JOB_ERROR, EventKind.JOB_MISSED, EventKind.JOB_SKIPPED)
+
+
+@dataclass(frozen=True)
+class Event:
+    """One ``events`` row; *detail* is the decoded JSON (rows of older versions, plain text, become
+    ``{"text": ...}``)."""
+
+    id: int
+    time: str
+    kind: EventKind
+    satellite: str | None
+    detail: dict
+
+    @classmethod
+    def from_row(cls, r) -> "Event":
+        try:
+            detail = json.loads(r["detail"])
+        except (TypeError, ValueError):
+            detail = None
+        if not isinstance(detail, dict):
+            detail = {"text": r["detail"]}
+        return cls(r["id"], r["time"], EventKind(r["kind"]), r["satellite"], detail)
 
 
 class StoreError(RuntimeError):
@@ -126,6 +183,12 @@ class Store:
 
     def close(self):
         self.db.close()
+
+    def __enter__(self) -> "Store":
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
     # -- schema
     @property
@@ -307,14 +370,16 @@ class Store:
         return None if r is None else (dt.date.fromisoformat(r["day"]), json.loads(r["body"]))
 
     # -- events (failures, misses: the alerting layer reads them)
-    def add_event(self, kind: str, satellite: str | None, detail: str):
+    def add_event(self, kind: "EventKind", satellite: str | None, detail: dict):
+        """Record an event; *detail* is stored as JSON."""
         with self.transaction():
             self.db.execute("INSERT INTO events (time, kind, satellite, detail) VALUES (?, ?, ?, ?)",
-                            (now_iso(), kind, satellite, detail))
+                            (now_iso(), EventKind(kind).value, satellite, json.dumps(detail)))
 
-    def events(self, kind: str | None = None) -> list:
+    def events(self, kind: "EventKind | None" = None) -> list["Event"]:
+        """The events (of *kind*), oldest first."""
         q = "SELECT * FROM events" + (" WHERE kind=?" if kind else "") + " ORDER BY id"
-        return [dict(r) for r in self.db.execute(q, (kind,) if kind else ())]
+        return [Event.from_row(r) for r in self.db.execute(q, (EventKind(kind).value,) if kind else ())]
 
     # -- outbox
     def queue_lines(self, target: str, satellite: str | None, lines: list):

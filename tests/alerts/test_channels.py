@@ -104,7 +104,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
 
     from alerts.engine import deliver
     from alerts.settings import AlertSettings, RuleSettings
-    from alerts.state import AlertState
+    from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
     monkeypatch.setenv("T_SLACK", webhook.url)
     settings = AlertSettings(rules=RuleSettings(), slack=SlackSettings(webhook_env="T_SLACK", timeout_s=5))
@@ -145,7 +145,7 @@ def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
     import subprocess
     import sys
 
-    from alerts.state import AlertState
+    from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
     cfg = tmp_path / "c.yaml"
     cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"

@@ -80,7 +80,7 @@ alerts:
 
 def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp_path):
     from alerts.engine import deliver
-    from alerts.state import AlertState
+    from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
     monkeypatch.setenv("T_HOOK", webhook.url)
     cfg_path = tmp_path / "c.yaml"

@@ -127,9 +127,9 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
     from prometheus_client import generate_latest
 
     from alerts.rules import Finding
-    from alerts.state import AlertState
     from monitor.health import Health
     from monitor.metrics import ServiceMetrics
+    from monitor.store.alerts import AlertState
     from tests.servers import victoria_metrics
 
     db = tmp_path / "s.sqlite"

@@ -9,10 +9,10 @@ import time
 import pytest
 import yaml
 
-from alerts.state import AlertState
 from monitor.cli import main
 from monitor.report.html import ReportOptions, build_report
 from monitor.simulate.history import fill_store
+from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
 from tests.servers import chromium_driver
 

@@ -1,24 +1,9 @@
-"""Alert state, silences and the delivery queue, in the service's SQLite file (own tables and version)."""
+"""Alert state, silences and the delivery queue: the alert tables of the store (created by its migrations)."""
 
 from __future__ import annotations
 
 import datetime as dt
 import json
-
-SCHEMA = [
-    """
-    CREATE TABLE IF NOT EXISTS alert_meta (version INTEGER NOT NULL);
-    CREATE TABLE IF NOT EXISTS alert_state (
-        fingerprint TEXT PRIMARY KEY, rule TEXT NOT NULL, satellite TEXT NOT NULL, grp TEXT, severity TEXT,
-        status TEXT NOT NULL, started TEXT, last_notified TEXT, resolved TEXT, summary TEXT, lines TEXT);
-    CREATE TABLE IF NOT EXISTS silences (
-        id INTEGER PRIMARY KEY, rule TEXT, satellite TEXT, until TEXT NOT NULL, reason TEXT NOT NULL, created TEXT);
-    CREATE TABLE IF NOT EXISTS deliveries (
-        id INTEGER PRIMARY KEY, channel TEXT NOT NULL, satellite TEXT, subject TEXT NOT NULL, body TEXT NOT NULL,
-        created TEXT NOT NULL, status TEXT NOT NULL, attempts INTEGER DEFAULT 0, next_attempt TEXT,
-        last_error TEXT, sent TEXT)
-    """,
-]
 
 
 def iso(t: dt.datetime) -> str:
@@ -31,11 +16,6 @@ class AlertState:
     def __init__(self, store):
         self.store = store
         self.db = store.db
-        with store.transaction():
-            for stmt in filter(str.strip, SCHEMA[0].split(";")):
-                self.db.execute(stmt)
-            if self.db.execute("SELECT COUNT(*) FROM alert_meta").fetchone()[0] == 0:
-                self.db.execute("INSERT INTO alert_meta VALUES (1)")
 
     def get(self, fingerprint: str):
         r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
