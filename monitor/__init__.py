@@ -5,13 +5,7 @@ The science lives in ``monitor.sdr`` (files), ``monitor.geometry`` (frames), ``m
 object, :class:`monitor.result.AssessmentResult`.
 """
 
-from importlib.metadata import PackageNotFoundError
-from importlib.metadata import version as _dist_version
-
-try:
-    __version__ = _dist_version("crisgeo-monitor")  # the one version: pyproject.toml's
-except PackageNotFoundError:  # a source tree that was never installed
-    __version__ = "0+unknown"
+from monitor.version import __version__
 
 __all__ = ["AssessmentResult", "assess_paths", "open_store", "__version__"]
 

@@ -15,7 +15,7 @@ import logging
 import sys
 from pathlib import Path
 
-from monitor import __version__
+from monitor.version import __version__
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
@@ -237,7 +237,7 @@ def _day(text: str) -> dt.date:
 
 
 def cmd_run(args) -> int:
-    from monitor.service import AlreadyRunning, InstanceLock, Service
+    from monitor.service import AlreadyRunning, Service
     cfg = _load(args)
     sats = [args.satellite] if args.satellite else cfg.satellites
     if args.satellite and args.satellite not in cfg.satellites:
@@ -249,11 +249,7 @@ def cmd_run(args) -> int:
     service = Service(cfg, progress=(lambda g: bar.update(1)) if bar else None)
     service.handle_signals()
     try:
-        with InstanceLock(cfg.state_dir):
-            service.recover()
-            outcomes = []
-            for sat in sats:
-                outcomes += [service.run(sat, args.date)] if args.date else service.catch_up(sat)
+        outcomes = service.run_once(sats, args.date)
     except AlreadyRunning as exc:
         print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
         return EXIT_ALREADY_RUNNING

@@ -39,7 +39,7 @@ def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.dat
     """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset."""
     import xarray as xr
 
-    from monitor import __version__
+    from monitor.version import __version__
     rows = store.series(satellite, since, until)
     days = sorted({r["day"] for r in rows})
     index = {d: i for i, d in enumerate(days)}

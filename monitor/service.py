@@ -208,6 +208,19 @@ class Service:
     def daily_job(self, satellite: str):
         self.catch_up(satellite)
 
+    def run_once(self, satellites, day: dt.date | None = None) -> list:
+        """``crisgeo run``: under the instance lock, recover what a killed process left, then per satellite
+        the given *day* or the days of the catch-up window; the outcomes. :class:`AlreadyRunning` when the
+        daemon (or another run) holds the state directory."""
+        with InstanceLock(self.cfg.state_dir):
+            self.recover()
+            outcomes = []
+            for sat in satellites:
+                if self.stop_event.is_set():
+                    break
+                outcomes += [self.run(sat, day)] if day else self.catch_up(sat)
+            return outcomes
+
     # -- daemon
     def add_jobs(self, scheduler):
         """The daemon's jobs: per satellite the daily run (catching up at start), the hourly alert
@@ -232,7 +245,7 @@ class Service:
         """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
         if listen == "off":
             return None
-        from monitor import __version__
+        from monitor.version import __version__
         from monitor.endpoint import Endpoint, parse_listen
         from monitor.metrics import ServiceMetrics
         self.metrics = ServiceMetrics(self.store, self.cfg.satellites, self.health, __version__)
