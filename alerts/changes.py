@@ -13,6 +13,7 @@ Two origins:
 from __future__ import annotations
 
 import datetime as dt
+import itertools
 import json
 import re
 from dataclasses import dataclass
@@ -35,7 +36,9 @@ class Change:
     origin: str  # calendar, metadata, fingerprint
 
     def label(self) -> str:
-        who = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS and VIIRS (common geolocation)"}[self.instrument]
+        who = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS and VIIRS (common geolocation)"}[
+            self.instrument
+        ]
         return f"{who} {self.kind} on {self.time:%Y-%m-%d %H:%M} UTC: {self.description} [{self.origin}]"
 
 
@@ -60,8 +63,16 @@ def load_calendar(path) -> list[Change]:
             inst = e["instrument"]
             if inst not in INSTRUMENTS:
                 raise ValueError(f"instrument {inst!r} is not one of {', '.join(INSTRUMENTS)}")
-            out.append(Change(_when(e["time"]), e["satellite"], inst, e.get("kind", "change"),
-                              str(e.get("description", "")).strip(), "calendar"))
+            out.append(
+                Change(
+                    _when(e["time"]),
+                    e["satellite"],
+                    inst,
+                    e.get("kind", "change"),
+                    str(e.get("description", "")).strip(),
+                    "calendar",
+                )
+            )
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{where}: {exc}") from None
     return out
@@ -71,9 +82,15 @@ def add_to_calendar(path, change: Change) -> None:
     """Append *change* to the calendar YAML at *path* (created if missing)."""
     path = Path(path)
     doc = (yaml.safe_load(path.read_text()) if path.exists() else None) or {}
-    doc.setdefault("events", []).append({
-        "satellite": change.satellite, "time": change.time.strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "instrument": change.instrument, "kind": change.kind, "description": change.description})
+    doc.setdefault("events", []).append(
+        {
+            "satellite": change.satellite,
+            "time": change.time.strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "instrument": change.instrument,
+            "kind": change.kind,
+            "description": change.description,
+        }
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(yaml.safe_dump(doc, sort_keys=False))
 
@@ -100,7 +117,7 @@ def metadata_changes(store, satellite: str) -> list[Change]:
             d["viirs_sw"].add(g["viirs_software"])
     out = []
     ordered = sorted(days)
-    for prev, cur in zip(ordered, ordered[1:]):
+    for prev, cur in itertools.pairwise(ordered):
         a, b = days[prev], days[cur]
         when = _when(cur)
         for inst in ("cris", "viirs"):
@@ -109,11 +126,21 @@ def metadata_changes(store, satellite: str) -> list[Change]:
                 if ka.get(kind) != kb.get(kind):
                     instrument = "common" if kind.startswith("CMNGEO") else inst
                     new = ", ".join(sorted(kb.get(kind, {"(none)"})))
-                    out.append(Change(when, satellite, instrument, "lut_change", f"{kind} now {new}", "metadata"))
+                    out.append(
+                        Change(when, satellite, instrument, "lut_change", f"{kind} now {new}", "metadata")
+                    )
             if a[f"{inst}_sw"] and b[f"{inst}_sw"] and a[f"{inst}_sw"] != b[f"{inst}_sw"]:
-                out.append(Change(when, satellite, inst, "software",
-                                  f"SDR software {', '.join(sorted(a[inst + '_sw']))} -> "
-                                  f"{', '.join(sorted(b[inst + '_sw']))}", "metadata"))
+                out.append(
+                    Change(
+                        when,
+                        satellite,
+                        inst,
+                        "software",
+                        f"SDR software {', '.join(sorted(a[inst + '_sw']))} -> "
+                        f"{', '.join(sorted(b[inst + '_sw']))}",
+                        "metadata",
+                    )
+                )
     unique = {}
     for c in out:  # a common LUT appears in both instruments' lists
         unique.setdefault((c.time, c.instrument, c.description), c)
@@ -126,14 +153,24 @@ def stored_changes(store, satellite: str) -> list[Change]:
     for e in store.events():
         if e.kind.is_change and e.satellite == satellite and "time" in e.detail:
             d = e.detail
-            out.append(Change(_when(d["time"]), satellite, e.kind.value.split(":", 1)[1], d.get("kind", "change"),
-                              d.get("description", ""), d.get("origin", "service")))
+            out.append(
+                Change(
+                    _when(d["time"]),
+                    satellite,
+                    e.kind.value.split(":", 1)[1],
+                    d.get("kind", "change"),
+                    d.get("description", ""),
+                    d.get("origin", "service"),
+                )
+            )
     return out
 
 
 def all_changes(store, satellite: str, calendar_path=None) -> list[Change]:
     cal = [c for c in load_calendar(calendar_path) if c.satellite == satellite] if calendar_path else []
-    return sorted(cal + metadata_changes(store, satellite) + stored_changes(store, satellite), key=lambda c: c.time)
+    return sorted(
+        cal + metadata_changes(store, satellite) + stored_changes(store, satellite), key=lambda c: c.time
+    )
 
 
 def preceding_change(changes: list[Change], split_day: dt.date, window_days: int = 10) -> Change | None:

@@ -44,7 +44,9 @@ class LogChannel:
     def send(self, msg):
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with open(self.path, "a") as fh:
-            fh.write(f"--- {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} {msg['subject']}\n")
+            fh.write(
+                f"--- {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} {msg['subject']}\n"
+            )
             fh.write(msg["text"].rstrip() + "\n")
 
 
@@ -87,7 +89,8 @@ class EmailChannel:
 
 
 class SlackChannel:
-    """Slack incoming webhook: 200 ``ok`` is success; 429 honours Retry-After; 5xx is retried; 4xx is permanent."""
+    """Slack incoming webhook: 200 ``ok`` is success; 429 honours Retry-After; 5xx is retried; 4xx is
+    permanent."""
 
     name = "slack"
 
@@ -99,13 +102,21 @@ class SlackChannel:
         url = secret(self.s.webhook_env)
         if not url:
             raise Permanent(f"Slack webhook: environment variable {self.s.webhook_env} is not set")
-        payload = {"text": msg["text"][:3500],
-                   "blocks": [{"type": "section", "text": {"type": "mrkdwn", "text": b[:2900]}} for b in msg["blocks"]]}
+        payload = {
+            "text": msg["text"][:3500],
+            "blocks": [
+                {"type": "section", "text": {"type": "mrkdwn", "text": b[:2900]}} for b in msg["blocks"]
+            ],
+        }
         delay = 1.0
         for attempt in range(self.s.retries + 1):
             try:
-                r = requests.post(url, data=json.dumps(payload), headers={"Content-Type": "application/json"},
-                                  timeout=self.s.timeout_s)
+                r = requests.post(
+                    url,
+                    data=json.dumps(payload),
+                    headers={"Content-Type": "application/json"},
+                    timeout=self.s.timeout_s,
+                )
             except requests.RequestException as exc:
                 raise Transient(f"Slack webhook unreachable ({type(exc).__name__})") from None
             if r.status_code == 200 and r.text.strip() == "ok":
@@ -122,7 +133,9 @@ class SlackChannel:
                 self.sleep(delay)
                 delay *= 2
                 continue
-            raise Permanent(f"Slack HTTP {r.status_code} {r.text.strip()[:100]!r}: check the webhook configuration")
+            raise Permanent(
+                f"Slack HTTP {r.status_code} {r.text.strip()[:100]!r}: check the webhook configuration"
+            )
         raise Transient("Slack: retries exhausted")
 
 

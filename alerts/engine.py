@@ -29,8 +29,15 @@ UTC = dt.timezone.utc
 
 def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
     s = settings.rules
-    out = [f for f in (spec_finding(store, satellite, s), stale_finding(store, satellite, s, now),
-                       failure_finding(store, satellite)) if f is not None]
+    out = [
+        f
+        for f in (
+            spec_finding(store, satellite, s),
+            stale_finding(store, satellite, s, now),
+            failure_finding(store, satellite),
+        )
+        if f is not None
+    ]
     latest = store.latest_day(satellite)
     if latest is not None:
         changes = all_changes(store, satellite, settings.events_file)
@@ -58,8 +65,11 @@ def build_message(store, satellite: str, items: list, settings) -> dict:
     for kind, _ in items:
         counts[kind] = counts.get(kind, 0) + 1
     head = ", ".join(f"{n} {k}" for k, n in counts.items())
-    worst = "critical" if any(f.severity == "critical" and k != "resolved" for k, f in items) else \
-        ("resolved" if all(k == "resolved" for k, _ in items) else "warning")
+    worst = (
+        "critical"
+        if any(f.severity == "critical" and k != "resolved" for k, f in items)
+        else ("resolved" if all(k == "resolved" for k, _ in items) else "warning")
+    )
     subject = f"[crisgeo] {satellite} {worst.upper()}: {head} - " + "; ".join(f.rule for _, f in items)
     blocks, text = [], []
     for kind, f in items:
@@ -69,8 +79,10 @@ def build_message(store, satellite: str, items: list, settings) -> dict:
     day = store.latest_day(satellite)
     if day is not None:
         grans = store.granules(satellite, day)
-        text.append(f"assessment of {day}: {len(grans)} granule pair(s): "
-                    + ", ".join(g["granule_id"] for g in grans[:14]))
+        text.append(
+            f"assessment of {day}: {len(grans)} granule pair(s): "
+            + ", ".join(g["granule_id"] for g in grans[:14])
+        )
     trend = _trend(store, satellite)
     if trend:
         text += ["trend (last days):"] + [f"  {t}" for t in trend]
@@ -78,18 +90,25 @@ def build_message(store, satellite: str, items: list, settings) -> dict:
     if settings.report_url:
         where.append(f"report: {settings.report_url.rstrip('/')}/{satellite}/")
     elif settings.report_dir:
-        where.append(f"report: {settings.report_dir / satellite / 'index.html'} (on the server; set report_url)")
+        where.append(
+            f"report: {settings.report_dir / satellite / 'index.html'} (on the server; set report_url)"
+        )
     if settings.dashboard_url:
         where.append(f"dashboard: {settings.dashboard_url}")
     text += where
     if trend or where:
         blocks.append(_slack_escape("\n".join(["trend:"] + trend + where)))
     body = "\n".join(text)
-    # the report is regenerated between evaluation and delivery; the e-mail attaches the plot if it exists then
+    # the report is regenerated between evaluation and delivery; the e-mail attaches the plot if it exists
+    # then
     attachments = [str(settings.report_dir / satellite / "trend.png")] if settings.report_dir else []
-    return {"subject": subject, "text": body,
-            "html": f"<html><body><h3>{html.escape(subject)}</h3><pre>{html.escape(body)}</pre></body></html>",
-            "blocks": blocks, "attachments": attachments}
+    return {
+        "subject": subject,
+        "text": body,
+        "html": f"<html><body><h3>{html.escape(subject)}</h3><pre>{html.escape(body)}</pre></body></html>",
+        "blocks": blocks,
+        "attachments": attachments,
+    }
 
 
 def _slack_escape(s: str) -> str:
@@ -111,7 +130,10 @@ def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> lis
                 quiet = state.silenced(f.rule, sat, now) is not None
                 if prev is None or prev["status"] != "firing":
                     kind = "firing"
-                elif prev["last_notified"] is None or now - dt.datetime.fromisoformat(prev["last_notified"]) >= repeat:
+                elif (
+                    prev["last_notified"] is None
+                    or now - dt.datetime.fromisoformat(prev["last_notified"]) >= repeat
+                ):
                     kind = "repeat"
                 else:
                     kind = None
@@ -125,8 +147,20 @@ def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> lis
                     state.resolve(prev["fingerprint"], now)
                     if state.silenced(prev["rule"], sat, now) is None:
                         from alerts.rules import Finding
-                        items.append(("resolved", Finding(prev["rule"], sat, prev["severity"],
-                                                          f"resolved: {prev['summary']}", [], prev["grp"] or "")))
+
+                        items.append(
+                            (
+                                "resolved",
+                                Finding(
+                                    prev["rule"],
+                                    sat,
+                                    prev["severity"],
+                                    f"resolved: {prev['summary']}",
+                                    [],
+                                    prev["grp"] or "",
+                                ),
+                            )
+                        )
             if items:
                 msg = build_message(store, sat, items, settings)
                 for channel in settings.channels:
@@ -179,24 +213,42 @@ def alerts_view(store, now: dt.datetime) -> dict:
     state = AlertState(store)
     alerts = []
     for r in state.all():
-        if r["status"] == "resolved" and r["resolved"] and \
-                now - dt.datetime.fromisoformat(r["resolved"]) > dt.timedelta(days=7):
+        if (
+            r["status"] == "resolved"
+            and r["resolved"]
+            and now - dt.datetime.fromisoformat(r["resolved"]) > dt.timedelta(days=7)
+        ):
             continue
         quiet = state.silenced(r["rule"], r["satellite"], now)
-        alerts.append({"status": "silenced" if quiet and r["status"] == "firing" else r["status"],
-                       "severity": r["severity"], "rule": r["rule"], "satellite": r["satellite"],
-                       "fingerprint": r["fingerprint"], "started": r["started"], "resolved": r["resolved"],
-                       "summary": r["summary"], "lines": json.loads(r["lines"] or "[]")})
+        alerts.append(
+            {
+                "status": "silenced" if quiet and r["status"] == "firing" else r["status"],
+                "severity": r["severity"],
+                "rule": r["rule"],
+                "satellite": r["satellite"],
+                "fingerprint": r["fingerprint"],
+                "started": r["started"],
+                "resolved": r["resolved"],
+                "summary": r["summary"],
+                "lines": json.loads(r["lines"] or "[]"),
+            }
+        )
     silences = [{k: s[k] for k in ("rule", "satellite", "until", "reason")} for s in state.silences(now)]
     return {"alerts": alerts, "silences": silences, "pending_deliveries": len(state.deliveries("pending"))}
 
 
 def fmt_alerts(view: dict) -> str:
     """The text of ``crisgeo alerts list`` from :func:`alerts_view`."""
-    lines = [f"{a['status']:<9} {a['severity'] or '':<8} {a['fingerprint']:<28} since {a['started']}"
-             + (f" resolved {a['resolved']}" if a["status"] == "resolved" else "") + f"  {a['summary']}"
-             for a in view["alerts"]]
-    lines += [f"silence   rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: {s['reason']}"
-              for s in view["silences"]]
+    lines = [
+        f"{a['status']:<9} {a['severity'] or '':<8} {a['fingerprint']:<28} since {a['started']}"
+        + (f" resolved {a['resolved']}" if a["status"] == "resolved" else "")
+        + f"  {a['summary']}"
+        for a in view["alerts"]
+    ]
+    lines += [
+        f"silence   rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: "
+        f"{s['reason']}"
+        for s in view["silences"]
+    ]
     lines.append(f"{view['pending_deliveries']} message(s) waiting for delivery")
     return "\n".join(lines) if view["alerts"] or view["pending_deliveries"] else "no alerts"

@@ -20,8 +20,12 @@ from monitor.store.sqlite import SCHEDULER_KINDS, EventKind
 
 UTC = dt.timezone.utc
 COMPONENTS = (("in_track_km", "in-track"), ("cross_track_km", "cross-track"))
-GROUPS = {"FOR 1-10": range(0, 10), "FOR 11-20": range(10, 20), "FOR 21-30": range(20, N_FOR),
-          "all FORs": range(N_FOR)}
+GROUPS = {
+    "FOR 1-10": range(0, 10),
+    "FOR 11-20": range(10, 20),
+    "FOR 21-30": range(20, N_FOR),
+    "all FORs": range(N_FOR),
+}
 
 
 @dataclass
@@ -74,10 +78,17 @@ def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
     for f in store.day_result(satellite, day):
         if not f.reliable:
             continue
-        sig_total = (math.hypot(f.in_track_km * f.sigma_in_track_km, f.cross_track_km * f.sigma_cross_track_km)
-                     / f.total_km if _f(f.sigma_in_track_km) and f.total_km > 0 else float("nan"))
-        checks = (("in-track", abs(f.in_track_km), f.sigma_in_track_km), ("cross-track", abs(f.cross_track_km),
-                  f.sigma_cross_track_km), ("total", f.total_km, sig_total))
+        sig_total = (
+            math.hypot(f.in_track_km * f.sigma_in_track_km, f.cross_track_km * f.sigma_cross_track_km)
+            / f.total_km
+            if _f(f.sigma_in_track_km) and f.total_km > 0
+            else float("nan")
+        )
+        checks = (
+            ("in-track", abs(f.in_track_km), f.sigma_in_track_km),
+            ("cross-track", abs(f.cross_track_km), f.sigma_cross_track_km),
+            ("total", f.total_km, sig_total),
+        )
         over = [(name, v, sg) for name, v, sg in checks if _f(v) and v > s.spec_km]
         if not over:
             continue
@@ -87,13 +98,21 @@ def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
         return None
     severity = "critical" if any(c for _, _, c in rows) else "warning"
     fors = [f.for_index for f, _, _ in rows]
-    lines = [f"FOR {f.for_index:2d}: in-track {f.in_track_km:+.2f} +- {f.sigma_in_track_km:.2f} km, cross-track "
-             f"{f.cross_track_km:+.2f} +- {f.sigma_cross_track_km:.2f} km, total {f.total_km:.2f} km "
-             f"(spec {s.spec_km} km){'' if c else ' (within 2 sigma of the spec)'}" for f, _, c in rows]
-    return Finding("spec", satellite, severity,
-                   f"{satellite}: {len(rows)} FOR(s) beyond the {s.spec_km} km specification on {day}: "
-                   f"FOR {', '.join(map(str, fors))}", lines,
-                   data={"day": day.isoformat(), "fors": fors})
+    lines = [
+        f"FOR {f.for_index:2d}: in-track {f.in_track_km:+.2f} +- {f.sigma_in_track_km:.2f} km, cross-track "
+        f"{f.cross_track_km:+.2f} +- {f.sigma_cross_track_km:.2f} km, total {f.total_km:.2f} km "
+        f"(spec {s.spec_km} km){'' if c else ' (within 2 sigma of the spec)'}"
+        for f, _, c in rows
+    ]
+    return Finding(
+        "spec",
+        satellite,
+        severity,
+        f"{satellite}: {len(rows)} FOR(s) beyond the {s.spec_km} km specification on {day}: "
+        f"FOR {', '.join(map(str, fors))}",
+        lines,
+        data={"day": day.isoformat(), "fors": fors},
+    )
 
 
 def _series(store, satellite: str):
@@ -165,8 +184,15 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
                     t = step_test(values[comp][:, i], days, split, s)
                     if t and abs(t[0]) >= s.min_jump_km:
                         fors.setdefault(i + 1, []).append((label, t[0]))
-            found.append({"split": split, "groups": hits, "fors": fors, "known": known,
-                          "score": max(abs(h[3]) for h in hits)})
+            found.append(
+                {
+                    "split": split,
+                    "groups": hits,
+                    "fors": fors,
+                    "known": known,
+                    "score": max(abs(h[3]) for h in hits),
+                }
+            )
     # a blind step is seen at several neighbouring split days: keep the strongest of each cluster
     found.sort(key=lambda j: j["split"])
     kept = []
@@ -187,18 +213,40 @@ def jump_findings(store, satellite: str, changes: list, s: RuleSettings, today: 
         if (today - j["split"]).days > s.active_days:
             continue
         change = preceding_change(changes, j["split"], s.attribution_days)
-        cause = (f"preceded by {change.label()}" if change else
-                 f"no known change in the {s.attribution_days} days before it")
-        who = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS/VIIRS common"}[change.instrument] if change else "unknown"
+        cause = (
+            f"preceded by {change.label()}"
+            if change
+            else f"no known change in the {s.attribution_days} days before it"
+        )
+        who = (
+            {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS/VIIRS common"}[change.instrument]
+            if change
+            else "unknown"
+        )
         groups = "; ".join(f"{g} {label} {d:+.2f} km (z {z:+.1f})" for g, label, d, z in j["groups"])
         lines = [f"step from {j['split']}: {groups}", f"attribution: {cause}"]
-        lines += [f"FOR {k:2d}: " + ", ".join(f"{label} {d:+.2f} km" for label, d in v) for k, v in sorted(j["fors"].items())]
-        out.append(Finding("jump", satellite, "warning",
-                           f"{satellite}: geolocation jump from {j['split']} ({who} change before it)" if change else
-                           f"{satellite}: geolocation jump from {j['split']} with no known change before it",
-                           lines, group=j["split"].isoformat(),
-                           data={"split": j["split"].isoformat(), "instrument": change.instrument if change else None,
-                                 "fors": sorted(j["fors"]), "change": change.label() if change else None}))
+        lines += [
+            f"FOR {k:2d}: " + ", ".join(f"{label} {d:+.2f} km" for label, d in v)
+            for k, v in sorted(j["fors"].items())
+        ]
+        out.append(
+            Finding(
+                "jump",
+                satellite,
+                "warning",
+                f"{satellite}: geolocation jump from {j['split']} ({who} change before it)"
+                if change
+                else f"{satellite}: geolocation jump from {j['split']} with no known change before it",
+                lines,
+                group=j["split"].isoformat(),
+                data={
+                    "split": j["split"].isoformat(),
+                    "instrument": change.instrument if change else None,
+                    "fors": sorted(j["fors"]),
+                    "change": change.label() if change else None,
+                },
+            )
+        )
     return out
 
 
@@ -212,9 +260,18 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
     age = (now - since).total_seconds() / 3600
     if age <= s.stale_hours:
         return None
-    what = f"last successful assessment {ok[-1]['day']} finished {ok[-1]['finished']}" if ok else "no successful assessment yet"
-    return Finding("stale", satellite, "critical", f"{satellite}: no successful assessment for {age:.0f} h",
-                   [what, f"latest run: {runs[-1]['day']} {runs[-1]['status']} {runs[-1]['reason'] or ''}".strip()])
+    what = (
+        f"last successful assessment {ok[-1]['day']} finished {ok[-1]['finished']}"
+        if ok
+        else "no successful assessment yet"
+    )
+    return Finding(
+        "stale",
+        satellite,
+        "critical",
+        f"{satellite}: no successful assessment for {age:.0f} h",
+        [what, f"latest run: {runs[-1]['day']} {runs[-1]['status']} {runs[-1]['reason'] or ''}".strip()],
+    )
 
 
 def failure_finding(store, satellite: str) -> Finding | None:
@@ -223,14 +280,21 @@ def failure_finding(store, satellite: str) -> Finding | None:
     last_ok = max((r["id"] for r in runs if r["status"] in ("ok", "no_data", "no_data_final")), default=0)
     failed = [r for r in runs if r["id"] > last_ok and r["status"] == "failed"]
     last_ok_time = next((r["finished"] for r in runs if r["id"] == last_ok), "")
-    jobs = [e for e in store.events() if e.kind in SCHEDULER_KINDS
-            and e.satellite == satellite and e.time > (last_ok_time or "")]
+    jobs = [
+        e
+        for e in store.events()
+        if e.kind in SCHEDULER_KINDS and e.satellite == satellite and e.time > (last_ok_time or "")
+    ]
     if not failed and not jobs:
         return None
-    lines = [f"run {r['day']}: {r['reason']}" for r in failed] + \
-        [f"scheduler: {e.detail.get('job')}: {e.detail.get('error', e.detail.get('text'))} "
-         f"(scheduled {e.detail.get('scheduled', '?')})" for e in jobs]
-    return Finding("failure", satellite, "critical", f"{satellite}: {len(lines)} failed or missed run(s)", lines)
+    lines = [f"run {r['day']}: {r['reason']}" for r in failed] + [
+        f"scheduler: {e.detail.get('job')}: {e.detail.get('error', e.detail.get('text'))} "
+        f"(scheduled {e.detail.get('scheduled', '?')})"
+        for e in jobs
+    ]
+    return Finding(
+        "failure", satellite, "critical", f"{satellite}: {len(lines)} failed or missed run(s)", lines
+    )
 
 
 def processing_change_findings(store, satellite: str, s: RuleSettings, today: dt.date) -> list[Finding]:
@@ -245,7 +309,15 @@ def processing_change_findings(store, satellite: str, s: RuleSettings, today: dt
         when = dt.datetime.fromisoformat(d["time"])
         if (today - when.date()).days > s.active_days:
             continue
-        out.append(Finding("processing", satellite, "warning", f"{satellite}: {d['description']}",
-                           [f"seen in the GEO files from {when:%Y-%m-%d %H:%M:%S} UTC, before any VIIRS comparison"],
-                           group=when.date().isoformat(), data=d))
+        out.append(
+            Finding(
+                "processing",
+                satellite,
+                "warning",
+                f"{satellite}: {d['description']}",
+                [f"seen in the GEO files from {when:%Y-%m-%d %H:%M:%S} UTC, before any VIIRS comparison"],
+                group=when.date().isoformat(),
+                data=d,
+            )
+        )
     return out

@@ -57,10 +57,20 @@ EMAIL_KEYS = {"host", "port", "from", "to", "starttls", "username_env", "passwor
 SLACK_KEYS = set(SlackSettings.__dataclass_fields__)
 
 RULE_LIMITS = {  # the accepted range of each rule setting, in its unit
-    "spec_km": (0.01, 100.0), "min_jump_km": (0.001, 100.0), "jump_z": (1.0, 100.0), "jump_z_at_change": (1.0, 100.0),
-    "pre_days": (2, 365), "min_pre_days": (2, 365), "min_post_days": (1, 365), "post_days": (1, 365),
-    "blind_window_days": (1, 365), "change_window_days": (1, 3650), "attribution_days": (0, 365),
-    "active_days": (1, 3650), "stale_hours": (1.0, 8760.0), "repeat_hours": (0.1, 8760.0),
+    "spec_km": (0.01, 100.0),
+    "min_jump_km": (0.001, 100.0),
+    "jump_z": (1.0, 100.0),
+    "jump_z_at_change": (1.0, 100.0),
+    "pre_days": (2, 365),
+    "min_pre_days": (2, 365),
+    "min_post_days": (1, 365),
+    "post_days": (1, 365),
+    "blind_window_days": (1, 365),
+    "change_window_days": (1, 3650),
+    "attribution_days": (0, 365),
+    "active_days": (1, 3650),
+    "stale_hours": (1.0, 8760.0),
+    "repeat_hours": (0.1, 8760.0),
 }
 
 
@@ -94,7 +104,9 @@ def _only(doc, allowed, where):
         raise AlertConfigError(f"{where}{unknown[0]}: unknown key")
 
 
-def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=None, report_url=None) -> AlertSettings:
+def load_alert_settings(
+    doc: dict, base: Path, report_dir=None, dashboard_url=None, report_url=None
+) -> AlertSettings:
     """Parse the alerts section *doc*; relative paths are relative to *base* (the config file's folder)."""
     doc = doc or {}
     if not isinstance(doc, dict):
@@ -104,8 +116,9 @@ def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=No
         typ = float if isinstance(getattr(rules, key), float) else int
         setattr(rules, key, _typed(doc, key, typ, "alerts.", getattr(rules, key), limits))
     if rules.min_pre_days > rules.pre_days:
-        raise AlertConfigError(f"alerts.min_pre_days: {rules.min_pre_days} is more than alerts.pre_days "
-                               f"({rules.pre_days})")
+        raise AlertConfigError(
+            f"alerts.min_pre_days: {rules.min_pre_days} is more than alerts.pre_days ({rules.pre_days})"
+        )
     _only(doc, ALERT_KEYS, "alerts.")
 
     def path(key, d=doc, where="alerts."):
@@ -131,23 +144,32 @@ def load_alert_settings(doc: dict, base: Path, report_dir=None, dashboard_url=No
         sender = _typed(e, "from", str, w, d.sender)
         if "@" not in sender:
             raise AlertConfigError(f"alerts.email.from: {sender!r} is not an address")
-        s.email = EmailSettings(host=e["host"], port=_typed(e, "port", int, w, d.port, (1, 65535)), sender=sender,
-                                to=list(to), starttls=_typed(e, "starttls", bool, w, d.starttls),
-                                username_env=_typed(e, "username_env", str, w, d.username_env),
-                                password_env=_typed(e, "password_env", str, w, d.password_env),
-                                cafile=str(path("cafile", e, w)) if e.get("cafile") else None,
-                                timeout_s=_typed(e, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)))
+        s.email = EmailSettings(
+            host=e["host"],
+            port=_typed(e, "port", int, w, d.port, (1, 65535)),
+            sender=sender,
+            to=list(to),
+            starttls=_typed(e, "starttls", bool, w, d.starttls),
+            username_env=_typed(e, "username_env", str, w, d.username_env),
+            password_env=_typed(e, "password_env", str, w, d.password_env),
+            cafile=str(path("cafile", e, w)) if e.get("cafile") else None,
+            timeout_s=_typed(e, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)),
+        )
     if doc.get("slack"):
         sl = _mapping(doc, "slack")
         w = "alerts.slack."
         _only(sl, SLACK_KEYS, w)
         if not sl.get("webhook_env"):
-            raise AlertConfigError("alerts.slack.webhook_env: missing (the name of the variable holding the URL)")
+            raise AlertConfigError(
+                "alerts.slack.webhook_env: missing (the name of the variable holding the URL)"
+            )
         d = SlackSettings(webhook_env=sl["webhook_env"])
-        s.slack = SlackSettings(webhook_env=_typed(sl, "webhook_env", str, w, None),
-                                retries=_typed(sl, "retries", int, w, d.retries, (0, 20)),
-                                max_wait_s=_typed(sl, "max_wait_s", float, w, d.max_wait_s, (0.0, 3600.0)),
-                                timeout_s=_typed(sl, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)))
+        s.slack = SlackSettings(
+            webhook_env=_typed(sl, "webhook_env", str, w, None),
+            retries=_typed(sl, "retries", int, w, d.retries, (0, 20)),
+            max_wait_s=_typed(sl, "max_wait_s", float, w, d.max_wait_s, (0.0, 3600.0)),
+            timeout_s=_typed(sl, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)),
+        )
     return s
 
 

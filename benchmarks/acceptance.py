@@ -1,4 +1,5 @@
-"""Full-size acceptance runs of the science core: recovery of injected offsets, and the uncertainty's calibration.
+"""Full-size acceptance runs of the science core: recovery of injected offsets, and the uncertainty's
+calibration.
 
 For each case size, profile (paper, random, zero), ground (flat, or 1-4 km terrain over 40 % land), pass
 (day: ascending; night: descending; also arctic, antarctic, and dateline = a night pass across 180 deg)
@@ -41,8 +42,15 @@ EXTRA_PASSES = {"dateline": ("night", 180.0)}
 def run_case(root: Path, size, profile, ground, pass_name, seed, workers, keep):
     orbit_pass, lon = EXTRA_PASSES.get(pass_name, (pass_name, None))
     case = root / f"{profile}_{ground}_{pass_name}_{seed}_{size}"
-    truth = simulate_case(case, granules=size, profile=profile, seed=seed, terrain=ground == "terrain",
-                          orbit_pass=orbit_pass, pass_lon_deg=lon)
+    truth = simulate_case(
+        case,
+        granules=size,
+        profile=profile,
+        seed=seed,
+        terrain=ground == "terrain",
+        orbit_pass=orbit_pass,
+        pass_lon_deg=lon,
+    )
     t0 = time.perf_counter()
     cfg = AssessConfig()
     result = assess_paths([case], cfg, workers=workers)
@@ -52,13 +60,20 @@ def run_case(root: Path, size, profile, ground, pass_name, seed, workers, keep):
         shutil.rmtree(case)
     ta = np.array([f["d_alpha_urad"] for f in truth["fors"]])
     tb = np.array([f["d_beta_urad"] for f in truth["fors"]])
-    return {"size": size, "profile": profile, "ground": ground, "pass": pass_name, "seed": seed, "assess_s": secs,
-            "floor_urad": cfg.sigma_floor_urad,
-            "err_alpha_urad": (np.array([f.d_alpha_urad for f in result.fors]) - ta).tolist(),
-            "err_beta_urad": (np.array([f.d_beta_urad for f in result.fors]) - tb).tolist(),
-            "sigma_alpha_urad": [f.sigma_alpha_urad for f in result.fors],
-            "sigma_beta_urad": [f.sigma_beta_urad for f in result.fors],
-            "reliable": [f.reliable for f in result.fors]}
+    return {
+        "size": size,
+        "profile": profile,
+        "ground": ground,
+        "pass": pass_name,
+        "seed": seed,
+        "assess_s": secs,
+        "floor_urad": cfg.sigma_floor_urad,
+        "err_alpha_urad": (np.array([f.d_alpha_urad for f in result.fors]) - ta).tolist(),
+        "err_beta_urad": (np.array([f.d_beta_urad for f in result.fors]) - tb).tolist(),
+        "sigma_alpha_urad": [f.sigma_alpha_urad for f in result.fors],
+        "sigma_beta_urad": [f.sigma_beta_urad for f in result.fors],
+        "reliable": [f.reliable for f in result.fors],
+    }
 
 
 def verdict(row) -> tuple[bool, str]:
@@ -67,9 +82,11 @@ def verdict(row) -> tuple[bool, str]:
     rms = np.sqrt(np.nanmean(ea**2)), np.sqrt(np.nanmean(eb**2))
     worst = np.nanmax(np.abs(ea)), np.nanmax(np.abs(eb))
     ok = max(rms) <= rms_max and max(worst) <= abs_max and np.all(np.isfinite(ea + eb))
-    line = (f"{row['profile']:<7} {row['ground']:<8} {row['pass']:<9} {row['seed']:>4} {row['size']:>4} "
-            f"{rms[0]:6.1f} {worst[0]:6.1f} {rms[1]:6.1f} {worst[1]:6.1f} {row['reliable'].count(False):>7} "
-            f"{row['assess_s']:8.1f}  {'pass' if ok else 'FAIL'}")
+    line = (
+        f"{row['profile']:<7} {row['ground']:<8} {row['pass']:<9} {row['seed']:>4} {row['size']:>4} "
+        f"{rms[0]:6.1f} {worst[0]:6.1f} {rms[1]:6.1f} {worst[1]:6.1f} {row['reliable'].count(False):>7} "
+        f"{row['assess_s']:8.1f}  {'pass' if ok else 'FAIL'}"
+    )
     return ok, line
 
 
@@ -80,14 +97,23 @@ def calibration(rows) -> str:
         sel = [r for r in rows if r["size"] == size]
         err = np.concatenate([np.r_[r["err_alpha_urad"], r["err_beta_urad"]] for r in sel])
         sig = np.concatenate([np.r_[r["sigma_alpha_urad"], r["sigma_beta_urad"]] for r in sel])
-        boot = np.sqrt(np.maximum(sig**2 - np.concatenate([np.full(60, r["floor_urad"]) for r in sel]) ** 2, 0))
-        ratios = [np.median(np.r_[r["sigma_alpha_urad"], r["sigma_beta_urad"]])
-                  / np.sqrt(np.mean(np.r_[r["err_alpha_urad"], r["err_beta_urad"]] ** 2)) for r in sel]
+        boot = np.sqrt(
+            np.maximum(sig**2 - np.concatenate([np.full(60, r["floor_urad"]) for r in sel]) ** 2, 0)
+        )
+        ratios = [
+            np.median(np.r_[r["sigma_alpha_urad"], r["sigma_beta_urad"]])
+            / np.sqrt(np.mean(np.r_[r["err_alpha_urad"], r["err_beta_urad"]] ** 2))
+            for r in sel
+        ]
         cover = np.mean(np.abs(err) <= 2 * sig)
-        floor = next((f for f in np.arange(0.0, 60.0, 0.5) if np.mean(np.abs(err) <= 2 * np.hypot(boot, f)) >= 0.9),
-                     np.nan)
-        lines.append(f"{size:>4} {len(sel):>5} {100 * cover:7.1f}% {np.median(ratios):10.2f} {max(ratios):11.2f} "
-                     f"{floor:9.1f}")
+        floor = next(
+            (f for f in np.arange(0.0, 60.0, 0.5) if np.mean(np.abs(err) <= 2 * np.hypot(boot, f)) >= 0.9),
+            np.nan,
+        )
+        lines.append(
+            f"{size:>4} {len(sel):>5} {100 * cover:7.1f}% {np.median(ratios):10.2f} {max(ratios):11.2f} "
+            f"{floor:9.1f}"
+        )
     return "\n".join(lines)
 
 
@@ -110,8 +136,12 @@ def main() -> int:
         print(calibration(rows))
         return 0
     root = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="crisgeo-acceptance-"))
-    print(f"{'profile':<7} {'ground':<8} {'pass':<9} {'seed':>4} {'gran':>4} {'rms_a':>6} {'max_a':>6} {'rms_b':>6} "
-          f"{'max_b':>6} {'flagged':>7} {'assess_s':>8}  verdict", flush=True)
+    print(
+        f"{'profile':<7} {'ground':<8} {'pass':<9} {'seed':>4} {'gran':>4} {'rms_a':>6} {'max_a':>6} "
+        f"{'rms_b':>6} "
+        f"{'max_b':>6} {'flagged':>7} {'assess_s':>8}  verdict",
+        flush=True,
+    )
     rows, failures = [], 0
     done = {}
     if args.rows and Path(args.rows).exists():  # resume: cases already in the rows file are not run again
@@ -126,7 +156,9 @@ def main() -> int:
                     for seed in args.seeds:
                         row = done.get((size, ground, pass_name, profile, seed))
                         if row is None:
-                            row = run_case(root, size, profile, ground, pass_name, seed, args.workers, args.keep)
+                            row = run_case(
+                                root, size, profile, ground, pass_name, seed, args.workers, args.keep
+                            )
                         rows.append(row)
                         if args.rows and (size, ground, pass_name, profile, seed) not in done:
                             with open(args.rows, "a") as fh:

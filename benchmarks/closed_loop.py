@@ -35,8 +35,14 @@ def main() -> int:
     args = p.parse_args()
     work = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="crisgeo-loop-"))
     try:
-        rep = run_closed_loop(work, load_ep(args.true_ep), load_ep(args.ground_ep), granules=args.granules,
-                              seed=args.seed, workers=args.workers)
+        rep = run_closed_loop(
+            work,
+            load_ep(args.true_ep),
+            load_ep(args.ground_ep),
+            granules=args.granules,
+            seed=args.seed,
+            workers=args.workers,
+        )
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
@@ -46,8 +52,10 @@ def main() -> int:
     resid = max(np.nanmax(np.abs(a2)), np.nanmax(np.abs(b2)))
     km = max(np.nanmax(np.abs(it)), np.nanmax(np.abs(ct)))
     print(f"kept FORs: {[r.for_index for r in rep.optimization.kept]}")
-    print(f"max |recovered - true| SSM angle {angle:.1f} urad (bound 100); second assessment max |offset| "
-          f"{resid:.1f} urad (bound 150), {km:.3f} km (bound 0.15)")
+    print(
+        f"max |recovered - true| SSM angle {angle:.1f} urad (bound 100); second assessment max |offset| "
+        f"{resid:.1f} urad (bound 150), {km:.3f} km (bound 0.15)"
+    )
     print("seconds: " + ", ".join(f"{k} {v:.1f}" for k, v in rep.seconds.items()))
     ok = angle <= 100 and resid <= 150 and km <= 0.15
     print("PASS" if ok else "FAIL")

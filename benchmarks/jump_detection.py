@@ -35,8 +35,10 @@ def noise_series(rng, n_days: int):
     sig_in = np.full(30, 0.12)
     sig_cross = 0.12 + 0.25 * ((k - 14.5) / 14.5) ** 2
     d_alpha, d_beta = paper_profile()
-    base = {"in_track_km": d_alpha * 1e-6 * 830.0, "cross_track_km": d_beta * 1e-6 * 830.0 / np.cos(
-        np.radians((k - 14.5) * 3.33)) ** 2}
+    base = {
+        "in_track_km": d_alpha * 1e-6 * 830.0,
+        "cross_track_km": d_beta * 1e-6 * 830.0 / np.cos(np.radians((k - 14.5) * 3.33)) ** 2,
+    }
     out = {}
     for comp, sig in (("in_track_km", sig_in), ("cross_track_km", sig_cross)):
         e = rng.normal(0, 1, (n_days, 30))
@@ -49,8 +51,17 @@ def noise_series(rng, n_days: int):
 def inert_changes(rng, n_days: int, satellite="j01"):
     """Calendar entries that change nothing in the geolocation (about six a year)."""
     days = sorted(rng.choice(np.arange(30, n_days), size=max(1, n_days // 60), replace=False))
-    return [Change(dt.datetime.combine(START + dt.timedelta(days=int(d)), dt.time(12), dt.timezone.utc), satellite,
-                   rng.choice(["cris", "viirs"]), "software", "inert", "calendar") for d in days]
+    return [
+        Change(
+            dt.datetime.combine(START + dt.timedelta(days=int(d)), dt.time(12), dt.timezone.utc),
+            satellite,
+            rng.choice(["cris", "viirs"]),
+            "software",
+            "inert",
+            "calendar",
+        )
+        for d in days
+    ]
 
 
 def alerts_day_by_day(days, values, changes, s: RuleSettings, start: int = 25) -> dict:
@@ -72,10 +83,19 @@ def jump_trial(rng, jump_km: float, s: RuleSettings):
     comp = COMPONENTS[rng.integers(2)][0]
     group = [range(0, 10), range(10, 20), range(20, 30), range(30)][rng.integers(4)]
     values[comp][event:, list(group)] += jump_km * rng.choice([-1, 1])
-    changes = inert_changes(rng, n) + [Change(dt.datetime.combine(days[event], dt.time(6), dt.timezone.utc), "j01",
-                                              instrument, "ep_upload" if instrument == "cris" else "lut_change",
-                                              "injected", "calendar")]
-    changes = [c for c in changes if abs((c.time.date() - days[event]).days) > 12 or c.description == "injected"]
+    changes = inert_changes(rng, n) + [
+        Change(
+            dt.datetime.combine(days[event], dt.time(6), dt.timezone.utc),
+            "j01",
+            instrument,
+            "ep_upload" if instrument == "cris" else "lut_change",
+            "injected",
+            "calendar",
+        )
+    ]
+    changes = [
+        c for c in changes if abs((c.time.date() - days[event]).days) > 12 or c.description == "injected"
+    ]
     seen = alerts_day_by_day(days, values, changes, s, start=event - 5)
     hit = seen.get(days[event])
     if hit is None:
@@ -107,9 +127,12 @@ def main() -> int:
         found = sum(r[0] for r in res)
         right = sum(r[0] and r[1] for r in res)
         delays = [r[2] for r in res if r[2] is not None]
-        print(f"jump {jump:.2f} km: found within 3 days {found}/{args.trials} ({100 * found / args.trials:.1f} %), "
-              f"attributed to the right instrument {right}/{found}; median delay "
-              f"{np.median(delays) if delays else float('nan'):.0f} day(s)")
+        print(
+            f"jump {jump:.2f} km: found within 3 days {found}/{args.trials} "
+            f"({100 * found / args.trials:.1f} %), "
+            f"attributed to the right instrument {right}/{found}; median delay "
+            f"{np.median(delays) if delays else float('nan'):.0f} day(s)"
+        )
     fa = false_alarms(rng, args.years, s)
     print(f"false alarms on noise-only years: {fa} (mean {np.mean(fa):.2f} per satellite-year)")
     return 0

@@ -1,7 +1,8 @@
 """Render time of the HTML report for years of daily runs, and a screenshot of a report page.
 
     .venv/bin/python benchmarks/report_render.py [--years 3] [--satellites npp j01 j02]
-    .venv/bin/python benchmarks/report_render.py --screenshot demo-state/report/j01/index.html docs/report-demo.png
+    .venv/bin/python benchmarks/report_render.py --screenshot demo-state/report/j01/index.html
+    docs/report-demo.png
 
 The first form fills a temporary store with synthetic daily results (monitor.simulate.history) and
 prints the time to build the report; the issue's bound is one minute for 3 years x 3 satellites.
@@ -26,6 +27,7 @@ from monitor.store.sqlite import Store
 def screenshot(page: Path, out: Path, width: int = 1200) -> None:
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
+
     options = webdriver.ChromeOptions()
     options.binary_location = shutil.which("chromium")
     for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", f"--window-size={width},1000"):
@@ -62,8 +64,11 @@ def main() -> int:
         build_report(store, work / "report", ReportOptions(satellites=args.satellites))
         render_s = time.perf_counter() - t0
         store.close()
-        print(f"{args.years} years x {len(args.satellites)} satellites ({days * len(args.satellites) * 30} per-FOR rows): "
-              f"store filled in {fill_s:.1f} s, report rendered in {render_s:.1f} s (bound 60 s)")
+        print(
+            f"{args.years} years x {len(args.satellites)} satellites ({days * len(args.satellites) * 30} "
+            "per-FOR rows): "
+            f"store filled in {fill_s:.1f} s, report rendered in {render_s:.1f} s (bound 60 s)"
+        )
         return 0 if render_s < 60 else 1
     finally:
         shutil.rmtree(work, ignore_errors=True)

@@ -13,9 +13,11 @@ __all__ = ["AssessmentResult", "assess_paths", "open_store", "__version__"]
 def __getattr__(name):  # the public API, imported when first used (keeps ``import monitor`` light)
     if name == "assess_paths":
         from monitor.assess import assess_paths
+
         return assess_paths
     if name == "AssessmentResult":
         from monitor.result import AssessmentResult
+
         return AssessmentResult
     if name == "open_store":
         return open_store
@@ -25,4 +27,5 @@ def __getattr__(name):  # the public API, imported when first used (keeps ``impo
 def open_store(path):
     """The service's SQLite store at *path*, e.g. ``open_store(p).to_xarray("j01")`` in a notebook."""
     from monitor.store.sqlite import Store
+
     return Store(path)

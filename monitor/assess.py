@@ -110,11 +110,15 @@ def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=N
         halo_before = read_viirs_geo_scan(before.geo, -1) if before is not None else None
         halo_after = read_viirs_geo_scan(after.geo, 0) if after is not None else None
     if sdr.bt_k.shape != geo.lat_rad.shape:
-        raise GranuleError(v.sdr, "BrightnessTemperature", f"shape {sdr.bt_k.shape} does not match the GEO "
-                                                           f"{geo.lat_rad.shape}")
+        raise GranuleError(
+            v.sdr,
+            "BrightnessTemperature",
+            f"shape {sdr.bt_k.shape} does not match the GEO {geo.lat_rad.shape}",
+        )
     with _stage(timings, "geometry"):
-        piece = collocate.swath_piece(geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band,
-                                      halo_before, halo_after)
+        piece = collocate.swath_piece(
+            geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after
+        )
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))
     cache.pieces[v.key] = piece
@@ -132,20 +136,37 @@ def _load_swath(viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathC
     return cache.swath[1]
 
 
-def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: AssessConfig, band,
-                      cache: _SwathCache, timings=None, viirs_all=None, should_stop=None) -> GranuleSamples:
+def collocate_granule(
+    cris: GranuleFiles,
+    viirs: list[GranuleFiles],
+    cfg: AssessConfig,
+    band,
+    cache: _SwathCache,
+    timings=None,
+    viirs_all=None,
+    should_stop=None,
+) -> GranuleSamples:
     """Read one CrIS granule and its VIIRS cover and collocate every FOV for every perturbation.
 
     *timings*, when a dict, accumulates seconds per stage: read, geometry, collocation.
     """
     with _stage(timings, "read"):
-        geo = next(g for g in read_file(cris.geo, kinds=("cris_geo",))
-                   if g.meta.granule_id == cris.geo_meta.granule_id)
-        sdr = next(g for g in read_file(cris.sdr, kinds=("cris_sdr",))
-                   if g.meta.granule_id == cris.sdr_meta.granule_id)
+        geo = next(
+            g
+            for g in read_file(cris.geo, kinds=("cris_geo",))
+            if g.meta.granule_id == cris.geo_meta.granule_id
+        )
+        sdr = next(
+            g
+            for g in read_file(cris.sdr, kinds=("cris_sdr",))
+            if g.meta.granule_id == cris.sdr_meta.granule_id
+        )
     if sdr.radiance_lw.shape[:3] != geo.lat_rad.shape:
-        raise GranuleError(cris.sdr, "ES_RealLW", f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO "
-                                                  f"{geo.lat_rad.shape}")
+        raise GranuleError(
+            cris.sdr,
+            "ES_RealLW",
+            f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO {geo.lat_rad.shape}",
+        )
     with _stage(timings, "geometry"):
         fg, valid, fill = _cris_geometry(geo)
     with _stage(timings, "spectral"):
@@ -153,26 +174,58 @@ def collocate_granule(cris: GranuleFiles, viirs: list[GranuleFiles], cfg: Assess
     swath = _load_swath(viirs, viirs_all or viirs, band, cache, timings)
     with _stage(timings, "collocation"):
         bt_viirs, coverage = _collocate_fors(swath, geo, fg, valid, fill, cfg, band, should_stop)
-    usable = (valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
-              & np.all(np.isfinite(bt_viirs), axis=(-2, -1)))
-    info = {"granule_id": geo.meta.granule_id, "start": geo.meta.start.isoformat(), "end": geo.meta.end.isoformat(),
-            "cris_geo": cris.geo.name, "cris_sdr": cris.sdr.name,
-            "viirs": [v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
-            "n_fovs": int(valid.sum()), "n_usable": int(usable.sum()),
-            "cris_meta": geo.meta.to_dict(), "viirs_meta": viirs[0].geo_meta.to_dict()}
+    usable = (
+        valid
+        & sdr.good
+        & np.isfinite(bt_cris)
+        & (coverage >= cfg.min_coverage)
+        & np.all(np.isfinite(bt_viirs), axis=(-2, -1))
+    )
+    info = {
+        "granule_id": geo.meta.granule_id,
+        "start": geo.meta.start.isoformat(),
+        "end": geo.meta.end.isoformat(),
+        "cris_geo": cris.geo.name,
+        "cris_sdr": cris.sdr.name,
+        "viirs": [v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
+        "n_fovs": int(valid.sum()),
+        "n_usable": int(usable.sum()),
+        "cris_meta": geo.meta.to_dict(),
+        "viirs_meta": viirs[0].geo_meta.to_dict(),
+    }
     s5 = (slice(None), slice(None), FOV5)
-    return GranuleSamples(cris.key, info, bt_viirs, bt_cris, usable, fg.sat_ecef_m[s5], fg.sbf_to_ecef[s5],
-                          fg.alpha_rad[s5], fg.beta_rad[s5], fg.velocity_ecef_m_s[s5])
+    return GranuleSamples(
+        cris.key,
+        info,
+        bt_viirs,
+        bt_cris,
+        usable,
+        fg.sat_ecef_m[s5],
+        fg.sbf_to_ecef[s5],
+        fg.alpha_rad[s5],
+        fg.beta_rad[s5],
+        fg.velocity_ecef_m_s[s5],
+    )
 
 
 def _cris_geometry(geo):
     """Inverse geolocation of a CrIS GEO granule, with fill FOVs given harmless values and masked."""
     valid = geo.valid
-    fill = {k: np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")}
-    fg = inverse_geolocation(fill["lat_rad"], fill["lon_rad"], fill["zenith_rad"], fill["azimuth_rad"],
-                             np.where(valid, geo.range_m, 1e6), geo.for_time_us, geo.mid_time_us,
-                             np.nan_to_num(geo.sc_position_m), np.nan_to_num(geo.sc_velocity_m_s),
-                             np.nan_to_num(geo.sc_attitude_rad))
+    fill = {
+        k: np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")
+    }
+    fg = inverse_geolocation(
+        fill["lat_rad"],
+        fill["lon_rad"],
+        fill["zenith_rad"],
+        fill["azimuth_rad"],
+        np.where(valid, geo.range_m, 1e6),
+        geo.for_time_us,
+        geo.mid_time_us,
+        np.nan_to_num(geo.sc_position_m),
+        np.nan_to_num(geo.sc_velocity_m_s),
+        np.nan_to_num(geo.sc_attitude_rad),
+    )
     return fg, valid, fill
 
 
@@ -190,10 +243,16 @@ def _collocate_fors(swath, geo, fg, valid, fill, cfg, band, should_stop=None):
         sl = (slice(None), k)
         shape = fg.alpha_rad[sl].shape
         mean, cov = collocate.cone_sums(
-            swath, fg.sat_ecef_m[sl].reshape(-1, 3), fg.sbf_to_ecef[sl].reshape(-1, 3, 3),
-            fg.alpha_rad[sl].ravel(), fg.beta_rad[sl].ravel(), offsets, kernel,
+            swath,
+            fg.sat_ecef_m[sl].reshape(-1, 3),
+            fg.sbf_to_ecef[sl].reshape(-1, 3, 3),
+            fg.alpha_rad[sl].ravel(),
+            fg.beta_rad[sl].ravel(),
+            offsets,
+            kernel,
             fov_range_m=np.where(valid[sl], geo.range_m[sl], 1e6).ravel(),
-            fov_cos_zen=np.cos(fill["zenith_rad"][sl]).ravel())
+            fov_cos_zen=np.cos(fill["zenith_rad"][sl]).ravel(),
+        )
         bt_viirs[sl] = band.bt_from_radiance(mean).reshape(shape + (m, m))
         coverage[sl] = np.nanmin(np.where(np.isfinite(cov), cov, 0.0), axis=(-2, -1)).reshape(shape)
     return bt_viirs, coverage
@@ -233,7 +292,7 @@ def find_minimum(cost, contrast=0.03):
         return float(i0 - n), float(j0 - n), flags + [FLAG_EDGE]
     x, y = np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.0, 1.0], indexing="ij")
     a = np.stack([np.ones(9), x.ravel(), y.ravel(), x.ravel() ** 2, x.ravel() * y.ravel(), y.ravel() ** 2], 1)
-    c = np.linalg.lstsq(a, cost[i0 - 1:i0 + 2, j0 - 1:j0 + 2].ravel(), rcond=None)[0]
+    c = np.linalg.lstsq(a, cost[i0 - 1 : i0 + 2, j0 - 1 : j0 + 2].ravel(), rcond=None)[0]
     hess = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
     if np.linalg.det(hess) <= 0 or hess[0, 0] <= 0:
         return float(i0 - n), float(j0 - n), sorted(set(flags + [FLAG_FLAT]))
@@ -244,11 +303,14 @@ def find_minimum(cost, contrast=0.03):
 
 def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
     """Mean in-track/cross-track km of a turn (rad) at FOR k over the FOV-5 views used, and the Jacobian."""
-    sel = [(s.sat_m[:, k], s.sbf_to_ecef[:, k], s.alpha_rad[:, k], s.beta_rad[:, k], s.velocity_m_s[:, k])
-           for s in samples if np.any(s.usable[:, k])]
+    sel = [
+        (s.sat_m[:, k], s.sbf_to_ecef[:, k], s.alpha_rad[:, k], s.beta_rad[:, k], s.velocity_m_s[:, k])
+        for s in samples
+        if np.any(s.usable[:, k])
+    ]
     if not sel:
         return np.nan, np.nan, np.full((2, 2), np.nan)
-    sat, mat, a, b, v = (np.concatenate(x) for x in zip(*sel))
+    sat, mat, a, b, v = (np.concatenate(x) for x in zip(*sel, strict=True))
     if not np.isfinite(d_alpha + d_beta):
         return np.nan, np.nan, np.full((2, 2), np.nan)
     it, ct = offset_km(sat, mat, a, b, v, d_alpha, d_beta)
@@ -264,7 +326,9 @@ def _scan_bootstrap_counts(rng, granule_of_unit, n_boot):
     counts = np.zeros((n_boot, len(granule_of_unit)))
     for g in np.unique(granule_of_unit):
         members = np.flatnonzero(granule_of_unit == g)
-        counts[:, members] = rng.multinomial(len(members), np.full(len(members), 1.0 / len(members)), size=n_boot)
+        counts[:, members] = rng.multinomial(
+            len(members), np.full(len(members), 1.0 / len(members)), size=n_boot
+        )
     return counts
 
 
@@ -294,7 +358,9 @@ def for_minimum(d, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
     return g, x, y, sig, flags
 
 
-def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=None, satellite="") -> AssessmentResult:
+def cost_and_offsets(
+    samples: list[GranuleSamples], cfg: AssessConfig, skipped=None, satellite=""
+) -> AssessmentResult:
     """The cost cube, per-FOR minimum, bootstrap uncertainty and km offsets of collocated *samples*."""
     offsets = cfg.offsets_rad
     m = len(offsets)
@@ -310,7 +376,9 @@ def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=N
             diffs.append(d.astype(np.float64))
             units.append(g_i * 1000 + np.nonzero(use)[0])
         d = np.concatenate(diffs) if diffs else np.empty((0, m, m))
-        scan_keys, unit_ids = np.unique(np.concatenate(units), return_inverse=True) if diffs else (np.empty(0), [])
+        scan_keys, unit_ids = (
+            np.unique(np.concatenate(units), return_inverse=True) if diffs else (np.empty(0), [])
+        )
         n = len(d)
         flags = []
         if n < max(cfg.min_samples, 3):
@@ -322,31 +390,59 @@ def cost_and_offsets(samples: list[GranuleSamples], cfg: AssessConfig, skipped=N
             g, x, y, (sig_a, sig_b), fl = for_minimum(d, unit_ids, scan_keys // 1000, cfg, rng)
             cube[k] = g
             flags += fl
-            sig_a, sig_b = np.hypot(sig_a * step_urad, cfg.sigma_floor_urad), np.hypot(sig_b * step_urad,
-                                                                                    cfg.sigma_floor_urad)
+            sig_a, sig_b = (
+                np.hypot(sig_a * step_urad, cfg.sigma_floor_urad),
+                np.hypot(sig_b * step_urad, cfg.sigma_floor_urad),
+            )
             if max(sig_a, sig_b) > cfg.max_sigma_urad:
                 flags.append(FLAG_UNCERTAIN)
         d_alpha, d_beta = x * step_urad, y * step_urad
         it, ct, jac = _ground_km(samples, k, d_alpha * 1e-6, d_beta * 1e-6)
         s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * 1e-6) if np.isfinite(sig_a) else np.nan
         s_ct = float(np.hypot(jac[1, 0] * sig_a, jac[1, 1] * sig_b) * 1e-6) if np.isfinite(sig_a) else np.nan
-        fors.append(ForOffset(
-            for_index=k + 1, d_alpha_urad=float(d_alpha), d_beta_urad=float(d_beta),
-            sigma_alpha_urad=float(sig_a), sigma_beta_urad=float(sig_b),
-            in_track_km=it, cross_track_km=ct, total_km=float(np.hypot(it, ct)),
-            sigma_in_track_km=s_it, sigma_cross_track_km=s_ct, n_samples=int(n),
-            cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
-            cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan, flags=tuple(sorted(set(flags)))))
+        fors.append(
+            ForOffset(
+                for_index=k + 1,
+                d_alpha_urad=float(d_alpha),
+                d_beta_urad=float(d_beta),
+                sigma_alpha_urad=float(sig_a),
+                sigma_beta_urad=float(sig_b),
+                in_track_km=it,
+                cross_track_km=ct,
+                total_km=float(np.hypot(it, ct)),
+                sigma_in_track_km=s_it,
+                sigma_cross_track_km=s_ct,
+                n_samples=int(n),
+                cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
+                cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan,
+                flags=tuple(sorted(set(flags))),
+            )
+        )
     starts = [s.info["start"] for s in samples]
     ends = [s.info["end"] for s in samples]
     return AssessmentResult(
-        satellite=satellite, start=min(starts) if starts else "", end=max(ends) if ends else "", fors=fors,
-        granules=[s.info for s in samples], skipped=[{"item": a, "reason": b} for a, b in (skipped or [])],
-        half_steps=cfg.half_steps, step_urad=step_urad, cost_cube_k=cube)
+        satellite=satellite,
+        start=min(starts) if starts else "",
+        end=max(ends) if ends else "",
+        fors=fors,
+        granules=[s.info for s in samples],
+        skipped=[{"item": a, "reason": b} for a, b in (skipped or [])],
+        half_steps=cfg.half_steps,
+        step_urad=step_urad,
+        cost_cube_k=cube,
+    )
 
 
-def _collocate_run(cris: list, viirs: dict, viirs_all: list, satellite: str, cfg: AssessConfig,
-                   progress=None, should_stop=None, timings=None):
+def _collocate_run(
+    cris: list,
+    viirs: dict,
+    viirs_all: list,
+    satellite: str,
+    cfg: AssessConfig,
+    progress=None,
+    should_stop=None,
+    timings=None,
+):
     """Collocate a time-ordered run of CrIS granules; returns (samples, skipped)."""
     band = i5_band(satellite)
     cache = _SwathCache()
@@ -356,7 +452,9 @@ def _collocate_run(cris: list, viirs: dict, viirs_all: list, satellite: str, cfg
             skipped.append((g.key, "not assessed: stop requested"))
             continue
         try:
-            samples.append(collocate_granule(g, viirs[g.key], cfg, band, cache, timings, viirs_all, should_stop))
+            samples.append(
+                collocate_granule(g, viirs[g.key], cfg, band, cache, timings, viirs_all, should_stop)
+            )
         except StopRequested:
             skipped.append((g.key, "not assessed: stop requested"))
             continue
@@ -372,13 +470,27 @@ def _worker(args):
     cris, viirs, viirs_all, satellite, cfg = args
     timings = {}
     done = (lambda g: _DONE.put(g.key)) if _DONE is not None else None
-    samples, skipped = _collocate_run(cris, viirs, viirs_all, satellite, cfg, progress=done, timings=timings,
-                                      should_stop=_STOP.is_set if _STOP is not None else None)
+    samples, skipped = _collocate_run(
+        cris,
+        viirs,
+        viirs_all,
+        satellite,
+        cfg,
+        progress=done,
+        timings=timings,
+        should_stop=_STOP.is_set if _STOP is not None else None,
+    )
     return samples, skipped, timings
 
 
-def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, should_stop=None,
-                timings=None, workers: int = 1) -> AssessmentResult:
+def assess_plan(
+    case: CasePlan,
+    cfg: AssessConfig | None = None,
+    progress=None,
+    should_stop=None,
+    timings=None,
+    workers: int = 1,
+) -> AssessmentResult:
     """Assess every CrIS granule of *case*; granules that fail are skipped with their reason. Fewer usable
     FOVs in all than ``cfg.min_samples`` is an :class:`AssessmentError` naming the files.
 
@@ -390,7 +502,9 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
     cfg = cfg or AssessConfig()
     skipped = list(case.skipped)
     if workers > 1 and len(case.cris) > 1:
-        runs = [list(r) for r in np.array_split(np.array(case.cris, dtype=object), min(workers, len(case.cris)))]
+        runs = [
+            list(r) for r in np.array_split(np.array(case.cris, dtype=object), min(workers, len(case.cris)))
+        ]
         samples = []
         for s, k, t in _in_processes(runs, case, cfg, should_stop, progress):
             samples += s
@@ -399,16 +513,19 @@ def assess_plan(case: CasePlan, cfg: AssessConfig | None = None, progress=None, 
                 if timings is not None:
                     timings[name] = timings.get(name, 0.0) + sec
     else:
-        samples, k = _collocate_run(case.cris, case.viirs, case.viirs_all, case.satellite, cfg,
-                                    progress, should_stop, timings)
+        samples, k = _collocate_run(
+            case.cris, case.viirs, case.viirs_all, case.satellite, cfg, progress, should_stop, timings
+        )
         skipped += k
     usable = sum(int(s.usable.sum()) for s in samples)
     stopped = should_stop is not None and should_stop()  # the caller records an interruption, not bad data
     if usable < cfg.min_samples and not stopped:
         files = ", ".join(sorted({s.info["cris_geo"] for s in samples} | {str(k) for k, _ in skipped}))[:800]
         why = "; ".join(f"{k}: {r}" for k, r in skipped[:3])
-        raise AssessmentError(f"too few usable FOVs to assess: {usable} (at least {cfg.min_samples}) in "
-                              f"{len(samples)} granule(s) [{files}]" + (f"; skipped: {why}" if why else ""))
+        raise AssessmentError(
+            f"too few usable FOVs to assess: {usable} (at least {cfg.min_samples}) in "
+            f"{len(samples)} granule(s) [{files}]" + (f"; skipped: {why}" if why else "")
+        )
     with _stage(timings, "cost"):
         return cost_and_offsets(samples, cfg, skipped, case.satellite)
 
@@ -425,6 +542,7 @@ def _die_with_parent(stop_event, done_queue):
     try:
         import ctypes
         import signal
+
         ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except (OSError, AttributeError):  # not Linux: the pool's own shutdown still applies
         pass
@@ -442,6 +560,7 @@ def _in_processes(runs, case, cfg, should_stop, progress=None):
     import multiprocessing as mp
     import queue
     import threading
+
     ctx = mp.get_context("spawn")
     event = ctx.Event()
     finished = ctx.Queue() if progress is not None else None
@@ -459,12 +578,14 @@ def _in_processes(runs, case, cfg, should_stop, progress=None):
                 progress(granules[finished.get(timeout=0.2)])
             except queue.Empty:
                 pass
+
     relay_thread = threading.Thread(target=relay, daemon=True)
     relay_thread.start()
     jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg) for r in runs]
     try:
-        with cf.ProcessPoolExecutor(len(jobs), mp_context=ctx, initializer=_die_with_parent,
-                                    initargs=(event, finished)) as pool:
+        with cf.ProcessPoolExecutor(
+            len(jobs), mp_context=ctx, initializer=_die_with_parent, initargs=(event, finished)
+        ) as pool:
             return list(pool.map(_worker, jobs))
     finally:
         done.set()

@@ -44,6 +44,7 @@ def _pyresample_reference(case, cfg, max_granules=1):
         return None
     from monitor.geometry import wgs84
     from monitor.geometry.perturb import perturbed_los_sbf
+
     g = case.cris[0]
     v = case.viirs[g.key]
     geo = read_file(g.geo, kinds=("cris_geo",))[0]
@@ -84,17 +85,24 @@ def run_bench(args) -> int:
         result = assess_plan(case, cfg, timings=timings, workers=args.workers)
         wall = time.perf_counter() - t0
         n_fov = sum(gr["n_fovs"] for gr in result.granules)
-        print(f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(cfg.offsets_rad) ** 2} "
-              f"perturbations (simulation {t_sim:.1f} s, not counted)")
+        print(
+            f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(cfg.offsets_rad) ** 2} "
+            f"perturbations (simulation {t_sim:.1f} s, not counted)"
+        )
         for stage in ("read", "geometry", "spectral", "collocation", "cost"):
             t = timings.get(stage, 0.0)
-            print(f"  {stage:<12} {t:8.2f} s  {n_fov / t if t else float('inf'):10.0f} FOVs/s (summed over workers)")
+            print(
+                f"  {stage:<12} {t:8.2f} s  {n_fov / t if t else float('inf'):10.0f} FOVs/s (summed over "
+                "workers)"
+            )
         print(f"  {'total':<12} {wall:8.2f} s  {n_fov / wall:10.0f} FOVs/s")
         own, child = peak_rss_mb(), peak_rss_mb(resource.RUSAGE_CHILDREN)
         workers = max(1, min(args.workers, len(result.granules)))
         if workers > 1:
-            print(f"peak memory: {own:.0f} MB main process + {workers} workers x {child:.0f} MB (largest) "
-                  f"<= {own + workers * child:.0f} MB in all")
+            print(
+                f"peak memory: {own:.0f} MB main process + {workers} workers x {child:.0f} MB (largest) "
+                f"<= {own + workers * child:.0f} MB in all"
+            )
         else:
             print(f"peak memory: {own:.0f} MB")
         if sim_counted:
@@ -105,7 +113,9 @@ def run_bench(args) -> int:
                 print("pyresample reference: not installed (pip install pyresample)")
             else:
                 secs, nf = ref
-                print(f"pyresample radius search for the same 441 perturbed LOS per FOV, one granule, only the "
-                      f"64 nearest pixels (a cone holds 1000-12000) and no angle test or averaging: "
-                      f"{secs:.2f} s for {nf} FOVs = {nf / secs:.0f} FOVs/s")
+                print(
+                    f"pyresample radius search for the same 441 perturbed LOS per FOV, one granule, only the "
+                    f"64 nearest pixels (a cone holds 1000-12000) and no angle test or averaging: "
+                    f"{secs:.2f} s for {nf} FOVs = {nf / secs:.0f} FOVs/s"
+                )
     return 0

@@ -37,27 +37,46 @@ def _iso(text: str) -> dt.datetime:
 
 def cmd_simulate(args) -> int:
     from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
+
     where = dict(terrain=args.terrain, orbit_pass=args.orbit_pass, pass_lon_deg=args.pass_lon)
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")
     try:
         spec = None
         if args.true_ep:
-            spec = SimulationSpec(satellite=args.satellite, granules=args.granules, seed=args.seed,
-                                  start=args.start or DEFAULT_START, profile="ep",
-                                  true_ep=_ep(args.true_ep), ground_ep=_ep(args.ground_ep), **where)
-        truth = simulate_case(args.out, satellite=args.satellite, granules=args.granules, profile=args.profile,
-                              seed=args.seed, start=args.start, spec=spec, **where)
+            spec = SimulationSpec(
+                satellite=args.satellite,
+                granules=args.granules,
+                seed=args.seed,
+                start=args.start or DEFAULT_START,
+                profile="ep",
+                true_ep=_ep(args.true_ep),
+                ground_ep=_ep(args.ground_ep),
+                **where,
+            )
+        truth = simulate_case(
+            args.out,
+            satellite=args.satellite,
+            granules=args.granules,
+            profile=args.profile,
+            seed=args.seed,
+            start=args.start,
+            spec=spec,
+            **where,
+        )
     except ValueError as exc:
         raise BadInput(str(exc)) from None
     error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {args.profile}"
-    print(f"wrote {len(truth['files'])} files and truth.json to {args.out} "
-          f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {args.seed})")
+    print(
+        f"wrote {len(truth['files'])} files and truth.json to {args.out} "
+        f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {args.seed})"
+    )
     return EXIT_OK
 
 
 def _ep(path, satellite=None):
     from monitor.mapping.engpkt import load_ep
+
     try:
         return load_ep(path, satellite)
     except ValueError as exc:
@@ -67,6 +86,7 @@ def _ep(path, satellite=None):
 def _residuals(args):
     """The residual table of --residuals FILE, or each granule's own against --own-residuals EP."""
     from monitor.mapping.residuals import OwnResiduals, ResidualError, load
+
     if args.residuals and args.own_residuals:
         raise BadInput("--residuals and --own-residuals exclude each other")
     if args.own_residuals:
@@ -85,6 +105,7 @@ def cmd_optimize(args) -> int:
     from monitor.mapping.engpkt import save_ep
     from monitor.mapping.optimize import optimize
     from monitor.result import AssessmentResult
+
     try:
         result = AssessmentResult.from_json(Path(args.result).read_text())
     except (OSError, ValueError, KeyError, TypeError) as exc:
@@ -94,8 +115,10 @@ def cmd_optimize(args) -> int:
         opt = optimize(result, ep, source=str(args.result))
     except ValueError as exc:
         raise BadInput(str(exc)) from None
-    print(f"EP {ep.version} ({ep.satellite}) corrected by {args.result} ({result.start} .. {result.end}, "
-          f"{len(result.granules)} granules)")
+    print(
+        f"EP {ep.version} ({ep.satellite}) corrected by {args.result} ({result.start} .. {result.end}, "
+        f"{len(result.granules)} granules)"
+    )
     print(opt.table())
     save_ep(opt.ep, args.out, like=args.ep)
     print(f"wrote {args.out}")
@@ -107,6 +130,7 @@ def cmd_optimize(args) -> int:
 def cmd_regeolocate(args) -> int:
     from monitor.mapping.regeolocate import regeolocate_file
     from monitor.sdr import GranuleError
+
     ep = _ep(args.ep)
     residuals = _residuals(args)
     failed = 0
@@ -127,15 +151,23 @@ def cmd_geolocate(args) -> int:
 
     from monitor.mapping.regeolocate import compare_with_files
     from monitor.sdr import GranuleError
+
     ep = _ep(args.ep)
     try:
         rows = compare_with_files(ep, args.files, _residuals(args))
     except (GranuleError, ValueError) as exc:
         raise BadInput(str(exc)) from None
     if args.json:
-        print(json.dumps({"ep": ep.version, "satellite": ep.satellite, "fors": [r.to_dict() for r in rows]}, indent=1))
+        print(
+            json.dumps(
+                {"ep": ep.version, "satellite": ep.satellite, "fors": [r.to_dict() for r in rows]}, indent=1
+            )
+        )
         return EXIT_OK
-    print(f"EP {ep.version} geolocation vs the files' own latitude/longitude ({len(args.files)} file(s)), metres")
+    print(
+        f"EP {ep.version} geolocation vs the files' own latitude/longitude ({len(args.files)} file(s)), "
+        "metres"
+    )
     print(f"{'FOR':>3} {'FOVs':>6} {'median':>8} {'p99':>8} {'max':>8}")
     for r in rows:
         print(f"{r.for_index:>3} {r.n:>6} {r.median_m:8.1f} {r.p99_m:8.1f} {r.max_m:8.1f}")
@@ -144,14 +176,25 @@ def cmd_geolocate(args) -> int:
 
 def format_table(result) -> str:
     """The per-FOR table printed by ``crisgeo assess``."""
-    head = (f"{'FOR':>3} {'d_alpha':>8} {'+-':>5} {'d_beta':>8} {'+-':>5} {'in-trk':>7} {'x-trk':>7} "
-            f"{'total':>6} {'N':>5} {'G_min':>6} {'G_0':>6}  flags")
-    units = f"{'':>3} {'urad':>8} {'':>5} {'urad':>8} {'':>5} {'km':>7} {'km':>7} {'km':>6} {'':>5} {'K':>6} {'K':>6}"
-    lines = [f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules", head, units]
+    head = (
+        f"{'FOR':>3} {'d_alpha':>8} {'+-':>5} {'d_beta':>8} {'+-':>5} {'in-trk':>7} {'x-trk':>7} "
+        f"{'total':>6} {'N':>5} {'G_min':>6} {'G_0':>6}  flags"
+    )
+    units = (
+        f"{'':>3} {'urad':>8} {'':>5} {'urad':>8} {'':>5} {'km':>7} {'km':>7} {'km':>6} "
+        f"{'':>5} {'K':>6} {'K':>6}"
+    )
+    lines = [
+        f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules",
+        head,
+        units,
+    ]
     for f in result.fors:
-        lines.append(f"{f.for_index:>3} {f.d_alpha_urad:8.0f} {f.sigma_alpha_urad:5.0f} {f.d_beta_urad:8.0f} "
-                     f"{f.sigma_beta_urad:5.0f} {f.in_track_km:7.3f} {f.cross_track_km:7.3f} {f.total_km:6.3f} "
-                     f"{f.n_samples:5d} {f.cost_min_k:6.3f} {f.cost_zero_k:6.3f}  {','.join(f.flags)}")
+        lines.append(
+            f"{f.for_index:>3} {f.d_alpha_urad:8.0f} {f.sigma_alpha_urad:5.0f} {f.d_beta_urad:8.0f} "
+            f"{f.sigma_beta_urad:5.0f} {f.in_track_km:7.3f} {f.cross_track_km:7.3f} {f.total_km:6.3f} "
+            f"{f.n_samples:5d} {f.cost_min_k:6.3f} {f.cost_zero_k:6.3f}  {','.join(f.flags)}"
+        )
     for s in result.skipped:
         lines.append(f"skipped {s['item']}: {s['reason']}")
     return "\n".join(lines)
@@ -161,6 +204,7 @@ def cmd_assess(args) -> int:
     from monitor.assess import AssessConfig, assess_paths
     from monitor.errors import DataError
     from monitor.sdr.pairing import PlanError
+
     if args.steps < 1 or args.step_urad <= 0:
         raise BadInput("--steps must be >= 1 and --step-urad > 0")
     cfg = AssessConfig(half_steps=args.steps, step_rad=args.step_urad * 1e-6, kernel=args.kernel)
@@ -179,6 +223,7 @@ def _load(args):
     import os
 
     from monitor.config import ConfigError, load_config
+
     args.config = args.config or os.environ.get("CRISGEO_CONFIG") or DEFAULT_CONFIG
     try:
         return load_config(args.config)
@@ -189,6 +234,7 @@ def _load(args):
 
 def cmd_install_files(args) -> int:
     from monitor.install import install_files, kept_files
+
     kept = [] if args.force else kept_files(args.dest)
     for path in install_files(args.dest, args.force):
         print(f"wrote {path}")
@@ -201,8 +247,10 @@ def cmd_check_config(args) -> int:
     import yaml
 
     from monitor.config import effective
+
     if args.reference:
         from monitor.config_reference import reference
+
         print(reference(), end="")
         return EXIT_OK
     cfg = _load(args)
@@ -214,6 +262,7 @@ def cmd_check_config(args) -> int:
 def cmd_export(args) -> int:
     from monitor.export import export
     from monitor.store.sqlite import Store
+
     cfg = _load(args)
     sats = [args.satellite] if args.satellite else cfg.satellites
     if len(sats) > 1:
@@ -222,7 +271,9 @@ def cmd_export(args) -> int:
     try:
         path = export(store, sats[0], args.out, args.format, args.since, args.until)
     except ImportError as exc:
-        raise BadInput(f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})") from None
+        raise BadInput(
+            f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
+        ) from None
     finally:
         store.close()
     print(f"wrote {path}")
@@ -238,13 +289,17 @@ def _day(text: str) -> dt.date:
 
 def cmd_run(args) -> int:
     from monitor.service import AlreadyRunning, Service
+
     cfg = _load(args)
     sats = [args.satellite] if args.satellite else cfg.satellites
     if args.satellite and args.satellite not in cfg.satellites:
-        raise BadInput(f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")
+        raise BadInput(
+            f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})"
+        )
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm
+
         bar = tqdm(unit="granule", desc="assessing")
     service = Service(cfg, progress=(lambda g: bar.update(1)) if bar else None)
     service.handle_signals()
@@ -269,9 +324,11 @@ def cmd_run(args) -> int:
 
 def cmd_daemon(args) -> int:
     from monitor.service import AlreadyRunning, Service
+
     cfg = _load(args)
     if args.listen is not None:
         from monitor.config import ConfigError, check_listen
+
         try:
             check_listen(args.listen, "--listen")
         except ConfigError as exc:
@@ -292,6 +349,7 @@ def status_report(cfg, store) -> dict:
     the alerts firing; the next run; the outbox size; and the Nagios state of it all."""
     from monitor.service import next_run
     from monitor.store.alerts import AlertState
+
     runs = {r["satellite"]: r for r in store.last_runs()}
     firing = AlertState(store).firing()
     sats = {}
@@ -302,13 +360,23 @@ def status_report(cfg, store) -> dict:
             "last_run": None if r is None else {k: r[k] for k in ("day", "status", "finished", "reason")},
             "latest_day": None if day is None else str(day),
             "fors": [] if day is None else [f.to_dict() for f in store.day_result(sat, day)],
-            "alerts": [{k: a[k] for k in ("rule", "severity", "summary", "started")}
-                       for a in firing if a["satellite"] == sat]}
-    critical = any(a["severity"] == "critical" for a in firing) or \
-        any(s["last_run"] and s["last_run"]["status"] == "failed" for s in sats.values())
+            "alerts": [
+                {k: a[k] for k in ("rule", "severity", "summary", "started")}
+                for a in firing
+                if a["satellite"] == sat
+            ],
+        }
+    critical = any(a["severity"] == "critical" for a in firing) or any(
+        s["last_run"] and s["last_run"]["status"] == "failed" for s in sats.values()
+    )
     state = NAGIOS_CRITICAL if critical else NAGIOS_WARNING if firing else NAGIOS_OK
-    return {"state": ["OK", "WARNING", "CRITICAL"][state], "exit": state, "satellites": sats,
-            "next_run_utc": f"{next_run(cfg.schedule):%Y-%m-%dT%H:%MZ}", "outbox": store.outbox_size()}
+    return {
+        "state": ["OK", "WARNING", "CRITICAL"][state],
+        "exit": state,
+        "satellites": sats,
+        "next_run_utc": f"{next_run(cfg.schedule):%Y-%m-%dT%H:%MZ}",
+        "outbox": store.outbox_size(),
+    }
 
 
 def cmd_status(args) -> int:
@@ -316,6 +384,7 @@ def cmd_status(args) -> int:
 
     from monitor.config import ConfigError
     from monitor.store.sqlite import Store, StoreError
+
     try:
         cfg = _load(args)
         store = Store(cfg.store.sqlite)
@@ -337,16 +406,21 @@ def cmd_status(args) -> int:
         if r is None:
             print(f"{sat}: no run yet")
             continue
-        print(f"{sat}: last run {r['day']} {r['status']} (finished {r['finished'] or '-'})"
-              + (f": {r['reason']}" if r["reason"] else ""))
+        print(
+            f"{sat}: last run {r['day']} {r['status']} (finished {r['finished'] or '-'})"
+            + (f": {r['reason']}" if r["reason"] else "")
+        )
         for a in s["alerts"]:
             print(f"  {a['severity']} {a['rule']}: {a['summary']} (since {a['started']})")
         if s["latest_day"]:
             print(f"  latest results: {s['latest_day']}")
             print(f"  {'FOR':>3} {'d_alpha':>8} {'d_beta':>8} {'in-trk':>7} {'x-trk':>7} {'total':>6}  flags")
             for f in s["fors"]:
-                print(f"  {f['for']:>3} {f['d_alpha_urad']:8.0f} {f['d_beta_urad']:8.0f} {f['in_track_km']:7.3f} "
-                      f"{f['cross_track_km']:7.3f} {f['total_km']:6.3f}  {','.join(f['flags'])}")
+                print(
+                    f"  {f['for']:>3} {f['d_alpha_urad']:8.0f} {f['d_beta_urad']:8.0f} "
+                    f"{f['in_track_km']:7.3f} "
+                    f"{f['cross_track_km']:7.3f} {f['total_km']:6.3f}  {','.join(f['flags'])}"
+                )
     print(f"next scheduled run: {rep['next_run_utc'].replace('T', ' ').replace('Z', '')} UTC")
     print(f"outbox: {rep['outbox']} point(s) waiting")
     return rep["exit"]
@@ -358,6 +432,7 @@ def cmd_alerts(args) -> int:
     from monitor.service import Service
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
+
     cfg = _load(args)
     service = Service(cfg)
     try:
@@ -373,11 +448,15 @@ def cmd_alerts(args) -> int:
             if args.until <= now:
                 raise BadInput("--until must be in the future")
             AlertState(store).silence(args.rule, args.satellite, args.until, args.reason, now)
-            print(f"silenced rule={args.rule or '*'} satellite={args.satellite or '*'} until {args.until:%Y-%m-%d %H:%M} UTC")
+            print(
+                f"silenced rule={args.rule or '*'} satellite={args.satellite or '*'} until "
+                f"{args.until:%Y-%m-%d %H:%M} UTC"
+            )
         elif args.action == "evaluate":
             print(evaluate_and_deliver(store, settings, cfg.satellites, now))
         elif args.json:
             import json
+
             print(json.dumps(alerts_view(store, now), indent=1))
         else:
             print(fmt_alerts(alerts_view(store, now)))
@@ -390,6 +469,7 @@ def cmd_events(args) -> int:
     from alerts.changes import Change, add_to_calendar, all_changes
     from monitor.service import Service
     from monitor.store.sqlite import Store
+
     cfg = _load(args)
     settings = Service(cfg).alert_settings()
     if settings.events_file is None:
@@ -397,8 +477,10 @@ def cmd_events(args) -> int:
     if args.action == "add":
         if not (args.satellite and args.time and args.instrument and args.description):
             raise BadInput("events add needs --satellite, --time, --instrument and --description")
-        add_to_calendar(settings.events_file, Change(args.time, args.satellite, args.instrument, args.kind,
-                                                     args.description, "calendar"))
+        add_to_calendar(
+            settings.events_file,
+            Change(args.time, args.satellite, args.instrument, args.kind, args.description, "calendar"),
+        )
         print(f"added to {settings.events_file}")
         return EXIT_OK
     store = Store(cfg.store.sqlite)
@@ -417,6 +499,7 @@ def cmd_fingerprint(args) -> int:
     from monitor import fingerprint as fpr
     from monitor.sdr import GranuleError, read_file
     from monitor.sdr.pairing import PlanError, find_files
+
     try:
         files = find_files(args.paths)
     except PlanError as exc:
@@ -433,14 +516,16 @@ def cmd_fingerprint(args) -> int:
     prints.sort(key=lambda p: p.start)
     day = fpr.day_print(prints)
     from monitor.mapping.engpkt import load_library
+
     library, problems = load_library(args.ep_library or [])
     matches = fpr.identify_ep(day, library, _geo_platform(files))
     within = fpr.change_within(prints, args.threshold_urad) if len(prints) >= 4 else None
     if args.json:
         doc = day.to_dict()
         doc["skipped"] = skipped
-        doc["change_within"] = None if within is None else {"first_granule": prints[within[0]].granule_id,
-                                                             "fors": within[1]}
+        doc["change_within"] = (
+            None if within is None else {"first_granule": prints[within[0]].granule_id, "fors": within[1]}
+        )
         doc["ep_match"] = [m.to_dict() for m in matches]
         doc["ep_library_problems"] = problems
         print(json.dumps(doc, indent=1))
@@ -448,8 +533,11 @@ def cmd_fingerprint(args) -> int:
         print(fpr.format_print(day))
         for s in skipped:
             print(f"skipped {s}")
-        print("no step within these granules" if within is None else
-              f"step from granule {prints[within[0]].granule_id} at FOR {', '.join(map(str, within[1]))}")
+        print(
+            "no step within these granules"
+            if within is None
+            else f"step from granule {prints[within[0]].granule_id} at FOR {', '.join(map(str, within[1]))}"
+        )
         print(fpr.format_matches(matches))
         for p in problems:
             print(f"EP library: {p}")
@@ -460,20 +548,27 @@ def cmd_fingerprint(args) -> int:
 
 def _write_residuals(args, day, matches, library):
     from monitor.mapping.residuals import learn
+
     if args.ep:
         ep = _ep(args.ep)
     elif matches:
         ep = library[matches[0].name]
     else:
-        raise BadInput("--write-residuals: no EP to learn against (give --ep or an --ep-library of this satellite)")
+        raise BadInput(
+            "--write-residuals: no EP to learn against (give --ep or an --ep-library of this satellite)"
+        )
     table = learn(day, ep)
     table.write(args.write_residuals)
-    print(f"wrote residual table against EP {ep.version} ({len(day.granules)} granule(s)) to {args.write_residuals}",
-          file=sys.stderr if args.json else sys.stdout)
+    print(
+        f"wrote residual table against EP {ep.version} ({len(day.granules)} granule(s)) to "
+        f"{args.write_residuals}",
+        file=sys.stderr if args.json else sys.stdout,
+    )
 
 
 def _geo_platform(files):
     from monitor.sdr.names import parse_name
+
     platforms = {parsed.platform for parsed in map(parse_name, (Path(f).name for f in files)) if parsed}
     return platforms.pop() if len(platforms) == 1 else None
 
@@ -484,9 +579,12 @@ def cmd_report(args) -> int:
     from alerts.settings import AlertConfigError
     from monitor.report.html import build_report, options_from_config
     from monitor.store.sqlite import Store
+
     cfg = _load(args)
     if args.satellite and args.satellite not in cfg.satellites:
-        raise BadInput(f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")
+        raise BadInput(
+            f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})"
+        )
     if args.since and args.until and args.since > args.until:
         raise BadInput(f"--since {args.since} is after --until {args.until}")
     try:
@@ -505,6 +603,7 @@ def cmd_report(args) -> int:
 
 def cmd_bench(args) -> int:
     from monitor.bench import run_bench
+
     return run_bench(args)
 
 
@@ -513,8 +612,15 @@ class JsonFormatter(logging.Formatter):
 
     def format(self, record):
         import json
-        doc = {"time": dt.datetime.fromtimestamp(record.created, dt.timezone.utc).isoformat(timespec="milliseconds"),
-               "level": record.levelname, "logger": record.name, "message": record.getMessage()}
+
+        doc = {
+            "time": dt.datetime.fromtimestamp(record.created, dt.timezone.utc).isoformat(
+                timespec="milliseconds"
+            ),
+            "level": record.levelname,
+            "logger": record.name,
+            "message": record.getMessage(),
+        }
         if record.exc_info:
             doc["exception"] = self.formatException(record.exc_info)
         return json.dumps(doc)
@@ -524,6 +630,7 @@ def setup_logging(verbose: bool, log_format: str) -> None:
     """Text with a timestamp on a terminal or in a file; without one under systemd, whose journal stamps
     every line itself (it sets JOURNAL_STREAM); or JSON lines."""
     import os
+
     handler = logging.StreamHandler()
     if log_format == "json":
         handler.setFormatter(JsonFormatter())
@@ -538,16 +645,25 @@ def build_parser() -> argparse.ArgumentParser:
     from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
     from monitor.satellites import SATELLITES
     from monitor.simulate.orbit import PASSES
-    p = argparse.ArgumentParser(prog="crisgeo", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+
+    p = argparse.ArgumentParser(
+        prog="crisgeo", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     p.add_argument("--version", action="version", version=f"crisgeo {__version__}")
-    p.add_argument("--log-format", choices=("text", "json"), default="text",
-                   help="text (no timestamp under systemd: the journal adds one) or JSON lines")
+    p.add_argument(
+        "--log-format",
+        choices=("text", "json"),
+        default="text",
+        help="text (no timestamp under systemd: the journal adds one) or JSON lines",
+    )
     common = argparse.ArgumentParser(add_help=False)  # -v and --log-format after the subcommand too
-    common.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="debug logging")
-    common.add_argument("--log-format", choices=("text", "json"), default=argparse.SUPPRESS,
-                        help="text or JSON lines")
+    common.add_argument(
+        "-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="debug logging"
+    )
+    common.add_argument(
+        "--log-format", choices=("text", "json"), default=argparse.SUPPRESS, help="text or JSON lines"
+    )
     sub = p.add_subparsers(dest="command", required=True)
     add_parser = sub.add_parser
     sub.add_parser = lambda *a, **kw: add_parser(*a, parents=[common], **kw)
@@ -555,22 +671,34 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("simulate", help="write simulated CrIS/VIIRS granules with an injected LOS error")
     s.add_argument("--out", required=True, help="output directory")
     s.add_argument("--satellite", choices=tuple(SATELLITES), default="j01")
-    s.add_argument("--granules", type=int, default=14, help="consecutive CrIS granules (default 14, as the paper)")
+    s.add_argument(
+        "--granules", type=int, default=14, help="consecutive CrIS granules (default 14, as the paper)"
+    )
     s.add_argument("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)")
     s.add_argument("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)")
     s.add_argument("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)")
     s.add_argument("--terrain", action="store_true", help="1-4 km ranges and plateaus over 40 %% land")
-    s.add_argument("--pass", dest="orbit_pass", choices=sorted(PASSES),
-                   help="start at this pass of the satellite's orbit after --start (day: ascending tropics, "
-                        "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass")
-    s.add_argument("--pass-lon", type=float, help="with --pass: the pass nearest this longitude, deg (e.g. 180)")
+    s.add_argument(
+        "--pass",
+        dest="orbit_pass",
+        choices=sorted(PASSES),
+        help="start at this pass of the satellite's orbit after --start (day: ascending tropics, "
+        "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass",
+    )
+    s.add_argument(
+        "--pass-lon", type=float, help="with --pass: the pass nearest this longitude, deg (e.g. 180)"
+    )
     s.set_defaults(func=cmd_simulate)
 
-    o = sub.add_parser("optimize", help="new scene-mirror angles (EP) from an assessment result (paper section 4)")
+    o = sub.add_parser(
+        "optimize", help="new scene-mirror angles (EP) from an assessment result (paper section 4)"
+    )
     o.add_argument("result", help="assessment result JSON (crisgeo assess --out)")
-    o.add_argument("--ep", required=True, help="the EP in force when the assessed data were made (XML or YAML)")
+    o.add_argument(
+        "--ep", required=True, help="the EP in force when the assessed data were made (XML or YAML)"
+    )
     o.add_argument("--out", required=True, help="the proposed EP, in the format of --ep")
     o.add_argument("--table-json", help="also write the old/new angle table as JSON here")
     o.set_defaults(func=cmd_optimize)
@@ -580,8 +708,11 @@ def build_parser() -> argparse.ArgumentParser:
     rg.add_argument("--ep", required=True)
     rg.add_argument("--out", required=True, help="output directory (never the input's)")
     rg.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
-    rg.add_argument("--own-residuals", metavar="EP_IN_FORCE",
-                    help="learn each granule's residual from itself, against the EP it was made with")
+    rg.add_argument(
+        "--own-residuals",
+        metavar="EP_IN_FORCE",
+        help="learn each granule's residual from itself, against the EP it was made with",
+    )
     rg.set_defaults(func=cmd_regeolocate)
 
     gl = sub.add_parser("geolocate", help="compare an EP's geolocation with CrIS GEO files' own, per FOR")
@@ -589,18 +720,29 @@ def build_parser() -> argparse.ArgumentParser:
     gl.add_argument("--ep", required=True)
     gl.add_argument("--json", action="store_true")
     gl.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
-    gl.add_argument("--own-residuals", metavar="EP_IN_FORCE",
-                    help="learn each granule's residual from itself, against the EP it was made with")
+    gl.add_argument(
+        "--own-residuals",
+        metavar="EP_IN_FORCE",
+        help="learn each granule's residual from itself, against the EP it was made with",
+    )
     gl.set_defaults(func=cmd_geolocate)
 
     a = sub.add_parser("assess", help="assess CrIS geolocation against VIIRS I5 for the granules given")
     a.add_argument("paths", nargs="+", help="granule files or directories")
     a.add_argument("--out", help="write the result JSON here")
-    a.add_argument("--steps", type=int, default=DEFAULT_HALF_STEPS,
-                   help="perturbation steps each side of zero (grid 2n+1)")
+    a.add_argument(
+        "--steps",
+        type=int,
+        default=DEFAULT_HALF_STEPS,
+        help="perturbation steps each side of zero (grid 2n+1)",
+    )
     a.add_argument("--step-urad", type=float, default=DEFAULT_STEP_URAD, help="perturbation step, urad")
-    a.add_argument("--kernel", choices=("top-hat", "response"), default="top-hat",
-                   help="FOV weighting: top-hat cone or the CrIS spatial response")
+    a.add_argument(
+        "--kernel",
+        choices=("top-hat", "response"),
+        default="top-hat",
+        help="FOV weighting: top-hat cone or the CrIS spatial response",
+    )
     a.add_argument("--workers", type=int, default=1, help="worker processes over granules")
     a.set_defaults(func=cmd_assess)
 
@@ -619,21 +761,31 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--until", type=_day, help="last day, YYYY-MM-DD")
     ex.set_defaults(func=cmd_export)
 
-    cc = sub.add_parser("check-config", help="validate a configuration; print it with its defaults, secrets masked")
+    cc = sub.add_parser(
+        "check-config", help="validate a configuration; print it with its defaults, secrets masked"
+    )
     cc.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    cc.add_argument("--reference", action="store_true", help="print the reference of every key (Markdown) instead")
+    cc.add_argument(
+        "--reference", action="store_true", help="print the reference of every key (Markdown) instead"
+    )
     cc.set_defaults(func=cmd_check_config)
 
-    inst = sub.add_parser("install-files", help="copy the shipped configs, Grafana and Prometheus files, EP files, "
-                          "systemd unit and docs into a directory")
+    inst = sub.add_parser(
+        "install-files",
+        help="copy the shipped configs, Grafana and Prometheus files, EP files, "
+        "systemd unit and docs into a directory",
+    )
     inst.add_argument("dest", type=Path, help="target directory, e.g. /opt/crisgeo/share")
     inst.add_argument("--force", action="store_true", help="replace files that exist")
     inst.set_defaults(func=cmd_install_files)
 
     d = sub.add_parser("daemon", help="the long-running service (systemd)")
     d.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    d.add_argument("--listen", metavar="HOST:PORT", help="serve /metrics, /healthz, /report/ here (overrides "
-                   "http.listen; off: no endpoint)")
+    d.add_argument(
+        "--listen",
+        metavar="HOST:PORT",
+        help="serve /metrics, /healthz, /report/ here (overrides http.listen; off: no endpoint)",
+    )
     d.set_defaults(func=cmd_daemon)
 
     st = sub.add_parser("status", help="last run per satellite, latest per-FOR table, next run, outbox size")
@@ -665,10 +817,17 @@ def build_parser() -> argparse.ArgumentParser:
     fp.add_argument("paths", nargs="+")
     fp.add_argument("--json", action="store_true")
     fp.add_argument("--threshold-urad", type=float, default=10.0)
-    fp.add_argument("--ep-library", action="append", metavar="PATH",
-                    help="EP file or directory to identify the EP from (repeatable; default: the packaged real EPs)")
-    fp.add_argument("--write-residuals", metavar="FILE",
-                    help="write the per-FOR FOV-5 LOS residual against --ep (default: the best-matching EP)")
+    fp.add_argument(
+        "--ep-library",
+        action="append",
+        metavar="PATH",
+        help="EP file or directory to identify the EP from (repeatable; default: the packaged real EPs)",
+    )
+    fp.add_argument(
+        "--write-residuals",
+        metavar="FILE",
+        help="write the per-FOR FOV-5 LOS residual against --ep (default: the best-matching EP)",
+    )
     fp.add_argument("--ep", help="the EP the residual table is learned against (XML or YAML)")
     fp.set_defaults(func=cmd_fingerprint)
 
@@ -683,7 +842,9 @@ def build_parser() -> argparse.ArgumentParser:
     b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")
     b.add_argument("--granules", type=int, default=14)
     b.add_argument("--data", help="case directory to reuse or create (default: a temporary directory)")
-    b.add_argument("--pyresample", action="store_true", help="also time pyresample's radius search as a reference")
+    b.add_argument(
+        "--pyresample", action="store_true", help="also time pyresample's radius search as a reference"
+    )
     b.add_argument("--workers", type=int, default=2, help="worker processes (default 2, the machine's cores)")
     b.set_defaults(func=cmd_bench)
     return p
@@ -691,6 +852,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     from monitor.store.sqlite import StoreError
+
     parser = build_parser()
     args = parser.parse_args(argv)
     setup_logging(args.verbose, args.log_format)

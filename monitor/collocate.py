@@ -45,8 +45,9 @@ TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)
 # CrIS spatial response as a staircase of concentric top hats, from the 70/50/10/3 % full widths of
 # 0.8735, 0.942, 1.100 and 1.238 deg (Wang slides, table 3): weight 1 inside 0.4368 deg, then 0.6,
 # 0.3 and 0.065 out to 0.619 deg.
-SPATIAL_RESPONSE = tuple((np.radians(r), c) for r, c in
-                         ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065)))
+SPATIAL_RESPONSE = tuple(
+    (np.radians(r), c) for r, c in ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065))
+)
 MIN_COVERAGE = 0.97
 BLOCK = 4096  # candidate pixels per block of the interval computation
 BLOCK_PX = 4  # VIIRS pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
@@ -97,10 +98,23 @@ class ViirsSwath(PixelArrays):
     @classmethod
     def from_pieces(cls, pieces: list[SwathPiece]) -> "ViirsSwath":
         def cat(name):
-            return np.concatenate([getattr(p, name) for p in pieces]) if len(pieces) > 1 else getattr(pieces[0], name)
-        stacked = [cat(name) for name in ("ecef_m", "radiance", "area_vec_m2", "block_centre_m", "block_radius_m")]
-        return cls(*stacked, pieces[0].col_spacing_m, np.nanmean([p.advance_m for p in pieces], axis=0),
-                   pieces[0].det_step_m, max(p.max_height_m for p in pieces), list(pieces))
+            return (
+                np.concatenate([getattr(p, name) for p in pieces])
+                if len(pieces) > 1
+                else getattr(pieces[0], name)
+            )
+
+        stacked = [
+            cat(name) for name in ("ecef_m", "radiance", "area_vec_m2", "block_centre_m", "block_radius_m")
+        ]
+        return cls(
+            *stacked,
+            pieces[0].col_spacing_m,
+            np.nanmean([p.advance_m for p in pieces], axis=0),
+            pieces[0].det_step_m,
+            max(p.max_height_m for p in pieces),
+            list(pieces),
+        )
 
     def nearest(self, points_m):
         """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point."""
@@ -149,8 +163,11 @@ def _blocks(pos, usable):
     scans), columns are padded. Blocks without a usable pixel get NaN, which fails every later test.
     """
     cols = usable.shape[1]
-    p = np.pad(np.where(usable[..., None], pos, np.float32(np.nan)), ((0, 0), (0, -cols % BLOCK_PX), (0, 0)),
-               constant_values=np.nan)
+    p = np.pad(
+        np.where(usable[..., None], pos, np.float32(np.nan)),
+        ((0, 0), (0, -cols % BLOCK_PX), (0, 0)),
+        constant_values=np.nan,
+    )
     lo = _block_reduce(np.fmin, p).astype(np.float64)  # fmin and fmax skip NaN
     hi = _block_reduce(np.fmax, p).astype(np.float64)
     return (lo + hi) / 2, np.linalg.norm(hi - lo, axis=-1) / 2 + 1.0  # 1 m for the float32 rounding
@@ -242,8 +259,20 @@ def swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band, before=None, after
     r_idx, c_idx = np.nonzero(np.isfinite(radius))
     tree = cKDTree(centre[r_idx, c_idx])
     r_idx, c_idx = r_idx * BLOCK_PX, c_idx * BLOCK_PX
-    return SwathPiece(pos, radiance, area, centre, radius, _fill_nan(col_spacing), _fill_nan(advance),
-                      _fill_nan(det_step), max(max_height, 0.0), tree, r_idx, c_idx)
+    return SwathPiece(
+        pos,
+        radiance,
+        area,
+        centre,
+        radius,
+        _fill_nan(col_spacing),
+        _fill_nan(advance),
+        _fill_nan(det_step),
+        max(max_height, 0.0),
+        tree,
+        r_idx,
+        c_idx,
+    )
 
 
 def build_swath(lat_rad, lon_rad, height_m, bt_k, good, band) -> ViirsSwath:
@@ -274,13 +303,22 @@ def _window_half_sizes(swath: ViirsSwath, col0, range_m, cos_zen, rho):
     ncol = len(swath.col_spacing_m)
     lo = np.clip(col0 - 200, 0, ncol - 1)
     hi = np.clip(col0 + 200, 0, ncol - 1)
-    spacing = np.array([swath.col_spacing_m[a:b + 1].min() for a, b in zip(lo, hi)])
+    spacing = np.array([swath.col_spacing_m[a : b + 1].min() for a, b in zip(lo, hi, strict=True)])
     half_cols = np.ceil(d_scan / spacing + 4).astype(int)
     return half_rows, half_cols
 
 
-def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offsets_rad, kernel=TOP_HAT,
-              fov_range_m=None, fov_cos_zen=None):
+def cone_sums(
+    swath: ViirsSwath,
+    sat_m,
+    sbf_to_ecef,
+    alpha_rad,
+    beta_rad,
+    offsets_rad,
+    kernel=TOP_HAT,
+    fov_range_m=None,
+    fov_cos_zen=None,
+):
     """Weighted VIIRS radiance means and coverage in every perturbed cone of a batch of FOVs.
 
     sat_m (F, 3) and sbf_to_ecef (F, 3, 3) give each FOV's satellite position and SBF; alpha_rad,
@@ -293,8 +331,9 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     n = (m - 1) // 2
     h_max = max(h for h, _ in kernel)
     rho = h_max + np.abs(offsets_rad).max() * np.sqrt(2.0) * 1.02
-    los0 = np.einsum("fij,fj->fi", sbf_to_ecef,
-                     np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(nf)], -1))
+    los0 = np.einsum(
+        "fij,fj->fi", sbf_to_ecef, np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(nf)], -1)
+    )
     los0 /= np.linalg.norm(los0, axis=-1, keepdims=True)
     t = wgs84.intersect_ellipsoid(sat_m, los0)
     centre = sat_m + t[:, None] * los0
@@ -327,8 +366,10 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     f_idx = np.repeat(f_idx, BLOCK_PX * BLOCK_PX)
     usable = np.isfinite(swath.radiance.reshape(-1)[pix])
     if ncol % BLOCK_PX:  # the padded last block column repeats the last pixel column: count it once
-        usable &= np.broadcast_to((b_col * BLOCK_PX)[:, None, None] + np.arange(BLOCK_PX) < ncol,
-                                  r_pix.shape[:1] + (BLOCK_PX, BLOCK_PX)).reshape(-1)
+        usable &= np.broadcast_to(
+            (b_col * BLOCK_PX)[:, None, None] + np.arange(BLOCK_PX) < ncol,
+            r_pix.shape[:1] + (BLOCK_PX, BLOCK_PX),
+        ).reshape(-1)
     f_idx, pix = f_idx[usable], pix[usable]
     pos32 = swath.ecef_m.reshape(-1, 3)[pix]
     vec = pos32.astype(np.float64)
@@ -337,7 +378,7 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
     bounds = np.searchsorted(f_idx, np.arange(nf + 1))
     d = np.empty_like(vec)
     for f in np.flatnonzero(np.diff(bounds)):
-        np.matmul(vec[bounds[f]:bounds[f + 1]], sbf_to_ecef[f], out=d[bounds[f]:bounds[f + 1]])
+        np.matmul(vec[bounds[f] : bounds[f + 1]], sbf_to_ecef[f], out=d[bounds[f] : bounds[f + 1]])
     # The union of the perturbed cones is a rounded rectangle in (alpha, beta): drop what lies outside,
     # comparing tangents (d_z > 0 within rho of the LOS).
     half_a = np.abs(offsets_rad).max() + 1.02 * h_max / np.cos(beta_rad)
@@ -378,9 +419,9 @@ def cone_sums(swath: ViirsSwath, sat_m, sbf_to_ecef, alpha_rad, beta_rad, offset
             stop = hi.astype(np.intp).ravel()
             for off, val in ((0, wv[blk]), (size, wk[blk])):
                 v = np.broadcast_to(val, lo.shape).ravel()
-                acc[off:off + size] += np.bincount(start, v, size) - np.bincount(stop, v, size)
+                acc[off : off + size] += np.bincount(start, v, size) - np.bincount(stop, v, size)
         solid += c_k * 2 * np.pi * (1 - np.cos(h))
-    acc = np.cumsum(acc.reshape(2, nf, m, width), axis=-1)[..., PAD:PAD + m]
+    acc = np.cumsum(acc.reshape(2, nf, m, width), axis=-1)[..., PAD : PAD + m]
     sums, wsum = acc[0], acc[1]
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(wsum > 0, sums / wsum, np.nan)

@@ -100,7 +100,9 @@ class PublishConfig:
 
 @dataclass
 class HttpConfig:
-    listen: str = "127.0.0.1:9782"  # HOST:PORT of /metrics, /healthz, /report/ ("off": none; port 0: any free)
+    listen: str = (
+        "127.0.0.1:9782"  # HOST:PORT of /metrics, /healthz, /report/ ("off": none; port 0: any free)
+    )
 
 
 @dataclass
@@ -133,10 +135,29 @@ class Config:
         return self.state_dir / "cache"
 
 
-TOP_KEYS = {"satellites", "state_dir", "source", "schedule", "scenes", "assessment", "store", "alerts", "fingerprint",
-            "http", "report_dir", "report_url", "dashboard_url"}
-SECTIONS = {"source": SourceConfig, "schedule": ScheduleConfig, "scenes": SceneConfig,
-            "assessment": AssessmentConfig, "fingerprint": FingerprintConfig, "http": HttpConfig}
+TOP_KEYS = {
+    "satellites",
+    "state_dir",
+    "source",
+    "schedule",
+    "scenes",
+    "assessment",
+    "store",
+    "alerts",
+    "fingerprint",
+    "http",
+    "report_dir",
+    "report_url",
+    "dashboard_url",
+}
+SECTIONS = {
+    "source": SourceConfig,
+    "schedule": ScheduleConfig,
+    "scenes": SceneConfig,
+    "assessment": AssessmentConfig,
+    "fingerprint": FingerprintConfig,
+    "http": HttpConfig,
+}
 STORE_KEYS = {"sqlite", "publish", "drain_minutes"}
 
 
@@ -149,7 +170,9 @@ def _get(doc: dict, key: str, typ, where: str, default=None, required=False):
     if typ is float and isinstance(value, int) and not isinstance(value, bool):
         value = float(value)
     if not isinstance(value, typ) or (typ in (int, float) and isinstance(value, bool)):
-        raise ConfigError(f"{where}{key}: expected {typ.__name__}, got {type(value).__name__} {str(value)[:60]!r}")
+        raise ConfigError(
+            f"{where}{key}: expected {typ.__name__}, got {type(value).__name__} {str(value)[:60]!r}"
+        )
     if typ is float and not math.isfinite(value):
         raise ConfigError(f"{where}{key}: {value} is not a finite number")
     if typ is str and "\x00" in value:
@@ -194,11 +217,19 @@ def _check_secrets(doc, where=""):
     if isinstance(doc, dict):
         for k, v in doc.items():
             if SECRET_WORDS.search(str(k)) and v not in (None, ""):
-                raise ConfigError(f"{where}{k}: secrets may not be written in the file; "
-                                  f"name an environment variable with {k}_env")
-            if str(k).endswith("_env") and v is not None and not (isinstance(v, str) and ENV_NAME.fullmatch(v)):
-                raise ConfigError(f"{where}{k}: {'a value' if isinstance(v, str) else repr(v)} is not the name "
-                                  f"of an environment variable")
+                raise ConfigError(
+                    f"{where}{k}: secrets may not be written in the file; "
+                    f"name an environment variable with {k}_env"
+                )
+            if (
+                str(k).endswith("_env")
+                and v is not None
+                and not (isinstance(v, str) and ENV_NAME.fullmatch(v))
+            ):
+                raise ConfigError(
+                    f"{where}{k}: {'a value' if isinstance(v, str) else repr(v)} is not the name "
+                    f"of an environment variable"
+                )
             _check_secrets(v, f"{where}{k}.")
     elif isinstance(doc, list):
         for i, v in enumerate(doc):
@@ -215,11 +246,14 @@ class _Loader(yaml.SafeLoader):
     def compose_node(self, parent, index):
         if self.check_event(yaml.events.AliasEvent):
             mark = self.peek_event().start_mark
-            raise ConfigError(f"line {mark.line + 1}: YAML aliases (*name) are not allowed in the configuration")
+            raise ConfigError(
+                f"line {mark.line + 1}: YAML aliases (*name) are not allowed in the configuration"
+            )
         event = self.peek_event()
         if getattr(event, "anchor", None):
-            raise ConfigError(f"line {event.start_mark.line + 1}: YAML anchors (&name) are not allowed in the "
-                              f"configuration")
+            raise ConfigError(
+                f"line {event.start_mark.line + 1}: YAML anchors (&name) are not allowed in the configuration"
+            )
         return super().compose_node(parent, index)
 
 
@@ -251,8 +285,10 @@ def check_url(url: str, where: str, placeholder: str | None = None) -> str:
     if parts.scheme not in ("http", "https") or not parts.netloc:
         raise ConfigError(f"{where}: {redact_url(url)!r} is not an http(s) URL")
     if parts.username or parts.password or "@" in parts.netloc:
-        raise ConfigError(f"{where}: credentials may not be written in a URL; name environment variables "
-                          f"with the *_env keys")
+        raise ConfigError(
+            f"{where}: credentials may not be written in a URL; name environment variables "
+            f"with the *_env keys"
+        )
     if placeholder and placeholder not in url:
         raise ConfigError(f"{where}: {url!r} has no {placeholder} placeholder")
     return url
@@ -263,6 +299,7 @@ def check_listen(text: str, where: str) -> str:
     if text == "off":
         return text
     from monitor.endpoint import parse_listen
+
     try:
         parse_listen(text)
     except ValueError as exc:
@@ -313,9 +350,25 @@ def load_config(path) -> Config:
     source = SourceConfig(kind=kind)
     if kind == "local":
         source.path = rel(_get(s, "path", str, "source.", required=True))
-    _fill(source, s, "source.", timeout_s=float, backoff_s=float, daily_budget_mb=float, run_deadline_min=float,
-          max_retry_after_s=float, min_rate_kb_s=float, max_list_pages=int, max_listed_keys=int, retries=int,
-          retention_days=int, granules=int, seed=int, profile=str, endpoint=str)
+    _fill(
+        source,
+        s,
+        "source.",
+        timeout_s=float,
+        backoff_s=float,
+        daily_budget_mb=float,
+        run_deadline_min=float,
+        max_retry_after_s=float,
+        min_rate_kb_s=float,
+        max_list_pages=int,
+        max_listed_keys=int,
+        retries=int,
+        retention_days=int,
+        granules=int,
+        seed=int,
+        profile=str,
+        endpoint=str,
+    )
     buckets = _get(s, "buckets", dict, "source.", None)
     if buckets:
         for k, v in buckets.items():
@@ -325,8 +378,16 @@ def load_config(path) -> Config:
 
     sc = _section(doc, "schedule")
     _known(sc, set(ScheduleConfig.__dataclass_fields__), "schedule.")
-    schedule = _fill(ScheduleConfig(), sc, "schedule.", catch_up_days=int, lag_days=int, no_data_retry_days=int,
-                     misfire_grace_hours=float, run_budget_min=float)
+    schedule = _fill(
+        ScheduleConfig(),
+        sc,
+        "schedule.",
+        catch_up_days=int,
+        lag_days=int,
+        no_data_retry_days=int,
+        misfire_grace_hours=float,
+        run_budget_min=float,
+    )
     t = _get(sc, "time_utc", str, "schedule.", schedule.time_utc.strftime("%H:%M"))
     m = re.fullmatch(r"(\d{1,2}):(\d{2})", t, re.ASCII)
     if not m or int(m[1]) > 23 or int(m[2]) > 59:
@@ -339,14 +400,20 @@ def load_config(path) -> Config:
 
     a = _section(doc, "assessment")
     _known(a, set(AssessmentConfig.__dataclass_fields__), "assessment.")
-    assessment = _fill(AssessmentConfig(), a, "assessment.", half_steps=int, step_urad=float, kernel=str, workers=int)
+    assessment = _fill(
+        AssessmentConfig(), a, "assessment.", half_steps=int, step_urad=float, kernel=str, workers=int
+    )
     if assessment.kernel not in ("top-hat", "response"):
         raise ConfigError(f"assessment.kernel: {assessment.kernel!r} is not top-hat or response")
 
     st = _section(doc, "store")
     _known(st, STORE_KEYS, "store.")
-    store = _fill(StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite")))), st,
-                  "store.", drain_minutes=float)
+    store = _fill(
+        StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite")))),
+        st,
+        "store.",
+        drain_minutes=float,
+    )
     for i, p in enumerate(_get(st, "publish", list, "store.", [])):
         where = f"store.publish[{i}]."
         if not isinstance(p, dict):
@@ -356,9 +423,21 @@ def load_config(path) -> Config:
         if pk not in ("influx2", "influx1"):
             raise ConfigError(f"{where}kind: {pk!r} is not influx2 or influx1")
         url = check_url(_get(p, "url", str, where, required=True), f"{where}url")
-        store.publish.append(_fill(PublishConfig(kind=pk, url=url.rstrip("/")), p, where, measurement=str, bucket=str,
-                                   org=str, database=str, token_env=str, username_env=str, password_env=str,
-                                   timeout_s=float))
+        store.publish.append(
+            _fill(
+                PublishConfig(kind=pk, url=url.rstrip("/")),
+                p,
+                where,
+                measurement=str,
+                bucket=str,
+                org=str,
+                database=str,
+                token_env=str,
+                username_env=str,
+                password_env=str,
+                timeout_s=float,
+            )
+        )
 
     fp = _section(doc, "fingerprint")
     _known(fp, set(FingerprintConfig.__dataclass_fields__), "fingerprint.")
@@ -367,8 +446,13 @@ def load_config(path) -> Config:
         library = [library]
     if not isinstance(library, list) or not all(isinstance(x, str) and "\x00" not in x for x in library):
         raise ConfigError(f"fingerprint.ep_library: expected a list of paths, got {library!r}")
-    fingerprint = _fill(FingerprintConfig(ep_library=tuple(rel(x) for x in library)), fp, "fingerprint.",
-                        granules=int, threshold_urad=float)
+    fingerprint = _fill(
+        FingerprintConfig(ep_library=tuple(rel(x) for x in library)),
+        fp,
+        "fingerprint.",
+        granules=int,
+        threshold_urad=float,
+    )
     h = _section(doc, "http")
     _known(h, set(HttpConfig.__dataclass_fields__), "http.")
     http = _fill(HttpConfig(), h, "http.", listen=str)
@@ -379,14 +463,29 @@ def load_config(path) -> Config:
     for key, url in (("report_url", report_url), ("dashboard_url", dashboard_url)):
         if url:
             check_url(url, key)
-    cfg = Config(path=path, satellites=list(sats), state_dir=state_dir, source=source, schedule=schedule,
-                 scenes=scenes, assessment=assessment, store=store, alerts=alerts, fingerprint=fingerprint, http=http,
-                 report_dir=rel(report_dir) if report_dir else None, report_url=report_url,
-                 dashboard_url=dashboard_url)
+    cfg = Config(
+        path=path,
+        satellites=list(sats),
+        state_dir=state_dir,
+        source=source,
+        schedule=schedule,
+        scenes=scenes,
+        assessment=assessment,
+        store=store,
+        alerts=alerts,
+        fingerprint=fingerprint,
+        http=http,
+        report_dir=rel(report_dir) if report_dir else None,
+        report_url=report_url,
+        dashboard_url=dashboard_url,
+    )
     _check_limits(cfg)
     from alerts.settings import AlertConfigError, load_alert_settings
+
     try:
-        cfg.alert_settings = load_alert_settings(alerts, base, cfg.report_dir, cfg.dashboard_url, cfg.report_url)
+        cfg.alert_settings = load_alert_settings(
+            alerts, base, cfg.report_dir, cfg.dashboard_url, cfg.report_url
+        )
     except AlertConfigError as exc:
         raise ConfigError(str(exc)) from None
     return cfg
@@ -394,16 +493,32 @@ def load_config(path) -> Config:
 
 # The accepted range of every bounded number: (lowest, highest), in the key's unit.
 LIMITS = {
-    "source.timeout_s": (0.1, 3600), "source.retries": (0, 20), "source.backoff_s": (0.01, 600),
-    "source.daily_budget_mb": (1, 1e6), "source.retention_days": (0, 3650), "source.run_deadline_min": (1, 1440),
-    "source.max_list_pages": (1, 10000), "source.max_listed_keys": (1, 10**6), "source.max_retry_after_s": (1, 3600),
-    "source.min_rate_kb_s": (1, 1e6), "source.granules": (1, 100), "source.seed": (0, 2**31 - 1),
-    "schedule.catch_up_days": (1, 366), "schedule.lag_days": (0, 30), "schedule.no_data_retry_days": (0, 366), "schedule.misfire_grace_hours": (0.01, 72),
+    "source.timeout_s": (0.1, 3600),
+    "source.retries": (0, 20),
+    "source.backoff_s": (0.01, 600),
+    "source.daily_budget_mb": (1, 1e6),
+    "source.retention_days": (0, 3650),
+    "source.run_deadline_min": (1, 1440),
+    "source.max_list_pages": (1, 10000),
+    "source.max_listed_keys": (1, 10**6),
+    "source.max_retry_after_s": (1, 3600),
+    "source.min_rate_kb_s": (1, 1e6),
+    "source.granules": (1, 100),
+    "source.seed": (0, 2**31 - 1),
+    "schedule.catch_up_days": (1, 366),
+    "schedule.lag_days": (0, 30),
+    "schedule.no_data_retry_days": (0, 366),
+    "schedule.misfire_grace_hours": (0.01, 72),
     "schedule.run_budget_min": (0.01, 10080),
-    "scenes.candidates": (1, 1000), "scenes.keep": (1, 200), "scenes.min_inhomogeneity_k": (0, 50),
-    "assessment.half_steps": (1, 40), "assessment.step_urad": (10, 5000), "assessment.workers": (1, 64),
+    "scenes.candidates": (1, 1000),
+    "scenes.keep": (1, 200),
+    "scenes.min_inhomogeneity_k": (0, 50),
+    "assessment.half_steps": (1, 40),
+    "assessment.step_urad": (10, 5000),
+    "assessment.workers": (1, 64),
     "store.drain_minutes": (0.01, 1440),
-    "fingerprint.granules": (1, 2000), "fingerprint.threshold_urad": (0.1, 10000),
+    "fingerprint.granules": (1, 2000),
+    "fingerprint.threshold_urad": (0.1, 10000),
 }
 BUCKET = re.compile(r"[a-z0-9][a-z0-9.-]{1,61}[a-z0-9]", re.ASCII)
 
@@ -413,7 +528,9 @@ def _check_limits(cfg: Config) -> None:
         section, name = key.split(".")
         _within(getattr(getattr(cfg, section), name), lo, hi, key)
     if cfg.scenes.keep > cfg.scenes.candidates:
-        raise ConfigError(f"scenes.keep: {cfg.scenes.keep} is more than scenes.candidates ({cfg.scenes.candidates})")
+        raise ConfigError(
+            f"scenes.keep: {cfg.scenes.keep} is more than scenes.candidates ({cfg.scenes.candidates})"
+        )
     if len(set(cfg.satellites)) != len(cfg.satellites):
         raise ConfigError("satellites: a satellite is listed twice")
     check_url(cfg.source.endpoint, "source.endpoint", "{bucket}")
@@ -433,8 +550,12 @@ def effective(cfg: Config) -> dict:
 
     def plain(v, key=""):
         if dataclasses.is_dataclass(v):
-            return {f.name: plain(getattr(v, f.name), f.name) for f in dataclasses.fields(v)
-                    if f.name not in ("path", "alerts", "report_dir", "report_url", "dashboard_url") or v is not cfg}
+            return {
+                f.name: plain(getattr(v, f.name), f.name)
+                for f in dataclasses.fields(v)
+                if f.name not in ("path", "alerts", "report_dir", "report_url", "dashboard_url")
+                or v is not cfg
+            }
         if isinstance(v, dict):
             return {str(k): plain(x, str(k)) for k, x in v.items()}
         if isinstance(v, (list, tuple)):
@@ -448,6 +569,7 @@ def effective(cfg: Config) -> dict:
         if key in ("url", "endpoint", "dashboard_url") and isinstance(v, str):
             return redact_url(v)
         return v
+
     out = plain(cfg)
     out["alerts"] = plain(cfg.alert_settings)
     out.pop("alert_settings", None)

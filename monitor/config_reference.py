@@ -19,14 +19,14 @@ from monitor import config as C
 MEANING = {
     "satellites": "Satellites to monitor, short names (npp, j01, j02). Required.",
     "state_dir": "Directory of the service's state: store, download cache, simulated granules, lock. "
-                 "Required; relative paths in the file are relative to the file.",
+    "Required; relative paths in the file are relative to the file.",
     "report_dir": "Where the HTML report is regenerated after every run (and served under /report/). None: "
-                  "no report.",
+    "no report.",
     "report_url": "The address at which readers open report_dir (e.g. behind a reverse proxy); messages link"
-                  " REPORT_URL/SATELLITE/. Without it they name the path on the server.",
+    " REPORT_URL/SATELLITE/. Without it they name the path on the server.",
     "dashboard_url": "Link to the Grafana dashboard, added to every message.",
     "source.kind": "Where granules come from: nodd (NOAA's archive on S3), local (a directory tree) or "
-                   "simulated (the offline demo). Required.",
+    "simulated (the offline demo). Required.",
     "source.path": "Root of the local tree (kind local); every *.h5 below it is considered.",
     "source.endpoint": "NODD URL template; {bucket} is replaced by the satellite's bucket.",
     "source.buckets": "NODD bucket per satellite (mapping); keys not given keep the published buckets.",
@@ -34,11 +34,11 @@ MEANING = {
     "source.retries": "Retries of a failed request (backoff doubling from backoff_s).",
     "source.backoff_s": "First wait between retries.",
     "source.daily_budget_mb": "Most bytes downloaded in one satellite-day run; further files are skipped "
-                              "with the reason.",
+    "with the reason.",
     "source.retention_days": "Downloaded files older than this are removed from the cache at the start of a "
-                             "run.",
+    "run.",
     "source.run_deadline_min": "Every request of one satellite-day run ends by this time after the run "
-                               "started.",
+    "started.",
     "source.max_list_pages": "Most pages of one listing (a day of one product is ~3 pages of 1000 keys).",
     "source.max_listed_keys": "Most keys of one listing.",
     "source.max_retry_after_s": "A server asking to wait longer than this (Retry-After) ends the attempt.",
@@ -48,34 +48,34 @@ MEANING = {
     "source.seed": "Seed of the simulator (kind simulated).",
     "schedule.time_utc": "Time of the daily run, HH:MM UTC.",
     "schedule.catch_up_days": "Days back (ending lag_days ago) that are assessed when they have no completed"
-                              " run.",
+    " run.",
     "schedule.misfire_grace_hours": "A daily run missed by less than this (e.g. host asleep) still runs.",
     "schedule.lag_days": "The daily run assesses the day that ended this many days ago (archive latency).",
     "schedule.no_data_retry_days": "A day found empty is tried again for this many days after it is due, "
-                                   "then recorded as no_data_final.",
+    "then recorded as no_data_final.",
     "schedule.run_budget_min": "A satellite-day run longer than this makes /healthz unhealthy and stops "
-                               "feeding the systemd watchdog (a restart follows). Keep it above "
-                               "source.run_deadline_min.",
+    "feeding the systemd watchdog (a restart follows). Keep it above "
+    "source.run_deadline_min.",
     "scenes.candidates": "CrIS granules of the day scored for inhomogeneity (spread over the day).",
     "scenes.keep": "Most inhomogeneous granules assessed (the paper uses 14).",
     "scenes.min_inhomogeneity_k": "A granule whose VIIRS-BT spread is below this is not used.",
     "assessment.half_steps": "Perturbations on each side of zero per direction: the grid is (2n+1)^2 (21 x "
-                             "21).",
+    "21).",
     "assessment.step_urad": "Perturbation step (375 m at nadir from 833 km).",
     "assessment.kernel": "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response).",
     "assessment.workers": "Processes collocating granules in parallel.",
     "fingerprint.granules": "GEO granules per day sampled (spread over the day) for the LOS fingerprint.",
     "fingerprint.threshold_urad": "A FOR whose fingerprint angle moves more than this is a processing "
-                                  "change.",
+    "change.",
     "fingerprint.ep_library": "EP files or directories to identify the EP in use from; empty: the packaged "
-                              "real EPs.",
+    "real EPs.",
     "http.listen": "HOST:PORT of /metrics, /healthz and /report/ (loopback by default; port 0: any free "
-                   "port; off: no endpoint). crisgeo daemon --listen overrides it.",
+    "port; off: no endpoint). crisgeo daemon --listen overrides it.",
     "store.sqlite": "The SQLite store (history, alert state, outbox). Default: state_dir/crisgeo.sqlite.",
     "store.drain_minutes": "The daemon sends the time-series points waiting in the outbox this often.",
     "store.publish": "Time-series databases the results are written to (list of the mappings below).",
     "store.publish[].kind": "influx2 (InfluxDB 2 API: token) or influx1 (InfluxDB 1 / VictoriaMetrics: user,"
-                            " password). Required.",
+    " password). Required.",
     "store.publish[].url": "Base URL of the database (no credentials in it). Required.",
     "store.publish[].measurement": "Measurement name of the points.",
     "store.publish[].bucket": "Bucket (influx2).",
@@ -86,10 +86,10 @@ MEANING = {
     "store.publish[].password_env": "Environment variable holding the password (influx1).",
     "store.publish[].timeout_s": "Timeout of one write.",
     "alerts.spec_km": "Specification of the geolocation error on the ground; a reliable FOR beyond it fires "
-                      "the spec rule (critical when value - 2 sigma is beyond it).",
+    "the spec rule (critical when value - 2 sigma is beyond it).",
     "alerts.min_jump_km": "Smallest step (median after minus median before) that counts as a jump.",
     "alerts.jump_z": "Step size in units of its standard error that counts as a jump, on any day of the "
-                     "recent window (blind search).",
+    "recent window (blind search).",
     "alerts.jump_z_at_change": "The same at the date of a known change (events calendar, fingerprint).",
     "alerts.pre_days": "Days before a candidate step that form the reference.",
     "alerts.min_pre_days": "Fewest assessed days before a step for the test to run.",
@@ -103,7 +103,7 @@ MEANING = {
     "alerts.repeat_hours": "A firing alert is notified again after this long.",
     "alerts.log": "File the alert messages are appended to (a channel that cannot fail).",
     "alerts.events_file": "The events calendar (EP uploads, LUT changes) used to attribute jumps and "
-                          "annotate plots.",
+    "annotate plots.",
     "alerts.email": "E-mail channel (mapping below); absent: none.",
     "alerts.email.host": "SMTP server. Required.",
     "alerts.email.port": "SMTP port.",

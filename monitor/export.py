@@ -40,6 +40,7 @@ def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.dat
     import xarray as xr
 
     from monitor.version import __version__
+
     rows = store.series(satellite, since, until)
     days = sorted({r["day"] for r in rows})
     index = {d: i for i, d in enumerate(days)}
@@ -53,23 +54,43 @@ def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.dat
             data[name][i, k] = np.nan if r[name] is None else r[name]
         n_samples[i, k] = r["n_samples"] or 0
         flags[i, k] = sum(FLAG_BITS[f] for f in json.loads(r["flags"] or "[]") if f in FLAG_BITS)
-    coords = {"time": np.array([np.datetime64(d, "ns") for d in days], dtype="datetime64[ns]"),
-              "for": np.arange(1, N_FOR + 1, dtype=np.int16)}
-    ds = xr.Dataset({name: (("time", "for"), data[name], {"units": unit, "long_name": long})
-                     for name, (unit, long) in VARIABLES.items()}, coords=coords)
-    ds["n_samples"] = (("time", "for"), n_samples, {"units": "1", "long_name": "CrIS FOVs in the cost function"})
-    ds["flags"] = (("time", "for"), flags, {
-        "long_name": "reliability flags (any set: not reliable)", "flag_masks": np.array(list(FLAG_BITS.values()),
-                                                                                       np.int8),
-        "flag_meanings": " ".join(FLAG_BITS)})
+    coords = {
+        "time": np.array([np.datetime64(d, "ns") for d in days], dtype="datetime64[ns]"),
+        "for": np.arange(1, N_FOR + 1, dtype=np.int16),
+    }
+    ds = xr.Dataset(
+        {
+            name: (("time", "for"), data[name], {"units": unit, "long_name": long})
+            for name, (unit, long) in VARIABLES.items()
+        },
+        coords=coords,
+    )
+    ds["n_samples"] = (
+        ("time", "for"),
+        n_samples,
+        {"units": "1", "long_name": "CrIS FOVs in the cost function"},
+    )
+    ds["flags"] = (
+        ("time", "for"),
+        flags,
+        {
+            "long_name": "reliability flags (any set: not reliable)",
+            "flag_masks": np.array(list(FLAG_BITS.values()), np.int8),
+            "flag_meanings": " ".join(FLAG_BITS),
+        },
+    )
     ds["for"].attrs.update(long_name="CrIS field of regard (scan position)", units="1")
     ds["time"].attrs.update(long_name="assessed day (00:00 UTC)")
     info = satellite_info(satellite)
-    ds.attrs.update(Conventions="CF-1.8", title=f"CrIS geolocation assessed against VIIRS I5, {info.name}",
-                    satellite=satellite, platform=info.name,
-                    method="LOS perturbation assessment, Wang et al. 2017, JGR 122:519",
-                    source=f"crisgeo-monitor {__version__}",
-                    history=f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ} exported from {store.path.name}")
+    ds.attrs.update(
+        Conventions="CF-1.8",
+        title=f"CrIS geolocation assessed against VIIRS I5, {info.name}",
+        satellite=satellite,
+        platform=info.name,
+        method="LOS perturbation assessment, Wang et al. 2017, JGR 122:519",
+        source=f"crisgeo-monitor {__version__}",
+        history=f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ} exported from {store.path.name}",
+    )
     return ds
 
 

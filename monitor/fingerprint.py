@@ -8,7 +8,8 @@ no VIIRS data needed.
 
 On the real NOAA-20 granules of 2018-10-22 the FOV-5 angles scatter from scan to scan by <= 2 urad
 in-track but 1.5-9.5 urad cross-track depending on the FOR (largest at FOR 1, 11, 21: scene-mirror
-servo errors, docs/jpss-formats.md 2.3), and the cross-track angle of those FORs drifts by ~20 urad within five
+servo errors, docs/jpss-formats.md 2.3), and the cross-track angle of those FORs drifts by ~20 urad within
+five
 minutes. The step threshold of each FOR and direction is therefore set from the measured scatter:
 max(10 urad, 4 x the scan-to-scan standard deviation).
 """
@@ -54,32 +55,62 @@ class DayPrint:
     def from_dict(cls, d: dict) -> "DayPrint":
         rows = sorted(d["fors"], key=lambda r: r["for"])
         col = lambda k: np.array([r[k] for r in rows], float)  # noqa: E731
-        return cls(col("alpha_urad"), col("beta_urad"), col("sd_alpha_urad"), col("sd_beta_urad"),
-                   np.array([r["pattern_alpha_urad"] for r in rows]), np.array([r["pattern_beta_urad"] for r in rows]),
-                   list(d.get("granules", [])))
+        return cls(
+            col("alpha_urad"),
+            col("beta_urad"),
+            col("sd_alpha_urad"),
+            col("sd_beta_urad"),
+            np.array([r["pattern_alpha_urad"] for r in rows]),
+            np.array([r["pattern_beta_urad"] for r in rows]),
+            list(d.get("granules", [])),
+        )
 
     def to_dict(self) -> dict:
-        return {"granules": self.granules, "fors": [
-            {"for": k + 1, "alpha_urad": float(self.alpha_urad[k]), "beta_urad": float(self.beta_urad[k]),
-             "sd_alpha_urad": float(self.sd_alpha_urad[k]), "sd_beta_urad": float(self.sd_beta_urad[k]),
-             "pattern_alpha_urad": np.round(self.pattern_alpha_urad[k], 2).tolist(),
-             "pattern_beta_urad": np.round(self.pattern_beta_urad[k], 2).tolist()} for k in range(len(self.alpha_urad))]}
+        return {
+            "granules": self.granules,
+            "fors": [
+                {
+                    "for": k + 1,
+                    "alpha_urad": float(self.alpha_urad[k]),
+                    "beta_urad": float(self.beta_urad[k]),
+                    "sd_alpha_urad": float(self.sd_alpha_urad[k]),
+                    "sd_beta_urad": float(self.sd_beta_urad[k]),
+                    "pattern_alpha_urad": np.round(self.pattern_alpha_urad[k], 2).tolist(),
+                    "pattern_beta_urad": np.round(self.pattern_beta_urad[k], 2).tolist(),
+                }
+                for k in range(len(self.alpha_urad))
+            ],
+        }
 
 
 def granule_print(geo) -> GranulePrint:
     """The fingerprint of one CrIS GEO granule (a :class:`monitor.sdr.CrisGeoGranule`)."""
     valid = geo.valid
-    args = [np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")]
-    fg = inverse_geolocation(*args, np.where(valid, geo.range_m, 1e6), geo.for_time_us, geo.mid_time_us,
-                             np.nan_to_num(geo.sc_position_m), np.nan_to_num(geo.sc_velocity_m_s),
-                             np.nan_to_num(geo.sc_attitude_rad))
+    args = [
+        np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")
+    ]
+    fg = inverse_geolocation(
+        *args,
+        np.where(valid, geo.range_m, 1e6),
+        geo.for_time_us,
+        geo.mid_time_us,
+        np.nan_to_num(geo.sc_position_m),
+        np.nan_to_num(geo.sc_velocity_m_s),
+        np.nan_to_num(geo.sc_attitude_rad),
+    )
     a = np.where(valid, fg.alpha_rad, np.nan) / URAD
     b = np.where(valid, fg.beta_rad, np.nan) / URAD
     with np.errstate(all="ignore"):
-        return GranulePrint(geo.meta.granule_id, geo.meta.start.isoformat(),
-                            np.nanmean(a[:, :, FOV5], axis=0), np.nanmean(b[:, :, FOV5], axis=0),
-                            np.nanmean(a - a[:, :, FOV5:FOV5 + 1], axis=0), np.nanmean(b - b[:, :, FOV5:FOV5 + 1], axis=0),
-                            a[:, :, FOV5], b[:, :, FOV5])
+        return GranulePrint(
+            geo.meta.granule_id,
+            geo.meta.start.isoformat(),
+            np.nanmean(a[:, :, FOV5], axis=0),
+            np.nanmean(b[:, :, FOV5], axis=0),
+            np.nanmean(a - a[:, :, FOV5 : FOV5 + 1], axis=0),
+            np.nanmean(b - b[:, :, FOV5 : FOV5 + 1], axis=0),
+            a[:, :, FOV5],
+            b[:, :, FOV5],
+        )
 
 
 def day_print(prints: list[GranulePrint]) -> DayPrint:
@@ -87,12 +118,15 @@ def day_print(prints: list[GranulePrint]) -> DayPrint:
     sa = np.concatenate([p.scan_alpha_urad for p in prints])
     sb = np.concatenate([p.scan_beta_urad for p in prints])
     with np.errstate(all="ignore"):
-        return DayPrint(np.nanmedian([p.alpha_urad for p in prints], axis=0),
-                        np.nanmedian([p.beta_urad for p in prints], axis=0),
-                        np.nanstd(sa, axis=0), np.nanstd(sb, axis=0),
-                        np.nanmedian([p.pattern_alpha_urad for p in prints], axis=0),
-                        np.nanmedian([p.pattern_beta_urad for p in prints], axis=0),
-                        [p.granule_id for p in prints])
+        return DayPrint(
+            np.nanmedian([p.alpha_urad for p in prints], axis=0),
+            np.nanmedian([p.beta_urad for p in prints], axis=0),
+            np.nanstd(sa, axis=0),
+            np.nanstd(sb, axis=0),
+            np.nanmedian([p.pattern_alpha_urad for p in prints], axis=0),
+            np.nanmedian([p.pattern_beta_urad for p in prints], axis=0),
+            [p.granule_id for p in prints],
+        )
 
 
 K_SIGMA = 4.0
@@ -100,8 +134,10 @@ K_SIGMA = 4.0
 
 def thresholds(sd_alpha_urad, sd_beta_urad, threshold_urad: float = 10.0):
     """Per-FOR step thresholds (urad): max(threshold, 4 x scan-to-scan scatter), per direction."""
-    return (np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_alpha_urad)),
-            np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_beta_urad)))
+    return (
+        np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_alpha_urad)),
+        np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_beta_urad)),
+    )
 
 
 def _changed_fors(before_a, before_b, after_a, after_b, thr_a, thr_b):
@@ -115,13 +151,25 @@ def compare_days(previous: DayPrint, current: DayPrint, threshold_urad: float = 
 
     Thresholds use the larger scatter of the two days: a step between days does not widen either.
     """
-    return _changed_fors(previous.alpha_urad, previous.beta_urad, current.alpha_urad, current.beta_urad,
-                         *thresholds(np.fmax(previous.sd_alpha_urad, current.sd_alpha_urad),
-                                     np.fmax(previous.sd_beta_urad, current.sd_beta_urad), threshold_urad))
+    return _changed_fors(
+        previous.alpha_urad,
+        previous.beta_urad,
+        current.alpha_urad,
+        current.beta_urad,
+        *thresholds(
+            np.fmax(previous.sd_alpha_urad, current.sd_alpha_urad),
+            np.fmax(previous.sd_beta_urad, current.sd_beta_urad),
+            threshold_urad,
+        ),
+    )
 
 
-def change_within(prints: list[GranulePrint], threshold_urad: float = 10.0, min_side: int = 2,
-                  reference: DayPrint | None = None):
+def change_within(
+    prints: list[GranulePrint],
+    threshold_urad: float = 10.0,
+    min_side: int = 2,
+    reference: DayPrint | None = None,
+):
     """The first granule after a step within a time-ordered day, or None.
 
     For every split with at least *min_side* granules on each side, the granule-median fingerprints
@@ -136,8 +184,13 @@ def change_within(prints: list[GranulePrint], threshold_urad: float = 10.0, min_
     b = np.array([p.beta_urad for p in prints])
     best = None
     for k in range(min_side, len(prints) - min_side + 1):
-        fors, da, db = _changed_fors(np.nanmedian(a[:k], 0), np.nanmedian(b[:k], 0), np.nanmedian(a[k:], 0),
-                                     np.nanmedian(b[k:], 0), *thr)
+        fors, da, db = _changed_fors(
+            np.nanmedian(a[:k], 0),
+            np.nanmedian(b[:k], 0),
+            np.nanmedian(a[k:], 0),
+            np.nanmedian(b[k:], 0),
+            *thr,
+        )
         excess = float(np.nanmax(np.concatenate([np.abs(da) / thr[0], np.abs(db) / thr[1]])))
         if fors and (best is None or excess > best[0]):
             best = (excess, k, fors, da, db)
@@ -160,9 +213,14 @@ class EpMatch:
         return float(np.sqrt(np.nanmean(np.concatenate([self.d_alpha_urad, self.d_beta_urad]) ** 2)))
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "satellite": self.satellite, "version": self.version, "rms_urad": self.rms_urad,
-                "d_alpha_urad": np.round(self.d_alpha_urad, 1).tolist(),
-                "d_beta_urad": np.round(self.d_beta_urad, 1).tolist()}
+        return {
+            "name": self.name,
+            "satellite": self.satellite,
+            "version": self.version,
+            "rms_urad": self.rms_urad,
+            "d_alpha_urad": np.round(self.d_alpha_urad, 1).tolist(),
+            "d_beta_urad": np.round(self.d_beta_urad, 1).tolist(),
+        }
 
 
 def identify_ep(day: DayPrint, library: dict, satellite: str | None = None) -> list[EpMatch]:
@@ -170,15 +228,19 @@ def identify_ep(day: DayPrint, library: dict, satellite: str | None = None) -> l
 
     Each EP's model FOV-5 angles (equations 14-18 and the mounting) are compared with the fingerprint's
     per-FOR medians. With *satellite*, EPs of other satellites are left out. On real NOAA-20 data the
-    right EP leaves ~30 urad (the servo and in-track residuals of docs/jpss-formats.md 2.3); a wrong one, hundreds.
+    right EP leaves ~30 urad (the servo and in-track residuals of docs/jpss-formats.md 2.3); a wrong one,
+    hundreds.
     """
     matches = []
     for name, ep in library.items():
         if satellite is not None and ep.satellite != satellite:
             continue
         alpha, beta = fov5_angles(ep)
-        matches.append(EpMatch(name, ep.satellite, ep.version, day.alpha_urad - alpha / URAD,
-                               day.beta_urad - beta / URAD))
+        matches.append(
+            EpMatch(
+                name, ep.satellite, ep.version, day.alpha_urad - alpha / URAD, day.beta_urad - beta / URAD
+            )
+        )
     return sorted(matches, key=lambda m: m.rms_urad)
 
 
@@ -190,15 +252,22 @@ def format_matches(matches: list[EpMatch]) -> str:
     lines += [f"  {m.name:<40} {m.satellite:<4} {m.version:<20} rms {m.rms_urad:9.1f} urad" for m in matches]
     best = matches[0]
     lines.append(f"best: {best.name}; residual per FOR (urad), in-track / cross-track:")
-    lines += [f"  FOR {k + 1:>2} {best.d_alpha_urad[k]:8.1f} {best.d_beta_urad[k]:8.1f}" for k in range(len(best.d_alpha_urad))]
+    lines += [
+        f"  FOR {k + 1:>2} {best.d_alpha_urad[k]:8.1f} {best.d_beta_urad[k]:8.1f}"
+        for k in range(len(best.d_alpha_urad))
+    ]
     return "\n".join(lines)
 
 
 def format_print(day: DayPrint) -> str:
     """The per-FOR table printed by ``crisgeo fingerprint``."""
-    lines = [f"{len(day.granules)} granule(s)",
-             f"{'FOR':>3} {'alpha5':>10} {'sd':>5} {'beta5':>10} {'sd':>5}   (urad, SBF, FOV 5; sd: scan to scan)"]
+    lines = [
+        f"{len(day.granules)} granule(s)",
+        f"{'FOR':>3} {'alpha5':>10} {'sd':>5} {'beta5':>10} {'sd':>5}   (urad, SBF, FOV 5; sd: scan to scan)",
+    ]
     for k in range(len(day.alpha_urad)):
-        lines.append(f"{k + 1:>3} {day.alpha_urad[k]:10.1f} {day.sd_alpha_urad[k]:5.1f} {day.beta_urad[k]:10.1f} "
-                     f"{day.sd_beta_urad[k]:5.1f}")
+        lines.append(
+            f"{k + 1:>3} {day.alpha_urad[k]:10.1f} {day.sd_alpha_urad[k]:5.1f} {day.beta_urad[k]:10.1f} "
+            f"{day.sd_beta_urad[k]:5.1f}"
+        )
     return "\n".join(lines)

@@ -64,11 +64,15 @@ class RunOutcome:
     def summary(self) -> str:
         """The one line a run leaves in the log."""
         c, t = self.counts, self.timings
-        parts = [f"run {self.satellite} {self.day}: {self.status}" + (f" ({self.reason})" if self.reason else "")]
+        parts = [
+            f"run {self.satellite} {self.day}: {self.status}" + (f" ({self.reason})" if self.reason else "")
+        ]
         if c:
-            parts.append(f"granules listed {c.get('listed', 0)}, selected {c.get('selected', 0)}, "
-                         f"assessed {c.get('assessed', 0)}; {c.get('downloaded', 0)} files, "
-                         f"{c.get('bytes', 0) / 1e6:.0f} MB downloaded")
+            parts.append(
+                f"granules listed {c.get('listed', 0)}, selected {c.get('selected', 0)}, "
+                f"assessed {c.get('assessed', 0)}; {c.get('downloaded', 0)} files, "
+                f"{c.get('bytes', 0) / 1e6:.0f} MB downloaded"
+            )
         if self.result is not None:
             ok = [f for f in self.result.fors if f.reliable]
             worst = max((f.total_km for f in ok), default=float("nan"))
@@ -78,8 +82,9 @@ class RunOutcome:
         return "; ".join(parts)
 
 
-def days_to_run(store, satellite: str, today: dt.date, catch_up_days: int, lag_days: int = 1,
-                no_data_retry_days: int = 3) -> list[dt.date]:
+def days_to_run(
+    store, satellite: str, today: dt.date, catch_up_days: int, lag_days: int = 1, no_data_retry_days: int = 3
+) -> list[dt.date]:
     """The days of the catch-up window (ending *lag_days* before *today*) without a completed run, oldest
     first. A day found empty (archive outage, late ingest) is tried again for *no_data_retry_days* after
     it became due; then its empty listing is final."""
@@ -112,11 +117,15 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
     A step against the previous day, or within the day, becomes a ``change:cris`` event (used for jump
     attribution and notified by the alerts). Problems are logged, never fatal to the run.
     """
-    geos = sorted((f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
-                  key=lambda f: f.parsed.start)
+    geos = sorted(
+        (f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
+        key=lambda f: f.parsed.start,
+    )
     if not geos:
         return None
-    picks = np.unique(np.round(np.linspace(0, len(geos) - 1, min(cfg.fingerprint.granules, len(geos)))).astype(int))
+    picks = np.unique(
+        np.round(np.linspace(0, len(geos) - 1, min(cfg.fingerprint.granules, len(geos)))).astype(int)
+    )
     prints = []
     for i in picks:
         try:
@@ -145,19 +154,40 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
         change = {"time": prints[k].start, "granule": prints[k].granule_id, "fors": fors, "da": da, "db": db}
     elif between is not None and between[0]:
         fors, da, db = between
-        change = {"time": f"{day.isoformat()}T00:00:00+00:00", "granule": prints[0].granule_id, "fors": fors,
-                  "da": da, "db": db}
+        change = {
+            "time": f"{day.isoformat()}T00:00:00+00:00",
+            "granule": prints[0].granule_id,
+            "fors": fors,
+            "da": da,
+            "db": db,
+        }
     if change is not None:
         big = max(float(np.nanmax(np.abs(change["da"]))), float(np.nanmax(np.abs(change["db"]))))
-        desc = (f"CrIS geolocation processing changed (LOS fingerprint): FOR {', '.join(map(str, change['fors']))}, "
-                f"up to {big:.0f} urad, from granule {change['granule']}")
+        desc = (
+            "CrIS geolocation processing changed (LOS fingerprint): FOR "
+            f"{', '.join(map(str, change['fors']))}, "
+            f"up to {big:.0f} urad, from granule {change['granule']}"
+        )
         if matches:
-            desc += f"; best-matching EP {matches[0].name} ({matches[0].version}, rms {matches[0].rms_urad:.0f} urad)"
-        body["change"] = {"time": change["time"], "granule": change["granule"], "fors": change["fors"],
-                          "d_alpha_urad": np.round(change["da"], 1).tolist(),
-                          "d_beta_urad": np.round(change["db"], 1).tolist()}
-        store.add_event(EventKind.CHANGE_CRIS, satellite, {"time": change["time"], "kind": "processing_change",
-                                                           "description": desc, "origin": "fingerprint"})
+            best = matches[0]
+            desc += f"; best-matching EP {best.name} ({best.version}, rms {best.rms_urad:.0f} urad)"
+        body["change"] = {
+            "time": change["time"],
+            "granule": change["granule"],
+            "fors": change["fors"],
+            "d_alpha_urad": np.round(change["da"], 1).tolist(),
+            "d_beta_urad": np.round(change["db"], 1).tolist(),
+        }
+        store.add_event(
+            EventKind.CHANGE_CRIS,
+            satellite,
+            {
+                "time": change["time"],
+                "kind": "processing_change",
+                "description": desc,
+                "origin": "fingerprint",
+            },
+        )
         LOG.warning("%s %s: %s", satellite, day, desc)
     store.save_fingerprint(satellite, day, body)
     return body
@@ -168,6 +198,7 @@ def publish_changes(cfg, store, satellite: str) -> None:
     if not cfg.store.publish:
         return
     from alerts.changes import all_changes
+
     try:
         changes = all_changes(store, satellite, cfg.alert_settings.events_file)
     except (ValueError, OSError) as exc:
@@ -198,22 +229,32 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         timings["list"] = time.perf_counter() - t0
         counts["listed"] = len(listing)
         if not any(f.product in CRIS_GEO for f in listing):
-            return _no_data(cfg, store, run_id, satellite, day, f"no CrIS GEO granule of {satellite} on {day} in "
-                                                                  f"the source", timings, counts=counts)
+            return _no_data(
+                cfg,
+                store,
+                run_id,
+                satellite,
+                day,
+                f"no CrIS GEO granule of {satellite} on {day} in the source",
+                timings,
+                counts=counts,
+            )
         if stop():
             raise Stopped
         t1 = time.perf_counter()
         fingerprint_day(cfg, store, source, satellite, day, listing)
         timings["fingerprint"] = time.perf_counter() - t1
         t1 = time.perf_counter()
-        chosen, decisions = select_scenes(listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep,
-                                          cfg.scenes.min_inhomogeneity_k)
+        chosen, decisions = select_scenes(
+            listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep, cfg.scenes.min_inhomogeneity_k
+        )
         timings["select"] = time.perf_counter() - t1
         counts["selected"] = len(chosen)
         if not chosen:
             reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in decisions}))[:500]
-            return _no_data(cfg, store, run_id, satellite, day, reason, timings, {"selection": decisions[:50]},
-                            counts)
+            return _no_data(
+                cfg, store, run_id, satellite, day, reason, timings, {"selection": decisions[:50]}, counts
+            )
         t1 = time.perf_counter()
         paths, fetch_skipped = [], []
         fetched = ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
@@ -234,26 +275,36 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         case.skipped += fetch_skipped
         a = cfg.assessment
         progress = progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris))
-        result = assess_plan(case, AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6,
-                                                kernel=a.kernel), progress=progress, should_stop=stop,
-                             workers=a.workers)
+        result = assess_plan(
+            case,
+            AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6, kernel=a.kernel),
+            progress=progress,
+            should_stop=stop,
+            workers=a.workers,
+        )
         timings["assess"] = time.perf_counter() - t1
         counts["assessed"] = len(result.granules)
         if stop():
             raise Stopped
-        lines = {target_name(p): result_lines(p.measurement, satellite, day, result.fors) for p in cfg.store.publish}
+        lines = {
+            target_name(p): result_lines(p.measurement, satellite, day, result.fors)
+            for p in cfg.store.publish
+        }
         store.save_day(run_id, satellite, day, result, decisions, lines)
         publish_changes(cfg, store, satellite)
         return RunOutcome(satellite, day, "ok", None, run_id, result, timings, counts)
     except Stopped:
         store.finish_run(run_id, "interrupted", "stop requested")
-        return RunOutcome(satellite, day, "interrupted", "stop requested", run_id, timings=timings, counts=counts)
+        return RunOutcome(
+            satellite, day, "interrupted", "stop requested", run_id, timings=timings, counts=counts
+        )
     except (SourceError, PlanError, DataError, OSError) as exc:
         return _failed(store, run_id, satellite, day, f"{type(exc).__name__}: {exc}", timings, counts)
     except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
         LOG.exception("run %s %s failed unexpectedly", satellite, day)
-        return _failed(store, run_id, satellite, day, f"unexpected {type(exc).__name__}: {exc}"[:1000], timings,
-                       counts)
+        return _failed(
+            store, run_id, satellite, day, f"unexpected {type(exc).__name__}: {exc}"[:1000], timings, counts
+        )
     finally:
         t1 = time.perf_counter()
         if cfg.store.publish:

@@ -32,14 +32,19 @@ def keys_weights(x):
     x = np.asarray(x, float)
     base = np.floor(x)
     t = x - base
-    taps = np.stack([((-0.5 * t + 1.0) * t - 0.5) * t,
-                     (1.5 * t - 2.5) * t * t + 1.0,
-                     ((-1.5 * t + 2.0) * t + 0.5) * t,
-                     (0.5 * t - 0.5) * t * t], -1)
+    taps = np.stack(
+        [
+            ((-0.5 * t + 1.0) * t - 0.5) * t,
+            (1.5 * t - 2.5) * t * t + 1.0,
+            ((-1.5 * t + 2.0) * t + 0.5) * t,
+            (0.5 * t - 0.5) * t * t,
+        ],
+        -1,
+    )
     w = np.zeros(x.shape + (2 * HALF + 1,))
     first = (base - 1 + HALF).astype(int)
     for k in range(4):
-        np.put_along_axis(w, (first + k)[..., None], taps[..., k:k + 1], axis=-1)
+        np.put_along_axis(w, (first + k)[..., None], taps[..., k : k + 1], axis=-1)
     return w
 
 
@@ -51,7 +56,7 @@ def refinable(i0: int, j0: int, m: int) -> bool:
 def window_covariance(d, i0: int, j0: int, counts=None):
     """Covariance (49 x 49) over samples of d (N, m, m) in the window around (i0, j0); with bootstrap
     *counts* (B, N) one covariance per replicate (B, 49, 49)."""
-    x = d[:, i0 - HALF:i0 + HALF + 1, j0 - HALF:j0 + HALF + 1].reshape(len(d), -1)
+    x = d[:, i0 - HALF : i0 + HALF + 1, j0 - HALF : j0 + HALF + 1].reshape(len(d), -1)
     x = x - x.mean(axis=0)  # centred once: the covariance does not depend on it, rounding does
     if counts is None:
         return np.cov(x, rowvar=False)

@@ -83,10 +83,16 @@ class AssessmentResult:
     cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
 
     def to_dict(self, with_cube: bool = False) -> dict:
-        d = {"satellite": self.satellite, "start": self.start, "end": self.end,
-             "half_steps": self.half_steps, "step_urad": self.step_urad,
-             "granules": self.granules, "skipped": self.skipped,
-             "fors": [f.to_dict() for f in self.fors]}
+        d = {
+            "satellite": self.satellite,
+            "start": self.start,
+            "end": self.end,
+            "half_steps": self.half_steps,
+            "step_urad": self.step_urad,
+            "granules": self.granules,
+            "skipped": self.skipped,
+            "fors": [f.to_dict() for f in self.fors],
+        }
         if with_cube and self.cost_cube_k is not None:
             d["cost_cube_k"] = np.round(self.cost_cube_k, 5).tolist()
         return d
@@ -97,11 +103,17 @@ class AssessmentResult:
     @classmethod
     def from_dict(cls, d: dict) -> "AssessmentResult":
         cube = d.get("cost_cube_k")
-        return cls(satellite=d["satellite"], start=d["start"], end=d["end"],
-                   fors=[ForOffset.from_dict(f) for f in d["fors"]], granules=d.get("granules", []),
-                   skipped=d.get("skipped", []), half_steps=int(d.get("half_steps", DEFAULT_HALF_STEPS)),
-                   step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),
-                   cost_cube_k=None if cube is None else np.asarray(cube, float))
+        return cls(
+            satellite=d["satellite"],
+            start=d["start"],
+            end=d["end"],
+            fors=[ForOffset.from_dict(f) for f in d["fors"]],
+            granules=d.get("granules", []),
+            skipped=d.get("skipped", []),
+            half_steps=int(d.get("half_steps", DEFAULT_HALF_STEPS)),
+            step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),
+            cost_cube_k=None if cube is None else np.asarray(cube, float),
+        )
 
     @classmethod
     def from_json(cls, text: str) -> "AssessmentResult":

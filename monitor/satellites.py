@@ -6,7 +6,8 @@ its implications on VIIRS geometric performance", drag make-up and inclination m
 NOAA-21 833 km, 98.8 deg (NASA mission facts); NOAA-20 flies the same orbit. Phasing as flown since the
 NOAA-20 rephasing of April 2024: NOAA-21 a quarter orbit ahead of S-NPP, NOAA-20 directly opposite
 NOAA-21 (a quarter orbit behind S-NPP). The phase reference itself (S-NPP at the ascending node at
-``PHASE_EPOCH_UNIX_S``, advancing with the shared ``NODAL_PERIOD_S``) is illustrative: the simulator needs consistent, not operational, ephemerides.
+``PHASE_EPOCH_UNIX_S``, advancing with the shared ``NODAL_PERIOD_S``) is illustrative: the simulator needs
+consistent, not operational, ephemerides.
 """
 
 from __future__ import annotations
@@ -28,11 +29,14 @@ class Satellite:
     phase_deg: float  # mean argument of latitude ahead of S-NPP
 
 
-SATELLITES = {s.short: s for s in (
-    Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0),
-    Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0),
-    Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0),
-)}
+SATELLITES = {
+    s.short: s
+    for s in (
+        Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0),
+        Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0),
+        Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0),
+    )
+}
 PHASE_EPOCH_UNIX_S = 1704067200.0  # 2024-01-01T00:00:00Z
 NODAL_PERIOD_S = 101.5 * 60.0  # the shared orbit's period (Lin et al. 2016): the phases keep their spacing
 

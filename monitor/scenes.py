@@ -50,26 +50,39 @@ def inhomogeneity_k(radiance_lw, satellite: str) -> float:
 
 
 def select_scenes(listing, source, satellite: str, candidates: int, keep: int, min_score_k: float):
-    """(chosen candidates, decisions) for one satellite-day; decisions are dicts granule/score_k/decision/reason."""
+    """(chosen candidates, decisions) for one satellite-day; decisions are dicts of granule, score_k,
+    decision, reason."""
     decisions = []
     cris, unpaired = _pairs(listing, CRIS_SDR, CRIS_GEO)
     for key in unpaired:
-        decisions.append({"granule": key, "decision": "rejected", "reason": "SDR or GEO file missing in the listing"})
+        decisions.append(
+            {"granule": key, "decision": "rejected", "reason": "SDR or GEO file missing in the listing"}
+        )
     viirs, _ = _pairs(listing, VIIRS_SDR, VIIRS_GEO)
     if len(cris) > candidates:
         picks = set(np.round(np.linspace(0, len(cris) - 1, candidates)).astype(int))
         for i, (key, _, _) in enumerate(cris):
             if i not in picks:
-                decisions.append({"granule": key, "decision": "not considered",
-                                  "reason": f"outside the {candidates} candidates spread over the day"})
+                decisions.append(
+                    {
+                        "granule": key,
+                        "decision": "not considered",
+                        "reason": f"outside the {candidates} candidates spread over the day",
+                    }
+                )
         cris = [c for i, c in enumerate(cris) if i in picks]
     pool = []
     for key, sdr, geo in cris:
         start, end = geo.parsed.start, geo.parsed.end
-        cover = [(vs, vg) for _, vs, vg in viirs
-                 if vg.parsed.start <= end + COVER_MARGIN and vg.parsed.end >= start - COVER_MARGIN]
+        cover = [
+            (vs, vg)
+            for _, vs, vg in viirs
+            if vg.parsed.start <= end + COVER_MARGIN and vg.parsed.end >= start - COVER_MARGIN
+        ]
         if not cover:
-            decisions.append({"granule": key, "decision": "rejected", "reason": "no VIIRS I5 + GEO granule covers it"})
+            decisions.append(
+                {"granule": key, "decision": "rejected", "reason": "no VIIRS I5 + GEO granule covers it"}
+            )
             continue
         try:
             sdr_path = source.fetch(sdr)
@@ -80,21 +93,41 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
             decisions.append({"granule": key, "decision": "rejected", "reason": str(exc)})
             break
         except (SourceError, GranuleError, ValueError) as exc:
-            decisions.append({"granule": key, "decision": "rejected", "reason": f"unusable CrIS granule: {exc}"})
+            decisions.append(
+                {"granule": key, "decision": "rejected", "reason": f"unusable CrIS granule: {exc}"}
+            )
             continue
         pool.append(Candidate(key, sdr, geo, cover, score))
     pool.sort(key=lambda c: -c.score_k)
     chosen = []
     for c in pool:
         if not np.isfinite(c.score_k) or c.score_k < min_score_k:
-            decisions.append({"granule": c.key, "score_k": c.score_k, "decision": "rejected",
-                              "reason": f"too homogeneous ({c.score_k:.2f} K < {min_score_k} K)"})
+            decisions.append(
+                {
+                    "granule": c.key,
+                    "score_k": c.score_k,
+                    "decision": "rejected",
+                    "reason": f"too homogeneous ({c.score_k:.2f} K < {min_score_k} K)",
+                }
+            )
         elif len(chosen) >= keep:
-            decisions.append({"granule": c.key, "score_k": c.score_k, "decision": "rejected",
-                              "reason": f"the {keep} more inhomogeneous granules were kept"})
+            decisions.append(
+                {
+                    "granule": c.key,
+                    "score_k": c.score_k,
+                    "decision": "rejected",
+                    "reason": f"the {keep} more inhomogeneous granules were kept",
+                }
+            )
         else:
             chosen.append(c)
-            decisions.append({"granule": c.key, "score_k": c.score_k, "decision": "chosen",
-                              "reason": f"inhomogeneity {c.score_k:.2f} K, rank {len(chosen)}"})
+            decisions.append(
+                {
+                    "granule": c.key,
+                    "score_k": c.score_k,
+                    "decision": "chosen",
+                    "reason": f"inhomogeneity {c.score_k:.2f} K, rank {len(chosen)}",
+                }
+            )
     chosen.sort(key=lambda c: c.geo.parsed.start)
     return chosen, decisions

@@ -79,10 +79,14 @@ class InstanceLock:
             holder = self.fh.read().strip()[:20] or "?"
             self.fh.close()
             raise AlreadyRunning(
-                f"{self.path}: another crisgeo process (pid {holder}) is running on this state directory. The "
-                f"daemon assesses the missed days of its catch-up window itself at its next daily run; to redo "
-                f"a day now, stop it (systemctl stop crisgeo), run 'crisgeo run --date YYYY-MM-DD', and start "
-                f"it again") from None
+                f"{self.path}: another crisgeo process (pid {holder}) is running on this state directory. "
+                "The "
+                "daemon assesses the missed days of its catch-up window itself at its next daily run; to "
+                "redo "
+                "a day now, stop it (systemctl stop crisgeo), run 'crisgeo run --date YYYY-MM-DD', and "
+                "start "
+                f"it again"
+            ) from None
         self.fh.seek(0)
         self.fh.truncate()
         self.fh.write(str(os.getpid()))
@@ -115,7 +119,9 @@ class Service:
             LOG.info("run %s %s", satellite, day)
             sd_notify(f"STATUS=assessing {satellite} {day}")
             with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
-                out = run_day(self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress)
+                out = run_day(
+                    self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress
+                )
             LOG.info("%s", out.summary())
             if self.metrics is not None:
                 self.metrics.record(out)
@@ -138,6 +144,7 @@ class Service:
         if not self.cfg.report_dir:
             return
         from monitor.report.html import build_report, options_from_config
+
         try:
             build_report(store, self.cfg.report_dir, options_from_config(self.cfg))
         except Exception:  # noqa: BLE001 - matplotlib, disk or data surprises are logged, not fatal
@@ -147,6 +154,7 @@ class Service:
         """Evaluate the alert rules for every satellite and deliver the queue (regenerating the report in
         between when *report*); a broken channel never stops the service."""
         from alerts.engine import deliver, evaluate
+
         own = store is None
         store = store or self.store()
         try:
@@ -165,6 +173,7 @@ class Service:
         """Send the time-series points waiting in the outbox (after an outage they need not wait for the
         next daily run); returns {target: (sent, left)}."""
         from monitor.store.timeseries import drain_outbox
+
         store = self.store()
         try:
             report = drain_outbox(store, self.cfg.store.publish)
@@ -195,7 +204,9 @@ class Service:
         store = self.store()
         try:
             sch = self.cfg.schedule
-            days = days_to_run(store, satellite, today, sch.catch_up_days, sch.lag_days, sch.no_data_retry_days)
+            days = days_to_run(
+                store, satellite, today, sch.catch_up_days, sch.lag_days, sch.no_data_retry_days
+            )
         finally:
             store.close()
         outcomes = []
@@ -227,27 +238,41 @@ class Service:
         evaluation, and (with publishing) the outbox timer."""
         from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED
         from apscheduler.triggers.cron import CronTrigger
+
         sch = self.cfg.schedule
         now = dt.datetime.now(UTC)
         for sat in self.cfg.satellites:
             trigger = CronTrigger(hour=sch.time_utc.hour, minute=sch.time_utc.minute, timezone=UTC)
-            scheduler.add_job(self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}",
-                              next_run_time=now)  # catch up at start, then daily
+            scheduler.add_job(
+                self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}", next_run_time=now
+            )  # catch up at start, then daily
         scheduler.add_job(self.check_alerts, "interval", hours=1, id="alerts", name="alert timer")
-        scheduler.add_job(self.health.beat, "interval", seconds=HEARTBEAT_S, id="heartbeat", name="heartbeat",
-                          next_run_time=now)
+        scheduler.add_job(
+            self.health.beat,
+            "interval",
+            seconds=HEARTBEAT_S,
+            id="heartbeat",
+            name="heartbeat",
+            next_run_time=now,
+        )
         if self.cfg.store.publish:
-            scheduler.add_job(self.drain_outbox, "interval", minutes=self.cfg.store.drain_minutes, id="outbox",
-                              name="outbox timer")
+            scheduler.add_job(
+                self.drain_outbox,
+                "interval",
+                minutes=self.cfg.store.drain_minutes,
+                id="outbox",
+                name="outbox timer",
+            )
         scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
 
     def start_endpoint(self, listen: str):
         """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
         if listen == "off":
             return None
-        from monitor.version import __version__
         from monitor.endpoint import Endpoint, parse_listen
         from monitor.metrics import ServiceMetrics
+        from monitor.version import __version__
+
         self.metrics = ServiceMetrics(self.store, self.cfg.satellites, self.health, __version__)
         report = self.cfg.report_dir if self.cfg.report_dir else None
         return Endpoint(*parse_listen(listen), self.metrics, self.health, report).start()
@@ -255,19 +280,29 @@ class Service:
     def daemon(self, listen: str | None = None):
         """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``."""
         from apscheduler.schedulers.blocking import BlockingScheduler
+
         sch = self.cfg.schedule
         with InstanceLock(self.cfg.state_dir):
             endpoint = self.start_endpoint(listen or self.cfg.http.listen)
             self.recover()
-            self.scheduler = BlockingScheduler(timezone=UTC, job_defaults={
-                "coalesce": True, "max_instances": 1, "misfire_grace_time": int(sch.misfire_grace_hours * 3600)})
+            self.scheduler = BlockingScheduler(
+                timezone=UTC,
+                job_defaults={
+                    "coalesce": True,
+                    "max_instances": 1,
+                    "misfire_grace_time": int(sch.misfire_grace_hours * 3600),
+                },
+            )
             self.add_jobs(self.scheduler)
             self.handle_signals()
             watchdog = self._start_watchdog()
             sd_notify("READY=1")
             sd_notify("STATUS=scheduled daily at " + sch.time_utc.strftime("%H:%M UTC"))
-            LOG.info("crisgeo daemon started for %s; daily at %s UTC", ", ".join(self.cfg.satellites),
-                     sch.time_utc.strftime("%H:%M"))
+            LOG.info(
+                "crisgeo daemon started for %s; daily at %s UTC",
+                ", ".join(self.cfg.satellites),
+                sch.time_utc.strftime("%H:%M"),
+            )
             try:
                 self.scheduler.start()
             finally:
@@ -289,10 +324,15 @@ class Service:
         from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MISSED
 
         from monitor.store.sqlite import EventKind
+
         kind = {EVENT_JOB_ERROR: EventKind.JOB_ERROR, EVENT_JOB_MISSED: EventKind.JOB_MISSED}.get(
-            event.code, EventKind.JOB_SKIPPED)
-        detail = {"job": event.job_id, "error": str(getattr(event, "exception", None) or kind.value),
-                  "scheduled": str(event.scheduled_run_time)}
+            event.code, EventKind.JOB_SKIPPED
+        )
+        detail = {
+            "job": event.job_id,
+            "error": str(getattr(event, "exception", None) or kind.value),
+            "scheduled": str(event.scheduled_run_time),
+        }
         LOG.error("scheduler: %s: %s (scheduled %s)", detail["job"], detail["error"], detail["scheduled"])
         with self.store() as store:
             store.add_event(kind, event.job_id.split("-", 1)[-1], detail)
@@ -308,7 +348,11 @@ class Service:
             reported = set()  # what is wrong, by source (a job, the scheduler): said once, not every ping
             while not self.stop_event.wait(interval):
                 sched = self.scheduler
-                problems = self.health.problems() if sched is not None and sched.running else ["scheduler: not running"]
+                problems = (
+                    self.health.problems()
+                    if sched is not None and sched.running
+                    else ["scheduler: not running"]
+                )
                 sources = {p.split(":", 1)[0] for p in problems}
                 if not problems:
                     if reported:
@@ -318,7 +362,7 @@ class Service:
                     LOG.error("unhealthy, the watchdog is no longer fed: %s", "; ".join(problems))
                     sd_notify("STATUS=unhealthy: " + "; ".join(problems)[:200])
                 reported = sources
+
         t = threading.Thread(target=ping, name="watchdog", daemon=True)
         t.start()
         return t
-

@@ -32,7 +32,9 @@ def load_srf(satellite: str):
     """(wavenumber_cm1, response) of the VIIRS I5 band of *satellite* (npp, j01, j02), ascending."""
     name = SRF_FILES.get(satellite)
     if name is None:
-        raise ValueError(f"no I5 spectral response for satellite {satellite!r} (known: {', '.join(SRF_FILES)})")
+        raise ValueError(
+            f"no I5 spectral response for satellite {satellite!r} (known: {', '.join(SRF_FILES)})"
+        )
     text = resources.files("monitor.data.srf").joinpath(name).read_text()
     data = _read_csv(text)
     order = np.argsort(data[:, 0])
@@ -59,7 +61,9 @@ class I5Band:
 
     def __init__(self, satellite: str, wavenumber_cm1=None):
         self.satellite = satellite
-        self.wavenumber_cm1 = cris_lw_wavenumbers_cm1() if wavenumber_cm1 is None else np.asarray(wavenumber_cm1)
+        self.wavenumber_cm1 = (
+            cris_lw_wavenumbers_cm1() if wavenumber_cm1 is None else np.asarray(wavenumber_cm1)
+        )
         nu, s = load_srf(satellite)
         self.response = np.interp(self.wavenumber_cm1, nu, s, left=0.0, right=0.0)
         self.weights = self.response / self.response.sum()

@@ -44,7 +44,10 @@ def cases(tmp_path_factory):
 
 
 def truth_arrays(truth):
-    return (np.array([f["d_alpha_urad"] for f in truth["fors"]]), np.array([f["d_beta_urad"] for f in truth["fors"]]))
+    return (
+        np.array([f["d_alpha_urad"] for f in truth["fors"]]),
+        np.array([f["d_beta_urad"] for f in truth["fors"]]),
+    )
 
 
 def load_truth(case_dir):

@@ -43,10 +43,16 @@ def chromium_driver(tmp_path):
     """Headless Chromium under Selenium, keeping the browser console log (read it with get_log)."""
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
+
     options = webdriver.ChromeOptions()
     options.binary_location = require("chromium")
-    for arg in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--window-size=1280,2400",
-                f"--user-data-dir={tmp_path / 'chrome-profile'}"):
+    for arg in (
+        "--headless=new",
+        "--no-sandbox",
+        "--disable-dev-shm-usage",
+        "--window-size=1280,2400",
+        f"--user-data-dir={tmp_path / 'chrome-profile'}",
+    ):
         options.add_argument(arg)
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     return webdriver.Chrome(service=Service(require("chromedriver")), options=options)
@@ -81,16 +87,29 @@ def victoria_metrics(tmp: Path, port: int | None = None, flags=()):
     """VictoriaMetrics on 127.0.0.1 (with extra command-line *flags*); yields its base URL."""
     exe = require("victoria-metrics")
     port = port or free_port()
-    with _running([exe, f"-httpListenAddr=127.0.0.1:{port}", f"-storageDataPath={tmp}", "-retentionPeriod=100y",
-                   "-loggerLevel=ERROR", *flags], f"http://127.0.0.1:{port}", "/health") as url:
+    with _running(
+        [
+            exe,
+            f"-httpListenAddr=127.0.0.1:{port}",
+            f"-storageDataPath={tmp}",
+            "-retentionPeriod=100y",
+            "-loggerLevel=ERROR",
+            *flags,
+        ],
+        f"http://127.0.0.1:{port}",
+        "/health",
+    ) as url:
         yield url
 
 
 def vm_export(url: str, metric_regex: str) -> list[dict]:
     """Every stored series matching *metric_regex*, after forcing VictoriaMetrics to flush."""
     import json
+
     requests.get(url + "/internal/force_flush", timeout=10)
-    r = requests.get(url + "/api/v1/export", params={"match[]": f'{{__name__=~"{metric_regex}"}}'}, timeout=30)
+    r = requests.get(
+        url + "/api/v1/export", params={"match[]": f'{{__name__=~"{metric_regex}"}}'}, timeout=30
+    )
     r.raise_for_status()
     return [json.loads(line) for line in r.text.splitlines() if line.strip()]
 
@@ -187,13 +206,18 @@ class S3Server:
 
     def _list(self, h, bucket, q):
         import hashlib
+
         prefix = q.get("prefix", [""])[0]
         base = self.root / bucket
         keys = sorted(str(p.relative_to(base)) for p in base.rglob("*") if p.is_file())
         keys = sorted(set(k for k in keys + self.extra_keys if k.startswith(prefix)))
         token_in = q.get("continuation-token", [None])[0]
-        start = int(base64.b64decode(token_in).decode().split(":")[0]) if token_in and not self.repeat_token else 0
-        page = keys[start:start + self.page_size]
+        start = (
+            int(base64.b64decode(token_in).decode().split(":")[0])
+            if token_in and not self.repeat_token
+            else 0
+        )
+        page = keys[start : start + self.page_size]
         more = start + self.page_size < len(keys) or self.endless_tokens or self.repeat_token
 
         def size(k):
@@ -204,18 +228,26 @@ class S3Server:
             return str((base / k).stat().st_size) if (base / k).is_file() else "10"
 
         def etag(k):
-            return f"<ETag>&quot;{hashlib.md5((base / k).read_bytes()).hexdigest()}&quot;</ETag>" \
-                if (base / k).is_file() else ""
-        items = "".join(f"<Contents><Key>{escape(k)}</Key><Size>{escape(size(k))}</Size>{etag(k)}</Contents>"
-                        for k in page)
+            return (
+                f"<ETag>&quot;{hashlib.md5((base / k).read_bytes()).hexdigest()}&quot;</ETag>"
+                if (base / k).is_file()
+                else ""
+            )
+
+        items = "".join(
+            f"<Contents><Key>{escape(k)}</Key><Size>{escape(size(k))}</Size>{etag(k)}</Contents>"
+            for k in page
+        )
         nxt = start + self.page_size if start + self.page_size < len(keys) else 0
         token = base64.b64encode(f"{0 if self.repeat_token else nxt}:{len(self.requests)}".encode()).decode()
         if self.repeat_token:
             token = "c2FtZQ=="
         token = f"<NextContinuationToken>{token}</NextContinuationToken>" if more else ""
-        body = (f'<?xml version="1.0" encoding="UTF-8"?><ListBucketResult xmlns="http://s3.amazonaws.com/doc/2006-03-01/">'
-                f"<Name>{bucket}</Name><Prefix>{escape(prefix)}</Prefix><KeyCount>{len(page)}</KeyCount>"
-                f"<IsTruncated>{'true' if more else 'false'}</IsTruncated>{token}{items}</ListBucketResult>").encode()
+        body = (
+            f'<?xml version="1.0" encoding="UTF-8"?><ListBucketResult xmlns="http://s3.amazonaws.com/doc/2006-03-01/">'
+            f"<Name>{bucket}</Name><Prefix>{escape(prefix)}</Prefix><KeyCount>{len(page)}</KeyCount>"
+            f"<IsTruncated>{'true' if more else 'false'}</IsTruncated>{token}{items}</ListBucketResult>"
+        ).encode()
         h.send_response(200)
         h.send_header("Content-Type", "application/xml")
         h.send_header("Content-Length", str(len(body)))
@@ -242,6 +274,7 @@ class S3Server:
             data = data[:100] + bytes([data[100] ^ 0xFF]) + data[101:]
         if self.gzip:
             import gzip
+
             data = gzip.compress(data)
         h.send_response(200)
         if self.gzip:
@@ -257,7 +290,7 @@ class S3Server:
                 return
             if self.slow_drip_s is not None:
                 for i in range(0, len(data), 64):
-                    h.wfile.write(data[i:i + 64])
+                    h.wfile.write(data[i : i + 64])
                     h.wfile.flush()
                     time.sleep(self.slow_drip_s)
                 return

@@ -64,6 +64,7 @@ def test_result_fields_and_km(cases):
 def test_too_few_samples_are_flagged(cases):
     from monitor.assess import _collocate_run, cost_and_offsets
     from monitor.sdr.pairing import plan
+
     out, _, _ = cases.get("paper", 1)
     case = plan([out])
     samples, _ = _collocate_run(case.cris[:1], case.viirs, case.viirs_all, "j01", AssessConfig())
@@ -79,9 +80,13 @@ def test_workers_die_with_a_killed_parent(cases, tmp_path):
     import subprocess
     import sys
     import time
+
     out, _, _ = cases.get()
-    proc = subprocess.Popen([sys.executable, "-m", "monitor.cli", "assess", str(out), "--workers", "2"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "monitor.cli", "assess", str(out), "--workers", "2"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
 
     def children():
         found = []
@@ -93,6 +98,7 @@ def test_workers_die_with_a_killed_parent(cases, tmp_path):
             if pid.isdigit() and int(stat.rsplit(")", 1)[1].split()[1]) == proc.pid:
                 found.append(int(pid))
         return found
+
     deadline = time.monotonic() + 60
     while len(children()) < 2 and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.2)
@@ -101,12 +107,18 @@ def test_workers_die_with_a_killed_parent(cases, tmp_path):
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
     deadline = time.monotonic() + 10
-    while time.monotonic() < deadline and any(os.path.exists(f"/proc/{k}") and "Z" not in
-                                              open(f"/proc/{k}/stat").read().rsplit(")", 1)[1].split()[0]
-                                              for k in kids if os.path.exists(f"/proc/{k}")):
+    while time.monotonic() < deadline and any(
+        os.path.exists(f"/proc/{k}")
+        and "Z" not in open(f"/proc/{k}/stat").read().rsplit(")", 1)[1].split()[0]
+        for k in kids
+        if os.path.exists(f"/proc/{k}")
+    ):
         time.sleep(0.2)
-    alive = [k for k in kids if os.path.exists(f"/proc/{k}")
-             and open(f"/proc/{k}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"]
+    alive = [
+        k
+        for k in kids
+        if os.path.exists(f"/proc/{k}") and open(f"/proc/{k}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"
+    ]
     assert not alive, f"workers {alive} outlived their parent"
 
 
@@ -118,6 +130,7 @@ def test_too_few_usable_fovs_is_an_error_naming_the_files(cases, tmp_path):
     import sys
 
     import h5py
+
     out, _, _ = cases.get()
     work = tmp_path / "data"
     work.mkdir()
@@ -128,7 +141,9 @@ def test_too_few_usable_fovs_is_an_error_naming_the_files(cases, tmp_path):
                 h5["All_Data/VIIRS-I5-SDR_All/BrightnessTemperatureFactors"][0] = 1e30
         else:
             (work / f.name).symlink_to(f)
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "assess", str(work)], capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "monitor.cli", "assess", str(work)], capture_output=True, text=True
+    )
     last = r.stderr.strip().splitlines()[-1]  # the log lines before it say which granule was skipped and why
     assert r.returncode == 2 and last.startswith("crisgeo assess: too few usable FOVs to assess: 0"), r.stderr
     assert "SVI05_j01" in last and "scale 1e+30" in last

@@ -13,8 +13,20 @@ def test_assess_writes_the_contract_json(cases, tmp_path, capsys):
     assert "FOR" in table and "d_beta" in table
     doc = json.loads(res.read_text())
     assert doc["satellite"] == "j01" and len(doc["fors"]) == 30 and len(doc["granules"]) == 2
-    keys = {"for", "d_alpha_urad", "d_beta_urad", "sigma_alpha_urad", "sigma_beta_urad", "in_track_km",
-            "cross_track_km", "total_km", "n_samples", "cost_min_k", "cost_zero_k", "flags"}
+    keys = {
+        "for",
+        "d_alpha_urad",
+        "d_beta_urad",
+        "sigma_alpha_urad",
+        "sigma_beta_urad",
+        "in_track_km",
+        "cross_track_km",
+        "total_km",
+        "n_samples",
+        "cost_min_k",
+        "cost_zero_k",
+        "flags",
+    }
     assert keys <= set(doc["fors"][0])
     assert doc["start"] < doc["end"]
 
@@ -26,7 +38,9 @@ def test_missing_path_is_exit_2_with_one_line(tmp_path, capsys):
 
 
 def test_only_corrupt_files_is_exit_2(tmp_path, capsys):
-    (tmp_path / "GCRSO_j01_d20181022_t0023599_e0024297_b04790_c20181022005852745013_noac_ops.h5").write_text("x")
+    (tmp_path / "GCRSO_j01_d20181022_t0023599_e0024297_b04790_c20181022005852745013_noac_ops.h5").write_text(
+        "x"
+    )
     assert main(["assess", str(tmp_path)]) == 2
     assert "not a readable HDF5 file" in capsys.readouterr().err
 
@@ -66,9 +80,18 @@ def test_bench_prints_every_stage_and_the_assessment_memory():
     import re
     import subprocess
     import sys
-    run = subprocess.run([sys.executable, "-c", "from monitor.cli import main; raise SystemExit(main("
-                          "['bench', '--granules', '1', '--workers', '1']))"],
-                         capture_output=True, text=True, timeout=600)
+
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "from monitor.cli import main; raise SystemExit(main("
+            "['bench', '--granules', '1', '--workers', '1']))",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr
     out = run.stdout
     assert "case: 1 CrIS granules, 1080 FOVs x 441 perturbations" in out
@@ -83,9 +106,11 @@ def test_bench_prints_every_stage_and_the_assessment_memory():
 def test_version_and_verbose_after_the_subcommand(capsys):
     import subprocess
     import sys
+
     r = subprocess.run([sys.executable, "-m", "monitor.cli", "--version"], capture_output=True, text=True)
     assert r.returncode == 0 and r.stdout.startswith("crisgeo ")
     from monitor.cli import build_parser
+
     args = build_parser().parse_args(["status", "-v", "--config", "x.yaml"])
     assert args.verbose is True and args.command == "status"
     assert build_parser().parse_args(["-v", "status"]).verbose is True
@@ -94,7 +119,9 @@ def test_version_and_verbose_after_the_subcommand(capsys):
 
 def _status_config(tmp_path):
     cfg = tmp_path / "c.yaml"
-    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+    )
     return cfg
 
 
@@ -104,6 +131,7 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     from alerts.rules import Finding
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
+
     cfg = _status_config(tmp_path)
     monkeypatch.setenv("CRISGEO_CONFIG", str(cfg))  # the default when --config is not given
     assert main(["status", "--json"]) == 0
@@ -115,9 +143,27 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     assert main(["status", "--json"]) == 1 and json.loads(capsys.readouterr().out)["state"] == "WARNING"
     assert main(["alerts", "list", "--json"]) == 0
     (alert,) = json.loads(capsys.readouterr().out)["alerts"]
-    assert (alert["status"], alert["rule"], alert["satellite"], alert["severity"]) == ("firing", "jump", "j01", "warning")
-    assert main(["alerts", "silence", "--rule", "jump", "--until", (now + dt.timedelta(hours=2)).isoformat(),
-                 "--reason", "known step"]) == 0
+    assert (alert["status"], alert["rule"], alert["satellite"], alert["severity"]) == (
+        "firing",
+        "jump",
+        "j01",
+        "warning",
+    )
+    assert (
+        main(
+            [
+                "alerts",
+                "silence",
+                "--rule",
+                "jump",
+                "--until",
+                (now + dt.timedelta(hours=2)).isoformat(),
+                "--reason",
+                "known step",
+            ]
+        )
+        == 0
+    )
     capsys.readouterr()
     assert main(["alerts", "list", "--json"]) == 0
     view = json.loads(capsys.readouterr().out)
@@ -139,13 +185,30 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
     import os
     import subprocess
     import sys
+
     data, _, _ = cases.get()
     cfg = tmp_path / "c.yaml"
-    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
-                   f"assessment: {{workers: 2}}\n")
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "run", "--config", str(cfg), "--date", "2024-06-01",
-                        "--log-format", "json"], capture_output=True, text=True,
-                       env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"})
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
+        f"assessment: {{workers: 2}}\n"
+    )
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "monitor.cli",
+            "run",
+            "--config",
+            str(cfg),
+            "--date",
+            "2024-06-01",
+            "--log-format",
+            "json",
+        ],
+        capture_output=True,
+        text=True,
+        env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"},
+    )
     assert r.returncode == 0, r.stderr
     lines = [json.loads(line) for line in r.stderr.splitlines() if line.startswith("{")]
     assert lines and all({"time", "level", "logger", "message"} <= set(d) for d in lines)
@@ -162,10 +225,17 @@ def test_under_systemd_lines_carry_no_second_timestamp(tmp_path):
     import os
     import subprocess
     import sys
+
     cfg = tmp_path / "c.yaml"
-    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "run", "--config", str(cfg), "--date", "2024-06-01"],
-                       capture_output=True, text=True, env={**os.environ, "JOURNAL_STREAM": "8:1234"})
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+    )
+    r = subprocess.run(
+        [sys.executable, "-m", "monitor.cli", "run", "--config", str(cfg), "--date", "2024-06-01"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "JOURNAL_STREAM": "8:1234"},
+    )
     assert r.returncode == 0, r.stderr
     log = [line for line in r.stderr.splitlines() if line.strip()]
     assert log and all(line.split()[0] in ("INFO", "WARNING", "ERROR", "DEBUG") for line in log), log

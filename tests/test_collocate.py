@@ -55,10 +55,23 @@ def test_interval_method_equals_brute_force(scene, scan, for_, fov):
     fg, swath = scene
     offsets = perturbation_grid(4, 900e-6)
     idx = (scan, for_, fov)
-    mean, cover = collocate.cone_sums(swath, fg.sat_ecef_m[idx][None], fg.sbf_to_ecef[idx][None],
-                                      fg.alpha_rad[idx][None], fg.beta_rad[idx][None], offsets)
-    bm, bc = _brute(swath, fg.sat_ecef_m[idx], fg.sbf_to_ecef[idx], fg.alpha_rad[idx], fg.beta_rad[idx],
-                    offsets, collocate.TOP_HAT[0][0])
+    mean, cover = collocate.cone_sums(
+        swath,
+        fg.sat_ecef_m[idx][None],
+        fg.sbf_to_ecef[idx][None],
+        fg.alpha_rad[idx][None],
+        fg.beta_rad[idx][None],
+        offsets,
+    )
+    bm, bc = _brute(
+        swath,
+        fg.sat_ecef_m[idx],
+        fg.sbf_to_ecef[idx],
+        fg.alpha_rad[idx],
+        fg.beta_rad[idx],
+        offsets,
+        collocate.TOP_HAT[0][0],
+    )
     np.testing.assert_allclose(mean[0], bm, rtol=1e-6)
     np.testing.assert_allclose(cover[0], bc, rtol=1e-6)
     # solid-angle weights fill the cone: coverage 1 inside the swath, also at nadir (FOR 15), where the
@@ -70,16 +83,28 @@ def test_fov_off_the_swath_has_no_coverage(scene):
     fg, swath = scene
     idx = (0, 14, 4)
     far = fg.sat_ecef_m[idx] + np.array([3e6, 0.0, 0.0])
-    mean, cover = collocate.cone_sums(swath, far[None], fg.sbf_to_ecef[idx][None], fg.alpha_rad[idx][None],
-                                      fg.beta_rad[idx][None], perturbation_grid(2, 450e-6))
+    mean, cover = collocate.cone_sums(
+        swath,
+        far[None],
+        fg.sbf_to_ecef[idx][None],
+        fg.alpha_rad[idx][None],
+        fg.beta_rad[idx][None],
+        perturbation_grid(2, 450e-6),
+    )
     assert np.all(np.nan_to_num(cover) < collocate.MIN_COVERAGE)
 
 
 def test_spatial_response_kernel_is_a_weighted_stack_of_top_hats(scene):
     fg, swath = scene
     idx = (1, 10, 4)
-    args = (swath, fg.sat_ecef_m[idx][None], fg.sbf_to_ecef[idx][None], fg.alpha_rad[idx][None],
-            fg.beta_rad[idx][None], perturbation_grid(1, 450e-6))
+    args = (
+        swath,
+        fg.sat_ecef_m[idx][None],
+        fg.sbf_to_ecef[idx][None],
+        fg.alpha_rad[idx][None],
+        fg.beta_rad[idx][None],
+        perturbation_grid(1, 450e-6),
+    )
     resp, cov = collocate.cone_sums(*args, kernel=collocate.SPATIAL_RESPONSE)
     top, _ = collocate.cone_sums(*args)
     assert np.all(np.isfinite(resp)) and np.all(np.abs(cov - 1) < 0.03)
@@ -101,14 +126,33 @@ def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):
     v = case_plan.viirs[case_plan.cris[0].key][int(row0[0]) // swath.pieces[0].radiance.shape[0]]
     (vgeo,) = read_file(v.geo, kinds=("viirs_geo",))
     (vsdr,) = read_file(v.sdr, kinds=("viirs_sdr",))
-    cut = collocate.build_swath(vgeo.lat_rad[:, :ncol], vgeo.lon_rad[:, :ncol], vgeo.height_m[:, :ncol],
-                                vsdr.bt_k[:, :ncol], vsdr.good[:, :ncol], i5_band("j01"))
+    cut = collocate.build_swath(
+        vgeo.lat_rad[:, :ncol],
+        vgeo.lon_rad[:, :ncol],
+        vgeo.height_m[:, :ncol],
+        vsdr.bt_k[:, :ncol],
+        vsdr.good[:, :ncol],
+        i5_band("j01"),
+    )
     assert cut.block_radius_m.shape[1] == -(-ncol // collocate.BLOCK_PX)
     offsets = perturbation_grid(2, 900e-6)
-    mean, cover = collocate.cone_sums(cut, fg.sat_ecef_m[idx][None], fg.sbf_to_ecef[idx][None],
-                                      fg.alpha_rad[idx][None], fg.beta_rad[idx][None], offsets)
-    bm, bc = _brute(cut, fg.sat_ecef_m[idx], fg.sbf_to_ecef[idx], fg.alpha_rad[idx], fg.beta_rad[idx],
-                    offsets, collocate.TOP_HAT[0][0])
+    mean, cover = collocate.cone_sums(
+        cut,
+        fg.sat_ecef_m[idx][None],
+        fg.sbf_to_ecef[idx][None],
+        fg.alpha_rad[idx][None],
+        fg.beta_rad[idx][None],
+        offsets,
+    )
+    bm, bc = _brute(
+        cut,
+        fg.sat_ecef_m[idx],
+        fg.sbf_to_ecef[idx],
+        fg.alpha_rad[idx],
+        fg.beta_rad[idx],
+        offsets,
+        collocate.TOP_HAT[0][0],
+    )
     assert 0.05 < bc.min() and bc.max() < 0.95  # the cut runs through the cones
     np.testing.assert_allclose(mean[0], bm, rtol=1e-6)
     np.testing.assert_allclose(cover[0], bc, rtol=1e-6)

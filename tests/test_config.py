@@ -12,7 +12,10 @@ def test_shipped_configs_load():
     assert demo.source.kind == "simulated" and demo.store.publish == [] and demo.satellites == ["j01"]
     prod = load_config(CONFIGS / "monitor.yaml")
     assert prod.source.kind == "nodd" and prod.satellites == ["npp", "j01", "j02"]
-    assert prod.store.publish[0].kind == "influx1" and prod.store.publish[0].password_env == "CRISGEO_INFLUX_PASSWORD"
+    assert (
+        prod.store.publish[0].kind == "influx1"
+        and prod.store.publish[0].password_env == "CRISGEO_INFLUX_PASSWORD"
+    )
     assert prod.schedule.time_utc.hour == 6
 
 
@@ -25,18 +28,27 @@ def _write(tmp_path, text):
 BASE = "satellites: [j01]\nstate_dir: s\nsource: {kind: simulated}\n"
 
 
-@pytest.mark.parametrize("text,message", [
-    ("state_dir: s\nsource: {kind: simulated}\n", "satellites: missing"),
-    ("satellites: [j05]\nstate_dir: s\nsource: {kind: simulated}\n", "satellites[0]: 'j05' is not one of"),
-    (BASE + "schedule: {time_utc: '25:00'}\n", "schedule.time_utc: '25:00' is not HH:MM"),
-    (BASE + "scenes: {keep: 0}\n", "scenes.keep: 0 is not within 1..200"),
-    (BASE + "scenes: {keep: ten}\n", "scenes.keep: expected int, got str"),
-    (BASE + "store: {publish: [{kind: influx2, url: 'localhost:8086'}]}\n", "store.publish[0].url"),
-    (BASE + "store: {publish: [{kind: influx2, url: 'http://h', token: abc}]}\n", "secrets may not be written"),
-    (BASE + "colour: blue\n", "colour: unknown key"),
-    ("satellites: [j01]\nstate_dir: s\nsource: {kind: local}\n", "source.path: missing"),
-    ("- a\n- b\n", "expected a mapping"),
-])
+@pytest.mark.parametrize(
+    "text,message",
+    [
+        ("state_dir: s\nsource: {kind: simulated}\n", "satellites: missing"),
+        (
+            "satellites: [j05]\nstate_dir: s\nsource: {kind: simulated}\n",
+            "satellites[0]: 'j05' is not one of",
+        ),
+        (BASE + "schedule: {time_utc: '25:00'}\n", "schedule.time_utc: '25:00' is not HH:MM"),
+        (BASE + "scenes: {keep: 0}\n", "scenes.keep: 0 is not within 1..200"),
+        (BASE + "scenes: {keep: ten}\n", "scenes.keep: expected int, got str"),
+        (BASE + "store: {publish: [{kind: influx2, url: 'localhost:8086'}]}\n", "store.publish[0].url"),
+        (
+            BASE + "store: {publish: [{kind: influx2, url: 'http://h', token: abc}]}\n",
+            "secrets may not be written",
+        ),
+        (BASE + "colour: blue\n", "colour: unknown key"),
+        ("satellites: [j01]\nstate_dir: s\nsource: {kind: local}\n", "source.path: missing"),
+        ("- a\n- b\n", "expected a mapping"),
+    ],
+)
 def test_errors_name_the_key(tmp_path, text, message):
     with pytest.raises(ConfigError) as e:
         load_config(_write(tmp_path, text))
@@ -44,72 +56,120 @@ def test_errors_name_the_key(tmp_path, text, message):
 
 
 def test_secret_comes_from_environment(tmp_path, monkeypatch):
-    cfg = load_config(_write(tmp_path, BASE + "store: {publish: [{kind: influx2, url: 'http://h', token_env: TOK}]}\n"))
+    cfg = load_config(
+        _write(tmp_path, BASE + "store: {publish: [{kind: influx2, url: 'http://h', token_env: TOK}]}\n")
+    )
     monkeypatch.setenv("TOK", "s3cret")
     assert cfg.store.publish[0].secret("token_env") == "s3cret"
     assert cfg.state_dir == tmp_path / "s"  # relative to the file
 
 
 GOOD = {
-    "satellites": ["j01"], "state_dir": "state", "source": {"kind": "nodd"},
+    "satellites": ["j01"],
+    "state_dir": "state",
+    "source": {"kind": "nodd"},
     "store": {"publish": [{"kind": "influx2", "url": "http://127.0.0.1:8428", "token_env": "T"}]},
-    "alerts": {"log": "alerts.log", "email": {"host": "smtp.example.org", "to": ["a@example.org"]},
-               "slack": {"webhook_env": "SLACK"}},
+    "alerts": {
+        "log": "alerts.log",
+        "email": {"host": "smtp.example.org", "to": ["a@example.org"]},
+        "slack": {"webhook_env": "SLACK"},
+    },
 }
 BAD = [  # (where, value or a function of the document, the key the one-line error must name)
-    ("satellites", [], "satellites"), ("satellites", ["j01", "j01"], "satellites"), ("satellites", "j01", "satellites"),
-    ("satellites", [1], "satellites[0]"), ("state_dir", 5, "state_dir"), ("source.kind", "ftp", "source.kind"),
-    ("source.timeout_s", float("nan"), "source.timeout_s"), ("source.timeout_s", float("inf"), "source.timeout_s"),
-    ("source.timeout_s", -1, "source.timeout_s"), ("source.timeout_s", 1e9, "source.timeout_s"),
-    ("source.timeout_s", "60s", "source.timeout_s"), ("source.timeout_s", True, "source.timeout_s"),
-    ("source.retries", -1, "source.retries"), ("source.retries", 1000, "source.retries"),
-    ("source.retries", 2.5, "source.retries"), ("source.backoff_s", 0, "source.backoff_s"),
+    ("satellites", [], "satellites"),
+    ("satellites", ["j01", "j01"], "satellites"),
+    ("satellites", "j01", "satellites"),
+    ("satellites", [1], "satellites[0]"),
+    ("state_dir", 5, "state_dir"),
+    ("source.kind", "ftp", "source.kind"),
+    ("source.timeout_s", float("nan"), "source.timeout_s"),
+    ("source.timeout_s", float("inf"), "source.timeout_s"),
+    ("source.timeout_s", -1, "source.timeout_s"),
+    ("source.timeout_s", 1e9, "source.timeout_s"),
+    ("source.timeout_s", "60s", "source.timeout_s"),
+    ("source.timeout_s", True, "source.timeout_s"),
+    ("source.retries", -1, "source.retries"),
+    ("source.retries", 1000, "source.retries"),
+    ("source.retries", 2.5, "source.retries"),
+    ("source.backoff_s", 0, "source.backoff_s"),
     ("source.daily_budget_mb", float("nan"), "source.daily_budget_mb"),
-    ("source.retention_days", -3, "source.retention_days"), ("source.run_deadline_min", 0, "source.run_deadline_min"),
-    ("source.max_list_pages", 0, "source.max_list_pages"), ("source.max_retry_after_s", -5, "source.max_retry_after_s"),
-    ("source.min_rate_kb_s", 0, "source.min_rate_kb_s"), ("source.endpoint", "ftp://x/{bucket}", "source.endpoint"),
+    ("source.retention_days", -3, "source.retention_days"),
+    ("source.run_deadline_min", 0, "source.run_deadline_min"),
+    ("source.max_list_pages", 0, "source.max_list_pages"),
+    ("source.max_retry_after_s", -5, "source.max_retry_after_s"),
+    ("source.min_rate_kb_s", 0, "source.min_rate_kb_s"),
+    ("source.endpoint", "ftp://x/{bucket}", "source.endpoint"),
     ("source.endpoint", "https://user:pw@{bucket}.s3.amazonaws.com", "source.endpoint"),
     ("source.endpoint", "https://s3.amazonaws.com", "source.endpoint"),
-    ("source.buckets", {"j09": "b"}, "source.buckets.j09"), ("source.buckets", {"j01": "Bad Bucket"}, "source.buckets.j01"),
-    ("source.buckets", {"j01": 7}, "source.buckets.j01"), ("source.colour", "x", "source.colour"),
-    ("schedule.time_utc", "3pm", "schedule.time_utc"), ("schedule.time_utc", "24:00", "schedule.time_utc"),
-    ("schedule.catch_up_days", 0, "schedule.catch_up_days"), ("schedule.catch_up_days", 10000, "schedule.catch_up_days"),
-    ("schedule.lag_days", -1, "schedule.lag_days"), ("schedule.misfire_grace_hours", float("nan"),
-                                                     "schedule.misfire_grace_hours"),
-    ("schedule.every", "day", "schedule.every"), ("scenes.keep", 50, "scenes.keep"),
-    ("scenes.candidates", -4, "scenes.candidates"), ("scenes.min_inhomogeneity_k", -1.0, "scenes.min_inhomogeneity_k"),
-    ("assessment.kernel", "gauss", "assessment.kernel"), ("assessment.workers", 0, "assessment.workers"),
-    ("assessment.workers", 1000, "assessment.workers"), ("assessment.half_steps", 500, "assessment.half_steps"),
+    ("source.buckets", {"j09": "b"}, "source.buckets.j09"),
+    ("source.buckets", {"j01": "Bad Bucket"}, "source.buckets.j01"),
+    ("source.buckets", {"j01": 7}, "source.buckets.j01"),
+    ("source.colour", "x", "source.colour"),
+    ("schedule.time_utc", "3pm", "schedule.time_utc"),
+    ("schedule.time_utc", "24:00", "schedule.time_utc"),
+    ("schedule.catch_up_days", 0, "schedule.catch_up_days"),
+    ("schedule.catch_up_days", 10000, "schedule.catch_up_days"),
+    ("schedule.lag_days", -1, "schedule.lag_days"),
+    ("schedule.misfire_grace_hours", float("nan"), "schedule.misfire_grace_hours"),
+    ("schedule.every", "day", "schedule.every"),
+    ("scenes.keep", 50, "scenes.keep"),
+    ("scenes.candidates", -4, "scenes.candidates"),
+    ("scenes.min_inhomogeneity_k", -1.0, "scenes.min_inhomogeneity_k"),
+    ("assessment.kernel", "gauss", "assessment.kernel"),
+    ("assessment.workers", 0, "assessment.workers"),
+    ("assessment.workers", 1000, "assessment.workers"),
+    ("assessment.half_steps", 500, "assessment.half_steps"),
     ("assessment.step_urad", float("inf"), "assessment.step_urad"),
-    ("store.drain_minutes", 0, "store.drain_minutes"), ("store.backend", "pg", "store.backend"),
-    ("store.publish", [{"kind": "influx2", "url": "http://admin:secret@127.0.0.1:8086"}], "store.publish[0].url"),
+    ("store.drain_minutes", 0, "store.drain_minutes"),
+    ("store.backend", "pg", "store.backend"),
+    (
+        "store.publish",
+        [{"kind": "influx2", "url": "http://admin:secret@127.0.0.1:8086"}],
+        "store.publish[0].url",
+    ),
     ("store.publish", [{"kind": "kafka", "url": "http://h"}], "store.publish[0].kind"),
     ("store.publish", [{"kind": "influx2"}], "store.publish[0].url"),
     ("store.publish", [{"kind": "influx2", "url": "http://h", "token": "abc"}], "store.publish[0].token"),
-    ("store.publish", [{"kind": "influx2", "url": "http://h", "token_env": "my secret token"}],
-     "store.publish[0].token_env"),
-    ("store.publish", [{"kind": "influx2", "url": "http://h", "timeout_s": float("nan")}],
-     "store.publish[0].timeout_s"),
+    (
+        "store.publish",
+        [{"kind": "influx2", "url": "http://h", "token_env": "my secret token"}],
+        "store.publish[0].token_env",
+    ),
+    (
+        "store.publish",
+        [{"kind": "influx2", "url": "http://h", "timeout_s": float("nan")}],
+        "store.publish[0].timeout_s",
+    ),
     ("store.publish", ["http://h"], "store.publish[0]"),
-    ("fingerprint.granules", 0, "fingerprint.granules"), ("fingerprint.ep_library", 5, "fingerprint.ep_library"),
-    ("dashboard_url", "grafana.local", "dashboard_url"), ("report_dir", ["a"], "report_dir"),
-    ("alerts.spec_km", "abc", "alerts.spec_km"), ("alerts.spec_km", float("nan"), "alerts.spec_km"),
-    ("alerts.spec_km", -1.5, "alerts.spec_km"), ("alerts.stale_hours", 0, "alerts.stale_hours"),
-    ("alerts.pre_days", 1.5, "alerts.pre_days"), ("alerts.min_pre_days", 100, "alerts.min_pre_days"),
-    ("alerts.jump_z", float("inf"), "alerts.jump_z"), ("alerts.colour", "red", "alerts.colour"),
-    ("alerts.email", "smtp.example.org", "alerts.email"), ("alerts.email.port", 70000, "alerts.email.port"),
-    ("alerts.email.to", "a@example.org", "alerts.email.to"), ("alerts.email.to", ["nobody"], "alerts.email.to"),
-    ("alerts.email.starttls", "yes", "alerts.email.starttls"), ("alerts.email.password", "x", "alerts.email.password"),
-    ("alerts.email.tls", True, "alerts.email.tls"), ("alerts.slack.webhook", "https://hooks.slack.com/x",
-                                                     "alerts.slack.webhook"),
+    ("fingerprint.granules", 0, "fingerprint.granules"),
+    ("fingerprint.ep_library", 5, "fingerprint.ep_library"),
+    ("dashboard_url", "grafana.local", "dashboard_url"),
+    ("report_dir", ["a"], "report_dir"),
+    ("alerts.spec_km", "abc", "alerts.spec_km"),
+    ("alerts.spec_km", float("nan"), "alerts.spec_km"),
+    ("alerts.spec_km", -1.5, "alerts.spec_km"),
+    ("alerts.stale_hours", 0, "alerts.stale_hours"),
+    ("alerts.pre_days", 1.5, "alerts.pre_days"),
+    ("alerts.min_pre_days", 100, "alerts.min_pre_days"),
+    ("alerts.jump_z", float("inf"), "alerts.jump_z"),
+    ("alerts.colour", "red", "alerts.colour"),
+    ("alerts.email", "smtp.example.org", "alerts.email"),
+    ("alerts.email.port", 70000, "alerts.email.port"),
+    ("alerts.email.to", "a@example.org", "alerts.email.to"),
+    ("alerts.email.to", ["nobody"], "alerts.email.to"),
+    ("alerts.email.starttls", "yes", "alerts.email.starttls"),
+    ("alerts.email.password", "x", "alerts.email.password"),
+    ("alerts.email.tls", True, "alerts.email.tls"),
+    ("alerts.slack.webhook", "https://hooks.slack.com/x", "alerts.slack.webhook"),
     ("alerts.slack.webhook_env", "https://hooks.slack.com/services/x", "alerts.slack.webhook_env"),
-    ("alerts.slack.retries", -1, "alerts.slack.retries"), ("alerts.slack.timeout_s", float("nan"),
-                                                           "alerts.slack.timeout_s"),
+    ("alerts.slack.retries", -1, "alerts.slack.retries"),
+    ("alerts.slack.timeout_s", float("nan"), "alerts.slack.timeout_s"),
 ]
 
 
 def _doc_with(where, value):
     import copy
+
     doc = copy.deepcopy(GOOD)
     *parents, key = where.split(".")
     d = doc
@@ -121,6 +181,7 @@ def _doc_with(where, value):
 
 def test_the_good_document_is_good(tmp_path):
     import yaml
+
     p = tmp_path / "c.yaml"
     p.write_text(yaml.safe_dump(GOOD))
     assert load_config(p).alert_settings.channels == ["log", "email", "slack"]
@@ -131,6 +192,7 @@ def test_bad_configurations_are_refused_in_one_line_naming_the_key(tmp_path, cap
     import yaml
 
     from monitor.cli import main
+
     p = tmp_path / "c.yaml"
     p.write_text(yaml.safe_dump(_doc_with(where, value)))
     assert main(["check-config", "--config", str(p)]) == 2
@@ -146,11 +208,14 @@ def test_there_are_at_least_60_bad_configurations():
     assert len(BAD) >= 60
 
 
-@pytest.mark.parametrize("text,message", [
-    ("a: &x [1, 2]\nb: *x\n", "line 1: YAML anchors"),
-    ("satellites: [j01]\n" + "#" * (1 << 20), "larger than 1 MiB"),
-    ("satellites: [\n", "not valid YAML"),
-])
+@pytest.mark.parametrize(
+    "text,message",
+    [
+        ("a: &x [1, 2]\nb: *x\n", "line 1: YAML anchors"),
+        ("satellites: [j01]\n" + "#" * (1 << 20), "larger than 1 MiB"),
+        ("satellites: [\n", "not valid YAML"),
+    ],
+)
 def test_yaml_bombs_and_giants_are_refused(tmp_path, text, message):
     p = _write(tmp_path, text)
     with pytest.raises(ConfigError, match=message):
@@ -161,6 +226,7 @@ def test_check_config_masks_secrets(tmp_path, capsys, monkeypatch):
     import yaml
 
     from monitor.cli import main
+
     monkeypatch.setenv("T", "the-token-value")
     p = tmp_path / "c.yaml"
     p.write_text(yaml.safe_dump(GOOD))

@@ -37,8 +37,14 @@ def _day(root, day, d_alpha, d_beta, change_at=None, new=None, n=4, seed=3):
         parts.append((change_at, n, *new))
     for a, b, da, db in parts:
         if b > a:
-            spec = SimulationSpec(granules=b - a, d_alpha_urad=np.asarray(da, float), d_beta_urad=np.asarray(db, float),
-                                  seed=seed, start=start + dt.timedelta(seconds=32 * a), cris_sdr=False)
+            spec = SimulationSpec(
+                granules=b - a,
+                d_alpha_urad=np.asarray(da, float),
+                d_beta_urad=np.asarray(db, float),
+                seed=seed,
+                start=start + dt.timedelta(seconds=32 * a),
+                cris_sdr=False,
+            )
             simulate_case(root / f"{day}_{a}", spec=spec, viirs=False)
 
 
@@ -55,10 +61,19 @@ def test_simulated_change_found_on_the_right_day_granule_and_fors(name, tmp_path
     new = SCENARIOS.get(name)
     _day(tmp_path, D0, zero, zero)
     _day(tmp_path, D0 + dt.timedelta(days=1), zero, zero)
-    _day(tmp_path, D0 + dt.timedelta(days=2), zero, zero, change_at=2 if new else None, new=new[:2] if new else None)
+    _day(
+        tmp_path,
+        D0 + dt.timedelta(days=2),
+        zero,
+        zero,
+        change_at=2 if new else None,
+        new=new[:2] if new else None,
+    )
     _day(tmp_path, D0 + dt.timedelta(days=3), *(new[:2] if new else (zero, zero)))
     cfg_file = tmp_path / "c.yaml"
-    cfg_file.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
+    cfg_file.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+    )
     cfg = load_config(cfg_file)
     store = Store(cfg.store.sqlite)
     src = LocalSource(tmp_path)
@@ -72,7 +87,9 @@ def test_simulated_change_found_on_the_right_day_granule_and_fors(name, tmp_path
         return
     assert changed_days == [2]  # found on the day of the change, not again the day after
     ch = bodies[2]["change"]
-    first_changed = sorted(read_file(f)[0].meta.granule_id for f in (tmp_path / f"{D0 + dt.timedelta(days=2)}_2").glob("GCRSO*"))[0]
+    first_changed = sorted(
+        read_file(f)[0].meta.granule_id for f in (tmp_path / f"{D0 + dt.timedelta(days=2)}_2").glob("GCRSO*")
+    )[0]
     assert ch["granule"] == first_changed
     assert ch["fors"] == new[2]
     # the change is attributed like a calendar event (CrIS), and notified by the alerts

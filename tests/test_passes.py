@@ -8,8 +8,12 @@ from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
 from tests.conftest import truth_arrays
 
-PASSES = {"night": ("night", None), "dateline": ("night", 180.0), "arctic": ("arctic", None),
-          "antarctic": ("antarctic", None)}
+PASSES = {
+    "night": ("night", None),
+    "dateline": ("night", 180.0),
+    "arctic": ("arctic", None),
+    "antarctic": ("antarctic", None),
+}
 
 
 @pytest.fixture(scope="module", params=sorted(PASSES))
@@ -17,7 +21,12 @@ def case(request, tmp_path_factory):
     orbit_pass, lon = PASSES[request.param]
     out = tmp_path_factory.mktemp(request.param)
     truth = simulate_case(out, granules=1, profile="random", seed=5, orbit_pass=orbit_pass, pass_lon_deg=lon)
-    return request.param, out, truth, assess_paths([out], AssessConfig(bootstrap=30))  # low-contrast FORs: uncertain
+    return (
+        request.param,
+        out,
+        truth,
+        assess_paths([out], AssessConfig(bootstrap=30)),
+    )  # low-contrast FORs: uncertain
 
 
 def test_the_granules_are_where_the_pass_is(case):
@@ -40,6 +49,8 @@ def test_offsets_are_recovered(case):
     ta, tb = truth_arrays(truth)
     ok = np.array([f.reliable for f in result.fors])
     assert ok.sum() >= 24
-    err = np.r_[np.array([f.d_alpha_urad for f in result.fors])[ok] - ta[ok],
-                np.array([f.d_beta_urad for f in result.fors])[ok] - tb[ok]]
+    err = np.r_[
+        np.array([f.d_alpha_urad for f in result.fors])[ok] - ta[ok],
+        np.array([f.d_beta_urad for f in result.fors])[ok] - tb[ok],
+    ]
     assert np.sqrt(np.mean(err**2)) < 40 and np.abs(err).max() < 120  # one granule: 36 samples per FOR

@@ -13,9 +13,11 @@ DAY = dt.date(2024, 6, 1)
 
 def make_config(tmp_path, data_dir, extra=""):
     p = tmp_path / "c.yaml"
-    p.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
-                 f"source: {{kind: local, path: {data_dir}}}\nassessment: {{workers: 1}}\n"
-                 f"schedule: {{catch_up_days: 3}}\n{extra}")
+    p.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
+        f"source: {{kind: local, path: {data_dir}}}\nassessment: {{workers: 1}}\n"
+        f"schedule: {{catch_up_days: 3}}\n{extra}"
+    )
     return load_config(p)
 
 
@@ -32,7 +34,9 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path):
     assert store.db.execute("SELECT COUNT(DISTINCT run_id) FROM results").fetchone()[0] == 1
     decisions = store.selection("j01", DAY)
     assert len(decisions) == 2 and all(d["decision"] == "chosen" and d["score_k"] > 0.5 for d in decisions)
-    assert [f.d_beta_urad for f in store.day_result("j01", DAY)] == [f.d_beta_urad for f in second.result.fors]
+    assert [f.d_beta_urad for f in store.day_result("j01", DAY)] == [
+        f.d_beta_urad for f in second.result.fors
+    ]
 
 
 def test_a_day_without_data_is_recorded(cases, tmp_path):
@@ -40,10 +44,14 @@ def test_a_day_without_data_is_recorded(cases, tmp_path):
     cfg = make_config(tmp_path, data)
     store = Store(cfg.store.sqlite)
     out = run_day(cfg, store, LocalSource(data), "j01", DAY + dt.timedelta(days=3))
-    assert out.status == "no_data_final" and "no CrIS GEO granule" in out.reason  # long past its retry horizon
+    assert (
+        out.status == "no_data_final" and "no CrIS GEO granule" in out.reason
+    )  # long past its retry horizon
     assert store.runs()[0]["status"] == "no_data_final"
     assert DAY + dt.timedelta(days=3) in store.done_days("j01")
-    assert days_to_run(store, "j01", DAY + dt.timedelta(days=5), 4) == [DAY + dt.timedelta(days=k) for k in (1, 2, 4)]
+    assert days_to_run(store, "j01", DAY + dt.timedelta(days=5), 4) == [
+        DAY + dt.timedelta(days=k) for k in (1, 2, 4)
+    ]
 
 
 def test_an_empty_day_is_tried_again_until_its_horizon(cases, tmp_path):
@@ -70,7 +78,11 @@ def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_p
     out = run_day(cfg, store, LocalSource(work), "j01", DAY)
     assert out.status == "ok" and len(out.result.granules) == 1
     rejected = [d for d in store.selection("j01", DAY) if d["decision"] == "rejected"]
-    assert len(rejected) == 1 and "unusable CrIS granule" in rejected[0]["reason"] and sdr.name in rejected[0]["reason"]
+    assert (
+        len(rejected) == 1
+        and "unusable CrIS granule" in rejected[0]["reason"]
+        and sdr.name in rejected[0]["reason"]
+    )
     assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
 
 
@@ -89,13 +101,19 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
     import monitor.pipeline as pipeline
     from monitor.service import Service
     from monitor.simulate.case import simulate_case
+
     data, _, _ = cases.get()
     tree = tmp_path / "tree"
     tree.mkdir()
     for f in data.glob("*.h5"):
         (tree / f.name).symlink_to(f)
-    simulate_case(tree / "next", granules=1, profile="paper", seed=2,
-                  start=dt.datetime(2024, 6, 2, 12, tzinfo=dt.timezone.utc))
+    simulate_case(
+        tree / "next",
+        granules=1,
+        profile="paper",
+        seed=2,
+        start=dt.datetime(2024, 6, 2, 12, tzinfo=dt.timezone.utc),
+    )
     log = tmp_path / "alerts.log"
     cfg = make_config(tmp_path, tree, f"alerts: {{log: {log}}}\n")
     real = pipeline.assess_plan
@@ -104,13 +122,16 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
         if case.cris[0].key.startswith("j01_d20240601"):
             raise RuntimeError("poison granule")
         return real(case, *args, **kw)
+
     monkeypatch.setattr(pipeline, "assess_plan", poison)
     outcomes = Service(cfg).catch_up("j01", today=DAY + dt.timedelta(days=2))
     assert [(o.day, o.status) for o in outcomes][-2:] == [(DAY, "failed"), (DAY + dt.timedelta(days=1), "ok")]
     assert outcomes[-2].reason == "unexpected RuntimeError: poison granule"
     store = Store(cfg.store.sqlite)
     assert {r["day"]: r["status"] for r in store.runs("j01")}[str(DAY)] == "failed"
-    assert any(e.kind == EventKind.RUN_FAILED and "poison granule" in e.detail["reason"] for e in store.events())
+    assert any(
+        e.kind == EventKind.RUN_FAILED and "poison granule" in e.detail["reason"] for e in store.events()
+    )
     text = log.read_text()
     assert "failure" in text and "poison granule" in text
 

@@ -33,7 +33,9 @@ def test_refined_minimum_finds_the_variance_minimum(x0, y0):
     i0, j0 = np.unravel_index(np.argmin(cost), cost.shape)
     assert refine.refinable(i0, j0, m)
     dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0))
-    assert i0 - m // 2 + dx == pytest.approx(x0, abs=1 / 256) and j0 - m // 2 + dy == pytest.approx(y0, abs=1 / 256)
+    assert i0 - m // 2 + dx == pytest.approx(x0, abs=1 / 256) and j0 - m // 2 + dy == pytest.approx(
+        y0, abs=1 / 256
+    )
 
 
 def test_bootstrap_covariances_match_one_by_one():
@@ -47,4 +49,6 @@ def test_bootstrap_covariances_match_one_by_one():
 
 
 def test_window_must_fit():
-    assert not refine.refinable(2, 10, 21) and not refine.refinable(10, 18, 21) and refine.refinable(3, 17, 21)
+    assert (
+        not refine.refinable(2, 10, 21) and not refine.refinable(10, 18, 21) and refine.refinable(3, 17, 21)
+    )

@@ -18,7 +18,9 @@ def _listing(cases):
 def test_every_candidate_gets_a_decision_and_the_best_are_kept(cases):
     source, listing = _listing(cases)
     chosen, decisions = select_scenes(listing, source, "j01", candidates=40, keep=1, min_score_k=0.0)
-    assert len(chosen) == 1 and all(vs.product == "SVI05" and vg.product == "GITCO" for vs, vg in chosen[0].viirs)
+    assert len(chosen) == 1 and all(
+        vs.product == "SVI05" and vg.product == "GITCO" for vs, vg in chosen[0].viirs
+    )
     by_decision = {}
     for d in decisions:
         by_decision.setdefault(d["decision"], []).append(d)

@@ -20,8 +20,10 @@ DAY = "2024-06-01"
 
 def _config(tmp_path, data, workers=1):
     p = tmp_path / "c.yaml"
-    p.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
-                 f"assessment: {{workers: {workers}}}\nschedule: {{catch_up_days: 2}}\n")
+    p.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
+        f"assessment: {{workers: {workers}}}\nschedule: {{catch_up_days: 2}}\n"
+    )
     return p
 
 
@@ -54,7 +56,9 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     db = tmp_path / "state" / "crisgeo.sqlite"
     log = tmp_path / "log"
     with open(log, "w") as fh:
-        p = subprocess.Popen(CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT)
+        p = subprocess.Popen(
+            CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT
+        )
     assert _wait_for(lambda: _assessing(log))
     time.sleep(3)  # inside scene selection or collocation
     p.kill()
@@ -63,8 +67,13 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     assert [r["status"] for r in s.runs()] == ["running"]
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0  # nothing half-written
     s.close()
-    r = subprocess.run(CRISGEO + ["run", "--config", str(cfg), "--date", DAY], capture_output=True, text=True,
-                       cwd=ROOT, timeout=600)
+    r = subprocess.run(
+        CRISGEO + ["run", "--config", str(cfg), "--date", DAY],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=600,
+    )
     assert r.returncode == 0, r.stderr
     s = Store(db)
     assert [r["status"] for r in s.runs()] == ["interrupted", "ok"]
@@ -77,7 +86,9 @@ def test_sigterm_mid_run_stops_within_seconds_and_consistent(cases, tmp_path, wo
     cfg = _config(tmp_path, data, workers)
     log = tmp_path / "log"
     with open(log, "w") as fh:
-        p = subprocess.Popen(CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT)
+        p = subprocess.Popen(
+            CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT
+        )
     assert _wait_for(lambda: _assessing(log))
     time.sleep(6)  # well into the assessment
     t0 = time.time()
@@ -99,8 +110,14 @@ def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
     sock.bind(sock_path)
     sock.settimeout(60)
     env = dict(os.environ, NOTIFY_SOCKET=sock_path, WATCHDOG_USEC="400000")
-    p = subprocess.Popen(CRISGEO + ["daemon", "--config", str(cfg)], env=env, cwd=ROOT,
-                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    p = subprocess.Popen(
+        CRISGEO + ["daemon", "--config", str(cfg)],
+        env=env,
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
     try:
         got = set()
         while not {"READY=1", "WATCHDOG=1"} <= got:
@@ -109,7 +126,9 @@ def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
         assert _wait_for(lambda: _status(tmp_path / "state" / "crisgeo.sqlite").count("no_data") == 2, 60)
         # a second instance on the same state directory is refused
         r = subprocess.run(CRISGEO + ["run", "--config", str(cfg)], capture_output=True, text=True, cwd=ROOT)
-        assert r.returncode == 75 and "another crisgeo process (pid" in r.stderr and "systemctl stop" in r.stderr
+        assert (
+            r.returncode == 75 and "another crisgeo process (pid" in r.stderr and "systemctl stop" in r.stderr
+        )
         p.send_signal(signal.SIGTERM)
         assert p.wait(timeout=20) == 0
         while "STOPPING=1" not in got:
@@ -150,16 +169,27 @@ def test_systemd_unit_verifies_without_any_warning(tmp_path):
 def test_systemd_unit_exposure_is_at_most_2(tmp_path):
     """`systemd-analyze security` rates the unit's sandbox; 10 is unprotected, the shipped unit <= 2.0."""
     import re
+
     unit = tmp_path / "crisgeo.service"
     unit.write_text((ROOT / "systemd" / "crisgeo.service").read_text())
-    r = subprocess.run(["systemd-analyze", "security", "--offline=true", "--no-pager", str(unit)],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        ["systemd-analyze", "security", "--offline=true", "--no-pager", str(unit)],
+        capture_output=True,
+        text=True,
+    )
     m = re.search(r"Overall exposure level for \S+: (\d+\.\d+)", r.stdout)
     assert m, r.stdout + r.stderr
     assert float(m.group(1)) <= 2.0, r.stdout
     loose = tmp_path / "loose.service"
-    loose.write_text(unit.read_text().replace("SystemCallFilter=", "#SystemCallFilter=")
-                     .replace("PrivateUsers=yes", "").replace("ProtectProc=invisible", ""))
-    r = subprocess.run(["systemd-analyze", "security", "--offline=true", "--no-pager", str(loose)],
-                       capture_output=True, text=True)
+    loose.write_text(
+        unit.read_text()
+        .replace("SystemCallFilter=", "#SystemCallFilter=")
+        .replace("PrivateUsers=yes", "")
+        .replace("ProtectProc=invisible", "")
+    )
+    r = subprocess.run(
+        ["systemd-analyze", "security", "--offline=true", "--no-pager", str(loose)],
+        capture_output=True,
+        text=True,
+    )
     assert float(re.search(r"Overall exposure level for \S+: (\d+\.\d+)", r.stdout).group(1)) > 2.0

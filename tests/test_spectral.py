@@ -23,7 +23,9 @@ def test_blackbody_spectrum_gives_its_temperature():
 
 def test_band_radiance_is_not_a_single_channel_planck():
     band = i5_band("j01")
-    spec = 0.5 * planck_radiance(band.wavenumber_cm1, 300.0) + 0.5 * planck_radiance(band.wavenumber_cm1, 220.0)
+    spec = 0.5 * planck_radiance(band.wavenumber_cm1, 300.0) + 0.5 * planck_radiance(
+        band.wavenumber_cm1, 220.0
+    )
     bt = band.bt_from_radiance(band.cris_band_radiance(spec))
     assert 220 < bt < 300 and abs(bt - 260.0) > 5  # radiance mixing is not temperature mixing
 

@@ -21,15 +21,18 @@ def mountains(tmp_path_factory):
 def _errors(result, truth):
     ta, tb = truth_arrays(truth)
     ok = np.array([f.reliable for f in result.fors])
-    return (np.array([f.d_alpha_urad for f in result.fors]) - ta)[ok], \
-        (np.array([f.d_beta_urad for f in result.fors]) - tb)[ok]
+    return (np.array([f.d_alpha_urad for f in result.fors]) - ta)[ok], (
+        np.array([f.d_beta_urad for f in result.fors]) - tb
+    )[ok]
 
 
 def test_simulated_terrain_in_the_files(mountains):
     out, truth = mountains
     (gcrso,) = read_file(next(out.glob("GCRSO_*.h5")))
     (gitco,) = read_file(next(out.glob("GITCO_*.h5")))
-    assert truth["terrain"] and (gcrso.height_m > 500).mean() > 0.25  # GCRSO reports the height (h = 0 points)
+    assert (
+        truth["terrain"] and (gcrso.height_m > 500).mean() > 0.25
+    )  # GCRSO reports the height (h = 0 points)
     assert np.nanmax(gitco.height_m) > 2500 and abs(np.nanmin(gitco.height_m)) < 1e-3
 
 
@@ -44,6 +47,7 @@ def test_assessment_needs_the_height(mountains, monkeypatch):
     def on_ellipsoid(lat, lon, height, *args, **kw):
         halo = [None if h is None else (h[0], h[1], np.zeros_like(h[2])) for h in args[3:5]]
         return real(lat, lon, np.zeros_like(height), *args[:3], *halo)
+
     monkeypatch.setattr(collocate, "swath_piece", on_ellipsoid)
     ea0, eb0 = _errors(assess_paths([out], cfg), truth)
     assert max(np.abs(ea0).max(), np.abs(eb0).max()) > 300  # ~0.5 mrad per km of terrain at the scan edge

@@ -72,7 +72,8 @@ def sbf_to_ocs(roll_rad, pitch_rad, yaw_rad):
     """Rotation (..., 3, 3) taking an SBF vector to the OCS for the given attitude.
 
     Yaw-roll-pitch (3-1-2): the orbit-to-body matrix is A = P(-pitch) R(-roll) Y(-yaw), so body to
-    orbit is A^T = Y(yaw) R(roll) P(pitch) (the convention that reproduces IDPS GCRSO, docs/jpss-formats.md 2.3).
+    orbit is A^T = Y(yaw) R(roll) P(pitch) (the convention that reproduces IDPS GCRSO, docs/jpss-formats.md
+    2.3).
     """
     return rot_z(yaw_rad) @ rot_x(roll_rad) @ rot_y(pitch_rad)
 

@@ -33,8 +33,9 @@ class GroundView:
     ground_ecef_m: np.ndarray
 
 
-def geolocate_fovs(los_spacecraft, for_time_us, mid_time_us, sc_position_m, sc_velocity_m_s, sc_attitude_rad,
-                   h_m=0.0) -> GroundView:
+def geolocate_fovs(
+    los_spacecraft, for_time_us, mid_time_us, sc_position_m, sc_velocity_m_s, sc_attitude_rad, h_m=0.0
+) -> GroundView:
     """Geolocate the LOS (30, 9, 3) (spacecraft body frame) of every scan.
 
     *for_time_us* (nscan, 30) IET; per scan *mid_time_us* (nscan,), *sc_position_m*, *sc_velocity_m_s*

@@ -28,9 +28,11 @@ def offset_km(sat_ecef_m, sbf_to_ecef, alpha_rad, beta_rad, velocity_ecef_m_s, d
     projected on the local along-track and cross-track directions at the original point.
     """
     p0 = forward_geolocation(sat_ecef_m, sbf_to_ecef, frames.los_from_angles(alpha_rad, beta_rad))
-    p1 = forward_geolocation(sat_ecef_m, sbf_to_ecef,
-                             frames.los_from_angles(np.asarray(alpha_rad) + d_alpha_rad,
-                                                    np.asarray(beta_rad) + d_beta_rad))
+    p1 = forward_geolocation(
+        sat_ecef_m,
+        sbf_to_ecef,
+        frames.los_from_angles(np.asarray(alpha_rad) + d_alpha_rad, np.asarray(beta_rad) + d_beta_rad),
+    )
     along, cross = track_axes(p0, velocity_ecef_m_s)
     d = p1 - p0
     return np.sum(d * along, axis=-1) / 1e3, np.sum(d * cross, axis=-1) / 1e3

@@ -59,11 +59,18 @@ class EngineeringPacket:
     provenance: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        for name, n in (("fov_crosstrack_offset_rad", N_FOV), ("fov_intrack_offset_rad", N_FOV),
-                        ("fov_size_rad", N_FOV), ("ssm_crosstrack_roll_rad", N_FOR),
-                        ("ssm_intrack_pitch_rad", N_FOR), ("ifr_boresight_to_ssmf_rad", 2),
-                        ("ssmr_to_ssmf_rad", 3), ("iar_to_ssmr_rad", 3), ("sbf_to_iar_rad", 3),
-                        ("sc_to_sbf_rad", 3)):
+        for name, n in (
+            ("fov_crosstrack_offset_rad", N_FOV),
+            ("fov_intrack_offset_rad", N_FOV),
+            ("fov_size_rad", N_FOV),
+            ("ssm_crosstrack_roll_rad", N_FOR),
+            ("ssm_intrack_pitch_rad", N_FOR),
+            ("ifr_boresight_to_ssmf_rad", 2),
+            ("ssmr_to_ssmf_rad", 3),
+            ("iar_to_ssmr_rad", 3),
+            ("sbf_to_iar_rad", 3),
+            ("sc_to_sbf_rad", 3),
+        ):
             value = np.asarray(getattr(self, name), float)
             if value.shape != (n,):
                 raise ValueError(f"EP {self.version}: {name} needs {n} values, got shape {value.shape}")
@@ -76,10 +83,13 @@ class EngineeringPacket:
 
     def with_ssm_angles(self, crosstrack_roll_rad, intrack_pitch_rad, version=None, provenance=None):
         """A copy with the 2 x 30 scene-mirror angles replaced (the only angles the optimiser changes)."""
-        return dataclasses.replace(self, ssm_crosstrack_roll_rad=np.asarray(crosstrack_roll_rad, float),
-                                   ssm_intrack_pitch_rad=np.asarray(intrack_pitch_rad, float),
-                                   version=self.version if version is None else version,
-                                   provenance=self.provenance if provenance is None else provenance)
+        return dataclasses.replace(
+            self,
+            ssm_crosstrack_roll_rad=np.asarray(crosstrack_roll_rad, float),
+            ssm_intrack_pitch_rad=np.asarray(intrack_pitch_rad, float),
+            version=self.version if version is None else version,
+            provenance=self.provenance if provenance is None else provenance,
+        )
 
 
 def attitude_matrix(roll_rad, pitch_rad, yaw_rad):
@@ -107,8 +117,12 @@ def fov_los_ssmf(ep: EngineeringPacket) -> np.ndarray:
 
 def mirror_normal(crosstrack_roll_rad, intrack_pitch_rad) -> np.ndarray:
     """Unit scene-mirror normal (..., 3) in the SSMF, equation (15): P(pitch) R(roll) [-1, 0, 1]/sqrt(2)."""
-    return np.einsum("...ij,...jk,k->...i", rot_y(np.asarray(intrack_pitch_rad, float)),
-                     rot_x(np.asarray(crosstrack_roll_rad, float)), _MIRROR_NORMAL_0)
+    return np.einsum(
+        "...ij,...jk,k->...i",
+        rot_y(np.asarray(intrack_pitch_rad, float)),
+        rot_x(np.asarray(crosstrack_roll_rad, float)),
+        _MIRROR_NORMAL_0,
+    )
 
 
 def ssm_angles_from_normal(normal):
@@ -130,8 +144,11 @@ def reflect(los, normal) -> np.ndarray:
 
 def ssmf_to_ep_sbf(ep: EngineeringPacket) -> np.ndarray:
     """T_SBF/SSMF = T_SBF/IAR T_IAR/SSMR T_SSMR/SSMF, equation (17), each T as in equation (10)."""
-    return attitude_matrix(*ep.sbf_to_iar_rad) @ attitude_matrix(*ep.iar_to_ssmr_rad) @ attitude_matrix(
-        *ep.ssmr_to_ssmf_rad)
+    return (
+        attitude_matrix(*ep.sbf_to_iar_rad)
+        @ attitude_matrix(*ep.iar_to_ssmr_rad)
+        @ attitude_matrix(*ep.ssmr_to_ssmf_rad)
+    )
 
 
 def ep_sbf_to_spacecraft(ep: EngineeringPacket) -> np.ndarray:

@@ -47,8 +47,18 @@ def satellite_from_fov(lat_rad, lon_rad, zenith_rad, azimuth_rad, range_m):
     return ground, ground + np.asarray(range_m, float)[..., None] * look
 
 
-def inverse_geolocation(lat_rad, lon_rad, zenith_rad, azimuth_rad, range_m, for_time_us,
-                        mid_time_us, sc_position_m, sc_velocity_m_s, sc_attitude_rad) -> FovGeometry:
+def inverse_geolocation(
+    lat_rad,
+    lon_rad,
+    zenith_rad,
+    azimuth_rad,
+    range_m,
+    for_time_us,
+    mid_time_us,
+    sc_position_m,
+    sc_velocity_m_s,
+    sc_attitude_rad,
+) -> FovGeometry:
     """LOS of each FOV in the SBF from the GEO fields (section 2.2).
 
     FOV fields are (nscan, nfor, nfov); *for_time_us* (nscan, nfor) IET; the per-scan ephemeris

@@ -19,8 +19,9 @@ J2 = 1.08262668e-3  # EGM96 second zonal harmonic
 
 def geodetic_to_ecef(lat_rad, lon_rad, h_m=0.0):
     """ECEF position (..., 3) in metres of geodetic *lat_rad*, *lon_rad* and ellipsoidal height *h_m*."""
-    lat, lon, h = np.broadcast_arrays(np.asarray(lat_rad, float), np.asarray(lon_rad, float),
-                                      np.asarray(h_m, float))
+    lat, lon, h = np.broadcast_arrays(
+        np.asarray(lat_rad, float), np.asarray(lon_rad, float), np.asarray(h_m, float)
+    )
     sin_lat = np.sin(lat)
     n = A_M / np.sqrt(1.0 - E2 * sin_lat**2)
     r = (n + h) * np.cos(lat)  # distance from the polar axis
@@ -69,8 +70,11 @@ def look_vector_ecef(lat_rad, lon_rad, zenith_rad, azimuth_rad):
     """
     east, north, up = enu_basis(lat_rad, lon_rad)
     sz = np.sin(zenith_rad)[..., None]
-    return (sz * np.sin(azimuth_rad)[..., None] * east + sz * np.cos(azimuth_rad)[..., None] * north
-            + np.cos(zenith_rad)[..., None] * up)
+    return (
+        sz * np.sin(azimuth_rad)[..., None] * east
+        + sz * np.cos(azimuth_rad)[..., None] * north
+        + np.cos(zenith_rad)[..., None] * up
+    )
 
 
 def zenith_azimuth(ground_ecef_m, sat_ecef_m):

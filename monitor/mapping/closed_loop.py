@@ -38,19 +38,27 @@ class LoopReport:
     def residual(self):
         """(d_alpha_urad, d_beta_urad, in_track_km, cross_track_km) (30,) of the second assessment."""
         f = self.second.fors
-        return (np.array([x.d_alpha_urad for x in f]), np.array([x.d_beta_urad for x in f]),
-                np.array([x.in_track_km for x in f]), np.array([x.cross_track_km for x in f]))
+        return (
+            np.array([x.d_alpha_urad for x in f]),
+            np.array([x.d_beta_urad for x in f]),
+            np.array([x.in_track_km for x in f]),
+            np.array([x.cross_track_km for x in f]),
+        )
 
     def table(self) -> str:
         a1 = [f.d_alpha_urad for f in self.first.fors]
         b1 = [f.d_beta_urad for f in self.first.fors]
         a2, b2, it, ct = self.residual()
-        lines = ["FOR   first assessment    recovered-true SSM     second assessment",
-                 "      d_alpha  d_beta      d_roll  d_pitch     d_alpha  d_beta  in_km   x_km",
-                 "       urad     urad        urad    urad        urad     urad"]
+        lines = [
+            "FOR   first assessment    recovered-true SSM     second assessment",
+            "      d_alpha  d_beta      d_roll  d_pitch     d_alpha  d_beta  in_km   x_km",
+            "       urad     urad        urad    urad        urad     urad",
+        ]
         for k in range(30):
-            lines.append(f"{k + 1:3d} {a1[k]:8.0f} {b1[k]:8.0f}    {self.roll_error_urad[k]:8.1f} "
-                         f"{self.pitch_error_urad[k]:8.1f}    {a2[k]:8.0f} {b2[k]:7.0f} {it[k]:6.3f} {ct[k]:6.3f}")
+            lines.append(
+                f"{k + 1:3d} {a1[k]:8.0f} {b1[k]:8.0f}    {self.roll_error_urad[k]:8.1f} "
+                f"{self.pitch_error_urad[k]:8.1f}    {a2[k]:8.0f} {b2[k]:7.0f} {it[k]:6.3f} {ct[k]:6.3f}"
+            )
         return "\n".join(lines)
 
 
@@ -61,16 +69,30 @@ def _link_or_copy(src: Path, dst: Path) -> None:
         dst.write_bytes(src.read_bytes())
 
 
-def run_closed_loop(work_dir, true_ep: EngineeringPacket, ground_ep: EngineeringPacket, granules: int = 14,
-                    seed: int = 1, workers: int = 2, config: AssessConfig | None = None) -> LoopReport:
+def run_closed_loop(
+    work_dir,
+    true_ep: EngineeringPacket,
+    ground_ep: EngineeringPacket,
+    granules: int = 14,
+    seed: int = 1,
+    workers: int = 2,
+    config: AssessConfig | None = None,
+) -> LoopReport:
     """Simulate with (*true_ep*, *ground_ep*), then assess, optimize, regeolocate and assess again."""
     work = Path(work_dir)
     case, regeo = work / "case", work / "regeolocated"
     config = config or AssessConfig()
     seconds = {}
     t = time.perf_counter()
-    spec = SimulationSpec(satellite=ground_ep.satellite, granules=granules, seed=seed, start=DEFAULT_START,
-                          profile="ep", true_ep=true_ep, ground_ep=ground_ep)
+    spec = SimulationSpec(
+        satellite=ground_ep.satellite,
+        granules=granules,
+        seed=seed,
+        start=DEFAULT_START,
+        profile="ep",
+        true_ep=true_ep,
+        ground_ep=ground_ep,
+    )
     truth = simulate_case(case, spec=spec)
     seconds["simulate"] = time.perf_counter() - t
     t = time.perf_counter()
@@ -89,6 +111,11 @@ def run_closed_loop(work_dir, true_ep: EngineeringPacket, ground_ep: Engineering
     t = time.perf_counter()
     second = assess_paths([regeo], config, workers=workers)
     seconds["reassess"] = time.perf_counter() - t
-    return LoopReport(first, opt, second,
-                      (opt.ep.ssm_crosstrack_roll_rad - true_ep.ssm_crosstrack_roll_rad) / URAD,
-                      (opt.ep.ssm_intrack_pitch_rad - true_ep.ssm_intrack_pitch_rad) / URAD, seconds)
+    return LoopReport(
+        first,
+        opt,
+        second,
+        (opt.ep.ssm_crosstrack_roll_rad - true_ep.ssm_crosstrack_roll_rad) / URAD,
+        (opt.ep.ssm_intrack_pitch_rad - true_ep.ssm_intrack_pitch_rad) / URAD,
+        seconds,
+    )

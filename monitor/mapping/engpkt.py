@@ -139,7 +139,9 @@ def load_ep(path, satellite: str | None = None) -> EngineeringPacket:
             raise EngPktError(path, "InstrumentId", f"not an integer: {src.get('InstrumentId')!r}") from None
         sat = satellite or INSTRUMENT_SATELLITE.get(instrument)
         if sat is None:
-            raise EngPktError(path, "InstrumentId", f"{instrument} is not a known instrument; pass the satellite")
+            raise EngPktError(
+                path, "InstrumentId", f"{instrument} is not a known instrument; pass the satellite"
+            )
         if sat not in MOUNTING_URAD:
             raise EngPktError(path, "mounting", f"no spacecraft mounting angles known for {sat}")
         kw = _read_angles(src, path)
@@ -154,8 +156,9 @@ def load_ep(path, satellite: str | None = None) -> EngineeringPacket:
     src = _YamlSource(path, doc)
     kw = _read_angles(src, path)
     group, parts = _MOUNTING
-    kw["sc_to_sbf_rad"] = np.asarray([_numbers(path, f"{group}/{p}", src.get(f"{group}/{p}"), None)
-                                      for p in parts]) * URAD
+    kw["sc_to_sbf_rad"] = (
+        np.asarray([_numbers(path, f"{group}/{p}", src.get(f"{group}/{p}"), None) for p in parts]) * URAD
+    )
     sat = satellite or doc.get("satellite")
     if sat not in SATELLITES:
         raise EngPktError(path, "satellite", f"{sat!r}, expected one of {', '.join(SATELLITES)}")
@@ -180,20 +183,24 @@ def _urad(values):
 
 def ep_to_yaml_doc(ep: EngineeringPacket) -> dict:
     """The YAML document of *ep*: the EP element names, values in urad (the time-stamp bias in ms)."""
-    doc = {"satellite": ep.satellite, "version": ep.version, "units": "urad; TimeStampBias in ms",
-           "provenance": ep.provenance}
+    doc = {
+        "satellite": ep.satellite,
+        "version": ep.version,
+        "units": "urad; TimeStampBias in ms",
+        "provenance": ep.provenance,
+    }
     for field, where, n in _ANGLES:
         value = _urad(getattr(ep, field))
         if isinstance(where, tuple):
             group, parts = where
             node = _subtree(doc, group)
-            for p, v in zip(parts, value):
+            for p, v in zip(parts, value, strict=True):
                 node[p] = v
         else:
             group, leaf = where.rsplit("/", 1)
             _subtree(doc, group)[leaf] = value if n is not None else value[0]
     _subtree(doc, "MappingParameters")["TimeStampBias"] = float(ep.time_stamp_bias_ms)
-    doc["ScToSbf"] = dict(zip(_MOUNTING[1], _urad(ep.sc_to_sbf_rad)))
+    doc["ScToSbf"] = dict(zip(_MOUNTING[1], _urad(ep.sc_to_sbf_rad), strict=True))
     return doc
 
 
@@ -218,8 +225,10 @@ def save_ep(ep: EngineeringPacket, out_path, like=None) -> Path:
     out = Path(out_path)
     if like is not None and Path(like).read_text().lstrip().startswith("<"):
         text = Path(like).read_text()
-        for name, values in (("ActualCrosstrackAngleRoll", ep.ssm_crosstrack_roll_rad),
-                             ("ActualIntrackAnglePitch", ep.ssm_intrack_pitch_rad)):
+        for name, values in (
+            ("ActualCrosstrackAngleRoll", ep.ssm_crosstrack_roll_rad),
+            ("ActualIntrackAnglePitch", ep.ssm_intrack_pitch_rad),
+        ):
             joined = " ".join(str(int(v)) for v in np.round(values / URAD))
             text, count = re.subn(rf"(<{name}>)[^<]*(</{name}>)", rf"\g<1>{joined}\g<2>", text)
             if count != 1:
@@ -230,7 +239,9 @@ def save_ep(ep: EngineeringPacket, out_path, like=None) -> Path:
         out.write_text(text)
         return out
     header = "# CrIS engineering packet (crisgeo YAML form of the EP XML; angles in urad)\n"
-    out.write_text(header + yaml.safe_dump(ep_to_yaml_doc(ep), sort_keys=False, width=200, default_flow_style=None))
+    out.write_text(
+        header + yaml.safe_dump(ep_to_yaml_doc(ep), sort_keys=False, width=200, default_flow_style=None)
+    )
     return out
 
 

@@ -40,10 +40,18 @@ class AngleRow:
         return self.new_pitch_urad - self.old_pitch_urad
 
     def to_dict(self) -> dict:
-        return {"for": self.for_index, "old_roll_urad": self.old_roll_urad, "new_roll_urad": self.new_roll_urad,
-                "d_roll_urad": self.d_roll_urad, "old_pitch_urad": self.old_pitch_urad,
-                "new_pitch_urad": self.new_pitch_urad, "d_pitch_urad": self.d_pitch_urad,
-                "d_alpha_urad": self.d_alpha_urad, "d_beta_urad": self.d_beta_urad, "kept": self.kept}
+        return {
+            "for": self.for_index,
+            "old_roll_urad": self.old_roll_urad,
+            "new_roll_urad": self.new_roll_urad,
+            "d_roll_urad": self.d_roll_urad,
+            "old_pitch_urad": self.old_pitch_urad,
+            "new_pitch_urad": self.new_pitch_urad,
+            "d_pitch_urad": self.d_pitch_urad,
+            "d_alpha_urad": self.d_alpha_urad,
+            "d_beta_urad": self.d_beta_urad,
+            "kept": self.kept,
+        }
 
 
 @dataclass(frozen=True)
@@ -59,15 +67,21 @@ class Optimization:
 
     def table(self) -> str:
         """The old/new angle table as fixed-width text (urad)."""
-        lines = ["FOR  ActualCrosstrackAngleRoll (urad)       ActualIntrackAnglePitch (urad)   assessed (urad)",
-                 "        old        new       diff          old      new     diff     d_alpha  d_beta  note"]
+        lines = [
+            "FOR  ActualCrosstrackAngleRoll (urad)       ActualIntrackAnglePitch (urad)   assessed (urad)",
+            "        old        new       diff          old      new     diff     d_alpha  d_beta  note",
+        ]
         for r in self.rows:
-            lines.append(f"{r.for_index:3d} {r.old_roll_urad:10.1f} {r.new_roll_urad:10.1f} {r.d_roll_urad:9.1f}"
-                         f"    {r.old_pitch_urad:9.1f} {r.new_pitch_urad:8.1f} {r.d_pitch_urad:8.1f}"
-                         f"    {r.d_alpha_urad:8.1f} {r.d_beta_urad:7.1f}  {r.kept}")
+            lines.append(
+                f"{r.for_index:3d} {r.old_roll_urad:10.1f} {r.new_roll_urad:10.1f} {r.d_roll_urad:9.1f}"
+                f"    {r.old_pitch_urad:9.1f} {r.new_pitch_urad:8.1f} {r.d_pitch_urad:8.1f}"
+                f"    {r.d_alpha_urad:8.1f} {r.d_beta_urad:7.1f}  {r.kept}"
+            )
         if self.kept:
-            lines.append(f"{len(self.kept)} FOR(s) kept their angles: "
-                         + ", ".join(f"FOR {r.for_index} ({r.kept})" for r in self.kept))
+            lines.append(
+                f"{len(self.kept)} FOR(s) kept their angles: "
+                + ", ".join(f"FOR {r.for_index} ({r.kept})" for r in self.kept)
+            )
         return "\n".join(lines)
 
 
@@ -85,15 +99,19 @@ def optimize(result: AssessmentResult, ep: EngineeringPacket, source: str = "") 
     Raises ValueError when the result is for another satellite than the EP or does not have 30 FORs.
     """
     if result.satellite != ep.satellite:
-        raise ValueError(f"assessment {source or ''} is for {result.satellite}, the EP {ep.version} for "
-                         f"{ep.satellite}: an EP is only corrected by its own satellite's assessment")
+        raise ValueError(
+            f"assessment {source or ''} is for {result.satellite}, the EP {ep.version} for "
+            f"{ep.satellite}: an EP is only corrected by its own satellite's assessment"
+        )
     if len(result.fors) != N_FOR or [f.for_index for f in result.fors] != list(range(1, N_FOR + 1)):
         raise ValueError(f"assessment {source}: needs FORs 1..30 in order, got {len(result.fors)} entries")
     reasons = [_why_kept(f) for f in result.fors]
     use = np.array([not r for r in reasons])
     d_alpha = np.array([f.d_alpha_urad for f in result.fors], float)
     d_beta = np.array([f.d_beta_urad for f in result.fors], float)
-    roll, pitch = corrected_ssm_angles(ep, np.where(use, d_alpha, 0.0) * URAD, np.where(use, d_beta, 0.0) * URAD)
+    roll, pitch = corrected_ssm_angles(
+        ep, np.where(use, d_alpha, 0.0) * URAD, np.where(use, d_beta, 0.0) * URAD
+    )
     roll = np.where(use, roll, ep.ssm_crosstrack_roll_rad)
     pitch = np.where(use, pitch, ep.ssm_intrack_pitch_rad)
     granules = list(result.granules)
@@ -101,13 +119,29 @@ def optimize(result: AssessmentResult, ep: EngineeringPacket, source: str = "") 
         "derived_from": ep.version,
         "derived_by": "crisgeo optimize (Wang et al. 2017 section 4.1, equations 19-23)",
         "created": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
-        "assessment": {"file": source, "satellite": result.satellite, "start": result.start, "end": result.end,
-                       "n_granules": len(granules), "first_granule": granules[0] if granules else None,
-                       "last_granule": granules[-1] if granules else None},
-        "fors_kept": {str(f.for_index): r for f, r in zip(result.fors, reasons) if r},
+        "assessment": {
+            "file": source,
+            "satellite": result.satellite,
+            "start": result.start,
+            "end": result.end,
+            "n_granules": len(granules),
+            "first_granule": granules[0] if granules else None,
+            "last_granule": granules[-1] if granules else None,
+        },
+        "fors_kept": {str(f.for_index): r for f, r in zip(result.fors, reasons, strict=True) if r},
     }
     new_ep = ep.with_ssm_angles(roll, pitch, version=f"{ep.version}+crisgeo", provenance=provenance)
-    rows = [AngleRow(k + 1, ep.ssm_crosstrack_roll_rad[k] / URAD, roll[k] / URAD,
-                     ep.ssm_intrack_pitch_rad[k] / URAD, pitch[k] / URAD, d_alpha[k], d_beta[k], reasons[k])
-            for k in range(N_FOR)]
+    rows = [
+        AngleRow(
+            k + 1,
+            ep.ssm_crosstrack_roll_rad[k] / URAD,
+            roll[k] / URAD,
+            ep.ssm_intrack_pitch_rad[k] / URAD,
+            pitch[k] / URAD,
+            d_alpha[k],
+            d_beta[k],
+            reasons[k],
+        )
+        for k in range(N_FOR)
+    ]
     return Optimization(new_ep, rows)

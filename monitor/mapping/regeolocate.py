@@ -30,12 +30,18 @@ from monitor.sdr.readers import CrisGeoGranule
 
 GEO = PRODUCTS["GCRSO"]
 FILL_F32 = -999.3  # IDPS float32 "missing" fill
-_REWRITTEN = {"Latitude": ("lat_rad", np.degrees), "Longitude": ("lon_rad", np.degrees),
-              "SatelliteZenithAngle": ("zenith_rad", np.degrees),
-              "SatelliteAzimuthAngle": ("azimuth_rad", np.degrees), "SatelliteRange": ("range_m", None)}
+_REWRITTEN = {
+    "Latitude": ("lat_rad", np.degrees),
+    "Longitude": ("lon_rad", np.degrees),
+    "SatelliteZenithAngle": ("zenith_rad", np.degrees),
+    "SatelliteAzimuthAngle": ("azimuth_rad", np.degrees),
+    "SatelliteRange": ("range_m", None),
+}
 
 
-def geolocate_granule(ep: EngineeringPacket, g: CrisGeoGranule, residuals: ResidualTable | OwnResiduals | None = None) -> GroundView:
+def geolocate_granule(
+    ep: EngineeringPacket, g: CrisGeoGranule, residuals: ResidualTable | OwnResiduals | None = None
+) -> GroundView:
     """Geolocation of every FOV of *g* with the LOS of *ep* (turned by the per-FOR *residuals*, if given)
     and the granule's own ephemeris and attitude."""
     if g.meta.platform != ep.satellite:
@@ -45,8 +51,9 @@ def geolocate_granule(ep: EngineeringPacket, g: CrisGeoGranule, residuals: Resid
     los = instrument.los_spacecraft(ep)
     if residuals is not None:
         los = residuals.table_for(g).apply(los)
-    return geolocate_fovs(los, g.for_time_us, g.mid_time_us, g.sc_position_m, g.sc_velocity_m_s,
-                          g.sc_attitude_rad)
+    return geolocate_fovs(
+        los, g.for_time_us, g.mid_time_us, g.sc_position_m, g.sc_velocity_m_s, g.sc_attitude_rad
+    )
 
 
 def _geo_granules(path) -> list:
@@ -67,11 +74,18 @@ class ForDistance:
     max_m: float
 
     def to_dict(self) -> dict:
-        return {"for": self.for_index, "n": self.n, "median_m": self.median_m, "p99_m": self.p99_m,
-                "max_m": self.max_m}
+        return {
+            "for": self.for_index,
+            "n": self.n,
+            "median_m": self.median_m,
+            "p99_m": self.p99_m,
+            "max_m": self.max_m,
+        }
 
 
-def compare_with_files(ep: EngineeringPacket, paths, residuals: ResidualTable | OwnResiduals | None = None) -> list[ForDistance]:
+def compare_with_files(
+    ep: EngineeringPacket, paths, residuals: ResidualTable | OwnResiduals | None = None
+) -> list[ForDistance]:
     """Per-FOR statistics of the distance between *ep*'s geolocation (with *residuals*, if given) and the
     files' latitude/longitude."""
     per_for = [[] for _ in range(N_FOR)]
@@ -89,18 +103,25 @@ def compare_with_files(ep: EngineeringPacket, paths, residuals: ResidualTable | 
         if d.size == 0:
             out.append(ForDistance(k + 1, 0, float("nan"), float("nan"), float("nan")))
         else:
-            out.append(ForDistance(k + 1, int(d.size), float(np.median(d)), float(np.percentile(d, 99)),
-                                   float(d.max())))
+            out.append(
+                ForDistance(
+                    k + 1, int(d.size), float(np.median(d)), float(np.percentile(d, 99)), float(d.max())
+                )
+            )
     return out
 
 
-def regeolocate_file(ep: EngineeringPacket, path, out_dir, residuals: ResidualTable | OwnResiduals | None = None) -> Path:
+def regeolocate_file(
+    ep: EngineeringPacket, path, out_dir, residuals: ResidualTable | OwnResiduals | None = None
+) -> Path:
     """Write a copy of the GEO file *path* into *out_dir* with its geolocation computed from *ep* (and the
     per-FOR *residuals*, if given)."""
     src = Path(path).resolve()
     dst_dir = Path(out_dir).resolve()
     if dst_dir == src.parent:
-        raise ValueError(f"{src}: the output directory is the input's; regeolocation never touches its inputs")
+        raise ValueError(
+            f"{src}: the output directory is the input's; regeolocation never touches its inputs"
+        )
     granules = _geo_granules(src)
     dst_dir.mkdir(parents=True, exist_ok=True)
     dst = dst_dir / src.name
@@ -123,10 +144,17 @@ def regeolocate_file(ep: EngineeringPacket, path, out_dir, residuals: ResidualTa
                     dset[rows] = np.where(keep, old, new).astype(dset.dtype)
                 _update_bounds(h5, k, view)
             group.attrs["crisgeo_engineering_packet"] = json.dumps(
-                {"version": ep.version, "satellite": ep.satellite, "provenance": ep.provenance,
-                 "residuals": None if residuals is None else
-                 {"own_against": residuals.ep_in_force.version} if isinstance(residuals, OwnResiduals) else
-                 {"ep_version": residuals.ep_version, "granules": list(residuals.granules)}})
+                {
+                    "version": ep.version,
+                    "satellite": ep.satellite,
+                    "provenance": ep.provenance,
+                    "residuals": None
+                    if residuals is None
+                    else {"own_against": residuals.ep_in_force.version}
+                    if isinstance(residuals, OwnResiduals)
+                    else {"ep_version": residuals.ep_version, "granules": list(residuals.granules)},
+                }
+            )
         tmp.replace(dst)
     except BaseException:
         tmp.unlink(missing_ok=True)
@@ -140,8 +168,15 @@ def _update_bounds(h5, k: int, view: GroundView) -> None:
         return
     a = h5[name].attrs
     lat, lon = np.degrees(view.lat_rad), np.degrees(view.lon_rad)
-    for key, value in (("North_Bounding_Coordinate", np.nanmax(lat)), ("South_Bounding_Coordinate", np.nanmin(lat)),
-                       ("East_Bounding_Coordinate", np.nanmax(lon)), ("West_Bounding_Coordinate", np.nanmin(lon))):
+    for key, value in (
+        ("North_Bounding_Coordinate", np.nanmax(lat)),
+        ("South_Bounding_Coordinate", np.nanmin(lat)),
+        ("East_Bounding_Coordinate", np.nanmax(lon)),
+        ("West_Bounding_Coordinate", np.nanmin(lon)),
+    ):
         if key in a:
-            a[key] = np.asarray(a[key]).dtype.type(value) if np.asarray(a[key]).ndim == 0 else \
-                np.full(np.asarray(a[key]).shape, value, np.asarray(a[key]).dtype)
+            a[key] = (
+                np.asarray(a[key]).dtype.type(value)
+                if np.asarray(a[key]).ndim == 0
+                else np.full(np.asarray(a[key]).shape, value, np.asarray(a[key]).dtype)
+            )

@@ -42,22 +42,32 @@ class ResidualTable:
     d_alpha_urad: np.ndarray
     d_beta_urad: np.ndarray
     granules: tuple = ()
-    created: str = field(default_factory=lambda: dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"))
+    created: str = field(
+        default_factory=lambda: dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+    )
 
     def apply(self, los_spacecraft) -> np.ndarray:
         """The LOS (30, 9, 3) (spacecraft frame) with every FOV of FOR k turned by the FOR's residual."""
         alpha, beta = los_angles(los_spacecraft)
-        return los_from_angles(alpha + self.d_alpha_urad[:, None] * URAD, beta + self.d_beta_urad[:, None] * URAD)
+        return los_from_angles(
+            alpha + self.d_alpha_urad[:, None] * URAD, beta + self.d_beta_urad[:, None] * URAD
+        )
 
     def table_for(self, granule) -> "ResidualTable":
         """The table to apply to *granule*: this one, whatever the granule."""
         return self
 
     def to_dict(self) -> dict:
-        return {"satellite": self.satellite, "ep_version": self.ep_version, "granules": list(self.granules),
-                "created": self.created,
-                "fors": [{"for": k + 1, "d_alpha_urad": round(float(a), 3), "d_beta_urad": round(float(b), 3)}
-                         for k, (a, b) in enumerate(zip(self.d_alpha_urad, self.d_beta_urad))]}
+        return {
+            "satellite": self.satellite,
+            "ep_version": self.ep_version,
+            "granules": list(self.granules),
+            "created": self.created,
+            "fors": [
+                {"for": k + 1, "d_alpha_urad": round(float(a), 3), "d_beta_urad": round(float(b), 3)}
+                for k, (a, b) in enumerate(zip(self.d_alpha_urad, self.d_beta_urad, strict=True))
+            ],
+        }
 
     def write(self, path) -> Path:
         """Write the table as JSON to *path* (through a temporary name)."""
@@ -72,8 +82,13 @@ def learn(day, ep: EngineeringPacket) -> ResidualTable:
     """The residual table of a fingerprint *day* (:class:`monitor.fingerprint.DayPrint`) against *ep*:
     measured minus modelled FOV-5 angles per FOR. FORs the fingerprint could not measure get 0."""
     alpha, beta = fov5_angles(ep)
-    return ResidualTable(ep.satellite, ep.version, np.nan_to_num(day.alpha_urad - alpha / URAD),
-                         np.nan_to_num(day.beta_urad - beta / URAD), tuple(day.granules))
+    return ResidualTable(
+        ep.satellite,
+        ep.version,
+        np.nan_to_num(day.alpha_urad - alpha / URAD),
+        np.nan_to_num(day.beta_urad - beta / URAD),
+        tuple(day.granules),
+    )
 
 
 @dataclass(frozen=True)
@@ -93,6 +108,7 @@ class OwnResiduals:
 
     def table_for(self, granule) -> ResidualTable:
         from monitor.fingerprint import day_print, granule_print
+
         return learn(day_print([granule_print(granule)]), self.ep_in_force)
 
 
@@ -112,17 +128,27 @@ def load(path) -> ResidualTable:
             raise ResidualError(f"{path}: {key}: missing")
     rows = doc["fors"]
     if not isinstance(rows, list) or len(rows) != N_FOR:
-        raise ResidualError(f"{path}: fors: expected {N_FOR} rows, found "
-                            f"{len(rows) if isinstance(rows, list) else type(rows).__name__}")
+        raise ResidualError(
+            f"{path}: fors: expected {N_FOR} rows, found "
+            f"{len(rows) if isinstance(rows, list) else type(rows).__name__}"
+        )
     values = {"d_alpha_urad": np.empty(N_FOR), "d_beta_urad": np.empty(N_FOR)}
     for i, row in enumerate(rows):
         if not isinstance(row, dict) or row.get("for") != i + 1:
-            raise ResidualError(f"{path}: fors[{i}].for: expected {i + 1}, found "
-                                f"{row.get('for') if isinstance(row, dict) else row!r}")
+            raise ResidualError(
+                f"{path}: fors[{i}].for: expected {i + 1}, found "
+                f"{row.get('for') if isinstance(row, dict) else row!r}"
+            )
         for key, out in values.items():
             v = row.get(key)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or abs(v) > 5000:
                 raise ResidualError(f"{path}: fors[{i}].{key}: {v!r} is not a number within +-5000 urad")
             out[i] = v
-    return ResidualTable(str(doc["satellite"]), str(doc["ep_version"]), values["d_alpha_urad"],
-                         values["d_beta_urad"], tuple(doc.get("granules", ())), str(doc.get("created", "")))
+    return ResidualTable(
+        str(doc["satellite"]),
+        str(doc["ep_version"]),
+        values["d_alpha_urad"],
+        values["d_beta_urad"],
+        tuple(doc.get("granules", ())),
+        str(doc.get("created", "")),
+    )

@@ -36,7 +36,8 @@ UTC = dt.timezone.utc
 CSS = """
 body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:1.5em auto;max-width:1100px;color:#222}
 h1{font-size:1.5em}h2{font-size:1.15em;margin-top:1.6em;border-bottom:1px solid #ccc}
-table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0}td,th{border:1px solid #ddd;padding:2px 7px;text-align:right}
+table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0}td,th{border:1px solid #ddd;padding:2px
+7px;text-align:right}
 th{background:#f3f3f3}td.l,th.l{text-align:left}tr.out td{background:#fde2e1}tr.flag td{color:#999}
 img{max-width:100%;border:1px solid #eee;margin:0.3em 0}.note{color:#666;font-size:0.85em}
 .ok{color:#1a7f37}.bad{color:#c62828;font-weight:bold}
@@ -56,8 +57,13 @@ class ReportOptions:
 def options_from_config(cfg, satellites=None, since=None, until=None) -> ReportOptions:
     """Report options of a service configuration: the spec of its alert rules, its events calendar."""
     settings = cfg.alert_settings
-    return ReportOptions(spec_km=settings.rules.spec_km, since=since, until=until, calendar=settings.events_file,
-                         satellites=list(satellites or cfg.satellites))
+    return ReportOptions(
+        spec_km=settings.rules.spec_km,
+        since=since,
+        until=until,
+        calendar=settings.events_file,
+        satellites=list(satellites or cfg.satellites),
+    )
 
 
 def _e(x) -> str:
@@ -71,9 +77,11 @@ def _write(path: Path, text: str) -> None:
 
 
 def _page(title: str, body: str) -> str:
-    return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{_e(title)}</title>"
-            "<link rel=\"icon\" href=\"data:,\">"  # no favicon request (a 404 in the browser console)
-            f"<style>{CSS}</style></head><body>\n{body}\n</body></html>\n")
+    return (
+        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{_e(title)}</title>'
+        '<link rel="icon" href="data:,">'  # no favicon request (a 404 in the browser console)
+        f"<style>{CSS}</style></head><body>\n{body}\n</body></html>\n"
+    )
 
 
 def _f(v, fmt):
@@ -94,42 +102,63 @@ def _series_arrays(rows):
 
 
 def _latest_table(fors, spec_km) -> str:
-    head = ("<tr><th>FOR</th><th>d_alpha urad</th><th>+-</th><th>d_beta urad</th><th>+-</th><th>% FOV a</th>"
-            "<th>% FOV b</th><th>in-track km</th><th>cross-track km</th><th>total km</th><th>N</th>"
-            "<th>G_min K</th><th>G_0 K</th><th class=l>flags</th></tr>")
+    head = (
+        "<tr><th>FOR</th><th>d_alpha urad</th><th>+-</th><th>d_beta urad</th><th>+-</th><th>% FOV a</th>"
+        "<th>% FOV b</th><th>in-track km</th><th>cross-track km</th><th>total km</th><th>N</th>"
+        "<th>G_min K</th><th>G_0 K</th><th class=l>flags</th></tr>"
+    )
     rows = []
     for f in fors:
-        cls = "flag" if not f.reliable else ("out" if np.isfinite(f.total_km) and
-                                              max(abs(f.in_track_km), abs(f.cross_track_km)) > spec_km else "")
+        cls = (
+            "flag"
+            if not f.reliable
+            else (
+                "out"
+                if np.isfinite(f.total_km) and max(abs(f.in_track_km), abs(f.cross_track_km)) > spec_km
+                else ""
+            )
+        )
         rows.append(
-            f"<tr class='{cls}'><td>{f.for_index}</td><td>{_f(f.d_alpha_urad, '.0f')}</td><td>{_f(f.sigma_alpha_urad, '.0f')}</td>"
-            f"<td>{_f(f.d_beta_urad, '.0f')}</td><td>{_f(f.sigma_beta_urad, '.0f')}</td><td>{_f(f.d_alpha_pct_fov, '.1f')}</td>"
-            f"<td>{_f(f.d_beta_pct_fov, '.1f')}</td><td>{_f(f.in_track_km, '.3f')}</td><td>{_f(f.cross_track_km, '.3f')}</td>"
+            f"<tr class='{cls}'><td>{f.for_index}</td><td>{_f(f.d_alpha_urad, '.0f')}</td>"
+            f"<td>{_f(f.sigma_alpha_urad, '.0f')}</td><td>{_f(f.d_beta_urad, '.0f')}</td>"
+            f"<td>{_f(f.sigma_beta_urad, '.0f')}</td><td>{_f(f.d_alpha_pct_fov, '.1f')}</td>"
+            f"<td>{_f(f.d_beta_pct_fov, '.1f')}</td><td>{_f(f.in_track_km, '.3f')}</td>"
+            f"<td>{_f(f.cross_track_km, '.3f')}</td>"
             f"<td>{_f(f.total_km, '.3f')}</td><td>{f.n_samples}</td><td>{_f(f.cost_min_k, '.3f')}</td>"
-            f"<td>{_f(f.cost_zero_k, '.3f')}</td><td class=l>{_e(', '.join(f.flags))}</td></tr>")
+            f"<td>{_f(f.cost_zero_k, '.3f')}</td><td class=l>{_e(', '.join(f.flags))}</td></tr>"
+        )
     return f"<table>{head}{''.join(rows)}</table>"
 
 
 def _alerts_table(rows) -> str:
     if not rows:
         return "<p class=ok>No alert is firing.</p>"
-    body = "".join(f"<tr><td class=l>{_e(r['severity'] or '')}</td><td class=l>{_e(r['rule'])}</td>"
-                   f"<td class=l>{_e(r['started'])}</td><td class=l>{_e(r['summary'])}</td></tr>" for r in rows)
-    return f"<table><tr><th class=l>severity</th><th class=l>rule</th><th class=l>since</th><th class=l>summary</th></tr>{body}</table>"
+    body = "".join(
+        f"<tr><td class=l>{_e(r['severity'] or '')}</td><td class=l>{_e(r['rule'])}</td>"
+        f"<td class=l>{_e(r['started'])}</td><td class=l>{_e(r['summary'])}</td></tr>"
+        for r in rows
+    )
+    head = "".join(f"<th class=l>{h}</th>" for h in ("severity", "rule", "since", "summary"))
+    return f"<table><tr>{head}</tr>{body}</table>"
 
 
 def _changes_table(changes) -> str:
     if not changes:
         return "<p class=note>No change known (calendar, granule metadata, LOS fingerprint).</p>"
-    body = "".join(f"<tr><td class=l>{c.time:%Y-%m-%d %H:%M}</td><td class=l>{_e(c.instrument)}</td>"
-                   f"<td class=l>{_e(c.kind)}</td><td class=l>{_e(c.description)}</td><td class=l>{_e(c.origin)}</td></tr>"
-                   for c in reversed(changes))
-    return ("<table><tr><th class=l>time (UTC)</th><th class=l>instrument</th><th class=l>kind</th>"
-            f"<th class=l>description</th><th class=l>origin</th></tr>{body}</table>")
+    body = "".join(
+        f"<tr><td class=l>{c.time:%Y-%m-%d %H:%M}</td><td class=l>{_e(c.instrument)}</td>"
+        f"<td class=l>{_e(c.kind)}</td><td class=l>{_e(c.description)}</td><td "
+        f"class=l>{_e(c.origin)}</td></tr>"
+        for c in reversed(changes)
+    )
+    return (
+        "<table><tr><th class=l>time (UTC)</th><th class=l>instrument</th><th class=l>kind</th>"
+        f"<th class=l>description</th><th class=l>origin</th></tr>{body}</table>"
+    )
 
 
 def _img(name, alt) -> str:
-    return f"<img src=\"{name}\" alt=\"{_e(alt)}\">"
+    return f'<img src="{name}" alt="{_e(alt)}">'
 
 
 def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dict:
@@ -138,15 +167,31 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     sat_dir.mkdir(parents=True, exist_ok=True)
     name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
     rows = store.series(satellite, opts.since, opts.until)
-    changes = [c for c in all_changes(store, satellite, opts.calendar)
-               if (opts.since is None or c.time.date() >= opts.since) and (opts.until is None or c.time.date() <= opts.until)]
+    changes = [
+        c
+        for c in all_changes(store, satellite, opts.calendar)
+        if (opts.since is None or c.time.date() >= opts.since)
+        and (opts.until is None or c.time.date() <= opts.until)
+    ]
     state = AlertState(store)
     firing = state.firing(satellite)
-    alert_times = sorted(dt.datetime.fromisoformat(r["started"]).replace(tzinfo=None)
-                         for r in state.all() if r["satellite"] == satellite and r["started"])
-    parts = [f"<p><a href=\"../index.html\">all satellites</a></p><h1>CrIS geolocation against VIIRS I5: {_e(name)}</h1>"]
-    summary = {"satellite": satellite, "name": name, "latest": None, "worst_km": None, "firing": len(firing),
-               "days": 0}
+    alert_times = sorted(
+        dt.datetime.fromisoformat(r["started"]).replace(tzinfo=None)
+        for r in state.all()
+        if r["satellite"] == satellite and r["started"]
+    )
+    parts = [
+        '<p><a href="../index.html">all satellites</a></p><h1>CrIS geolocation against VIIRS I5: '
+        f"{_e(name)}</h1>"
+    ]
+    summary = {
+        "satellite": satellite,
+        "name": name,
+        "latest": None,
+        "worst_km": None,
+        "firing": len(firing),
+        "days": 0,
+    }
     if not rows:
         parts.append("<p>No assessment in the store for this period yet.</p>")
         parts.append("<h2>Active alerts</h2>" + _alerts_table(firing))
@@ -159,47 +204,107 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     fors = store.day_result(satellite, latest)
     reliable = [f.reliable for f in fors]
     col = lambda k: np.array([getattr(f, k) for f in fors], float)  # noqa: E731
-    worst = max((f for f in fors if f.reliable and np.isfinite(f.total_km)), key=lambda f: f.total_km, default=None)
-    summary.update(latest=latest.isoformat(), days=len(days), worst_km=None if worst is None else worst.total_km,
-                   worst_for=None if worst is None else worst.for_index)
+    worst = max(
+        (f for f in fors if f.reliable and np.isfinite(f.total_km)), key=lambda f: f.total_km, default=None
+    )
+    summary.update(
+        latest=latest.isoformat(),
+        days=len(days),
+        worst_km=None if worst is None else worst.total_km,
+        worst_for=None if worst is None else worst.for_index,
+    )
     title = f"{name}, {latest.isoformat()}"
-    plots.latest_km(sat_dir / "latest_km.png", col("in_track_km"), col("cross_track_km"), col("sigma_in_track_km"),
-                    col("sigma_cross_track_km"), reliable, opts.spec_km, title)
-    plots.latest_urad(sat_dir / "latest_urad.png", col("d_alpha_urad"), col("d_beta_urad"), col("sigma_alpha_urad"),
-                      col("sigma_beta_urad"), title)
+    plots.latest_km(
+        sat_dir / "latest_km.png",
+        col("in_track_km"),
+        col("cross_track_km"),
+        col("sigma_in_track_km"),
+        col("sigma_cross_track_km"),
+        reliable,
+        opts.spec_km,
+        title,
+    )
+    plots.latest_urad(
+        sat_dir / "latest_urad.png",
+        col("d_alpha_urad"),
+        col("d_beta_urad"),
+        col("sigma_alpha_urad"),
+        col("sigma_beta_urad"),
+        title,
+    )
     marks = [(c.time.replace(tzinfo=None), c.instrument, c.description) for c in changes]
     span = f"{name}, {days[0].isoformat()} .. {latest.isoformat()} ({len(days)} days)"
-    plots.heatmaps(sat_dir / "heatmap.png", days, arrays["in_track_km"], arrays["cross_track_km"], opts.spec_km,
-                   marks, span)
+    plots.heatmaps(
+        sat_dir / "heatmap.png",
+        days,
+        arrays["in_track_km"],
+        arrays["cross_track_km"],
+        opts.spec_km,
+        marks,
+        span,
+    )
     # an alert fires after the run of the day it concerns: mark it on the last day plotted at that time
     lo, hi = dt.datetime.combine(days[0], dt.time()), dt.datetime.combine(days[-1], dt.time())
-    alert_days = sorted({min(max(dt.datetime.combine(t.date(), dt.time()) - dt.timedelta(days=1), lo), hi)
-                         for t in alert_times if t.date() >= days[0]})
-    plots.trend_lines(sat_dir / "trend.png", days, opts.trend_fors, arrays["in_track_km"], arrays["cross_track_km"],
-                      opts.spec_km, marks, alert_days, span)
+    alert_days = sorted(
+        {
+            min(max(dt.datetime.combine(t.date(), dt.time()) - dt.timedelta(days=1), lo), hi)
+            for t in alert_times
+            if t.date() >= days[0]
+        }
+    )
+    plots.trend_lines(
+        sat_dir / "trend.png",
+        days,
+        opts.trend_fors,
+        arrays["in_track_km"],
+        arrays["cross_track_km"],
+        opts.spec_km,
+        marks,
+        alert_days,
+        span,
+    )
     stored = store.cost_cube(satellite, latest)
     cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
     figures = {"latest_km.png", "latest_urad.png", "heatmap.png", "trend.png"}
     if stored is not None and worst is not None:
         cube, step = stored
         runs = [r for r in store.runs(satellite) if r["day"] == latest.isoformat() and r["status"] == "ok"]
-        plots.cost_contour(sat_dir / "cost.png", np.asarray(cube[worst.for_index - 1], float), worst.for_index, step,
-                           worst.d_alpha_urad, worst.d_beta_urad, f"{title}: worst FOR {worst.for_index}, "
-                           f"{worst.total_km:.2f} km" + (f" (run {runs[-1]['id']})" if runs else ""))
+        plots.cost_contour(
+            sat_dir / "cost.png",
+            np.asarray(cube[worst.for_index - 1], float),
+            worst.for_index,
+            step,
+            worst.d_alpha_urad,
+            worst.d_beta_urad,
+            f"{title}: worst FOR {worst.for_index}, "
+            f"{worst.total_km:.2f} km" + (f" (run {runs[-1]['id']})" if runs else ""),
+        )
         figures.add("cost.png")
-        cost_html = (_img("cost.png", f"cost surface of FOR {worst.for_index}") +
-                     f"<p class=note>G_min {worst.cost_min_k:.3f} K against {worst.cost_zero_k:.3f} K as geolocated; "
-                     "a sharp, closed minimum is a trustworthy result, a flat or open one is flagged.</p>")
-    status = ("<span class=bad>out of specification</span>" if worst is not None and worst.total_km > opts.spec_km
-              else "<span class=ok>within specification</span>")
+        cost_html = (
+            _img("cost.png", f"cost surface of FOR {worst.for_index}")
+            + f"<p class=note>G_min {worst.cost_min_k:.3f} K against {worst.cost_zero_k:.3f} K as "
+            "geolocated; "
+            "a sharp, closed minimum is a trustworthy result, a flat or open one is flagged.</p>"
+        )
+    status = (
+        "<span class=bad>out of specification</span>"
+        if worst is not None and worst.total_km > opts.spec_km
+        else "<span class=ok>within specification</span>"
+    )
     flagged = [f.for_index for f in fors if any(x in RELIABILITY_FLAGS for x in f.flags)]
     parts += [
         f"<p>Latest day {latest.isoformat()}: {status}; worst reliable FOR "
-        f"{'-' if worst is None else worst.for_index} at {'-' if worst is None else format(worst.total_km, '.2f')} km "
-        f"(spec {opts.spec_km:g} km). {len(days)} day(s) shown. Flagged FORs: {', '.join(map(str, flagged)) or 'none'}.</p>",
+        f"{'-' if worst is None else worst.for_index} at "
+        f"{'-' if worst is None else format(worst.total_km, '.2f')} km "
+        f"(spec {opts.spec_km:g} km). {len(days)} day(s) shown. Flagged FORs: "
+        f"{', '.join(map(str, flagged)) or 'none'}.</p>",
         "<h2>Active alerts</h2>" + _alerts_table(firing),
-        "<h2>Latest per-FOR offsets</h2>" + _img("latest_km.png", "per-FOR km") + _img("latest_urad.png", "per-FOR urad"),
-        "<h2>Over time</h2>" + _img("heatmap.png", "FOR x day heat maps") + _img("trend.png", "chosen FORs over time"),
+        "<h2>Latest per-FOR offsets</h2>"
+        + _img("latest_km.png", "per-FOR km")
+        + _img("latest_urad.png", "per-FOR urad"),
+        "<h2>Over time</h2>"
+        + _img("heatmap.png", "FOR x day heat maps")
+        + _img("trend.png", "chosen FORs over time"),
         "<p class=note>Dotted vertical lines: known changes (purple CrIS, green VIIRS, brown common); "
         "red triangles: alerts.</p>",
         "<h2>Cost surface of the worst FOR</h2>" + cost_html,
@@ -229,14 +334,19 @@ def build_report(store, out_dir, opts: ReportOptions) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     summaries = [satellite_page(store, sat, out, opts) for sat in opts.satellites]
     rows = "".join(
-        f"<tr><td class=l><a href=\"{s['satellite']}/index.html\">{_e(s['name'])}</a></td>"
+        f'<tr><td class=l><a href="{s["satellite"]}/index.html">{_e(s["name"])}</a></td>'
         f"<td class=l>{s['latest'] or 'no data'}</td><td>{s['days']}</td>"
         f"<td>{'' if s['worst_km'] is None else format(s['worst_km'], '.2f')}</td>"
-        f"<td class={'bad' if s['firing'] else 'ok'}>{s['firing']}</td></tr>" for s in summaries)
-    body = ("<h1>crisgeo-monitor: CrIS geolocation against VIIRS</h1>"
-            "<table><tr><th class=l>satellite</th><th class=l>latest day</th><th>days</th>"
-            f"<th>worst FOR km</th><th>firing alerts</th></tr>{rows}</table>"
-            f"<p class=note>Specification {opts.spec_km:g} km. Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} UTC.</p>")
+        f"<td class={'bad' if s['firing'] else 'ok'}>{s['firing']}</td></tr>"
+        for s in summaries
+    )
+    body = (
+        "<h1>crisgeo-monitor: CrIS geolocation against VIIRS</h1>"
+        "<table><tr><th class=l>satellite</th><th class=l>latest day</th><th>days</th>"
+        f"<th>worst FOR km</th><th>firing alerts</th></tr>{rows}</table>"
+        f"<p class=note>Specification {opts.spec_km:g} km. Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} "
+        "UTC.</p>"
+    )
     _write(out / "index.html", _page("crisgeo-monitor report", body))
     _write(out / "report.json", json.dumps(summaries, indent=1, default=str))
     return out / "index.html"

@@ -36,15 +36,25 @@ def _save(fig, path: Path) -> Path:
 def latest_km(path, in_track_km, cross_track_km, sigma_in_km, sigma_cross_km, reliable, spec_km, title):
     """Per-FOR offsets on the ground with 1-sigma bars and the +-spec band (Wang et al. 2017 figure 8)."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.6), sharey=True, constrained_layout=True)
-    for ax, v, s, name in ((axes[0], in_track_km, sigma_in_km, "in-track"),
-                           (axes[1], cross_track_km, sigma_cross_km, "cross-track")):
+    for ax, v, s, name in (
+        (axes[0], in_track_km, sigma_in_km, "in-track"),
+        (axes[1], cross_track_km, sigma_cross_km, "cross-track"),
+    ):
         ax.axhspan(-spec_km, spec_km, color="tab:green", alpha=0.08, label=f"+-{spec_km:g} km specification")
         for y in (-spec_km, spec_km):
             ax.axhline(y, color="tab:green", lw=1, ls="--")
         ax.axhline(0, color="0.6", lw=0.8)
         ok = np.asarray(reliable, bool)
-        ax.errorbar(FORS[ok], np.asarray(v)[ok], yerr=np.asarray(s)[ok], fmt="o", ms=4, color="tab:blue",
-                    capsize=2, label="offset +- 1 sigma")
+        ax.errorbar(
+            FORS[ok],
+            np.asarray(v)[ok],
+            yerr=np.asarray(s)[ok],
+            fmt="o",
+            ms=4,
+            color="tab:blue",
+            capsize=2,
+            label="offset +- 1 sigma",
+        )
         if np.any(~ok):
             ax.plot(FORS[~ok], np.asarray(v)[~ok], "x", color="tab:red", label="flagged")
         ax.set_title(f"{name} error (km)")
@@ -61,16 +71,19 @@ def latest_km(path, in_track_km, cross_track_km, sigma_in_km, sigma_cross_km, re
 def latest_urad(path, d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_urad, title):
     """Per-FOR LOS offset angles in urad with a % of FOV axis (Wang et al. 2017 figure 7)."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.4), constrained_layout=True)
-    for ax, v, s, name in ((axes[0], d_alpha_urad, sigma_alpha_urad, "in-track d_alpha"),
-                           (axes[1], d_beta_urad, sigma_beta_urad, "cross-track d_beta")):
+    for ax, v, s, name in (
+        (axes[0], d_alpha_urad, sigma_alpha_urad, "in-track d_alpha"),
+        (axes[1], d_beta_urad, sigma_beta_urad, "cross-track d_beta"),
+    ):
         ax.axhline(0, color="0.6", lw=0.8)
         ax.errorbar(FORS, v, yerr=s, fmt="o", ms=4, color="tab:blue", capsize=2)
         ax.set_title(f"{name} (urad)")
         ax.set_xlabel("FOR (scan position)")
         ax.set_xlim(0, 31)
         ax.grid(alpha=0.3)
-        pct = ax.secondary_yaxis("right", functions=(lambda u: 100 * u / FOV_DIAMETER_URAD,
-                                                     lambda p: p * FOV_DIAMETER_URAD / 100))
+        pct = ax.secondary_yaxis(
+            "right", functions=(lambda u: 100 * u / FOV_DIAMETER_URAD, lambda p: p * FOV_DIAMETER_URAD / 100)
+        )
         pct.set_ylabel("% of FOV")
     fig.suptitle(title, fontsize=10)
     return _save(fig, Path(path))
@@ -78,7 +91,7 @@ def latest_urad(path, d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_ur
 
 def _mark_changes(ax, changes, label=True):
     seen = set()
-    for when, instrument, text in changes:
+    for when, instrument, _description in changes:
         colour = CHANGE_COLOURS.get(instrument, "0.3")
         lab = f"{instrument} change" if label and instrument not in seen else None
         seen.add(instrument)
@@ -88,13 +101,28 @@ def _mark_changes(ax, changes, label=True):
 def heatmaps(path, days, in_track_km, cross_track_km, spec_km, changes, title):
     """FOR x day heat maps of in-track and cross-track km; *days* (n,) dates, arrays (n, 30), NaN gaps."""
     days = [dt.datetime(d.year, d.month, d.day) for d in days]
-    x0, x1 = mdates.date2num(days[0] - dt.timedelta(hours=12)), mdates.date2num(days[-1] + dt.timedelta(hours=12))
-    vmax = max(spec_km, float(np.nanmax(np.abs(np.concatenate([in_track_km.ravel(), cross_track_km.ravel()]))))
-                if np.any(np.isfinite(in_track_km)) else spec_km)
+    x0, x1 = (
+        mdates.date2num(days[0] - dt.timedelta(hours=12)),
+        mdates.date2num(days[-1] + dt.timedelta(hours=12)),
+    )
+    vmax = max(
+        spec_km,
+        float(np.nanmax(np.abs(np.concatenate([in_track_km.ravel(), cross_track_km.ravel()]))))
+        if np.any(np.isfinite(in_track_km))
+        else spec_km,
+    )
     fig, axes = plt.subplots(2, 1, figsize=(11, 5.6), sharex=True, constrained_layout=True)
     for ax, v, name in ((axes[0], in_track_km, "in-track"), (axes[1], cross_track_km, "cross-track")):
-        im = ax.imshow(np.asarray(v, float).T, aspect="auto", origin="lower", cmap="RdBu_r", vmin=-vmax, vmax=vmax,
-                       extent=(x0, x1, 0.5, 30.5), interpolation="nearest")
+        im = ax.imshow(
+            np.asarray(v, float).T,
+            aspect="auto",
+            origin="lower",
+            cmap="RdBu_r",
+            vmin=-vmax,
+            vmax=vmax,
+            extent=(x0, x1, 0.5, 30.5),
+            interpolation="nearest",
+        )
         ax.set_ylabel("FOR")
         ax.set_title(f"{name} error (km)", fontsize=10)
         fig.colorbar(im, ax=ax, label="km", pad=0.01)
@@ -117,8 +145,14 @@ def trend_lines(path, days, fors, in_track_km, cross_track_km, spec_km, changes,
             ax.plot(days, v[:, k - 1], "-", marker="." if len(days) < 60 else None, lw=1.2, label=f"FOR {k}")
         _mark_changes(ax, changes, label=ax is axes[0])
         for when in alerts:
-            ax.plot([when], [spec_km * 1.1], "v", color="tab:red", ms=8,
-                    label="alert" if ax is axes[0] and when == alerts[0] else None)
+            ax.plot(
+                [when],
+                [spec_km * 1.1],
+                "v",
+                color="tab:red",
+                ms=8,
+                label="alert" if ax is axes[0] and when == alerts[0] else None,
+            )
         ax.set_ylabel("km")
         ax.set_title(f"{name} error (km)", fontsize=10)
         ax.grid(alpha=0.3)

@@ -2,13 +2,20 @@
 
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.readers import (
-                                 CrisGeoGranule,
-                                 CrisSdrGranule,
-                                 GranuleMeta,
-                                 ViirsGeoGranule,
-                                 ViirsSdrGranule,
-                                 read_file,
+    CrisGeoGranule,
+    CrisSdrGranule,
+    GranuleMeta,
+    ViirsGeoGranule,
+    ViirsSdrGranule,
+    read_file,
 )
 
-__all__ = ["GranuleError", "GranuleMeta", "CrisGeoGranule", "CrisSdrGranule", "ViirsGeoGranule",
-           "ViirsSdrGranule", "read_file"]
+__all__ = [
+    "GranuleError",
+    "GranuleMeta",
+    "CrisGeoGranule",
+    "CrisSdrGranule",
+    "ViirsGeoGranule",
+    "ViirsSdrGranule",
+    "read_file",
+]

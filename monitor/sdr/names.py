@@ -1,4 +1,5 @@
-"""JPSS file names: ``{PRODIDS}_{plat}_d{YYYYMMDD}_t{HHMMSSS}_e{HHMMSSS}_b{orbit}_c{created}_{origin}_{domain}.h5``.
+"""JPSS file names:
+``{PRODIDS}_{plat}_d{YYYYMMDD}_t{HHMMSSS}_e{HHMMSSS}_b{orbit}_c{created}_{origin}_{domain}.h5``.
 
 The t/e fields are HHMMSS plus tenths of a second; the end may roll past midnight. An SDR and its GEO
 file differ only in the creation time, so granules are paired on ``plat_d_t_e_b`` (docs/jpss-formats.md 1.1).
@@ -13,7 +14,8 @@ from dataclasses import dataclass
 _PATTERN = re.compile(
     r"^(?P<products>[A-Z0-9]+(?:-[A-Z0-9]+)*)_(?P<platform>[a-z0-9]{3})_d(?P<date>\d{8})_t(?P<start>\d{7})"
     r"_e(?P<end>\d{7})_b(?P<orbit>\d{5,})_c(?P<created>\d{20})_(?P<origin>[a-z0-9-]{4})_(?P<domain>[a-z_]+)\.h5$",
-    re.ASCII)  # ASCII digits only: a key with other digits must not pass for a granule
+    re.ASCII,
+)  # ASCII digits only: a key with other digits must not pass for a granule
 
 
 @dataclass(frozen=True)
@@ -32,13 +34,23 @@ class JpssName:
     @property
     def granule_key(self) -> str:
         """``plat_dYYYYMMDD_tHHMMSSS_eHHMMSSS_bNNNNN``: identical for an SDR and its GEO file."""
-        return (f"{self.platform}_d{self.start:%Y%m%d}_t{self.start:%H%M%S}{self.start.microsecond // 100000}"
-                f"_e{self.end:%H%M%S}{self.end.microsecond // 100000}_b{self.orbit:05d}")
+        return (
+            f"{self.platform}_d{self.start:%Y%m%d}_t{self.start:%H%M%S}{self.start.microsecond // 100000}"
+            f"_e{self.end:%H%M%S}{self.end.microsecond // 100000}_b{self.orbit:05d}"
+        )
 
 
 def _clock(date: dt.date, hhmmsst: str) -> dt.datetime:
-    return dt.datetime(date.year, date.month, date.day, int(hhmmsst[:2]), int(hhmmsst[2:4]),
-                       int(hhmmsst[4:6]), int(hhmmsst[6]) * 100000, tzinfo=dt.timezone.utc)
+    return dt.datetime(
+        date.year,
+        date.month,
+        date.day,
+        int(hhmmsst[:2]),
+        int(hhmmsst[2:4]),
+        int(hhmmsst[4:6]),
+        int(hhmmsst[6]) * 100000,
+        tzinfo=dt.timezone.utc,
+    )
 
 
 def parse_name(name: str) -> JpssName | None:
@@ -55,14 +67,34 @@ def parse_name(name: str) -> JpssName | None:
         return None
     if end < start:
         end += dt.timedelta(days=1)
-    return JpssName(tuple(m["products"].split("-")), m["platform"], start, end, int(m["orbit"]),
-                    m["created"], m["origin"], m["domain"])
+    return JpssName(
+        tuple(m["products"].split("-")),
+        m["platform"],
+        start,
+        end,
+        int(m["orbit"]),
+        m["created"],
+        m["origin"],
+        m["domain"],
+    )
 
 
-def format_name(products, platform: str, start: dt.datetime, end: dt.datetime, orbit: int,
-                created: dt.datetime, origin: str = "oebc", domain: str = "ops") -> str:
+def format_name(
+    products,
+    platform: str,
+    start: dt.datetime,
+    end: dt.datetime,
+    orbit: int,
+    created: dt.datetime,
+    origin: str = "oebc",
+    domain: str = "ops",
+) -> str:
     """A JPSS file name for the given fields (used by the simulator)."""
+
     def clock(t):
         return f"{t:%H%M%S}{t.microsecond // 100000}"
-    return (f"{'-'.join(products)}_{platform}_d{start:%Y%m%d}_t{clock(start)}_e{clock(end)}_b{orbit:05d}"
-            f"_c{created:%Y%m%d%H%M%S%f}_{origin}_{domain}.h5")
+
+    return (
+        f"{'-'.join(products)}_{platform}_d{start:%Y%m%d}_t{clock(start)}_e{clock(end)}_b{orbit:05d}"
+        f"_c{created:%Y%m%d%H%M%S%f}_{origin}_{domain}.h5"
+    )

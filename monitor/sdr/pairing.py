@@ -22,8 +22,12 @@ CONTIGUOUS = dt.timedelta(seconds=5)  # VIIRS granules this close in time form o
 
 def neighbours(viirs_all: list, granule) -> tuple:
     """The VIIRS granules just before and just after *granule* in a continuous swath (None if absent)."""
-    before = next((v for v in viirs_all if abs(v.end - granule.start) < CONTIGUOUS and v.key != granule.key), None)
-    after = next((v for v in viirs_all if abs(v.start - granule.end) < CONTIGUOUS and v.key != granule.key), None)
+    before = next(
+        (v for v in viirs_all if abs(v.end - granule.start) < CONTIGUOUS and v.key != granule.key), None
+    )
+    after = next(
+        (v for v in viirs_all if abs(v.start - granule.end) < CONTIGUOUS and v.key != granule.key), None
+    )
     return before, after
 
 
@@ -94,15 +98,21 @@ def plan(paths) -> CasePlan:
             continue
         platforms[name.platform] += 1
         for meta in metas:
-            key = f"{meta.platform}_{meta.granule_id}" if len(metas) > len(name.products) else name.granule_key
+            key = (
+                f"{meta.platform}_{meta.granule_id}" if len(metas) > len(name.products) else name.granule_key
+            )
             prev = by_prefix[meta.product].get(key)
             if prev is None or prev[0].name < path.name:  # the newest creation time wins
                 by_prefix[meta.product][key] = (path, meta)
     if len(platforms) > 1:
-        raise PlanError("mixed satellites: " + ", ".join(f"{p} ({n} files)" for p, n in sorted(platforms.items())))
+        raise PlanError(
+            "mixed satellites: " + ", ".join(f"{p} ({n} files)" for p, n in sorted(platforms.items()))
+        )
     if not platforms:
-        raise PlanError("no readable JPSS granule: " + "; ".join(s[1] if s[0] in s[1] else f"{s[0]}: {s[1]}"
-                                                                 for s in skipped[:3]))
+        raise PlanError(
+            "no readable JPSS granule: "
+            + "; ".join(s[1] if s[0] in s[1] else f"{s[0]}: {s[1]}" for s in skipped[:3])
+        )
     satellite = next(iter(platforms))
     cris = _pair(by_prefix, CRIS_SDR, CRIS_GEO, skipped)
     viirs = sorted(_pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped), key=lambda g: g.start)

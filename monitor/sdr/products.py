@@ -25,7 +25,16 @@ from monitor.constants import N_FOR, N_FOV
 
 DEG = np.pi / 180.0
 ARCSEC = np.pi / (180.0 * 3600.0)
-FLOAT_FILLS = (-999.9, -999.8, -999.7, -999.6, -999.5, -999.4, -999.3, -999.2)  # IDPS float fills (NA ... SOUB)
+FLOAT_FILLS = (
+    -999.9,
+    -999.8,
+    -999.7,
+    -999.6,
+    -999.5,
+    -999.4,
+    -999.3,
+    -999.2,
+)  # IDPS float fills (NA ... SOUB)
 UINT16_FILL_MIN = 65528  # IDPS uint16 fills are 65528 ... 65535
 
 
@@ -69,7 +78,8 @@ class Product:
         return f"All_Data/{self.collection}_All"
 
 
-# CrIS long-wave grid: 717 channels from 648.75 cm-1 every 0.625 cm-1 (2 guard channels each end), NSR and FSR.
+# CrIS long-wave grid: 717 channels from 648.75 cm-1 every 0.625 cm-1 (2 guard channels each end), NSR and
+# FSR.
 CRIS_LW_FIRST_CM1 = 648.75
 CRIS_LW_STEP_CM1 = 0.625
 CRIS_LW_CHANNELS = 717
@@ -91,14 +101,22 @@ CRIS_GEO_FIELDS = {
 }
 
 CRIS_SDR_FIELDS = {
-    "radiance_lw": Field("ES_RealLW", dims=FOV + (CRIS_LW_CHANNELS,), limits=(-200.0, 500.0)),  # mW/(m2 sr cm-1)
+    "radiance_lw": Field(
+        "ES_RealLW", dims=FOV + (CRIS_LW_CHANNELS,), limits=(-200.0, 500.0)
+    ),  # mW/(m2 sr cm-1)
     "qf3": Field("QF3_CRISSDR", kind="flags", dims=FOV + (3,)),
     "qf1_scan": Field("QF1_SCAN_CRISSDR", kind="flags", required=False),
 }
 
 VIIRS_SDR_FIELDS = {
-    "bt_k": Field("BrightnessTemperature", per="row", kind="scaled", factors="BrightnessTemperatureFactors",
-                  dims=(VIIRS_COLUMNS,), limits=(120.0, 380.0)),
+    "bt_k": Field(
+        "BrightnessTemperature",
+        per="row",
+        kind="scaled",
+        factors="BrightnessTemperatureFactors",
+        dims=(VIIRS_COLUMNS,),
+        limits=(120.0, 380.0),
+    ),
     "qf1": Field("QF1_VIIRSIBANDSDR", per="row", kind="flags", dims=(VIIRS_COLUMNS,)),
 }
 
@@ -118,15 +136,33 @@ VIIRS_TC_GEO_FIELDS = {**VIIRS_GEO_FIELDS, "height_m": Field("Height", per="row"
 
 # The product table. Within a kind the first listed is preferred (full spectral resolution; terrain-corrected
 # geolocation, the only one NOAA's archive carries). The collection is also the product's NODD folder.
-PRODUCTS = {p.prefix: p for p in (
-    Product("SCRIF", "CrIS-FS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
-    Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
-    Product("GCRSO", "CrIS-SDR-GEO", "cris_geo", fields=CRIS_GEO_FIELDS),
-    Product("SVI05", "VIIRS-I5-SDR", "viirs_sdr", rows_per_scan=32, scans_reserved=48, fields=VIIRS_SDR_FIELDS),
-    Product("GITCO", "VIIRS-IMG-GEO-TC", "viirs_geo", rows_per_scan=32, scans_reserved=48,
-            fields=VIIRS_TC_GEO_FIELDS),
-    Product("GIMGO", "VIIRS-IMG-GEO", "viirs_geo", rows_per_scan=32, scans_reserved=48, fields=VIIRS_GEO_FIELDS),
-)}
+PRODUCTS = {
+    p.prefix: p
+    for p in (
+        Product("SCRIF", "CrIS-FS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
+        Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
+        Product("GCRSO", "CrIS-SDR-GEO", "cris_geo", fields=CRIS_GEO_FIELDS),
+        Product(
+            "SVI05", "VIIRS-I5-SDR", "viirs_sdr", rows_per_scan=32, scans_reserved=48, fields=VIIRS_SDR_FIELDS
+        ),
+        Product(
+            "GITCO",
+            "VIIRS-IMG-GEO-TC",
+            "viirs_geo",
+            rows_per_scan=32,
+            scans_reserved=48,
+            fields=VIIRS_TC_GEO_FIELDS,
+        ),
+        Product(
+            "GIMGO",
+            "VIIRS-IMG-GEO",
+            "viirs_geo",
+            rows_per_scan=32,
+            scans_reserved=48,
+            fields=VIIRS_GEO_FIELDS,
+        ),
+    )
+}
 
 
 def prefixes(kind: str) -> tuple:
@@ -134,9 +170,10 @@ def prefixes(kind: str) -> tuple:
     return tuple(p.prefix for p in PRODUCTS.values() if p.kind == kind)
 
 
-CRIS_SDR, CRIS_GEO, VIIRS_SDR, VIIRS_GEO = (prefixes(k) for k in ("cris_sdr", "cris_geo", "viirs_sdr", "viirs_geo"))
+CRIS_SDR, CRIS_GEO, VIIRS_SDR, VIIRS_GEO = (
+    prefixes(k) for k in ("cris_sdr", "cris_geo", "viirs_sdr", "viirs_geo")
+)
 CRIS_PRODUCTS = CRIS_SDR + CRIS_GEO
-
 
 
 def cris_lw_wavenumbers_cm1(nchan: int = CRIS_LW_CHANNELS) -> np.ndarray:

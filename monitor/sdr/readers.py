@@ -83,8 +83,12 @@ class CrisGeoGranule:
         ok = np.ones(self.lat_rad.shape, bool)
         for a in (self.lat_rad, self.lon_rad, self.range_m, self.zenith_rad, self.azimuth_rad):
             ok &= np.isfinite(a)
-        scan_ok = np.all(np.isfinite(self.sc_position_m) & np.isfinite(self.sc_velocity_m_s)
-                         & np.isfinite(self.sc_attitude_rad), axis=1)
+        scan_ok = np.all(
+            np.isfinite(self.sc_position_m)
+            & np.isfinite(self.sc_velocity_m_s)
+            & np.isfinite(self.sc_attitude_rad),
+            axis=1,
+        )
         return ok & scan_ok[:, None, None] & (self.for_time_us > 0)[:, :, None]
 
 
@@ -143,8 +147,12 @@ class ViirsGeoGranule:
             self.height_m = np.zeros_like(self.lat_rad)
 
 
-_GRANULE_TYPES = {"cris_geo": CrisGeoGranule, "cris_sdr": CrisSdrGranule, "viirs_sdr": ViirsSdrGranule,
-                  "viirs_geo": ViirsGeoGranule}
+_GRANULE_TYPES = {
+    "cris_geo": CrisGeoGranule,
+    "cris_sdr": CrisSdrGranule,
+    "viirs_sdr": ViirsSdrGranule,
+    "viirs_geo": ViirsGeoGranule,
+}
 
 
 def _text(value) -> str:
@@ -156,8 +164,10 @@ def _text(value) -> str:
 def _texts(value) -> tuple[str, ...]:
     if value is None:
         return ()
-    return tuple(v.decode("ascii", "replace").strip() if isinstance(v, bytes) else str(v)
-                 for v in np.asarray(value).ravel())
+    return tuple(
+        v.decode("ascii", "replace").strip() if isinstance(v, bytes) else str(v)
+        for v in np.asarray(value).ravel()
+    )
 
 
 def _when(date: str, time: str) -> dt.datetime:
@@ -194,8 +204,11 @@ def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform:
         if not IET_LIMITS_US[0] <= value <= IET_LIMITS_US[1]:
             raise GranuleError(path, f"{name}/{key}", f"{value} is not an IET time of the JPSS era")
     if not 0 <= end_iet - start_iet <= 600_000_000:
-        raise GranuleError(path, f"{name}/N_Ending_Time_IET", f"{end_iet} is not within 10 min after the "
-                                                               f"beginning {start_iet}")
+        raise GranuleError(
+            path,
+            f"{name}/N_Ending_Time_IET",
+            f"{end_iet} is not within 10 min after the beginning {start_iet}",
+        )
     limit = product.scans_reserved or 64
     if not 1 <= n_scans <= limit:
         raise GranuleError(path, f"{name}/N_Number_Of_Scans", f"{n_scans} is not within 1..{limit}")
@@ -210,13 +223,23 @@ def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform:
     if granule_id and not granule_id.upper().startswith(platform.upper()):
         raise GranuleError(path, f"{name}/N_Granule_ID", f"{granule_id!r} is not a granule of {platform}")
     return GranuleMeta(
-        path=str(path), product=product.prefix, collection=product.collection, platform=platform,
-        granule_id=granule_id, orbit=0 if orbit is None else _number(path, f"{name}/N_Beginning_Orbit_Number", orbit),
-        start=start, end=end, start_iet_us=start_iet, end_iet_us=end_iet, n_scans=n_scans,
+        path=str(path),
+        product=product.prefix,
+        collection=product.collection,
+        platform=platform,
+        granule_id=granule_id,
+        orbit=0 if orbit is None else _number(path, f"{name}/N_Beginning_Orbit_Number", orbit),
+        start=start,
+        end=end,
+        start_iet_us=start_iet,
+        end_iet_us=end_iet,
+        n_scans=n_scans,
         ascending=None if asc is None else _number(path, f"{name}/Ascending/Descending_Indicator", asc) == 0,
         software_version=_text(a.get("N_Software_Version", b"")),
         algorithm_version=_text(a.get("N_Algorithm_Version", b"")),
-        aux_files=_texts(a.get("N_Aux_Filename")), anc_files=_texts(a.get("N_Anc_Filename")))
+        aux_files=_texts(a.get("N_Aux_Filename")),
+        anc_files=_texts(a.get("N_Anc_Filename")),
+    )
 
 
 def _check_raw(path, name: str, raw: np.ndarray, f, rows: int) -> None:
@@ -232,7 +255,13 @@ def _check_raw(path, name: str, raw: np.ndarray, f, rows: int) -> None:
 def _check_values(path, name: str, data: np.ndarray, f) -> None:
     """Physical limits of every value that is not a fill (file units, after scaling)."""
     if f.limits is not None:
-        v = data[data > 0] if f.kind == "time" else data[np.isfinite(data)] if data.dtype.kind == "f" else data
+        v = (
+            data[data > 0]
+            if f.kind == "time"
+            else data[np.isfinite(data)]
+            if data.dtype.kind == "f"
+            else data
+        )
         if v.size:
             lo, hi = v.min(), v.max()
             if lo < f.limits[0] or hi > f.limits[1]:
@@ -270,12 +299,14 @@ def _factors(path, h5, group: str, f, n_gran: int) -> np.ndarray:
     raw = np.asarray(h5[name][()])
     if raw.dtype.kind not in "fiu" or raw.size < 2 * n_gran:
         raise GranuleError(path, name, f"{raw.size} {raw.dtype} values for {n_gran} granule(s)")
-    fac = raw.astype(np.float64).ravel()[:2 * n_gran].reshape(-1, 2)
+    fac = raw.astype(np.float64).ravel()[: 2 * n_gran].reshape(-1, 2)
     for k, (scale, offset) in enumerate(fac):
         if is_float_fill(scale) or is_float_fill(offset):
             raise GranuleError(path, name, f"fill value in factors of granule {k}")
         if not (np.isfinite(scale) and np.isfinite(offset) and 0 < scale < 1e3 and abs(offset) < 1e6):
-            raise GranuleError(path, name, f"scale {scale:g}, offset {offset:g} of granule {k} are not usable")
+            raise GranuleError(
+                path, name, f"scale {scale:g}, offset {offset:g} of granule {k} are not usable"
+            )
     return fac
 
 
@@ -313,7 +344,7 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
         fac = _factors(path, h5, group, f, n_gran) if f.factors else None
         parts = []
         for k in range(n_gran):
-            part = data[bounds[k] * per:bounds[k + 1] * per]
+            part = data[bounds[k] * per : bounds[k + 1] * per]
             if fac is not None:
                 part = (part * fac[k, 0] + fac[k, 1]).astype(np.float32)
             _check_values(path, name, part, f)
@@ -346,8 +377,11 @@ def _check_times(path, product: Product, granule) -> None:
     lo, hi = granule.meta.start_iet_us - 10_000_000, granule.meta.end_iet_us + 10_000_000
     if t.size and (t.min() < lo or t.max() > hi):
         bad = t.min() if t.min() < lo else t.max()
-        raise GranuleError(path, name, f"time {bad} (IET us) outside the granule "
-                                       f"{granule.meta.start_iet_us}..{granule.meta.end_iet_us}")
+        raise GranuleError(
+            path,
+            name,
+            f"time {bad} (IET us) outside the granule {granule.meta.start_iet_us}..{granule.meta.end_iet_us}",
+        )
     if np.any(np.diff(t) <= 0):
         i = int(np.argmax(np.diff(t) <= 0))
         raise GranuleError(path, name, f"times do not increase: {t[i]} then {t[i + 1]}")
@@ -359,17 +393,28 @@ _MAIN_FIELD = {"cris_geo": "lat_rad", "cris_sdr": "radiance_lw", "viirs_sdr": "b
 def _check_not_all_fill(path, product: Product, granule) -> None:
     key = _MAIN_FIELD[product.kind]
     if not np.any(np.isfinite(getattr(granule, key))):
-        raise GranuleError(path, f"{product.data_group}/{product.fields[key].dataset}",
-                           f"granule {granule.meta.granule_id or '?'} holds only fill values")
+        raise GranuleError(
+            path,
+            f"{product.data_group}/{product.fields[key].dataset}",
+            f"granule {granule.meta.granule_id or '?'} holds only fill values",
+        )
     if product.kind in ("viirs_geo", "cris_geo"):
         lat_ok, lon_ok = np.isfinite(granule.lat_rad), np.isfinite(granule.lon_rad)
         if np.any(lat_ok != lon_ok):
             n = int(np.sum(lat_ok != lon_ok))
-            raise GranuleError(path, f"{product.data_group}/Longitude", f"fill at {n} pixel(s) where Latitude is set, "
-                                                                       f"or set where it is fill")
+            raise GranuleError(
+                path,
+                f"{product.data_group}/Longitude",
+                f"fill at {n} pixel(s) where Latitude is set, or set where it is fill",
+            )
     if product.kind == "viirs_geo" and "height_m" in product.fields:
-        _check_height(path, f"{product.data_group}/{product.fields['height_m'].dataset}",
-                      granule.lat_rad, granule.lon_rad, granule.height_m)
+        _check_height(
+            path,
+            f"{product.data_group}/{product.fields['height_m'].dataset}",
+            granule.lat_rad,
+            granule.lon_rad,
+            granule.height_m,
+        )
 
 
 def _check_height(path, name, lat_rad, lon_rad, height_m) -> None:
@@ -378,13 +423,19 @@ def _check_height(path, name, lat_rad, lon_rad, height_m) -> None:
     missing = located & ~np.isfinite(height_m)
     if missing.any():
         r, c = np.argwhere(missing)[0]
-        raise GranuleError(path, name, f"fill or non-finite at {int(missing.sum())} geolocated pixel(s), "
-                                       f"first at row {r}, column {c}")
+        raise GranuleError(
+            path,
+            name,
+            f"fill or non-finite at {int(missing.sum())} geolocated pixel(s), first at row {r}, column {c}",
+        )
     bad = located & ((height_m < -500.0) | (height_m > 9000.0))
     if bad.any():
         r, c = np.argwhere(bad)[0]
-        raise GranuleError(path, name, f"terrain height {float(height_m[r, c]):.6g} m at row {r}, column {c} "
-                                       f"is outside -500..9000 m")
+        raise GranuleError(
+            path,
+            name,
+            f"terrain height {float(height_m[r, c]):.6g} m at row {r}, column {c} is outside -500..9000 m",
+        )
 
 
 def _open(path: Path) -> h5py.File:
@@ -401,10 +452,19 @@ def _reading(path):
         yield
     except GranuleError:
         raise
-    except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, OverflowError,
-            UnicodeDecodeError) as exc:
-        raise GranuleError(path, "(file)", f"corrupt or unreadable HDF5 structure "
-                                           f"({type(exc).__name__}: {exc})"[:300]) from None
+    except (
+        OSError,
+        RuntimeError,
+        KeyError,
+        ValueError,
+        TypeError,
+        IndexError,
+        OverflowError,
+        UnicodeDecodeError,
+    ) as exc:
+        raise GranuleError(
+            path, "(file)", f"corrupt or unreadable HDF5 structure ({type(exc).__name__}: {exc})"[:300]
+        ) from None
 
 
 def _platform(path: Path, h5: h5py.File) -> str:
@@ -417,10 +477,15 @@ def _platform(path: Path, h5: h5py.File) -> str:
         return parsed.platform
     platform = _text(attr).lower()
     if parsed is not None and parsed.platform != platform:
-        raise GranuleError(path, "Platform_Short_Name", f"{_text(attr)!r} in a file named for {parsed.platform}")
+        raise GranuleError(
+            path, "Platform_Short_Name", f"{_text(attr)!r} in a file named for {parsed.platform}"
+        )
     if platform not in SATELLITES:
-        raise GranuleError(path, "Platform_Short_Name", f"{_text(attr)!r} is not one of "
-                                                        f"{', '.join(s.idps for s in SATELLITES.values())}")
+        raise GranuleError(
+            path,
+            "Platform_Short_Name",
+            f"{_text(attr)!r} is not one of {', '.join(s.idps for s in SATELLITES.values())}",
+        )
     return platform
 
 
@@ -431,8 +496,11 @@ def _check_name_time(path: Path, metas) -> None:
         return
     first = min(m.start for m in metas)
     if abs((first - parsed.start).total_seconds()) > 60:
-        raise GranuleError(path, "(file name)", f"start {parsed.start:%Y-%m-%d %H:%M:%S} but the first granule "
-                                                f"begins {first:%Y-%m-%d %H:%M:%S}")
+        raise GranuleError(
+            path,
+            "(file name)",
+            f"start {parsed.start:%Y-%m-%d %H:%M:%S} but the first granule begins {first:%Y-%m-%d %H:%M:%S}",
+        )
 
 
 def products_in(path: Path, h5: h5py.File) -> list[Product]:
@@ -474,7 +542,9 @@ def read_metadata(path) -> list[GranuleMeta]:
             aggr = f"Data_Products/{product.collection}/{product.collection}_Aggr"
             n = 1
             if aggr in h5 and "AggregateNumberGranules" in h5[aggr].attrs:
-                n = _number(path, f"{aggr}/AggregateNumberGranules", h5[aggr].attrs["AggregateNumberGranules"])
+                n = _number(
+                    path, f"{aggr}/AggregateNumberGranules", h5[aggr].attrs["AggregateNumberGranules"]
+                )
                 if not 1 <= n <= 1000:
                     raise GranuleError(path, f"{aggr}/AggregateNumberGranules", f"{n} is not within 1..1000")
             metas.extend(_granule_meta(path, h5, product, k, platform) for k in range(n))
@@ -503,7 +573,7 @@ def read_viirs_geo_scan(path, scan: int):
             if rows < product.rows_per_scan:
                 raise GranuleError(path, name, f"{rows} rows, less than one scan")
             start = (scan % (rows // product.rows_per_scan)) * product.rows_per_scan
-            raw = h5[name][start:start + product.rows_per_scan]
+            raw = h5[name][start : start + product.rows_per_scan]
             _check_raw(path, name, raw, f, product.rows_per_scan)
             data = _clean(path, name, raw, f)
             _check_values(path, name, data, f)

@@ -44,10 +44,14 @@ RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
 OBPT_U16, OBPT_F32 = 65533, -999.7
 
 DEFAULT_AUX = {
-    "cris": ["CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops",
-             "CrIS-SDR-CC_{p}_20180426000000Z_20180808000000Z_ee00000000000000Z_PS-1-O-CCR-3542-002-LE-PE_all-_all_all-_ops"],
-    "viirs": ["VIIRS-SDR-GEO-IMG-PARAM-LUT_{p}_20130601000000Z_20130601000000Z_ee00000000000000Z_PS-1-O-CCR-13-1171-JPSS-DPA-009-PE_noaa_all_all-_all",
-              "CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops"],
+    "cris": [
+        "CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops",
+        "CrIS-SDR-CC_{p}_20180426000000Z_20180808000000Z_ee00000000000000Z_PS-1-O-CCR-3542-002-LE-PE_all-_all_all-_ops",
+    ],
+    "viirs": [
+        "VIIRS-SDR-GEO-IMG-PARAM-LUT_{p}_20130601000000Z_20130601000000Z_ee00000000000000Z_PS-1-O-CCR-13-1171-JPSS-DPA-009-PE_noaa_all_all-_all",
+        "CMNGEO-PARAM-LUT_{p}_20160331000000Z_20170807130000Z_ee00000000000000Z_PS-1-O-CCR-16-2859-v002-LE-PE_all-_all_all-_ops",
+    ],
 }
 
 
@@ -85,7 +89,9 @@ class SimulationSpec:
         if self.true_ep is not None:
             for ep in (self.true_ep, self.ground_ep):
                 if ep.satellite != self.satellite:
-                    raise ValueError(f"EP {ep.version} is for {ep.satellite}, the simulation for {self.satellite}")
+                    raise ValueError(
+                        f"EP {ep.version} is for {ep.satellite}, the simulation for {self.satellite}"
+                    )
             self.d_alpha_urad, self.d_beta_urad = ep_offsets_urad(self.true_ep, self.ground_ep)
 
 
@@ -140,16 +146,21 @@ class Simulator:
         night = False
         if spec.orbit_pass is None:
             self.t0 = _unix_s(spec.start)
-            self.orbit = CircularOrbit.through(self.t0, lon0_deg=rng.uniform(-180, 180),
-                                               u0_deg=-14.0 + rng.uniform(-3, 3), altitude_m=sat.altitude_m,
-                                               inclination_deg=sat.inclination_deg)
+            self.orbit = CircularOrbit.through(
+                self.t0,
+                lon0_deg=rng.uniform(-180, 180),
+                u0_deg=-14.0 + rng.uniform(-3, 3),
+                altitude_m=sat.altitude_m,
+                inclination_deg=sat.inclination_deg,
+            )
         else:
             lat, ascending = PASSES[spec.orbit_pass]
             self.t0 = round(find_pass(sat, _unix_s(spec.start), lat, ascending, spec.pass_lon_deg), 1)
             self.orbit = CircularOrbit.of(sat, self.t0)
             night = not ascending  # the descending node of a 13:30 orbit is at 01:30 local time
-        self.scene = Scene(spec.seed, land_fraction=0.4 if spec.terrain else 0.3, terrain=spec.terrain,
-                           night=night)
+        self.scene = Scene(
+            spec.seed, land_fraction=0.4 if spec.terrain else 0.3, terrain=spec.terrain, night=night
+        )
         self.band = i5_band(spec.satellite)
         self.nu = cris_lw_wavenumbers_cm1()
         tau = transmittance(self.nu)
@@ -202,55 +213,87 @@ class Simulator:
         att_mid = self.attitude_rad(iet.iet_to_unix_us(mid_iet) * 1e-6) / frames.ARCSEC_RAD
         begin, end = for_unix[0, 0], for_unix[-1, -1]
         gid = _granule_id(spec.satellite, int(start_iet[0]) - 4_400_000)
-        attrs = self._granule_attrs(begin, end, int(for_iet[0, 0]), int(for_iet[-1, -1]), gid, 4,
-                                    v[0, 0], lat, lon, spec.aux["cris"], "CrIS-SDR-GEO")
+        attrs = self._granule_attrs(
+            begin,
+            end,
+            int(for_iet[0, 0]),
+            int(for_iet[-1, -1]),
+            gid,
+            4,
+            v[0, 0],
+            lat,
+            lon,
+            spec.aux["cris"],
+            "CrIS-SDR-GEO",
+        )
         geo = {
-            "FORTime": for_iet, "StartTime": start_iet, "MidTime": mid_iet,
-            "Latitude": np.degrees(lat).astype(np.float32), "Longitude": np.degrees(lon).astype(np.float32),
+            "FORTime": for_iet,
+            "StartTime": start_iet,
+            "MidTime": mid_iet,
+            "Latitude": np.degrees(lat).astype(np.float32),
+            "Longitude": np.degrees(lon).astype(np.float32),
             "Height": height.astype(np.float32),
             "SatelliteRange": rng_m.astype(np.float32),
             "SatelliteZenithAngle": np.degrees(zen).astype(np.float32),
             "SatelliteAzimuthAngle": np.degrees(az).astype(np.float32),
             "SolarZenithAngle": np.full(lat.shape, -999.3, np.float32),
             "SolarAzimuthAngle": np.full(lat.shape, -999.3, np.float32),
-            "SCPosition": r_mid.astype(np.float32), "SCVelocity": v_mid.astype(np.float32),
+            "SCPosition": r_mid.astype(np.float32),
+            "SCVelocity": v_mid.astype(np.float32),
             "SCAttitude": att_mid.astype(np.float32),
-            "QF1_CRISSDRGEO": np.zeros(4, np.uint8), "PadByte1": np.zeros(4, np.uint8),
+            "QF1_CRISSDRGEO": np.zeros(4, np.uint8),
+            "PadByte1": np.zeros(4, np.uint8),
         }
         products = [("GCRSO", geo, "GEO")]
         if spec.cris_sdr:
             t_mean = self.band.bt_from_radiance(self.band.band_radiance(radiance))
             mw = planck_radiance(1208.75 + 0.625 * np.arange(869), t_mean[..., None]).astype(np.float32)
             sw = planck_radiance(2153.75 + 0.625 * np.arange(637), t_mean[..., None]).astype(np.float32)
-            products.append(("SCRIF", {"ES_RealLW": radiance.astype(np.float32), "ES_RealMW": mw, "ES_RealSW": sw,
-                                       "QF1_SCAN_CRISSDR": np.zeros(4, np.uint8),
-                                       "QF3_CRISSDR": np.zeros((4, 30, 9, 3), np.uint8)}, "SDR"))
+            products.append(
+                (
+                    "SCRIF",
+                    {
+                        "ES_RealLW": radiance.astype(np.float32),
+                        "ES_RealMW": mw,
+                        "ES_RealSW": sw,
+                        "QF1_SCAN_CRISSDR": np.zeros(4, np.uint8),
+                        "QF3_CRISSDR": np.zeros((4, 30, 9, 3), np.uint8),
+                    },
+                    "SDR",
+                )
+            )
         names = []
         for prefix, data, tag in products:
             product = PRODUCTS[prefix]
             created = _utc(end + 1800 + (7 if prefix == "GCRSO" else 0))
             a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1")
-            name = format_name([prefix], spec.satellite, _utc(begin), _utc(end),
-                               attrs["N_Beginning_Orbit_Number"], created)
-            write_file(out / name, spec.satellite, created,
-                       [ProductData(product, "CrIS", tag, data, [a], {})])
+            name = format_name(
+                [prefix], spec.satellite, _utc(begin), _utc(end), attrs["N_Beginning_Orbit_Number"], created
+            )
+            write_file(
+                out / name, spec.satellite, created, [ProductData(product, "CrIS", tag, data, [a], {})]
+            )
             names.append(name)
         return names
 
     def _surface(self, origin, los):
-        """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is one."""
+        """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is
+        one."""
         if not self.spec.terrain:
             pts = origin + wgs84.intersect_ellipsoid(origin, los)[..., None] * los
             return wgs84.ecef_to_geodetic(pts)
         return intersect_terrain(origin, los, self.scene.height_m, MAX_HEIGHT_M)[1:]
 
     def _cris_spectra(self, sat, los_ecef):
-        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV cone on the scene, not the VIIRS grid."""
+        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV cone on the scene, not the VIIRS
+        grid."""
         x, y = _sunflower_disk(CONE_SAMPLES, np.tan(ins.CRIS_FOV_HALF_ANGLE_RAD))
         helper = np.where(np.abs(los_ecef[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
         e1 = frames.unit(np.cross(los_ecef, helper))
         e2 = np.cross(los_ecef, e1)
-        dirs = frames.unit(los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :])
+        dirs = frames.unit(
+            los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :]
+        )
         origin = np.broadcast_to(sat[..., None, :], dirs.shape)
         temp = self.scene.temperature_k(*self._surface(origin, dirs)).reshape(-1, CONE_SAMPLES)
         nfov = temp.shape[0]
@@ -293,10 +336,14 @@ class Simulator:
             lat_out[rows] = np.degrees(lat).reshape(-1, ins.VIIRS_COLUMNS)
             lon_out[rows] = np.degrees(lon).reshape(-1, ins.VIIRS_COLUMNS)
             h_out[rows] = h.reshape(-1, ins.VIIRS_COLUMNS)
-            bt_dn[rows] = np.clip(np.round((bt - BT_OFFSET) / BT_SCALE), 0, 65527).reshape(-1, ins.VIIRS_COLUMNS)
+            bt_dn[rows] = np.clip(np.round((bt - BT_OFFSET) / BT_SCALE), 0, 65527).reshape(
+                -1, ins.VIIRS_COLUMNS
+            )
             # W/(m2 sr um) from mW/(m2 sr cm-1): L_lambda = L_nu * nu^2 / 1e4 / 1e3
             lam = self.band.radiance_from_bt(bt) * cwv**2 * 1e-7
-            rad_dn[rows] = np.clip(np.round((lam - RAD_OFFSET) / RAD_SCALE), 0, 65527).reshape(-1, ins.VIIRS_COLUMNS)
+            rad_dn[rows] = np.clip(np.round((lam - RAD_OFFSET) / RAD_SCALE), 0, 65527).reshape(
+                -1, ins.VIIRS_COLUMNS
+            )
         mask = np.tile(deleted, (ins.VIIRS_SCANS, 1))
         bt_dn[mask] = OBPT_U16
         rad_dn[mask] = OBPT_U16
@@ -312,29 +359,62 @@ class Simulator:
         end = g0 + VIIRS_GRANULE_S
         gid = _granule_id(spec.satellite, int(start_iet[0]))
         valid = ~mask
-        attrs = self._granule_attrs(g0, end, int(start_iet[0]), int(_iet_us(end)), gid, ins.VIIRS_SCANS,
-                                    v_mid[0], np.radians(lat_out[valid][::97]), np.radians(lon_out[valid][::97]),
-                                    spec.aux["viirs"], "VIIRS-IMG-GEO-TC")
-        per_scan = {"StartTime": start_iet, "MidTime": mid_iet, "SCPosition": r_mid.astype(np.float32),
-                    "SCVelocity": v_mid.astype(np.float32), "SCAttitude": att_mid.astype(np.float32),
-                    "QF1_SCAN_VIIRSSDRGEO": np.zeros(ins.VIIRS_SCANS, np.uint8),
-                    "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32)}
-        geo = {"Latitude": lat_out, "Longitude": lon_out, "Height": h_out,
-               "QF2_VIIRSSDRGEO": np.zeros(lat_out.shape, np.uint8), **per_scan}
-        sdr = {"BrightnessTemperature": bt_dn, "BrightnessTemperatureFactors": np.array([BT_SCALE, BT_OFFSET], np.float32),
-               "Radiance": rad_dn, "RadianceFactors": np.array([RAD_SCALE, RAD_OFFSET], np.float32),
-               "QF1_VIIRSIBANDSDR": np.zeros(bt_dn.shape, np.uint8),
-               "QF2_SCAN_SDR": np.zeros(ins.VIIRS_SCANS, np.uint8),
-               "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32)}
+        attrs = self._granule_attrs(
+            g0,
+            end,
+            int(start_iet[0]),
+            int(_iet_us(end)),
+            gid,
+            ins.VIIRS_SCANS,
+            v_mid[0],
+            np.radians(lat_out[valid][::97]),
+            np.radians(lon_out[valid][::97]),
+            spec.aux["viirs"],
+            "VIIRS-IMG-GEO-TC",
+        )
+        per_scan = {
+            "StartTime": start_iet,
+            "MidTime": mid_iet,
+            "SCPosition": r_mid.astype(np.float32),
+            "SCVelocity": v_mid.astype(np.float32),
+            "SCAttitude": att_mid.astype(np.float32),
+            "QF1_SCAN_VIIRSSDRGEO": np.zeros(ins.VIIRS_SCANS, np.uint8),
+            "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32),
+        }
+        geo = {
+            "Latitude": lat_out,
+            "Longitude": lon_out,
+            "Height": h_out,
+            "QF2_VIIRSSDRGEO": np.zeros(lat_out.shape, np.uint8),
+            **per_scan,
+        }
+        sdr = {
+            "BrightnessTemperature": bt_dn,
+            "BrightnessTemperatureFactors": np.array([BT_SCALE, BT_OFFSET], np.float32),
+            "Radiance": rad_dn,
+            "RadianceFactors": np.array([RAD_SCALE, RAD_OFFSET], np.float32),
+            "QF1_VIIRSIBANDSDR": np.zeros(bt_dn.shape, np.uint8),
+            "QF2_SCAN_SDR": np.zeros(ins.VIIRS_SCANS, np.uint8),
+            "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32),
+        }
         names = []
         for prefix, data, tag in (("GITCO", geo, "GEO"), ("SVI05", sdr, "SDR")):
             product = PRODUCTS[prefix]
             created = _utc(end + 1700 + (3 if prefix == "GITCO" else 0))
-            a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1", Band_ID="I5" if tag == "SDR" else "N/A")
-            name = format_name([prefix], spec.satellite, _utc(g0), _utc(end),
-                               attrs["N_Beginning_Orbit_Number"], created)
-            write_file(out / name, spec.satellite, created,
-                       [ProductData(product, "VIIRS", tag, data, [a], {}, fills={}, compress=False)])
+            a = dict(
+                attrs,
+                N_Reference_ID=f"{product.collection}:{gid}:A1",
+                Band_ID="I5" if tag == "SDR" else "N/A",
+            )
+            name = format_name(
+                [prefix], spec.satellite, _utc(g0), _utc(end), attrs["N_Beginning_Orbit_Number"], created
+            )
+            write_file(
+                out / name,
+                spec.satellite,
+                created,
+                [ProductData(product, "VIIRS", tag, data, [a], {}, fills={}, compress=False)],
+            )
             names.append(name)
         return names
 
@@ -343,15 +423,26 @@ class Simulator:
         lat_d, lon_d = np.degrees(lat), np.degrees(lon)
         return {
             "Ascending/Descending_Indicator": 0 if v0[2] > 0 else 1,
-            **date_time_attrs("Beginning", _utc(begin)), **date_time_attrs("Ending", _utc(end)),
-            "East_Bounding_Coordinate": float(np.nanmax(lon_d)), "West_Bounding_Coordinate": float(np.nanmin(lon_d)),
-            "North_Bounding_Coordinate": float(np.nanmax(lat_d)), "South_Bounding_Coordinate": float(np.nanmin(lat_d)),
-            "N_Algorithm_Version": "2.O.000.001", "N_Aux_Filename": [a.format(p=p) for a in aux],
+            **date_time_attrs("Beginning", _utc(begin)),
+            **date_time_attrs("Ending", _utc(end)),
+            "East_Bounding_Coordinate": float(np.nanmax(lon_d)),
+            "West_Bounding_Coordinate": float(np.nanmin(lon_d)),
+            "North_Bounding_Coordinate": float(np.nanmax(lat_d)),
+            "South_Bounding_Coordinate": float(np.nanmin(lat_d)),
+            "N_Algorithm_Version": "2.O.000.001",
+            "N_Aux_Filename": [a.format(p=p) for a in aux],
             "N_Anc_Filename": ["Terrain-Eco-ANC-Tile_20030125000000Z_ee00000000000000Z_NA_NA_S0388_1.O.0.0"],
-            "N_Beginning_Orbit_Number": _orbit_number(begin), "N_Beginning_Time_IET": begin_iet,
-            "N_Ending_Time_IET": end_iet, "N_Granule_ID": gid, "N_Granule_Status": "N/A", "N_Granule_Version": "A1",
-            "N_IDPS_Mode": "ops", "N_Number_Of_Scans": nscan, "N_Software_Version": self.spec.software_version,
-            "N_Spacecraft_Maneuver": "Normal Operations", "N_Primary_Label": "Primary",
+            "N_Beginning_Orbit_Number": _orbit_number(begin),
+            "N_Beginning_Time_IET": begin_iet,
+            "N_Ending_Time_IET": end_iet,
+            "N_Granule_ID": gid,
+            "N_Granule_Status": "N/A",
+            "N_Granule_Version": "A1",
+            "N_IDPS_Mode": "ops",
+            "N_Number_Of_Scans": nscan,
+            "N_Software_Version": self.spec.software_version,
+            "N_Spacecraft_Maneuver": "Normal Operations",
+            "N_Primary_Label": "Primary",
             **date_time_attrs("N_Creation", _utc(end + 1700)),
         }
 
@@ -365,18 +456,36 @@ class Simulator:
         return ref + np.arange(k0, k1 + 1) * VIIRS_GRANULE_S
 
 
-def simulate_case(out_dir, satellite="j01", granules=14, profile="paper", seed=0, start=None,
-                  spec: SimulationSpec | None = None, viirs: bool = True, terrain: bool = False,
-                  orbit_pass: str | None = None, pass_lon_deg: float | None = None) -> dict:
+def simulate_case(
+    out_dir,
+    satellite="j01",
+    granules=14,
+    profile="paper",
+    seed=0,
+    start=None,
+    spec: SimulationSpec | None = None,
+    viirs: bool = True,
+    terrain: bool = False,
+    orbit_pass: str | None = None,
+    pass_lon_deg: float | None = None,
+) -> dict:
     """Write a case's granules into *out_dir* and ``truth.json``; return the truth document."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if spec is None:
         d_alpha, d_beta = load_profile(profile, seed)
-        spec = SimulationSpec(satellite=satellite, granules=granules, d_alpha_urad=np.asarray(d_alpha, float),
-                              d_beta_urad=np.asarray(d_beta, float), seed=seed,
-                              start=start or DEFAULT_START, profile=profile, terrain=terrain,
-                              orbit_pass=orbit_pass, pass_lon_deg=pass_lon_deg)
+        spec = SimulationSpec(
+            satellite=satellite,
+            granules=granules,
+            d_alpha_urad=np.asarray(d_alpha, float),
+            d_beta_urad=np.asarray(d_beta, float),
+            seed=seed,
+            start=start or DEFAULT_START,
+            profile=profile,
+            terrain=terrain,
+            orbit_pass=orbit_pass,
+            pass_lon_deg=pass_lon_deg,
+        )
     sim = Simulator(spec)
     files = []
     for k in range(spec.granules):
@@ -385,14 +494,23 @@ def simulate_case(out_dir, satellite="j01", granules=14, profile="paper", seed=0
         for g0 in sim.viirs_granule_starts():
             files += sim.viirs_granule(float(g0), out)
     truth = {
-        "satellite": spec.satellite, "profile": spec.profile, "seed": spec.seed,
-        "start": spec.start.isoformat(), "granules": spec.granules, "files": sorted(files),
-        "first_granule_start": _utc(sim.t0).isoformat(), "orbit_pass": spec.orbit_pass,
-        "pass_lon_deg": spec.pass_lon_deg, "terrain": spec.terrain,
-        "engineering_packets": None if spec.true_ep is None else
-        {"true": spec.true_ep.version, "ground": spec.ground_ep.version},
-        "fors": [{"for": k + 1, "d_alpha_urad": float(a), "d_beta_urad": float(b)}
-                 for k, (a, b) in enumerate(zip(spec.d_alpha_urad, spec.d_beta_urad))],
+        "satellite": spec.satellite,
+        "profile": spec.profile,
+        "seed": spec.seed,
+        "start": spec.start.isoformat(),
+        "granules": spec.granules,
+        "files": sorted(files),
+        "first_granule_start": _utc(sim.t0).isoformat(),
+        "orbit_pass": spec.orbit_pass,
+        "pass_lon_deg": spec.pass_lon_deg,
+        "terrain": spec.terrain,
+        "engineering_packets": None
+        if spec.true_ep is None
+        else {"true": spec.true_ep.version, "ground": spec.ground_ep.version},
+        "fors": [
+            {"for": k + 1, "d_alpha_urad": float(a), "d_beta_urad": float(b)}
+            for k, (a, b) in enumerate(zip(spec.d_alpha_urad, spec.d_beta_urad, strict=True))
+        ],
     }
     (out / "truth.json").write_text(json.dumps(truth, indent=1))
     return truth

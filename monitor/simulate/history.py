@@ -17,8 +17,11 @@ from monitor.simulate.profiles import paper_profile
 KM_PER_URAD = 0.00083  # at nadir; enough for a picture
 
 
-def day_result(satellite: str, day: dt.date, rng, step_urad: float = 0.0, with_cube: bool = True) -> AssessmentResult:
-    """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR 21-30."""
+def day_result(
+    satellite: str, day: dt.date, rng, step_urad: float = 0.0, with_cube: bool = True
+) -> AssessmentResult:
+    """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR
+    21-30."""
     d_alpha, d_beta = paper_profile()
     d_alpha = 0.3 * d_alpha + rng.normal(0, 15, N_FOR)
     d_beta = 0.3 * d_beta + rng.normal(0, 15, N_FOR) + np.where(np.arange(N_FOR) >= 20, step_urad, 0.0)
@@ -27,19 +30,44 @@ def day_result(satellite: str, day: dt.date, rng, step_urad: float = 0.0, with_c
     fors = []
     for k in range(N_FOR):
         it, ct = d_alpha[k] * KM_PER_URAD, d_beta[k] * KM_PER_URAD * stretch[k]
-        fors.append(ForOffset(k + 1, float(d_alpha[k]), float(d_beta[k]), 12.0, 14.0, float(it), float(ct),
-                              float(np.hypot(it, ct)), 0.01, 0.012 * stretch[k], 500, 0.8, 1.2,
-                              (FLAG_FLAT,) if rng.random() < 0.01 else ()))
+        fors.append(
+            ForOffset(
+                k + 1,
+                float(d_alpha[k]),
+                float(d_beta[k]),
+                12.0,
+                14.0,
+                float(it),
+                float(ct),
+                float(np.hypot(it, ct)),
+                0.01,
+                0.012 * stretch[k],
+                500,
+                0.8,
+                1.2,
+                (FLAG_FLAT,) if rng.random() < 0.01 else (),
+            )
+        )
     cube = None
     if with_cube:
         off = (np.arange(21) - 10) * 450.0
-        cube = 0.8 + 1e-7 * ((off[:, None] - d_alpha[:, None, None]) ** 2 + (off[None, :] - d_beta[:, None, None]) ** 2)
+        cube = 0.8 + 1e-7 * (
+            (off[:, None] - d_alpha[:, None, None]) ** 2 + (off[None, :] - d_beta[:, None, None]) ** 2
+        )
     start = dt.datetime(day.year, day.month, day.day, 12, tzinfo=dt.timezone.utc).isoformat()
     return AssessmentResult(satellite, start, start, fors, cost_cube_k=cube)
 
 
-def fill_store(store, satellites, first: dt.date, days: int, step_day: int | None = None, step_urad: float = 800.0,
-               seed: int = 0, cubes: str = "last") -> list[dt.date]:
+def fill_store(
+    store,
+    satellites,
+    first: dt.date,
+    days: int,
+    step_day: int | None = None,
+    step_urad: float = 800.0,
+    seed: int = 0,
+    cubes: str = "last",
+) -> list[dt.date]:
     """Write *days* daily results per satellite from *first*; cost cubes on every day or only the last."""
     rng = np.random.default_rng(seed)
     out = [first + dt.timedelta(days=i) for i in range(days)]

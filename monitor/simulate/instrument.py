@@ -54,8 +54,14 @@ def cris_los_sbf(d_alpha_rad=None, d_beta_rad=None) -> np.ndarray:
     los = np.einsum("kij,kfj->kfi", rot_x(-theta), local)
     if d_alpha_rad is None and d_beta_rad is None:
         return los
-    alpha = np.arctan2(los[..., 0], los[..., 2]) + np.asarray(d_alpha_rad if d_alpha_rad is not None else 0.0)[..., None]
-    beta = np.arctan2(los[..., 1], los[..., 2]) + np.asarray(d_beta_rad if d_beta_rad is not None else 0.0)[..., None]
+    alpha = (
+        np.arctan2(los[..., 0], los[..., 2])
+        + np.asarray(d_alpha_rad if d_alpha_rad is not None else 0.0)[..., None]
+    )
+    beta = (
+        np.arctan2(los[..., 1], los[..., 2])
+        + np.asarray(d_beta_rad if d_beta_rad is not None else 0.0)[..., None]
+    )
     return unit(np.stack([np.tan(alpha), np.tan(beta), np.ones_like(alpha)], axis=-1))
 
 

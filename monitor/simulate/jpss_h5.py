@@ -72,21 +72,27 @@ def write_file(path, platform: str, created: dt.datetime, products: list[Product
             _write_product(f, pd)
     first = [pd.granule_attrs[0] for pd in products]
     last = [pd.granule_attrs[-1] for pd in products]
-    xml = ["<HDF_UserBlock>", f"<Mission_Name>{MISSION[platform]}</Mission_Name>",
-           f"<Platform_Short_Name>{PLATFORM_ATTR[platform]}</Platform_Short_Name>",
-           f"<Number_of_Data_Products>{len(products)}</Number_of_Data_Products>"]
-    for pd, a, z in zip(products, first, last):
-        xml += ["<Data_Product>", f"<Instrument_Short_Name>{pd.instrument}</Instrument_Short_Name>",
-                f"<N_Collection_Short_Name>{pd.product.collection}</N_Collection_Short_Name>",
-                "<N_Processing_Domain>ops</N_Processing_Domain>",
-                f"<N_Dataset_Type_Tag>{pd.type_tag}</N_Dataset_Type_Tag>",
-                f"<AggregateBeginningDate>{a['Beginning_Date']}</AggregateBeginningDate>",
-                f"<AggregateBeginningTime>{a['Beginning_Time']}</AggregateBeginningTime>",
-                f"<AggregateEndingDate>{z['Ending_Date']}</AggregateEndingDate>",
-                f"<AggregateEndingTime>{z['Ending_Time']}</AggregateEndingTime>",
-                f"<AggregateBeginningGranuleID>{a['N_Granule_ID']}</AggregateBeginningGranuleID>",
-                f"<AggregateEndingGranuleID>{z['N_Granule_ID']}</AggregateEndingGranuleID>",
-                "</Data_Product>"]
+    xml = [
+        "<HDF_UserBlock>",
+        f"<Mission_Name>{MISSION[platform]}</Mission_Name>",
+        f"<Platform_Short_Name>{PLATFORM_ATTR[platform]}</Platform_Short_Name>",
+        f"<Number_of_Data_Products>{len(products)}</Number_of_Data_Products>",
+    ]
+    for pd, a, z in zip(products, first, last, strict=True):
+        xml += [
+            "<Data_Product>",
+            f"<Instrument_Short_Name>{pd.instrument}</Instrument_Short_Name>",
+            f"<N_Collection_Short_Name>{pd.product.collection}</N_Collection_Short_Name>",
+            "<N_Processing_Domain>ops</N_Processing_Domain>",
+            f"<N_Dataset_Type_Tag>{pd.type_tag}</N_Dataset_Type_Tag>",
+            f"<AggregateBeginningDate>{a['Beginning_Date']}</AggregateBeginningDate>",
+            f"<AggregateBeginningTime>{a['Beginning_Time']}</AggregateBeginningTime>",
+            f"<AggregateEndingDate>{z['Ending_Date']}</AggregateEndingDate>",
+            f"<AggregateEndingTime>{z['Ending_Time']}</AggregateEndingTime>",
+            f"<AggregateBeginningGranuleID>{a['N_Granule_ID']}</AggregateBeginningGranuleID>",
+            f"<AggregateEndingGranuleID>{z['N_Granule_ID']}</AggregateEndingGranuleID>",
+            "</Data_Product>",
+        ]
     xml.append("</HDF_UserBlock>")
     block = "".join(xml).encode("ascii")[:USERBLOCK]
     with open(path, "r+b") as fh:
@@ -125,7 +131,7 @@ def _write_product(f: h5py.File, pd: ProductData) -> None:
         regions = []
         for d in refs:
             n = pd.granule_rows.get(d.name.rsplit("/", 1)[-1])
-            regions.append(d.regionref[k * n:(k + 1) * n] if n else d.regionref[...])
+            regions.append(d.regionref[k * n : (k + 1) * n] if n else d.regionref[...])
         gran = dp.create_dataset(f"{coll}_Gran_{k}", data=np.array(regions, dtype=h5py.regionref_dtype))
         for key, value in attrs.items():
             if key == "N_Beginning_Orbit_Number" or key.endswith("_IET"):

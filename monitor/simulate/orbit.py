@@ -83,8 +83,15 @@ class CircularOrbit:
         c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
 
         def rot(w):
-            return np.stack([c[..., 0] * w[..., 0] + s[..., 0] * w[..., 1],
-                             -s[..., 0] * w[..., 0] + c[..., 0] * w[..., 1], w[..., 2]], axis=-1)
+            return np.stack(
+                [
+                    c[..., 0] * w[..., 0] + s[..., 0] * w[..., 1],
+                    -s[..., 0] * w[..., 0] + c[..., 0] * w[..., 1],
+                    w[..., 2],
+                ],
+                axis=-1,
+            )
+
         r_e = rot(r)
         v_e = rot(v) - np.cross([0.0, 0.0, OMEGA_EARTH_RAD_S], r_e)
         return r_e, v_e
@@ -96,11 +103,21 @@ def _node_right_ascension(sat: Satellite, unix_s):
 
 def _argument_of_latitude(sat: Satellite, unix_s):
     """Mean argument of latitude (rad): the satellite's phase advancing with the shared orbit's period."""
-    return np.radians(sat.phase_deg) + 2 * np.pi * (np.asarray(unix_s, float) - PHASE_EPOCH_UNIX_S) / NODAL_PERIOD_S
+    return (
+        np.radians(sat.phase_deg)
+        + 2 * np.pi * (np.asarray(unix_s, float) - PHASE_EPOCH_UNIX_S) / NODAL_PERIOD_S
+    )
 
 
-def find_pass(sat: Satellite, after_unix_s: float, lat_deg: float, ascending: bool = True,
-              lon_deg: float | None = None, days: int = 16, step_s: float = 5.0) -> float:
+def find_pass(
+    sat: Satellite,
+    after_unix_s: float,
+    lat_deg: float,
+    ascending: bool = True,
+    lon_deg: float | None = None,
+    days: int = 16,
+    step_s: float = 5.0,
+) -> float:
     """UTC seconds of the satellite's sub-point crossing *lat_deg* (geocentric, northbound when
     *ascending*) after *after_unix_s*; with *lon_deg*, the crossing nearest that longitude within
     *days* (16: the JPSS repeat cycle, so every longitude comes within ~1 deg). ValueError if the

@@ -54,7 +54,8 @@ def _unit_vectors(lat_rad, lon_rad):
 
 
 class _Triplanar:
-    """Bilinear samples of stacked periodic fields (3 planes, n, n, channels) blended over the three planes."""
+    """Bilinear samples of stacked periodic fields (3 planes, n, n, channels) blended over the three
+    planes."""
 
     def __init__(self, fields, cell_km):
         self.n = fields.shape[1]
@@ -98,25 +99,32 @@ class Scene:
     *terrain*); *night* makes land colder than the sea instead of warmer.
     """
 
-    def __init__(self, seed: int = 0, cloud_fraction: float = 0.45, land_fraction: float = 0.3,
-                 terrain: bool = False, night: bool = False):
+    def __init__(
+        self,
+        seed: int = 0,
+        cloud_fraction: float = 0.45,
+        land_fraction: float = 0.3,
+        terrain: bool = False,
+        night: bool = False,
+    ):
         rng = np.random.default_rng(seed)
         self.terrain = terrain
         self.land_offset_k = LAND_NIGHT_K if night else LAND_DAY_K
-        self.cloud = _Triplanar(np.stack([_random_field(rng, FINE_N, 3.2, 4) for _ in range(3)])[..., None],
-                                FINE_KM)
+        self.cloud = _Triplanar(
+            np.stack([_random_field(rng, FINE_N, 3.2, 4) for _ in range(3)])[..., None], FINE_KM
+        )
         # land, terrain relief and ridges (the shape of the Earth); cloud top and land texture
         coarse = [[_random_field(rng, COARSE_N, s, 2) for s in (3.6, 4.0, 3.0, 3.0, 2.5)] for _ in range(3)]
         self.shape = _Triplanar(np.stack([np.stack(c[:3], -1) for c in coarse]), COARSE_KM)
         self.surface = _Triplanar(np.stack([np.stack(c[3:], -1) for c in coarse]), COARSE_KM)
-        probe = self.shape(_unit_vectors(*np.radians(np.meshgrid(np.linspace(-80, 80, 161),
-                                                                  np.linspace(-180, 180, 361)))))
+        probe = self.shape(
+            _unit_vectors(*np.radians(np.meshgrid(np.linspace(-80, 80, 161), np.linspace(-180, 180, 361))))
+        )
         self.cloud_threshold = float(np.quantile(self.cloud.flat[0][::61, 0], 1.0 - cloud_fraction))
         self.land_threshold = float(np.quantile(probe[..., 0], 1.0 - land_fraction))
         self.relief_gain = 1.0
         if terrain:
             self.relief_gain = min(1.0, MAX_SLOPE / self._max_slope())
-
 
     def _height(self, land, relief, ridges):
         """Terrain height (m): a coastal ramp times ranges (ridged noise) on plateaus (a squashed field)."""

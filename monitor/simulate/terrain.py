@@ -32,7 +32,9 @@ def intersect_terrain(origin_m, los, height_fn, top_m, iterations=12):
     act = np.flatnonzero(np.isfinite(t) & (ground > 0))
     if act.size:
         t[act] = _root(o[act], d[act], t[act], -ground[act], height_fn, top_m + 10.0, iterations)
-        lat[act], lon[act], h[act] = wgs84.ecef_to_geodetic(o[act] + t[act, None] * d[act], NEAR_SURFACE_ITERATIONS)
+        lat[act], lon[act], h[act] = wgs84.ecef_to_geodetic(
+            o[act] + t[act, None] * d[act], NEAR_SURFACE_ITERATIONS
+        )
     return t.reshape(shape), lat.reshape(shape), lon.reshape(shape), h.reshape(shape)
 
 

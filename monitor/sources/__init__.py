@@ -57,6 +57,7 @@ def make_source(cfg):
     """The source named by the configuration's ``source.kind``."""
     from monitor.sources.local import LocalSource, SimulatedSource
     from monitor.sources.nodd import NoddSource
+
     kind = cfg.source.kind
     if kind == "local":
         return LocalSource(cfg.source.path)

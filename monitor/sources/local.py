@@ -27,8 +27,12 @@ class LocalSource:
         out = []
         for p in sorted(self.root.rglob("*.h5")):
             f = listed(p.name, p.stat().st_size, str(p))
-            if f is not None and f.parsed.platform == satellite and f.product in products \
-                    and abs((f.parsed.start.date() - day).days) <= 1:
+            if (
+                f is not None
+                and f.parsed.platform == satellite
+                and f.product in products
+                and abs((f.parsed.start.date() - day).days) <= 1
+            ):
                 out.append(f)
         return [f for f in out if on_day(f, day) or f.product not in CRIS_PRODUCTS]
 
@@ -48,11 +52,20 @@ class SimulatedSource(LocalSource):
 
     def list_day(self, satellite, day, products):
         from monitor.simulate.case import simulate_case
+
         target = self.root / satellite / day.isoformat()
         if not (target / "truth.json").exists():
-            LOG.info("simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target)
+            LOG.info(
+                "simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target
+            )
             start = dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc)
-            simulate_case(target, satellite=satellite, granules=self.cfg.granules, profile=self.cfg.profile,
-                          seed=self.cfg.seed + day.toordinal() % 1000, start=start)
+            simulate_case(
+                target,
+                satellite=satellite,
+                granules=self.cfg.granules,
+                profile=self.cfg.profile,
+                seed=self.cfg.seed + day.toordinal() % 1000,
+                start=start,
+            )
         self.root.mkdir(parents=True, exist_ok=True)
         return LocalSource(target).list_day(satellite, day, products)

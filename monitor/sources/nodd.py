@@ -101,10 +101,15 @@ class NoddSource:
         """GET *url* with the one retry layer; the response is 200 (the caller closes it)."""
         last = "no attempt"
         for attempt in range(self.cfg.retries + 1):
-            wait = self.cfg.backoff_s * 2 ** attempt
+            wait = self.cfg.backoff_s * 2**attempt
             try:
-                r = self.session.get(url, params=params, stream=stream, allow_redirects=False,
-                                     timeout=min(self.cfg.timeout_s, self._left_s(what)))
+                r = self.session.get(
+                    url,
+                    params=params,
+                    stream=stream,
+                    allow_redirects=False,
+                    timeout=min(self.cfg.timeout_s, self._left_s(what)),
+                )
             except requests.RequestException as exc:
                 last = type(exc).__name__
             else:
@@ -115,8 +120,10 @@ class NoddSource:
                     target = urljoin(r.url, r.headers.get("Location", ""))
                     here, there = urlsplit(r.url), urlsplit(target)
                     if (there.scheme, there.netloc) != (here.scheme, here.netloc):
-                        raise SourceError(f"{what}: redirect to {there.scheme}://{there.netloc} refused "
-                                          f"(only {here.netloc} is trusted)")
+                        raise SourceError(
+                            f"{what}: redirect to {there.scheme}://{there.netloc} refused "
+                            f"(only {here.netloc} is trusted)"
+                        )
                     url, params, last = target, None, f"redirect to {there.path}"
                     continue
                 if r.status_code not in RETRYABLE:
@@ -125,8 +132,10 @@ class NoddSource:
                 asked = _retry_after_s(r.headers.get("Retry-After"))
                 if asked is not None:
                     if asked > self.cfg.max_retry_after_s:
-                        raise SourceError(f"{what}: HTTP {r.status_code} with Retry-After {asked:.0f} s, more than "
-                                          f"the {self.cfg.max_retry_after_s:g} s allowed")
+                        raise SourceError(
+                            f"{what}: HTTP {r.status_code} with Retry-After {asked:.0f} s, more than "
+                            f"the {self.cfg.max_retry_after_s:g} s allowed"
+                        )
                     wait = max(wait, asked)
             if attempt < self.cfg.retries:
                 LOG.warning("%s: %s, retrying in %.1f s", what, last, wait)
@@ -177,12 +186,16 @@ class NoddSource:
         key = c.findtext(f"{S3_NS}Key") or ""
         size = (c.findtext(f"{S3_NS}Size") or "").strip()
         etag = _MD5.fullmatch((c.findtext(f"{S3_NS}ETag") or "").strip())
-        name = key[len(folder):]
+        name = key[len(folder) :]
         ok = key.isascii() and key.startswith(prefix) and "/" not in name and _DIGITS.fullmatch(size)
         f = listed(name, int(size), key, etag.group(1).lower() if etag else None) if ok else None
         if f is None:
-            LOG.warning("ignoring listed key %r (size %r): not a plain JPSS granule name under %s", key[:200],
-                        size[:20], folder)
+            LOG.warning(
+                "ignoring listed key %r (size %r): not a plain JPSS granule name under %s",
+                key[:200],
+                size[:20],
+                folder,
+            )
         return f
 
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
@@ -190,10 +203,14 @@ class NoddSource:
         for product in products:
             folder = PRODUCTS[product].collection  # the NODD folder is the collection name
             prefixes = [(day, f"{product}_{satellite}_d{day:%Y%m%d}")]
-            if product not in CRIS_PRODUCTS:  # VIIRS granules spanning midnight cover the day's first/last CrIS
+            if (
+                product not in CRIS_PRODUCTS
+            ):  # VIIRS granules spanning midnight cover the day's first/last CrIS
                 prev, nxt = day - dt.timedelta(days=1), day + dt.timedelta(days=1)
-                prefixes += [(prev, f"{product}_{satellite}_d{prev:%Y%m%d}_t23"),
-                             (nxt, f"{product}_{satellite}_d{nxt:%Y%m%d}_t00")]
+                prefixes += [
+                    (prev, f"{product}_{satellite}_d{prev:%Y%m%d}_t23"),
+                    (nxt, f"{product}_{satellite}_d{nxt:%Y%m%d}_t00"),
+                ]
             for d, name_prefix in prefixes:
                 out += self.list_prefix(satellite, f"{folder}/{d:%Y/%m/%d}/{name_prefix}")
         return _newest_per_granule(out)
@@ -205,7 +222,9 @@ class NoddSource:
         if target.exists() and (f.size is None or target.stat().st_size == f.size):
             return target
         if f.size is not None and self.spent_bytes + f.size > self.cfg.daily_budget_mb * 1e6:
-            raise BudgetExceeded(f"{f.name}: the day's download budget of {self.cfg.daily_budget_mb:.0f} MB is spent")
+            raise BudgetExceeded(
+                f"{f.name}: the day's download budget of {self.cfg.daily_budget_mb:.0f} MB is spent"
+            )
         part = target.with_name(target.name + ".part")
         url = f"{self._base(f.parsed.platform)}/{f.location}"
         last = None
@@ -217,7 +236,7 @@ class NoddSource:
                 part.unlink(missing_ok=True)
                 if attempt < self.cfg.retries and "refused" not in str(exc) and "deadline" not in str(exc):
                     LOG.warning("download of %s failed (attempt %d): %s", f.name, attempt + 1, exc)
-                    self.sleep(min(self.cfg.backoff_s * 2 ** attempt, self._left_s(f.name)))
+                    self.sleep(min(self.cfg.backoff_s * 2**attempt, self._left_s(f.name)))
                     continue
                 break
             self.spent_bytes += n
@@ -243,7 +262,12 @@ class NoddSource:
                 while True:
                     try:
                         chunk = r.raw.read1(1 << 20, decode_content=False)
-                    except (requests.RequestException, urllib3.exceptions.HTTPError, OSError, ValueError) as exc:
+                    except (
+                        requests.RequestException,
+                        urllib3.exceptions.HTTPError,
+                        OSError,
+                        ValueError,
+                    ) as exc:
                         raise SourceError(f"{f.name}: {type(exc).__name__} after {n} bytes") from None
                     if not chunk:
                         break
@@ -251,8 +275,9 @@ class NoddSource:
                     if f.size is not None and n > f.size:
                         raise SourceError(f"{f.name}: more than the {f.size} bytes listed")
                     if time.monotonic() > slowest:
-                        raise SourceError(f"{f.name}: slower than {self.cfg.min_rate_kb_s:g} kB/s "
-                                          f"({n} bytes received)")
+                        raise SourceError(
+                            f"{f.name}: slower than {self.cfg.min_rate_kb_s:g} kB/s ({n} bytes received)"
+                        )
                     self._left_s(f.name)
                     out.write(chunk)
                     if md5 is not None:

@@ -34,40 +34,70 @@ class AlertState:
         last = iso(now) if notified else (prev["last_notified"] if prev else None)
         self.db.execute(
             "INSERT OR REPLACE INTO alert_state VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-            (finding.fingerprint, finding.rule, finding.satellite, finding.group, finding.severity, status, started,
-             last, None, finding.summary, json.dumps(finding.lines)))
+            (
+                finding.fingerprint,
+                finding.rule,
+                finding.satellite,
+                finding.group,
+                finding.severity,
+                status,
+                started,
+                last,
+                None,
+                finding.summary,
+                json.dumps(finding.lines),
+            ),
+        )
 
     def resolve(self, fingerprint: str, now: dt.datetime):
-        self.db.execute("UPDATE alert_state SET status='resolved', resolved=? WHERE fingerprint=?",
-                        (iso(now), fingerprint))
+        self.db.execute(
+            "UPDATE alert_state SET status='resolved', resolved=? WHERE fingerprint=?",
+            (iso(now), fingerprint),
+        )
 
     # -- silences
-    def silence(self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime):
+    def silence(
+        self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime
+    ):
         with self.store.transaction():
-            self.db.execute("INSERT INTO silences (rule, satellite, until, reason, created) VALUES (?, ?, ?, ?, ?)",
-                            (rule, satellite, iso(until), reason, iso(now)))
+            self.db.execute(
+                "INSERT INTO silences (rule, satellite, until, reason, created) VALUES (?, ?, ?, ?, ?)",
+                (rule, satellite, iso(until), reason, iso(now)),
+            )
 
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> dict | None:
-        r = self.db.execute("SELECT * FROM silences WHERE until > ? AND (rule IS NULL OR rule=?) "
-                            "AND (satellite IS NULL OR satellite=?) ORDER BY until DESC",
-                            (iso(now), rule, satellite)).fetchone()
+        r = self.db.execute(
+            "SELECT * FROM silences WHERE until > ? AND (rule IS NULL OR rule=?) "
+            "AND (satellite IS NULL OR satellite=?) ORDER BY until DESC",
+            (iso(now), rule, satellite),
+        ).fetchone()
         return dict(r) if r else None
 
     def silences(self, now: dt.datetime) -> list:
-        return [dict(r) for r in self.db.execute("SELECT * FROM silences WHERE until > ? ORDER BY until", (iso(now),))]
+        return [
+            dict(r)
+            for r in self.db.execute("SELECT * FROM silences WHERE until > ? ORDER BY until", (iso(now),))
+        ]
 
     # -- delivery queue
     def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime):
-        self.db.execute("INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
-                        "VALUES (?, ?, ?, ?, ?, 'pending', ?)",
-                        (channel, satellite, message["subject"], json.dumps(message), iso(now), iso(now)))
+        self.db.execute(
+            "INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
+            "VALUES (?, ?, ?, ?, ?, 'pending', ?)",
+            (channel, satellite, message["subject"], json.dumps(message), iso(now), iso(now)),
+        )
 
     def due(self, now: dt.datetime) -> list:
         """Deliveries to try now: pending ones whose time has come, and claims whose lease ran out (a
         sender that died mid-send)."""
-        return [dict(r) for r in self.db.execute(
-            "SELECT * FROM deliveries WHERE status IN ('pending', 'sending') AND next_attempt <= ? ORDER BY id",
-            (iso(now),))]
+        return [
+            dict(r)
+            for r in self.db.execute(
+                "SELECT * FROM deliveries WHERE status IN ('pending', 'sending') AND next_attempt <= ? "
+                "ORDER BY id",
+                (iso(now),),
+            )
+        ]
 
     def claim(self, delivery_id: int, now: dt.datetime, lease_s: float = 600.0) -> bool:
         """Take a due delivery for sending, atomically: False when another sender has it (no double send).
@@ -78,17 +108,31 @@ class AlertState:
             cur = self.db.execute(
                 "UPDATE deliveries SET status='sending', next_attempt=? "
                 "WHERE id=? AND status IN ('pending', 'sending') AND next_attempt <= ?",
-                (iso(now + dt.timedelta(seconds=lease_s)), delivery_id, iso(now)))
+                (iso(now + dt.timedelta(seconds=lease_s)), delivery_id, iso(now)),
+            )
             return cur.rowcount == 1
 
     def deliveries(self, status: str | None = None) -> list:
         q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"
         return [dict(r) for r in self.db.execute(q, (status,) if status else ())]
 
-    def mark(self, delivery_id: int, status: str, now: dt.datetime, error: str | None = None,
-             retry_after_s: float = 0.0):
+    def mark(
+        self,
+        delivery_id: int,
+        status: str,
+        now: dt.datetime,
+        error: str | None = None,
+        retry_after_s: float = 0.0,
+    ):
         with self.store.transaction():
             self.db.execute(
-                "UPDATE deliveries SET status=?, attempts=attempts+1, last_error=?, next_attempt=?, sent=? WHERE id=?",
-                (status, error, iso(now + dt.timedelta(seconds=retry_after_s)),
-                 iso(now) if status == "sent" else None, delivery_id))
+                "UPDATE deliveries SET status=?, attempts=attempts+1, last_error=?, next_attempt=?, sent=? "
+                "WHERE id=?",
+                (
+                    status,
+                    error,
+                    iso(now + dt.timedelta(seconds=retry_after_s)),
+                    iso(now) if status == "sent" else None,
+                    delivery_id,
+                ),
+            )

@@ -3,7 +3,8 @@
 It holds the runs (the ledger of processed days), the per-FOR results with their flags, the granules
 used with their metadata (aux file lists, software versions), the scene-selection decisions, the cost
 cubes, service events, the alert state, silences and delivery queue (:mod:`monitor.store.alerts`), and the
-outbox of time-series points still to publish. All of the service's SQL lives in this package. A day's results are
+outbox of time-series points still to publish. All of the service's SQL lives in this package. A day's
+results are
 replaced in one transaction, so a re-run never duplicates and a crash never leaves half a day.
 """
 
@@ -69,18 +70,31 @@ MIGRATIONS = [
         fingerprint TEXT PRIMARY KEY, rule TEXT NOT NULL, satellite TEXT NOT NULL, grp TEXT, severity TEXT,
         status TEXT NOT NULL, started TEXT, last_notified TEXT, resolved TEXT, summary TEXT, lines TEXT);
     CREATE TABLE IF NOT EXISTS silences (
-        id INTEGER PRIMARY KEY, rule TEXT, satellite TEXT, until TEXT NOT NULL, reason TEXT NOT NULL, created TEXT);
+        id INTEGER PRIMARY KEY, rule TEXT, satellite TEXT, until TEXT NOT NULL, reason TEXT NOT NULL,
+        created TEXT);
     CREATE TABLE IF NOT EXISTS deliveries (
-        id INTEGER PRIMARY KEY, channel TEXT NOT NULL, satellite TEXT, subject TEXT NOT NULL, body TEXT NOT NULL,
+        id INTEGER PRIMARY KEY, channel TEXT NOT NULL, satellite TEXT, subject TEXT NOT NULL, body TEXT NOT
+        NULL,
         created TEXT NOT NULL, status TEXT NOT NULL, attempts INTEGER DEFAULT 0, next_attempt TEXT,
         last_error TEXT, sent TEXT);
     DROP TABLE IF EXISTS alert_meta;
     """,
 ]
 
-RESULT_FIELDS = ("d_alpha_urad", "d_beta_urad", "sigma_alpha_urad", "sigma_beta_urad", "in_track_km",
-                 "cross_track_km", "total_km", "sigma_in_track_km", "sigma_cross_track_km", "n_samples",
-                 "cost_min_k", "cost_zero_k")
+RESULT_FIELDS = (
+    "d_alpha_urad",
+    "d_beta_urad",
+    "sigma_alpha_urad",
+    "sigma_beta_urad",
+    "in_track_km",
+    "cross_track_km",
+    "total_km",
+    "sigma_in_track_km",
+    "sigma_cross_track_km",
+    "n_samples",
+    "cost_min_k",
+    "cost_zero_k",
+)
 
 
 def now_iso() -> str:
@@ -149,16 +163,20 @@ class Store:
         if not self.path.exists():
             self._create()
         elif self.path.stat().st_size == 0:
-            raise StoreError(f"{self.path}: empty file, not a crisgeo store (restore it from a backup, or remove "
-                             f"it to start a new history)")
+            raise StoreError(
+                f"{self.path}: empty file, not a crisgeo store (restore it from a backup, or remove "
+                f"it to start a new history)"
+            )
         try:
             self.db = self._connect(self.path)
             tables = self.db.execute("SELECT COUNT(*) FROM sqlite_master").fetchone()[0]
             if 0 < len(MIGRATIONS) < self.schema_version:
                 self._migrate()  # says it is newer than this program
             if self.schema_version == 0 or tables == 0:
-                raise StoreError(f"{self.path}: not a crisgeo store (schema version {self.schema_version}, "
-                                 f"{tables} tables)")
+                raise StoreError(
+                    f"{self.path}: not a crisgeo store (schema version {self.schema_version}, "
+                    f"{tables} tables)"
+                )
             self._migrate()
         except sqlite3.DatabaseError as exc:
             raise StoreError(f"{self.path}: not a usable crisgeo store ({exc})") from None
@@ -198,8 +216,10 @@ class Store:
     def _migrate(self):
         version = self.schema_version
         if version > len(MIGRATIONS):
-            raise StoreError(f"{self.path}: schema version {version} is newer than this program "
-                               f"({len(MIGRATIONS)}); upgrade crisgeo")
+            raise StoreError(
+                f"{self.path}: schema version {version} is newer than this program "
+                f"({len(MIGRATIONS)}); upgrade crisgeo"
+            )
         for v in range(version, len(MIGRATIONS)):
             with self.transaction():
                 for stmt in filter(str.strip, MIGRATIONS[v].split(";")):
@@ -212,31 +232,47 @@ class Store:
     # -- runs (the ledger)
     def begin_run(self, satellite: str, day: dt.date) -> int:
         with self.transaction():
-            cur = self.db.execute("INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, 'running')",
-                                  (satellite, day.isoformat(), now_iso()))
+            cur = self.db.execute(
+                "INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, 'running')",
+                (satellite, day.isoformat(), now_iso()),
+            )
             return cur.lastrowid
 
-    def finish_run(self, run_id: int, status: str, reason: str | None = None, n_granules: int = 0,
-                   summary: dict | None = None):
+    def finish_run(
+        self,
+        run_id: int,
+        status: str,
+        reason: str | None = None,
+        n_granules: int = 0,
+        summary: dict | None = None,
+    ):
         with self.transaction():
             self._finish(run_id, status, reason, n_granules, summary)
 
     def _finish(self, run_id, status, reason, n_granules, summary):
-        self.db.execute("UPDATE runs SET finished=?, status=?, reason=?, n_granules=?, summary=? WHERE id=?",
-                        (now_iso(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id))
+        self.db.execute(
+            "UPDATE runs SET finished=?, status=?, reason=?, n_granules=?, summary=? WHERE id=?",
+            (now_iso(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id),
+        )
 
     def interrupt_stale_runs(self) -> int:
         """Mark runs left 'running' by a killed process as 'interrupted'; returns how many."""
         with self.transaction():
-            cur = self.db.execute("UPDATE runs SET status='interrupted', finished=?, "
-                                  "reason='process ended during the run' WHERE status='running'", (now_iso(),))
+            cur = self.db.execute(
+                "UPDATE runs SET status='interrupted', finished=?, "
+                "reason='process ended during the run' WHERE status='running'",
+                (now_iso(),),
+            )
             return cur.rowcount
 
     def done_days(self, satellite: str, no_data_final_before: dt.date | None = None) -> set:
         """Days with a completed run: results stored, or no data for good. A plain ``no_data`` day counts
         as done only before *no_data_final_before* (None: always); later ones are tried again."""
-        rows = self.db.execute("SELECT DISTINCT day, status FROM runs WHERE satellite=? "
-                               "AND status IN ('ok', 'no_data', 'no_data_final')", (satellite,))
+        rows = self.db.execute(
+            "SELECT DISTINCT day, status FROM runs WHERE satellite=? "
+            "AND status IN ('ok', 'no_data', 'no_data_final')",
+            (satellite,),
+        )
         out = set()
         for day, status in rows:
             d = dt.date.fromisoformat(day)
@@ -245,19 +281,33 @@ class Store:
         return out
 
     def last_runs(self) -> list:
-        return [dict(r) for r in self.db.execute(
-            "SELECT r.* FROM runs r JOIN (SELECT satellite, MAX(id) AS id FROM runs GROUP BY satellite) m "
-            "ON r.id = m.id ORDER BY r.satellite")]
+        return [
+            dict(r)
+            for r in self.db.execute(
+                "SELECT r.* FROM runs r JOIN (SELECT satellite, MAX(id) AS id FROM runs GROUP BY satellite) "
+                "m "
+                "ON r.id = m.id ORDER BY r.satellite"
+            )
+        ]
 
     def run_counts(self) -> dict:
         """{(satellite, status): number of runs} over the whole ledger."""
-        return {(r[0], r[1]): r[2] for r in self.db.execute(
-            "SELECT satellite, status, COUNT(*) FROM runs GROUP BY satellite, status")}
+        return {
+            (r[0], r[1]): r[2]
+            for r in self.db.execute(
+                "SELECT satellite, status, COUNT(*) FROM runs GROUP BY satellite, status"
+            )
+        }
 
     def last_success(self) -> dict:
         """{satellite: finish time (aware UTC datetime) of its latest ok run}."""
-        return {r[0]: dt.datetime.fromisoformat(r[1]) for r in self.db.execute(
-            "SELECT satellite, MAX(finished) FROM runs WHERE status='ok' AND finished IS NOT NULL GROUP BY satellite")}
+        return {
+            r[0]: dt.datetime.fromisoformat(r[1])
+            for r in self.db.execute(
+                "SELECT satellite, MAX(finished) FROM runs WHERE status='ok' AND finished IS NOT NULL GROUP "
+                "BY satellite"
+            )
+        }
 
     def outbox_sizes(self) -> dict:
         """{target: points waiting}."""
@@ -268,51 +318,111 @@ class Store:
         return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
 
     # -- results
-    def save_day(self, run_id: int, satellite: str, day: dt.date, result: AssessmentResult,
-                 selection: list, outbox_lines: dict):
-        """Replace the day's results, granules, selection and cube, queue its points, close the run: atomic."""
+    def save_day(
+        self,
+        run_id: int,
+        satellite: str,
+        day: dt.date,
+        result: AssessmentResult,
+        selection: list,
+        outbox_lines: dict,
+    ):
+        """Replace the day's results, granules, selection and cube, queue its points, close the run, in one
+        transaction."""
         d = day.isoformat()
         with self.transaction():
             for table in ("results", "granules", "selection", "cost_cubes", "skipped"):
                 self.db.execute(f"DELETE FROM {table} WHERE satellite=? AND day=?", (satellite, d))
             for f in result.fors:
                 self.db.execute(
-                    f"INSERT INTO results (satellite, day, for_index, run_id, {', '.join(RESULT_FIELDS)}, flags) "
+                    f"INSERT INTO results (satellite, day, for_index, run_id, {', '.join(RESULT_FIELDS)}, "
+                    "flags) "
                     f"VALUES (?, ?, ?, ?, {', '.join('?' * len(RESULT_FIELDS))}, ?)",
-                    (satellite, d, f.for_index, run_id, *[_num(getattr(f, k)) for k in RESULT_FIELDS],
-                     json.dumps(list(f.flags))))
+                    (
+                        satellite,
+                        d,
+                        f.for_index,
+                        run_id,
+                        *[_num(getattr(f, k)) for k in RESULT_FIELDS],
+                        json.dumps(list(f.flags)),
+                    ),
+                )
             for g in result.granules:
                 cm, vm = g.get("cris_meta", {}), g.get("viirs_meta", {})
                 self.db.execute(
                     "INSERT OR REPLACE INTO granules VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    (satellite, d, run_id, g["granule_id"], g["start"], g["cris_geo"], g["cris_sdr"],
-                     json.dumps(g["viirs"]), g["n_usable"], cm.get("software_version"), cm.get("algorithm_version"),
-                     json.dumps(cm.get("aux_files", [])), json.dumps(vm.get("aux_files", [])),
-                     vm.get("software_version")))
+                    (
+                        satellite,
+                        d,
+                        run_id,
+                        g["granule_id"],
+                        g["start"],
+                        g["cris_geo"],
+                        g["cris_sdr"],
+                        json.dumps(g["viirs"]),
+                        g["n_usable"],
+                        cm.get("software_version"),
+                        cm.get("algorithm_version"),
+                        json.dumps(cm.get("aux_files", [])),
+                        json.dumps(vm.get("aux_files", [])),
+                        vm.get("software_version"),
+                    ),
+                )
             for s in selection:
-                self.db.execute("INSERT INTO selection VALUES (?, ?, ?, ?, ?, ?, ?)",
-                                (satellite, d, run_id, s["granule"], _num(s.get("score_k")), s["decision"],
-                                 s.get("reason")))
+                self.db.execute(
+                    "INSERT INTO selection VALUES (?, ?, ?, ?, ?, ?, ?)",
+                    (
+                        satellite,
+                        d,
+                        run_id,
+                        s["granule"],
+                        _num(s.get("score_k")),
+                        s["decision"],
+                        s.get("reason"),
+                    ),
+                )
             for s in result.skipped:
-                self.db.execute("INSERT INTO skipped VALUES (?, ?, ?, ?, ?)",
-                                (satellite, d, run_id, s["item"], s["reason"]))
+                self.db.execute(
+                    "INSERT INTO skipped VALUES (?, ?, ?, ?, ?)",
+                    (satellite, d, run_id, s["item"], s["reason"]),
+                )
             if result.cost_cube_k is not None:
-                self.db.execute("INSERT INTO cost_cubes VALUES (?, ?, ?, ?, ?, ?)",
-                                (satellite, d, run_id, result.half_steps, result.step_urad,
-                                 np.asarray(result.cost_cube_k, np.float32).tobytes()))
+                self.db.execute(
+                    "INSERT INTO cost_cubes VALUES (?, ?, ?, ?, ?, ?)",
+                    (
+                        satellite,
+                        d,
+                        run_id,
+                        result.half_steps,
+                        result.step_urad,
+                        np.asarray(result.cost_cube_k, np.float32).tobytes(),
+                    ),
+                )
             self.db.execute("DELETE FROM outbox WHERE satellite=? AND day=?", (satellite, d))
             for target, lines in outbox_lines.items():
                 for line in lines:
-                    self.db.execute("INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, ?, ?, ?)",
-                                    (target, satellite, d, line, now_iso()))
-            self._finish(run_id, "ok", None, len(result.granules),
-                         {"reliable_fors": sum(f.reliable for f in result.fors),
-                          "max_total_km": max((f.total_km for f in result.fors if np.isfinite(f.total_km)),
-                                              default=None)})
+                    self.db.execute(
+                        "INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, ?, ?, ?)",
+                        (target, satellite, d, line, now_iso()),
+                    )
+            self._finish(
+                run_id,
+                "ok",
+                None,
+                len(result.granules),
+                {
+                    "reliable_fors": sum(f.reliable for f in result.fors),
+                    "max_total_km": max(
+                        (f.total_km for f in result.fors if np.isfinite(f.total_km)), default=None
+                    ),
+                },
+            )
 
     def day_result(self, satellite: str, day: dt.date) -> list[ForOffset]:
-        rows = self.db.execute("SELECT * FROM results WHERE satellite=? AND day=? ORDER BY for_index",
-                               (satellite, day.isoformat())).fetchall()
+        rows = self.db.execute(
+            "SELECT * FROM results WHERE satellite=? AND day=? ORDER BY for_index",
+            (satellite, day.isoformat()),
+        ).fetchall()
         out = []
         for r in rows:
             kw = {k: (float("nan") if r[k] is None else r[k]) for k in RESULT_FIELDS}
@@ -327,6 +437,7 @@ class Store:
     def to_xarray(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
         """The per-FOR results of *satellite* as a CF-style xarray Dataset (:mod:`monitor.export`)."""
         from monitor.export import to_xarray
+
         return to_xarray(self, satellite, since, until)
 
     def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> list:
@@ -341,17 +452,27 @@ class Store:
         return [dict(r) for r in self.db.execute(q + " ORDER BY day, for_index", args)]
 
     def granules(self, satellite: str, day: dt.date | None = None) -> list:
-        q = "SELECT * FROM granules WHERE satellite=?" + (" AND day=?" if day else "") + " ORDER BY day, start"
+        q = (
+            "SELECT * FROM granules WHERE satellite=?"
+            + (" AND day=?" if day else "")
+            + " ORDER BY day, start"
+        )
         return [dict(r) for r in self.db.execute(q, (satellite, day.isoformat()) if day else (satellite,))]
 
     def selection(self, satellite: str, day: dt.date) -> list:
-        return [dict(r) for r in self.db.execute("SELECT * FROM selection WHERE satellite=? AND day=?",
-                                                 (satellite, day.isoformat()))]
+        return [
+            dict(r)
+            for r in self.db.execute(
+                "SELECT * FROM selection WHERE satellite=? AND day=?", (satellite, day.isoformat())
+            )
+        ]
 
     def cost_cube(self, satellite: str, day: dt.date):
         """(cube_k (30, 2n+1, 2n+1), step_urad) of the day's assessment, or None."""
-        r = self.db.execute("SELECT half_steps, step_urad, cube FROM cost_cubes WHERE satellite=? AND day=?",
-                            (satellite, day.isoformat())).fetchone()
+        r = self.db.execute(
+            "SELECT half_steps, step_urad, cube FROM cost_cubes WHERE satellite=? AND day=?",
+            (satellite, day.isoformat()),
+        ).fetchone()
         if r is None:
             return None
         m = 2 * r["half_steps"] + 1
@@ -360,21 +481,27 @@ class Store:
     # -- fingerprints
     def save_fingerprint(self, satellite: str, day: dt.date, body: dict):
         with self.transaction():
-            self.db.execute("INSERT OR REPLACE INTO fingerprints VALUES (?, ?, ?, ?)",
-                            (satellite, day.isoformat(), now_iso(), json.dumps(body)))
+            self.db.execute(
+                "INSERT OR REPLACE INTO fingerprints VALUES (?, ?, ?, ?)",
+                (satellite, day.isoformat(), now_iso(), json.dumps(body)),
+            )
 
     def fingerprint(self, satellite: str, before: dt.date):
         """(day, body) of the latest fingerprint strictly before *before*, or None."""
-        r = self.db.execute("SELECT day, body FROM fingerprints WHERE satellite=? AND day < ? ORDER BY day DESC LIMIT 1",
-                            (satellite, before.isoformat())).fetchone()
+        r = self.db.execute(
+            "SELECT day, body FROM fingerprints WHERE satellite=? AND day < ? ORDER BY day DESC LIMIT 1",
+            (satellite, before.isoformat()),
+        ).fetchone()
         return None if r is None else (dt.date.fromisoformat(r["day"]), json.loads(r["body"]))
 
     # -- events (failures, misses: the alerting layer reads them)
     def add_event(self, kind: "EventKind", satellite: str | None, detail: dict):
         """Record an event; *detail* is stored as JSON."""
         with self.transaction():
-            self.db.execute("INSERT INTO events (time, kind, satellite, detail) VALUES (?, ?, ?, ?)",
-                            (now_iso(), EventKind(kind).value, satellite, json.dumps(detail)))
+            self.db.execute(
+                "INSERT INTO events (time, kind, satellite, detail) VALUES (?, ?, ?, ?)",
+                (now_iso(), EventKind(kind).value, satellite, json.dumps(detail)),
+            )
 
     def events(self, kind: "EventKind | None" = None) -> list["Event"]:
         """The events (of *kind*), oldest first."""
@@ -386,12 +513,18 @@ class Store:
         """Queue points not tied to a day's results (e.g. change annotations)."""
         with self.transaction():
             for line in lines:
-                self.db.execute("INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, NULL, ?, ?)",
-                                (target, satellite, line, now_iso()))
+                self.db.execute(
+                    "INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, NULL, ?, ?)",
+                    (target, satellite, line, now_iso()),
+                )
 
     def outbox(self, target: str, limit: int = 5000) -> list:
-        return [dict(r) for r in self.db.execute("SELECT id, line FROM outbox WHERE target=? ORDER BY id LIMIT ?",
-                                                 (target, limit))]
+        return [
+            dict(r)
+            for r in self.db.execute(
+                "SELECT id, line FROM outbox WHERE target=? ORDER BY id LIMIT ?", (target, limit)
+            )
+        ]
 
     def outbox_size(self, target: str | None = None) -> int:
         q = "SELECT COUNT(*) FROM outbox" + (" WHERE target=?" if target else "")
@@ -403,8 +536,10 @@ class Store:
 
     def outbox_failed(self, ids: list, error: str):
         with self.transaction():
-            self.db.executemany("UPDATE outbox SET attempts = attempts + 1, last_error=? WHERE id=?",
-                                [(error[:500], i) for i in ids])
+            self.db.executemany(
+                "UPDATE outbox SET attempts = attempts + 1, last_error=? WHERE id=?",
+                [(error[:500], i) for i in ids],
+            )
 
 
 class _Transaction:

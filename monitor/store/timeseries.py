@@ -32,8 +32,17 @@ from influxdb_client.client.exceptions import InfluxDBError
 from influxdb_client.client.write_api import SYNCHRONOUS
 
 LOG = logging.getLogger(__name__)
-FLOAT_FIELDS = ("d_alpha_urad", "d_beta_urad", "sigma_alpha_urad", "sigma_beta_urad", "in_track_km",
-                "cross_track_km", "total_km", "cost_min_k", "cost_zero_k")
+FLOAT_FIELDS = (
+    "d_alpha_urad",
+    "d_beta_urad",
+    "sigma_alpha_urad",
+    "sigma_beta_urad",
+    "in_track_km",
+    "cross_track_km",
+    "total_km",
+    "cost_min_k",
+    "cost_zero_k",
+)
 
 
 class PublishError(RuntimeError):
@@ -56,15 +65,22 @@ def result_lines(measurement: str, satellite: str, day: dt.date, fors) -> list[s
 
 
 def change_lines(measurement: str, changes) -> list[str]:
-    """Line-protocol points of known changes (measurement ``<measurement>_change``, for dashboard annotations).
+    """Line-protocol points of known changes (measurement ``<measurement>_change``, for dashboard
+    annotations).
 
     Tags satellite, instrument, kind, origin; string field ``description``; time = the change time. The
     same change written again overwrites its point (same measurement, tags and time).
     """
     lines = []
     for c in changes:
-        p = (Point(f"{measurement}_change").tag("satellite", c.satellite).tag("instrument", c.instrument)
-             .tag("kind", c.kind).tag("origin", c.origin).field("description", c.description))
+        p = (
+            Point(f"{measurement}_change")
+            .tag("satellite", c.satellite)
+            .tag("instrument", c.instrument)
+            .tag("kind", c.kind)
+            .tag("origin", c.origin)
+            .field("description", c.description)
+        )
         lines.append(p.time(c.time, WritePrecision.S).to_line_protocol())
     return lines
 
@@ -79,16 +95,20 @@ class Influx2Writer:
 
     def __init__(self, cfg):
         self.cfg = cfg
-        self.client = InfluxDBClient(url=cfg.url, token=cfg.secret("token_env") or "", org=cfg.org,
-                                     timeout=int(cfg.timeout_s * 1000))
+        self.client = InfluxDBClient(
+            url=cfg.url, token=cfg.secret("token_env") or "", org=cfg.org, timeout=int(cfg.timeout_s * 1000)
+        )
         self.api = self.client.write_api(write_options=SYNCHRONOUS)
 
     def write(self, lines: list[str]):
         try:
-            self.api.write(bucket=self.cfg.bucket, org=self.cfg.org, record=lines, write_precision=WritePrecision.S)
+            self.api.write(
+                bucket=self.cfg.bucket, org=self.cfg.org, record=lines, write_precision=WritePrecision.S
+            )
         except InfluxDBError as exc:
-            raise PublishError(f"{self.cfg.url}: HTTP {getattr(exc, 'status', '?')} {getattr(exc, 'message', exc)}") \
-                from None
+            raise PublishError(
+                f"{self.cfg.url}: HTTP {getattr(exc, 'status', '?')} {getattr(exc, 'message', exc)}"
+            ) from None
         except Exception as exc:  # urllib3 raises its own errors when the server is unreachable
             raise PublishError(f"{self.cfg.url}: {type(exc).__name__}: {exc}") from None
 
@@ -105,15 +125,24 @@ class Influx1Writer:
         self.auth = (user, password) if user else None
 
     def _post(self, lines):
-        return requests.post(f"{self.cfg.url}/write", params={"db": self.cfg.database, "precision": "s"},
-                             data="\n".join(lines).encode(), auth=self.auth, timeout=self.cfg.timeout_s)
+        return requests.post(
+            f"{self.cfg.url}/write",
+            params={"db": self.cfg.database, "precision": "s"},
+            data="\n".join(lines).encode(),
+            auth=self.auth,
+            timeout=self.cfg.timeout_s,
+        )
 
     def write(self, lines: list[str]):
         try:
             r = self._post(lines)
             if r.status_code == 404 and "database not found" in r.text:
-                requests.post(f"{self.cfg.url}/query", data={"q": f'CREATE DATABASE "{self.cfg.database}"'},
-                              auth=self.auth, timeout=self.cfg.timeout_s).raise_for_status()
+                requests.post(
+                    f"{self.cfg.url}/query",
+                    data={"q": f'CREATE DATABASE "{self.cfg.database}"'},
+                    auth=self.auth,
+                    timeout=self.cfg.timeout_s,
+                ).raise_for_status()
                 r = self._post(lines)
         except requests.RequestException as exc:
             raise PublishError(f"{self.cfg.url}: {type(exc).__name__}") from None
@@ -143,8 +172,12 @@ def drain_outbox(store, publish_cfgs, batch: int = 5000) -> dict:
                     writer.write([r["line"] for r in rows])
                 except PublishError as exc:
                     store.outbox_failed([r["id"] for r in rows], str(exc))
-                    LOG.warning("publishing to %s failed, %d points wait in the outbox: %s", target,
-                                store.outbox_size(target), exc)
+                    LOG.warning(
+                        "publishing to %s failed, %d points wait in the outbox: %s",
+                        target,
+                        store.outbox_size(target),
+                        exc,
+                    )
                     break
                 store.outbox_delivered([r["id"] for r in rows])
                 sent += len(rows)

@@ -6,14 +6,27 @@ from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
 from alerts.settings import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
 
-MSG = {"subject": "[crisgeo] j01 CRITICAL: 1 firing - spec", "text": "FOR 30: total 4.51 km\nspec 1.5 km",
-       "html": "<pre>FOR 30: total 4.51 km</pre>", "blocks": ["*FIRING spec*\nFOR 30 <4.5 km> & more"],
-       "attachments": []}
+MSG = {
+    "subject": "[crisgeo] j01 CRITICAL: 1 firing - spec",
+    "text": "FOR 30: total 4.51 km\nspec 1.5 km",
+    "html": "<pre>FOR 30: total 4.51 km</pre>",
+    "blocks": ["*FIRING spec*\nFOR 30 <4.5 km> & more"],
+    "attachments": [],
+}
 
 
 def _email(port, cafile, **kw):
-    return EmailSettings(host="localhost", port=port, sender="crisgeo@test", to=["sdr@test"], cafile=cafile,
-                         username_env="T_SMTP_USER", password_env="T_SMTP_PASS", timeout_s=10, **kw)
+    return EmailSettings(
+        host="localhost",
+        port=port,
+        sender="crisgeo@test",
+        to=["sdr@test"],
+        cafile=cafile,
+        username_env="T_SMTP_USER",
+        password_env="T_SMTP_PASS",
+        timeout_s=10,
+        **kw,
+    )
 
 
 def test_email_over_starttls_with_login_arrives_intact_once(smtp_server, monkeypatch, tmp_path):
@@ -106,6 +119,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     from alerts.settings import AlertSettings, RuleSettings
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
+
     monkeypatch.setenv("T_SLACK", webhook.url)
     settings = AlertSettings(rules=RuleSettings(), slack=SlackSettings(webhook_env="T_SLACK", timeout_s=5))
     path = tmp_path / "s.sqlite"
@@ -114,11 +128,13 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     AlertState(store).enqueue("slack", "j01", {"subject": "s", "text": "t", "blocks": []}, now)
     store.close()
     import requests
+
     real_post = requests.post
 
     def slow_post(*a, **kw):
         time.sleep(0.5)  # both deliverers see the message as due before either has sent it
         return real_post(*a, **kw)
+
     monkeypatch.setattr(requests, "post", slow_post)
     counts, start = [], threading.Barrier(2)
 
@@ -127,6 +143,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
         start.wait()
         counts.append(deliver(s, settings, now=now))
         s.close()
+
     threads = [threading.Thread(target=run) for _ in range(2)]
     for t in threads:
         t.start()
@@ -147,16 +164,27 @@ def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
 
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
+
     cfg = tmp_path / "c.yaml"
-    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
-                   f"alerts: {{slack: {{webhook_env: T_SLACK}}}}\n")
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+        f"alerts: {{slack: {{webhook_env: T_SLACK}}}}\n"
+    )
     (tmp_path / "state").mkdir()
     store = Store(tmp_path / "state" / "crisgeo.sqlite")
-    AlertState(store).enqueue("slack", "j01", {"subject": "s", "text": "t", "blocks": []},
-                              dt.datetime.now(dt.timezone.utc) - dt.timedelta(minutes=1))
+    AlertState(store).enqueue(
+        "slack",
+        "j01",
+        {"subject": "s", "text": "t", "blocks": []},
+        dt.datetime.now(dt.timezone.utc) - dt.timedelta(minutes=1),
+    )
     store.close()
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "-v", "alerts", "evaluate", "--config", str(cfg)],
-                       capture_output=True, text=True, env={**os.environ, "T_SLACK": webhook.url})
+    r = subprocess.run(
+        [sys.executable, "-m", "monitor.cli", "-v", "alerts", "evaluate", "--config", str(cfg)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "T_SLACK": webhook.url},
+    )
     assert r.returncode == 0, r.stderr
     assert len(webhook.received) >= 1  # it was sent
     assert "secret-token" not in r.stderr + r.stdout and "DEBUG" in r.stderr

@@ -19,8 +19,9 @@ DAY1, DAY2 = dt.date(2024, 6, 1), dt.date(2024, 6, 2)
 def two_days(cases, tmp_path_factory):
     paper, _, _ = cases.get("paper", 1)
     fixed = tmp_path_factory.mktemp("corrected")
-    simulate_case(fixed, granules=2, profile="zero", seed=1,
-                  start=dt.datetime(2024, 6, 2, 12, tzinfo=dt.timezone.utc))
+    simulate_case(
+        fixed, granules=2, profile="zero", seed=1, start=dt.datetime(2024, 6, 2, 12, tzinfo=dt.timezone.utc)
+    )
     data = tmp_path_factory.mktemp("data")
     for d in (paper, fixed):
         for f in d.glob("*.h5"):
@@ -35,14 +36,14 @@ def test_fire_once_then_quiet_then_resolved(two_days, smtp_server, webhook, monk
     monkeypatch.setenv("T_HOOK", webhook.url)
     cfg_path = tmp_path / "c.yaml"
     cfg_path.write_text(f"""satellites: [j01]
-state_dir: {tmp_path / 'state'}
+state_dir: {tmp_path / "state"}
 source: {{kind: local, path: {two_days}}}
 assessment: {{workers: 1}}
 dashboard_url: http://grafana.test/d/crisgeo
-report_dir: {tmp_path / 'report'}
+report_dir: {tmp_path / "report"}
 report_url: https://crisgeo.test/report/
 alerts:
-  log: {tmp_path / 'alerts.log'}
+  log: {tmp_path / "alerts.log"}
   email: {{host: localhost, port: {port}, from: crisgeo@test, to: [sdr@test], cafile: {cafile},
            username_env: T_SMTP_USER, password_env: T_SMTP_PASS}}
   slack: {{webhook_env: T_HOOK}}
@@ -82,11 +83,14 @@ def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp
     from alerts.engine import deliver
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
+
     monkeypatch.setenv("T_HOOK", webhook.url)
     cfg_path = tmp_path / "c.yaml"
-    cfg_path.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
-                        f"source: {{kind: local, path: {two_days}}}\nassessment: {{workers: 1}}\n"
-                        "alerts: {slack: {webhook_env: T_HOOK, retries: 0}}\n")
+    cfg_path.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
+        f"source: {{kind: local, path: {two_days}}}\nassessment: {{workers: 1}}\n"
+        "alerts: {slack: {webhook_env: T_HOOK, retries: 0}}\n"
+    )
     webhook.script = [(503, "", {})]
     service = Service(load_config(cfg_path))
     service.run("j01", DAY1)

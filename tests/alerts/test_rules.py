@@ -14,7 +14,9 @@ UTC = dt.timezone.utc
 
 
 def _for(k, it, ct, sig=0.05, flags=()):
-    return ForOffset(k, 0.0, 0.0, 10.0, 10.0, it, ct, float(np.hypot(it, ct)), sig, sig, 100, 0.1, 0.2, tuple(flags))
+    return ForOffset(
+        k, 0.0, 0.0, 10.0, 10.0, it, ct, float(np.hypot(it, ct)), sig, sig, 100, 0.1, 0.2, tuple(flags)
+    )
 
 
 def _result(fors, granules=()):
@@ -22,9 +24,16 @@ def _result(fors, granules=()):
 
 
 def _granule(gid, cris_aux, viirs_aux, sw="I2.1.03.00"):
-    return {"granule_id": gid, "start": "t", "cris_geo": "g", "cris_sdr": "s", "viirs": [], "n_usable": 1,
-            "cris_meta": {"aux_files": cris_aux, "software_version": sw, "algorithm_version": "2.O"},
-            "viirs_meta": {"aux_files": viirs_aux, "software_version": "I2.0"}}
+    return {
+        "granule_id": gid,
+        "start": "t",
+        "cris_geo": "g",
+        "cris_sdr": "s",
+        "viirs": [],
+        "n_usable": 1,
+        "cris_meta": {"aux_files": cris_aux, "software_version": sw, "algorithm_version": "2.O"},
+        "viirs_meta": {"aux_files": viirs_aux, "software_version": "I2.0"},
+    }
 
 
 def test_spec_severity_uses_the_uncertainty(tmp_path):
@@ -52,12 +61,17 @@ def test_stale_and_failure(tmp_path):
     later = dt.datetime.now(UTC) + dt.timedelta(hours=40)
     assert "no successful assessment" in stale_finding(s, "j01", RuleSettings(), later).lines[0]
     s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result([_for(k, 0, 0) for k in range(1, 31)]), [], {})
-    assert failure_finding(s, "j01") is None and stale_finding(s, "j01", RuleSettings(), dt.datetime.now(UTC)) is None
+    assert (
+        failure_finding(s, "j01") is None
+        and stale_finding(s, "j01", RuleSettings(), dt.datetime.now(UTC)) is None
+    )
 
 
 def test_metadata_changes_name_the_instrument(tmp_path):
     s = Store(tmp_path / "s.sqlite")
-    viirs_lut = "VIIRS-SDR-GEO-IMG-PARAM-LUT_j01_20130601000000Z_20130601000000Z_ee00000000000000Z_PS-1-O-CCR-{}_all"
+    viirs_lut = (
+        "VIIRS-SDR-GEO-IMG-PARAM-LUT_j01_20130601000000Z_20130601000000Z_ee00000000000000Z_PS-1-O-CCR-{}_all"
+    )
     cris = ["CrIS-SDR-CC_j01_20180426000000Z_x_ops", "CrIS-SDR-ENGPKT-BACKUP-AUX_j01_{}_ops"]
     for i, (vl, eng) in enumerate([("1171", "a"), ("1171", "b"), ("2042", "c")]):
         day = DAY + dt.timedelta(days=i)
@@ -85,9 +99,12 @@ def test_calendar_round_trip_and_attribution(tmp_path):
 
 def test_shipped_calendar_holds_the_known_history():
     from pathlib import Path
+
     events = load_calendar(Path(__file__).resolve().parents[2] / "configs" / "events.yaml")
     assert any(e.kind == "ep_upload" and e.time.date() == dt.date(2014, 2, 27) for e in events)
-    assert any(e.instrument == "viirs" and e.time == dt.datetime(2012, 11, 22, 16, 32, tzinfo=UTC) for e in events)
+    assert any(
+        e.instrument == "viirs" and e.time == dt.datetime(2012, 11, 22, 16, 32, tzinfo=UTC) for e in events
+    )
 
 
 def test_jumps_found_and_attributed_and_noise_stays_quiet():

@@ -21,9 +21,12 @@ def _distances(ep, files, los=None):
     out = []
     for f in files:
         (g,) = read_file(f)
-        view = geolocate_fovs(los, g.for_time_us, g.mid_time_us, g.sc_position_m, g.sc_velocity_m_s,
-                              g.sc_attitude_rad)
-        out.append(np.linalg.norm(view.ground_ecef_m - wgs84.geodetic_to_ecef(g.lat_rad, g.lon_rad, 0.0), axis=-1))
+        view = geolocate_fovs(
+            los, g.for_time_us, g.mid_time_us, g.sc_position_m, g.sc_velocity_m_s, g.sc_attitude_rad
+        )
+        out.append(
+            np.linalg.norm(view.ground_ecef_m - wgs84.geodetic_to_ecef(g.lat_rad, g.lon_rad, 0.0), axis=-1)
+        )
     return np.concatenate(out)  # (nscan, 30, 9)
 
 

@@ -9,8 +9,18 @@ from monitor.sdr import read_file
 
 
 def _geometry(g):
-    return inverse_geolocation(g.lat_rad, g.lon_rad, g.zenith_rad, g.azimuth_rad, g.range_m, g.for_time_us,
-                               g.mid_time_us, g.sc_position_m, g.sc_velocity_m_s, g.sc_attitude_rad)
+    return inverse_geolocation(
+        g.lat_rad,
+        g.lon_rad,
+        g.zenith_rad,
+        g.azimuth_rad,
+        g.range_m,
+        g.for_time_us,
+        g.mid_time_us,
+        g.sc_position_m,
+        g.sc_velocity_m_s,
+        g.sc_attitude_rad,
+    )
 
 
 def test_implied_satellite_matches_propagated_ephemeris(real_geo_files):

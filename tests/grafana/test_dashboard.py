@@ -45,12 +45,16 @@ def influx(tmp_path_factory):
             lines += result_lines("cris_geolocation", sat, day, fors)
             for f in fors:
                 RELIABLE[sat][f.for_index] += f.reliable
-    change = Change(dt.datetime(2025, 2, 10, 6, tzinfo=UTC), "j01", "cris", "ep_upload", "EP V116 uploaded", "calendar")
+    change = Change(
+        dt.datetime(2025, 2, 10, 6, tzinfo=UTC), "j01", "cris", "ep_upload", "EP V116 uploaded", "calendar"
+    )
     lines += change_lines("cris_geolocation", [change])
     store.close()
     with influxdb1(tmp / "srv") as url:
         requests.post(url + "/query", data={"q": 'CREATE DATABASE "crisgeo"'}, timeout=10).raise_for_status()
-        r = requests.post(url + "/write", params={"db": "crisgeo", "precision": "s"}, data="\n".join(lines), timeout=30)
+        r = requests.post(
+            url + "/write", params={"db": "crisgeo", "precision": "s"}, data="\n".join(lines), timeout=30
+        )
         assert r.status_code == 204, r.text
         yield url
 
@@ -68,7 +72,9 @@ def test_variables(influx, dashboard):
     variables = {v["name"]: v for v in dashboard["templating"]["list"]}
     assert variables["datasource"]["query"] == "influxdb"
     assert _values(influxql(influx, "crisgeo", variables["satellite"]["query"])) == ["j01", "npp"]
-    assert _values(influxql(influx, "crisgeo", _macros(variables["for"]["query"]))) == [f"{k:02d}" for k in range(1, 31)]
+    assert _values(influxql(influx, "crisgeo", _macros(variables["for"]["query"]))) == [
+        f"{k:02d}" for k in range(1, 31)
+    ]
 
 
 def _influx_panels(dashboard):
@@ -115,10 +121,15 @@ def test_annotations_from_changes(influx, dashboard):
 
 
 def test_every_query_names_the_measurement_and_the_satellite(dashboard):
-    queries = [t["query"] for p in _influx_panels(dashboard) for t in p["targets"]] + \
-              [a["query"] for a in dashboard["annotations"]["list"]]
+    queries = [t["query"] for p in _influx_panels(dashboard) for t in p["targets"]] + [
+        a["query"] for a in dashboard["annotations"]["list"]
+    ]
     for q in queries:
-        assert re.search(r'FROM "cris_geolocation(_change)?"', q) and "/^$satellite$/" in q and "$timeFilter" in q
+        assert (
+            re.search(r'FROM "cris_geolocation(_change)?"', q)
+            and "/^$satellite$/" in q
+            and "$timeFilter" in q
+        )
 
 
 def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
@@ -139,18 +150,23 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
     store.db.execute("UPDATE runs SET finished=?", (ten_hours_ago,))  # the last success, 10 h ago
     store.finish_run(store.begin_run("j01", dt.date.today()), "failed", "HTTP 503")
     store.queue_lines("influx2:db.example", "j01", ["m x=1 1"] * 3)
-    AlertState(store).upsert(Finding("spec", "j01", "critical", "FOR 30 beyond spec"), "firing",
-                             dt.datetime.now(UTC), True)
+    AlertState(store).upsert(
+        Finding("spec", "j01", "critical", "FOR 30 beyond spec"), "firing", dt.datetime.now(UTC), True
+    )
     store.close()
     metrics = ServiceMetrics(lambda: Store(db), ["j01"], Health(300), "test")
     panels = [p for p in dashboard["panels"] if p.get("datasource", {}).get("type") == "prometheus"]
     assert {p["type"] for p in panels} == {"stat", "timeseries"} and len(panels) == 5
-    assert any(v["name"] == "prometheus" and v["query"] == "prometheus" for v in dashboard["templating"]["list"])
+    assert any(
+        v["name"] == "prometheus" and v["query"] == "prometheus" for v in dashboard["templating"]["list"]
+    )
     now = int(time.time())
     with victoria_metrics(tmp_path / "vm") as url:
         text = generate_latest(metrics.registry).decode()
         for t in (now - 3600, now - 60):
-            r = requests.post(url + "/api/v1/import/prometheus", params={"timestamp": t * 1000}, data=text, timeout=10)
+            r = requests.post(
+                url + "/api/v1/import/prometheus", params={"timestamp": t * 1000}, data=text, timeout=10
+            )
             assert r.status_code == 204, r.text
         requests.get(url + "/internal/force_flush", timeout=10)
         time.sleep(1)

@@ -8,7 +8,9 @@ from monitor.mapping.closed_loop import run_closed_loop
 
 def _check(rep):
     a2, b2, it, ct = rep.residual()
-    assert np.max(np.abs(rep.roll_error_urad)) <= 100 and np.max(np.abs(rep.pitch_error_urad)) <= 100, rep.table()
+    assert np.max(np.abs(rep.roll_error_urad)) <= 100 and np.max(np.abs(rep.pitch_error_urad)) <= 100, (
+        rep.table()
+    )
     assert np.nanmax(np.abs(a2)) <= 150 and np.nanmax(np.abs(b2)) <= 150, rep.table()
     assert np.nanmax(np.abs(it)) <= 0.15 and np.nanmax(np.abs(ct)) <= 0.15, rep.table()
     # the first assessment did see the injected error (up to ~1200 urad cross-track at FOR 30)

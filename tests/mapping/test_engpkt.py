@@ -21,14 +21,22 @@ def test_real_xml_angles_satellite_and_mounting():
     assert tuple(ep.sc_to_sbf_rad * 1e6) == pytest.approx((-145.84994, 267.42417, 594.61832))
     assert ep.time_stamp_bias_ms == -183
     npp = packaged_ep("npp")
-    assert (npp.satellite, npp.version) == ("npp", "V37") and npp.los_relative_yaw_rad == pytest.approx(-359e-6)
+    assert (npp.satellite, npp.version) == ("npp", "V37") and npp.los_relative_yaw_rad == pytest.approx(
+        -359e-6
+    )
 
 
 def test_yaml_round_trip(tmp_path):
     ep = packaged_ep("npp")
     again = load_ep(save_ep(ep, tmp_path / "ep.yaml"))
-    for name in ("ssm_crosstrack_roll_rad", "ssm_intrack_pitch_rad", "sc_to_sbf_rad", "iar_to_ssmr_rad",
-                 "fov_intrack_offset_rad", "ifr_boresight_to_ssmf_rad"):
+    for name in (
+        "ssm_crosstrack_roll_rad",
+        "ssm_intrack_pitch_rad",
+        "sc_to_sbf_rad",
+        "iar_to_ssmr_rad",
+        "fov_intrack_offset_rad",
+        "ifr_boresight_to_ssmf_rad",
+    ):
         assert np.allclose(getattr(again, name), getattr(ep, name), atol=1e-12), name
     assert again.satellite == "npp" and again.version == "V37"
 
@@ -36,8 +44,11 @@ def test_yaml_round_trip(tmp_path):
 def test_xml_output_changes_only_the_mirror_angles(tmp_path):
     src = packaged_path("j01")
     ep = load_ep(src)
-    new = ep.with_ssm_angles(ep.ssm_crosstrack_roll_rad + 123.4e-6, ep.ssm_intrack_pitch_rad - 56.6e-6,
-                             provenance={"assessment": "x.json", "note": "a -- b"})
+    new = ep.with_ssm_angles(
+        ep.ssm_crosstrack_roll_rad + 123.4e-6,
+        ep.ssm_intrack_pitch_rad - 56.6e-6,
+        provenance={"assessment": "x.json", "note": "a -- b"},
+    )
     out = save_ep(new, tmp_path / "new.xml", like=src)
     back = load_ep(out)
     assert np.allclose(back.ssm_crosstrack_roll_rad, np.round(new.ssm_crosstrack_roll_rad * 1e6) * 1e-6)
@@ -60,15 +71,29 @@ def test_shipped_configs_load():
     assert abs(d_roll[-1]) == pytest.approx(1000.0) and np.all(d_roll[:10] == 0)
 
 
-@pytest.mark.parametrize("edit, field", [
-    (lambda t: t[: len(t) // 2], "XML"),
-    (lambda t: t.replace("<ActualCrosstrackAngleRoll>844883 ", "<ActualCrosstrackAngleRoll>"),
-     "MappingParameters/ActualCrosstrackAngleRoll: expected 30 values, got 29"),
-    (lambda t: t.replace("<LosRelativeYaw>-520<", "<LosRelativeYaw>abc<"), "FovParam/Lw/LosRelativeYaw: not numbers"),
-    (lambda t: t.replace("<TimeStampBias>-183</TimeStampBias>", ""), "MappingParameters/TimeStampBias: missing"),
-    (lambda t: t.replace("<InstrumentId>4<", "<InstrumentId>9<"), "InstrumentId: 9 is not a known instrument"),
-    (lambda t: t.replace("<Pitch>310</Pitch>", "<Pitch>nan</Pitch>"), "non-finite"),
-])
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda t: t[: len(t) // 2], "XML"),
+        (
+            lambda t: t.replace("<ActualCrosstrackAngleRoll>844883 ", "<ActualCrosstrackAngleRoll>"),
+            "MappingParameters/ActualCrosstrackAngleRoll: expected 30 values, got 29",
+        ),
+        (
+            lambda t: t.replace("<LosRelativeYaw>-520<", "<LosRelativeYaw>abc<"),
+            "FovParam/Lw/LosRelativeYaw: not numbers",
+        ),
+        (
+            lambda t: t.replace("<TimeStampBias>-183</TimeStampBias>", ""),
+            "MappingParameters/TimeStampBias: missing",
+        ),
+        (
+            lambda t: t.replace("<InstrumentId>4<", "<InstrumentId>9<"),
+            "InstrumentId: 9 is not a known instrument",
+        ),
+        (lambda t: t.replace("<Pitch>310</Pitch>", "<Pitch>nan</Pitch>"), "non-finite"),
+    ],
+)
 def test_malformed_xml_names_file_and_field(tmp_path, edit, field):
     bad = tmp_path / "bad.xml"
     bad.write_text(edit(packaged_path("j01").read_text()))

@@ -41,8 +41,20 @@ def test_simulated_ep_change_is_identified(ep_geo_case, nominal_ep, error_ep, tm
 def test_cli_fingerprint_reports_the_match(real_geo_files, tmp_path, capsys):
     bad = tmp_path / "broken.xml"
     bad.write_text("<EngPkt>")
-    assert main(["fingerprint", "--json", "--ep-library", str(bad), "--ep-library",
-                 str(real_geo_files[0].parents[3] / "configs" / "ep"), *map(str, real_geo_files)]) == 0
+    assert (
+        main(
+            [
+                "fingerprint",
+                "--json",
+                "--ep-library",
+                str(bad),
+                "--ep-library",
+                str(real_geo_files[0].parents[3] / "configs" / "ep"),
+                *map(str, real_geo_files),
+            ]
+        )
+        == 0
+    )
     doc = json.loads(capsys.readouterr().out)
     assert doc["ep_match"][0]["name"] == "j01_nominal.yaml" and "broken.xml" in doc["ep_library_problems"][0]
     assert all(m["satellite"] == "j01" for m in doc["ep_match"])

@@ -15,10 +15,32 @@ from monitor.simulate.case import ep_offsets_urad
 
 def _result(d_alpha, d_beta, satellite="j01", flags=None):
     flags = flags or {}
-    fors = [ForOffset(k + 1, float(a), float(b), 5.0, 5.0, 0.0, 0.0, 0.0, 0.01, 0.01, 100, 1.0, 2.0,
-                      tuple(flags.get(k + 1, ()))) for k, (a, b) in enumerate(zip(d_alpha, d_beta))]
-    return AssessmentResult(satellite, "2024-06-01T12:00:00", "2024-06-01T12:07:28", fors,
-                            granules=[{"granule_id": "J01001"}, {"granule_id": "J01002"}])
+    fors = [
+        ForOffset(
+            k + 1,
+            float(a),
+            float(b),
+            5.0,
+            5.0,
+            0.0,
+            0.0,
+            0.0,
+            0.01,
+            0.01,
+            100,
+            1.0,
+            2.0,
+            tuple(flags.get(k + 1, ())),
+        )
+        for k, (a, b) in enumerate(zip(d_alpha, d_beta, strict=True))
+    ]
+    return AssessmentResult(
+        satellite,
+        "2024-06-01T12:00:00",
+        "2024-06-01T12:07:28",
+        fors,
+        granules=[{"granule_id": "J01001"}, {"granule_id": "J01002"}],
+    )
 
 
 def test_exact_offsets_recover_the_true_mirror_angles(nominal_ep, error_ep):
@@ -60,8 +82,22 @@ def test_cli_optimize_writes_the_ep_in_the_input_format(tmp_path, nominal_ep, er
     res = tmp_path / "result.json"
     res.write_text(_result(d_alpha, d_beta).to_json())
     from monitor.mapping.engpkt import packaged_path
-    assert main(["optimize", str(res), "--ep", str(packaged_path("j01")), "--out", str(tmp_path / "new.xml"),
-                 "--table-json", str(tmp_path / "table.json")]) == 0
+
+    assert (
+        main(
+            [
+                "optimize",
+                str(res),
+                "--ep",
+                str(packaged_path("j01")),
+                "--out",
+                str(tmp_path / "new.xml"),
+                "--table-json",
+                str(tmp_path / "table.json"),
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert "ActualCrosstrackAngleRoll" in out and "wrote" in out
     new = load_ep(tmp_path / "new.xml")
@@ -72,19 +108,25 @@ def test_cli_optimize_writes_the_ep_in_the_input_format(tmp_path, nominal_ep, er
 
 def test_cli_optimize_bad_inputs(tmp_path, capsys):
     from monitor.mapping.engpkt import packaged_path
+
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
-    assert main(["optimize", str(bad), "--ep", str(packaged_path("j01")), "--out", str(tmp_path / "x.xml")]) == 2
+    assert (
+        main(["optimize", str(bad), "--ep", str(packaged_path("j01")), "--out", str(tmp_path / "x.xml")]) == 2
+    )
     assert "not an assessment result" in capsys.readouterr().err
     res = tmp_path / "npp.json"
     res.write_text(_result(np.zeros(30), np.zeros(30), satellite="npp").to_json())
-    assert main(["optimize", str(res), "--ep", str(packaged_path("j01")), "--out", str(tmp_path / "x.xml")]) == 2
+    assert (
+        main(["optimize", str(res), "--ep", str(packaged_path("j01")), "--out", str(tmp_path / "x.xml")]) == 2
+    )
     assert "is for npp" in capsys.readouterr().err
     assert not (tmp_path / "x.xml").exists()
 
 
 def test_cli_simulate_in_ep_terms_checks_its_inputs(tmp_path, capsys):
     from monitor.mapping.engpkt import packaged_path
+
     v115, v37 = str(packaged_path("j01")), str(packaged_path("npp"))
     assert main(["simulate", "--out", str(tmp_path / "a"), "--true-ep", v115]) == 2
     assert "go together" in capsys.readouterr().err

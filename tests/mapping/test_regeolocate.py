@@ -40,7 +40,11 @@ def test_regeolocated_copy_moves_by_the_ep_difference(ep_geo_case, nominal_ep, e
     with h5py.File(out[0]) as h5:
         doc = json.loads(h5["All_Data/CrIS-SDR-GEO_All"].attrs["crisgeo_engineering_packet"])
         assert doc["version"] == error_ep.version
-        north = float(np.asarray(h5["Data_Products/CrIS-SDR-GEO/CrIS-SDR-GEO_Gran_0"].attrs["North_Bounding_Coordinate"]).ravel()[0])
+        north = float(
+            np.asarray(
+                h5["Data_Products/CrIS-SDR-GEO/CrIS-SDR-GEO_Gran_0"].attrs["North_Bounding_Coordinate"]
+            ).ravel()[0]
+        )
     assert north == pytest.approx(np.degrees(np.nanmax(new.lat_rad)), abs=1e-3)
 
 
@@ -62,6 +66,7 @@ def test_fills_are_kept_and_inputs_refused_in_place(ep_geo_case, nominal_ep, tmp
 
 def test_cli_geolocate_json_on_real_granules(real_geo_files, capsys):
     from monitor.mapping.engpkt import packaged_path
+
     assert main(["geolocate", "--ep", str(packaged_path("j01")), "--json", *map(str, real_geo_files)]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert [r["for"] for r in doc["fors"]] == list(range(1, 31))
@@ -72,9 +77,23 @@ def test_cli_regeolocate_and_wrong_satellite(ep_geo_case, tmp_path, capsys):
     case, _ = ep_geo_case
     files = list(map(str, _geo_files(case)))
     from monitor.mapping.engpkt import packaged_path
+
     assert main(["regeolocate", "--ep", str(packaged_path("npp")), "--out", str(tmp_path / "o"), *files]) == 2
     assert "granule of j01, EP V37 of npp" in capsys.readouterr().err
     bad = tmp_path / "GCRSO_j01_d20240601_t1200000_e1200300_b00001_c20240601123000000000_noac_ops.h5"
     bad.write_bytes(b"not hdf5")
-    assert main(["regeolocate", "--ep", str(packaged_path("j01")), "--out", str(tmp_path / "o"), files[0], str(bad)]) == 1
+    assert (
+        main(
+            [
+                "regeolocate",
+                "--ep",
+                str(packaged_path("j01")),
+                "--out",
+                str(tmp_path / "o"),
+                files[0],
+                str(bad),
+            ]
+        )
+        == 1
+    )
     assert "skipped" in capsys.readouterr().err and (tmp_path / "o" / _geo_files(case)[0].name).exists()

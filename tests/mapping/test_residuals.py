@@ -38,7 +38,7 @@ def test_learned_on_five_real_granules_reproduces_the_next_five(real_geo_files, 
     after = compare_with_files(v115, real_geo_files[5:], table)
     assert np.median([r.median_m for r in before]) > 20
     assert np.median([r.median_m for r in after]) <= 10 and max(r.median_m for r in after) <= 35
-    assert all(a.p99_m < b.p99_m for a, b in zip(after, before))
+    assert all(a.p99_m < b.p99_m for a, b in zip(after, before, strict=True))
     assert all(r.p99_m <= 50 for r in after[2:29])
     assert all(r.p99_m <= 80 for r in after)
     before_shift = compare_with_files(v115, real_geo_files[5:7], table)
@@ -56,22 +56,52 @@ def test_table_file_round_trip_and_cli(real_geo_files, v115, tmp_path):
     turned = back.apply(los)
     assert np.allclose(np.arctan2(turned[:, 0, 1], turned[:, 0, 2]), back.d_beta_urad * 1e-6)
     out = tmp_path / "cli.json"
-    run = subprocess.run([sys.executable, "-m", "monitor.cli", "fingerprint", *map(str, real_geo_files[:2]),
-                          "--ep", str(V115), "--write-residuals", str(out)], capture_output=True, text=True)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "monitor.cli",
+            "fingerprint",
+            *map(str, real_geo_files[:2]),
+            "--ep",
+            str(V115),
+            "--write-residuals",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert run.returncode == 0 and "wrote residual table against EP V115" in run.stdout
     assert np.allclose(residuals.load(out).d_beta_urad, back.d_beta_urad, atol=1e-3)
-    run = subprocess.run([sys.executable, "-m", "monitor.cli", "geolocate", "--ep", str(V115), "--residuals",
-                          str(out), "--json", str(real_geo_files[5])], capture_output=True, text=True)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "monitor.cli",
+            "geolocate",
+            "--ep",
+            str(V115),
+            "--residuals",
+            str(out),
+            "--json",
+            str(real_geo_files[5]),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert run.returncode == 0 and json.loads(run.stdout)["fors"][14]["median_m"] < 15
 
 
-@pytest.mark.parametrize("edit,field", [
-    (lambda d: d.pop("fors"), "fors: missing"),
-    (lambda d: d["fors"].pop(), "fors: expected 30 rows, found 29"),
-    (lambda d: d["fors"][3].update(d_beta_urad="x"), "fors\\[3\\].d_beta_urad: 'x' is not a number"),
-    (lambda d: d["fors"][3].update(d_alpha_urad=float("nan")), "fors\\[3\\].d_alpha_urad: nan"),
-    (lambda d: d["fors"][5].update({"for": 9}), "fors\\[5\\].for: expected 6, found 9"),
-])
+@pytest.mark.parametrize(
+    "edit,field",
+    [
+        (lambda d: d.pop("fors"), "fors: missing"),
+        (lambda d: d["fors"].pop(), "fors: expected 30 rows, found 29"),
+        (lambda d: d["fors"][3].update(d_beta_urad="x"), "fors\\[3\\].d_beta_urad: 'x' is not a number"),
+        (lambda d: d["fors"][3].update(d_alpha_urad=float("nan")), "fors\\[3\\].d_alpha_urad: nan"),
+        (lambda d: d["fors"][5].update({"for": 9}), "fors\\[5\\].for: expected 6, found 9"),
+    ],
+)
 def test_bad_tables_name_file_and_field(real_geo_files, v115, tmp_path, edit, field):
     doc = _table(real_geo_files[:1], v115).to_dict()
     edit(doc)
@@ -89,8 +119,23 @@ def test_own_residuals_reproduce_the_operational_geolocation(real_geo_files, v11
     that minute's servo corrections: median 2 m, p99 <= 16 m at every FOR on granules 6-10."""
     rows = compare_with_files(v115, real_geo_files[5:], residuals.OwnResiduals(v115))
     assert np.median([r.median_m for r in rows]) < 4 and max(r.p99_m for r in rows) < 20
-    run = subprocess.run([sys.executable, "-m", "monitor.cli", "regeolocate", "--ep", str(V115), "--own-residuals",
-                          str(V115), "--out", str(tmp_path), str(real_geo_files[6])], capture_output=True, text=True)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "monitor.cli",
+            "regeolocate",
+            "--ep",
+            str(V115),
+            "--own-residuals",
+            str(V115),
+            "--out",
+            str(tmp_path),
+            str(real_geo_files[6]),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert run.returncode == 0, run.stderr
     (g,) = read_file(tmp_path / real_geo_files[6].name)
     (orig,) = read_file(real_geo_files[6])

@@ -29,8 +29,21 @@ def store(tmp_path):
 
 def _calendar(tmp_path, day):
     path = tmp_path / "events.yaml"
-    path.write_text(yaml.safe_dump({"events": [{"time": f"{day}T00:00:00Z", "satellite": "j01", "instrument": "cris",
-                                                "kind": "ep_upload", "description": "EP V116 uploaded"}]}))
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "events": [
+                    {
+                        "time": f"{day}T00:00:00Z",
+                        "satellite": "j01",
+                        "instrument": "cris",
+                        "kind": "ep_upload",
+                        "description": "EP V116 uploaded",
+                    }
+                ]
+            }
+        )
+    )
     return path
 
 
@@ -55,35 +68,64 @@ def test_single_run(store, tmp_path):
 def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
     days = fill_store(store, ["j01"], dt.date(2025, 1, 1), 400, step_day=300)
     AlertState(store)  # creates its tables
-    store.db.execute("INSERT INTO alert_state VALUES ('spec:j01:x','spec','j01','x','critical','firing',"
-                     "'2025-10-28T00:00:00+00:00',NULL,NULL,'FOR 30 cross-track 2.5 km over the 1.5 km spec','[]')")
+    store.db.execute(
+        "INSERT INTO alert_state VALUES ('spec:j01:x','spec','j01','x','critical','firing',"
+        "'2025-10-28T00:00:00+00:00',NULL,NULL,'FOR 30 cross-track 2.5 km over the 1.5 km spec','[]')"
+    )
     store.db.commit()
     opts = ReportOptions(satellites=["j01"], calendar=_calendar(tmp_path, days[300]))
     build_report(store, tmp_path / "rep", opts)
     page = (tmp_path / "rep" / "j01" / "index.html").read_text()
-    assert "EP V116 uploaded" in page and "FOR 30 cross-track 2.5 km" in page and "out of specification" in page
+    assert (
+        "EP V116 uploaded" in page and "FOR 30 cross-track 2.5 km" in page and "out of specification" in page
+    )
     assert "400 day(s) shown" in page
     summary = json.loads((tmp_path / "rep" / "report.json").read_text())
     assert summary[0]["worst_for"] == 30 and summary[0]["firing"] == 1
     # --since/--until through the command line
     cfg = tmp_path / "c.yaml"
-    cfg.write_text(yaml.safe_dump({"satellites": ["j01"], "state_dir": str(tmp_path / "st"),
-                                   "source": {"kind": "simulated"}, "store": {"sqlite": str(tmp_path / "s.sqlite")}}))
-    assert main(["report", "--config", str(cfg), "--out", str(tmp_path / "r2"), "--since", "2025-03-01",
-                 "--until", "2025-03-31"]) == 0
+    cfg.write_text(
+        yaml.safe_dump(
+            {
+                "satellites": ["j01"],
+                "state_dir": str(tmp_path / "st"),
+                "source": {"kind": "simulated"},
+                "store": {"sqlite": str(tmp_path / "s.sqlite")},
+            }
+        )
+    )
+    assert (
+        main(
+            [
+                "report",
+                "--config",
+                str(cfg),
+                "--out",
+                str(tmp_path / "r2"),
+                "--since",
+                "2025-03-01",
+                "--until",
+                "2025-03-31",
+            ]
+        )
+        == 0
+    )
     assert "31 day(s) shown" in (tmp_path / "r2" / "j01" / "index.html").read_text()
     assert main(["report", "--config", str(cfg), "--since", "2025-03-31", "--until", "2025-03-01"]) == 2
 
 
 def test_report_in_headless_chromium(store, tmp_path):
     days = fill_store(store, SATS, dt.date(2025, 6, 1), 120, step_day=90)
-    build_report(store, tmp_path / "rep", ReportOptions(satellites=SATS, calendar=_calendar(tmp_path, days[90])))
+    build_report(
+        store, tmp_path / "rep", ReportOptions(satellites=SATS, calendar=_calendar(tmp_path, days[90]))
+    )
     driver = chromium_driver(tmp_path)
     try:
         for page in ["index.html"] + [f"{s}/index.html" for s in SATS]:
             driver.get((tmp_path / "rep" / page).as_uri())
             images = driver.execute_script(
-                "return Array.from(document.images).map(i => [i.src, i.complete, i.naturalWidth]);")
+                "return Array.from(document.images).map(i => [i.src, i.complete, i.naturalWidth]);"
+            )
             assert all(ok and width > 0 for _, ok, width in images), images
             if page != "index.html":
                 assert len(images) == 5

@@ -25,8 +25,16 @@ PER_PRODUCT = {"GCRSO": 350, "SCRIF": 350, "SVI05": 150, "GITCO": 150}  # 1000 m
 FAMILIES = ("dtype", "shape", "value", "attribute", "structure", "bytes", "factors", "time")
 EXTREMES = (1e28, -1e28, np.inf, -np.inf, np.nan, 0.0, -307.0, 65535, -999.3, 7e9)
 BAD_ATTRS = ("abc", "", -5, 0, 10**19, 1e300, "NPP", "J02")
-GRAN_ATTRS = ("N_Number_Of_Scans", "N_Beginning_Time_IET", "N_Ending_Time_IET", "N_Granule_ID", "Beginning_Time",
-              "Beginning_Date", "N_Beginning_Orbit_Number", "Ascending/Descending_Indicator")
+GRAN_ATTRS = (
+    "N_Number_Of_Scans",
+    "N_Beginning_Time_IET",
+    "N_Ending_Time_IET",
+    "N_Granule_ID",
+    "Beginning_Time",
+    "Beginning_Date",
+    "N_Beginning_Orbit_Number",
+    "Ascending/Descending_Indicator",
+)
 
 
 def _scratch(tmp_path_factory) -> Path:
@@ -56,7 +64,9 @@ def mutate(path: Path, prefix: str, family: str, rng) -> str:
         path.write_bytes(bytes(raw))
         return f"{len(spots)} bit flips"
     with h5py.File(path, "r+") as h5:
-        names = sorted(f"{group}/{f.dataset}" for f in product.fields.values() if f"{group}/{f.dataset}" in h5)
+        names = sorted(
+            f"{group}/{f.dataset}" for f in product.fields.values() if f"{group}/{f.dataset}" in h5
+        )
         name = names[int(rng.integers(len(names)))]
         data = h5[name][()]
         gran = f"Data_Products/{product.collection}/{product.collection}_Gran_0"
@@ -82,8 +92,11 @@ def mutate(path: Path, prefix: str, family: str, rng) -> str:
             n = int(rng.choice([1, max(1, flat.size // 50), flat.size]))
             at = rng.choice(flat.size, n, replace=False)
             with np.errstate(invalid="ignore", over="ignore"):
-                flat[at] = np.array(value).astype(flat.dtype) if flat.dtype.kind in "iu" and not np.isfinite(value) \
+                flat[at] = (
+                    np.array(value).astype(flat.dtype)
+                    if flat.dtype.kind in "iu" and not np.isfinite(value)
                     else np.array(value, dtype=np.float64).astype(flat.dtype)
+                )
             h5[name][...] = flat.reshape(data.shape)
             return f"{name}: {n} value(s) set to {value}"
         if family == "attribute":
@@ -113,7 +126,9 @@ def mutate(path: Path, prefix: str, family: str, rng) -> str:
             name = times[int(rng.integers(len(times)))]
             t = h5[name][()]
             how = int(rng.integers(3))
-            new = t - 3_600_000_000 if how == 0 else t[::-1].copy() if how == 1 else np.full_like(t, t.flat[0])
+            new = (
+                t - 3_600_000_000 if how == 0 else t[::-1].copy() if how == 1 else np.full_like(t, t.flat[0])
+            )
             h5[name][...] = new.reshape(t.shape)
             return f"{name} {['an hour early', 'reversed', 'constant'][how]}"
         h5.attrs["Platform_Short_Name"] = np.array([[b"J02"]])
@@ -157,8 +172,16 @@ def test_no_mutant_escapes_the_readers(cases, scratch):
     assert sum(outcomes.values()) == 1000 and outcomes["rejected"] > 500, outcomes
 
 
-SAMPLE = [("GCRSO", 1, "shape"), ("GCRSO", 2, "value"), ("GCRSO", 7, "time"), ("SCRIF", 1, "shape"),
-          ("SCRIF", 9, "dtype"), ("SVI05", 6, "factors"), ("GITCO", 2, "value"), ("GITCO", 4, "structure")]
+SAMPLE = [
+    ("GCRSO", 1, "shape"),
+    ("GCRSO", 2, "value"),
+    ("GCRSO", 7, "time"),
+    ("SCRIF", 1, "shape"),
+    ("SCRIF", 9, "dtype"),
+    ("SVI05", 6, "factors"),
+    ("GITCO", 2, "value"),
+    ("GITCO", 4, "structure"),
+]
 
 
 @pytest.mark.parametrize("prefix,k,family", SAMPLE)
@@ -179,6 +202,6 @@ def test_assessment_names_the_mutant_or_keeps_its_numbers(cases, tmp_path, prefi
         return
     if any(victim.name in s["item"] + s["reason"] for s in result.skipped):
         return
-    for a, b in zip(result.fors, intact.fors):
+    for a, b in zip(result.fors, intact.fors, strict=True):
         if a.reliable and b.reliable:
             assert abs(a.d_alpha_urad - b.d_alpha_urad) <= 1 and abs(a.d_beta_urad - b.d_beta_urad) <= 1, what

@@ -32,8 +32,14 @@ def test_non_jpss_names_are_rejected():
 
 def test_format_name_round_trips():
     start = dt.datetime(2024, 6, 1, 12, 0, 0, 300000, tzinfo=UTC)
-    name = format_name(["SVI05"], "j02", start, start + dt.timedelta(seconds=85.7), 123,
-                       dt.datetime(2024, 6, 1, 13, tzinfo=UTC))
+    name = format_name(
+        ["SVI05"],
+        "j02",
+        start,
+        start + dt.timedelta(seconds=85.7),
+        123,
+        dt.datetime(2024, 6, 1, 13, tzinfo=UTC),
+    )
     p = parse_name(name)
     assert p.platform == "j02" and p.start == start and p.orbit == 123
 
@@ -48,11 +54,14 @@ def test_iet_matches_real_granule_attributes(real_geo_files):
     assert iet.datetime_to_iet(expected) == start_iet
 
 
-@pytest.mark.parametrize("when,offset_s", [
-    (dt.datetime(2016, 12, 31, 23, 59, 59, tzinfo=UTC), 36),
-    (dt.datetime(2017, 1, 1, 0, 0, 0, tzinfo=UTC), 37),
-    (dt.datetime(2012, 6, 30, 12, 0, 0, tzinfo=UTC), 34),
-])
+@pytest.mark.parametrize(
+    "when,offset_s",
+    [
+        (dt.datetime(2016, 12, 31, 23, 59, 59, tzinfo=UTC), 36),
+        (dt.datetime(2017, 1, 1, 0, 0, 0, tzinfo=UTC), 37),
+        (dt.datetime(2012, 6, 30, 12, 0, 0, tzinfo=UTC), 34),
+    ],
+)
 def test_leap_seconds_around_changes(when, offset_s):
     naive_us = int((when - iet.IET_EPOCH).total_seconds()) * 1_000_000
     assert iet.datetime_to_iet(when) - naive_us == offset_s * 1_000_000

@@ -82,11 +82,14 @@ def test_wrong_axis0_is_reported(real_geo_files, tmp_path):
         read_file(f)
 
 
-@pytest.mark.parametrize("dataset,value,reason", [
-    ("Latitude", 1e28, r"value 1e\+28 outside -90..90"),
-    ("SatelliteRange", 10.0, r"value 10 outside 700000..4e\+06"),
-    ("SCPosition", 7e9, "vector length .* outside"),
-])
+@pytest.mark.parametrize(
+    "dataset,value,reason",
+    [
+        ("Latitude", 1e28, r"value 1e\+28 outside -90..90"),
+        ("SatelliteRange", 10.0, r"value 10 outside 700000..4e\+06"),
+        ("SCPosition", 7e9, "vector length .* outside"),
+    ],
+)
 def test_out_of_range_values_are_refused(real_geo_files, tmp_path, dataset, value, reason):
     f = _copy(real_geo_files[0], tmp_path / real_geo_files[0].name)
     with h5py.File(f, "r+") as h5:
@@ -112,7 +115,9 @@ def test_times_and_platform_must_match_the_granule(real_geo_files, tmp_path):
         read_file(f)
     f = _copy(real_geo_files[2], tmp_path / real_geo_files[2].name)
     with h5py.File(f, "r+") as h5:
-        h5["Data_Products/CrIS-SDR-GEO/CrIS-SDR-GEO_Gran_0"].attrs["N_Number_Of_Scans"] = np.array([[b"four"]])
+        h5["Data_Products/CrIS-SDR-GEO/CrIS-SDR-GEO_Gran_0"].attrs["N_Number_Of_Scans"] = np.array(
+            [[b"four"]]
+        )
     with pytest.raises(GranuleError, match="N_Number_Of_Scans: not a number: 'four'"):
         read_file(f)
 
@@ -141,11 +146,15 @@ def test_aggregated_file_splits_into_granules(real_geo_files, tmp_path):
             attrs.append(_gran_attrs(h5, "CrIS-SDR-GEO"))
     data = {k: np.concatenate(v) for k, v in data.items()}
     out = tmp_path / "GCRSO_j01_d20181022_t0023599_e0025337_b04790_c20181022010000000000_noac_ops.h5"
-    write_file(out, "j01", dt.datetime(2018, 10, 22, 1, tzinfo=dt.timezone.utc),
-               [ProductData(product, "CrIS", "GEO", data, attrs, {k: 4 for k in data})])
+    write_file(
+        out,
+        "j01",
+        dt.datetime(2018, 10, 22, 1, tzinfo=dt.timezone.utc),
+        [ProductData(product, "CrIS", "GEO", data, attrs, {k: 4 for k in data})],
+    )
     grans = read_file(out)
     assert [g.meta.granule_id for g in grans] == [read_file(f)[0].meta.granule_id for f in real_geo_files[:3]]
-    for g, f in zip(grans, real_geo_files[:3]):
+    for g, f in zip(grans, real_geo_files[:3], strict=True):
         single = read_file(f)[0]
         np.testing.assert_array_equal(g.lat_rad, single.lat_rad)
         np.testing.assert_array_equal(g.for_time_us, single.for_time_us)
@@ -218,8 +227,13 @@ def test_gitco_height_is_read_and_checked(cases, tmp_path):
     assert geo.height_m.shape == geo.lat_rad.shape
     assert np.array_equal(np.isnan(geo.height_m), np.isnan(geo.lat_rad))  # fill only where the pixel is fill
     for dataset, edit, reason in (
-            ("Height", lambda h: np.where(np.arange(h.shape[1]) == 3000, np.float32(-999.3), h), "fill or non-finite"),
-            ("Height", lambda h: np.where(h > -999, np.float32(12000.0), h), "outside -500..9000 m")):
+        (
+            "Height",
+            lambda h: np.where(np.arange(h.shape[1]) == 3000, np.float32(-999.3), h),
+            "fill or non-finite",
+        ),
+        ("Height", lambda h: np.where(h > -999, np.float32(12000.0), h), "outside -500..9000 m"),
+    ):
         bad = _copy(src, tmp_path / src.name)
         _edit(bad, dataset, edit)
         with pytest.raises(GranuleError, match=f"{bad.name}: .*/Height: .*{reason}"):
@@ -241,8 +255,12 @@ def test_gimgo_pixels_are_on_the_ellipsoid(cases, tmp_path):
         data = {k: v[()] for k, v in h5[p.data_group].items() if k != "Height"}
         attrs = _gran_attrs(h5, p.collection)
     dst = tmp_path / src.name.replace("GITCO_", "GIMGO_")
-    write_file(dst, "j01", dt.datetime(2024, 6, 1, tzinfo=dt.timezone.utc),
-               [ProductData(PRODUCTS["GIMGO"], "VIIRS", "GEO", data, [attrs], {}, fills={}, compress=False)])
+    write_file(
+        dst,
+        "j01",
+        dt.datetime(2024, 6, 1, tzinfo=dt.timezone.utc),
+        [ProductData(PRODUCTS["GIMGO"], "VIIRS", "GEO", data, [attrs], {}, fills={}, compress=False)],
+    )
     (geo,) = read_file(dst)
     assert np.all(geo.height_m == 0) and read_viirs_geo_scan(dst, 0)[2].max() == 0
 

@@ -17,7 +17,9 @@ def test_paper_profile_shape():
 
 def test_profile_from_file_and_bad_profiles(tmp_path):
     f = tmp_path / "p.json"
-    f.write_text(json.dumps({"fors": [{"for": k, "d_alpha_urad": k, "d_beta_urad": -k} for k in range(1, 31)]}))
+    f.write_text(
+        json.dumps({"fors": [{"for": k, "d_alpha_urad": k, "d_beta_urad": -k} for k in range(1, 31)]})
+    )
     a, b = load_profile(str(f))
     assert a[4] == 5 and b[4] == -5
     f.write_text(json.dumps({"d_alpha_urad": [1] * 29, "d_beta_urad": [1] * 30}))

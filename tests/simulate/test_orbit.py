@@ -18,8 +18,17 @@ def _sub_point(orbit, t):
     return np.degrees(lat), np.degrees(lon), h, v
 
 
-@pytest.mark.parametrize("lat,ascending,lon", [(-14, True, None), (14, False, None), (60, True, None),
-                                               (-60, False, None), (14, False, 180.0), (0, True, -75.0)])
+@pytest.mark.parametrize(
+    "lat,ascending,lon",
+    [
+        (-14, True, None),
+        (14, False, None),
+        (60, True, None),
+        (-60, False, None),
+        (14, False, 180.0),
+        (0, True, -75.0),
+    ],
+)
 def test_find_pass_puts_the_satellite_where_asked(lat, ascending, lon):
     sat = satellite("j01")
     t = find_pass(sat, T0, lat, ascending, lon)
@@ -29,7 +38,9 @@ def test_find_pass_puts_the_satellite_where_asked(lat, ascending, lon):
     assert (v[2] > 0) == ascending
     assert h == pytest.approx(sat.altitude_m, abs=25e3)  # the ellipsoid is not a sphere
     if lon is not None:
-        assert abs((glon - lon + 180) % 360 - 180) < 1.5  # the 16-day repeat brings every longitude within ~1 deg
+        assert (
+            abs((glon - lon + 180) % 360 - 180) < 1.5
+        )  # the 16-day repeat brings every longitude within ~1 deg
 
 
 def test_satellites_have_distinct_orbits_and_local_time():

@@ -22,7 +22,9 @@ def test_terrain_heights_land_and_slopes(scene):
     assert 1000 < np.percentile(h[land], 75) and np.percentile(h[land], 99) > 3000  # ranges of 1-4 km
     step = 200.0 / wgs84.A_M  # slopes on a 200 m grid around a high point
     k = np.argmax(h)
-    la, lo = np.meshgrid(lat[k] + step * np.arange(-50, 51), lon[k] + step * np.arange(-50, 51), indexing="ij")
+    la, lo = np.meshgrid(
+        lat[k] + step * np.arange(-50, 51), lon[k] + step * np.arange(-50, 51), indexing="ij"
+    )
     gy, gx = np.gradient(scene.height_m(la, lo), 200.0, 200.0 * np.cos(lat[k]))
     assert np.hypot(gx, gy).max() < MAX_SLOPE * 1.1
     assert np.all(Scene(3).height_m(lat[:10], lon[:10]) == 0)  # no terrain unless asked
@@ -41,7 +43,9 @@ def test_scene_is_continuous_across_the_antimeridian_and_poles(scene):
 def test_rays_meet_the_terrain_on_their_line(scene):
     rng = np.random.default_rng(1)
     sat = wgs84.geodetic_to_ecef(0.6, 2.0, 833e3)
-    ground = wgs84.geodetic_to_ecef(0.6 + rng.uniform(-0.15, 0.15, 20_000), 2.0 + rng.uniform(-0.2, 0.2, 20_000))
+    ground = wgs84.geodetic_to_ecef(
+        0.6 + rng.uniform(-0.15, 0.15, 20_000), 2.0 + rng.uniform(-0.2, 0.2, 20_000)
+    )
     los = (ground - sat) / np.linalg.norm(ground - sat, axis=1, keepdims=True)
     t, lat, lon, h = intersect_terrain(sat, los, scene.height_m, MAX_HEIGHT_M)
     point = wgs84.geodetic_to_ecef(lat, lon, h)

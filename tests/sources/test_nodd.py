@@ -13,7 +13,12 @@ from monitor.sources.nodd import NoddSource
 from tests.servers import S3Server
 
 DAY = dt.date(2024, 6, 1)
-FOLDER = {"GCRSO": "CrIS-SDR-GEO", "SCRIF": "CrIS-FS-SDR", "SVI05": "VIIRS-I5-SDR", "GITCO": "VIIRS-IMG-GEO-TC"}
+FOLDER = {
+    "GCRSO": "CrIS-SDR-GEO",
+    "SCRIF": "CrIS-FS-SDR",
+    "SVI05": "VIIRS-I5-SDR",
+    "GITCO": "VIIRS-IMG-GEO-TC",
+}
 
 
 @pytest.fixture(scope="module")
@@ -36,8 +41,9 @@ def bucket(cases, tmp_path_factory):
 
 
 def _source(url, tmp_path, **kw):
-    cfg = SourceConfig(kind="nodd", endpoint=url + "/{bucket}", **{"retries": 2, "backoff_s": 0.01, "timeout_s": 10,
-                                                                   **kw})
+    cfg = SourceConfig(
+        kind="nodd", endpoint=url + "/{bucket}", **{"retries": 2, "backoff_s": 0.01, "timeout_s": 10, **kw}
+    )
     return NoddSource(cfg, tmp_path / "cache")
 
 
@@ -109,6 +115,7 @@ def test_unreachable_server_is_a_source_error(tmp_path):
 
 def _timed(fn):
     import tracemalloc
+
     tracemalloc.start()
     t0 = time.monotonic()
     try:
@@ -123,7 +130,9 @@ def _timed(fn):
 def test_endless_and_repeated_continuation_tokens_end(bucket, tmp_path):
     with S3Server(bucket, page_size=1) as s3:
         s3.endless_tokens = True
-        secs, peak, why = _timed(lambda: _source(s3.url, tmp_path, max_list_pages=20).list_day("j01", DAY, ("GCRSO",)))
+        secs, peak, why = _timed(
+            lambda: _source(s3.url, tmp_path, max_list_pages=20).list_day("j01", DAY, ("GCRSO",))
+        )
         assert "more than 20 pages" in why and secs < 10 and peak < 20e6
         assert sum("continuation-token" in r for r in s3.requests) == 19
     with S3Server(bucket, page_size=1) as s3:
@@ -139,10 +148,13 @@ def test_a_huge_retry_after_is_not_waited_for(bucket, tmp_path):
         assert "Retry-After 3600 s, more than the 120 s allowed" in why and secs < 5 and len(s3.requests) == 1
 
 
-@pytest.mark.parametrize("bound,reason,limit_s", [
-    ({"min_rate_kb_s": 1000.0}, "slower than 1000 kB/s", 45),
-    ({"run_deadline_min": 0.02}, "run deadline of 0.02 min has passed", 5),
-])
+@pytest.mark.parametrize(
+    "bound,reason,limit_s",
+    [
+        ({"min_rate_kb_s": 1000.0}, "slower than 1000 kB/s", 45),
+        ({"run_deadline_min": 0.02}, "run deadline of 0.02 min has passed", 5),
+    ],
+)
 def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s):
     """By the minimum rate of each download, or by the run deadline, whichever comes first."""
     with S3Server(bucket) as s3:
@@ -187,9 +199,13 @@ def test_odd_keys_never_shadow_the_granule(bucket, tmp_path):
         genuine = _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",))
         g = next(f.name for f in genuine if "_c2024" in f.name)
         newer = g.replace("_c2024", "_c2099")
-        s3.extra_keys = [folder + "./" + newer, folder + "sub/../" + newer, folder + newer.replace("_t12", "_t\u0661\u0662"),
-                         folder + g.replace("_t1200", "_t1299").replace("_e1200", "_e1299"),
-                         folder + newer.replace("_c2099", "_c2098")]
+        s3.extra_keys = [
+            folder + "./" + newer,
+            folder + "sub/../" + newer,
+            folder + newer.replace("_t12", "_t\u0661\u0662"),
+            folder + g.replace("_t1200", "_t1299").replace("_e1200", "_e1299"),
+            folder + newer.replace("_c2099", "_c2098"),
+        ]
         s3.extra_sizes = {folder + newer.replace("_c2099", "_c2098"): "\u00b2"}
         files = _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",))
     assert sorted(f.name for f in files) == sorted(f.name for f in genuine)

@@ -29,8 +29,14 @@ def test_save_day_replaces_and_queues(cases, tmp_path):
     s = Store(tmp_path / "c.sqlite")
     for _ in range(2):
         run = s.begin_run("j01", DAY)
-        s.save_day(run, "j01", DAY, result, [{"granule": "g", "score_k": 1.0, "decision": "chosen"}],
-                   {"influx2:http://x": ["m f=1 1"] * 30})
+        s.save_day(
+            run,
+            "j01",
+            DAY,
+            result,
+            [{"granule": "g", "score_k": 1.0, "decision": "chosen"}],
+            {"influx2:http://x": ["m f=1 1"] * 30},
+        )
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
     assert s.outbox_size() == 30 and len(s.granules("j01", DAY)) == 2
     assert [r["status"] for r in s.runs("j01")] == ["ok", "ok"]
@@ -68,11 +74,17 @@ def test_outbox_delivery_bookkeeping(tmp_path):
     assert s.done_days("j01") == {DAY}
 
 
-@pytest.mark.parametrize("content,reason", [(b"", "empty file, not a crisgeo store"),
-                                            (b"SQLite format 3\x00" + bytes(range(256)) * 20, "not a usable"),
-                                            (b"not a database at all" * 100, "not a usable")])
+@pytest.mark.parametrize(
+    "content,reason",
+    [
+        (b"", "empty file, not a crisgeo store"),
+        (b"SQLite format 3\x00" + bytes(range(256)) * 20, "not a usable"),
+        (b"not a database at all" * 100, "not a usable"),
+    ],
+)
 def test_an_unusable_store_is_refused_and_left_as_it_is(tmp_path, content, reason):
     from monitor.store.sqlite import StoreError
+
     path = tmp_path / "store.sqlite"
     path.write_bytes(content)
     with pytest.raises(StoreError, match=f"{path}: {reason}"):
@@ -82,6 +94,7 @@ def test_an_unusable_store_is_refused_and_left_as_it_is(tmp_path, content, reaso
 
 def test_a_foreign_sqlite_file_is_refused(tmp_path):
     from monitor.store.sqlite import StoreError
+
     db = sqlite3.connect(tmp_path / "other.sqlite")
     db.execute("CREATE TABLE t (x)")
     db.close()
@@ -92,14 +105,21 @@ def test_a_foreign_sqlite_file_is_refused(tmp_path):
 def test_cli_reports_a_corrupt_store_in_one_line(tmp_path):
     import subprocess
     import sys
+
     (tmp_path / "state").mkdir()
     (tmp_path / "state" / "crisgeo.sqlite").write_bytes(b"garbage" * 500)
     cfg = tmp_path / "c.yaml"
-    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n")
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "alerts", "list", "--config", str(cfg)],
-                       capture_output=True, text=True)
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+    )
+    r = subprocess.run(
+        [sys.executable, "-m", "monitor.cli", "alerts", "list", "--config", str(cfg)],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "crisgeo.sqlite: not a usable crisgeo store" in r.stderr
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "status", "--config", str(cfg)],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "monitor.cli", "status", "--config", str(cfg)], capture_output=True, text=True
+    )
     assert r.returncode == 3 and "UNKNOWN" in r.stderr  # status speaks Nagios

@@ -14,8 +14,14 @@ DAY = dt.date(2024, 6, 1)
 
 def _queue(store, cfg, result, day=DAY):
     run = store.begin_run("j01", day)
-    store.save_day(run, "j01", day, result, [], {target_name(cfg): result_lines(cfg.measurement, "j01", day,
-                                                                                 result.fors)})
+    store.save_day(
+        run,
+        "j01",
+        day,
+        result,
+        [],
+        {target_name(cfg): result_lines(cfg.measurement, "j01", day, result.fors)},
+    )
 
 
 def test_lines_have_fixed_types_and_skip_non_finite(cases):
@@ -49,8 +55,11 @@ def test_influxdb1_over_write_endpoint_read_back_with_influxql(cases, tmp_path):
         store = Store(tmp_path / "s.sqlite")
         _queue(store, cfg, result)
         assert drain_outbox(store, [cfg])[target_name(cfg)] == (30, 0)
-        rows = influxql(url, "crisgeo", 'SELECT "cross_track_km", "n_samples" FROM "cris_geolocation" '
-                                       'WHERE "for" = \'30\'')[0]["values"]
+        rows = influxql(
+            url,
+            "crisgeo",
+            'SELECT "cross_track_km", "n_samples" FROM "cris_geolocation" WHERE "for" = \'30\'',
+        )[0]["values"]
         assert len(rows) == 1 and rows[0][0] == 1717200000
         assert rows[0][1] == pytest.approx(result.fors[29].cross_track_km) and rows[0][2] == 72
         # the v2 API is missing on InfluxDB 1.6: the client's 404 is a PublishError, not a crash
@@ -78,20 +87,25 @@ def test_server_down_then_up_nothing_lost_nothing_twice(cases, tmp_path):
 def test_known_changes_reach_influxdb_for_annotations(tmp_path):
     from monitor.config import load_config
     from monitor.pipeline import publish_changes
+
     (tmp_path / "events.yaml").write_text(
         "events:\n  - {time: '2024-05-20T08:00:00Z', satellite: j01, instrument: viirs, kind: lut_change,\n"
-        "     description: VIIRS-SDR-GEO-IMG-PARAM-LUT update}\n")
+        "     description: VIIRS-SDR-GEO-IMG-PARAM-LUT update}\n"
+    )
     with influxdb1(tmp_path / "influx") as url:
         (tmp_path / "c.yaml").write_text(
             f"satellites: [j01]\nstate_dir: {tmp_path / 'st'}\nsource: {{kind: simulated}}\n"
             f"store: {{publish: [{{kind: influx1, url: '{url}', database: crisgeo}}]}}\n"
-            "alerts: {events_file: events.yaml}\n")
+            "alerts: {events_file: events.yaml}\n"
+        )
         cfg = load_config(tmp_path / "c.yaml")
         store = Store(cfg.store.sqlite)
         publish_changes(cfg, store, "j01")
         publish_changes(cfg, store, "j01")  # re-sent after every run: overwrites, never duplicates
         assert drain_outbox(store, cfg.store.publish)[target_name(cfg.store.publish[0])] == (2, 0)
-        (series,) = influxql(url, "crisgeo", 'SELECT "description", "instrument" FROM "cris_geolocation_change"')
+        (series,) = influxql(
+            url, "crisgeo", 'SELECT "description", "instrument" FROM "cris_geolocation_change"'
+        )
         assert series["values"] == [[1716192000, "VIIRS-SDR-GEO-IMG-PARAM-LUT update", "viirs"]]
 
 
@@ -104,12 +118,15 @@ def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
 
     from monitor.config import load_config
     from monitor.service import Service
+
     _, _, result = cases.get()
     with victoria_metrics(tmp_path / "vm") as url:
         cfg_file = tmp_path / "c.yaml"
-        cfg_file.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: "
-                            f"{tmp_path}}}\nstore: {{drain_minutes: 0.02, publish: [{{kind: influx2, url: '{url}', "
-                            f"bucket: crisgeo}}]}}\n")
+        cfg_file.write_text(
+            f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: "
+            f"{tmp_path}}}\nstore: {{drain_minutes: 0.02, publish: [{{kind: influx2, url: '{url}', "
+            f"bucket: crisgeo}}]}}\n"
+        )
         service = Service(load_config(cfg_file))
         store = service.store()
         _queue(store, service.cfg.store.publish[0], result)
@@ -121,13 +138,17 @@ def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
         scheduler.start()
         try:
             deadline = time.monotonic() + 30
-            while store.outbox_size(target_name(service.cfg.store.publish[0])) and time.monotonic() < deadline:
+            while (
+                store.outbox_size(target_name(service.cfg.store.publish[0])) and time.monotonic() < deadline
+            ):
                 time.sleep(0.2)
         finally:
             scheduler.shutdown(wait=True)
         assert store.outbox_size(target_name(service.cfg.store.publish[0])) == 0
         assert len(vm_export(url, "cris_geolocation_d_beta_urad")) == 30
-        assert not store.runs("j01") or all(r["status"] != "ok" or r["day"] == str(DAY) for r in store.runs("j01"))
+        assert not store.runs("j01") or all(
+            r["status"] != "ok" or r["day"] == str(DAY) for r in store.runs("j01")
+        )
 
 
 def test_a_rerun_day_keeps_one_value_per_series_with_dedup(cases, tmp_path):
