@@ -28,6 +28,8 @@ KIND_RE = re.compile(r"^(?P<kind>.+?-LUT)_(?P<plat>npp|j0\d)_")
 
 @dataclass(frozen=True)
 class Change:
+    """A known change: when, satellite, instrument (cris, viirs, common), kind, description, origin."""
+
     time: dt.datetime
     satellite: str
     instrument: str  # cris, viirs or common (both: spacecraft-level geolocation LUT)
@@ -36,6 +38,7 @@ class Change:
     origin: str  # calendar, metadata, fingerprint
 
     def label(self) -> str:
+        """The change in a few words, for messages and plots."""
         who = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS and VIIRS (common geolocation)"}[
             self.instrument
         ]
@@ -167,6 +170,7 @@ def stored_changes(store, satellite: str) -> list[Change]:
 
 
 def all_changes(store, satellite: str, calendar_path=None) -> list[Change]:
+    """Every known change of *satellite*, in time order: the calendar, the metadata, the recorded events."""
     cal = [c for c in load_calendar(calendar_path) if c.satellite == satellite] if calendar_path else []
     return sorted(
         cal + metadata_changes(store, satellite) + stored_changes(store, satellite), key=lambda c: c.time

@@ -36,12 +36,15 @@ class Permanent(Exception):
 
 
 class LogChannel:
+    """Appends each message to a file (a channel that cannot fail)."""
+
     name = "log"
 
     def __init__(self, path: Path):
         self.path = Path(path)
 
     def send(self, msg):
+        """Append *message* to the log file."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with open(self.path, "a") as fh:
             fh.write(
@@ -51,12 +54,15 @@ class LogChannel:
 
 
 class EmailChannel:
+    """SMTP with STARTTLS and a verified certificate; the trend plot attached."""
+
     name = "email"
 
     def __init__(self, settings):
         self.s = settings
 
     def send(self, msg):
+        """Send *message* as a multipart e-mail; raises on failure (the queue retries)."""
         s = self.s
         m = EmailMessage()
         m["Subject"] = msg["subject"]
@@ -99,6 +105,7 @@ class SlackChannel:
         self.sleep = sleep
 
     def send(self, msg):
+        """Post *message* to the webhook; raises on failure (the queue retries)."""
         url = secret(self.s.webhook_env)
         if not url:
             raise Permanent(f"Slack webhook: environment variable {self.s.webhook_env} is not set")
@@ -140,6 +147,7 @@ class SlackChannel:
 
 
 def make_channels(settings) -> dict:
+    """The channels the settings configure, by name."""
     out = {}
     if settings.log:
         out["log"] = LogChannel(settings.log)

@@ -28,6 +28,7 @@ UTC = dt.timezone.utc
 
 
 def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
+    """Every rule's findings for *satellite* at *now*."""
     s = settings.rules
     out = [
         f
@@ -201,6 +202,7 @@ def deliver(store, settings, now: dt.datetime | None = None, channels=None) -> d
 
 
 def evaluate_and_deliver(store, settings, satellites, now=None) -> dict:
+    """Evaluate the rules, queue, deliver; the counts (queued, sent, failed)."""
     queued = evaluate(store, settings, satellites, now)
     counts = deliver(store, settings, now)
     counts["queued"] = len(queued)

@@ -30,6 +30,8 @@ GROUPS = {
 
 @dataclass
 class RuleSettings:
+    """The rule parameters (docs/configuration.md, alerts.*)."""
+
     spec_km: float = 1.5
     min_jump_km: float = 0.25
     jump_z: float = 5.0  # blind search, any day of the recent window
@@ -48,6 +50,8 @@ class RuleSettings:
 
 @dataclass
 class Finding:
+    """What a rule found: rule, satellite, severity, summary, detail lines, group."""
+
     rule: str
     satellite: str
     severity: str
@@ -58,6 +62,7 @@ class Finding:
 
     @property
     def fingerprint(self) -> str:
+        """rule:satellite:group, the identity the alert state tracks."""
         return f"{self.rule}:{self.satellite}:{self.group}"
 
 
@@ -206,6 +211,7 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
 
 
 def jump_findings(store, satellite: str, changes: list, s: RuleSettings, today: dt.date) -> list[Finding]:
+    """A finding per recent step in the FOR-group series, attributed to the change before it."""
     days, values = _series(store, satellite)
     jumps = detect_jumps(days, values, sorted({c.time.date() for c in changes}), s)
     out = []

@@ -16,6 +16,8 @@ class AlertConfigError(ValueError):
 
 @dataclass
 class EmailSettings:
+    """The ``alerts.email`` section."""
+
     host: str
     port: int = 587
     sender: str = "crisgeo@localhost"
@@ -29,6 +31,8 @@ class EmailSettings:
 
 @dataclass
 class SlackSettings:
+    """The ``alerts.slack`` section."""
+
     webhook_env: str
     retries: int = 3
     max_wait_s: float = 30.0
@@ -37,6 +41,8 @@ class SlackSettings:
 
 @dataclass
 class AlertSettings:
+    """The ``alerts`` section, validated."""
+
     rules: RuleSettings
     log: Path | None = None
     email: EmailSettings | None = None
@@ -48,6 +54,7 @@ class AlertSettings:
 
     @property
     def channels(self) -> list[str]:
+        """The names of the configured channels."""
         return [n for n in ("log", "email", "slack") if getattr(self, n)]
 
 
@@ -174,4 +181,5 @@ def load_alert_settings(
 
 
 def secret(name: str | None) -> str | None:
+    """The value of the environment variable *name*, or None."""
     return os.environ.get(name) if name else None

@@ -36,6 +36,7 @@ def _iso(text: str) -> dt.datetime:
 
 
 def cmd_simulate(args) -> int:
+    """crisgeo simulate: write a simulated case."""
     from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
 
     where = dict(terrain=args.terrain, orbit_pass=args.orbit_pass, pass_lon_deg=args.pass_lon)
@@ -100,6 +101,7 @@ def _residuals(args):
 
 
 def cmd_optimize(args) -> int:
+    """crisgeo optimize: new scene-mirror angles from an assessment."""
     import json
 
     from monitor.mapping.engpkt import save_ep
@@ -128,6 +130,7 @@ def cmd_optimize(args) -> int:
 
 
 def cmd_regeolocate(args) -> int:
+    """crisgeo regeolocate: GEO copies geolocated with another EP."""
     from monitor.mapping.regeolocate import regeolocate_file
     from monitor.sdr import GranuleError
 
@@ -147,6 +150,7 @@ def cmd_regeolocate(args) -> int:
 
 
 def cmd_geolocate(args) -> int:
+    """crisgeo geolocate: an EP's geolocation against the files' own, per FOR."""
     import json
 
     from monitor.mapping.regeolocate import compare_with_files
@@ -201,6 +205,7 @@ def format_table(result) -> str:
 
 
 def cmd_assess(args) -> int:
+    """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assess import AssessConfig, assess_paths
     from monitor.errors import DataError
     from monitor.sdr.pairing import PlanError
@@ -233,6 +238,7 @@ def _load(args):
 
 
 def cmd_install_files(args) -> int:
+    """crisgeo install-files: copy the shipped files out."""
     from monitor.install import install_files, kept_files
 
     kept = [] if args.force else kept_files(args.dest)
@@ -244,6 +250,7 @@ def cmd_install_files(args) -> int:
 
 
 def cmd_check_config(args) -> int:
+    """crisgeo check-config: validate and print the effective configuration, or the reference."""
     import yaml
 
     from monitor.config import effective
@@ -260,6 +267,7 @@ def cmd_check_config(args) -> int:
 
 
 def cmd_export(args) -> int:
+    """crisgeo export: the results as NetCDF or CSV."""
     from monitor.export import export
     from monitor.store.sqlite import Store
 
@@ -288,6 +296,7 @@ def _day(text: str) -> dt.date:
 
 
 def cmd_run(args) -> int:
+    """crisgeo run: one run of the daily job, then exit."""
     from monitor.service import AlreadyRunning, Service
 
     cfg = _load(args)
@@ -323,6 +332,7 @@ def cmd_run(args) -> int:
 
 
 def cmd_daemon(args) -> int:
+    """crisgeo daemon: the long-running service."""
     from monitor.service import AlreadyRunning, Service
 
     cfg = _load(args)
@@ -380,6 +390,7 @@ def status_report(cfg, store) -> dict:
 
 
 def cmd_status(args) -> int:
+    """crisgeo status: the state of every satellite, as text or JSON, with Nagios exit codes."""
     import json
 
     from monitor.config import ConfigError
@@ -427,6 +438,7 @@ def cmd_status(args) -> int:
 
 
 def cmd_alerts(args) -> int:
+    """crisgeo alerts: list, silence, evaluate."""
     from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts
     from alerts.settings import AlertConfigError
     from monitor.service import Service
@@ -466,6 +478,7 @@ def cmd_alerts(args) -> int:
 
 
 def cmd_events(args) -> int:
+    """crisgeo events: list the known changes, or add one to the calendar."""
     from alerts.changes import Change, add_to_calendar, all_changes
     from monitor.service import Service
     from monitor.store.sqlite import Store
@@ -494,6 +507,7 @@ def cmd_events(args) -> int:
 
 
 def cmd_fingerprint(args) -> int:
+    """crisgeo fingerprint: the per-FOR LOS fingerprint of GEO files."""
     import json
 
     from monitor import fingerprint as fpr
@@ -574,6 +588,7 @@ def _geo_platform(files):
 
 
 def cmd_report(args) -> int:
+    """crisgeo report: write the HTML report."""
     import time
 
     from alerts.settings import AlertConfigError
@@ -602,6 +617,7 @@ def cmd_report(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    """crisgeo bench: time each stage on a simulated case."""
     from monitor.bench import run_bench
 
     return run_bench(args)
@@ -611,6 +627,7 @@ class JsonFormatter(logging.Formatter):
     """One JSON object per line: time (UTC, ISO 8601), level, logger, message (and the exception)."""
 
     def format(self, record):
+        """One JSON object per record: time, level, logger, message (and the exception)."""
         import json
 
         doc = {
@@ -642,6 +659,7 @@ def setup_logging(verbose: bool, log_format: str) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every subcommand."""
     from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
     from monitor.satellites import SATELLITES
     from monitor.simulate.orbit import PASSES
@@ -851,6 +869,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """The crisgeo command: parse, set up logging, run the subcommand; its exit status."""
     from monitor.store.sqlite import StoreError
 
     parser = build_parser()

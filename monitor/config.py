@@ -29,6 +29,8 @@ class ConfigError(ValueError):
 
 @dataclass
 class SourceConfig:
+    """The ``source`` section (docs/configuration.md)."""
+
     kind: str  # simulated | local | nodd
     path: Path | None = None
     endpoint: str = "https://{bucket}.s3.amazonaws.com"
@@ -50,6 +52,8 @@ class SourceConfig:
 
 @dataclass
 class ScheduleConfig:
+    """The ``schedule`` section."""
+
     time_utc: dt.time = dt.time(3, 30)
     catch_up_days: int = 7
     misfire_grace_hours: float = 6.0
@@ -60,6 +64,8 @@ class ScheduleConfig:
 
 @dataclass
 class SceneConfig:
+    """The ``scenes`` section."""
+
     candidates: int = 40
     keep: int = 14
     min_inhomogeneity_k: float = 0.5
@@ -67,6 +73,8 @@ class SceneConfig:
 
 @dataclass
 class FingerprintConfig:
+    """The ``fingerprint`` section."""
+
     granules: int = 100  # GEO granules per day, spread over the day
     threshold_urad: float = 10.0
     ep_library: tuple = ()  # EP files/directories to identify the EP from; empty: the packaged real EPs
@@ -74,6 +82,8 @@ class FingerprintConfig:
 
 @dataclass
 class AssessmentConfig:
+    """The ``assessment`` section."""
+
     half_steps: int = DEFAULT_HALF_STEPS
     step_urad: float = DEFAULT_STEP_URAD
     kernel: str = "top-hat"
@@ -82,6 +92,8 @@ class AssessmentConfig:
 
 @dataclass
 class PublishConfig:
+    """One entry of ``store.publish``."""
+
     kind: str  # influx2 | influx1
     url: str
     measurement: str = "cris_geolocation"
@@ -94,12 +106,15 @@ class PublishConfig:
     timeout_s: float = 30.0
 
     def secret(self, key: str) -> str | None:
+        """The value of the environment variable named by *key* (e.g. token_env), or None."""
         name = getattr(self, key)
         return os.environ.get(name) if name else None
 
 
 @dataclass
 class HttpConfig:
+    """The ``http`` section."""
+
     listen: str = (
         "127.0.0.1:9782"  # HOST:PORT of /metrics, /healthz, /report/ ("off": none; port 0: any free)
     )
@@ -107,6 +122,8 @@ class HttpConfig:
 
 @dataclass
 class StoreConfig:
+    """The ``store`` section."""
+
     sqlite: Path
     publish: list = field(default_factory=list)
     drain_minutes: float = 10.0  # the daemon sends what waits in the outbox this often, between daily runs
@@ -114,6 +131,8 @@ class StoreConfig:
 
 @dataclass
 class Config:
+    """The whole configuration, validated; ``alert_settings`` is its alerts section parsed."""
+
     path: Path
     satellites: list
     state_dir: Path
@@ -132,6 +151,7 @@ class Config:
 
     @property
     def cache_dir(self) -> Path:
+        """Where downloads are cached: ``state_dir/cache``."""
         return self.state_dir / "cache"
 
 

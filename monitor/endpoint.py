@@ -110,15 +110,18 @@ class Endpoint:
 
     @property
     def address(self) -> str:
+        """HOST:PORT actually listened on (port 0 resolved)."""
         host, port = self.server.server_address[:2]
         return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
 
     def start(self) -> "Endpoint":
+        """Serve on a daemon thread."""
         self.thread.start()
         LOG.info("serving /metrics, /healthz and /report/ on http://%s/", self.address)
         return self
 
     def stop(self) -> None:
+        """Stop serving and close the socket."""
         self.server.shutdown()
         self.server.server_close()
         self.thread.join(timeout=5)

@@ -52,6 +52,8 @@ class Stopped(Exception):
 
 @dataclass
 class RunOutcome:
+    """What one satellite-day run did: status and reason, the result, seconds per stage, counts."""
+
     satellite: str
     day: dt.date
     status: str

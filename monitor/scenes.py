@@ -27,6 +27,8 @@ COVER_MARGIN = dt.timedelta(seconds=10)
 
 @dataclass
 class Candidate:
+    """A CrIS granule considered: its listed SDR and GEO, the VIIRS pairs covering it, its score (K)."""
+
     key: str
     sdr: object
     geo: object

@@ -111,9 +111,11 @@ class Service:
         self.metrics = None  # monitor.metrics.ServiceMetrics, while the daemon serves /metrics
 
     def store(self) -> Store:
+        """A new connection to the configured store (close it, or use it in ``with``)."""
         return Store(self.cfg.store.sqlite)
 
     def run(self, satellite: str, day: dt.date):
+        """Run one satellite-day (health-tracked), then evaluate the alerts and regenerate the report."""
         store = self.store()
         try:
             LOG.info("run %s %s", satellite, day)
@@ -217,6 +219,7 @@ class Service:
         return outcomes
 
     def daily_job(self, satellite: str):
+        """The scheduled job of *satellite*: the days of its catch-up window."""
         self.catch_up(satellite)
 
     def run_once(self, satellites, day: dt.date | None = None) -> list:

@@ -46,6 +46,8 @@ img{max-width:100%;border:1px solid #eee;margin:0.3em 0}.note{color:#666;font-si
 
 @dataclass
 class ReportOptions:
+    """What the report shows: satellites, period, calendar, specification, FORs over time."""
+
     spec_km: float = 1.5
     trend_fors: tuple = (1, 15, 30)
     since: dt.date | None = None

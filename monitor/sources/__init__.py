@@ -37,6 +37,7 @@ class ListedFile:
 
     @property
     def product(self) -> str:
+        """The file's (first) product prefix, e.g. GCRSO."""
         return self.parsed.products[0]
 
 
@@ -50,6 +51,7 @@ def listed(name: str, size, location: str, md5: str | None = None) -> ListedFile
 
 
 def on_day(f: ListedFile, day: dt.date) -> bool:
+    """Whether *f* starts on *day* (UTC)."""
     return f.parsed.start.date() == day
 
 

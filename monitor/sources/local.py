@@ -22,6 +22,8 @@ class LocalSource:
         self.root = Path(root)
 
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
+        """The granule files of *satellite* on *day* (and VIIRS of the days around it) whose product is in
+        *products*."""
         if not self.root.is_dir():
             raise FileNotFoundError(f"source.path {self.root}: no such directory")
         out = []
@@ -37,6 +39,7 @@ class LocalSource:
         return [f for f in out if on_day(f, day) or f.product not in CRIS_PRODUCTS]
 
     def fetch(self, f: ListedFile) -> Path:
+        """The file itself: a local tree needs no download."""
         return Path(f.location)
 
     def start_day(self):
@@ -51,6 +54,7 @@ class SimulatedSource(LocalSource):
         self.cfg = source_cfg
 
     def list_day(self, satellite, day, products):
+        """Simulate the satellite-day once (into ``root/<satellite>/<day>``), then list it."""
         from monitor.simulate.case import simulate_case
 
         target = self.root / satellite / day.isoformat()

@@ -199,6 +199,7 @@ class NoddSource:
         return f
 
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
+        """The day's files of *products* in the satellite's bucket (the newest creation per granule)."""
         out = []
         for product in products:
             folder = PRODUCTS[product].collection  # the NODD folder is the collection name
@@ -216,6 +217,7 @@ class NoddSource:
         return _newest_per_granule(out)
 
     def fetch(self, f: ListedFile) -> Path:
+        """The cached copy of *f*, downloaded (bounded, checked against the listing) if missing."""
         folder = self.cache_dir / f.product
         folder.mkdir(parents=True, exist_ok=True)
         target = folder / f.name  # f.name is a checked base name: it cannot leave the cache

@@ -7,6 +7,7 @@ import json
 
 
 def iso(t: dt.datetime) -> str:
+    """*t* as an ISO 8601 UTC string, to the second."""
     return t.astimezone(dt.timezone.utc).isoformat(timespec="seconds")
 
 
@@ -18,17 +19,22 @@ class AlertState:
         self.db = store.db
 
     def get(self, fingerprint: str):
+        """The alert row of *fingerprint* (rule:satellite:group), or None."""
         r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
         return dict(r) if r else None
 
     def firing(self, satellite: str | None = None) -> list:
+        """The alerts firing now (of *satellite*)."""
         q = "SELECT * FROM alert_state WHERE status='firing'" + (" AND satellite=?" if satellite else "")
         return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
 
     def all(self) -> list:
+        """Every alert row, firing or resolved."""
         return [dict(r) for r in self.db.execute("SELECT * FROM alert_state ORDER BY satellite, rule, grp")]
 
     def upsert(self, finding, status: str, now: dt.datetime, notified: bool):
+        """Record *finding* as firing (keeping its start while it fires); *notified* stamps the notification
+        time."""
         prev = self.get(finding.fingerprint)
         started = prev["started"] if prev and prev["status"] == "firing" else iso(now)
         last = iso(now) if notified else (prev["last_notified"] if prev else None)
@@ -50,6 +56,7 @@ class AlertState:
         )
 
     def resolve(self, fingerprint: str, now: dt.datetime):
+        """Mark an alert resolved at *now*."""
         self.db.execute(
             "UPDATE alert_state SET status='resolved', resolved=? WHERE fingerprint=?",
             (iso(now), fingerprint),
@@ -59,6 +66,7 @@ class AlertState:
     def silence(
         self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime
     ):
+        """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason."""
         with self.store.transaction():
             self.db.execute(
                 "INSERT INTO silences (rule, satellite, until, reason, created) VALUES (?, ?, ?, ?, ?)",
@@ -66,6 +74,7 @@ class AlertState:
             )
 
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> dict | None:
+        """The silence in force for *rule* and *satellite* at *now*, or None."""
         r = self.db.execute(
             "SELECT * FROM silences WHERE until > ? AND (rule IS NULL OR rule=?) "
             "AND (satellite IS NULL OR satellite=?) ORDER BY until DESC",
@@ -74,6 +83,7 @@ class AlertState:
         return dict(r) if r else None
 
     def silences(self, now: dt.datetime) -> list:
+        """The silences in force at *now*."""
         return [
             dict(r)
             for r in self.db.execute("SELECT * FROM silences WHERE until > ? ORDER BY until", (iso(now),))
@@ -81,6 +91,7 @@ class AlertState:
 
     # -- delivery queue
     def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime):
+        """Queue *message* (subject, text, ...) for delivery on *channel*."""
         self.db.execute(
             "INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
             "VALUES (?, ?, ?, ?, ?, 'pending', ?)",
@@ -113,6 +124,7 @@ class AlertState:
             return cur.rowcount == 1
 
     def deliveries(self, status: str | None = None) -> list:
+        """The queued deliveries (with *status*: pending, sending, sent, failed), oldest first."""
         q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"
         return [dict(r) for r in self.db.execute(q, (status,) if status else ())]
 
@@ -124,6 +136,7 @@ class AlertState:
         error: str | None = None,
         retry_after_s: float = 0.0,
     ):
+        """Record a delivery attempt's *status*; a retry waits *retry_after_s*."""
         with self.store.transaction():
             self.db.execute(
                 "UPDATE deliveries SET status=?, attempts=attempts+1, last_error=?, next_attempt=?, sent=? "

@@ -98,6 +98,7 @@ RESULT_FIELDS = (
 
 
 def now_iso() -> str:
+    """Now as an ISO 8601 UTC string, to the second."""
     return dt.datetime.now(UTC).isoformat(timespec="seconds")
 
 
@@ -117,6 +118,7 @@ class EventKind(str, enum.Enum):
 
     @property
     def is_change(self) -> bool:
+        """Whether the event records a processing change (change:<instrument>)."""
         return self.value.startswith("change:")
 
 
@@ -136,6 +138,7 @@ class Event:
 
     @classmethod
     def from_row(cls, r) -> "Event":
+        """The event of an ``events`` row."""
         try:
             detail = json.loads(r["detail"])
         except (TypeError, ValueError):
@@ -200,6 +203,7 @@ class Store:
         tmp.replace(self.path)
 
     def close(self):
+        """Close the connection."""
         self.db.close()
 
     def __enter__(self) -> "Store":
@@ -211,6 +215,7 @@ class Store:
     # -- schema
     @property
     def schema_version(self) -> int:
+        """The schema version of the file (SQLite user_version)."""
         return self.db.execute("PRAGMA user_version").fetchone()[0]
 
     def _migrate(self):
@@ -227,10 +232,12 @@ class Store:
                 self.db.execute(f"PRAGMA user_version={v + 1}")
 
     def transaction(self):
+        """A context manager: BEGIN IMMEDIATE ... COMMIT, rolled back on an exception."""
         return _Transaction(self.db)
 
     # -- runs (the ledger)
     def begin_run(self, satellite: str, day: dt.date) -> int:
+        """Open a run of *satellite* on *day* in the ledger (status running); its id."""
         with self.transaction():
             cur = self.db.execute(
                 "INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, 'running')",
@@ -246,6 +253,7 @@ class Store:
         n_granules: int = 0,
         summary: dict | None = None,
     ):
+        """Close run *run_id* with *status* and *reason*."""
         with self.transaction():
             self._finish(run_id, status, reason, n_granules, summary)
 
@@ -281,6 +289,7 @@ class Store:
         return out
 
     def last_runs(self) -> list:
+        """The latest run of each satellite (dict rows of the ledger)."""
         return [
             dict(r)
             for r in self.db.execute(
@@ -314,6 +323,7 @@ class Store:
         return dict(self.db.execute("SELECT target, COUNT(*) FROM outbox GROUP BY target").fetchall())
 
     def runs(self, satellite: str | None = None) -> list:
+        """The runs (of *satellite*), oldest first."""
         q = "SELECT * FROM runs" + (" WHERE satellite=?" if satellite else "") + " ORDER BY id"
         return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
 
@@ -419,6 +429,7 @@ class Store:
             )
 
     def day_result(self, satellite: str, day: dt.date) -> list[ForOffset]:
+        """The per-FOR offsets stored for *satellite* on *day*."""
         rows = self.db.execute(
             "SELECT * FROM results WHERE satellite=? AND day=? ORDER BY for_index",
             (satellite, day.isoformat()),
@@ -431,6 +442,7 @@ class Store:
         return out
 
     def latest_day(self, satellite: str) -> dt.date | None:
+        """The latest day with results for *satellite*, or None."""
         r = self.db.execute("SELECT MAX(day) FROM results WHERE satellite=?", (satellite,)).fetchone()[0]
         return dt.date.fromisoformat(r) if r else None
 
@@ -441,6 +453,7 @@ class Store:
         return to_xarray(self, satellite, since, until)
 
     def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> list:
+        """The per-FOR result rows of *satellite* between *since* and *until*, by day and FOR."""
         q = "SELECT * FROM results WHERE satellite=?"
         args = [satellite]
         if since:
@@ -452,6 +465,7 @@ class Store:
         return [dict(r) for r in self.db.execute(q + " ORDER BY day, for_index", args)]
 
     def granules(self, satellite: str, day: dt.date | None = None) -> list:
+        """The granules assessed for *satellite* (on *day*), with their metadata."""
         q = (
             "SELECT * FROM granules WHERE satellite=?"
             + (" AND day=?" if day else "")
@@ -460,6 +474,7 @@ class Store:
         return [dict(r) for r in self.db.execute(q, (satellite, day.isoformat()) if day else (satellite,))]
 
     def selection(self, satellite: str, day: dt.date) -> list:
+        """The scene-selection decisions of *satellite* on *day*."""
         return [
             dict(r)
             for r in self.db.execute(
@@ -480,6 +495,7 @@ class Store:
 
     # -- fingerprints
     def save_fingerprint(self, satellite: str, day: dt.date, body: dict):
+        """Store the LOS fingerprint of *satellite* on *day* (replacing one computed before)."""
         with self.transaction():
             self.db.execute(
                 "INSERT OR REPLACE INTO fingerprints VALUES (?, ?, ?, ?)",
@@ -519,6 +535,7 @@ class Store:
                 )
 
     def outbox(self, target: str, limit: int = 5000) -> list:
+        """Up to *limit* points waiting for *target*, oldest first."""
         return [
             dict(r)
             for r in self.db.execute(
@@ -527,14 +544,17 @@ class Store:
         ]
 
     def outbox_size(self, target: str | None = None) -> int:
+        """The number of points waiting (for *target*)."""
         q = "SELECT COUNT(*) FROM outbox" + (" WHERE target=?" if target else "")
         return self.db.execute(q, (target,) if target else ()).fetchone()[0]
 
     def outbox_delivered(self, ids: list):
+        """Remove delivered points."""
         with self.transaction():
             self.db.executemany("DELETE FROM outbox WHERE id=?", [(i,) for i in ids])
 
     def outbox_failed(self, ids: list, error: str):
+        """Count a failed attempt and its error on the points."""
         with self.transaction():
             self.db.executemany(
                 "UPDATE outbox SET attempts = attempts + 1, last_error=? WHERE id=?",

@@ -101,6 +101,7 @@ class Influx2Writer:
         self.api = self.client.write_api(write_options=SYNCHRONOUS)
 
     def write(self, lines: list[str]):
+        """Write line-protocol *lines*; raises on any failure (the outbox keeps them)."""
         try:
             self.api.write(
                 bucket=self.cfg.bucket, org=self.cfg.org, record=lines, write_precision=WritePrecision.S
@@ -113,6 +114,7 @@ class Influx2Writer:
             raise PublishError(f"{self.cfg.url}: {type(exc).__name__}: {exc}") from None
 
     def close(self):
+        """Close the client."""
         self.client.close()
 
 
@@ -134,6 +136,7 @@ class Influx1Writer:
         )
 
     def write(self, lines: list[str]):
+        """POST line-protocol *lines* to /write; raises on any failure (the outbox keeps them)."""
         try:
             r = self._post(lines)
             if r.status_code == 404 and "database not found" in r.text:
@@ -150,6 +153,7 @@ class Influx1Writer:
             raise PublishError(f"{self.cfg.url}: HTTP {r.status_code} {r.text[:200]}")
 
     def close(self):
+        """Close the session."""
         pass
 
 
