@@ -25,7 +25,7 @@ import numpy as np
 
 from monitor import collocate, refine
 from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR
-from monitor.errors import AssessmentError
+from monitor.errors import AssessmentError, StopRequested
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import inverse_geolocation
@@ -58,10 +58,6 @@ class AssessConfig:
     @property
     def offsets_rad(self) -> np.ndarray:
         return perturbation_grid(self.half_steps, self.step_rad)
-
-
-class StopRequested(Exception):
-    """The caller asked to stop; raised between FORs so that a stop takes effect within a second."""
 
 
 @dataclass

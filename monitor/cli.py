@@ -15,6 +15,7 @@ import logging
 import sys
 from pathlib import Path
 
+from monitor.errors import DataError
 from monitor.version import __version__
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
@@ -65,7 +66,7 @@ def cmd_simulate(args) -> int:
             spec=spec,
             **where,
         )
-    except ValueError as exc:
+    except DataError as exc:
         raise BadInput(str(exc)) from None
     error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {args.profile}"
     print(
@@ -80,7 +81,7 @@ def _ep(path, satellite=None):
 
     try:
         return load_ep(path, satellite)
-    except ValueError as exc:
+    except DataError as exc:
         raise BadInput(str(exc)) from None
 
 
@@ -115,7 +116,7 @@ def cmd_optimize(args) -> int:
     ep = _ep(args.ep)
     try:
         opt = optimize(result, ep, source=str(args.result))
-    except ValueError as exc:
+    except DataError as exc:
         raise BadInput(str(exc)) from None
     print(
         f"EP {ep.version} ({ep.satellite}) corrected by {args.result} ({result.start} .. {result.end}, "
@@ -132,7 +133,6 @@ def cmd_optimize(args) -> int:
 def cmd_regeolocate(args) -> int:
     """crisgeo regeolocate: GEO copies geolocated with another EP."""
     from monitor.mapping.regeolocate import regeolocate_file
-    from monitor.sdr import GranuleError
 
     ep = _ep(args.ep)
     residuals = _residuals(args)
@@ -141,7 +141,7 @@ def cmd_regeolocate(args) -> int:
         try:
             out = regeolocate_file(ep, path, args.out, residuals)
             print(f"wrote {out}")
-        except (GranuleError, ValueError, OSError) as exc:
+        except (DataError, OSError) as exc:
             failed += 1
             print(f"skipped {path}: {exc}", file=sys.stderr)
     if failed == len(args.files):
@@ -154,12 +154,11 @@ def cmd_geolocate(args) -> int:
     import json
 
     from monitor.mapping.regeolocate import compare_with_files
-    from monitor.sdr import GranuleError
 
     ep = _ep(args.ep)
     try:
         rows = compare_with_files(ep, args.files, _residuals(args))
-    except (GranuleError, ValueError) as exc:
+    except DataError as exc:
         raise BadInput(str(exc)) from None
     if args.json:
         print(
@@ -207,15 +206,13 @@ def format_table(result) -> str:
 def cmd_assess(args) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assess import AssessConfig, assess_paths
-    from monitor.errors import DataError
-    from monitor.sdr.pairing import PlanError
 
     if args.steps < 1 or args.step_urad <= 0:
         raise BadInput("--steps must be >= 1 and --step-urad > 0")
     cfg = AssessConfig(half_steps=args.steps, step_rad=args.step_urad * 1e-6, kernel=args.kernel)
     try:
         result = assess_paths(args.paths, cfg, workers=args.workers)
-    except (PlanError, DataError) as exc:
+    except DataError as exc:
         raise BadInput(str(exc)) from None
     print(format_table(result))
     if args.out:

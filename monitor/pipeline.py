@@ -16,10 +16,10 @@ import numpy as np
 
 from monitor import fingerprint as fpr
 from monitor.assess import AssessConfig, assess_plan
-from monitor.errors import DataError
+from monitor.errors import DataError, StopRequested
 from monitor.mapping.engpkt import load_library
 from monitor.scenes import select_scenes
-from monitor.sdr import GranuleError, read_file
+from monitor.sdr import read_file
 from monitor.sdr.pairing import PlanError, plan
 from monitor.sdr.products import CRIS_GEO
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
@@ -44,10 +44,6 @@ class ProgressLines:
         if self.done >= self.total or now - self.last >= self.every_s:
             self.last = now
             LOG.info("%s: %d/%d after %.0f s", self.what, self.done, self.total, now - self.t0)
-
-
-class Stopped(Exception):
-    """A stop was requested between two steps of a run."""
 
 
 @dataclass
@@ -133,7 +129,7 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
         try:
             (g,) = read_file(source.fetch(geos[i]), kinds=("cris_geo",))[:1]
             prints.append(fpr.granule_print(g))
-        except (SourceError, GranuleError, ValueError) as exc:
+        except (SourceError, DataError) as exc:
             LOG.warning("fingerprint: skipping %s: %s", geos[i].name, exc)
     if not prints:
         return None
@@ -242,7 +238,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
                 counts=counts,
             )
         if stop():
-            raise Stopped
+            raise StopRequested
         t1 = time.perf_counter()
         fingerprint_day(cfg, store, source, satellite, day, listing)
         timings["fingerprint"] = time.perf_counter() - t1
@@ -262,7 +258,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         fetched = ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
         for c in chosen:
             if stop():
-                raise Stopped
+                raise StopRequested
             paths += [source.fetch(c.sdr), source.fetch(c.geo)]
             for vs, vg in c.viirs:
                 try:
@@ -287,7 +283,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         timings["assess"] = time.perf_counter() - t1
         counts["assessed"] = len(result.granules)
         if stop():
-            raise Stopped
+            raise StopRequested
         lines = {
             target_name(p): result_lines(p.measurement, satellite, day, result.fors)
             for p in cfg.store.publish
@@ -295,7 +291,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         store.save_day(run_id, satellite, day, result, decisions, lines)
         publish_changes(cfg, store, satellite)
         return RunOutcome(satellite, day, "ok", None, run_id, result, timings, counts)
-    except Stopped:
+    except StopRequested:
         store.finish_run(run_id, "interrupted", "stop requested")
         return RunOutcome(
             satellite, day, "interrupted", "stop requested", run_id, timings=timings, counts=counts

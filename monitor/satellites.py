@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from monitor.errors import DataError
+
 
 @dataclass(frozen=True)
 class Satellite:
@@ -46,4 +48,4 @@ def satellite(short: str) -> Satellite:
     try:
         return SATELLITES[short]
     except KeyError:
-        raise ValueError(f"unknown satellite {short!r} (known: {', '.join(SATELLITES)})") from None
+        raise DataError(f"unknown satellite {short!r} (known: {', '.join(SATELLITES)})") from None

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from monitor.sdr import GranuleError, read_file
+from monitor.errors import DataError
+from monitor.sdr import read_file
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
 from monitor.sources import BudgetExceeded, SourceError
 from monitor.spectral import i5_band
@@ -94,7 +95,7 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
         except BudgetExceeded as exc:
             decisions.append({"granule": key, "decision": "rejected", "reason": str(exc)})
             break
-        except (SourceError, GranuleError, ValueError) as exc:
+        except (SourceError, DataError) as exc:
             decisions.append(
                 {"granule": key, "decision": "rejected", "reason": f"unusable CrIS granule: {exc}"}
             )

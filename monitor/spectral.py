@@ -14,6 +14,7 @@ from importlib import resources
 
 import numpy as np
 
+from monitor.errors import DataError
 from monitor.sdr.products import cris_lw_wavenumbers_cm1
 
 C1 = 1.191042972e-5  # 2hc^2, mW/(m2 sr cm-4)
@@ -32,7 +33,7 @@ def load_srf(satellite: str):
     """(wavenumber_cm1, response) of the VIIRS I5 band of *satellite* (npp, j01, j02), ascending."""
     name = SRF_FILES.get(satellite)
     if name is None:
-        raise ValueError(
+        raise DataError(
             f"no I5 spectral response for satellite {satellite!r} (known: {', '.join(SRF_FILES)})"
         )
     text = resources.files("monitor.data.srf").joinpath(name).read_text()

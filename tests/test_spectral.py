@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from monitor.errors import DataError
 from monitor.spectral import I5Band, apodize_hamming, i5_band, load_srf, planck_radiance
 
 
@@ -34,5 +35,5 @@ def test_hamming_keeps_smooth_spectra_and_out_of_table_is_nan():
     x = np.linspace(1, 2, 50)
     assert np.allclose(apodize_hamming(x)[1:-1], x[1:-1])
     assert np.isnan(i5_band("j01").radiance_from_bt(400.0))
-    with pytest.raises(ValueError, match="no I5 spectral response"):
+    with pytest.raises(DataError, match="no I5 spectral response"):
         I5Band("metop")

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor.constants import N_FOR, N_FOV
+from monitor.errors import DataError
 from monitor.geometry.frames import los_angles, los_from_angles, rot_x, rot_y, rot_z, unit
 
 FOV5 = 4  # index of the central FOV, whose LOS defines the FOR's pointing (section 4.1)
@@ -73,13 +74,13 @@ class EngineeringPacket:
         ):
             value = np.asarray(getattr(self, name), float)
             if value.shape != (n,):
-                raise ValueError(f"EP {self.version}: {name} needs {n} values, got shape {value.shape}")
+                raise DataError(f"EP {self.version}: {name} needs {n} values, got shape {value.shape}")
             if not np.all(np.isfinite(value)):
-                raise ValueError(f"EP {self.version}: {name} has a non-finite value: {value.tolist()}")
+                raise DataError(f"EP {self.version}: {name} has a non-finite value: {value.tolist()}")
             object.__setattr__(self, name, value)
         for name in ("los_relative_yaw_rad", "los_relative_pitch_rad", "time_stamp_bias_ms"):
             if not np.isfinite(float(getattr(self, name))):
-                raise ValueError(f"EP {self.version}: {name} is not finite")
+                raise DataError(f"EP {self.version}: {name} is not finite")
 
     def with_ssm_angles(self, crosstrack_roll_rad, intrack_pitch_rad, version=None, provenance=None):
         """A copy with the 2 x 30 scene-mirror angles replaced (the only angles the optimiser changes)."""

@@ -20,6 +20,7 @@ import numpy as np
 import yaml
 
 from monitor.constants import N_FOR, N_FOV, URAD
+from monitor.errors import DataError
 from monitor.geometry.instrument import EngineeringPacket
 from monitor.satellites import SATELLITES
 
@@ -47,7 +48,7 @@ MOUNTING_URAD = {"npp": (-518.45683, -77.760702, 46.109524), "j01": (-145.84994,
 PACKAGED = {"npp": "SNPP_side1_V37_EngPkt.xml", "j01": "JPSS1_side1_V115_EngPkt.xml"}
 
 
-class EngPktError(ValueError):
+class EngPktError(DataError):
     """A malformed EP file; the message names the file, the field and the value."""
 
     def __init__(self, path, field, problem):

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from monitor.constants import N_FOR, URAD
+from monitor.errors import DataError
 from monitor.geometry.instrument import EngineeringPacket, corrected_ssm_angles
 from monitor.result import AssessmentResult
 
@@ -99,12 +100,12 @@ def optimize(result: AssessmentResult, ep: EngineeringPacket, source: str = "") 
     Raises ValueError when the result is for another satellite than the EP or does not have 30 FORs.
     """
     if result.satellite != ep.satellite:
-        raise ValueError(
+        raise DataError(
             f"assessment {source or ''} is for {result.satellite}, the EP {ep.version} for "
             f"{ep.satellite}: an EP is only corrected by its own satellite's assessment"
         )
     if len(result.fors) != N_FOR or [f.for_index for f in result.fors] != list(range(1, N_FOR + 1)):
-        raise ValueError(f"assessment {source}: needs FORs 1..30 in order, got {len(result.fors)} entries")
+        raise DataError(f"assessment {source}: needs FORs 1..30 in order, got {len(result.fors)} entries")
     reasons = [_why_kept(f) for f in result.fors]
     use = np.array([not r for r in reasons])
     d_alpha = np.array([f.d_alpha_urad for f in result.fors], float)

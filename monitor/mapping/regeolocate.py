@@ -19,6 +19,7 @@ import h5py
 import numpy as np
 
 from monitor.constants import N_FOR
+from monitor.errors import DataError
 from monitor.geometry import instrument, wgs84
 from monitor.geometry.geolocate import GroundView, geolocate_fovs
 from monitor.geometry.instrument import EngineeringPacket
@@ -45,9 +46,9 @@ def geolocate_granule(
     """Geolocation of every FOV of *g* with the LOS of *ep* (turned by the per-FOR *residuals*, if given)
     and the granule's own ephemeris and attitude."""
     if g.meta.platform != ep.satellite:
-        raise ValueError(f"{g.meta.path}: granule of {g.meta.platform}, EP {ep.version} of {ep.satellite}")
+        raise DataError(f"{g.meta.path}: granule of {g.meta.platform}, EP {ep.version} of {ep.satellite}")
     if residuals is not None and residuals.satellite != ep.satellite:
-        raise ValueError(f"residual table of {residuals.satellite}, EP {ep.version} of {ep.satellite}")
+        raise DataError(f"residual table of {residuals.satellite}, EP {ep.version} of {ep.satellite}")
     los = instrument.los_spacecraft(ep)
     if residuals is not None:
         los = residuals.table_for(g).apply(los)
@@ -119,9 +120,7 @@ def regeolocate_file(
     src = Path(path).resolve()
     dst_dir = Path(out_dir).resolve()
     if dst_dir == src.parent:
-        raise ValueError(
-            f"{src}: the output directory is the input's; regeolocation never touches its inputs"
-        )
+        raise DataError(f"{src}: the output directory is the input's; regeolocation never touches its inputs")
     granules = _geo_granules(src)
     dst_dir.mkdir(parents=True, exist_ok=True)
     dst = dst_dir / src.name

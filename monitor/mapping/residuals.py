@@ -25,11 +25,12 @@ from pathlib import Path
 import numpy as np
 
 from monitor.constants import N_FOR, URAD
+from monitor.errors import DataError
 from monitor.geometry.frames import los_angles, los_from_angles
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles
 
 
-class ResidualError(ValueError):
+class ResidualError(DataError):
     """A residual table that cannot be used; the message names the file and the field."""
 
 

@@ -10,6 +10,8 @@ import datetime as dt
 
 import numpy as np
 
+from monitor.errors import DataError
+
 UTC = dt.timezone.utc
 IET_EPOCH = dt.datetime(1958, 1, 1, tzinfo=UTC)
 _UNIX_MINUS_IET_EPOCH_US = int((dt.datetime(1970, 1, 1, tzinfo=UTC) - IET_EPOCH).total_seconds()) * 1_000_000
@@ -57,7 +59,7 @@ def iet_to_unix_us(iet_us):
     iet = np.asarray(iet_us, np.int64)
     k = np.searchsorted(_CHANGE_IET_US, iet, side="right") - 1
     if np.any(k < 0):
-        raise ValueError(f"IET {int(np.min(iet))} is before 1972, outside the leap-second table")
+        raise DataError(f"IET {int(np.min(iet))} is before 1972, outside the leap-second table")
     return iet - _UNIX_MINUS_IET_EPOCH_US - _OFFSET_US[k]
 
 
@@ -66,7 +68,7 @@ def unix_us_to_iet(unix_us):
     u = np.asarray(unix_us, np.int64)
     k = np.searchsorted(_CHANGE_UNIX_US, u, side="right") - 1
     if np.any(k < 0):
-        raise ValueError("UTC time before 1972 is outside the leap-second table")
+        raise DataError("UTC time before 1972 is outside the leap-second table")
     return u + _UNIX_MINUS_IET_EPOCH_US + _OFFSET_US[k]
 
 

@@ -11,6 +11,7 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from monitor.errors import DataError
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
@@ -61,7 +62,7 @@ class CasePlan:
     skipped: list = field(default_factory=list)  # (path or key, reason)
 
 
-class PlanError(ValueError):
+class PlanError(DataError):
     """Inputs that cannot form an assessment at all (no files, mixed satellites)."""
 
 

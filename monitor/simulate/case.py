@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from monitor.errors import DataError
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
 from monitor.satellites import satellite as satellite_info
@@ -81,15 +82,15 @@ class SimulationSpec:
 
     def __post_init__(self):
         if self.orbit_pass is not None and self.orbit_pass not in PASSES:
-            raise ValueError(f"orbit pass {self.orbit_pass!r} is not one of {', '.join(PASSES)}")
+            raise DataError(f"orbit pass {self.orbit_pass!r} is not one of {', '.join(PASSES)}")
         if self.pass_lon_deg is not None and self.orbit_pass is None:
-            raise ValueError("a pass longitude needs an orbit pass")
+            raise DataError("a pass longitude needs an orbit pass")
         if (self.true_ep is None) != (self.ground_ep is None):
-            raise ValueError("a simulation in EP terms needs both the true EP and the ground-processing EP")
+            raise DataError("a simulation in EP terms needs both the true EP and the ground-processing EP")
         if self.true_ep is not None:
             for ep in (self.true_ep, self.ground_ep):
                 if ep.satellite != self.satellite:
-                    raise ValueError(
+                    raise DataError(
                         f"EP {ep.version} is for {ep.satellite}, the simulation for {self.satellite}"
                     )
             self.d_alpha_urad, self.d_beta_urad = ep_offsets_urad(self.true_ep, self.ground_ep)

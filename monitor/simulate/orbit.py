@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from monitor.errors import DataError
 from monitor.geometry.wgs84 import A_M, GM_M3_S2, OMEGA_EARTH_RAD_S
 from monitor.satellites import NODAL_PERIOD_S, PHASE_EPOCH_UNIX_S, Satellite
 
@@ -123,7 +124,7 @@ def find_pass(
     *days* (16: the JPSS repeat cycle, so every longitude comes within ~1 deg). ValueError if the
     latitude is beyond the orbit's reach."""
     if abs(np.sin(np.radians(lat_deg))) >= np.sin(np.radians(180.0 - sat.inclination_deg)):
-        raise ValueError(f"latitude {lat_deg} deg is beyond the reach of the {sat.name} orbit")
+        raise DataError(f"latitude {lat_deg} deg is beyond the reach of the {sat.name} orbit")
     t = after_unix_s + np.arange(0.0, (days if lon_deg is not None else 1) * DAY_S, step_s)
     u = _argument_of_latitude(sat, t)
     i = np.radians(sat.inclination_deg)

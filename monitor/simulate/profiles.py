@@ -9,6 +9,7 @@ import numpy as np
 import yaml
 
 from monitor.constants import FOV_DIAMETER_URAD, N_FOR
+from monitor.errors import DataError
 
 
 def paper_profile():
@@ -57,7 +58,7 @@ def load_profile(name: str, seed: int = 0):
         return np.zeros(N_FOR), np.zeros(N_FOR)
     path = Path(name)
     if not path.is_file():
-        raise ValueError(f"profile {name!r} is neither paper, random, zero nor an existing file")
+        raise DataError(f"profile {name!r} is neither paper, random, zero nor an existing file")
     try:
         doc = json.loads(path.read_text()) if path.suffix == ".json" else yaml.safe_load(path.read_text())
         if "fors" in doc:
@@ -68,7 +69,7 @@ def load_profile(name: str, seed: int = 0):
             d_alpha = np.asarray(doc["d_alpha_urad"], float)
             d_beta = np.asarray(doc["d_beta_urad"], float)
     except (ValueError, KeyError, TypeError, AttributeError, yaml.YAMLError) as exc:
-        raise ValueError(f"{path}: not a profile file ({exc})") from None
+        raise DataError(f"{path}: not a profile file ({exc})") from None
     if d_alpha.shape != (N_FOR,) or d_beta.shape != (N_FOR,) or not np.all(np.isfinite(d_alpha + d_beta)):
-        raise ValueError(f"{path}: a profile needs 30 finite d_alpha_urad and d_beta_urad values")
+        raise DataError(f"{path}: a profile needs 30 finite d_alpha_urad and d_beta_urad values")
     return d_alpha, d_beta

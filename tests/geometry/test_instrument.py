@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from monitor.errors import DataError
 from monitor.geometry import instrument as ins
 from monitor.geometry import wgs84
 from monitor.geometry.frames import los_angles, los_from_angles
@@ -88,7 +89,7 @@ def test_zero_offsets_give_the_same_angles(v115):
 
 
 def test_bad_angles_are_refused(v115):
-    with pytest.raises(ValueError, match="ssm_crosstrack_roll_rad needs 30 values"):
+    with pytest.raises(DataError, match="ssm_crosstrack_roll_rad needs 30 values"):
         v115.with_ssm_angles(np.zeros(29), v115.ssm_intrack_pitch_rad)
-    with pytest.raises(ValueError, match="non-finite"):
+    with pytest.raises(DataError, match="non-finite"):
         v115.with_ssm_angles(np.full(30, np.nan), v115.ssm_intrack_pitch_rad)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from monitor.cli import main
+from monitor.errors import DataError
 from monitor.mapping.engpkt import load_ep
 from monitor.mapping.optimize import optimize
 from monitor.result import AssessmentResult, ForOffset
@@ -69,11 +70,11 @@ def test_flagged_and_missing_fors_keep_their_angles(nominal_ep, error_ep):
 
 
 def test_wrong_satellite_or_incomplete_result_is_refused(nominal_ep):
-    with pytest.raises(ValueError, match="is for npp, the EP V115 for j01"):
+    with pytest.raises(DataError, match="is for npp, the EP V115 for j01"):
         optimize(_result(np.zeros(30), np.zeros(30), satellite="npp"), nominal_ep)
     short = _result(np.zeros(30), np.zeros(30))
     short = dataclasses.replace(short, fors=short.fors[:29])
-    with pytest.raises(ValueError, match="needs FORs 1..30"):
+    with pytest.raises(DataError, match="needs FORs 1..30"):
         optimize(short, nominal_ep)
 
 

@@ -3,6 +3,7 @@ import json
 import numpy as np
 import pytest
 
+from monitor.errors import DataError
 from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
 from monitor.simulate.instrument import cris_los_sbf, viirs_bowtie_deleted, viirs_column_geometry
@@ -23,9 +24,9 @@ def test_profile_from_file_and_bad_profiles(tmp_path):
     a, b = load_profile(str(f))
     assert a[4] == 5 and b[4] == -5
     f.write_text(json.dumps({"d_alpha_urad": [1] * 29, "d_beta_urad": [1] * 30}))
-    with pytest.raises(ValueError, match="30 finite"):
+    with pytest.raises(DataError, match="30 finite"):
         load_profile(str(f))
-    with pytest.raises(ValueError, match="neither"):
+    with pytest.raises(DataError, match="neither"):
         load_profile("papr")
 
 

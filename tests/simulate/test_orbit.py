@@ -5,6 +5,7 @@ import datetime as dt
 import numpy as np
 import pytest
 
+from monitor.errors import DataError
 from monitor.geometry import wgs84
 from monitor.satellites import SATELLITES, satellite
 from monitor.simulate.orbit import CircularOrbit, find_pass
@@ -57,7 +58,7 @@ def test_satellites_have_distinct_orbits_and_local_time():
 
 
 def test_unreachable_latitude_and_unknown_satellite():
-    with pytest.raises(ValueError, match="beyond the reach"):
+    with pytest.raises(DataError, match="beyond the reach"):
         find_pass(satellite("npp"), T0, 85.0)
-    with pytest.raises(ValueError, match="unknown satellite 'metop'"):
+    with pytest.raises(DataError, match="unknown satellite 'metop'"):
         satellite("metop")
