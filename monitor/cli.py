@@ -530,12 +530,12 @@ def cmd_fingerprint(args) -> int:
 
     library, problems = load_library(args.ep_library or [])
     matches = fpr.identify_ep(day, library, _geo_platform(files))
-    within = fpr.change_within(prints, args.threshold_urad) if len(prints) >= 4 else None
+    change = fpr.detect_change(prints, args.threshold_urad)
     if args.json:
         doc = day.to_dict()
         doc["skipped"] = skipped
         doc["change_within"] = (
-            None if within is None else {"first_granule": prints[within[0]].granule_id, "fors": within[1]}
+            None if change is None else {"first_granule": change.granule, "fors": change.fors}
         )
         doc["ep_match"] = [m.to_dict() for m in matches]
         doc["ep_library_problems"] = problems
@@ -546,8 +546,8 @@ def cmd_fingerprint(args) -> int:
             print(f"skipped {s}")
         print(
             "no step within these granules"
-            if within is None
-            else f"step from granule {prints[within[0]].granule_id} at FOR {', '.join(map(str, within[1]))}"
+            if change is None
+            else f"step from granule {change.granule} at FOR {', '.join(map(str, change.fors))}"
         )
         print(fpr.format_matches(matches))
         for p in problems:

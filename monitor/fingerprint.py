@@ -16,6 +16,7 @@ max(10 urad, 4 x the scan-to-scan standard deviation).
 
 from __future__ import annotations
 
+import datetime as dt
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -195,6 +196,62 @@ def change_within(
         if fors and (best is None or excess > best[0]):
             best = (excess, k, fors, da, db)
     return None if best is None else best[1:]
+
+
+@dataclass(frozen=True)
+class ProcessingChange:
+    """A step in the CrIS geolocation processing seen by the fingerprint: from *time* (ISO 8601 UTC; the
+    first changed granule *granule*), at *fors* (1-based), by d_alpha_urad/d_beta_urad per FOR (30,)."""
+
+    time: str
+    granule: str
+    fors: list
+    d_alpha_urad: np.ndarray
+    d_beta_urad: np.ndarray
+
+    @property
+    def largest_urad(self) -> float:
+        """The largest change of any FOR in either direction."""
+        return float(np.nanmax(np.abs(np.concatenate([self.d_alpha_urad, self.d_beta_urad]))))
+
+    def describe(self, matches=()) -> str:
+        """One sentence for logs, events and messages; with the best-matching EP of *matches* if any."""
+        text = (
+            f"CrIS geolocation processing changed (LOS fingerprint): FOR {', '.join(map(str, self.fors))}, "
+            f"up to {self.largest_urad:.0f} urad, from granule {self.granule}"
+        )
+        if matches:
+            best = matches[0]
+            text += f"; best-matching EP {best.name} ({best.version}, rms {best.rms_urad:.0f} urad)"
+        return text
+
+    def to_dict(self) -> dict:
+        """JSON-ready: time, granule, fors and the per-FOR changes rounded to 0.1 urad."""
+        return {
+            "time": self.time,
+            "granule": self.granule,
+            "fors": list(self.fors),
+            "d_alpha_urad": np.round(self.d_alpha_urad, 1).tolist(),
+            "d_beta_urad": np.round(self.d_beta_urad, 1).tolist(),
+        }
+
+
+def detect_change(
+    prints: list[GranulePrint], threshold_urad: float, reference: DayPrint | None = None, day=None
+) -> ProcessingChange | None:
+    """The processing change of a day: a step within its time-ordered *prints* (from 4 granules), else a
+    step against *reference* (the previous day's print; dated 00:00 UTC of *day*), else None."""
+    if len(prints) >= 4:
+        within = change_within(prints, threshold_urad, reference=reference)
+        if within is not None:
+            k, fors, da, db = within
+            return ProcessingChange(prints[k].start, prints[k].granule_id, fors, da, db)
+    if reference is not None:
+        fors, da, db = compare_days(reference, day_print(prints), threshold_urad)
+        if fors:
+            when = f"{(day or dt.datetime.fromisoformat(prints[0].start).date()).isoformat()}T00:00:00+00:00"
+            return ProcessingChange(when, prints[0].granule_id, fors, da, db)
+    return None
 
 
 @dataclass(frozen=True)

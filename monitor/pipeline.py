@@ -143,48 +143,14 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
     matches = fpr.identify_ep(today, library, satellite)
     if matches:
         body["ep_match"] = [m.to_dict() for m in matches[:3]]
-    thr = cfg.fingerprint.threshold_urad
-    within = fpr.change_within(prints, thr, reference=reference) if len(prints) >= 4 else None
-    between = fpr.compare_days(reference, today, thr) if reference is not None else None
-    change = None
-    if within is not None:
-        k, fors, da, db = within
-        change = {"time": prints[k].start, "granule": prints[k].granule_id, "fors": fors, "da": da, "db": db}
-    elif between is not None and between[0]:
-        fors, da, db = between
-        change = {
-            "time": f"{day.isoformat()}T00:00:00+00:00",
-            "granule": prints[0].granule_id,
-            "fors": fors,
-            "da": da,
-            "db": db,
-        }
+    change = fpr.detect_change(prints, cfg.fingerprint.threshold_urad, reference, day)
     if change is not None:
-        big = max(float(np.nanmax(np.abs(change["da"]))), float(np.nanmax(np.abs(change["db"]))))
-        desc = (
-            "CrIS geolocation processing changed (LOS fingerprint): FOR "
-            f"{', '.join(map(str, change['fors']))}, "
-            f"up to {big:.0f} urad, from granule {change['granule']}"
-        )
-        if matches:
-            best = matches[0]
-            desc += f"; best-matching EP {best.name} ({best.version}, rms {best.rms_urad:.0f} urad)"
-        body["change"] = {
-            "time": change["time"],
-            "granule": change["granule"],
-            "fors": change["fors"],
-            "d_alpha_urad": np.round(change["da"], 1).tolist(),
-            "d_beta_urad": np.round(change["db"], 1).tolist(),
-        }
+        desc = change.describe(matches)
+        body["change"] = change.to_dict()
         store.add_event(
             EventKind.CHANGE_CRIS,
             satellite,
-            {
-                "time": change["time"],
-                "kind": "processing_change",
-                "description": desc,
-                "origin": "fingerprint",
-            },
+            {"time": change.time, "kind": "processing_change", "description": desc, "origin": "fingerprint"},
         )
         LOG.warning("%s %s: %s", satellite, day, desc)
     store.save_fingerprint(satellite, day, body)

@@ -25,8 +25,34 @@ def test_real_noaa20_fingerprint_is_stable(real_geo_files):
     assert np.max(day.sd_alpha_urad) < 3.0  # in-track: ~1.5 urad scan to scan
     assert np.max(day.sd_beta_urad) < 12.0 and np.min(day.sd_beta_urad) < 3.0  # cross-track: 1.5-9.5 by FOR
     assert fpr.change_within(prints) is None  # no false change over the ten granules
+    assert fpr.detect_change(prints, 10.0) is None
     # the 9-FOV pattern: FOV 1 and 9 about 19 mrad from FOV 5 in each direction
     assert 18000 < abs(day.pattern_alpha_urad[14, 0]) < 20000 and abs(day.pattern_alpha_urad[14, 4]) < 1e-6
+
+
+def test_a_step_in_the_real_prints_is_a_typed_change(real_geo_files):
+    """Shift FOR 28-30 of the last six real granules by 60 urad cross-track: against the unshifted day's
+    scatter (the previous day, as in the daily run) the change starts at granule 5 and names those FORs;
+    a later day made only of shifted granules shows the step against that reference too."""
+    import dataclasses
+
+    prints = [fpr.granule_print(read_file(f)[0]) for f in real_geo_files]
+    shift = np.where(np.arange(30) >= 27, 60.0, 0.0)
+    moved = prints[:4] + [
+        dataclasses.replace(p, beta_urad=p.beta_urad + shift, scan_beta_urad=p.scan_beta_urad + shift)
+        for p in prints[4:]
+    ]
+    change = fpr.detect_change(moved, 10.0, reference=fpr.day_print(prints))
+    assert change.granule == prints[4].granule_id and change.time == prints[4].start
+    assert change.fors == [28, 29, 30] and abs(change.largest_urad - 60) < 10
+    assert f"FOR 28, 29, 30, up to {change.largest_urad:.0f} urad" in change.describe() and change.to_dict()[
+        "fors"
+    ] == [28, 29, 30]
+    later = moved[4:]
+    between = fpr.detect_change(
+        later[:3], 10.0, reference=fpr.day_print(prints[:4]), day=dt.date(2018, 10, 23)
+    )
+    assert between.time == "2018-10-23T00:00:00+00:00" and set(between.fors) >= {28, 29, 30}
 
 
 def _day(root, day, d_alpha, d_beta, change_at=None, new=None, n=4, seed=3):
