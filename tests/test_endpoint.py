@@ -18,6 +18,8 @@ from prometheus_client.parser import text_string_to_metric_families
 from monitor.store.sqlite import Store
 from tests.servers import chromium_driver, free_port
 
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
+
 ROOT = Path(__file__).resolve().parent.parent
 CRISGEO = [sys.executable, "-m", "monitor.cli"]
 DAY = "2024-06-01"

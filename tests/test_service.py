@@ -13,6 +13,8 @@ import pytest
 
 from monitor.store.sqlite import Store
 
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
+
 ROOT = Path(__file__).resolve().parent.parent
 CRISGEO = [sys.executable, "-m", "monitor.cli"]
 DAY = "2024-06-01"

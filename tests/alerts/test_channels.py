@@ -6,6 +6,8 @@ from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
 from alerts.settings import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
 
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
+
 MSG = {
     "subject": "[crisgeo] j01 CRITICAL: 1 firing - spec",
     "text": "FOR 30: total 4.51 km\nspec 1.5 km",

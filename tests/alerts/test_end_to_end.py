@@ -12,6 +12,8 @@ from monitor.service import Service
 from monitor.simulate.case import simulate_case
 from tests.alerts.conftest import PASSWORD, USER
 
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
+
 DAY1, DAY2 = dt.date(2024, 6, 1), dt.date(2024, 6, 2)
 
 

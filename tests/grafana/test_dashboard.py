@@ -15,6 +15,8 @@ from monitor.store.sqlite import Store
 from monitor.store.timeseries import change_lines, result_lines
 from tests.servers import influxdb1, influxql
 
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
+
 DASHBOARD = Path(__file__).resolve().parents[2] / "configs" / "grafana" / "crisgeo-dashboard.json"
 FIRST, DAYS = dt.date(2025, 1, 1), 60
 RELIABLE = {}  # satellite -> {FOR: days with a reliable result}, filled by the influx fixture

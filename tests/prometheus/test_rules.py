@@ -4,7 +4,11 @@ tests, with the series a dead, a stuck and a healthy daemon would expose)."""
 import subprocess
 from pathlib import Path
 
+import pytest
+
 from tests.servers import require
+
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
 ROOT = Path(__file__).resolve().parents[2]
 RULES = ROOT / "configs" / "prometheus" / "crisgeo-rules.yml"

@@ -114,6 +114,7 @@ def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
     assert main(["report", "--config", str(cfg), "--since", "2025-03-31", "--until", "2025-03-01"]) == 2
 
 
+@pytest.mark.servers
 def test_report_in_headless_chromium(store, tmp_path):
     days = fill_store(store, SATS, dt.date(2025, 6, 1), 120, step_day=90)
     build_report(

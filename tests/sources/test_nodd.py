@@ -12,6 +12,8 @@ from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
 from monitor.sources.nodd import NoddSource
 from tests.servers import S3Server
 
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
+
 DAY = dt.date(2024, 6, 1)
 FOLDER = {
     "GCRSO": "CrIS-SDR-GEO",

@@ -9,6 +9,8 @@ from monitor.store.sqlite import Store
 from monitor.store.timeseries import Influx2Writer, PublishError, drain_outbox, result_lines, target_name
 from tests.servers import free_port, influxdb1, influxql, victoria_metrics, vm_export
 
+pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
+
 DAY = dt.date(2024, 6, 1)
 
 
