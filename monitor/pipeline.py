@@ -20,9 +20,9 @@ from monitor.errors import DataError, StopRequested
 from monitor.mapping.engpkt import load_library
 from monitor.scenes import select_scenes
 from monitor.sdr import read_file
-from monitor.sdr.pairing import PlanError, plan
+from monitor.sdr.pairing import CasePlan, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
-from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError
+from monitor.sources import ALL_PRODUCTS, SourceError
 from monitor.store.sqlite import EventKind
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
@@ -172,6 +172,27 @@ def publish_changes(cfg, store, satellite: str) -> None:
         store.queue_lines(target_name(p), satellite, change_lines(p.measurement, changes))
 
 
+def fetch_plan(source, satellite: str, chosen: list, stop=lambda: False, progress=None) -> CasePlan:
+    """The assessment plan of the chosen scenes: their CrIS files as selection read them (no second
+    reading, no second pairing) with the VIIRS granules covering them, each fetched and its metadata read
+    once; a VIIRS granule that cannot be fetched or read is skipped with its reason."""
+    viirs, skipped = {}, []
+    for c in chosen:
+        if stop():
+            raise StopRequested
+        for vs, vg in c.viirs:
+            key = vg.parsed.granule_key
+            if key in viirs or any(key == k for k, _ in skipped):
+                continue
+            try:
+                viirs[key] = granule_files(key, source.fetch(vs), source.fetch(vg))
+            except (SourceError, DataError) as exc:  # BudgetExceeded is a SourceError
+                skipped.append((key, str(exc)))
+        if progress is not None:
+            progress()
+    return assemble(satellite, [c.files for c in chosen], list(viirs.values()), skipped)
+
+
 def _failed(store, run_id, satellite, day, reason, timings, counts=None) -> RunOutcome:
     """Record a failed run and its ``run_failed`` event (the failure alert reads both)."""
     store.finish_run(run_id, "failed", reason)
@@ -220,23 +241,12 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
                 cfg, store, run_id, satellite, day, reason, timings, {"selection": decisions[:50]}, counts
             )
         t1 = time.perf_counter()
-        paths, fetch_skipped = [], []
-        fetched = ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
-        for c in chosen:
-            if stop():
-                raise StopRequested
-            paths += [source.fetch(c.sdr), source.fetch(c.geo)]
-            for vs, vg in c.viirs:
-                try:
-                    paths += [source.fetch(vs), source.fetch(vg)]
-                except (SourceError, BudgetExceeded) as exc:
-                    fetch_skipped.append((vs.name, str(exc)))
-            fetched()
+        case = fetch_plan(
+            source, satellite, chosen, stop, ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
+        )
         timings["fetch"] = time.perf_counter() - t1
         counts["downloaded"], counts["bytes"] = source.downloaded_files, source.spent_bytes
         t1 = time.perf_counter()
-        case = plan(sorted(set(paths)))
-        case.skipped += fetch_skipped
         a = cfg.assessment
         progress = progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris))
         result = assess_plan(
@@ -262,7 +272,7 @@ def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, 
         return RunOutcome(
             satellite, day, "interrupted", "stop requested", run_id, timings=timings, counts=counts
         )
-    except (SourceError, PlanError, DataError, OSError) as exc:
+    except (SourceError, DataError, OSError) as exc:
         return _failed(store, run_id, satellite, day, f"{type(exc).__name__}: {exc}", timings, counts)
     except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
         LOG.exception("run %s %s failed unexpectedly", satellite, day)

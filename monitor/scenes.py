@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from monitor.errors import DataError
-from monitor.sdr import read_file
+from monitor.sdr import GranuleError, read_file
+from monitor.sdr.pairing import GranuleFiles, granule_files
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
 from monitor.sources import BudgetExceeded, SourceError
 from monitor.spectral import i5_band
@@ -28,13 +29,15 @@ COVER_MARGIN = dt.timedelta(seconds=10)
 
 @dataclass
 class Candidate:
-    """A CrIS granule considered: its listed SDR and GEO, the VIIRS pairs covering it, its score (K)."""
+    """A CrIS granule considered: its listed SDR and GEO, the listed VIIRS pairs covering it, its score (K)
+    and, once fetched and read, its :class:`monitor.sdr.pairing.GranuleFiles` (paths and metadata)."""
 
     key: str
     sdr: object
     geo: object
     viirs: list  # [(sdr, geo)] listed VIIRS pairs covering it
     score_k: float = float("nan")
+    files: GranuleFiles | None = None
 
 
 def _pairs(files, sdr_prefixes, geo_prefixes):
@@ -88,9 +91,12 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
             )
             continue
         try:
-            sdr_path = source.fetch(sdr)
-            source.fetch(geo)
-            (granule,) = [g for g in read_file(sdr_path, kinds=("cris_sdr",))][:1]
+            sdr_path, geo_path = source.fetch(sdr), source.fetch(geo)
+            granules = read_file(sdr_path, kinds=("cris_sdr",))
+            if len(granules) != 1:
+                raise GranuleError(sdr_path, "(file)", f"holds {len(granules)} granules; one is expected")
+            (granule,) = granules
+            files = granule_files(key, sdr_path, geo_path, sdr_meta=granule.meta)
             score = inhomogeneity_k(np.where(granule.good[..., None], granule.radiance_lw, np.nan), satellite)
         except BudgetExceeded as exc:
             decisions.append({"granule": key, "decision": "rejected", "reason": str(exc)})
@@ -100,7 +106,7 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
                 {"granule": key, "decision": "rejected", "reason": f"unusable CrIS granule: {exc}"}
             )
             continue
-        pool.append(Candidate(key, sdr, geo, cover, score))
+        pool.append(Candidate(key, sdr, geo, cover, score, files))
     pool.sort(key=lambda c: -c.score_k)
     chosen = []
     for c in pool:

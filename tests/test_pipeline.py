@@ -1,6 +1,10 @@
 """The daily run on a local source: outcomes recorded, idempotent, corrupt input skipped."""
 
+import collections
 import datetime as dt
+from pathlib import Path
+
+import pytest
 
 from monitor.config import load_config
 from monitor.pipeline import days_to_run, run_day
@@ -21,12 +25,30 @@ def make_config(tmp_path, data_dir, extra=""):
     return load_config(p)
 
 
-def test_run_is_recorded_and_idempotent(cases, tmp_path):
-    data, _, _ = cases.get()
+def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
+    """... and single-pass: selection pairs the granules and reads the CrIS files, the VIIRS files' metadata
+    is read once when they are fetched, and nothing is read or paired again before the assessment."""
+    from monitor.sdr import pairing, readers
+
+    data, truth, reference = cases.get()
     cfg = make_config(tmp_path, data)
     store = Store(cfg.store.sqlite)
     src = LocalSource(data)
+    reads = collections.Counter()
+
+    def counting(path):
+        reads[Path(path).name[:5]] += 1
+        return readers.read_metadata(path)
+
+    monkeypatch.setattr(pairing, "read_metadata", counting)
+    monkeypatch.setattr(pairing, "find_files", lambda paths: pytest.fail("the daily run paired files again"))
     first = run_day(cfg, store, src, "j01", DAY)
+    monkeypatch.undo()
+    # two CrIS granules (their GEO metadata read once each, the SDR's came with selection's reading), and one
+    # VIIRS granule covering both, fetched and read once
+    assert reads == {"GCRSO": 2, "GITCO": 1, "SVI05": 1}, reads
+    # the same numbers as assessing the files directly (crisgeo assess)
+    assert [f.d_beta_urad for f in first.result.fors] == [f.d_beta_urad for f in reference.fors]
     assert first.status == "ok" and len(first.result.fors) == 30
     second = run_day(cfg, store, src, "j01", DAY)
     assert second.status == "ok"

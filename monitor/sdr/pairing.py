@@ -116,7 +116,15 @@ def plan(paths) -> CasePlan:
         )
     satellite = next(iter(platforms))
     cris = _pair(by_prefix, CRIS_SDR, CRIS_GEO, skipped)
-    viirs = sorted(_pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped), key=lambda g: g.start)
+    viirs = _pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped)
+    return assemble(satellite, cris, viirs, skipped)
+
+
+def assemble(satellite: str, cris: list, viirs: list, skipped: list) -> CasePlan:
+    """The :class:`CasePlan` of paired CrIS and VIIRS granules (:class:`GranuleFiles`): each CrIS granule
+    with the VIIRS granules covering it in time; one without cover joins *skipped* with the reason. The one
+    place the coverage rule lives, for ``crisgeo assess`` and the daily run alike."""
+    viirs = sorted(viirs, key=lambda g: g.start)
     result = CasePlan(satellite, skipped=skipped, viirs_all=viirs)
     for g in sorted(cris, key=lambda g: g.start):
         cover = [v for v in viirs if v.start <= g.end + COVER_MARGIN and v.end >= g.start - COVER_MARGIN]
@@ -126,6 +134,21 @@ def plan(paths) -> CasePlan:
         result.cris.append(g)
         result.viirs[g.key] = cover
     return result
+
+
+def granule_files(key: str, sdr: Path, geo: Path, sdr_meta=None) -> GranuleFiles:
+    """The :class:`GranuleFiles` of one single-granule SDR file and its GEO file, reading the metadata not
+    given (*sdr_meta*, e.g. from a granule already read). :class:`GranuleError` for a file holding other
+    than one granule of its product."""
+    metas = []
+    for path, known in ((sdr, sdr_meta), (geo, None)):
+        found = [known] if known is not None else read_metadata(path)
+        if len(found) != 1:
+            raise GranuleError(
+                path, "(file)", f"holds {len(found)} granules; one granule per file is expected"
+            )
+        metas.append(found[0])
+    return GranuleFiles(key, Path(sdr), Path(geo), metas[0], metas[1])
 
 
 def _pair(by_prefix, sdr_prefixes, geo_prefixes, skipped) -> list[GranuleFiles]:
