@@ -272,15 +272,13 @@ def cmd_export(args) -> int:
     sats = [args.satellite] if args.satellite else cfg.satellites
     if len(sats) > 1:
         raise BadInput(f"--satellite: one of {', '.join(sats)} (a file holds one satellite)")
-    store = Store(cfg.store.sqlite)
-    try:
-        path = export(store, sats[0], args.out, args.format, args.since, args.until)
-    except ImportError as exc:
-        raise BadInput(
-            f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
-        ) from None
-    finally:
-        store.close()
+    with Store(cfg.store.sqlite) as store:
+        try:
+            path = export(store, sats[0], args.out, args.format, args.since, args.until)
+        except ImportError as exc:
+            raise BadInput(
+                f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
+            ) from None
     print(f"wrote {path}")
     return EXIT_OK
 
@@ -401,10 +399,8 @@ def cmd_status(args) -> int:
             print(json.dumps({"state": "UNKNOWN", "exit": NAGIOS_UNKNOWN, "error": str(exc)}))
         print(f"crisgeo status: UNKNOWN: {exc}", file=sys.stderr)
         return NAGIOS_UNKNOWN
-    try:
+    with store:
         rep = status_report(cfg, store)
-    finally:
-        store.close()
     if args.json:
         print(json.dumps(rep, indent=1, default=str))
         return rep["exit"]
@@ -437,20 +433,13 @@ def cmd_status(args) -> int:
 def cmd_alerts(args) -> int:
     """crisgeo alerts: list, silence, evaluate."""
     from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts
-    from alerts.settings import AlertConfigError
-    from monitor.service import Service
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
 
     cfg = _load(args)
-    service = Service(cfg)
-    try:
-        settings = service.alert_settings()
-    except AlertConfigError as exc:
-        raise BadInput(str(exc)) from None
-    store = Store(cfg.store.sqlite)
+    settings = cfg.alert_settings
     now = dt.datetime.now(dt.timezone.utc)
-    try:
+    with Store(cfg.store.sqlite) as store:
         if args.action == "silence":
             if args.until is None or not args.reason:
                 raise BadInput("alerts silence needs --until and --reason")
@@ -469,37 +458,30 @@ def cmd_alerts(args) -> int:
             print(json.dumps(alerts_view(store, now), indent=1))
         else:
             print(fmt_alerts(alerts_view(store, now)))
-    finally:
-        store.close()
     return EXIT_OK
 
 
 def cmd_events(args) -> int:
     """crisgeo events: list the known changes, or add one to the calendar."""
     from alerts.changes import Change, add_to_calendar, all_changes
-    from monitor.service import Service
     from monitor.store.sqlite import Store
 
     cfg = _load(args)
-    settings = Service(cfg).alert_settings()
-    if settings.events_file is None:
+    if cfg.events_file is None:
         raise BadInput("alerts.events_file is not set in the configuration")
     if args.action == "add":
         if not (args.satellite and args.time and args.instrument and args.description):
             raise BadInput("events add needs --satellite, --time, --instrument and --description")
         add_to_calendar(
-            settings.events_file,
+            cfg.events_file,
             Change(args.time, args.satellite, args.instrument, args.kind, args.description, "calendar"),
         )
-        print(f"added to {settings.events_file}")
+        print(f"added to {cfg.events_file}")
         return EXIT_OK
-    store = Store(cfg.store.sqlite)
-    try:
+    with Store(cfg.store.sqlite) as store:
         for sat in cfg.satellites:
-            for c in all_changes(store, sat, settings.events_file):
+            for c in all_changes(store, sat, cfg.events_file):
                 print(f"{sat} {c.label()}")
-    finally:
-        store.close()
     return EXIT_OK
 
 
@@ -604,11 +586,8 @@ def cmd_report(args) -> int:
     except AlertConfigError as exc:
         raise BadInput(f"{cfg.path}: {exc}") from None
     t0 = time.perf_counter()
-    store = Store(cfg.store.sqlite)
-    try:
+    with Store(cfg.store.sqlite) as store:
         index = build_report(store, args.out or cfg.report_dir or "report", opts)
-    finally:
-        store.close()
     print(f"wrote {Path(index).resolve()} ({', '.join(opts.satellites)}) in {time.perf_counter() - t0:.1f} s")
     return EXIT_OK
 

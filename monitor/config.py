@@ -150,6 +150,11 @@ class Config:
     alert_settings: object = None  # alerts.settings.AlertSettings, parsed and validated with the rest
 
     @property
+    def events_file(self) -> Path | None:
+        """The events calendar (``alerts.events_file``): attribution of jumps, annotations, the report."""
+        return self.alert_settings.events_file if self.alert_settings else None
+
+    @property
     def cache_dir(self) -> Path:
         """Where downloads are cached: ``state_dir/cache``."""
         return self.state_dir / "cache"

@@ -41,16 +41,13 @@ class _StoreCollector:
     def collect(self):
         from monitor.store.alerts import AlertState
 
-        store = self.open_store()
-        try:
+        with self.open_store() as store:
             success = store.last_success()
             counts = store.run_counts()
             outbox = store.outbox_sizes()
             firing = AlertState(store).firing()
             latest = {s: store.latest_day(s) for s in self.satellites}
             fors = {s: store.day_result(s, d) for s, d in latest.items() if d is not None}
-        finally:
-            store.close()
         g = GaugeMetricFamily(
             "crisgeo_last_success_timestamp_seconds",
             "End of the latest successful run (Unix time)",

@@ -22,7 +22,7 @@ from monitor.scenes import select_scenes
 from monitor.sdr import read_file
 from monitor.sdr.pairing import CasePlan, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
-from monitor.sources import ALL_PRODUCTS, SourceError
+from monitor.sources import ALL_PRODUCTS, Source, SourceError
 from monitor.store.sqlite import EventKind
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
@@ -164,7 +164,7 @@ def publish_changes(cfg, store, satellite: str) -> None:
     from alerts.changes import all_changes
 
     try:
-        changes = all_changes(store, satellite, cfg.alert_settings.events_file)
+        changes = all_changes(store, satellite, cfg.events_file)
     except (ValueError, OSError) as exc:
         LOG.warning("changes not published: %s", exc)
         return
@@ -200,7 +200,9 @@ def _failed(store, run_id, satellite, day, reason, timings, counts=None) -> RunO
     return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings, counts=counts or {})
 
 
-def run_day(cfg, store, source, satellite: str, day: dt.date, should_stop=None, progress=None) -> RunOutcome:
+def run_day(
+    cfg, store, source: Source, satellite: str, day: dt.date, should_stop=None, progress=None
+) -> RunOutcome:
     """Process one satellite-day end to end; never raises for a problem of the day's data or source: every
     outcome is recorded (an unexpected exception too, as ``failed`` with its type and message)."""
     stop = should_stop or (lambda: False)

@@ -116,8 +116,7 @@ class Service:
 
     def run(self, satellite: str, day: dt.date):
         """Run one satellite-day (health-tracked), then evaluate the alerts and regenerate the report."""
-        store = self.store()
-        try:
+        with self.store() as store:
             LOG.info("run %s %s", satellite, day)
             sd_notify(f"STATUS=assessing {satellite} {day}")
             with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
@@ -129,12 +128,6 @@ class Service:
                 self.metrics.record(out)
             self._after_run(store, out)
             return out
-        finally:
-            store.close()
-
-    def alert_settings(self):
-        """The alerts section, validated with the rest of the configuration at load."""
-        return self.cfg.alert_settings
 
     def _after_run(self, store, outcome):
         """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the
@@ -160,7 +153,7 @@ class Service:
         own = store is None
         store = store or self.store()
         try:
-            settings = self.alert_settings()
+            settings = self.cfg.alert_settings
             queued = evaluate(store, settings, self.cfg.satellites)
             if report:
                 self.regenerate_report(store)
@@ -176,24 +169,18 @@ class Service:
         next daily run); returns {target: (sent, left)}."""
         from monitor.store.timeseries import drain_outbox
 
-        store = self.store()
-        try:
+        with self.store() as store:
             report = drain_outbox(store, self.cfg.store.publish)
             if any(sent for sent, _ in report.values()):
                 LOG.info("outbox: %s", report)
             return report
-        finally:
-            store.close()
 
     def recover(self):
         """Mark runs left 'running' by a killed process as interrupted (call with the instance lock held)."""
-        store = self.store()
-        try:
+        with self.store() as store:
             n = store.interrupt_stale_runs()
             if n:
                 LOG.warning("%d run(s) were cut short by a previous process; their days will be redone", n)
-        finally:
-            store.close()
 
     def handle_signals(self):
         """SIGTERM and SIGINT request a clean stop between steps."""
@@ -203,14 +190,11 @@ class Service:
     def catch_up(self, satellite: str, today: dt.date | None = None) -> list:
         """Run the days of the catch-up window that have no completed run, oldest first."""
         today = today or dt.datetime.now(UTC).date()
-        store = self.store()
-        try:
+        with self.store() as store:
             sch = self.cfg.schedule
             days = days_to_run(
                 store, satellite, today, sch.catch_up_days, sch.lag_days, sch.no_data_retry_days
             )
-        finally:
-            store.close()
         outcomes = []
         for day in days:
             if self.stop_event.is_set():

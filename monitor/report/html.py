@@ -63,7 +63,7 @@ def options_from_config(cfg, satellites=None, since=None, until=None) -> ReportO
         spec_km=settings.rules.spec_km,
         since=since,
         until=until,
-        calendar=settings.events_file,
+        calendar=cfg.events_file,
         satellites=list(satellites or cfg.satellites),
     )
 

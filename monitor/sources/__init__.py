@@ -9,6 +9,7 @@ from __future__ import annotations
 import datetime as dt
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 from monitor.sdr.names import JpssName, parse_name
 from monitor.sdr.products import PRODUCTS
@@ -55,7 +56,23 @@ def on_day(f: ListedFile, day: dt.date) -> bool:
     return f.parsed.start.date() == day
 
 
-def make_source(cfg):
+class Source(Protocol):
+    """What the daily run needs of a source (local tree, simulator, NODD)."""
+
+    spent_bytes: int  # downloaded in this run
+    downloaded_files: int
+
+    def start_day(self) -> None:
+        """Start a run: reset the run's budget and deadline, apply the cache retention."""
+
+    def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
+        """The granule files of *satellite* for *day* whose product is in *products*."""
+
+    def fetch(self, f: ListedFile) -> Path:
+        """A local path holding *f* (downloaded if need be); :class:`SourceError` on failure."""
+
+
+def make_source(cfg) -> Source:
     """The source named by the configuration's ``source.kind``."""
     from monitor.sources.local import LocalSource, SimulatedSource
     from monitor.sources.nodd import NoddSource
