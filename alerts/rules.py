@@ -261,13 +261,13 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
     runs = store.runs(satellite)
     if not runs:
         return None
-    ok = [r for r in runs if r["status"] == "ok"]
-    since = dt.datetime.fromisoformat((ok[-1]["finished"] if ok else runs[0]["started"]))
+    ok = [r for r in runs if r.status == "ok"]
+    since = dt.datetime.fromisoformat((ok[-1].finished if ok else runs[0].started))
     age = (now - since).total_seconds() / 3600
     if age <= s.stale_hours:
         return None
     what = (
-        f"last successful assessment {ok[-1]['day']} finished {ok[-1]['finished']}"
+        f"last successful assessment {ok[-1].day} finished {ok[-1].finished}"
         if ok
         else "no successful assessment yet"
     )
@@ -276,16 +276,16 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
         satellite,
         "critical",
         f"{satellite}: no successful assessment for {age:.0f} h",
-        [what, f"latest run: {runs[-1]['day']} {runs[-1]['status']} {runs[-1]['reason'] or ''}".strip()],
+        [what, f"latest run: {runs[-1].day} {runs[-1].status} {runs[-1].reason or ''}".strip()],
     )
 
 
 def failure_finding(store, satellite: str) -> Finding | None:
     """The latest run failed, or the scheduler reported a failed or missed job since the last good run."""
     runs = store.runs(satellite)
-    last_ok = max((r["id"] for r in runs if r["status"] in ("ok", "no_data", "no_data_final")), default=0)
-    failed = [r for r in runs if r["id"] > last_ok and r["status"] == "failed"]
-    last_ok_time = next((r["finished"] for r in runs if r["id"] == last_ok), "")
+    last_ok = max((r.id for r in runs if r.status in ("ok", "no_data", "no_data_final")), default=0)
+    failed = [r for r in runs if r.id > last_ok and r.status == "failed"]
+    last_ok_time = next((r.finished for r in runs if r.id == last_ok), "")
     jobs = [
         e
         for e in store.events()
@@ -293,7 +293,7 @@ def failure_finding(store, satellite: str) -> Finding | None:
     ]
     if not failed and not jobs:
         return None
-    lines = [f"run {r['day']}: {r['reason']}" for r in failed] + [
+    lines = [f"run {r.day}: {r.reason}" for r in failed] + [
         f"scheduler: {e.detail.get('job')}: {e.detail.get('error', e.detail.get('text'))} "
         f"(scheduled {e.detail.get('scheduled', '?')})"
         for e in jobs

@@ -355,14 +355,16 @@ def status_report(cfg, store) -> dict:
     from monitor.service import next_run
     from monitor.store.alerts import AlertState
 
-    runs = {r["satellite"]: r for r in store.last_runs()}
+    runs = {r.satellite: r for r in store.last_runs()}
     firing = AlertState(store).firing()
     sats = {}
     for sat in cfg.satellites:
         r = runs.get(sat)
         day = store.latest_day(sat)
         sats[sat] = {
-            "last_run": None if r is None else {k: r[k] for k in ("day", "status", "finished", "reason")},
+            "last_run": None
+            if r is None
+            else {k: getattr(r, k) for k in ("day", "status", "finished", "reason")},
             "latest_day": None if day is None else str(day),
             "fors": [] if day is None else [f.to_dict() for f in store.day_result(sat, day)],
             "alerts": [

@@ -96,7 +96,7 @@ def served(cases, tmp_path_factory):
     db = tmp / "state" / "crisgeo.sqlite"
     try:
         assert sock.recv(4096) == b"READY=1"
-        runs = lambda: [r["status"] for r in Store(db).runs()]  # noqa: E731
+        runs = lambda: [r.status for r in Store(db).runs()]  # noqa: E731
         assert _wait_for(lambda: "no_data" in runs(), 120), (tmp / "daemon.log").read_text()
         yield f"http://127.0.0.1:{port}", db
     finally:

@@ -69,7 +69,7 @@ def test_a_day_without_data_is_recorded(cases, tmp_path):
     assert (
         out.status == "no_data_final" and "no CrIS GEO granule" in out.reason
     )  # long past its retry horizon
-    assert store.runs()[0]["status"] == "no_data_final"
+    assert store.runs()[0].status == "no_data_final"
     assert DAY + dt.timedelta(days=3) in store.done_days("j01")
     assert days_to_run(store, "j01", DAY + dt.timedelta(days=5), 4) == [
         DAY + dt.timedelta(days=k) for k in (1, 2, 4)
@@ -150,7 +150,7 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
     assert [(o.day, o.status) for o in outcomes][-2:] == [(DAY, "failed"), (DAY + dt.timedelta(days=1), "ok")]
     assert outcomes[-2].reason == "unexpected RuntimeError: poison granule"
     store = Store(cfg.store.sqlite)
-    assert {r["day"]: r["status"] for r in store.runs("j01")}[str(DAY)] == "failed"
+    assert {r.day: r.status for r in store.runs("j01")}[str(DAY)] == "failed"
     assert any(
         e.kind == EventKind.RUN_FAILED and "poison granule" in e.detail["reason"] for e in store.events()
     )

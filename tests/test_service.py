@@ -43,7 +43,7 @@ def _status(db):
         return []
     s = Store(db)
     try:
-        return [r["status"] for r in s.runs()]
+        return [r.status for r in s.runs()]
     finally:
         s.close()
 
@@ -66,7 +66,7 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     p.kill()
     p.wait()
     s = Store(db)
-    assert [r["status"] for r in s.runs()] == ["running"]
+    assert [r.status for r in s.runs()] == ["running"]
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0  # nothing half-written
     s.close()
     r = subprocess.run(
@@ -78,7 +78,7 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     )
     assert r.returncode == 0, r.stderr
     s = Store(db)
-    assert [r["status"] for r in s.runs()] == ["interrupted", "ok"]
+    assert [r.status for r in s.runs()] == ["interrupted", "ok"]
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
 
 

@@ -270,7 +270,7 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     figures = {"latest_km.png", "latest_urad.png", "heatmap.png", "trend.png"}
     if stored is not None and worst is not None:
         cube, step = stored
-        runs = [r for r in store.runs(satellite) if r["day"] == latest.isoformat() and r["status"] == "ok"]
+        runs = [r for r in store.runs(satellite) if r.day == latest.isoformat() and r.status == "ok"]
         plots.cost_contour(
             sat_dir / "cost.png",
             np.asarray(cube[worst.for_index - 1], float),
@@ -279,7 +279,7 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
             worst.d_alpha_urad,
             worst.d_beta_urad,
             f"{title}: worst FOR {worst.for_index}, "
-            f"{worst.total_km:.2f} km" + (f" (run {runs[-1]['id']})" if runs else ""),
+            f"{worst.total_km:.2f} km" + (f" (run {runs[-1].id})" if runs else ""),
         )
         figures.add("cost.png")
         cost_html = (

@@ -73,10 +73,9 @@ MIGRATIONS = [
         id INTEGER PRIMARY KEY, rule TEXT, satellite TEXT, until TEXT NOT NULL, reason TEXT NOT NULL,
         created TEXT);
     CREATE TABLE IF NOT EXISTS deliveries (
-        id INTEGER PRIMARY KEY, channel TEXT NOT NULL, satellite TEXT, subject TEXT NOT NULL, body TEXT NOT
-        NULL,
-        created TEXT NOT NULL, status TEXT NOT NULL, attempts INTEGER DEFAULT 0, next_attempt TEXT,
-        last_error TEXT, sent TEXT);
+        id INTEGER PRIMARY KEY, channel TEXT NOT NULL, satellite TEXT, subject TEXT NOT NULL,
+        body TEXT NOT NULL, created TEXT NOT NULL, status TEXT NOT NULL, attempts INTEGER DEFAULT 0,
+        next_attempt TEXT, last_error TEXT, sent TEXT);
     DROP TABLE IF EXISTS alert_meta;
     """,
 ]
@@ -146,6 +145,26 @@ class Event:
         if not isinstance(detail, dict):
             detail = {"text": r["detail"]}
         return cls(r["id"], r["time"], EventKind(r["kind"]), r["satellite"], detail)
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of the ledger: *status* is running, ok, no_data, no_data_final, failed or interrupted; times
+    ISO 8601 UTC (*finished* None while running); *day* YYYY-MM-DD."""
+
+    id: int
+    satellite: str
+    day: str
+    started: str
+    finished: str | None
+    status: str
+    reason: str | None
+    n_granules: int
+    summary: str | None
+
+    @classmethod
+    def from_row(cls, r) -> "Run":
+        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
 
 class StoreError(RuntimeError):
@@ -288,14 +307,13 @@ class Store:
                 out.add(d)
         return out
 
-    def last_runs(self) -> list:
-        """The latest run of each satellite (dict rows of the ledger)."""
+    def last_runs(self) -> list[Run]:
+        """The latest run of each satellite."""
         return [
-            dict(r)
+            Run.from_row(r)
             for r in self.db.execute(
                 "SELECT r.* FROM runs r JOIN (SELECT satellite, MAX(id) AS id FROM runs GROUP BY satellite) "
-                "m "
-                "ON r.id = m.id ORDER BY r.satellite"
+                "m ON r.id = m.id ORDER BY r.satellite"
             )
         ]
 
@@ -322,10 +340,10 @@ class Store:
         """{target: points waiting}."""
         return dict(self.db.execute("SELECT target, COUNT(*) FROM outbox GROUP BY target").fetchall())
 
-    def runs(self, satellite: str | None = None) -> list:
+    def runs(self, satellite: str | None = None) -> list[Run]:
         """The runs (of *satellite*), oldest first."""
         q = "SELECT * FROM runs" + (" WHERE satellite=?" if satellite else "") + " ORDER BY id"
-        return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
+        return [Run.from_row(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
 
     # -- results
     def save_day(

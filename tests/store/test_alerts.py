@@ -55,11 +55,10 @@ def test_a_store_of_schema_2_with_the_old_alert_tables_keeps_its_alerts(tmp_path
         CREATE TABLE alert_state (fingerprint TEXT PRIMARY KEY, rule TEXT NOT NULL, satellite TEXT NOT NULL,
             grp TEXT, severity TEXT, status TEXT NOT NULL, started TEXT, last_notified TEXT, resolved TEXT,
             summary TEXT, lines TEXT);
-        INSERT INTO alert_state VALUES ('spec:j01:', 'spec', 'j01', '', 'critical', 'firing', '2026-11-01',
-        NULL,
-            NULL, 'old', '[]');
-        INSERT INTO events (time, kind, satellite, detail) VALUES ('2026-11-01', 'run_failed', 'j01', 'a
-        text');
+        INSERT INTO alert_state VALUES ('spec:j01:', 'spec', 'j01', '', 'critical', 'firing',
+            '2026-11-01', NULL, NULL, 'old', '[]');
+        INSERT INTO events (time, kind, satellite, detail)
+            VALUES ('2026-11-01', 'run_failed', 'j01', 'a text');
         PRAGMA user_version=2;""")
     db.close()
     with Store(path) as store:

@@ -39,7 +39,7 @@ def test_save_day_replaces_and_queues(cases, tmp_path):
         )
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
     assert s.outbox_size() == 30 and len(s.granules("j01", DAY)) == 2
-    assert [r["status"] for r in s.runs("j01")] == ["ok", "ok"]
+    assert [r.status for r in s.runs("j01")] == ["ok", "ok"]
     assert s.day_result("j01", DAY) == result.fors
     cube, step_urad = s.cost_cube("j01", DAY)
     assert cube.shape == (30, 21, 21) and step_urad == pytest.approx(375.0 / 833000.0 * 1e6)
@@ -55,8 +55,8 @@ def test_failed_transaction_leaves_nothing(cases, tmp_path):
     with pytest.raises(sqlite3.Error):
         s.save_day(run, "j01", DAY, result, [{"granule": None, "decision": None}], {})  # NOT NULL violated
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0
-    assert s.runs()[0]["status"] == "running"
-    assert s.interrupt_stale_runs() == 1 and s.runs()[0]["status"] == "interrupted"
+    assert s.runs()[0].status == "running"
+    assert s.interrupt_stale_runs() == 1 and s.runs()[0].status == "interrupted"
 
 
 def test_outbox_delivery_bookkeeping(tmp_path):

@@ -148,9 +148,7 @@ def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
             scheduler.shutdown(wait=True)
         assert store.outbox_size(target_name(service.cfg.store.publish[0])) == 0
         assert len(vm_export(url, "cris_geolocation_d_beta_urad")) == 30
-        assert not store.runs("j01") or all(
-            r["status"] != "ok" or r["day"] == str(DAY) for r in store.runs("j01")
-        )
+        assert not store.runs("j01") or all(r.status != "ok" or r.day == str(DAY) for r in store.runs("j01"))
 
 
 def test_a_rerun_day_keeps_one_value_per_series_with_dedup(cases, tmp_path):
