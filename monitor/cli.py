@@ -15,7 +15,10 @@ import logging
 import sys
 from pathlib import Path
 
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
 from monitor.errors import DataError
+from monitor.satellites import SATELLITES
+from monitor.simulate.orbit import PASSES
 from monitor.version import __version__
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
@@ -36,6 +39,62 @@ def _iso(text: str) -> dt.datetime:
     return when if when.tzinfo else when.replace(tzinfo=dt.timezone.utc)
 
 
+def _day(text: str) -> dt.date:
+    try:
+        return dt.date.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a date (YYYY-MM-DD): {text!r}") from None
+
+
+def arg(*names, **options) -> tuple:
+    """One argument of a subcommand: the add_argument call, as data."""
+    return names, options
+
+
+CONFIG = arg("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+RESIDUAL_ARGS = (
+    arg("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)"),
+    arg(
+        "--own-residuals",
+        metavar="EP_IN_FORCE",
+        help="learn each granule's residual from itself, against the EP it was made with",
+    ),
+)
+RULES = ("spec", "jump", "stale", "failure", "processing")
+COMMANDS: dict = {}  # name -> (handler, help, arguments), in the order of ``crisgeo --help``
+
+
+def command(name: str, help: str, *arguments):
+    """Register the decorated handler as subcommand *name* with its *arguments* (:func:`arg`)."""
+
+    def register(handler):
+        COMMANDS[name] = (handler, help, arguments)
+        return handler
+
+    return register
+
+
+@command(
+    "simulate",
+    "write simulated CrIS/VIIRS granules with an injected LOS error",
+    arg("--out", required=True, help="output directory"),
+    arg("--satellite", choices=tuple(SATELLITES), default="j01"),
+    arg("--granules", type=int, default=14, help="consecutive CrIS granules (default 14, as the paper)"),
+    arg("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file"),
+    arg("--seed", type=int, default=0),
+    arg("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)"),
+    arg("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)"),
+    arg("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)"),
+    arg("--terrain", action="store_true", help="1-4 km ranges and plateaus over 40 %% land"),
+    arg(
+        "--pass",
+        dest="orbit_pass",
+        choices=sorted(PASSES),
+        help="start at this pass of the satellite's orbit after --start (day: ascending tropics, "
+        "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass",
+    ),
+    arg("--pass-lon", type=float, help="with --pass: the pass nearest this longitude, deg (e.g. 180)"),
+)
 def cmd_simulate(args) -> int:
     """crisgeo simulate: write a simulated case."""
     from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
@@ -101,6 +160,14 @@ def _residuals(args):
         raise BadInput(str(exc)) from None
 
 
+@command(
+    "optimize",
+    "new scene-mirror angles (EP) from an assessment result (paper section 4)",
+    arg("result", help="assessment result JSON (crisgeo assess --out)"),
+    arg("--ep", required=True, help="the EP in force when the assessed data were made (XML or YAML)"),
+    arg("--out", required=True, help="the proposed EP, in the format of --ep"),
+    arg("--table-json", help="also write the old/new angle table as JSON here"),
+)
 def cmd_optimize(args) -> int:
     """crisgeo optimize: new scene-mirror angles from an assessment."""
     import json
@@ -130,6 +197,14 @@ def cmd_optimize(args) -> int:
     return EXIT_OK
 
 
+@command(
+    "regeolocate",
+    "write copies of CrIS GEO files geolocated with another EP",
+    arg("files", nargs="+"),
+    arg("--ep", required=True),
+    arg("--out", required=True, help="output directory (never the input's)"),
+    *RESIDUAL_ARGS,
+)
 def cmd_regeolocate(args) -> int:
     """crisgeo regeolocate: GEO copies geolocated with another EP."""
     from monitor.mapping.regeolocate import regeolocate_file
@@ -149,6 +224,14 @@ def cmd_regeolocate(args) -> int:
     return EXIT_FAIL if failed else EXIT_OK
 
 
+@command(
+    "geolocate",
+    "compare an EP's geolocation with CrIS GEO files' own, per FOR",
+    arg("files", nargs="+"),
+    arg("--ep", required=True),
+    arg("--json", action="store_true"),
+    *RESIDUAL_ARGS,
+)
 def cmd_geolocate(args) -> int:
     """crisgeo geolocate: an EP's geolocation against the files' own, per FOR."""
     import json
@@ -203,6 +286,26 @@ def format_table(result) -> str:
     return "\n".join(lines)
 
 
+@command(
+    "assess",
+    "assess CrIS geolocation against VIIRS I5 for the granules given",
+    arg("paths", nargs="+", help="granule files or directories"),
+    arg("--out", help="write the result JSON here"),
+    arg(
+        "--steps",
+        type=int,
+        default=DEFAULT_HALF_STEPS,
+        help="perturbation steps each side of zero (grid 2n+1)",
+    ),
+    arg("--step-urad", type=float, default=DEFAULT_STEP_URAD, help="perturbation step, urad"),
+    arg(
+        "--kernel",
+        choices=("top-hat", "response"),
+        default="top-hat",
+        help="FOV weighting: top-hat cone or the CrIS spatial response",
+    ),
+    arg("--workers", type=int, default=1, help="worker processes over granules"),
+)
 def cmd_assess(args) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assess import AssessConfig, assess_paths
@@ -234,6 +337,12 @@ def _load(args):
         raise BadInput(msg if msg.startswith(str(args.config)) else f"{args.config}: {msg}") from None
 
 
+@command(
+    "install-files",
+    "copy the shipped configs, Grafana and Prometheus files, EP files, the unit and docs into a directory",
+    arg("dest", type=Path, help="target directory, e.g. /opt/crisgeo/share"),
+    arg("--force", action="store_true", help="replace files that exist"),
+)
 def cmd_install_files(args) -> int:
     """crisgeo install-files: copy the shipped files out."""
     from monitor.install import install_files, kept_files
@@ -246,6 +355,12 @@ def cmd_install_files(args) -> int:
     return EXIT_OK
 
 
+@command(
+    "check-config",
+    "validate a configuration; print it with its defaults, secrets masked",
+    CONFIG,
+    arg("--reference", action="store_true", help="print the reference of every key (Markdown) instead"),
+)
 def cmd_check_config(args) -> int:
     """crisgeo check-config: validate and print the effective configuration, or the reference."""
     import yaml
@@ -263,6 +378,16 @@ def cmd_check_config(args) -> int:
     return EXIT_OK
 
 
+@command(
+    "export",
+    "per-FOR results as CF NetCDF (xarray) or CSV",
+    CONFIG,
+    arg("--format", choices=("netcdf", "csv"), default="netcdf"),
+    arg("--out", required=True),
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--since", type=_day, help="first day, YYYY-MM-DD"),
+    arg("--until", type=_day, help="last day, YYYY-MM-DD"),
+)
 def cmd_export(args) -> int:
     """crisgeo export: the results as NetCDF or CSV."""
     from monitor.export import export
@@ -283,13 +408,13 @@ def cmd_export(args) -> int:
     return EXIT_OK
 
 
-def _day(text: str) -> dt.date:
-    try:
-        return dt.date.fromisoformat(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a date (YYYY-MM-DD): {text!r}") from None
-
-
+@command(
+    "run",
+    "one run of the daily job (the missed days, or --date), then exit",
+    CONFIG,
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD"),
+)
 def cmd_run(args) -> int:
     """crisgeo run: one run of the daily job, then exit."""
     from monitor.service import AlreadyRunning, Service
@@ -326,6 +451,16 @@ def cmd_run(args) -> int:
     return EXIT_FAIL if any(o.status == "failed" for o in outcomes) else EXIT_OK
 
 
+@command(
+    "daemon",
+    "the long-running service (systemd)",
+    CONFIG,
+    arg(
+        "--listen",
+        metavar="HOST:PORT",
+        help="serve /metrics, /healthz, /report/ here (overrides http.listen; off: no endpoint)",
+    ),
+)
 def cmd_daemon(args) -> int:
     """crisgeo daemon: the long-running service."""
     from monitor.service import AlreadyRunning, Service
@@ -386,6 +521,12 @@ def status_report(cfg, store) -> dict:
     }
 
 
+@command(
+    "status",
+    "last run per satellite, latest per-FOR table, next run, outbox size",
+    CONFIG,
+    arg("--json", action="store_true", help="machine-readable status"),
+)
 def cmd_status(args) -> int:
     """crisgeo status: the state of every satellite, as text or JSON, with Nagios exit codes."""
     import json
@@ -432,6 +573,17 @@ def cmd_status(args) -> int:
     return rep["exit"]
 
 
+@command(
+    "alerts",
+    "list firing, silenced and resolved alerts; silence; evaluate now",
+    arg("action", choices=("list", "silence", "evaluate"), nargs="?", default="list"),
+    CONFIG,
+    arg("--rule", choices=RULES),
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--until", type=_iso, help="end of the silence (ISO 8601, UTC)"),
+    arg("--reason", default=""),
+    arg("--json", action="store_true", help="list as JSON"),
+)
 def cmd_alerts(args) -> int:
     """crisgeo alerts: list, silence, evaluate."""
     from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts
@@ -463,6 +615,17 @@ def cmd_alerts(args) -> int:
     return EXIT_OK
 
 
+@command(
+    "events",
+    "list the known changes, or add one to the events calendar",
+    arg("action", choices=("list", "add"), nargs="?", default="list"),
+    CONFIG,
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--time", type=_iso),
+    arg("--instrument", choices=("cris", "viirs", "common")),
+    arg("--kind", default="change", help="ep_upload, lut_change, software, ..."),
+    arg("--description"),
+)
 def cmd_events(args) -> int:
     """crisgeo events: list the known changes, or add one to the calendar."""
     from alerts.changes import Change, add_to_calendar, all_changes
@@ -487,6 +650,25 @@ def cmd_events(args) -> int:
     return EXIT_OK
 
 
+@command(
+    "fingerprint",
+    "per-FOR LOS fingerprint (SBF angles) of CrIS GEO files",
+    arg("paths", nargs="+"),
+    arg("--json", action="store_true"),
+    arg("--threshold-urad", type=float, default=10.0),
+    arg(
+        "--ep-library",
+        action="append",
+        metavar="PATH",
+        help="EP file or directory to identify the EP from (repeatable; default: the packaged real EPs)",
+    ),
+    arg(
+        "--write-residuals",
+        metavar="FILE",
+        help="write the per-FOR FOV-5 LOS residual against --ep (default: the best-matching EP)",
+    ),
+    arg("--ep", help="the EP the residual table is learned against (XML or YAML)"),
+)
 def cmd_fingerprint(args) -> int:
     """crisgeo fingerprint: the per-FOR LOS fingerprint of GEO files."""
     import json
@@ -568,6 +750,15 @@ def _geo_platform(files):
     return platforms.pop() if len(platforms) == 1 else None
 
 
+@command(
+    "report",
+    "the self-contained HTML trend report (one page per satellite)",
+    CONFIG,
+    arg("--out", help="output directory (default: report_dir of the configuration)"),
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--since", type=_day, help="first day shown, YYYY-MM-DD"),
+    arg("--until", type=_day, help="last day shown, YYYY-MM-DD"),
+)
 def cmd_report(args) -> int:
     """crisgeo report: write the HTML report."""
     import time
@@ -594,6 +785,14 @@ def cmd_report(args) -> int:
     return EXIT_OK
 
 
+@command(
+    "bench",
+    "time each stage on a simulated case; print FOVs/s and peak memory",
+    arg("--granules", type=int, default=14),
+    arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
+    arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
+    arg("--workers", type=int, default=2, help="worker processes (default 2, the machine's cores)"),
+)
 def cmd_bench(args) -> int:
     """crisgeo bench: time each stage on a simulated case."""
     from monitor.bench import run_bench
@@ -637,11 +836,7 @@ def setup_logging(verbose: bool, log_format: str) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of every subcommand."""
-    from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
-    from monitor.satellites import SATELLITES
-    from monitor.simulate.orbit import PASSES
-
+    """The argument parser: the global options and one subparser per entry of :data:`COMMANDS`."""
     p = argparse.ArgumentParser(
         prog="crisgeo", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
@@ -661,188 +856,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--log-format", choices=("text", "json"), default=argparse.SUPPRESS, help="text or JSON lines"
     )
     sub = p.add_subparsers(dest="command", required=True)
-    add_parser = sub.add_parser
-    sub.add_parser = lambda *a, **kw: add_parser(*a, parents=[common], **kw)
-
-    s = sub.add_parser("simulate", help="write simulated CrIS/VIIRS granules with an injected LOS error")
-    s.add_argument("--out", required=True, help="output directory")
-    s.add_argument("--satellite", choices=tuple(SATELLITES), default="j01")
-    s.add_argument(
-        "--granules", type=int, default=14, help="consecutive CrIS granules (default 14, as the paper)"
-    )
-    s.add_argument("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)")
-    s.add_argument("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)")
-    s.add_argument("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)")
-    s.add_argument("--terrain", action="store_true", help="1-4 km ranges and plateaus over 40 %% land")
-    s.add_argument(
-        "--pass",
-        dest="orbit_pass",
-        choices=sorted(PASSES),
-        help="start at this pass of the satellite's orbit after --start (day: ascending tropics, "
-        "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass",
-    )
-    s.add_argument(
-        "--pass-lon", type=float, help="with --pass: the pass nearest this longitude, deg (e.g. 180)"
-    )
-    s.set_defaults(func=cmd_simulate)
-
-    o = sub.add_parser(
-        "optimize", help="new scene-mirror angles (EP) from an assessment result (paper section 4)"
-    )
-    o.add_argument("result", help="assessment result JSON (crisgeo assess --out)")
-    o.add_argument(
-        "--ep", required=True, help="the EP in force when the assessed data were made (XML or YAML)"
-    )
-    o.add_argument("--out", required=True, help="the proposed EP, in the format of --ep")
-    o.add_argument("--table-json", help="also write the old/new angle table as JSON here")
-    o.set_defaults(func=cmd_optimize)
-
-    rg = sub.add_parser("regeolocate", help="write copies of CrIS GEO files geolocated with another EP")
-    rg.add_argument("files", nargs="+")
-    rg.add_argument("--ep", required=True)
-    rg.add_argument("--out", required=True, help="output directory (never the input's)")
-    rg.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
-    rg.add_argument(
-        "--own-residuals",
-        metavar="EP_IN_FORCE",
-        help="learn each granule's residual from itself, against the EP it was made with",
-    )
-    rg.set_defaults(func=cmd_regeolocate)
-
-    gl = sub.add_parser("geolocate", help="compare an EP's geolocation with CrIS GEO files' own, per FOR")
-    gl.add_argument("files", nargs="+")
-    gl.add_argument("--ep", required=True)
-    gl.add_argument("--json", action="store_true")
-    gl.add_argument("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)")
-    gl.add_argument(
-        "--own-residuals",
-        metavar="EP_IN_FORCE",
-        help="learn each granule's residual from itself, against the EP it was made with",
-    )
-    gl.set_defaults(func=cmd_geolocate)
-
-    a = sub.add_parser("assess", help="assess CrIS geolocation against VIIRS I5 for the granules given")
-    a.add_argument("paths", nargs="+", help="granule files or directories")
-    a.add_argument("--out", help="write the result JSON here")
-    a.add_argument(
-        "--steps",
-        type=int,
-        default=DEFAULT_HALF_STEPS,
-        help="perturbation steps each side of zero (grid 2n+1)",
-    )
-    a.add_argument("--step-urad", type=float, default=DEFAULT_STEP_URAD, help="perturbation step, urad")
-    a.add_argument(
-        "--kernel",
-        choices=("top-hat", "response"),
-        default="top-hat",
-        help="FOV weighting: top-hat cone or the CrIS spatial response",
-    )
-    a.add_argument("--workers", type=int, default=1, help="worker processes over granules")
-    a.set_defaults(func=cmd_assess)
-
-    r = sub.add_parser("run", help="one run of the daily job (the missed days, or --date), then exit")
-    r.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    r.add_argument("--satellite", choices=tuple(SATELLITES))
-    r.add_argument("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD")
-    r.set_defaults(func=cmd_run)
-
-    ex = sub.add_parser("export", help="per-FOR results as CF NetCDF (xarray) or CSV")
-    ex.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    ex.add_argument("--format", choices=("netcdf", "csv"), default="netcdf")
-    ex.add_argument("--out", required=True)
-    ex.add_argument("--satellite", choices=tuple(SATELLITES))
-    ex.add_argument("--since", type=_day, help="first day, YYYY-MM-DD")
-    ex.add_argument("--until", type=_day, help="last day, YYYY-MM-DD")
-    ex.set_defaults(func=cmd_export)
-
-    cc = sub.add_parser(
-        "check-config", help="validate a configuration; print it with its defaults, secrets masked"
-    )
-    cc.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    cc.add_argument(
-        "--reference", action="store_true", help="print the reference of every key (Markdown) instead"
-    )
-    cc.set_defaults(func=cmd_check_config)
-
-    inst = sub.add_parser(
-        "install-files",
-        help="copy the shipped configs, Grafana and Prometheus files, EP files, "
-        "systemd unit and docs into a directory",
-    )
-    inst.add_argument("dest", type=Path, help="target directory, e.g. /opt/crisgeo/share")
-    inst.add_argument("--force", action="store_true", help="replace files that exist")
-    inst.set_defaults(func=cmd_install_files)
-
-    d = sub.add_parser("daemon", help="the long-running service (systemd)")
-    d.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    d.add_argument(
-        "--listen",
-        metavar="HOST:PORT",
-        help="serve /metrics, /healthz, /report/ here (overrides http.listen; off: no endpoint)",
-    )
-    d.set_defaults(func=cmd_daemon)
-
-    st = sub.add_parser("status", help="last run per satellite, latest per-FOR table, next run, outbox size")
-    st.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    st.add_argument("--json", action="store_true", help="machine-readable status")
-    st.set_defaults(func=cmd_status)
-
-    al = sub.add_parser("alerts", help="list firing, silenced and resolved alerts; silence; evaluate now")
-    al.add_argument("action", choices=("list", "silence", "evaluate"), nargs="?", default="list")
-    al.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    al.add_argument("--rule", choices=("spec", "jump", "stale", "failure", "processing"))
-    al.add_argument("--satellite", choices=tuple(SATELLITES))
-    al.add_argument("--until", type=_iso, help="end of the silence (ISO 8601, UTC)")
-    al.add_argument("--reason", default="")
-    al.add_argument("--json", action="store_true", help="list as JSON")
-    al.set_defaults(func=cmd_alerts)
-
-    ev = sub.add_parser("events", help="list the known changes, or add one to the events calendar")
-    ev.add_argument("action", choices=("list", "add"), nargs="?", default="list")
-    ev.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    ev.add_argument("--satellite", choices=tuple(SATELLITES))
-    ev.add_argument("--time", type=_iso)
-    ev.add_argument("--instrument", choices=("cris", "viirs", "common"))
-    ev.add_argument("--kind", default="change", help="ep_upload, lut_change, software, ...")
-    ev.add_argument("--description")
-    ev.set_defaults(func=cmd_events)
-
-    fp = sub.add_parser("fingerprint", help="per-FOR LOS fingerprint (SBF angles) of CrIS GEO files")
-    fp.add_argument("paths", nargs="+")
-    fp.add_argument("--json", action="store_true")
-    fp.add_argument("--threshold-urad", type=float, default=10.0)
-    fp.add_argument(
-        "--ep-library",
-        action="append",
-        metavar="PATH",
-        help="EP file or directory to identify the EP from (repeatable; default: the packaged real EPs)",
-    )
-    fp.add_argument(
-        "--write-residuals",
-        metavar="FILE",
-        help="write the per-FOR FOV-5 LOS residual against --ep (default: the best-matching EP)",
-    )
-    fp.add_argument("--ep", help="the EP the residual table is learned against (XML or YAML)")
-    fp.set_defaults(func=cmd_fingerprint)
-
-    rp = sub.add_parser("report", help="the self-contained HTML trend report (one page per satellite)")
-    rp.add_argument("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
-    rp.add_argument("--out", help="output directory (default: report_dir of the configuration)")
-    rp.add_argument("--satellite", choices=tuple(SATELLITES))
-    rp.add_argument("--since", type=_day, help="first day shown, YYYY-MM-DD")
-    rp.add_argument("--until", type=_day, help="last day shown, YYYY-MM-DD")
-    rp.set_defaults(func=cmd_report)
-
-    b = sub.add_parser("bench", help="time each stage on a simulated case; print FOVs/s and peak memory")
-    b.add_argument("--granules", type=int, default=14)
-    b.add_argument("--data", help="case directory to reuse or create (default: a temporary directory)")
-    b.add_argument(
-        "--pyresample", action="store_true", help="also time pyresample's radius search as a reference"
-    )
-    b.add_argument("--workers", type=int, default=2, help="worker processes (default 2, the machine's cores)")
-    b.set_defaults(func=cmd_bench)
+    for name, (handler, help_text, arguments) in COMMANDS.items():
+        sp = sub.add_parser(name, help=help_text, parents=[common])
+        for names, options in arguments:
+            sp.add_argument(*names, **options)
+        sp.set_defaults(func=handler)
     return p
 
 
