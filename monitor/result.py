@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 
 import numpy as np
 
@@ -66,6 +66,10 @@ class ForOffset:
         kw = {k: (float("nan") if v is None else v) for k, v in kw.items()}
         kw["flags"] = tuple(d.get("flags", ()))
         return cls(for_index=int(d["for"]), **kw)
+
+
+# the measured fields of a FOR (all but its index and flags), in the order of the dataclass
+MEASURED_FIELDS = tuple(f.name for f in fields(ForOffset) if f.name not in ("for_index", "flags"))
 
 
 @dataclass

@@ -31,17 +31,12 @@ from influxdb_client import InfluxDBClient, Point, WritePrecision
 from influxdb_client.client.exceptions import InfluxDBError
 from influxdb_client.client.write_api import SYNCHRONOUS
 
+from monitor.result import MEASURED_FIELDS
+
 LOG = logging.getLogger(__name__)
-FLOAT_FIELDS = (
-    "d_alpha_urad",
-    "d_beta_urad",
-    "sigma_alpha_urad",
-    "sigma_beta_urad",
-    "in_track_km",
-    "cross_track_km",
-    "total_km",
-    "cost_min_k",
-    "cost_zero_k",
+# the published float fields: the measured ones but the sample count (an integer field) and the sigmas in km
+FLOAT_FIELDS = tuple(
+    f for f in MEASURED_FIELDS if f not in ("n_samples", "sigma_in_track_km", "sigma_cross_track_km")
 )
 
 
