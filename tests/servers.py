@@ -39,6 +39,16 @@ def require(binary: str) -> str:
     return path
 
 
+def wait_for(pred, timeout=120.0) -> bool:
+    """Poll *pred* every 0.2 s until it is true (True) or *timeout* seconds have passed (False)."""
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        if pred():
+            return True
+        time.sleep(0.2)
+    return False
+
+
 def chromium_driver(tmp_path):
     """Headless Chromium under Selenium, keeping the browser console log (read it with get_log)."""
     from selenium import webdriver

@@ -16,22 +16,13 @@ import requests
 from prometheus_client.parser import text_string_to_metric_families
 
 from monitor.store.sqlite import Store
-from tests.servers import chromium_driver, free_port
+from tests.servers import chromium_driver, free_port, wait_for
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
 ROOT = Path(__file__).resolve().parent.parent
 CRISGEO = [sys.executable, "-m", "monitor.cli"]
 DAY = "2024-06-01"
-
-
-def _wait_for(pred, timeout=120.0):
-    t0 = time.time()
-    while time.time() - t0 < timeout:
-        if pred():
-            return True
-        time.sleep(0.2)
-    return False
 
 
 def _notify_socket(tmp_path):
@@ -97,7 +88,7 @@ def served(cases, tmp_path_factory):
     try:
         assert sock.recv(4096) == b"READY=1"
         runs = lambda: [r.status for r in Store(db).runs()]  # noqa: E731
-        assert _wait_for(lambda: "no_data" in runs(), 120), (tmp / "daemon.log").read_text()
+        assert wait_for(lambda: "no_data" in runs(), 120), (tmp / "daemon.log").read_text()
         yield f"http://127.0.0.1:{port}", db
     finally:
         _stop(proc)
@@ -121,7 +112,7 @@ def _samples(fam, name=None, **labels):
 def test_metrics_after_a_run(served):
     url, db = served
     # the daemon's catch-up run is recorded in the ledger before its figures reach the gauges
-    assert _wait_for(lambda: _samples(_families(url)["crisgeo_run_duration_seconds"], satellite="j01"), 30)
+    assert wait_for(lambda: _samples(_families(url)["crisgeo_run_duration_seconds"], satellite="j01"), 30)
     fams = _families(url)
     (last,) = _samples(fams["crisgeo_last_success_timestamp_seconds"], satellite="j01")
     assert abs(last.value - time.time()) < 3600
@@ -216,7 +207,7 @@ def test_a_run_over_its_budget_makes_the_daemon_unhealthy_and_starves_the_watchd
         got = []
         while "READY=1" not in got:
             got.append(sock.recv(4096).decode())
-        assert _wait_for(lambda: (r := _get(url + "/healthz")) is not None and r.status_code == 503, 60)
+        assert wait_for(lambda: (r := _get(url + "/healthz")) is not None and r.status_code == 503, 60)
         body = requests.get(url + "/healthz", timeout=10).json()
         assert body["status"] == "unhealthy" and "over its budget of 1 s" in body["problems"][0]
         assert body["running"][0]["job"].startswith("run j01 ")

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from monitor.store.sqlite import Store
+from tests.servers import wait_for
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
@@ -27,15 +28,6 @@ def _config(tmp_path, data, workers=1):
         f"assessment: {{workers: {workers}}}\nschedule: {{catch_up_days: 2}}\n"
     )
     return p
-
-
-def _wait_for(pred, timeout=120.0):
-    t0 = time.time()
-    while time.time() - t0 < timeout:
-        if pred():
-            return True
-        time.sleep(0.2)
-    return False
 
 
 def _status(db):
@@ -61,7 +53,7 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
         p = subprocess.Popen(
             CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT
         )
-    assert _wait_for(lambda: _assessing(log))
+    assert wait_for(lambda: _assessing(log))
     time.sleep(3)  # inside scene selection or collocation
     p.kill()
     p.wait()
@@ -91,7 +83,7 @@ def test_sigterm_mid_run_stops_within_seconds_and_consistent(cases, tmp_path, wo
         p = subprocess.Popen(
             CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT
         )
-    assert _wait_for(lambda: _assessing(log))
+    assert wait_for(lambda: _assessing(log))
     time.sleep(6)  # well into the assessment
     t0 = time.time()
     p.send_signal(signal.SIGTERM)
@@ -125,7 +117,7 @@ def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
         while not {"READY=1", "WATCHDOG=1"} <= got:
             got.add(sock.recv(4096).decode())
         # the catch-up runs at start and records the days without data
-        assert _wait_for(lambda: _status(tmp_path / "state" / "crisgeo.sqlite").count("no_data") == 2, 60)
+        assert wait_for(lambda: _status(tmp_path / "state" / "crisgeo.sqlite").count("no_data") == 2, 60)
         # a second instance on the same state directory is refused
         r = subprocess.run(CRISGEO + ["run", "--config", str(cfg)], capture_output=True, text=True, cwd=ROOT)
         assert (
