@@ -129,11 +129,11 @@ def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> lis
             for f in found:
                 prev = state.get(f.fingerprint)
                 quiet = state.silenced(f.rule, sat, now) is not None
-                if prev is None or prev["status"] != "firing":
+                if prev is None or prev.status != "firing":
                     kind = "firing"
                 elif (
-                    prev["last_notified"] is None
-                    or now - dt.datetime.fromisoformat(prev["last_notified"]) >= repeat
+                    prev.last_notified is None
+                    or now - dt.datetime.fromisoformat(prev.last_notified) >= repeat
                 ):
                     kind = "repeat"
                 else:
@@ -144,21 +144,21 @@ def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> lis
                     items.append((kind, f))
             current = {f.fingerprint for f in found}
             for prev in state.firing(sat):
-                if prev["fingerprint"] not in current:
-                    state.resolve(prev["fingerprint"], now)
-                    if state.silenced(prev["rule"], sat, now) is None:
+                if prev.fingerprint not in current:
+                    state.resolve(prev.fingerprint, now)
+                    if state.silenced(prev.rule, sat, now) is None:
                         from alerts.rules import Finding
 
                         items.append(
                             (
                                 "resolved",
                                 Finding(
-                                    prev["rule"],
+                                    prev.rule,
                                     sat,
-                                    prev["severity"],
-                                    f"resolved: {prev['summary']}",
+                                    prev.severity,
+                                    f"resolved: {prev.summary}",
                                     [],
-                                    prev["grp"] or "",
+                                    prev.grp or "",
                                 ),
                             )
                         )
@@ -216,23 +216,23 @@ def alerts_view(store, now: dt.datetime) -> dict:
     alerts = []
     for r in state.all():
         if (
-            r["status"] == "resolved"
-            and r["resolved"]
-            and now - dt.datetime.fromisoformat(r["resolved"]) > dt.timedelta(days=7)
+            r.status == "resolved"
+            and r.resolved
+            and now - dt.datetime.fromisoformat(r.resolved) > dt.timedelta(days=7)
         ):
             continue
-        quiet = state.silenced(r["rule"], r["satellite"], now)
+        quiet = state.silenced(r.rule, r.satellite, now)
         alerts.append(
             {
-                "status": "silenced" if quiet and r["status"] == "firing" else r["status"],
-                "severity": r["severity"],
-                "rule": r["rule"],
-                "satellite": r["satellite"],
-                "fingerprint": r["fingerprint"],
-                "started": r["started"],
-                "resolved": r["resolved"],
-                "summary": r["summary"],
-                "lines": json.loads(r["lines"] or "[]"),
+                "status": "silenced" if quiet and r.status == "firing" else r.status,
+                "severity": r.severity,
+                "rule": r.rule,
+                "satellite": r.satellite,
+                "fingerprint": r.fingerprint,
+                "started": r.started,
+                "resolved": r.resolved,
+                "summary": r.summary,
+                "lines": r.lines,
             }
         )
     silences = [{k: s[k] for k in ("rule", "satellite", "until", "reason")} for s in state.silences(now)]

@@ -503,12 +503,12 @@ def status_report(cfg, store) -> dict:
             "latest_day": None if day is None else str(day),
             "fors": [] if day is None else [f.to_dict() for f in store.day_result(sat, day)],
             "alerts": [
-                {k: a[k] for k in ("rule", "severity", "summary", "started")}
+                {k: getattr(a, k) for k in ("rule", "severity", "summary", "started")}
                 for a in firing
-                if a["satellite"] == sat
+                if a.satellite == sat
             ],
         }
-    critical = any(a["severity"] == "critical" for a in firing) or any(
+    critical = any(a.severity == "critical" for a in firing) or any(
         s["last_run"] and s["last_run"]["status"] == "failed" for s in sats.values()
     )
     state = NAGIOS_CRITICAL if critical else NAGIOS_WARNING if firing else NAGIOS_OK

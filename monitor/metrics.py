@@ -74,7 +74,7 @@ class _StoreCollector:
         )
         per = {}
         for a in firing:
-            key = (a["satellite"], a["rule"], a["severity"] or "")
+            key = (a.satellite, a.rule, a.severity or "")
             per[key] = per.get(key, 0) + 1
         for key, n in sorted(per.items()):
             g.add_metric(list(key), n)

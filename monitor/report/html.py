@@ -136,8 +136,8 @@ def _alerts_table(rows) -> str:
     if not rows:
         return "<p class=ok>No alert is firing.</p>"
     body = "".join(
-        f"<tr><td class=l>{_e(r['severity'] or '')}</td><td class=l>{_e(r['rule'])}</td>"
-        f"<td class=l>{_e(r['started'])}</td><td class=l>{_e(r['summary'])}</td></tr>"
+        f"<tr><td class=l>{_e(r.severity or '')}</td><td class=l>{_e(r.rule)}</td>"
+        f"<td class=l>{_e(r.started)}</td><td class=l>{_e(r.summary)}</td></tr>"
         for r in rows
     )
     head = "".join(f"<th class=l>{h}</th>" for h in ("severity", "rule", "since", "summary"))
@@ -178,9 +178,9 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     state = AlertState(store)
     firing = state.firing(satellite)
     alert_times = sorted(
-        dt.datetime.fromisoformat(r["started"]).replace(tzinfo=None)
+        dt.datetime.fromisoformat(r.started).replace(tzinfo=None)
         for r in state.all()
-        if r["satellite"] == satellite and r["started"]
+        if r.satellite == satellite and r.started
     )
     parts = [
         '<p><a href="../index.html">all satellites</a></p><h1>CrIS geolocation against VIIRS I5: '

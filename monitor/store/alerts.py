@@ -4,11 +4,36 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+from dataclasses import dataclass
 
 
 def iso(t: dt.datetime) -> str:
     """*t* as an ISO 8601 UTC string, to the second."""
     return t.astimezone(dt.timezone.utc).isoformat(timespec="seconds")
+
+
+@dataclass(frozen=True)
+class Alert:
+    """One alert: identified by *fingerprint* (rule:satellite:group); *status* firing or resolved; times ISO
+    8601 UTC; *lines* the finding's detail lines."""
+
+    fingerprint: str
+    rule: str
+    satellite: str
+    grp: str | None
+    severity: str | None
+    status: str
+    started: str | None
+    last_notified: str | None
+    resolved: str | None
+    summary: str | None
+    lines: list
+
+    @classmethod
+    def from_row(cls, r) -> "Alert":
+        d = {k: r[k] for k in cls.__dataclass_fields__}
+        d["lines"] = json.loads(r["lines"] or "[]")
+        return cls(**d)
 
 
 class AlertState:
@@ -21,23 +46,24 @@ class AlertState:
     def get(self, fingerprint: str):
         """The alert row of *fingerprint* (rule:satellite:group), or None."""
         r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
-        return dict(r) if r else None
+        return Alert.from_row(r) if r else None
 
-    def firing(self, satellite: str | None = None) -> list:
+    def firing(self, satellite: str | None = None) -> list[Alert]:
         """The alerts firing now (of *satellite*)."""
         q = "SELECT * FROM alert_state WHERE status='firing'" + (" AND satellite=?" if satellite else "")
-        return [dict(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
+        return [Alert.from_row(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
 
-    def all(self) -> list:
-        """Every alert row, firing or resolved."""
-        return [dict(r) for r in self.db.execute("SELECT * FROM alert_state ORDER BY satellite, rule, grp")]
+    def all(self) -> list[Alert]:
+        """Every alert, firing or resolved."""
+        q = "SELECT * FROM alert_state ORDER BY satellite, rule, grp"
+        return [Alert.from_row(r) for r in self.db.execute(q)]
 
     def upsert(self, finding, status: str, now: dt.datetime, notified: bool):
         """Record *finding* as firing (keeping its start while it fires); *notified* stamps the notification
         time."""
         prev = self.get(finding.fingerprint)
-        started = prev["started"] if prev and prev["status"] == "firing" else iso(now)
-        last = iso(now) if notified else (prev["last_notified"] if prev else None)
+        started = prev.started if prev and prev.status == "firing" else iso(now)
+        last = iso(now) if notified else (prev.last_notified if prev else None)
         self.db.execute(
             "INSERT OR REPLACE INTO alert_state VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             (

@@ -17,10 +17,10 @@ def test_alert_lifecycle_keeps_its_start(tmp_path):
         state.upsert(f, "firing", T0, notified=True)
         state.upsert(f, "firing", T0 + dt.timedelta(hours=3), notified=False)
         (row,) = state.firing("j01")
-        assert row["started"] == T0.isoformat() and row["last_notified"] == T0.isoformat()
+        assert row.started == T0.isoformat() and row.last_notified == T0.isoformat()
         assert state.firing("npp") == []
         state.resolve(f.fingerprint, T0 + dt.timedelta(days=1))
-        assert state.firing() == [] and state.get(f.fingerprint)["status"] == "resolved"
+        assert state.firing() == [] and state.get(f.fingerprint).status == "resolved"
 
 
 def test_silence_matches_rule_and_satellite_until_it_ends(tmp_path):
@@ -63,7 +63,7 @@ def test_a_store_of_schema_2_with_the_old_alert_tables_keeps_its_alerts(tmp_path
     db.close()
     with Store(path) as store:
         assert store.schema_version == len(MIGRATIONS)
-        assert AlertState(store).firing("j01")[0]["summary"] == "old"
+        assert AlertState(store).firing("j01")[0].summary == "old"
         tables = {r[0] for r in store.db.execute("SELECT name FROM sqlite_master WHERE type='table'")}
         assert "alert_meta" not in tables and {"silences", "deliveries"} <= tables
         (event,) = store.events(EventKind.RUN_FAILED)
