@@ -44,10 +44,13 @@ def sd_notify(message: str) -> bool:
     try:
         with socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as s:
             s.connect(addr)
-            s.sendall(message.encode())
+            # never block: a notify socket nobody reads (a wedged systemd, a test) must not stop the
+            # daemon, even inside the SIGTERM handler; the message is dropped instead
+            s.send(message.encode(), socket.MSG_DONTWAIT)
         return True
     except OSError as exc:
-        LOG.warning("sd_notify failed: %s", exc)
+        log = LOG.debug if isinstance(exc, BlockingIOError) else LOG.warning
+        log("sd_notify %s not delivered: %s", message.split("=", 1)[0], exc)
         return False
 
 

@@ -133,6 +133,35 @@ def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
         sock.close()
 
 
+def test_daemon_stops_even_when_nobody_reads_its_notify_socket(tmp_path):
+    """A notify socket whose queue is full (a wedged systemd) must not block the daemon: its keep-alives
+    are dropped, and SIGTERM still stops it at once (it used to hang in the handler's STOPPING=1)."""
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    cfg = _config(tmp_path, empty)
+    sock_path = str(tmp_path / "notify.sock")
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    sock.bind(sock_path)  # bound, never read
+    qlen = int(Path("/proc/sys/net/unix/max_dgram_qlen").read_text())
+    env = dict(os.environ, NOTIFY_SOCKET=sock_path, WATCHDOG_USEC="2000")  # a keep-alive every ms
+    p = subprocess.Popen(
+        CRISGEO + ["daemon", "--config", str(cfg), "--listen", "off"],
+        env=env,
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        assert wait_for(lambda: _status(tmp_path / "state" / "crisgeo.sqlite").count("no_data") == 2, 60)
+        time.sleep(max(2.0, qlen * 0.002))  # the queue is full by now
+        p.send_signal(signal.SIGTERM)
+        assert p.wait(timeout=30) == 0
+    finally:
+        if p.poll() is None:
+            p.kill()
+        sock.close()
+
+
 def test_status_command(cases, tmp_path):
     data, _, _ = cases.get()
     cfg = _config(tmp_path, tmp_path / "none")
