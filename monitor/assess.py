@@ -28,7 +28,7 @@ from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR
 from monitor.errors import AssessmentError, StopRequested
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
-from monitor.geometry.inverse import inverse_geolocation
+from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbation_grid
 from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult, ForOffset
 from monitor.sdr import GranuleError, read_file
@@ -210,19 +210,7 @@ def _cris_geometry(geo):
     fill = {
         k: np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")
     }
-    fg = inverse_geolocation(
-        fill["lat_rad"],
-        fill["lon_rad"],
-        fill["zenith_rad"],
-        fill["azimuth_rad"],
-        np.where(valid, geo.range_m, 1e6),
-        geo.for_time_us,
-        geo.mid_time_us,
-        np.nan_to_num(geo.sc_position_m),
-        np.nan_to_num(geo.sc_velocity_m_s),
-        np.nan_to_num(geo.sc_attitude_rad),
-    )
-    return fg, valid, fill
+    return granule_geometry(geo), valid, fill
 
 
 def _collocate_fors(swath, geo, fg, valid, fill, cfg, band, should_stop=None):

@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.assess import AssessConfig, _cris_geometry, assess_plan
+from monitor.assess import AssessConfig, assess_plan
+from monitor.geometry.inverse import granule_geometry
 from monitor.sdr import read_file
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
@@ -54,7 +55,7 @@ def _pyresample_reference(case, cfg, max_granules=1):
     ok = np.isfinite(lat)
     source = prgeo.SwathDefinition(lons=lon[ok], lats=lat[ok])
     t0 = time.perf_counter()
-    fg, valid, _ = _cris_geometry(geo)
+    fg, valid = granule_geometry(geo), geo.valid
     los = perturbed_los_sbf(fg.alpha_rad, fg.beta_rad, cfg.offsets_rad)  # (4,30,9,m,m,3)
     los_e = np.einsum("skfij,skfabj->skfabi", fg.sbf_to_ecef, los)
     sat = np.broadcast_to(fg.sat_ecef_m[..., None, None, :], los_e.shape)

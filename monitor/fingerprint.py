@@ -23,7 +23,7 @@ import numpy as np
 
 from monitor.constants import URAD
 from monitor.geometry.instrument import FOV5, fov5_angles
-from monitor.geometry.inverse import inverse_geolocation
+from monitor.geometry.inverse import granule_geometry
 
 
 @dataclass
@@ -87,18 +87,7 @@ class DayPrint:
 def granule_print(geo) -> GranulePrint:
     """The fingerprint of one CrIS GEO granule (a :class:`monitor.sdr.CrisGeoGranule`)."""
     valid = geo.valid
-    args = [
-        np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")
-    ]
-    fg = inverse_geolocation(
-        *args,
-        np.where(valid, geo.range_m, 1e6),
-        geo.for_time_us,
-        geo.mid_time_us,
-        np.nan_to_num(geo.sc_position_m),
-        np.nan_to_num(geo.sc_velocity_m_s),
-        np.nan_to_num(geo.sc_attitude_rad),
-    )
+    fg = granule_geometry(geo)
     a = np.where(valid, fg.alpha_rad, np.nan) / URAD
     b = np.where(valid, fg.beta_rad, np.nan) / URAD
     with np.errstate(all="ignore"):

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from monitor import collocate
-from monitor.assess import AssessConfig, _cris_geometry, _load_swath, _SwathCache
+from monitor.assess import AssessConfig, _load_swath, _SwathCache
 from monitor.geometry import wgs84
+from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbation_grid
 from monitor.sdr import read_file
 from monitor.sdr.pairing import plan
@@ -22,7 +23,7 @@ def case_plan(cases):
 def scene(case_plan):
     g = case_plan.cris[0]
     (geo,) = read_file(g.geo, kinds=("cris_geo",))
-    fg, valid, _ = _cris_geometry(geo)
+    fg = granule_geometry(geo)
     swath = _load_swath(case_plan.viirs[g.key], case_plan.viirs_all, i5_band("j01"), _SwathCache())
     return fg, swath
 

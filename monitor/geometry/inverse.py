@@ -86,3 +86,19 @@ def forward_geolocation(sat_ecef_m, sbf_to_ecef, los_sbf, h_m=0.0):
     los_ecef = np.einsum("...ij,...j->...i", sbf_to_ecef, los_sbf)
     t = wgs84.intersect_ellipsoid(sat_ecef_m, los_ecef, h_m)
     return np.asarray(sat_ecef_m) + t[..., None] * los_ecef
+
+
+def granule_geometry(geo):
+    """The inverse geolocation of a CrIS GEO granule (:class:`monitor.sdr.CrisGeoGranule`): its fields in,
+    fill FOVs given harmless values (a ground point at 0, 0 and a range of 1000 km) so that the arrays stay
+    finite; mask the result with ``geo.valid``."""
+    valid = geo.valid
+    return inverse_geolocation(
+        *(np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")),
+        np.where(valid, geo.range_m, 1e6),
+        geo.for_time_us,
+        geo.mid_time_us,
+        np.nan_to_num(geo.sc_position_m),
+        np.nan_to_num(geo.sc_velocity_m_s),
+        np.nan_to_num(geo.sc_attitude_rad),
+    )
