@@ -16,14 +16,14 @@ floor calibrated on simulated cases (what the estimator itself leaves, ``AssessC
 from __future__ import annotations
 
 import logging
-import os
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
-from monitor import collocate, refine
+from monitor import collocate, refine, swath
 from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR
 from monitor.errors import AssessmentError, StopRequested
 from monitor.geometry.ground import offset_km
@@ -92,8 +92,7 @@ class _SwathCache:
     """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept."""
 
     pieces: dict = field(default_factory=dict)
-    keep: int = 2
-    swath: tuple = ((), None)  # the last stacked swath and the keys of its pieces
+    keep: int = 3
 
 
 def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=None):
@@ -112,7 +111,7 @@ def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=N
             f"shape {sdr.bt_k.shape} does not match the GEO {geo.lat_rad.shape}",
         )
     with _stage(timings, "geometry"):
-        piece = collocate.swath_piece(
+        piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after
         )
     while len(cache.pieces) >= cache.keep:
@@ -122,14 +121,8 @@ def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=N
 
 
 def _load_swath(viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, timings=None):
-    keys = tuple(v.key for v in viirs)
-    if cache.swath[0] == keys:  # consecutive CrIS granules often lie on the same VIIRS granules
-        return cache.swath[1]
-    pieces = [_piece(v, viirs_all, band, cache, timings) for v in viirs]
-    with _stage(timings, "geometry"):
-        cache.swath = ((), None)  # let the old stack go before the new one is made
-        cache.swath = (keys, collocate.ViirsSwath.from_pieces(pieces))
-    return cache.swath[1]
+    """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*)."""
+    return swath.ViirsSwath([_piece(v, viirs_all, band, cache, timings) for v in viirs])
 
 
 def collocate_granule(
@@ -167,9 +160,9 @@ def collocate_granule(
         fg, valid, fill = _cris_geometry(geo)
     with _stage(timings, "spectral"):
         bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
-    swath = _load_swath(viirs, viirs_all or viirs, band, cache, timings)
+    pieces = _load_swath(viirs, viirs_all or viirs, band, cache, timings)
     with _stage(timings, "collocation"):
-        bt_viirs, coverage = _collocate_fors(swath, geo, fg, valid, fill, cfg, band, should_stop)
+        bt_viirs, coverage = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (
         valid
         & sdr.good
@@ -213,32 +206,26 @@ def _cris_geometry(geo):
     return granule_geometry(geo), valid, fill
 
 
-def _collocate_fors(swath, geo, fg, valid, fill, cfg, band, should_stop=None):
-    """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone and the worst coverage per FOV, FOR by FOR."""
-    offsets = cfg.offsets_rad
-    m = len(offsets)
-    nscan = geo.lat_rad.shape[0]
-    bt_viirs = np.full((nscan, N_FOR, 9, m, m), np.nan, np.float32)
-    coverage = np.zeros((nscan, N_FOR, 9))
-    kernel = KERNELS[cfg.kernel]
-    for k in range(N_FOR):
-        if should_stop is not None and should_stop():
-            raise StopRequested
-        sl = (slice(None), k)
-        shape = fg.alpha_rad[sl].shape
-        mean, cov = collocate.cone_sums(
-            swath,
-            fg.sat_ecef_m[sl].reshape(-1, 3),
-            fg.sbf_to_ecef[sl].reshape(-1, 3, 3),
-            fg.alpha_rad[sl].ravel(),
-            fg.beta_rad[sl].ravel(),
-            offsets,
-            kernel,
-            fov_range_m=np.where(valid[sl], geo.range_m[sl], 1e6).ravel(),
-            fov_cos_zen=np.cos(fill["zenith_rad"][sl]).ravel(),
-        )
-        bt_viirs[sl] = band.bt_from_radiance(mean).reshape(shape + (m, m))
-        coverage[sl] = np.nanmin(np.where(np.isfinite(cov), cov, 0.0), axis=(-2, -1)).reshape(shape)
+def _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop=None):
+    """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone and the worst coverage per FOV (all FOVs of the
+    granule in one call of the parallel kernel)."""
+    if should_stop is not None and should_stop():
+        raise StopRequested
+    m = len(cfg.offsets_rad)
+    shape = fg.alpha_rad.shape
+    mean, cov = collocate.cone_sums(
+        pieces,
+        fg.sat_ecef_m.reshape(-1, 3),
+        fg.sbf_to_ecef.reshape(-1, 3, 3),
+        fg.alpha_rad.ravel(),
+        fg.beta_rad.ravel(),
+        cfg.offsets_rad,
+        KERNELS[cfg.kernel],
+        fov_range_m=np.where(valid, geo.range_m, 1e6).ravel(),
+        fov_cos_zen=np.cos(fill["zenith_rad"]).ravel(),
+    )
+    bt_viirs = band.bt_from_radiance(mean).astype(np.float32).reshape(shape + (m, m))
+    coverage = np.nanmin(np.where(np.isfinite(cov), cov, 0.0), axis=(-2, -1)).reshape(shape)
     return bt_viirs, coverage
 
 
@@ -450,21 +437,15 @@ def _collocate_run(
     return samples, skipped
 
 
-def _worker(args):
-    cris, viirs, viirs_all, satellite, cfg = args
-    timings = {}
-    done = (lambda g: _DONE.put(g.key)) if _DONE is not None else None
-    samples, skipped = _collocate_run(
-        cris,
-        viirs,
-        viirs_all,
-        satellite,
-        cfg,
-        progress=done,
-        timings=timings,
-        should_stop=_STOP.is_set if _STOP is not None else None,
-    )
-    return samples, skipped, timings
+@contextmanager
+def parallel_threads(workers: int):
+    """Run the compiled kernels on *workers* threads (at most numba's pool) in this block."""
+    previous = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(workers, numba.config.NUMBA_NUM_THREADS)))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
 
 
 def assess_plan(
@@ -479,28 +460,17 @@ def assess_plan(
     FOVs in all than ``cfg.min_samples`` is an :class:`AssessmentError` naming the files.
 
     *progress* is called after each granule; *should_stop* is polled before each (a stop request
-    skips the rest, recorded); *timings*, a dict, collects seconds per stage (summed over workers).
-    With *workers* > 1 the time-ordered granules are split into that many runs, one process each;
-    a stop request reaches the workers through an event they poll between granules.
+    skips the rest, recorded); *timings*, a dict, collects seconds per stage. *workers* is the number of
+    threads of the compiled VIIRS preparation and collocation (granules go one after the other, each
+    VIIRS granule prepared once).
     """
     cfg = cfg or AssessConfig()
     skipped = list(case.skipped)
-    if workers > 1 and len(case.cris) > 1:
-        runs = [
-            list(r) for r in np.array_split(np.array(case.cris, dtype=object), min(workers, len(case.cris)))
-        ]
-        samples = []
-        for s, k, t in _in_processes(runs, case, cfg, should_stop, progress):
-            samples += s
-            skipped += k
-            for name, sec in t.items():
-                if timings is not None:
-                    timings[name] = timings.get(name, 0.0) + sec
-    else:
+    with parallel_threads(workers):
         samples, k = _collocate_run(
             case.cris, case.viirs, case.viirs_all, case.satellite, cfg, progress, should_stop, timings
         )
-        skipped += k
+    skipped += k
     usable = sum(int(s.usable.sum()) for s in samples)
     stopped = should_stop is not None and should_stop()  # the caller records an interruption, not bad data
     if usable < cfg.min_samples and not stopped:
@@ -512,74 +482,6 @@ def assess_plan(
         )
     with _stage(timings, "cost"):
         return cost_and_offsets(samples, cfg, skipped, case.satellite)
-
-
-_STOP = None  # in a worker process: the event the parent sets to ask for a stop
-_DONE = None  # ... and the queue it tells each finished granule (its key) for the parent's progress
-
-
-def _die_with_parent(stop_event, done_queue):
-    """Worker initializer: die when the parent dies, even by SIGKILL (Linux parent-death signal), and keep
-    the stop event and the progress queue."""
-    global _STOP, _DONE
-    _STOP, _DONE = stop_event, done_queue
-    try:
-        import ctypes
-        import signal
-
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):  # not Linux: the pool's own shutdown still applies
-        pass
-    if os.getppid() == 1:  # the parent died before the signal was armed
-        os._exit(1)
-
-
-def _in_processes(runs, case, cfg, should_stop, progress=None):
-    """Collocate each run of granules in its own (spawned) process; a stop request is relayed to them,
-    and *progress* is called here as each granule finishes there.
-
-    The workers hold no manager or server process of their own, and die with this process.
-    """
-    import concurrent.futures as cf
-    import multiprocessing as mp
-    import queue
-    import threading
-
-    ctx = mp.get_context("spawn")
-    event = ctx.Event()
-    finished = ctx.Queue() if progress is not None else None
-    done = threading.Event()
-    granules = {g.key: g for r in runs for g in r}
-
-    def relay():
-        while not done.is_set():
-            if should_stop is not None and should_stop():
-                event.set()
-            if progress is None:
-                done.wait(0.2)
-                continue
-            try:
-                progress(granules[finished.get(timeout=0.2)])
-            except queue.Empty:
-                pass
-
-    relay_thread = threading.Thread(target=relay, daemon=True)
-    relay_thread.start()
-    jobs = [(r, {g.key: case.viirs[g.key] for g in r}, case.viirs_all, case.satellite, cfg) for r in runs]
-    try:
-        with cf.ProcessPoolExecutor(
-            len(jobs), mp_context=ctx, initializer=_die_with_parent, initargs=(event, finished)
-        ) as pool:
-            return list(pool.map(_worker, jobs))
-    finally:
-        done.set()
-        relay_thread.join(timeout=5)
-        if progress is not None:  # granules whose report was still on its way
-            while True:
-                try:
-                    progress(granules[finished.get(timeout=0.05)])
-                except queue.Empty:
-                    break
 
 
 def assess_paths(paths, cfg: AssessConfig | None = None, progress=None, workers: int = 1) -> AssessmentResult:

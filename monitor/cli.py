@@ -304,7 +304,7 @@ def format_table(result) -> str:
         default="top-hat",
         help="FOV weighting: top-hat cone or the CrIS spatial response",
     ),
-    arg("--workers", type=int, default=1, help="worker processes over granules"),
+    arg("--workers", type=int, default=1, help="threads of the compiled kernels"),
 )
 def cmd_assess(args) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
@@ -449,6 +449,42 @@ def cmd_run(args) -> int:
     if not outcomes:
         print("nothing to do: every day of the catch-up window is done")
     return EXIT_FAIL if any(o.status == "failed" for o in outcomes) else EXIT_OK
+
+
+@command(
+    "reprocess",
+    "assess a period on a Dask cluster (resumable; the days already ok are skipped)",
+    CONFIG,
+    arg("--since", type=_day, required=True, help="first day, YYYY-MM-DD"),
+    arg("--until", type=_day, required=True, help="last day, YYYY-MM-DD"),
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--scheduler", help="address of a running Dask scheduler (tcp://HOST:8786); default a local cluster"),
+    arg("--workers", type=int, default=2, help="processes of the local cluster (default 2)"),
+    arg("--force", action="store_true", help="redo the days already ok"),
+)
+def cmd_reprocess(args) -> int:
+    """crisgeo reprocess: a period on Dask; this process alone writes the store."""
+    from monitor.reprocess import run_reprocess
+    from monitor.service import AlreadyRunning
+
+    cfg = _load(args)
+    sats = [args.satellite] if args.satellite else cfg.satellites
+    if args.satellite and args.satellite not in cfg.satellites:
+        raise BadInput(
+            f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})"
+        )
+    if args.until < args.since:
+        raise BadInput(f"--until {args.until} is before --since {args.since}")
+    if args.workers < 1:
+        raise BadInput(f"--workers: {args.workers}, at least 1")
+    try:
+        summary = run_reprocess(cfg, args.since, args.until, sats, args.scheduler, args.workers, args.force)
+    except AlreadyRunning as exc:
+        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
+        return EXIT_ALREADY_RUNNING
+    for line in summary.lines():
+        print(line)
+    return EXIT_FAIL if summary.unfinished or summary.statuses.get("failed") else EXIT_OK
 
 
 @command(
@@ -791,7 +827,7 @@ def cmd_report(args) -> int:
     arg("--granules", type=int, default=14),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
-    arg("--workers", type=int, default=2, help="worker processes (default 2, the machine's cores)"),
+    arg("--workers", type=int, default=2, help="threads of the compiled kernels (default 2)"),
 )
 def cmd_bench(args) -> int:
     """crisgeo bench: time each stage on a simulated case."""

@@ -63,7 +63,7 @@ MEANING = {
     "21).",
     "assessment.step_urad": "Perturbation step (375 m at nadir from 833 km).",
     "assessment.kernel": "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response).",
-    "assessment.workers": "Processes collocating granules in parallel.",
+    "assessment.workers": "Threads of the compiled VIIRS preparation and collocation kernels.",
     "fingerprint.granules": "GEO granules per day sampled (spread over the day) for the LOS fingerprint.",
     "fingerprint.threshold_urad": "A FOR whose fingerprint angle moves more than this is a processing "
     "change.",

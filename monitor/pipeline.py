@@ -97,30 +97,15 @@ def no_data_horizon(today: dt.date, lag_days: int, no_data_retry_days: int) -> d
     return today - dt.timedelta(days=lag_days + no_data_retry_days)
 
 
-def _no_data(cfg, store, run_id, satellite, day, reason, timings, summary=None, counts=None) -> RunOutcome:
-    """Record an empty day: ``no_data`` while it may still fill (tried again at the next runs),
-    ``no_data_final`` once past the retry horizon."""
-    s = cfg.schedule
-    final = day < no_data_horizon(dt.datetime.now(dt.timezone.utc).date(), s.lag_days, s.no_data_retry_days)
-    status = "no_data_final" if final else "no_data"
-    if not final:
-        reason += f" (tried again for {s.no_data_retry_days} day(s) after it is due)"
-    store.finish_run(run_id, status, reason, summary=summary)
-    return RunOutcome(satellite, day, status, reason, run_id, timings=timings, counts=counts or {})
-
-
-def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -> dict | None:
-    """Compute, store and compare the day's LOS fingerprint from a sample of its GEO granules.
-
-    A step against the previous day, or within the day, becomes a ``change:cris`` event (used for jump
-    attribution and notified by the alerts). Problems are logged, never fatal to the run.
-    """
+def day_prints(cfg, source, day: dt.date, listing) -> list:
+    """LOS fingerprints (:func:`monitor.fingerprint.granule_print`) of a sample of the day's GEO granules;
+    a granule that cannot be fetched or read is logged and left out."""
     geos = sorted(
         (f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
         key=lambda f: f.parsed.start,
     )
     if not geos:
-        return None
+        return []
     picks = np.unique(
         np.round(np.linspace(0, len(geos) - 1, min(cfg.fingerprint.granules, len(geos)))).astype(int)
     )
@@ -131,6 +116,14 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
             prints.append(fpr.granule_print(g))
         except (SourceError, DataError) as exc:
             LOG.warning("fingerprint: skipping %s: %s", geos[i].name, exc)
+    return prints
+
+
+def record_fingerprint(cfg, store, satellite: str, day: dt.date, prints: list) -> dict | None:
+    """Store the day's fingerprint and compare it with the previous day's and within the day.
+
+    A step becomes a ``change:cris`` event (used for jump attribution and notified by the alerts).
+    """
     if not prints:
         return None
     today = fpr.day_print(prints)
@@ -155,6 +148,12 @@ def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -
         LOG.warning("%s %s: %s", satellite, day, desc)
     store.save_fingerprint(satellite, day, body)
     return body
+
+
+def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -> dict | None:
+    """Compute, store and compare the day's LOS fingerprint (:func:`day_prints`, :func:`record_fingerprint`).
+    Problems are logged, never fatal to the run."""
+    return record_fingerprint(cfg, store, satellite, day, day_prints(cfg, source, day, listing))
 
 
 def publish_changes(cfg, store, satellite: str) -> None:
@@ -193,96 +192,128 @@ def fetch_plan(source, satellite: str, chosen: list, stop=lambda: False, progres
     return assemble(satellite, [c.files for c in chosen], list(viirs.values()), skipped)
 
 
-def _failed(store, run_id, satellite, day, reason, timings, counts=None) -> RunOutcome:
-    """Record a failed run and its ``run_failed`` event (the failure alert reads both)."""
-    store.finish_run(run_id, "failed", reason)
-    store.add_event(EventKind.RUN_FAILED, satellite, {"day": day.isoformat(), "reason": reason})
-    return RunOutcome(satellite, day, "failed", reason, run_id, timings=timings, counts=counts or {})
+@dataclass
+class DayWork:
+    """What the computing half of a satellite-day produced, before anything is stored: picklable, so that
+    a reprocessing worker returns it to the one process that writes the store."""
+
+    satellite: str
+    day: dt.date
+    status: str  # ok, no_data, failed, interrupted
+    reason: str | None = None
+    result: object = None
+    decisions: list = field(default_factory=list)
+    prints: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+    counts: dict = field(default_factory=dict)
+
+
+def compute_day(
+    cfg, source: Source, satellite: str, day: dt.date, should_stop=None, progress=None
+) -> DayWork:
+    """List, fingerprint, select, fetch and assess one satellite-day, touching no store. Never raises for
+    a problem of the day's data or source: it becomes the work's status and reason."""
+    stop = should_stop or (lambda: False)
+    w = DayWork(satellite, day, "ok")
+    w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}
+    t0 = time.perf_counter()
+    try:
+        source.start_day()
+        listing = source.list_day(satellite, day, ALL_PRODUCTS)
+        w.timings["list"] = time.perf_counter() - t0
+        w.counts["listed"] = len(listing)
+        if not any(f.product in CRIS_GEO for f in listing):
+            w.status, w.reason = "no_data", f"no CrIS GEO granule of {satellite} on {day} in the source"
+            return w
+        if stop():
+            raise StopRequested
+        t1 = time.perf_counter()
+        w.prints = day_prints(cfg, source, day, listing)
+        w.timings["fingerprint"] = time.perf_counter() - t1
+        t1 = time.perf_counter()
+        chosen, w.decisions = select_scenes(
+            listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep, cfg.scenes.min_inhomogeneity_k
+        )
+        w.timings["select"] = time.perf_counter() - t1
+        w.counts["selected"] = len(chosen)
+        if not chosen:
+            w.status = "no_data"
+            w.reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in w.decisions}))[:500]
+            return w
+        t1 = time.perf_counter()
+        case = fetch_plan(
+            source, satellite, chosen, stop, ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
+        )
+        w.timings["fetch"] = time.perf_counter() - t1
+        w.counts["downloaded"], w.counts["bytes"] = source.downloaded_files, source.spent_bytes
+        t1 = time.perf_counter()
+        a = cfg.assessment
+        w.result = assess_plan(
+            case,
+            AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6, kernel=a.kernel),
+            progress=progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris)),
+            should_stop=stop,
+            workers=a.workers,
+        )
+        w.timings["assess"] = time.perf_counter() - t1
+        w.counts["assessed"] = len(w.result.granules)
+        if stop():
+            raise StopRequested
+    except StopRequested:
+        w.status, w.reason, w.result = "interrupted", "stop requested", None
+    except (SourceError, DataError, OSError) as exc:
+        w.status, w.reason, w.result = "failed", f"{type(exc).__name__}: {exc}", None
+    except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
+        LOG.exception("run %s %s failed unexpectedly", satellite, day)
+        w.status, w.reason = "failed", f"unexpected {type(exc).__name__}: {exc}"[:1000]
+        w.result = None
+    return w
+
+
+def record_day(cfg, store, run_id: int, w: DayWork) -> RunOutcome:
+    """Write what :func:`compute_day` produced under the ledger row *run_id*: the fingerprint, then the
+    day's results and their outbox lines in one transaction (ok), or the empty, failed or interrupted
+    run with its reason; then drain the outbox."""
+    t1 = time.perf_counter()
+    try:
+        if w.prints:
+            try:
+                record_fingerprint(cfg, store, w.satellite, w.day, w.prints)
+            except (DataError, OSError, ValueError) as exc:
+                LOG.warning("fingerprint of %s %s not recorded: %s", w.satellite, w.day, exc)
+        out = RunOutcome(w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts)
+        if w.status == "ok":
+            lines = {
+                target_name(p): result_lines(p.measurement, w.satellite, w.day, w.result.fors)
+                for p in cfg.store.publish
+            }
+            store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, lines)
+            publish_changes(cfg, store, w.satellite)
+        elif w.status == "no_data":
+            s = cfg.schedule
+            today = dt.datetime.now(dt.timezone.utc).date()
+            if w.day < no_data_horizon(today, s.lag_days, s.no_data_retry_days):
+                out.status = "no_data_final"
+            else:
+                out.reason += f" (tried again for {s.no_data_retry_days} day(s) after it is due)"
+            summary = {"selection": w.decisions[:50]} if w.decisions else None
+            store.finish_run(run_id, out.status, out.reason, summary=summary)
+        elif w.status == "failed":
+            store.finish_run(run_id, "failed", w.reason)
+            store.add_event(EventKind.RUN_FAILED, w.satellite, {"day": w.day.isoformat(), "reason": w.reason})
+        else:
+            store.finish_run(run_id, w.status, w.reason)
+        return out
+    finally:
+        if cfg.store.publish:
+            drain_outbox(store, cfg.store.publish)
+        w.timings["publish"] = time.perf_counter() - t1
 
 
 def run_day(
     cfg, store, source: Source, satellite: str, day: dt.date, should_stop=None, progress=None
 ) -> RunOutcome:
-    """Process one satellite-day end to end; never raises for a problem of the day's data or source: every
-    outcome is recorded (an unexpected exception too, as ``failed`` with its type and message)."""
-    stop = should_stop or (lambda: False)
+    """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`); every outcome
+    is recorded in the ledger, an unexpected exception too (``failed`` with its type and message)."""
     run_id = store.begin_run(satellite, day)
-    timings = {}
-    counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}
-    t0 = time.perf_counter()
-    try:
-        source.start_day()
-        listing = source.list_day(satellite, day, ALL_PRODUCTS)
-        timings["list"] = time.perf_counter() - t0
-        counts["listed"] = len(listing)
-        if not any(f.product in CRIS_GEO for f in listing):
-            return _no_data(
-                cfg,
-                store,
-                run_id,
-                satellite,
-                day,
-                f"no CrIS GEO granule of {satellite} on {day} in the source",
-                timings,
-                counts=counts,
-            )
-        if stop():
-            raise StopRequested
-        t1 = time.perf_counter()
-        fingerprint_day(cfg, store, source, satellite, day, listing)
-        timings["fingerprint"] = time.perf_counter() - t1
-        t1 = time.perf_counter()
-        chosen, decisions = select_scenes(
-            listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep, cfg.scenes.min_inhomogeneity_k
-        )
-        timings["select"] = time.perf_counter() - t1
-        counts["selected"] = len(chosen)
-        if not chosen:
-            reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in decisions}))[:500]
-            return _no_data(
-                cfg, store, run_id, satellite, day, reason, timings, {"selection": decisions[:50]}, counts
-            )
-        t1 = time.perf_counter()
-        case = fetch_plan(
-            source, satellite, chosen, stop, ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
-        )
-        timings["fetch"] = time.perf_counter() - t1
-        counts["downloaded"], counts["bytes"] = source.downloaded_files, source.spent_bytes
-        t1 = time.perf_counter()
-        a = cfg.assessment
-        progress = progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris))
-        result = assess_plan(
-            case,
-            AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6, kernel=a.kernel),
-            progress=progress,
-            should_stop=stop,
-            workers=a.workers,
-        )
-        timings["assess"] = time.perf_counter() - t1
-        counts["assessed"] = len(result.granules)
-        if stop():
-            raise StopRequested
-        lines = {
-            target_name(p): result_lines(p.measurement, satellite, day, result.fors)
-            for p in cfg.store.publish
-        }
-        store.save_day(run_id, satellite, day, result, decisions, lines)
-        publish_changes(cfg, store, satellite)
-        return RunOutcome(satellite, day, "ok", None, run_id, result, timings, counts)
-    except StopRequested:
-        store.finish_run(run_id, "interrupted", "stop requested")
-        return RunOutcome(
-            satellite, day, "interrupted", "stop requested", run_id, timings=timings, counts=counts
-        )
-    except (SourceError, DataError, OSError) as exc:
-        return _failed(store, run_id, satellite, day, f"{type(exc).__name__}: {exc}", timings, counts)
-    except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
-        LOG.exception("run %s %s failed unexpectedly", satellite, day)
-        return _failed(
-            store, run_id, satellite, day, f"unexpected {type(exc).__name__}: {exc}"[:1000], timings, counts
-        )
-    finally:
-        t1 = time.perf_counter()
-        if cfg.store.publish:
-            drain_outbox(store, cfg.store.publish)
-        timings["publish"] = time.perf_counter() - t1
+    return record_day(cfg, store, run_id, compute_day(cfg, source, satellite, day, should_stop, progress))

@@ -79,6 +79,11 @@ class I5Band:
         """Band radiance of unapodized CrIS LW spectra: Hamming apodization, then the SRF convolution."""
         return self.band_radiance(apodize_hamming(radiance_lw))
 
+    @property
+    def radiance_table(self):
+        """(first BT K, BT step K, band radiance per BT): the uniform table radiance_from_bt interpolates."""
+        return self.T_MIN_K, self.T_STEP_K, self._l
+
     def radiance_from_bt(self, bt_k):
         """Band radiance of a band brightness temperature (K); NaN outside 150-350 K.
 

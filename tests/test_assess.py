@@ -73,55 +73,6 @@ def test_too_few_samples_are_flagged(cases):
     assert all(FLAG_FEW_SAMPLES in f.flags and not f.reliable for f in result.fors)
 
 
-def test_workers_die_with_a_killed_parent(cases, tmp_path):
-    """SIGKILL of an assessing process leaves no worker behind (parent-death signal, no manager process)."""
-    import os
-    import signal
-    import subprocess
-    import sys
-    import time
-
-    out, _, _ = cases.get()
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "monitor.cli", "assess", str(out), "--workers", "2"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-
-    def children():
-        found = []
-        for pid in os.listdir("/proc"):
-            try:
-                stat = open(f"/proc/{pid}/stat").read()
-            except OSError:
-                continue
-            if pid.isdigit() and int(stat.rsplit(")", 1)[1].split()[1]) == proc.pid:
-                found.append(int(pid))
-        return found
-
-    deadline = time.monotonic() + 60
-    while len(children()) < 2 and time.monotonic() < deadline and proc.poll() is None:
-        time.sleep(0.2)
-    kids = children()
-    assert len(kids) >= 2, "the assessment did not start its workers"
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
-    deadline = time.monotonic() + 10
-    while time.monotonic() < deadline and any(
-        os.path.exists(f"/proc/{k}")
-        and "Z" not in open(f"/proc/{k}/stat").read().rsplit(")", 1)[1].split()[0]
-        for k in kids
-        if os.path.exists(f"/proc/{k}")
-    ):
-        time.sleep(0.2)
-    alive = [
-        k
-        for k in kids
-        if os.path.exists(f"/proc/{k}") and open(f"/proc/{k}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"
-    ]
-    assert not alive, f"workers {alive} outlived their parent"
-
-
 def test_too_few_usable_fovs_is_an_error_naming_the_files(cases, tmp_path):
     """VIIRS scale factors of 1e30 used to give a table of NaN with exit 0: now the granule is refused and
     the assessment, left with nothing, exits 2 naming the files."""

@@ -21,11 +21,14 @@ CRISGEO = [sys.executable, "-m", "monitor.cli"]
 DAY = "2024-06-01"
 
 
-def _config(tmp_path, data, workers=1):
+def _config(tmp_path, data, workers=1, slow=False):
+    """A configuration; *slow* makes the assessment ~30x the work (41 x 41 cones of the 4-ring kernel),
+    so that a signal lands mid-run."""
+    heavy = ", half_steps: 20, kernel: response" if slow else ""
     p = tmp_path / "c.yaml"
     p.write_text(
         f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
-        f"assessment: {{workers: {workers}}}\nschedule: {{catch_up_days: 2}}\n"
+        f"assessment: {{workers: {workers}{heavy}}}\nschedule: {{catch_up_days: 2}}\n"
     )
     return p
 
@@ -46,7 +49,7 @@ def _assessing(proc_log: Path):
 
 def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     data, _, _ = cases.get()
-    cfg = _config(tmp_path, data)
+    cfg = _config(tmp_path, data, slow=True)
     db = tmp_path / "state" / "crisgeo.sqlite"
     log = tmp_path / "log"
     with open(log, "w") as fh:
@@ -61,6 +64,7 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     assert [r.status for r in s.runs()] == ["running"]
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0  # nothing half-written
     s.close()
+    cfg = _config(tmp_path, data)
     r = subprocess.run(
         CRISGEO + ["run", "--config", str(cfg), "--date", DAY],
         capture_output=True,
@@ -77,14 +81,14 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
 @pytest.mark.parametrize("workers", [1, 2])
 def test_sigterm_mid_run_stops_within_seconds_and_consistent(cases, tmp_path, workers):
     data, _, _ = cases.get()
-    cfg = _config(tmp_path, data, workers)
+    cfg = _config(tmp_path, data, workers, slow=True)
     log = tmp_path / "log"
     with open(log, "w") as fh:
         p = subprocess.Popen(
             CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT
         )
     assert wait_for(lambda: _assessing(log))
-    time.sleep(6)  # well into the assessment
+    time.sleep(4)  # well into the assessment
     t0 = time.time()
     p.send_signal(signal.SIGTERM)
     p.wait(timeout=60)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from monitor import collocate
+from monitor import swath
 from monitor.assess import AssessConfig, assess_paths
 from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
@@ -42,12 +42,12 @@ def test_assessment_needs_the_height(mountains, monkeypatch):
     ea, eb = _errors(assess_paths([out], cfg), truth)
     assert len(ea) >= 25 and max(np.abs(ea).max(), np.abs(eb).max()) < 100
     assert np.sqrt(np.mean(np.r_[ea, eb] ** 2)) < 40
-    real = collocate.swath_piece
+    real = swath.swath_piece
 
     def on_ellipsoid(lat, lon, height, *args, **kw):
         halo = [None if h is None else (h[0], h[1], np.zeros_like(h[2])) for h in args[3:5]]
         return real(lat, lon, np.zeros_like(height), *args[:3], *halo)
 
-    monkeypatch.setattr(collocate, "swath_piece", on_ellipsoid)
+    monkeypatch.setattr(swath, "swath_piece", on_ellipsoid)
     ea0, eb0 = _errors(assess_paths([out], cfg), truth)
     assert max(np.abs(ea0).max(), np.abs(eb0).max()) > 300  # ~0.5 mrad per km of terrain at the scan edge

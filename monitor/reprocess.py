@@ -1,0 +1,179 @@
+"""``crisgeo reprocess``: assess a whole period on a Dask cluster; this process alone writes the store.
+
+One task per satellite-day runs :func:`monitor.pipeline.compute_day` (list, fingerprint, select, fetch,
+assess) on a worker and returns its :class:`~monitor.pipeline.DayWork`; the client records each as it
+arrives with :func:`monitor.pipeline.record_day`, the path of the daily run (ledger row, results and
+outbox lines in one transaction). Days already ``ok`` are skipped unless forced, so a second call does
+nothing and an interrupted call resumes. SIGINT/SIGTERM cancel what is still queued or running; what
+finished is recorded.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as dt
+import logging
+import signal
+import threading
+import time
+from dataclasses import dataclass, field
+
+from monitor.pipeline import DayWork, ProgressLines, compute_day, record_day
+from monitor.service import InstanceLock
+from monitor.sources import make_source
+from monitor.store.sqlite import Store
+
+LOG = logging.getLogger(__name__)
+
+
+def day_task(cfg, satellite: str, day: dt.date) -> DayWork:
+    """One satellite-day on a worker: its own source (a NODD source shares ``cache_dir`` when that is on
+    a shared file system), no store."""
+    return compute_day(cfg, make_source(cfg), satellite, day)
+
+
+@dataclass
+class ReprocessSummary:
+    """What a reprocessing call did: days per status, days skipped as already ok, days not finished."""
+
+    planned: int = 0
+    skipped_ok: int = 0
+    statuses: dict = field(default_factory=dict)
+    unfinished: int = 0
+    wall_s: float = 0.0
+
+    @property
+    def finished(self) -> int:
+        return sum(self.statuses.values())
+
+    def lines(self) -> list[str]:
+        """The summary printed at the end."""
+        rate = self.finished / (self.wall_s / 3600) if self.wall_s > 0 and self.finished else 0.0
+        out = [
+            f"satellite-days: {self.planned} in the period, {self.skipped_ok} already ok (skipped), "
+            f"{self.finished} processed in {self.wall_s:.0f} s ({rate:.0f} days/hour)"
+        ]
+        if self.statuses:
+            out.append("  " + ", ".join(f"{k} {v}" for k, v in sorted(self.statuses.items())))
+        if self.unfinished:
+            out.append(f"  {self.unfinished} not finished (stopped): run the same command again to resume")
+        return out
+
+
+def period_days(since: dt.date, until: dt.date) -> list[dt.date]:
+    """The days from *since* to *until*, both included."""
+    if until < since:
+        raise ValueError(f"--until {until} is before --since {since}")
+    return [since + dt.timedelta(days=k) for k in range((until - since).days + 1)]
+
+
+def _client(scheduler: str | None, workers: int):
+    """A Dask client: of the scheduler at *scheduler*, or of a local cluster of *workers* processes with
+    one thread each (the assessment's own threads are set per task)."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler, timeout="30s"), None
+    logging.getLogger("distributed").setLevel(logging.WARNING)  # its INFO lines would drown the days'
+    cluster = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.WARNING,
+    )
+    return Client(cluster), cluster
+
+
+def reprocess(
+    cfg,
+    since: dt.date,
+    until: dt.date,
+    satellites: list[str],
+    scheduler: str | None = None,
+    workers: int = 2,
+    force: bool = False,
+    progress=None,
+    stop: threading.Event | None = None,
+) -> ReprocessSummary:
+    """Assess every satellite-day of the period not yet ``ok`` (all with *force*) on Dask and record each.
+
+    *progress*, called with each recorded :class:`~monitor.pipeline.RunOutcome`; *stop*, an event that
+    ends the call cleanly (queued and running days are cancelled and stay to do).
+    """
+    from distributed import wait
+
+    stop = stop or threading.Event()
+    summary = ReprocessSummary()
+    t0 = time.monotonic()
+    task_cfg = dataclasses.replace(cfg, assessment=dataclasses.replace(cfg.assessment, workers=1))
+    with InstanceLock(cfg.state_dir), Store(cfg.store.sqlite) as store:
+        store.interrupt_stale_runs()
+        todo = []
+        for sat in satellites:
+            ok = {r.day for r in store.runs(sat) if r.status == "ok"}  # YYYY-MM-DD
+            for day in period_days(since, until):
+                summary.planned += 1
+                if day.isoformat() in ok and not force:
+                    summary.skipped_ok += 1
+                else:
+                    todo.append((sat, day))
+        if not todo:
+            summary.wall_s = time.monotonic() - t0
+            return summary
+        client, cluster = _client(scheduler, workers)
+        try:
+            pending = {
+                client.submit(day_task, task_cfg, s, d, pure=False, key=f"crisgeo-{s}-{d}"): (s, d)
+                for s, d in todo
+            }
+            while pending and not stop.is_set():
+                try:
+                    done, _ = wait(list(pending), timeout=0.5, return_when="FIRST_COMPLETED")
+                except TimeoutError:  # none finished yet: look at the stop event again
+                    continue
+                for fut in done:
+                    sat, day = pending.pop(fut)
+                    try:
+                        work = fut.result()
+                    except Exception as exc:  # noqa: BLE001 - a worker lost or crashed: the day failed
+                        work = DayWork(sat, day, "failed", f"worker: {type(exc).__name__}: {exc}"[:1000])
+                    out = record_day(cfg, store, store.begin_run(sat, day), work)
+                    summary.statuses[out.status] = summary.statuses.get(out.status, 0) + 1
+                    LOG.info("%s", out.summary())
+                    if progress is not None:
+                        progress(out)
+            summary.unfinished = len(pending)
+            if pending:
+                client.cancel(list(pending))
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    summary.wall_s = time.monotonic() - t0
+    return summary
+
+
+def run_reprocess(cfg, since, until, satellites, scheduler=None, workers=2, force=False) -> ReprocessSummary:
+    """``crisgeo reprocess``: :func:`reprocess` with SIGINT/SIGTERM as a clean stop and a progress bar on a
+    terminal (log lines otherwise)."""
+    import sys
+
+    stop = threading.Event()
+    previous = {s: signal.signal(s, lambda *_: stop.set()) for s in (signal.SIGINT, signal.SIGTERM)}
+    total = len(satellites) * len(period_days(since, until))
+    bar = None
+    if sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, unit="day", desc="reprocessing")
+        progress = lambda _out: bar.update(1)  # noqa: E731
+    else:
+        progress = ProgressLines("reprocessed satellite-days", total, every_s=60)
+    try:
+        return reprocess(cfg, since, until, satellites, scheduler, workers, force, progress, stop)
+    finally:
+        if bar is not None:
+            bar.close()
+        for s, h in previous.items():
+            signal.signal(s, h)

@@ -1,0 +1,337 @@
+"""VIIRS I5 granules prepared for the cone test: pixel points, band radiance, solid-angle weights, blocks.
+
+Pixels where they are. A terrain-corrected (GITCO) pixel is the 3-D point where its line of sight meets
+the terrain: (lat, lon, Height). Put at h = 0 instead, a pixel on terrain of height h seen from CrIS at
+view zenith z moves by about h sin(z) / range towards nadir (~0.5 mrad for 1 km at the scan edge), so
+every position below is the 3-D point; the ellipsoid product (GIMGO) has h = 0.
+
+Weights. CrIS sees the scene averaged over the solid angle of its FOV; VIIRS pixels do not sample
+that solid angle evenly (scan overlap towards the swath edge, footprint steps at the aggregation-zone
+edges). Each pixel is weighted by the solid angle it covers seen from CrIS,
+``w = |A . u| / range^2``, where ``A`` is the pixel's vector footprint (the cross product of the steps to
+its neighbours, so that a slope is foreshortened as seen along the unit direction ``u`` from CrIS) with
+the overlap between consecutive scans removed (the part of a footprint that a neighbouring scan also
+covers counts half). The sum of the weights inside a cone over the cone's solid angle is its coverage:
+1 when VIIRS fills it.
+
+Search blocks. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans),
+a sphere holding its usable pixels, and a KD-tree of the block centres to find where a FOV lands.
+
+A granule is prepared once per run (about 10 million pixels): the per-pixel work is compiled (numba) and
+runs scan by scan in parallel; only the one-scan statistics and the KD-tree are numpy/scipy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from scipy.ndimage import minimum_filter1d
+from scipy.spatial import cKDTree
+
+from monitor.geometry import wgs84
+
+DETECTORS = 32  # VIIRS I-band detectors per scan
+BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
+SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smallest within +-200 columns
+
+
+@dataclass
+class SwathPiece:
+    """One VIIRS granule (rows of 32-detector scans) ready for collocation.
+
+    ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (rows, cols) I5 band
+    radiance mW/(m2 sr cm-1), NaN where unusable; area_vec_m2 (rows, cols, 3) float32 the vector footprint
+    with scan overlap removed. block_centre_m (rows/4, ceil(cols/4), 3) and block_radius_m bound the usable
+    pixels of each 4 x 4 block (NaN where it has none). Per column: the smallest column spacing within
+    +-200 columns (col_spacing_m), the along-track advance of a scan (advance_m) and the detector step
+    (det_step_m), all m; max_height_m the highest usable pixel. They size the search windows.
+    """
+
+    ecef_m: np.ndarray
+    radiance: np.ndarray
+    area_vec_m2: np.ndarray
+    block_centre_m: np.ndarray
+    block_radius_m: np.ndarray
+    col_spacing_m: np.ndarray
+    advance_m: np.ndarray
+    det_step_m: np.ndarray
+    max_height_m: float
+    tree: cKDTree
+    tree_rows: np.ndarray
+    tree_cols: np.ndarray
+
+    @property
+    def shape(self):
+        return self.radiance.shape
+
+    def nearest(self, points_m):
+        """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point,
+        and that distance (m)."""
+        dist, idx = self.tree.query(points_m)
+        return self.tree_rows[idx], self.tree_cols[idx], dist
+
+
+@dataclass
+class ViirsSwath:
+    """The prepared granules (consecutive or not) that a CrIS granule's cones may reach.
+
+    Pieces are never stacked: cone sums add over pixels, so each piece is searched on its own.
+    """
+
+    pieces: list
+
+
+@numba.njit(cache=True, nogil=True)
+def _ecef(lat, lon, h, out):
+    """WGS84 geodetic (rad, rad, m; float32 arrays) to ECEF float32 *out* (..., 3): wgs84.geodetic_to_ecef."""
+    rows, cols = lat.shape
+    for r in range(rows):
+        for c in range(cols):
+            la = np.float64(lat[r, c])
+            lo = np.float64(lon[r, c])
+            hh = np.float64(h[r, c])
+            s = math.sin(la)
+            n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * s * s)
+            rr = (n + hh) * math.cos(la)
+            out[r, c, 0] = rr * math.cos(lo)
+            out[r, c, 1] = rr * math.sin(lo)
+            out[r, c, 2] = (n * (1.0 - wgs84.E2) + hh) * s
+
+
+@numba.njit(cache=True, nogil=True)
+def _scan_ends(scan, first, last, step):
+    """First and last valid detector positions (float64 (cols, 3), NaN where the column has none) of one
+    scan (32, cols, 3) and the detector step between them (m)."""
+    for c in range(scan.shape[1]):
+        i0 = -1
+        i1 = -1
+        for d in range(DETECTORS):
+            if math.isfinite(scan[d, c, 0]):
+                if i0 < 0:
+                    i0 = d
+                i1 = d
+        if i0 < 0:
+            first[c, :] = np.nan
+            last[c, :] = np.nan
+            step[c] = np.nan
+            continue
+        s2 = 0.0
+        for x in range(3):
+            first[c, x] = scan[i0, c, x]
+            last[c, x] = scan[i1, c, x]
+            s2 += (last[c, x] - first[c, x]) ** 2
+        step[c] = math.sqrt(s2) / max(i1 - i0, 1)
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def _locate(lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step):
+    """Pass 1, scan by scan: pixel points, band radiance from BT (linear in the uniform BT table, NaN outside
+    it or where not *good*), and each scan's ends (slot k + 1 for scan k; 0 and nscan + 1 are the halos)."""
+    rows, cols = lat.shape
+    nt = table.shape[0]
+    for k in numba.prange(rows // DETECTORS):
+        sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
+        _ecef(lat[sl], lon[sl], h[sl], pos[sl])
+        for r in range(k * DETECTORS, (k + 1) * DETECTORS):
+            for c in range(cols):
+                x = (np.float64(bt[r, c]) - t_min_k) / t_step_k
+                if good[r, c] and x >= 0.0 and x <= nt - 1:
+                    i = min(int(x), nt - 2)
+                    w = x - i
+                    radiance[r, c] = table[i] * (1.0 - w) + table[i + 1] * w
+                else:
+                    radiance[r, c] = np.nan
+        _scan_ends(pos[sl], first[k + 1], last[k + 1], step[k + 1])
+
+
+@numba.njit(cache=True, nogil=True)
+def _half_diff(pos, r, c, dr, dc, has_prev, has_next, x):
+    """Half the difference of the two neighbours (r -+ dr, c -+ dc) of pixel (r, c) in component x,
+    one-sided where one is missing (outside the scan or NaN)."""
+    here = np.float64(pos[r, c, x])
+    fwd = np.float64(pos[r + dr, c + dc, x]) - here if has_next else np.nan
+    bwd = here - np.float64(pos[r - dr, c - dc, x]) if has_prev else np.nan
+    both = (fwd + bwd) * 0.5
+    if math.isfinite(both):
+        return both
+    return fwd if math.isfinite(fwd) else bwd
+
+
+@numba.njit(cache=True, nogil=True)
+def _along(first, last, k, n, c, u0, u1, u2):
+    """Position along the unit vector u of scan slot n's first and last valid detectors of column c,
+    measured from scan slot k's first."""
+    lo = (first[n, c, 0] - first[k, c, 0]) * u0 + (first[n, c, 1] - first[k, c, 1]) * u1
+    lo += (first[n, c, 2] - first[k, c, 2]) * u2
+    hi = (last[n, c, 0] - first[k, c, 0]) * u0 + (last[n, c, 1] - first[k, c, 1]) * u1
+    hi += (last[n, c, 2] - first[k, c, 2]) * u2
+    return lo, hi
+
+
+@numba.njit(cache=True, nogil=True)
+def _share(pos, r, c, k, first, last, step, have):
+    """The share (0.5..1) of the footprint of pixel (r, c) of scan slot k that is its own.
+
+    Along the track each pixel spans one detector step centred on it, each neighbouring scan its
+    first-to-last valid detector span plus half a step each side; an overlap of a fraction f of the
+    footprint leaves the pixel 1 - f / 2. (Counting whole pixels in or out instead leaves ~1 % too much
+    weight in stripes at the scan edges near nadir, where the overlap is a fraction of a detector, and
+    biases the in-track minimum there.) A neighbour with no valid pixel in the column overlaps nothing.
+    """
+    u0 = last[k, c, 0] - first[k, c, 0]
+    u1 = last[k, c, 1] - first[k, c, 1]
+    u2 = last[k, c, 2] - first[k, c, 2]
+    norm = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    u0, u1, u2 = u0 / norm, u1 / norm, u2 / norm
+    s_pix = (pos[r, c, 0] - first[k, c, 0]) * u0 + (pos[r, c, 1] - first[k, c, 1]) * u1
+    s_pix += (pos[r, c, 2] - first[k, c, 2]) * u2
+    half = step[k, c] / 2
+    share = 1.0
+    for n in (k - 1, k + 1):
+        if not have[n] or not math.isfinite(step[n, c]):
+            continue
+        lo, hi = _along(first, last, k, n, c, u0, u1, u2)
+        overlap = min(s_pix + half, hi + step[n, c] / 2) - max(s_pix - half, lo - step[n, c] / 2)
+        share -= min(max(overlap / (2 * half), 0.0), 1.0) / 2
+    return share
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def _weigh(pos, radiance, first, last, step, have, area, centre, radius):
+    """Pass 2, scan by scan: vector footprints with the scan overlap removed, radiance NaN where either is
+    unusable, and the bounding sphere (centre, radius + 1 m for the float32 rounding) of each block's
+    usable pixels (NaN where it has none)."""
+    rows, cols = radiance.shape
+    nbc = centre.shape[1]
+    for k in numba.prange(rows // DETECTORS):
+        for r in range(k * DETECTORS, (k + 1) * DETECTORS):
+            d = r - k * DETECTORS
+            for c in range(cols):
+                a0 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 0)
+                a1 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 1)
+                a2 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 2)
+                b0 = _half_diff(pos, r, c, 1, 0, d > 0, d + 1 < DETECTORS, 0)
+                b1 = _half_diff(pos, r, c, 1, 0, d > 0, d + 1 < DETECTORS, 1)
+                b2 = _half_diff(pos, r, c, 1, 0, d > 0, d + 1 < DETECTORS, 2)
+                s = _share(pos, r, c, k + 1, first, last, step, have)
+                x0 = (a1 * b2 - a2 * b1) * s
+                x1 = (a2 * b0 - a0 * b2) * s
+                x2 = (a0 * b1 - a1 * b0) * s
+                area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
+                if not (math.isfinite(x0) and math.isfinite(x1) and math.isfinite(x2)):
+                    radiance[r, c] = np.nan
+        for br in range(k * DETECTORS // BLOCK_PX, (k + 1) * DETECTORS // BLOCK_PX):
+            for bc in range(nbc):
+                lo0 = lo1 = lo2 = np.inf
+                hi0 = hi1 = hi2 = -np.inf
+                for r in range(br * BLOCK_PX, (br + 1) * BLOCK_PX):
+                    for c in range(bc * BLOCK_PX, min((bc + 1) * BLOCK_PX, cols)):
+                        if math.isfinite(radiance[r, c]):
+                            lo0, hi0 = min(lo0, pos[r, c, 0]), max(hi0, pos[r, c, 0])
+                            lo1, hi1 = min(lo1, pos[r, c, 1]), max(hi1, pos[r, c, 1])
+                            lo2, hi2 = min(lo2, pos[r, c, 2]), max(hi2, pos[r, c, 2])
+                if lo0 > hi0:
+                    centre[br, bc, :] = np.nan
+                    radius[br, bc] = np.nan
+                    continue
+                centre[br, bc, 0] = (lo0 + hi0) / 2
+                centre[br, bc, 1] = (lo1 + hi1) / 2
+                centre[br, bc, 2] = (lo2 + hi2) / 2
+                radius[br, bc] = math.sqrt((hi0 - lo0) ** 2 + (hi1 - lo1) ** 2 + (hi2 - lo2) ** 2) / 2 + 1.0
+
+
+def _np_half_diff(p, axis):
+    """Half the difference of the two neighbours along *axis* (numpy), one-sided where one is missing."""
+    fwd = np.full_like(p, np.nan)
+    bwd = np.full_like(p, np.nan)
+    n = p.shape[axis]
+    a, b = [slice(None)] * p.ndim, [slice(None)] * p.ndim
+    a[axis], b[axis] = slice(0, n - 1), slice(1, n)
+    np.subtract(p[tuple(b)], p[tuple(a)], out=fwd[tuple(a)])
+    bwd[tuple(b)] = fwd[tuple(a)]
+    both = (fwd + bwd) * 0.5
+    return np.where(np.isfinite(both), both, np.where(np.isfinite(fwd), fwd, bwd))
+
+
+def _fill_nan(a):
+    a = np.asarray(a, float)
+    ok = np.isfinite(a)
+    return np.interp(np.arange(len(a)), np.nonzero(ok)[0], a[ok]) if not ok.all() else a
+
+
+def swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band, before=None, after=None) -> SwathPiece:
+    """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
+
+    Pixels are the 3-D points (lat_rad, lon_rad, height_m) (height above the ellipsoid; zeros for the
+    ellipsoid product). *band* (:class:`monitor.spectral.I5Band`) turns pixel BT into band radiance.
+    *before* and *after* are optional (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent
+    scan, so that the scan overlap at the granule's first and last scan is counted as inside a continuous
+    swath.
+    """
+    f32 = np.float32
+    lat, lon, h = (np.ascontiguousarray(a, f32) for a in (lat_rad, lon_rad, height_m))
+    rows, cols = lat.shape
+    nscan = rows // DETECTORS
+    pos = np.empty((rows, cols, 3), f32)
+    radiance = np.empty((rows, cols), f32)
+    first = np.full((nscan + 2, cols, 3), np.nan)
+    last = np.full_like(first, np.nan)
+    step = np.full((nscan + 2, cols), np.nan)
+    have = np.zeros(nscan + 2, bool)
+    have[1:-1] = True
+    t_min, t_step, table = band.radiance_table
+    _locate(
+        lat,
+        lon,
+        h,
+        np.ascontiguousarray(bt_k, f32),
+        np.ascontiguousarray(good, bool),
+        table,
+        t_min,
+        t_step,
+        pos,
+        radiance,
+        first,
+        last,
+        step,
+    )
+    for slot, halo in ((0, before), (nscan + 1, after)):
+        if halo is not None:
+            hp = np.empty(np.shape(halo[0]) + (3,), f32)
+            _ecef(*(np.ascontiguousarray(a, f32) for a in halo), hp)
+            _scan_ends(hp, first[slot], last[slot], step[slot])
+            have[slot] = True
+    area = np.empty((rows, cols, 3), f32)
+    centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
+    radius = np.empty(centre.shape[:2])
+    _weigh(pos, radiance, first, last, step, have, area, centre, radius)
+    located = np.isfinite(radiance)
+    max_height = float(np.max(h, where=located, initial=0.0))
+
+    scan = pos.reshape(nscan, DETECTORS, cols, 3)
+    mid = scan[nscan // 2]
+    col_spacing = _fill_nan(np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=1), axis=-1), axis=0))
+    det_step = np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=0), axis=-1), axis=0)
+    if nscan > 1:
+        advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
+    else:
+        advance = det_step * DETECTORS
+    r_idx, c_idx = np.nonzero(np.isfinite(radius))
+    tree = cKDTree(centre[r_idx, c_idx])
+    return SwathPiece(
+        pos,
+        radiance,
+        area,
+        centre,
+        radius,
+        minimum_filter1d(col_spacing, SPACING_WINDOW_COLS, mode="nearest"),
+        _fill_nan(advance),
+        _fill_nan(det_step),
+        max(max_height, 0.0),
+        tree,
+        r_idx * BLOCK_PX,
+        c_idx * BLOCK_PX,
+    )
