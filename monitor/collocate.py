@@ -31,7 +31,7 @@ import threading
 import numba
 import numpy as np
 
-from monitor.constants import FOV_DIAMETER_RAD
+from monitor.constants import FOV_DIAMETER_RAD, MAX_GRID_SPREAD_RAD
 from monitor.geometry import wgs84
 from monitor.swath import BLOCK_PX, DETECTORS, SwathPiece, ViirsSwath
 
@@ -66,29 +66,29 @@ def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _nearest_index(t, guess0, guess_scale, m):
-    """The j nearest t, from (t - guess0) * guess_scale, clipped to 0..m. tan B_j is so nearly linear
-    in j (within 0.05 of a step over the grid) that the count of tan B_j below t is this or one more."""
+    """The j nearest t on the chord through (tan B_0, 0) and (tan B_{m-1}, m - 1), clipped to 0..m.
+
+    tan B_j departs from that chord by at most tan|beta| n^2 s (index units), < 0.3 within
+    MAX_GRID_SPREAD_RAD, so the count of tan B_j below t is this index or the next.
+    """
     g = (t - guess0) * guess_scale + 0.5
     return 0 if not g > 0.0 else (m if g > m else int(g))
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _first_at_or_above(padded, t, guess0, guess_scale):
-    """How many tan B_j are < t: the first j of a run starting at t. *padded* is (-inf, tan B_0 ..
-    tan B_{m-1}, +inf); a branch-free step corrects the guess (and one back, for a tie)."""
-    j = _nearest_index(t, guess0, guess_scale, padded.shape[0] - 2)
-    j += padded[j + 1] < t
-    j -= padded[j] >= t
-    return j
+def _first_at_or_above(tan_b_inf, t, guess0, guess_scale):
+    """How many tan B_j are < t: the first j of a run starting at t. *tan_b_inf* is tan B_0 ..
+    tan B_{m-1}, +inf; one comparison settles the guess."""
+    j = _nearest_index(t, guess0, guess_scale, tan_b_inf.shape[0] - 1)
+    return j + (tan_b_inf[j] < t)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _first_above(padded, t, guess0, guess_scale):
+def _first_above(tan_b_inf, t, guess0, guess_scale):
     """How many tan B_j are <= t: the j after a run ending at t (see _first_at_or_above)."""
-    j = _nearest_index(t, guess0, guess_scale, padded.shape[0] - 2)
-    j += padded[j + 1] <= t
-    j -= padded[j] > t
-    return j
+    m = tan_b_inf.shape[0] - 1
+    j = _nearest_index(t, guess0, guess_scale, m)
+    return min(j + (tan_b_inf[j] <= t), m)
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
@@ -119,9 +119,9 @@ def _accumulate(
         for k in range(nk):
             for i in range(m):
                 g2k[k, i] = ring_g2[k] * (1.0 + ta[i] * ta[i])
-        padded = np.empty(m + 2)  # -inf, tan B_0 .. tan B_{m-1}, +inf
-        padded[0], padded[m + 1] = -np.inf, np.inf
-        padded[1 : m + 1] = tan_b[f]
+        tan_b_inf = np.empty(m + 1)  # tan B_0 .. tan B_{m-1}, +inf
+        tan_b_inf[:m] = tan_b[f]
+        tan_b_inf[m] = np.inf
         guess0 = tan_b[f, 0]
         guess_scale = (m - 1) / (tan_b[f, m - 1] - tan_b[f, 0]) if m > 1 else 0.0
         t_lo = np.empty(m)
@@ -178,8 +178,8 @@ def _accumulate(
                                 t_lo[i] = (sq - b1) * inv_a2 if disc >= 0.0 else np.inf
                                 t_hi[i] = -(b1 + sq) * inv_a2 if disc >= 0.0 else -np.inf
                             for i in range(m):  # its run of j: +w at the first, -w after the last
-                                j0 = _first_at_or_above(padded, t_lo[i], guess0, guess_scale)
-                                j1 = _first_above(padded, t_hi[i], guess0, guess_scale)
+                                j0 = _first_at_or_above(tan_b_inf, t_lo[i], guess0, guess_scale)
+                                j1 = _first_above(tan_b_inf, t_hi[i], guess0, guess_scale)
                                 if j0 < j1:
                                     out[0, i, j0] += wv
                                     out[0, i, j1] -= wv
@@ -211,6 +211,11 @@ def cone_sums(
     mat = np.ascontiguousarray(sbf_to_ecef, np.float64)
     h_max = max(h for h, _ in kernel)
     big = np.abs(offsets_rad).max()
+    if m > 1 and big * big / (offsets_rad[1] - offsets_rad[0]) > MAX_GRID_SPREAD_RAD * (1 + 1e-9):
+        raise ValueError(
+            f"perturbation grid of {m} x {m} steps of {offsets_rad[1] - offsets_rad[0]:.3g} rad: n^2 s "
+            f"exceeds {MAX_GRID_SPREAD_RAD} rad, beyond the compiled kernel's index guess"
+        )
     rho = h_max + big * np.sqrt(2.0) * 1.02  # angle from the LOS within which a cone can hold a pixel
     los0 = np.einsum("fij,fj->fi", mat, np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(nf)], -1))
     los0 /= np.linalg.norm(los0, axis=-1, keepdims=True)

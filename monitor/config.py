@@ -17,7 +17,7 @@ from urllib.parse import urlsplit, urlunsplit
 import yaml
 import yaml.events
 
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, MAX_GRID_SPREAD_RAD, URAD
 from monitor.satellites import SATELLITES
 
 NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
@@ -555,6 +555,13 @@ def _check_limits(cfg: Config) -> None:
     if cfg.scenes.keep > cfg.scenes.candidates:
         raise ConfigError(
             f"scenes.keep: {cfg.scenes.keep} is more than scenes.candidates ({cfg.scenes.candidates})"
+        )
+    spread = cfg.assessment.half_steps**2 * cfg.assessment.step_urad * URAD
+    if spread > MAX_GRID_SPREAD_RAD:
+        raise ConfigError(
+            f"assessment.half_steps: {cfg.assessment.half_steps} with step_urad "
+            f"{cfg.assessment.step_urad:g}: half_steps^2 x step_urad = {spread / URAD:.0f} urad is more "
+            f"than {MAX_GRID_SPREAD_RAD / URAD:.0f} (the widest grid of the compiled collocation)"
         )
     if len(set(cfg.satellites)) != len(cfg.satellites):
         raise ConfigError("satellites: a satellite is listed twice")

@@ -61,7 +61,8 @@ MEANING = {
     "scenes.min_inhomogeneity_k": "A granule whose VIIRS-BT spread is below this is not used.",
     "assessment.half_steps": "Perturbations on each side of zero per direction: the grid is (2n+1)^2 (21 x "
     "21).",
-    "assessment.step_urad": "Perturbation step (375 m at nadir from 833 km).",
+    "assessment.step_urad": "Perturbation step (375 m at nadir from 833 km); half_steps^2 x step_urad <= "
+    "200000.",
     "assessment.kernel": "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response).",
     "assessment.workers": "Threads of the compiled VIIRS preparation and collocation kernels.",
     "fingerprint.granules": "GEO granules per day sampled (spread over the day) for the LOS fingerprint.",

@@ -15,3 +15,6 @@ REFERENCE_ALTITUDE_M = 833000.0  # the JPSS orbit altitude the paper's grid step
 DEFAULT_STEP_RAD = VIIRS_I_PIXEL_M / REFERENCE_ALTITUDE_M  # one I-band pixel seen from 833 km, ~450 urad
 DEFAULT_STEP_URAD = DEFAULT_STEP_RAD / URAD
 DEFAULT_HALF_STEPS = 10  # perturbations on each side of zero: a 21 x 21 grid
+# The widest perturbation grid the compiled cone kernel takes: half_steps^2 x step <= 0.2 rad (the paper's
+# grid: 100 x 450 urad = 0.045 rad); within it tan B_j is linear in j to 0.3 of a step at |beta| <= 55 deg.
+MAX_GRID_SPREAD_RAD = 0.2

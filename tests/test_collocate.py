@@ -230,3 +230,44 @@ def test_threads_give_identical_sums(scene):
     np.testing.assert_array_equal(one[0], two[0])
     np.testing.assert_array_equal(one[1], two[1])
     assert np.isfinite(one[0]).all()
+
+
+@pytest.mark.parametrize("beta", [-0.96, -0.4, 0.0, 0.3, 0.96])
+@pytest.mark.parametrize("n", [1, 10, 20])
+def test_run_ends_are_exact_up_to_the_widest_grid(beta, n):
+    """The kernel's j of a run end (a chord guess and one comparison) is the exact count of tan B_j
+    below t (np.searchsorted), for grids up to MAX_GRID_SPREAD_RAD, ties and points off the grid."""
+    from monitor.constants import MAX_GRID_SPREAD_RAD
+
+    step = MAX_GRID_SPREAD_RAD / n**2
+    tan_b = np.tan(beta + perturbation_grid(n, step))
+    m = len(tan_b)
+    guess0, scale = tan_b[0], (m - 1) / (tan_b[-1] - tan_b[0])
+    rng = np.random.default_rng(n)
+    t = np.concatenate(
+        [
+            np.tan(beta + rng.uniform(-2, 2, 3000) * n * step),
+            tan_b,
+            np.nextafter(tan_b, np.inf),
+            [-np.inf, np.inf],
+        ]
+    )
+    padded = np.append(tan_b, np.inf)
+    lo = [collocate._first_at_or_above(padded, x, guess0, scale) for x in t]
+    hi = [collocate._first_above(padded, x, guess0, scale) for x in t]
+    np.testing.assert_array_equal(lo, np.searchsorted(tan_b, t, "left"))
+    np.testing.assert_array_equal(hi, np.searchsorted(tan_b, t, "right"))
+
+
+def test_a_grid_beyond_the_kernels_reach_is_refused(scene):
+    fg, viirs = scene
+    idx = (0, 14, 4)
+    with pytest.raises(ValueError, match="n\\^2 s exceeds"):
+        collocate.cone_sums(
+            viirs,
+            fg.sat_ecef_m[idx][None],
+            fg.sbf_to_ecef[idx][None],
+            fg.alpha_rad[idx][None],
+            fg.beta_rad[idx][None],
+            perturbation_grid(30, 450e-6),
+        )

@@ -119,6 +119,7 @@ BAD = [  # (where, value or a function of the document, the key the one-line err
     ("assessment.workers", 0, "assessment.workers"),
     ("assessment.workers", 1000, "assessment.workers"),
     ("assessment.half_steps", 500, "assessment.half_steps"),
+    ("assessment.half_steps", 30, "assessment.half_steps"),  # wider than the kernel takes
     ("assessment.step_urad", float("inf"), "assessment.step_urad"),
     ("store.drain_minutes", 0, "store.drain_minutes"),
     ("store.backend", "pg", "store.backend"),
