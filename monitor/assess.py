@@ -15,6 +15,7 @@ floor calibrated on simulated cases (what the estimator itself leaves, ``AssessC
 
 from __future__ import annotations
 
+import concurrent.futures as cf
 import logging
 import time
 from contextlib import contextmanager
@@ -95,50 +96,34 @@ class _SwathCache:
     keep: int = 3
 
 
-def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=None):
-    if v.key in cache.pieces:
-        return cache.pieces[v.key]
+@dataclass
+class GranuleInputs:
+    """What one CrIS granule's assessment reads from disk: its GEO and SDR, and the raw VIIRS granules
+    (key -> (GEO, SDR, scan before, scan after)) not yet prepared."""
+
+    geo: object
+    sdr: object
+    viirs: dict = field(default_factory=dict)
+
+
+def _read_viirs(v: GranuleFiles, viirs_all: list):
+    """A VIIRS granule's GEO and SDR, with the adjacent scans of its neighbours (for the scan overlap)."""
     before, after = neighbours(viirs_all, v)
-    with _stage(timings, "read"):
-        geo = read_file(v.geo, kinds=("viirs_geo",))[0]
-        sdr = read_file(v.sdr, kinds=("viirs_sdr",))[0]
-        halo_before = read_viirs_geo_scan(before.geo, -1) if before is not None else None
-        halo_after = read_viirs_geo_scan(after.geo, 0) if after is not None else None
+    geo = read_file(v.geo, kinds=("viirs_geo",))[0]
+    sdr = read_file(v.sdr, kinds=("viirs_sdr",))[0]
+    halo_before = read_viirs_geo_scan(before.geo, -1) if before is not None else None
+    halo_after = read_viirs_geo_scan(after.geo, 0) if after is not None else None
     if sdr.bt_k.shape != geo.lat_rad.shape:
         raise GranuleError(
             v.sdr,
             "BrightnessTemperature",
             f"shape {sdr.bt_k.shape} does not match the GEO {geo.lat_rad.shape}",
         )
-    with _stage(timings, "geometry"):
-        piece = swath.swath_piece(
-            geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after
-        )
-    while len(cache.pieces) >= cache.keep:
-        cache.pieces.pop(next(iter(cache.pieces)))
-    cache.pieces[v.key] = piece
-    return piece
+    return geo, sdr, halo_before, halo_after
 
 
-def _load_swath(viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, timings=None):
-    """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*)."""
-    return swath.ViirsSwath([_piece(v, viirs_all, band, cache, timings) for v in viirs])
-
-
-def collocate_granule(
-    cris: GranuleFiles,
-    viirs: list[GranuleFiles],
-    cfg: AssessConfig,
-    band,
-    cache: _SwathCache,
-    timings=None,
-    viirs_all=None,
-    should_stop=None,
-) -> GranuleSamples:
-    """Read one CrIS granule and its VIIRS cover and collocate every FOV for every perturbation.
-
-    *timings*, when a dict, accumulates seconds per stage: read, geometry, collocation.
-    """
+def read_inputs(cris: GranuleFiles, viirs: list, viirs_all: list, prepared=(), timings=None) -> GranuleInputs:
+    """Read what :func:`collocate_granule` needs of *cris*, except the VIIRS granules in *prepared*."""
     with _stage(timings, "read"):
         geo = next(
             g
@@ -150,17 +135,67 @@ def collocate_granule(
             for g in read_file(cris.sdr, kinds=("cris_sdr",))
             if g.meta.granule_id == cris.sdr_meta.granule_id
         )
-    if sdr.radiance_lw.shape[:3] != geo.lat_rad.shape:
-        raise GranuleError(
-            cris.sdr,
-            "ES_RealLW",
-            f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO {geo.lat_rad.shape}",
+        if sdr.radiance_lw.shape[:3] != geo.lat_rad.shape:
+            raise GranuleError(
+                cris.sdr,
+                "ES_RealLW",
+                f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO {geo.lat_rad.shape}",
+            )
+        raw = {v.key: _read_viirs(v, viirs_all) for v in viirs if v.key not in prepared}
+    return GranuleInputs(geo, sdr, raw)
+
+
+def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=None, raw=None):
+    if v.key in cache.pieces:
+        return cache.pieces[v.key]
+    if raw is None:
+        with _stage(timings, "read"):
+            raw = _read_viirs(v, viirs_all)
+    geo, sdr, halo_before, halo_after = raw
+    with _stage(timings, "geometry"):
+        piece = swath.swath_piece(
+            geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after
         )
+    while len(cache.pieces) >= cache.keep:
+        cache.pieces.pop(next(iter(cache.pieces)))
+    cache.pieces[v.key] = piece
+    return piece
+
+
+def _load_swath(
+    viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, timings=None, raw=None
+) -> swath.ViirsSwath:
+    """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*), from
+    the raw granules in *raw* (key -> :func:`_read_viirs`) or read here."""
+    raw = raw or {}
+    return swath.ViirsSwath([_piece(v, viirs_all, band, cache, timings, raw.get(v.key)) for v in viirs])
+
+
+def collocate_granule(
+    cris: GranuleFiles,
+    viirs: list[GranuleFiles],
+    cfg: AssessConfig,
+    band,
+    cache: _SwathCache,
+    timings=None,
+    viirs_all=None,
+    should_stop=None,
+    inputs: GranuleInputs | None = None,
+) -> GranuleSamples:
+    """Collocate every FOV of one CrIS granule for every perturbation with its VIIRS cover.
+
+    *inputs* is what :func:`read_inputs` read ahead (read here when None); *timings*, when a dict,
+    accumulates seconds per stage: read, geometry, spectral, collocation.
+    """
+    viirs_all = viirs_all or viirs
+    if inputs is None:
+        inputs = read_inputs(cris, viirs, viirs_all, tuple(cache.pieces), timings)
+    geo, sdr = inputs.geo, inputs.sdr
     with _stage(timings, "geometry"):
         fg, valid, fill = _cris_geometry(geo)
     with _stage(timings, "spectral"):
         bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
-    pieces = _load_swath(viirs, viirs_all or viirs, band, cache, timings)
+    pieces = _load_swath(viirs, viirs_all, band, cache, timings, inputs.viirs)
     with _stage(timings, "collocation"):
         bt_viirs, coverage = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (
@@ -418,22 +453,44 @@ def _collocate_run(
     band = i5_band(satellite)
     cache = _SwathCache()
     samples, skipped = [], []
-    for g in cris:
-        if should_stop is not None and should_stop():
-            skipped.append((g.key, "not assessed: stop requested"))
-            continue
-        try:
-            samples.append(
-                collocate_granule(g, viirs[g.key], cfg, band, cache, timings, viirs_all, should_stop)
-            )
-        except StopRequested:
-            skipped.append((g.key, "not assessed: stop requested"))
-            continue
-        except GranuleError as exc:
-            LOG.warning("skipping granule %s: %s", g.key, exc)
-            skipped.append((g.key, str(exc)))
-        if progress is not None:
-            progress(g)
+    reading = {}  # the read-ahead thread's seconds, added to *timings* at the end
+
+    def read_ahead(i):
+        """Read granule i's inputs in the background while granule i - 1 is computed (h5py and the
+        compiled kernels release the interpreter to each other)."""
+        prepared = set(cache.pieces) | ({v.key for v in viirs[cris[i - 1].key]} if i else set())
+        return pool.submit(read_inputs, cris[i], viirs[cris[i].key], viirs_all, prepared, reading)
+
+    with cf.ThreadPoolExecutor(1, thread_name_prefix="crisgeo-read") as pool:
+        ahead = read_ahead(0) if cris else None
+        for i, g in enumerate(cris):
+            current, ahead = ahead, None
+            if should_stop is not None and should_stop():
+                if current is not None:
+                    current.cancel()
+                skipped.append((g.key, "not assessed: stop requested"))
+                continue
+            if i + 1 < len(cris):
+                ahead = read_ahead(i + 1)
+            try:
+                samples.append(
+                    collocate_granule(
+                        g, viirs[g.key], cfg, band, cache, timings, viirs_all, should_stop, current.result()
+                    )
+                )
+            except StopRequested:
+                skipped.append((g.key, "not assessed: stop requested"))
+                continue
+            except GranuleError as exc:
+                LOG.warning("skipping granule %s: %s", g.key, exc)
+                skipped.append((g.key, str(exc)))
+            if progress is not None:
+                progress(g)
+        if ahead is not None:
+            ahead.cancel()
+    if timings is not None:
+        for name, sec in reading.items():
+            timings[name] = timings.get(name, 0.0) + sec
     return samples, skipped
 
 

@@ -257,3 +257,27 @@ def cone_sums(
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(occupied, sums / wsum, np.nan)
     return mean, np.where(occupied, wsum / solid, 0.0)
+
+
+def warm_up() -> float:
+    """Compile the kernels (or load them from numba's cache) on a tiny synthetic granule, so that a timing
+    or the first granule does not pay for it; the seconds it took."""
+    import time
+
+    from monitor.spectral import i5_band
+    from monitor.swath import swath_piece
+
+    t0 = time.perf_counter()
+    rows, cols = 2 * DETECTORS, 16
+    r, c = np.meshgrid(np.arange(rows), np.arange(cols), indexing="ij")
+    lat, lon = np.radians(0.004 * r).astype(np.float32), np.radians(0.004 * c).astype(np.float32)
+    zeros = np.zeros((rows, cols), np.float32)
+    piece = swath_piece(lat, lon, zeros, zeros + 280.0, zeros == 0, i5_band("j01"))
+    ground = wgs84.geodetic_to_ecef(np.radians(0.06), np.radians(0.03), 0.0)
+    sat = ground * (1 + 833e3 / np.linalg.norm(ground))
+    z = -ground / np.linalg.norm(ground)
+    x = np.cross([0.0, 0.0, 1.0], z)
+    sbf = np.stack([x, np.cross(z, x), z], axis=1)
+    offsets = np.array([-1e-3, 0.0, 1e-3])
+    cone_sums(ViirsSwath([piece]), sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
+    return time.perf_counter() - t0

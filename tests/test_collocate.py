@@ -271,3 +271,8 @@ def test_a_grid_beyond_the_kernels_reach_is_refused(scene):
             fg.beta_rad[idx][None],
             perturbation_grid(30, 450e-6),
         )
+
+
+def test_warm_up_compiles_the_kernels():
+    assert collocate.warm_up() >= 0
+    assert collocate._accumulate.signatures and swath._weigh.signatures and swath._locate.signatures
