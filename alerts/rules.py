@@ -16,7 +16,7 @@ import numpy as np
 from alerts.changes import preceding_change
 from monitor.constants import N_FOR
 from monitor.result import RELIABILITY_FLAGS
-from monitor.store.sqlite import SCHEDULER_KINDS, EventKind
+from monitor.store.sqlite import DONE, SCHEDULER_KINDS, EventKind, RunStatus
 
 UTC = dt.timezone.utc
 COMPONENTS = (("in_track_km", "in-track"), ("cross_track_km", "cross-track"))
@@ -261,7 +261,7 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
     runs = store.runs(satellite)
     if not runs:
         return None
-    ok = [r for r in runs if r.status == "ok"]
+    ok = [r for r in runs if r.status == RunStatus.OK]
     since = dt.datetime.fromisoformat((ok[-1].finished if ok else runs[0].started))
     age = (now - since).total_seconds() / 3600
     if age <= s.stale_hours:
@@ -283,8 +283,8 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
 def failure_finding(store, satellite: str) -> Finding | None:
     """The latest run failed, or the scheduler reported a failed or missed job since the last good run."""
     runs = store.runs(satellite)
-    last_ok = max((r.id for r in runs if r.status in ("ok", "no_data", "no_data_final")), default=0)
-    failed = [r for r in runs if r.id > last_ok and r.status == "failed"]
+    last_ok = max((r.id for r in runs if r.status in DONE), default=0)
+    failed = [r for r in runs if r.id > last_ok and r.status == RunStatus.FAILED]
     last_ok_time = next((r.finished for r in runs if r.id == last_ok), "")
     jobs = [
         e

@@ -418,6 +418,7 @@ def cmd_export(args) -> int:
 def cmd_run(args) -> int:
     """crisgeo run: one run of the daily job, then exit."""
     from monitor.service import AlreadyRunning, Service
+    from monitor.store.sqlite import RunStatus
 
     cfg = _load(args)
     sats = [args.satellite] if args.satellite else cfg.satellites
@@ -448,7 +449,7 @@ def cmd_run(args) -> int:
             print("wall time per stage: " + ", ".join(f"{k} {v:.1f} s" for k, v in o.timings.items()))
     if not outcomes:
         print("nothing to do: every day of the catch-up window is done")
-    return EXIT_FAIL if any(o.status == "failed" for o in outcomes) else EXIT_OK
+    return EXIT_FAIL if any(o.status == RunStatus.FAILED for o in outcomes) else EXIT_OK
 
 
 @command(
@@ -466,6 +467,7 @@ def cmd_reprocess(args) -> int:
     """crisgeo reprocess: a period on Dask; this process alone writes the store."""
     from monitor.reprocess import run_reprocess
     from monitor.service import AlreadyRunning
+    from monitor.store.sqlite import RunStatus
 
     cfg = _load(args)
     sats = [args.satellite] if args.satellite else cfg.satellites
@@ -484,7 +486,7 @@ def cmd_reprocess(args) -> int:
         return EXIT_ALREADY_RUNNING
     for line in summary.lines():
         print(line)
-    return EXIT_FAIL if summary.unfinished or summary.statuses.get("failed") else EXIT_OK
+    return EXIT_FAIL if summary.unfinished or summary.statuses.get(RunStatus.FAILED) else EXIT_OK
 
 
 @command(
@@ -525,6 +527,7 @@ def status_report(cfg, store) -> dict:
     the alerts firing; the next run; the outbox size; and the Nagios state of it all."""
     from monitor.service import next_run
     from monitor.store.alerts import AlertState
+    from monitor.store.sqlite import RunStatus
 
     runs = {r.satellite: r for r in store.last_runs()}
     firing = AlertState(store).firing()
@@ -545,7 +548,7 @@ def status_report(cfg, store) -> dict:
             ],
         }
     critical = any(a.severity == "critical" for a in firing) or any(
-        s["last_run"] and s["last_run"]["status"] == "failed" for s in sats.values()
+        s["last_run"] and s["last_run"]["status"] == RunStatus.FAILED for s in sats.values()
     )
     state = NAGIOS_CRITICAL if critical else NAGIOS_WARNING if firing else NAGIOS_OK
     return {

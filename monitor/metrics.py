@@ -27,7 +27,9 @@ import math
 from prometheus_client import CollectorRegistry, Counter, Gauge
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 
-OUTCOMES = ("ok", "no_data", "no_data_final", "failed", "interrupted", "running")
+from monitor.store.sqlite import RunStatus
+
+OUTCOMES = tuple(RunStatus)
 
 
 class _StoreCollector:

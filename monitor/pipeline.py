@@ -23,7 +23,7 @@ from monitor.sdr import read_file
 from monitor.sdr.pairing import CasePlan, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 from monitor.sources import ALL_PRODUCTS, Source, SourceError
-from monitor.store.sqlite import EventKind
+from monitor.store.sqlite import EventKind, RunStatus
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
 LOG = logging.getLogger(__name__)
@@ -199,7 +199,7 @@ class DayWork:
 
     satellite: str
     day: dt.date
-    status: str  # ok, no_data, failed, interrupted
+    status: RunStatus  # ok, no_data, failed or interrupted
     reason: str | None = None
     result: object = None
     decisions: list = field(default_factory=list)
@@ -214,7 +214,7 @@ def compute_day(
     """List, fingerprint, select, fetch and assess one satellite-day, touching no store. Never raises for
     a problem of the day's data or source: it becomes the work's status and reason."""
     stop = should_stop or (lambda: False)
-    w = DayWork(satellite, day, "ok")
+    w = DayWork(satellite, day, RunStatus.OK)
     w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}
     t0 = time.perf_counter()
     try:
@@ -223,7 +223,10 @@ def compute_day(
         w.timings["list"] = time.perf_counter() - t0
         w.counts["listed"] = len(listing)
         if not any(f.product in CRIS_GEO for f in listing):
-            w.status, w.reason = "no_data", f"no CrIS GEO granule of {satellite} on {day} in the source"
+            w.status, w.reason = (
+                RunStatus.NO_DATA,
+                f"no CrIS GEO granule of {satellite} on {day} in the source",
+            )
             return w
         if stop():
             raise StopRequested
@@ -237,7 +240,7 @@ def compute_day(
         w.timings["select"] = time.perf_counter() - t1
         w.counts["selected"] = len(chosen)
         if not chosen:
-            w.status = "no_data"
+            w.status = RunStatus.NO_DATA
             w.reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in w.decisions}))[:500]
             return w
         t1 = time.perf_counter()
@@ -260,12 +263,12 @@ def compute_day(
         if stop():
             raise StopRequested
     except StopRequested:
-        w.status, w.reason, w.result = "interrupted", "stop requested", None
+        w.status, w.reason, w.result = RunStatus.INTERRUPTED, "stop requested", None
     except (SourceError, DataError, OSError) as exc:
-        w.status, w.reason, w.result = "failed", f"{type(exc).__name__}: {exc}", None
+        w.status, w.reason, w.result = RunStatus.FAILED, f"{type(exc).__name__}: {exc}", None
     except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
         LOG.exception("run %s %s failed unexpectedly", satellite, day)
-        w.status, w.reason = "failed", f"unexpected {type(exc).__name__}: {exc}"[:1000]
+        w.status, w.reason = RunStatus.FAILED, f"unexpected {type(exc).__name__}: {exc}"[:1000]
         w.result = None
     return w
 
@@ -282,24 +285,24 @@ def record_day(cfg, store, run_id: int, w: DayWork) -> RunOutcome:
             except (DataError, OSError, ValueError) as exc:
                 LOG.warning("fingerprint of %s %s not recorded: %s", w.satellite, w.day, exc)
         out = RunOutcome(w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts)
-        if w.status == "ok":
+        if w.status == RunStatus.OK:
             lines = {
                 target_name(p): result_lines(p.measurement, w.satellite, w.day, w.result.fors)
                 for p in cfg.store.publish
             }
             store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, lines)
             publish_changes(cfg, store, w.satellite)
-        elif w.status == "no_data":
+        elif w.status == RunStatus.NO_DATA:
             s = cfg.schedule
             today = dt.datetime.now(dt.timezone.utc).date()
             if w.day < no_data_horizon(today, s.lag_days, s.no_data_retry_days):
-                out.status = "no_data_final"
+                out.status = RunStatus.NO_DATA_FINAL
             else:
                 out.reason += f" (tried again for {s.no_data_retry_days} day(s) after it is due)"
             summary = {"selection": w.decisions[:50]} if w.decisions else None
             store.finish_run(run_id, out.status, out.reason, summary=summary)
-        elif w.status == "failed":
-            store.finish_run(run_id, "failed", w.reason)
+        elif w.status == RunStatus.FAILED:
+            store.finish_run(run_id, RunStatus.FAILED, w.reason)
             store.add_event(EventKind.RUN_FAILED, w.satellite, {"day": w.day.isoformat(), "reason": w.reason})
         else:
             store.finish_run(run_id, w.status, w.reason)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from monitor.pipeline import DayWork, ProgressLines, compute_day, record_day
 from monitor.service import InstanceLock
 from monitor.sources import make_source
-from monitor.store.sqlite import Store
+from monitor.store.sqlite import RunStatus, Store
 
 LOG = logging.getLogger(__name__)
 
@@ -111,7 +111,7 @@ def reprocess(
         store.interrupt_stale_runs()
         todo = []
         for sat in satellites:
-            ok = {r.day for r in store.runs(sat) if r.status == "ok"}  # YYYY-MM-DD
+            ok = {r.day for r in store.runs(sat) if r.status == RunStatus.OK}  # YYYY-MM-DD
             for day in period_days(since, until):
                 summary.planned += 1
                 if day.isoformat() in ok and not force:
@@ -137,7 +137,9 @@ def reprocess(
                     try:
                         work = fut.result()
                     except Exception as exc:  # noqa: BLE001 - a worker lost or crashed: the day failed
-                        work = DayWork(sat, day, "failed", f"worker: {type(exc).__name__}: {exc}"[:1000])
+                        work = DayWork(
+                            sat, day, RunStatus.FAILED, f"worker: {type(exc).__name__}: {exc}"[:1000]
+                        )
                     out = record_day(cfg, store, store.begin_run(sat, day), work)
                     summary.statuses[out.status] = summary.statuses.get(out.status, 0) + 1
                     LOG.info("%s", out.summary())

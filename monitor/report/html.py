@@ -31,6 +31,7 @@ from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
 from monitor.store.alerts import AlertState
+from monitor.store.sqlite import RunStatus
 
 UTC = dt.timezone.utc
 CSS = """
@@ -270,7 +271,7 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     figures = {"latest_km.png", "latest_urad.png", "heatmap.png", "trend.png"}
     if stored is not None and worst is not None:
         cube, step = stored
-        runs = [r for r in store.runs(satellite) if r.day == latest.isoformat() and r.status == "ok"]
+        runs = [r for r in store.runs(satellite) if r.day == latest.isoformat() and r.status == RunStatus.OK]
         plots.cost_contour(
             sat_dir / "cost.png",
             np.asarray(cube[worst.for_index - 1], float),

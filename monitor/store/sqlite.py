@@ -15,6 +15,7 @@ import enum
 import json
 import sqlite3
 from dataclasses import dataclass
+from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
@@ -134,24 +135,38 @@ class Event:
         return cls(r["id"], r["time"], EventKind(r["kind"]), r["satellite"], detail)
 
 
+class RunStatus(StrEnum):
+    """The status of a run in the ledger (the string stored)."""
+
+    RUNNING = "running"
+    OK = "ok"  # results stored
+    NO_DATA = "no_data"  # nothing to assess yet: tried again for schedule.no_data_retry_days
+    NO_DATA_FINAL = "no_data_final"  # nothing to assess, for good
+    FAILED = "failed"
+    INTERRUPTED = "interrupted"  # a stop request or a killed process: redone at the next run
+
+
+DONE = (RunStatus.OK, RunStatus.NO_DATA, RunStatus.NO_DATA_FINAL)  # a day with one of these is not redone
+
+
 @dataclass(frozen=True)
 class Run:
-    """One run of the ledger: *status* is running, ok, no_data, no_data_final, failed or interrupted; times
-    ISO 8601 UTC (*finished* None while running); *day* YYYY-MM-DD."""
+    """One run of the ledger; times ISO 8601 UTC (*finished* None while running); *day* YYYY-MM-DD."""
 
     id: int
     satellite: str
     day: str
     started: str
     finished: str | None
-    status: str
+    status: RunStatus
     reason: str | None
     n_granules: int
     summary: str | None
 
     @classmethod
     def from_row(cls, r) -> "Run":
-        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
+        row = {k: r[k] for k in cls.__dataclass_fields__}
+        return cls(**{**row, "status": RunStatus(row["status"])})
 
 
 class StoreError(RuntimeError):
@@ -246,15 +261,15 @@ class Store:
         """Open a run of *satellite* on *day* in the ledger (status running); its id."""
         with self.transaction():
             cur = self.db.execute(
-                "INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, 'running')",
-                (satellite, day.isoformat(), now_iso()),
+                "INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, ?)",
+                (satellite, day.isoformat(), now_iso(), RunStatus.RUNNING),
             )
             return cur.lastrowid
 
     def finish_run(
         self,
         run_id: int,
-        status: str,
+        status: RunStatus,
         reason: str | None = None,
         n_granules: int = 0,
         summary: dict | None = None,
@@ -273,9 +288,8 @@ class Store:
         """Mark runs left 'running' by a killed process as 'interrupted'; returns how many."""
         with self.transaction():
             cur = self.db.execute(
-                "UPDATE runs SET status='interrupted', finished=?, "
-                "reason='process ended during the run' WHERE status='running'",
-                (now_iso(),),
+                "UPDATE runs SET status=?, finished=?, reason='process ended during the run' WHERE status=?",
+                (RunStatus.INTERRUPTED, now_iso(), RunStatus.RUNNING),
             )
             return cur.rowcount
 
@@ -283,14 +297,13 @@ class Store:
         """Days with a completed run: results stored, or no data for good. A plain ``no_data`` day counts
         as done only before *no_data_final_before* (None: always); later ones are tried again."""
         rows = self.db.execute(
-            "SELECT DISTINCT day, status FROM runs WHERE satellite=? "
-            "AND status IN ('ok', 'no_data', 'no_data_final')",
-            (satellite,),
+            "SELECT DISTINCT day, status FROM runs WHERE satellite=? AND status IN (?, ?, ?)",
+            (satellite, *DONE),
         )
         out = set()
         for day, status in rows:
             d = dt.date.fromisoformat(day)
-            if status != "no_data" or no_data_final_before is None or d < no_data_final_before:
+            if status != RunStatus.NO_DATA or no_data_final_before is None or d < no_data_final_before:
                 out.add(d)
         return out
 
@@ -318,8 +331,9 @@ class Store:
         return {
             r[0]: dt.datetime.fromisoformat(r[1])
             for r in self.db.execute(
-                "SELECT satellite, MAX(finished) FROM runs WHERE status='ok' AND finished IS NOT NULL GROUP "
-                "BY satellite"
+                "SELECT satellite, MAX(finished) FROM runs WHERE status=? AND finished IS NOT NULL GROUP "
+                "BY satellite",
+                (RunStatus.OK,),
             )
         }
 
@@ -422,7 +436,7 @@ class Store:
                     )
             self._finish(
                 run_id,
-                "ok",
+                RunStatus.OK,
                 None,
                 len(result.granules),
                 {
