@@ -96,6 +96,7 @@ def run_bench(args) -> int:
             t = timings.get(stage, 0.0)
             print(f"  {stage:<12} {t:8.2f} s  {n_fov / t if t else float('inf'):10.0f} FOVs/s")
         print(f"  {'total':<12} {wall:8.2f} s  {n_fov / wall:10.0f} FOVs/s")
+        print("(the next granule is read in a thread while one is computed: the stages add up to more)")
         print(f"peak memory: {peak_rss_mb():.0f} MB ({args.workers} threads in one process)")
         if sim_counted:
             print("(the main process's peak includes the simulation: this system cannot reset the count)")
