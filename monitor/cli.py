@@ -408,6 +408,13 @@ def cmd_export(args) -> int:
     return EXIT_OK
 
 
+def _satellites(cfg, satellite: str | None) -> list[str]:
+    """The configured satellites, or the one asked for (which must be configured)."""
+    if satellite and satellite not in cfg.satellites:
+        raise BadInput(f"satellite {satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")
+    return [satellite] if satellite else list(cfg.satellites)
+
+
 @command(
     "run",
     "one run of the daily job (the missed days, or --date), then exit",
@@ -421,11 +428,7 @@ def cmd_run(args) -> int:
     from monitor.store.sqlite import RunStatus
 
     cfg = _load(args)
-    sats = [args.satellite] if args.satellite else cfg.satellites
-    if args.satellite and args.satellite not in cfg.satellites:
-        raise BadInput(
-            f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})"
-        )
+    sats = _satellites(cfg, args.satellite)
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm
@@ -470,11 +473,7 @@ def cmd_reprocess(args) -> int:
     from monitor.store.sqlite import RunStatus
 
     cfg = _load(args)
-    sats = [args.satellite] if args.satellite else cfg.satellites
-    if args.satellite and args.satellite not in cfg.satellites:
-        raise BadInput(
-            f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})"
-        )
+    sats = _satellites(cfg, args.satellite)
     if args.until < args.since:
         raise BadInput(f"--until {args.until} is before --since {args.since}")
     if args.workers < 1:
@@ -807,10 +806,7 @@ def cmd_report(args) -> int:
     from monitor.store.sqlite import Store
 
     cfg = _load(args)
-    if args.satellite and args.satellite not in cfg.satellites:
-        raise BadInput(
-            f"satellite {args.satellite!r} is not in the configuration ({', '.join(cfg.satellites)})"
-        )
+    _satellites(cfg, args.satellite)
     if args.since and args.until and args.since > args.until:
         raise BadInput(f"--since {args.since} is after --until {args.until}")
     try:
