@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import datetime as dt
 import itertools
-import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -111,13 +110,13 @@ def metadata_changes(store, satellite: str) -> list[Change]:
     """Changes of LUTs and SDR software between consecutive days of stored granule metadata."""
     days = {}
     for g in store.granules(satellite):
-        d = days.setdefault(g["day"], {"cris": set(), "viirs": set(), "cris_sw": set(), "viirs_sw": set()})
-        d["cris"].update(json.loads(g["cris_aux"] or "[]"))
-        d["viirs"].update(json.loads(g["viirs_aux"] or "[]"))
-        if g["software_version"]:
-            d["cris_sw"].add(f"{g['software_version']} / algorithm {g['algorithm_version']}")
-        if g["viirs_software"]:
-            d["viirs_sw"].add(g["viirs_software"])
+        d = days.setdefault(g.day, {"cris": set(), "viirs": set(), "cris_sw": set(), "viirs_sw": set()})
+        d["cris"].update(g.cris_aux)
+        d["viirs"].update(g.viirs_aux)
+        if g.software_version:
+            d["cris_sw"].add(f"{g.software_version} / algorithm {g.algorithm_version}")
+        if g.viirs_software:
+            d["viirs_sw"].add(g.viirs_software)
     out = []
     ordered = sorted(days)
     for prev, cur in itertools.pairwise(ordered):

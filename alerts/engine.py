@@ -82,7 +82,7 @@ def build_message(store, satellite: str, items: list, settings) -> dict:
         grans = store.granules(satellite, day)
         text.append(
             f"assessment of {day}: {len(grans)} granule pair(s): "
-            + ", ".join(g["granule_id"] for g in grans[:14])
+            + ", ".join(g.granule_id for g in grans[:14])
         )
     trend = _trend(store, satellite)
     if trend:

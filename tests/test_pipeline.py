@@ -55,7 +55,7 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
     assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
     assert store.db.execute("SELECT COUNT(DISTINCT run_id) FROM results").fetchone()[0] == 1
     decisions = store.selection("j01", DAY)
-    assert len(decisions) == 2 and all(d["decision"] == "chosen" and d["score_k"] > 0.5 for d in decisions)
+    assert len(decisions) == 2 and all(d.decision == "chosen" and d.score_k > 0.5 for d in decisions)
     assert [f.d_beta_urad for f in store.day_result("j01", DAY)] == [
         f.d_beta_urad for f in second.result.fors
     ]
@@ -99,11 +99,11 @@ def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_p
     store = Store(cfg.store.sqlite)
     out = run_day(cfg, store, LocalSource(work), "j01", DAY)
     assert out.status == "ok" and len(out.result.granules) == 1
-    rejected = [d for d in store.selection("j01", DAY) if d["decision"] == "rejected"]
+    rejected = [d for d in store.selection("j01", DAY) if d.decision == "rejected"]
     assert (
         len(rejected) == 1
-        and "unusable CrIS granule" in rejected[0]["reason"]
-        and sdr.name in rejected[0]["reason"]
+        and "unusable CrIS granule" in rejected[0].reason
+        and sdr.name in rejected[0].reason
     )
     assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
 

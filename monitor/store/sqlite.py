@@ -169,6 +169,54 @@ class Run:
         return cls(**{**row, "status": RunStatus(row["status"])})
 
 
+def _json_list(text) -> tuple:
+    return tuple(json.loads(text)) if text else ()
+
+
+@dataclass(frozen=True)
+class GranuleRow:
+    """One assessed CrIS granule as stored: its files and VIIRS cover, usable FOVs, and the processing
+    metadata (SDR software and algorithm versions, auxiliary files) that change attribution compares from
+    day to day; *day* YYYY-MM-DD, *start* ISO 8601."""
+
+    satellite: str
+    day: str
+    run_id: int
+    granule_id: str
+    start: str | None
+    cris_geo: str | None
+    cris_sdr: str | None
+    viirs: tuple[str, ...]
+    n_usable: int | None
+    software_version: str | None
+    algorithm_version: str | None
+    cris_aux: tuple[str, ...]
+    viirs_aux: tuple[str, ...]
+    viirs_software: str | None
+
+    @classmethod
+    def from_row(cls, r) -> "GranuleRow":
+        row = {k: r[k] for k in cls.__dataclass_fields__}
+        return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
+
+
+@dataclass(frozen=True)
+class SelectionRow:
+    """One scene-selection decision: the granule, its inhomogeneity score (K), kept or rejected and why."""
+
+    satellite: str
+    day: str
+    run_id: int
+    granule: str
+    score_k: float | None
+    decision: str
+    reason: str | None
+
+    @classmethod
+    def from_row(cls, r) -> "SelectionRow":
+        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
+
+
 class StoreError(RuntimeError):
     """The store file cannot be used (corrupt, empty, not a crisgeo store, too new); one line, naming it."""
 
@@ -483,19 +531,20 @@ class Store:
             args.append(until.isoformat())
         return [dict(r) for r in self.db.execute(q + " ORDER BY day, for_index", args)]
 
-    def granules(self, satellite: str, day: dt.date | None = None) -> list:
+    def granules(self, satellite: str, day: dt.date | None = None) -> list[GranuleRow]:
         """The granules assessed for *satellite* (on *day*), with their metadata."""
         q = (
             "SELECT * FROM granules WHERE satellite=?"
             + (" AND day=?" if day else "")
             + " ORDER BY day, start"
         )
-        return [dict(r) for r in self.db.execute(q, (satellite, day.isoformat()) if day else (satellite,))]
+        args = (satellite, day.isoformat()) if day else (satellite,)
+        return [GranuleRow.from_row(r) for r in self.db.execute(q, args)]
 
-    def selection(self, satellite: str, day: dt.date) -> list:
+    def selection(self, satellite: str, day: dt.date) -> list[SelectionRow]:
         """The scene-selection decisions of *satellite* on *day*."""
         return [
-            dict(r)
+            SelectionRow.from_row(r)
             for r in self.db.execute(
                 "SELECT * FROM selection WHERE satellite=? AND day=?", (satellite, day.isoformat())
             )
