@@ -1,5 +1,7 @@
 import json
 
+import pytest
+
 from monitor.cli import main
 from monitor.simulate.case import simulate_case
 from tests.conftest import tree_with_truncated
@@ -239,3 +241,19 @@ def test_under_systemd_lines_carry_no_second_timestamp(tmp_path):
     assert r.returncode == 0, r.stderr
     log = [line for line in r.stderr.splitlines() if line.strip()]
     assert log and all(line.split()[0] in ("INFO", "WARNING", "ERROR", "DEBUG") for line in log), log
+
+
+@pytest.mark.parametrize(
+    "extra,message",
+    [
+        (["--since", "2024-03-05", "--until", "2024-03-01"], "--until 2024-03-01 is before --since"),
+        (["--since", "2024-03-01", "--until", "2024-03-02", "--satellite", "npp"], "'npp' is not in"),
+        (["--since", "2024-03-01", "--until", "2024-03-02", "--workers", "0"], "--workers: 0"),
+    ],
+)
+def test_reprocess_refuses_bad_input_in_one_line(tmp_path, capsys, extra, message):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 's'}\nsource: {{kind: simulated}}\n")
+    assert main(["reprocess", "--config", str(cfg), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0]
