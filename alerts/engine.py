@@ -12,6 +12,8 @@ import html
 import json
 import logging
 
+import numpy as np
+
 from alerts.changes import all_changes
 from alerts.channels import Permanent, Transient, make_channels
 from alerts.rules import (
@@ -48,15 +50,12 @@ def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
 
 
 def _trend(store, satellite: str, days: int = 7) -> list[str]:
-    rows = store.series(satellite)
-    by_day = {}
-    for r in rows:
-        if r["total_km"] is not None:
-            by_day.setdefault(r["day"], []).append((r["total_km"], r["for_index"]))
+    series = store.series(satellite)
+    total = series.values["total_km"]
     lines = []
-    for d in sorted(by_day)[-days:]:
-        worst, k = max(by_day[d])
-        lines.append(f"{d}: worst FOR {k} total {worst:.2f} km")
+    for i in [i for i in range(len(series)) if np.isfinite(total[i]).any()][-days:]:
+        k = int(np.nanargmax(total[i]))
+        lines.append(f"{series.days[i]}: worst FOR {k + 1} total {total[i, k]:.2f} km")
     return lines
 
 

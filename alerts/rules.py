@@ -7,7 +7,6 @@ identified by rule + satellite + group, which is what the alert state tracks.
 from __future__ import annotations
 
 import datetime as dt
-import json
 import math
 from dataclasses import dataclass, field
 
@@ -15,7 +14,6 @@ import numpy as np
 
 from alerts.changes import preceding_change
 from monitor.constants import N_FOR
-from monitor.result import RELIABILITY_FLAGS
 from monitor.store.sqlite import DONE, SCHEDULER_KINDS, EventKind, RunStatus
 
 UTC = dt.timezone.utc
@@ -121,17 +119,9 @@ def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
 
 
 def _series(store, satellite: str):
-    rows = store.series(satellite)
-    days = sorted({r["day"] for r in rows})
-    index = {d: i for i, d in enumerate(days)}
-    values = {c: np.full((len(days), N_FOR), np.nan) for c, _ in COMPONENTS}
-    for r in rows:
-        if any(f in json.loads(r["flags"] or "[]") for f in RELIABILITY_FLAGS):
-            continue
-        for c, _ in COMPONENTS:
-            if r[c] is not None:
-                values[c][index[r["day"]], r["for_index"] - 1] = r[c]
-    return [dt.date.fromisoformat(d) for d in days], values
+    series = store.series(satellite)
+    reliable = series.reliable()
+    return series.days, {c: np.where(reliable, series.values[c], np.nan) for c, _ in COMPONENTS}
 
 
 def step_test(y: np.ndarray, days: list, split: dt.date, s: RuleSettings):

@@ -9,7 +9,6 @@ xarray and h5netcdf are an optional extra: ``pip install 'crisgeo-monitor[export
 from __future__ import annotations
 
 import datetime as dt
-import json
 from pathlib import Path
 
 import numpy as np
@@ -41,21 +40,13 @@ def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.dat
 
     from monitor.version import __version__
 
-    rows = store.series(satellite, since, until)
-    days = sorted({r["day"] for r in rows})
-    index = {d: i for i, d in enumerate(days)}
-    shape = (len(days), N_FOR)
-    data = {k: np.full(shape, np.nan) for k in VARIABLES}
-    n_samples = np.zeros(shape, np.int32)
-    flags = np.zeros(shape, np.int8)
-    for r in rows:
-        i, k = index[r["day"]], r["for_index"] - 1
-        for name in VARIABLES:
-            data[name][i, k] = np.nan if r[name] is None else r[name]
-        n_samples[i, k] = r["n_samples"] or 0
-        flags[i, k] = sum(FLAG_BITS[f] for f in json.loads(r["flags"] or "[]") if f in FLAG_BITS)
+    series = store.series(satellite, since, until)
+    data = {k: series.values[k] for k in VARIABLES}
+    n_samples = series.values["n_samples"].astype(np.int32)
+    bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int8])
+    flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
     coords = {
-        "time": np.array([np.datetime64(d, "ns") for d in days], dtype="datetime64[ns]"),
+        "time": np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]"),
         "for": np.arange(1, N_FOR + 1, dtype=np.int16),
     }
     ds = xr.Dataset(

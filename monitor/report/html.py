@@ -26,7 +26,6 @@ from pathlib import Path
 import numpy as np
 
 from alerts.changes import all_changes
-from monitor.constants import N_FOR
 from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
@@ -89,19 +88,6 @@ def _page(title: str, body: str) -> str:
 
 def _f(v, fmt):
     return "" if v is None or (isinstance(v, float) and not np.isfinite(v)) else format(v, fmt)
-
-
-def _series_arrays(rows):
-    """(days, {field: (ndays, 30) array}) from the store's per-FOR rows; missing values NaN."""
-    days = sorted({r["day"] for r in rows})
-    index = {d: i for i, d in enumerate(days)}
-    names = ("in_track_km", "cross_track_km", "total_km")
-    out = {n: np.full((len(days), N_FOR), np.nan) for n in names}
-    for r in rows:
-        for n in names:
-            if r[n] is not None:
-                out[n][index[r["day"]], r["for_index"] - 1] = r[n]
-    return [dt.date.fromisoformat(d) for d in days], out
 
 
 def _latest_table(fors, spec_km) -> str:
@@ -169,7 +155,7 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
     sat_dir = out / satellite
     sat_dir.mkdir(parents=True, exist_ok=True)
     name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
-    rows = store.series(satellite, opts.since, opts.until)
+    series = store.series(satellite, opts.since, opts.until)
     changes = [
         c
         for c in all_changes(store, satellite, opts.calendar)
@@ -195,14 +181,14 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
         "firing": len(firing),
         "days": 0,
     }
-    if not rows:
+    if not len(series):
         parts.append("<p>No assessment in the store for this period yet.</p>")
         parts.append("<h2>Active alerts</h2>" + _alerts_table(firing))
         parts.append("<h2>Known changes</h2>" + _changes_table(changes))
         _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))
         _drop_figures_except(sat_dir, set())
         return summary
-    days, arrays = _series_arrays(rows)
+    days, arrays = series.days, series.values
     latest = days[-1]
     fors = store.day_result(satellite, latest)
     reliable = [f.reliable for f in fors]

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.result import MEASURED_FIELDS, AssessmentResult, ForOffset
+from monitor.constants import N_FOR
+from monitor.result import MEASURED_FIELDS, RELIABILITY_FLAGS, AssessmentResult, ForOffset
 
 UTC = dt.timezone.utc
 
@@ -167,6 +168,26 @@ class Run:
     def from_row(cls, r) -> "Run":
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, "status": RunStatus(row["status"])})
+
+
+@dataclass(frozen=True)
+class ForSeries:
+    """The per-FOR results of one satellite over days, as arrays: *days* ascending (dates); *values* per
+    measured field an array (days, N_FOR), NaN where nothing is stored (n_samples 0); *flags* a
+    (days, N_FOR) object array of flag-name tuples; *stored* where a result is."""
+
+    days: list
+    values: dict
+    flags: np.ndarray
+    stored: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.days)
+
+    def reliable(self) -> np.ndarray:
+        """(days, N_FOR): a stored FOR without any of the reliability flags."""
+        flagged = np.vectorize(lambda f: bool(set(f) & set(RELIABILITY_FLAGS)), otypes=[bool])(self.flags)
+        return self.stored & ~flagged if self.flags.size else self.stored
 
 
 def _json_list(text) -> tuple:
@@ -519,8 +540,8 @@ class Store:
 
         return to_xarray(self, satellite, since, until)
 
-    def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> list:
-        """The per-FOR result rows of *satellite* between *since* and *until*, by day and FOR."""
+    def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> ForSeries:
+        """The per-FOR results of *satellite* from *since* to *until* (both included) as arrays."""
         q = "SELECT * FROM results WHERE satellite=?"
         args = [satellite]
         if since:
@@ -529,7 +550,23 @@ class Store:
         if until:
             q += " AND day <= ?"
             args.append(until.isoformat())
-        return [dict(r) for r in self.db.execute(q + " ORDER BY day, for_index", args)]
+        rows = self.db.execute(q + " ORDER BY day, for_index", args).fetchall()
+        days = sorted({r["day"] for r in rows})
+        index = {d: i for i, d in enumerate(days)}
+        shape = (len(days), N_FOR)
+        values = {k: np.full(shape, np.nan) for k in RESULT_FIELDS if k != "n_samples"}
+        values["n_samples"] = np.zeros(shape, np.int64)
+        flags = np.empty(shape, object)
+        flags.fill(())
+        stored = np.zeros(shape, bool)
+        for r in rows:
+            at = (index[r["day"]], r["for_index"] - 1)
+            for k in values:
+                if r[k] is not None:
+                    values[k][at] = r[k]
+            flags[at] = tuple(json.loads(r["flags"] or "[]"))
+            stored[at] = True
+        return ForSeries([dt.date.fromisoformat(d) for d in days], values, flags, stored)
 
     def granules(self, satellite: str, day: dt.date | None = None) -> list[GranuleRow]:
         """The granules assessed for *satellite* (on *day*), with their metadata."""
