@@ -26,14 +26,13 @@ The j run of an interval [t_lo, t_hi] is found by comparing with the FOV's tan B
 from __future__ import annotations
 
 import math
-import threading
 
 import numba
 import numpy as np
 
 from monitor.constants import FOV_DIAMETER_RAD, MAX_GRID_SPREAD_RAD
 from monitor.geometry import wgs84
-from monitor.swath import BLOCK_PX, DETECTORS, SwathPiece, ViirsSwath
+from monitor.swath import BLOCK_PX, DETECTORS, KERNEL_LOCK, SwathPiece, ViirsSwath
 
 TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)
 # CrIS spatial response as a staircase of concentric top hats, from the 70/50/10/3 % full widths of
@@ -43,7 +42,6 @@ SPATIAL_RESPONSE = tuple(
     (np.radians(r), c) for r, c in ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065))
 )
 MIN_COVERAGE = 0.97
-_PARALLEL = threading.Lock()  # numba's default (workqueue) threading layer runs one parallel region at a time
 
 
 def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
@@ -242,7 +240,7 @@ def cone_sums(
         hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, rho)
         # a FOV whose cones cannot reach this granule's nearest usable block skips it
         far = ~ok_fov | (dist > reach_m + 2 * BLOCK_PX * piece.col_spacing_m[col0] + piece.advance_m[col0])
-        with _PARALLEL:
+        with KERNEL_LOCK:
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
                 sat_m, mat, los0, reach0, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,

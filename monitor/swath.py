@@ -24,6 +24,7 @@ runs scan by scan in parallel; only the one-scan statistics and the KD-tree are 
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 
 import numba
@@ -36,6 +37,9 @@ from monitor.geometry import wgs84
 DETECTORS = 32  # VIIRS I-band detectors per scan
 BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
 SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smallest within +-200 columns
+# numba's default (workqueue) threading layer runs one parallel region at a time in a process: every
+# parallel kernel launch takes this lock (the daemon may assess two satellites in two threads)
+KERNEL_LOCK = threading.Lock()
 
 
 @dataclass
@@ -289,21 +293,9 @@ def swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band, before=None, after
     have = np.zeros(nscan + 2, bool)
     have[1:-1] = True
     t_min, t_step, table = band.radiance_table
-    _locate(
-        lat,
-        lon,
-        h,
-        np.ascontiguousarray(bt_k, f32),
-        np.ascontiguousarray(good, bool),
-        table,
-        t_min,
-        t_step,
-        pos,
-        radiance,
-        first,
-        last,
-        step,
-    )
+    bt, good = np.ascontiguousarray(bt_k, f32), np.ascontiguousarray(good, bool)
+    with KERNEL_LOCK:
+        _locate(lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, first, last, step)
     for slot, halo in ((0, before), (nscan + 1, after)):
         if halo is not None:
             hp = np.empty(np.shape(halo[0]) + (3,), f32)
@@ -313,7 +305,8 @@ def swath_piece(lat_rad, lon_rad, height_m, bt_k, good, band, before=None, after
     area = np.empty((rows, cols, 3), f32)
     centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
     radius = np.empty(centre.shape[:2])
-    _weigh(pos, radiance, first, last, step, have, area, centre, radius)
+    with KERNEL_LOCK:
+        _weigh(pos, radiance, first, last, step, have, area, centre, radius)
     located = np.isfinite(radiance)
     max_height = float(np.max(h, where=located, initial=0.0))
 

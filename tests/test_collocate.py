@@ -1,5 +1,7 @@
 """The compiled interval formulation of the cone test against a brute-force angle test on every pixel."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -276,3 +278,44 @@ def test_a_grid_beyond_the_kernels_reach_is_refused(scene):
 def test_warm_up_compiles_the_kernels():
     assert collocate.warm_up() >= 0
     assert collocate._accumulate.signatures and swath._weigh.signatures and swath._locate.signatures
+
+
+def _two_threads():
+    """Prepare and collocate in two threads at once, five times each; the results must agree."""
+    import threading
+
+    viirs, sat, sbf = _synthetic(20.0, 30.0, 7)
+    offsets = perturbation_grid(3, 450e-6)
+    out, errors = [], []
+
+    def work():
+        try:
+            for _ in range(5):
+                _synthetic(20.0, 30.0, 7)  # the preparation kernels
+                mean, _ = collocate.cone_sums(viirs, sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
+                out.append(mean)
+        except Exception as exc:  # noqa: BLE001 - reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=work) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors and len(out) == 10
+    assert all(np.array_equal(o, out[0], equal_nan=True) for o in out)
+
+
+def test_two_threads_may_assess_at_once():
+    """The daemon may run two satellites' jobs in two threads. Under numba's workqueue threading layer
+    (the one left where neither OpenMP nor TBB is installed) concurrent parallel regions terminate the
+    process, unless every launch takes swath.KERNEL_LOCK: run it there, in a process of its own."""
+    import os
+    import subprocess
+    import sys
+
+    code = "from tests.test_collocate import _two_threads; _two_threads(); print('both threads done')"
+    env = dict(os.environ, NUMBA_THREADING_LAYER="workqueue")
+    root = Path(__file__).resolve().parent.parent
+    r = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True)
+    assert r.returncode == 0 and "both threads done" in r.stdout, r.stderr[-2000:]
