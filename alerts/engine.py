@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import datetime as dt
 import html
-import json
 import logging
 
 import numpy as np
@@ -176,26 +175,26 @@ def deliver(store, settings, now: dt.datetime | None = None, channels=None) -> d
     channels = channels if channels is not None else make_channels(settings)
     counts = {"sent": 0, "retry": 0, "failed": 0}
     for d in state.due(now):
-        if not state.claim(d["id"], now):
+        if not state.claim(d.id, now):
             continue  # another process is sending it
-        ch = channels.get(d["channel"])
+        ch = channels.get(d.channel)
         if ch is None:
-            state.mark(d["id"], "failed", now, f"channel {d['channel']} is no longer configured")
+            state.mark(d.id, "failed", now, f"channel {d.channel} is no longer configured")
             counts["failed"] += 1
             continue
         try:
-            ch.send(json.loads(d["body"]))
+            ch.send(d.body)
         except Transient as exc:
-            wait = max(exc.retry_after_s, 60.0 * min(2 ** d["attempts"], 60))
-            state.mark(d["id"], "pending", now, str(exc), retry_after_s=wait)
-            LOG.warning("alert delivery via %s postponed: %s", d["channel"], exc)
+            wait = max(exc.retry_after_s, 60.0 * min(2 ** d.attempts, 60))
+            state.mark(d.id, "pending", now, str(exc), retry_after_s=wait)
+            LOG.warning("alert delivery via %s postponed: %s", d.channel, exc)
             counts["retry"] += 1
         except Permanent as exc:
-            state.mark(d["id"], "failed", now, str(exc))
-            LOG.error("alert delivery via %s failed (configuration error): %s", d["channel"], exc)
+            state.mark(d.id, "failed", now, str(exc))
+            LOG.error("alert delivery via %s failed (configuration error): %s", d.channel, exc)
             counts["failed"] += 1
         else:
-            state.mark(d["id"], "sent", now)
+            state.mark(d.id, "sent", now)
             counts["sent"] += 1
     return counts
 
@@ -234,7 +233,10 @@ def alerts_view(store, now: dt.datetime) -> dict:
                 "lines": r.lines,
             }
         )
-    silences = [{k: s[k] for k in ("rule", "satellite", "until", "reason")} for s in state.silences(now)]
+    silences = [
+        {"rule": s.rule, "satellite": s.satellite, "until": s.until, "reason": s.reason}
+        for s in state.silences(now)
+    ]
     return {"alerts": alerts, "silences": silences, "pending_deliveries": len(state.deliveries("pending"))}
 
 

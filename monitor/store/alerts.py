@@ -36,6 +36,45 @@ class Alert:
         return cls(**d)
 
 
+@dataclass(frozen=True)
+class Silence:
+    """A silence: *rule* and *satellite* (None: all) are quiet until *until* (ISO 8601 UTC), for *reason*."""
+
+    id: int
+    rule: str | None
+    satellite: str | None
+    until: str
+    reason: str
+    created: str | None
+
+    @classmethod
+    def from_row(cls, r) -> "Silence":
+        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
+
+
+@dataclass(frozen=True)
+class Delivery:
+    """A queued notification: *body* the message (subject, text, ...), *status* pending, sending, sent or
+    failed, after *attempts* tries; times ISO 8601 UTC."""
+
+    id: int
+    channel: str
+    satellite: str | None
+    subject: str
+    body: dict
+    created: str
+    status: str
+    attempts: int
+    next_attempt: str | None
+    last_error: str | None
+    sent: str | None
+
+    @classmethod
+    def from_row(cls, r) -> "Delivery":
+        d = {k: r[k] for k in cls.__dataclass_fields__}
+        return cls(**{**d, "body": json.loads(d["body"]), "attempts": int(d["attempts"] or 0)})
+
+
 class AlertState:
     """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries."""
 
@@ -99,19 +138,19 @@ class AlertState:
                 (rule, satellite, iso(until), reason, iso(now)),
             )
 
-    def silenced(self, rule: str, satellite: str, now: dt.datetime) -> dict | None:
+    def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None:
         """The silence in force for *rule* and *satellite* at *now*, or None."""
         r = self.db.execute(
             "SELECT * FROM silences WHERE until > ? AND (rule IS NULL OR rule=?) "
             "AND (satellite IS NULL OR satellite=?) ORDER BY until DESC",
             (iso(now), rule, satellite),
         ).fetchone()
-        return dict(r) if r else None
+        return Silence.from_row(r) if r else None
 
-    def silences(self, now: dt.datetime) -> list:
+    def silences(self, now: dt.datetime) -> list[Silence]:
         """The silences in force at *now*."""
         return [
-            dict(r)
+            Silence.from_row(r)
             for r in self.db.execute("SELECT * FROM silences WHERE until > ? ORDER BY until", (iso(now),))
         ]
 
@@ -124,11 +163,11 @@ class AlertState:
             (channel, satellite, message["subject"], json.dumps(message), iso(now), iso(now)),
         )
 
-    def due(self, now: dt.datetime) -> list:
+    def due(self, now: dt.datetime) -> list[Delivery]:
         """Deliveries to try now: pending ones whose time has come, and claims whose lease ran out (a
         sender that died mid-send)."""
         return [
-            dict(r)
+            Delivery.from_row(r)
             for r in self.db.execute(
                 "SELECT * FROM deliveries WHERE status IN ('pending', 'sending') AND next_attempt <= ? "
                 "ORDER BY id",
@@ -149,10 +188,10 @@ class AlertState:
             )
             return cur.rowcount == 1
 
-    def deliveries(self, status: str | None = None) -> list:
+    def deliveries(self, status: str | None = None) -> list[Delivery]:
         """The queued deliveries (with *status*: pending, sending, sent, failed), oldest first."""
         q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"
-        return [dict(r) for r in self.db.execute(q, (status,) if status else ())]
+        return [Delivery.from_row(r) for r in self.db.execute(q, (status,) if status else ())]
 
     def mark(
         self,

@@ -153,7 +153,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
         t.join()
     assert len(webhook.received) == 1 and sorted(c["sent"] for c in counts) == [0, 1]
     s = Store(path)
-    assert [d["status"] for d in AlertState(s).deliveries()] == ["sent"]
+    assert [d.status for d in AlertState(s).deliveries()] == ["sent"]
 
 
 def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):

@@ -99,7 +99,7 @@ def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp
     assert len(webhook.received) == 1
     store = Store(service.cfg.store.sqlite)
     (pending,) = AlertState(store).deliveries("pending")
-    assert "503" in pending["last_error"]
+    assert "503" in pending.last_error
     later = dt.datetime.now(dt.timezone.utc) + dt.timedelta(hours=2)
     assert deliver(store, service.cfg.alert_settings, later)["sent"] == 1
     assert deliver(store, service.cfg.alert_settings, later)["sent"] == 0  # not twice

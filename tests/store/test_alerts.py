@@ -27,10 +27,10 @@ def test_silence_matches_rule_and_satellite_until_it_ends(tmp_path):
     with Store(tmp_path / "s.sqlite") as store:
         state = AlertState(store)
         state.silence("jump", None, T0 + dt.timedelta(hours=2), "EP upload", T0)
-        assert state.silenced("jump", "j01", T0 + dt.timedelta(hours=1))["reason"] == "EP upload"
+        assert state.silenced("jump", "j01", T0 + dt.timedelta(hours=1)).reason == "EP upload"
         assert state.silenced("spec", "j01", T0 + dt.timedelta(hours=1)) is None
         assert state.silenced("jump", "j01", T0 + dt.timedelta(hours=3)) is None
-        assert [s["reason"] for s in state.silences(T0)] == ["EP upload"]
+        assert [s.reason for s in state.silences(T0)] == ["EP upload"]
 
 
 def test_a_delivery_is_claimed_once_and_retried_after_its_lease(tmp_path):
@@ -38,11 +38,11 @@ def test_a_delivery_is_claimed_once_and_retried_after_its_lease(tmp_path):
         state = AlertState(store)
         state.enqueue("slack", "j01", {"subject": "s", "text": "t"}, T0)
         (d,) = state.due(T0)
-        assert state.claim(d["id"], T0) and not state.claim(d["id"], T0)  # a second sender gets nothing
+        assert state.claim(d.id, T0) and not state.claim(d.id, T0)  # a second sender gets nothing
         assert state.due(T0 + dt.timedelta(seconds=599)) == []
-        assert [x["id"] for x in state.due(T0 + dt.timedelta(seconds=601))] == [d["id"]]  # the sender died
-        state.mark(d["id"], "sent", T0)
-        assert state.deliveries("sent")[0]["attempts"] == 1 and state.due(T0 + dt.timedelta(days=1)) == []
+        assert [x.id for x in state.due(T0 + dt.timedelta(seconds=601))] == [d.id]  # the sender died
+        state.mark(d.id, "sent", T0)
+        assert state.deliveries("sent")[0].attempts == 1 and state.due(T0 + dt.timedelta(days=1)) == []
 
 
 def test_a_store_of_schema_2_with_the_old_alert_tables_keeps_its_alerts(tmp_path):
