@@ -185,7 +185,7 @@ def deliver(store, settings, now: dt.datetime | None = None, channels=None) -> d
         try:
             ch.send(d.body)
         except Transient as exc:
-            wait = max(exc.retry_after_s, 60.0 * min(2 ** d.attempts, 60))
+            wait = max(exc.retry_after_s, 60.0 * min(2**d.attempts, 60))
             state.mark(d.id, "pending", now, str(exc), retry_after_s=wait)
             LOG.warning("alert delivery via %s postponed: %s", d.channel, exc)
             counts["retry"] += 1
