@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from alerts.changes import preceding_change
-from monitor.constants import N_FOR
+from monitor.constants import N_FOR, SPEC_KM
 from monitor.store.sqlite import DONE, SCHEDULER_KINDS, EventKind, RunStatus
 
 UTC = dt.timezone.utc
@@ -30,7 +30,7 @@ GROUPS = {
 class RuleSettings:
     """The rule parameters (docs/configuration.md, alerts.*)."""
 
-    spec_km: float = 1.5
+    spec_km: float = SPEC_KM
     min_jump_km: float = 0.25
     jump_z: float = 5.0  # blind search, any day of the recent window
     jump_z_at_change: float = 3.5  # at the date of a known change

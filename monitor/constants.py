@@ -10,6 +10,8 @@ N_FOV = 9  # CrIS fields of view per FOR (3 x 3)
 FOV_DIAMETER_URAD = 16807.5  # CrIS FOV size, 0.963 deg (Wang et al. 2017; the EP files carry 16808)
 FOV_DIAMETER_RAD = FOV_DIAMETER_URAD * URAD
 
+SPEC_KM = 1.5  # the CrIS geolocation specification (each of in-track and cross-track), km
+
 VIIRS_I_PIXEL_M = 375.0  # VIIRS I-band pixel at nadir
 REFERENCE_ALTITUDE_M = 833000.0  # the JPSS orbit altitude the paper's grid step is defined at
 DEFAULT_STEP_RAD = VIIRS_I_PIXEL_M / REFERENCE_ALTITUDE_M  # one I-band pixel seen from 833 km, ~450 urad

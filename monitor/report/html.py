@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from alerts.changes import all_changes
+from monitor.constants import SPEC_KM
 from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
@@ -48,7 +49,7 @@ img{max-width:100%;border:1px solid #eee;margin:0.3em 0}.note{color:#666;font-si
 class ReportOptions:
     """What the report shows: satellites, period, calendar, specification, FORs over time."""
 
-    spec_km: float = 1.5
+    spec_km: float = SPEC_KM
     trend_fors: tuple = (1, 15, 30)
     since: dt.date | None = None
     until: dt.date | None = None
