@@ -23,7 +23,6 @@ from monitor.version import __version__
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
-NAGIOS_OK, NAGIOS_WARNING, NAGIOS_CRITICAL, NAGIOS_UNKNOWN = 0, 1, 2, 3
 DEFAULT_CONFIG = "/etc/crisgeo/monitor.yaml"
 
 
@@ -521,44 +520,6 @@ def cmd_daemon(args) -> int:
     return EXIT_OK
 
 
-def status_report(cfg, store) -> dict:
-    """What ``crisgeo status`` shows, as data: per satellite the last run, the latest per-FOR offsets and
-    the alerts firing; the next run; the outbox size; and the Nagios state of it all."""
-    from monitor.service import next_run
-    from monitor.store.alerts import AlertState
-    from monitor.store.sqlite import RunStatus
-
-    runs = {r.satellite: r for r in store.last_runs()}
-    firing = AlertState(store).firing()
-    sats = {}
-    for sat in cfg.satellites:
-        r = runs.get(sat)
-        day = store.latest_day(sat)
-        sats[sat] = {
-            "last_run": None
-            if r is None
-            else {k: getattr(r, k) for k in ("day", "status", "finished", "reason")},
-            "latest_day": None if day is None else str(day),
-            "fors": [] if day is None else [f.to_dict() for f in store.day_result(sat, day)],
-            "alerts": [
-                {k: getattr(a, k) for k in ("rule", "severity", "summary", "started")}
-                for a in firing
-                if a.satellite == sat
-            ],
-        }
-    critical = any(a.severity == "critical" for a in firing) or any(
-        s["last_run"] and s["last_run"]["status"] == RunStatus.FAILED for s in sats.values()
-    )
-    state = NAGIOS_CRITICAL if critical else NAGIOS_WARNING if firing else NAGIOS_OK
-    return {
-        "state": ["OK", "WARNING", "CRITICAL"][state],
-        "exit": state,
-        "satellites": sats,
-        "next_run_utc": f"{next_run(cfg.schedule):%Y-%m-%dT%H:%MZ}",
-        "outbox": store.outbox_size(),
-    }
-
-
 @command(
     "status",
     "last run per satellite, latest per-FOR table, next run, outbox size",
@@ -570,6 +531,7 @@ def cmd_status(args) -> int:
     import json
 
     from monitor.config import ConfigError
+    from monitor.status import NAGIOS_UNKNOWN, status_report
     from monitor.store.sqlite import Store, StoreError
 
     try:
@@ -712,52 +674,29 @@ def cmd_fingerprint(args) -> int:
     import json
 
     from monitor import fingerprint as fpr
-    from monitor.sdr import GranuleError, read_file
-    from monitor.sdr.pairing import PlanError, find_files
+    from monitor.errors import DataError
 
     try:
-        files = find_files(args.paths)
-    except PlanError as exc:
+        fp = fpr.fingerprint_files(args.paths, args.ep_library or [], args.threshold_urad)
+    except DataError as exc:
         raise BadInput(str(exc)) from None
-    prints, skipped = [], []
-    for f in files:
-        try:
-            for g in read_file(f, kinds=("cris_geo",)):
-                prints.append(fpr.granule_print(g))
-        except GranuleError as exc:
-            skipped.append(str(exc))
-    if not prints:
-        raise BadInput("no readable CrIS GEO granule" + (f" ({skipped[0]})" if skipped else ""))
-    prints.sort(key=lambda p: p.start)
-    day = fpr.day_print(prints)
-    from monitor.mapping.engpkt import load_library
-
-    library, problems = load_library(args.ep_library or [])
-    matches = fpr.identify_ep(day, library, _geo_platform(files))
-    change = fpr.detect_change(prints, args.threshold_urad)
     if args.json:
-        doc = day.to_dict()
-        doc["skipped"] = skipped
-        doc["change_within"] = (
-            None if change is None else {"first_granule": change.granule, "fors": change.fors}
-        )
-        doc["ep_match"] = [m.to_dict() for m in matches]
-        doc["ep_library_problems"] = problems
-        print(json.dumps(doc, indent=1))
+        print(json.dumps(fp.to_dict(), indent=1))
     else:
-        print(fpr.format_print(day))
-        for s in skipped:
+        print(fpr.format_print(fp.day))
+        for s in fp.skipped:
             print(f"skipped {s}")
+        c = fp.change
         print(
             "no step within these granules"
-            if change is None
-            else f"step from granule {change.granule} at FOR {', '.join(map(str, change.fors))}"
+            if c is None
+            else f"step from granule {c.granule} at FOR {', '.join(map(str, c.fors))}"
         )
-        print(fpr.format_matches(matches))
-        for p in problems:
+        print(fpr.format_matches(fp.matches))
+        for p in fp.problems:
             print(f"EP library: {p}")
     if args.write_residuals:
-        _write_residuals(args, day, matches, library)
+        _write_residuals(args, fp.day, fp.matches, fp.library)
     return EXIT_OK
 
 
@@ -779,13 +718,6 @@ def _write_residuals(args, day, matches, library):
         f"{args.write_residuals}",
         file=sys.stderr if args.json else sys.stdout,
     )
-
-
-def _geo_platform(files):
-    from monitor.sdr.names import parse_name
-
-    platforms = {parsed.platform for parsed in map(parse_name, (Path(f).name for f in files)) if parsed}
-    return platforms.pop() if len(platforms) == 1 else None
 
 
 @command(

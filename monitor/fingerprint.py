@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor.constants import URAD
+from monitor.errors import DataError
 from monitor.geometry.instrument import FOV5, fov5_angles
 from monitor.geometry.inverse import granule_geometry
 
@@ -317,3 +318,52 @@ def format_print(day: DayPrint) -> str:
             f"{day.sd_beta_urad[k]:5.1f}"
         )
     return "\n".join(lines)
+
+
+@dataclass
+class FilesPrint:
+    """The fingerprint of a set of GEO files (``crisgeo fingerprint``): the day's print, the files that
+    could not be read (with the reason), the library EPs ranked against it, and a step within the files."""
+
+    day: DayPrint
+    skipped: list
+    matches: list
+    library: dict
+    problems: list
+    change: ProcessingChange | None
+
+    def to_dict(self) -> dict:
+        """The JSON document of ``crisgeo fingerprint --json``."""
+        doc = self.day.to_dict()
+        doc["skipped"] = self.skipped
+        c = self.change
+        doc["change_within"] = None if c is None else {"first_granule": c.granule, "fors": c.fors}
+        doc["ep_match"] = [m.to_dict() for m in self.matches]
+        doc["ep_library_problems"] = self.problems
+        return doc
+
+
+def fingerprint_files(paths, ep_library=(), threshold_urad: float = 10.0) -> FilesPrint:
+    """Fingerprint the CrIS GEO files under *paths*, rank the EPs of *ep_library* (files or directories;
+    empty: the packaged real EPs) against it and look for a step within the files. A
+    :class:`~monitor.errors.DataError` when no file can be read."""
+    from monitor.mapping.engpkt import load_library
+    from monitor.sdr import GranuleError, read_file
+    from monitor.sdr.names import parse_name
+    from monitor.sdr.pairing import find_files
+
+    files = find_files(paths)
+    prints, skipped = [], []
+    for f in files:
+        try:
+            prints += [granule_print(g) for g in read_file(f, kinds=("cris_geo",))]
+        except GranuleError as exc:
+            skipped.append(str(exc))
+    if not prints:
+        raise DataError("no readable CrIS GEO granule" + (f" ({skipped[0]})" if skipped else ""))
+    prints.sort(key=lambda p: p.start)
+    day = day_print(prints)
+    library, problems = load_library(list(ep_library))
+    platforms = {p.platform for p in map(parse_name, (f.name for f in files)) if p}
+    matches = identify_ep(day, library, platforms.pop() if len(platforms) == 1 else None)
+    return FilesPrint(day, skipped, matches, library, problems, detect_change(prints, threshold_urad))
