@@ -71,6 +71,7 @@ def _pyresample_reference(case, cfg, max_granules=1):
 
 
 def run_bench(args) -> int:
+    """``crisgeo bench``: simulate (or take --data), warm the kernels, time each stage, print; exit status."""
     cfg = AssessConfig()
     with tempfile.TemporaryDirectory() as tmp:
         data = Path(args.data) if args.data else Path(tmp)

@@ -44,6 +44,7 @@ class ReprocessSummary:
 
     @property
     def finished(self) -> int:
+        """Satellite-days processed and recorded by this call."""
         return sum(self.statuses.values())
 
     def lines(self) -> list[str]:

@@ -31,6 +31,7 @@ class Alert:
 
     @classmethod
     def from_row(cls, r) -> "Alert":
+        """The Alert of a row of the store."""
         d = {k: r[k] for k in cls.__dataclass_fields__}
         d["lines"] = json.loads(r["lines"] or "[]")
         return cls(**d)
@@ -49,6 +50,7 @@ class Silence:
 
     @classmethod
     def from_row(cls, r) -> "Silence":
+        """The Silence of a row of the store."""
         return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
 
@@ -71,6 +73,7 @@ class Delivery:
 
     @classmethod
     def from_row(cls, r) -> "Delivery":
+        """The Delivery of a row of the store."""
         d = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**d, "body": json.loads(d["body"]), "attempts": int(d["attempts"] or 0)})
 

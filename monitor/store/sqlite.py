@@ -126,6 +126,7 @@ class Event:
 
     @classmethod
     def from_row(cls, r) -> "Event":
+        """The Event of a row of the store."""
         """The event of an ``events`` row."""
         try:
             detail = json.loads(r["detail"])
@@ -166,6 +167,7 @@ class Run:
 
     @classmethod
     def from_row(cls, r) -> "Run":
+        """The Run of a row of the store."""
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, "status": RunStatus(row["status"])})
 
@@ -217,6 +219,7 @@ class GranuleRow:
 
     @classmethod
     def from_row(cls, r) -> "GranuleRow":
+        """The GranuleRow of a row of the store."""
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
 
@@ -235,6 +238,7 @@ class SelectionRow:
 
     @classmethod
     def from_row(cls, r) -> "SelectionRow":
+        """The SelectionRow of a row of the store."""
         return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
 
