@@ -126,7 +126,6 @@ class Event:
 
     @classmethod
     def from_row(cls, r) -> "Event":
-        """The Event of a row of the store."""
         """The event of an ``events`` row."""
         try:
             detail = json.loads(r["detail"])
