@@ -456,14 +456,14 @@ def cmd_run(args) -> int:
 
 @command(
     "reprocess",
-    "assess a period on a Dask cluster (resumable; the days already ok are skipped)",
+    "assess a period on a Dask cluster (resumable; the days already done are skipped)",
     CONFIG,
     arg("--since", type=_day, required=True, help="first day, YYYY-MM-DD"),
     arg("--until", type=_day, required=True, help="last day, YYYY-MM-DD"),
     arg("--satellite", choices=tuple(SATELLITES)),
     arg("--scheduler", help="address of a running Dask scheduler (tcp://HOST:8786); default a local cluster"),
     arg("--workers", type=int, default=2, help="processes of the local cluster (default 2)"),
-    arg("--force", action="store_true", help="redo the days already ok"),
+    arg("--force", action="store_true", help="redo the days already done"),
 )
 def cmd_reprocess(args) -> int:
     """crisgeo reprocess: a period on Dask; this process alone writes the store."""

@@ -3,9 +3,9 @@
 One task per satellite-day runs :func:`monitor.pipeline.compute_day` (list, fingerprint, select, fetch,
 assess) on a worker and returns its :class:`~monitor.pipeline.DayWork`; the client records each as it
 arrives with :func:`monitor.pipeline.record_day`, the path of the daily run (ledger row, results and
-outbox lines in one transaction). Days already ``ok`` are skipped unless forced, so a second call does
-nothing and an interrupted call resumes. SIGINT/SIGTERM cancel what is still queued or running; what
-finished is recorded.
+outbox lines in one transaction). Days already done (``ok``, or found empty for good) are skipped unless
+forced, so a second call does nothing and an interrupted call resumes. SIGINT/SIGTERM cancel what is
+still queued or running; what finished is recorded.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 
-from monitor.pipeline import DayWork, ProgressLines, compute_day, record_day
+from monitor.pipeline import DayWork, ProgressLines, compute_day, no_data_horizon, record_day
 from monitor.service import InstanceLock
 from monitor.sources import make_source
 from monitor.store.sqlite import RunStatus, Store
@@ -34,10 +34,10 @@ def day_task(cfg, satellite: str, day: dt.date) -> DayWork:
 
 @dataclass
 class ReprocessSummary:
-    """What a reprocessing call did: days per status, days skipped as already ok, days not finished."""
+    """What a reprocessing call did: days per status, days skipped as already done, days not finished."""
 
     planned: int = 0
-    skipped_ok: int = 0
+    skipped_done: int = 0
     statuses: dict = field(default_factory=dict)
     unfinished: int = 0
     wall_s: float = 0.0
@@ -51,7 +51,7 @@ class ReprocessSummary:
         """The summary printed at the end."""
         rate = self.finished / (self.wall_s / 3600) if self.wall_s > 0 and self.finished else 0.0
         out = [
-            f"satellite-days: {self.planned} in the period, {self.skipped_ok} already ok (skipped), "
+            f"satellite-days: {self.planned} in the period, {self.skipped_done} already done (skipped), "
             f"{self.finished} processed in {self.wall_s:.0f} s ({rate:.0f} days/hour)"
         ]
         if self.statuses:
@@ -97,7 +97,7 @@ def reprocess(
     progress=None,
     stop: threading.Event | None = None,
 ) -> ReprocessSummary:
-    """Assess every satellite-day of the period not yet ``ok`` (all with *force*) on Dask and record each.
+    """Assess every satellite-day of the period not yet done (all with *force*) on Dask and record each.
 
     *progress*, called with each recorded :class:`~monitor.pipeline.RunOutcome`; *stop*, an event that
     ends the call cleanly (queued and running days are cancelled and stay to do).
@@ -111,12 +111,14 @@ def reprocess(
     with InstanceLock(cfg.state_dir), Store(cfg.store.sqlite) as store:
         store.interrupt_stale_runs()
         todo = []
+        s = cfg.schedule
+        horizon = no_data_horizon(dt.datetime.now(dt.timezone.utc).date(), s.lag_days, s.no_data_retry_days)
         for sat in satellites:
-            ok = {r.day for r in store.runs(sat) if r.status == RunStatus.OK}  # YYYY-MM-DD
+            done = store.done_days(sat, horizon)  # as the daily run: ok, or no data for good
             for day in period_days(since, until):
                 summary.planned += 1
-                if day.isoformat() in ok and not force:
-                    summary.skipped_ok += 1
+                if day in done and not force:
+                    summary.skipped_done += 1
                 else:
                     todo.append((sat, day))
         if not todo:

@@ -46,7 +46,7 @@ def reprocessed(tmp_path_factory):
 
 def test_each_day_once_with_the_daily_runs_numbers(reprocessed):
     tmp, cfg, summary = reprocessed
-    assert summary.statuses == {"ok": 3} and summary.unfinished == 0 and summary.skipped_ok == 0
+    assert summary.statuses == {"ok": 3} and summary.unfinished == 0 and summary.skipped_done == 0
     rows, runs = _results(cfg)
     days = [d.isoformat() for d in period_days(*DAYS)]
     assert sorted(runs) == [(d, "ok") for d in days]
@@ -66,7 +66,7 @@ def test_a_second_call_does_nothing(reprocessed):
     _, cfg, _ = reprocessed
     before = _results(cfg)
     again = reprocess(cfg, *DAYS, ["j01"], workers=2)
-    assert again.skipped_ok == 3 and again.finished == 0 and again.unfinished == 0
+    assert again.skipped_done == 3 and again.finished == 0 and again.unfinished == 0
     assert _results(cfg) == before
 
 
@@ -82,6 +82,15 @@ def test_an_interrupted_call_records_what_finished_and_resumes(reprocessed, tmp_
     _, runs = _results(cfg)
     assert len(runs) == first.finished and all(s == "ok" for _, s in runs)  # nothing half-recorded
     rest = reprocess(cfg, *DAYS, ["j01"], workers=2)
-    assert rest.skipped_ok == first.finished and rest.finished == first.unfinished
+    assert rest.skipped_done == first.finished and rest.finished == first.unfinished
     rows, runs = _results(cfg)
     assert sorted(runs) == [(d.isoformat(), "ok") for d in period_days(*DAYS)] and len(rows) == 90
+
+
+def test_days_found_empty_for_good_are_done(tmp_path):
+    (tmp_path / "none").mkdir()
+    cfg = _config(tmp_path, "empty", f"{{kind: local, path: {tmp_path / 'none'}}}")
+    first = reprocess(cfg, *DAYS, ["j01"], workers=1)
+    assert first.statuses == {"no_data_final": 3}  # long past: no retry
+    again = reprocess(cfg, *DAYS, ["j01"], workers=1)
+    assert again.skipped_done == 3 and again.finished == 0
