@@ -217,7 +217,7 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
     (summary,) = [d["message"] for d in lines if d["message"].startswith("run j01 2024-06-01: ok")]
     assert "granules listed 6, selected 2, assessed 2" in summary and "reliable FORs" in summary
     assert "worst" in summary and "stages list" in summary
-    # not on a terminal: progress as log lines, the granules as the worker processes finish them
+    # not on a terminal: progress as log lines, the granules as they finish
     progress = [d["message"] for d in lines if " after " in d["message"]]
     assert any(m.startswith("j01 2024-06-01: fetched scenes: 2/2") for m in progress), progress
     assert any(m.startswith("j01 2024-06-01: assessed granules: 2/2") for m in progress), progress
