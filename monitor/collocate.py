@@ -26,13 +26,15 @@ The j run of an interval [t_lo, t_hi] is found by comparing with the FOV's tan B
 from __future__ import annotations
 
 import math
+import time
 
 import numba
 import numpy as np
 
 from monitor.constants import FOV_DIAMETER_RAD, MAX_GRID_SPREAD_RAD
 from monitor.geometry import wgs84
-from monitor.swath import BLOCK_PX, DETECTORS, KERNEL_LOCK, SwathPiece, ViirsSwath
+from monitor.spectral import i5_band
+from monitor.swath import BLOCK_PX, DETECTORS, KERNEL_LOCK, SwathPiece, ViirsSwath, swath_piece
 
 TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)
 # CrIS spatial response as a staircase of concentric top hats, from the 70/50/10/3 % full widths of
@@ -96,7 +98,7 @@ def _accumulate(
 ):  # fmt: skip
     """Add the pixels of one prepared granule to each FOV's cone sums (difference arrays along j).
 
-    Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*, the angle *reach0* (rad)
+    Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*; *reach0* the angle (rad)
     within which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones'
     union, and the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none).
     *ring_g2*, *ring_c* are cos^2 h and the weight of each top hat of the kernel. FOVs are taken in
@@ -139,7 +141,7 @@ def _accumulate(
                 vy = block_centre[br, bc, 1] - sy
                 vz = block_centre[br, bc, 2] - sz
                 dist = math.sqrt(vx * vx + vy * vy + vz * vz)
-                reach = reach0[f] + math.asin(min(rad / dist, 1.0))
+                reach = reach0 + math.asin(min(rad / dist, 1.0))
                 if reach < math.pi and vx * lx + vy * ly + vz * lz < dist * math.cos(reach):
                     continue
                 for r in range(br * BLOCK_PX, (br + 1) * BLOCK_PX):
@@ -230,7 +232,6 @@ def cone_sums(
     tan_b = np.tan(offsets_rad[None, :] + beta_rad[:, None])
     ring_g2 = np.array([np.cos(h) ** 2 for h, _ in kernel])
     ring_c = np.array([c for _, c in kernel], np.float64)
-    reach0 = np.full(nf, rho * 1.01)
     acc = np.zeros((nf, 2, m, m + 1))
     # each thread's contiguous share of the FOVs is spread over the granule (scans lie on different pieces)
     threads = numba.get_num_threads()
@@ -243,7 +244,7 @@ def cone_sums(
         with KERNEL_LOCK:
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
-                sat_m, mat, los0, reach0, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
+                sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
                 np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, ring_c, order, acc,
             )  # fmt: skip
     acc = np.cumsum(acc, axis=-1)[..., :m]
@@ -260,11 +261,6 @@ def cone_sums(
 def warm_up() -> float:
     """Compile the kernels (or load them from numba's cache) on a tiny synthetic granule, so that a timing
     or the first granule does not pay for it; the seconds it took."""
-    import time
-
-    from monitor.spectral import i5_band
-    from monitor.swath import swath_piece
-
     t0 = time.perf_counter()
     rows, cols = 2 * DETECTORS, 16
     r, c = np.meshgrid(np.arange(rows), np.arange(cols), indexing="ij")

@@ -150,12 +150,6 @@ def record_fingerprint(cfg, store, satellite: str, day: dt.date, prints: list) -
     return body
 
 
-def fingerprint_day(cfg, store, source, satellite: str, day: dt.date, listing) -> dict | None:
-    """Compute, store and compare the day's LOS fingerprint (:func:`day_prints`, :func:`record_fingerprint`).
-    Problems are logged, never fatal to the run."""
-    return record_fingerprint(cfg, store, satellite, day, day_prints(cfg, source, day, listing))
-
-
 def publish_changes(cfg, store, satellite: str) -> None:
     """Queue every known change of *satellite* for the time-series stores (dashboard annotations)."""
     if not cfg.store.publish:

@@ -9,9 +9,23 @@ import numpy as np
 import pytest
 
 from monitor.assess import AssessConfig, assess_paths
+from monitor.mapping.engpkt import load_ep
 from monitor.simulate.case import simulate_case
 
 REAL_DIR = Path(__file__).parent / "data" / "real"
+EP_CONFIGS = Path(__file__).resolve().parent.parent / "configs" / "ep"
+
+
+@pytest.fixture(scope="session")
+def nominal_ep():
+    """The nominal NOAA-20 EP (V115) of configs/ep."""
+    return load_ep(EP_CONFIGS / "j01_nominal.yaml")
+
+
+@pytest.fixture(scope="session")
+def error_ep():
+    """V115 with the paper-like scene-mirror error of configs/ep."""
+    return load_ep(EP_CONFIGS / "j01_paper_ssm_error.yaml")
 
 
 @pytest.fixture(scope="session")

@@ -1,24 +1,9 @@
 """The whole loop of section 4: assess -> optimize -> regeolocate -> assess again (issue #6)."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from benchmarks.closed_loop import run_closed_loop
-from monitor.mapping.engpkt import load_ep
-
-CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "ep"
-
-
-@pytest.fixture(scope="module")
-def nominal_ep():
-    return load_ep(CONFIGS / "j01_nominal.yaml")
-
-
-@pytest.fixture(scope="module")
-def error_ep():
-    return load_ep(CONFIGS / "j01_paper_ssm_error.yaml")
 
 
 def _check(rep):

@@ -1,23 +1,8 @@
 """EP-mode simulated GEO granules shared by the mapping tests."""
 
-from pathlib import Path
-
 import pytest
 
-from monitor.mapping.engpkt import load_ep
 from monitor.simulate.case import SimulationSpec, simulate_case
-
-CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "ep"
-
-
-@pytest.fixture(scope="session")
-def nominal_ep():
-    return load_ep(CONFIGS / "j01_nominal.yaml")
-
-
-@pytest.fixture(scope="session")
-def error_ep():
-    return load_ep(CONFIGS / "j01_paper_ssm_error.yaml")
 
 
 @pytest.fixture(scope="session")

@@ -12,9 +12,9 @@ from monitor.mapping import residuals
 from monitor.mapping.engpkt import load_ep
 from monitor.mapping.regeolocate import compare_with_files
 from monitor.sdr import read_file
-from tests.mapping.conftest import CONFIGS
+from tests.conftest import EP_CONFIGS
 
-V115 = CONFIGS.parents[1] / "monitor" / "data" / "ep" / "JPSS1_side1_V115_EngPkt.xml"
+V115 = EP_CONFIGS.parents[1] / "monitor" / "data" / "ep" / "JPSS1_side1_V115_EngPkt.xml"
 
 
 @pytest.fixture(scope="module")
