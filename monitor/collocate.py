@@ -20,7 +20,8 @@ testing its pixels.
 
 Compiled. The search, the interval test and the accumulation run in one numba kernel, in parallel over
 FOVs; each FOV accumulates its own 2 x (2n+1) x (2n+2) difference arrays, so threads never share a sum.
-The j run of an interval [t_lo, t_hi] is found by comparing with the FOV's tan B_j (no arctangent).
+The j run of an interval [t_lo, t_hi] is found by comparing with the FOV's tan B_j (no arctangent), for
+all rows in one loop that the compiler vectorises (the accumulation, a scatter, is a loop of its own).
 """
 
 from __future__ import annotations
@@ -66,29 +67,30 @@ def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _nearest_index(t, guess0, guess_scale, m):
-    """The j nearest t on the chord through (tan B_0, 0) and (tan B_{m-1}, m - 1), clipped to 0..m.
-
-    tan B_j departs from that chord by at most tan|beta| n^2 s (index units), < 0.3 within
-    MAX_GRID_SPREAD_RAD, so the count of tan B_j below t is this index or the next.
-    """
+    """The j nearest t on the chord through (tan B_0, 0) and (tan B_{m-1}, m - 1), clipped to 0..m
+    (0 for NaN)."""
     g = (t - guess0) * guess_scale + 0.5
-    return 0 if not g > 0.0 else (m if g > m else int(g))
+    g = g if g > 0.0 else 0.0
+    return int(g if g < m else m)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _first_at_or_above(tan_b_inf, t, guess0, guess_scale):
-    """How many tan B_j are < t: the first j of a run starting at t. *tan_b_inf* is tan B_0 ..
-    tan B_{m-1}, +inf; one comparison settles the guess."""
-    j = _nearest_index(t, guess0, guess_scale, tan_b_inf.shape[0] - 1)
-    return j + (tan_b_inf[j] < t)
+def _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after):
+    """The run of j with t_lo <= tan B_j <= t_hi in each row: its first j and the j after its last
+    (j_first >= j_after: empty, as for a NaN interval). *tan_b_inf* is tan B_0 .. tan B_{m-1}, +inf.
 
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def _first_above(tan_b_inf, t, guess0, guess_scale):
-    """How many tan B_j are <= t: the j after a run ending at t (see _first_at_or_above)."""
+    tan B_j departs from the chord of :func:`_nearest_index` by at most tan|beta| n^2 s (index units),
+    < 0.3 within MAX_GRID_SPREAD_RAD, so the count of tan B_j below t is the nearest index or the next:
+    one comparison settles it. Selects, not branches, so that the loop vectorises.
+    """
     m = tan_b_inf.shape[0] - 1
-    j = _nearest_index(t, guess0, guess_scale, m)
-    return min(j + (tan_b_inf[j] <= t), m)
+    for i in range(t_lo.shape[0]):
+        t = t_lo[i]
+        j = _nearest_index(t, guess0, guess_scale, m)
+        j_first[i] = j + (tan_b_inf[j] < t)
+        t = t_hi[i]
+        j = _nearest_index(t, guess0, guess_scale, m)
+        j_after[i] = min(j + (tan_b_inf[j] <= t), m)
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
@@ -126,6 +128,8 @@ def _accumulate(
         guess_scale = (m - 1) / (tan_b[f, m - 1] - tan_b[f, 0]) if m > 1 else 0.0
         t_lo = np.empty(m)
         t_hi = np.empty(m)
+        j_first = np.empty(m, np.int64)
+        j_after = np.empty(m, np.int64)
         sx, sy, sz = sat[f, 0], sat[f, 1], sat[f, 2]
         m00, m01, m02 = mat[f, 0, 0], mat[f, 0, 1], mat[f, 0, 2]
         m10, m11, m12 = mat[f, 1, 0], mat[f, 1, 1], mat[f, 1, 2]
@@ -177,9 +181,10 @@ def _accumulate(
                                 sq = math.sqrt(max(disc, 0.0))
                                 t_lo[i] = (sq - b1) * inv_a2 if disc >= 0.0 else np.inf
                                 t_hi[i] = -(b1 + sq) * inv_a2 if disc >= 0.0 else -np.inf
+                            _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after)
                             for i in range(m):  # its run of j: +w at the first, -w after the last
-                                j0 = _first_at_or_above(tan_b_inf, t_lo[i], guess0, guess_scale)
-                                j1 = _first_above(tan_b_inf, t_hi[i], guess0, guess_scale)
+                                j0 = j_first[i]
+                                j1 = j_after[i]
                                 if j0 < j1:
                                     out[0, i, j0] += wv
                                     out[0, i, j1] -= wv

@@ -254,11 +254,13 @@ def test_run_ends_are_exact_up_to_the_widest_grid(beta, n):
             [-np.inf, np.inf],
         ]
     )
-    padded = np.append(tan_b, np.inf)
-    lo = [collocate._first_at_or_above(padded, x, guess0, scale) for x in t]
-    hi = [collocate._first_above(padded, x, guess0, scale) for x in t]
-    np.testing.assert_array_equal(lo, np.searchsorted(tan_b, t, "left"))
-    np.testing.assert_array_equal(hi, np.searchsorted(tan_b, t, "right"))
+    first, after = np.empty(len(t), np.int64), np.empty(len(t), np.int64)
+    collocate._run_ends(np.append(tan_b, np.inf), t, t, guess0, scale, first, after)
+    np.testing.assert_array_equal(first, np.searchsorted(tan_b, t, "left"))
+    np.testing.assert_array_equal(after, np.searchsorted(tan_b, t, "right"))
+    nan = np.full(1, np.nan)
+    collocate._run_ends(np.append(tan_b, np.inf), nan, nan, guess0, scale, first, after)
+    assert first[0] >= after[0]  # an interval of NaN: an empty run
 
 
 def test_a_grid_beyond_the_kernels_reach_is_refused(scene):
