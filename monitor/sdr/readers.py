@@ -255,15 +255,12 @@ def _check_raw(path, name: str, raw: np.ndarray, f, rows: int) -> None:
 def _check_values(path, name: str, data: np.ndarray, f) -> None:
     """Physical limits of every value that is not a fill (file units, after scaling)."""
     if f.limits is not None:
-        v = (
-            data[data > 0]
-            if f.kind == "time"
-            else data[np.isfinite(data)]
-            if data.dtype.kind == "f"
-            else data
-        )
-        if v.size:
-            lo, hi = v.min(), v.max()
+        if data.dtype.kind == "f":  # fmin/fmax skip NaN (fill) without a copy; all NaN gives NaN
+            lo, hi = np.fmin.reduce(data, axis=None), np.fmax.reduce(data, axis=None)
+        else:
+            v = data[data > 0] if f.kind == "time" else data
+            lo, hi = (v.min(), v.max()) if v.size else (np.nan, np.nan)
+        if not np.isnan(lo):
             if lo < f.limits[0] or hi > f.limits[1]:
                 bad = lo if lo < f.limits[0] else hi
                 raise GranuleError(path, name, f"value {bad:.6g} outside {f.limits[0]:g}..{f.limits[1]:g}")
@@ -279,7 +276,7 @@ def _clean(path, dataset: str, raw: np.ndarray, f) -> np.ndarray:
     if f.kind == "float":
         # Per-scan and per-FOV fields become float64; VIIRS pixel arrays and spectra stay float32 (memory).
         wide = raw.dtype == np.float64 or (raw.ndim < 4 and f.per != "row")
-        out = raw.astype(np.float64 if wide else np.float32)
+        out = raw.astype(np.float64 if wide else np.float32, copy=False)
         out[is_float_fill(raw)] = np.nan
         return out
     if f.kind == "scaled":
@@ -348,7 +345,9 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
             if fac is not None:
                 part = (part * fac[k, 0] + fac[k, 1]).astype(np.float32)
             _check_values(path, name, part, f)
-            parts.append(part * f.to_si if f.to_si != 1.0 else part)
+            if f.to_si != 1.0:
+                part *= f.to_si  # part is this reader's own array (a copy or a slice of one)
+            parts.append(part)
         arrays[key] = parts
     out = []
     for k, meta in enumerate(metas):
