@@ -145,17 +145,21 @@ def read_inputs(cris: GranuleFiles, viirs: list, viirs_all: list, prepared=(), t
     return GranuleInputs(geo, sdr, raw)
 
 
-def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=None, raw=None):
-    if v.key in cache.pieces:
+def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, view_rad, timings=None, raw=None):
+    """The granule prepared out to at least *view_rad* from nadir: from the cache, or prepared out to
+    view_rad + VIEW_MARGIN_RAD (so that the next CrIS granule's slightly wider reach finds it ready)."""
+    if v.key in cache.pieces and cache.pieces[v.key].view_rad >= view_rad:
         return cache.pieces[v.key]
+    cache.pieces.pop(v.key, None)
     if raw is None:
         with _stage(timings, "read"):
             raw = _read_viirs(v, viirs_all)
     geo, sdr, halo_before, halo_after = raw
     with _stage(timings, "geometry"):
         piece = swath.swath_piece(
-            geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after
-        )
+            geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
+            sat_m=geo.sc_position_m, view_rad=view_rad + collocate.VIEW_MARGIN_RAD,
+        )  # fmt: skip
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))
     cache.pieces[v.key] = piece
@@ -163,12 +167,14 @@ def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, timings=N
 
 
 def _load_swath(
-    viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, timings=None, raw=None
+    viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, view_rad, timings=None, raw=None
 ) -> swath.ViirsSwath:
-    """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*), from
-    the raw granules in *raw* (key -> :func:`_read_viirs`) or read here."""
+    """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*) out
+    to *view_rad* from nadir, from the raw granules in *raw* (key -> :func:`_read_viirs`) or read here."""
     raw = raw or {}
-    return swath.ViirsSwath([_piece(v, viirs_all, band, cache, timings, raw.get(v.key)) for v in viirs])
+    return swath.ViirsSwath(
+        [_piece(v, viirs_all, band, cache, view_rad, timings, raw.get(v.key)) for v in viirs]
+    )
 
 
 def collocate_granule(
@@ -191,11 +197,19 @@ def collocate_granule(
     if inputs is None:
         inputs = read_inputs(cris, viirs, viirs_all, tuple(cache.pieces), timings)
     geo, sdr = inputs.geo, inputs.sdr
-    with _stage(timings, "geometry"):
-        fg, valid, fill = _cris_geometry(geo)
     with _stage(timings, "spectral"):
         bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
-    pieces = _load_swath(viirs, viirs_all, band, cache, timings, inputs.viirs)
+    with _stage(timings, "geometry"):
+        fg, valid, fill = _cris_geometry(geo)
+        view_rad = collocate.view_reach_rad(
+            fg.sat_ecef_m[valid],
+            fg.sbf_to_ecef[valid],
+            fg.alpha_rad[valid],
+            fg.beta_rad[valid],
+            cfg.offsets_rad,
+            KERNELS[cfg.kernel],
+        )
+    pieces = _load_swath(viirs, viirs_all, band, cache, view_rad, timings, inputs.viirs)
     with _stage(timings, "collocation"):
         bt_viirs, coverage = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (

@@ -21,7 +21,8 @@ testing its pixels.
 Compiled. The search, the interval test and the accumulation run in one numba kernel, in parallel over
 FOVs; each FOV accumulates its own 2 x (2n+1) x (2n+2) difference arrays, so threads never share a sum.
 The j run of an interval [t_lo, t_hi] is found by comparing with the FOV's tan B_j (no arctangent), for
-all rows in one loop that the compiler vectorises (the accumulation, a scatter, is a loop of its own).
+all rows in one loop of selects, not branches (the accumulation, a scatter, is a loop of its own). The
+kernel uses numba's numpy error model (a division by zero gives inf or NaN, which it tests for).
 """
 
 from __future__ import annotations
@@ -45,6 +46,37 @@ SPATIAL_RESPONSE = tuple(
     (np.radians(r), c) for r, c in ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065))
 )
 MIN_COVERAGE = 0.97
+# The kernel's threads take FOVs in chunks of this many as they come free (FOVs differ in pixel count, and
+# the read-ahead thread takes turns on the cores), not in equal shares fixed in advance
+FOVS_PER_TASK = 8
+# VIIRS columns are prepared out to the farthest view angle a cone reaches plus this: the two instruments
+# see a ground point from spacecraft positions seconds apart (its cross-track angle differs by far less)
+VIEW_MARGIN_RAD = math.radians(0.5)
+
+
+def reach_rad(offsets_rad, kernel=TOP_HAT) -> float:
+    """The angle (rad) from a FOV's LOS within which one of its perturbed cones (*offsets_rad*, the
+    perturbation grid; *kernel*, the (half-angle rad, weight) top hats) can hold a pixel."""
+    return max(h for h, _ in kernel) + float(np.abs(offsets_rad).max()) * math.sqrt(2.0) * 1.02
+
+
+def los_ecef(sbf_to_ecef, alpha_rad, beta_rad) -> np.ndarray:
+    """Unit LOS (F, 3) in ECEF of FOVs at SBF angles alpha_rad, beta_rad (F,) (equations 1-2)."""
+    t = np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(np.shape(alpha_rad))], -1)
+    los = np.einsum("fij,fj->fi", sbf_to_ecef, t)
+    return los / np.linalg.norm(los, axis=-1, keepdims=True)
+
+
+def view_reach_rad(sat_m, sbf_to_ecef, alpha_rad, beta_rad, offsets_rad, kernel=TOP_HAT) -> float:
+    """The farthest angle from the geocentric nadir (rad) that a perturbed cone of these FOVs reaches,
+    plus VIEW_MARGIN_RAD: the VIIRS columns beyond it need no preparation (:func:`swath.view_columns`).
+    NaN FOVs are ignored; pi when there is none."""
+    los = los_ecef(sbf_to_ecef, alpha_rad, beta_rad)
+    nadir = -np.asarray(sat_m, float) / np.linalg.norm(sat_m, axis=-1, keepdims=True)
+    off = np.arccos(np.clip(np.sum(los * nadir, -1), -1.0, 1.0))
+    if not np.isfinite(off).any():
+        return math.pi
+    return float(np.nanmax(off)) + reach_rad(offsets_rad, kernel) + VIEW_MARGIN_RAD
 
 
 def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
@@ -65,7 +97,7 @@ def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
     return half_rows, half_cols, np.maximum(d_track, d_scan)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _nearest_index(t, guess0, guess_scale, m):
     """The j nearest t on the chord through (tan B_0, 0) and (tan B_{m-1}, m - 1), clipped to 0..m
     (0 for NaN)."""
@@ -74,7 +106,7 @@ def _nearest_index(t, guess0, guess_scale, m):
     return int(g if g < m else m)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after):
     """The run of j with t_lo <= tan B_j <= t_hi in each row: its first j and the j after its last
     (j_first >= j_after: empty, as for a NaN interval). *tan_b_inf* is tan B_0 .. tan B_{m-1}, +inf.
@@ -93,7 +125,7 @@ def _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after):
         j_after[i] = min(j + (tan_b_inf[j] <= t), m)
 
 
-@numba.njit(cache=True, nogil=True, parallel=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _accumulate(
     ecef, radiance, area, block_centre, block_radius, sat, mat, los0, reach0, tan_a, tan_b, box,
     block_row, block_col, half_brows, half_bcols, ring_g2, ring_c, order, acc,
@@ -104,8 +136,8 @@ def _accumulate(
     within which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones'
     union, and the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none).
     *ring_g2*, *ring_c* are cos^2 h and the weight of each top hat of the kernel. FOVs are taken in
-    *order* (the threads get equal contiguous shares of it). acc (F, 2, m, m + 1)
-    receives weight x radiance and weight runs: +w at the first j, -w after the last.
+    *order*, in chunks of FOVS_PER_TASK. acc (F, 2, m, m + 1) receives weight x radiance and weight runs:
+    +w at the first j, -w after the last.
     """
     nrow, ncol = radiance.shape
     nbr, nbc = block_radius.shape
@@ -221,9 +253,8 @@ def cone_sums(
             f"perturbation grid of {m} x {m} steps of {offsets_rad[1] - offsets_rad[0]:.3g} rad: n^2 s "
             f"exceeds {MAX_GRID_SPREAD_RAD} rad, beyond the compiled kernel's index guess"
         )
-    rho = h_max + big * np.sqrt(2.0) * 1.02  # angle from the LOS within which a cone can hold a pixel
-    los0 = np.einsum("fij,fj->fi", mat, np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(nf)], -1))
-    los0 /= np.linalg.norm(los0, axis=-1, keepdims=True)
+    rho = reach_rad(offsets_rad, kernel)
+    los0 = los_ecef(mat, alpha_rad, beta_rad)
     t = wgs84.intersect_ellipsoid(sat_m, los0)
     ok_fov = np.isfinite(t)
     centre = sat_m + np.where(ok_fov, t, 0.0)[:, None] * los0
@@ -238,7 +269,8 @@ def cone_sums(
     ring_g2 = np.array([np.cos(h) ** 2 for h, _ in kernel])
     ring_c = np.array([c for _, c in kernel], np.float64)
     acc = np.zeros((nf, 2, m, m + 1))
-    # each thread's contiguous share of the FOVs is spread over the granule (scans lie on different pieces)
+    # FOVs interleaved by thread count: each thread's first share is spread over the granule (the scans
+    # that a VIIRS granule reaches are a contiguous part of it)
     threads = numba.get_num_threads()
     order = np.concatenate([np.arange(t0, nf, threads) for t0 in range(threads)])
     for piece in swath.pieces:
@@ -246,7 +278,7 @@ def cone_sums(
         hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, rho)
         # a FOV whose cones cannot reach this granule's nearest usable block skips it
         far = ~ok_fov | (dist > reach_m + 2 * BLOCK_PX * piece.col_spacing_m[col0] + piece.advance_m[col0])
-        with KERNEL_LOCK:
+        with KERNEL_LOCK, numba.parallel_chunksize(FOVS_PER_TASK):
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
                 sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,

@@ -1,12 +1,13 @@
 """The compiled interval formulation of the cone test against a brute-force angle test on every pixel."""
 
+import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from monitor import collocate, swath
-from monitor.assess import AssessConfig, _load_swath, _SwathCache, parallel_threads
+from monitor.assess import AssessConfig, _piece, _SwathCache, parallel_threads
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbation_grid
@@ -26,8 +27,9 @@ def scene(case_plan):
     g = case_plan.cris[0]
     (geo,) = read_file(g.geo, kinds=("cris_geo",))
     fg = granule_geometry(geo)
-    swath = _load_swath(case_plan.viirs[g.key], case_plan.viirs_all, i5_band("j01"), _SwathCache())
-    return fg, swath
+    band = i5_band("j01")  # every column prepared (no reach given)
+    pieces = [_piece(v, case_plan.viirs_all, band, _SwathCache(), math.inf) for v in case_plan.viirs[g.key]]
+    return fg, swath.ViirsSwath(pieces)
 
 
 def _brute(viirs, sat, m, alpha, beta, offsets, half_angle):

@@ -46,7 +46,7 @@ def test_assessment_needs_the_height(mountains, monkeypatch):
 
     def on_ellipsoid(lat, lon, height, *args, **kw):
         halo = [None if h is None else (h[0], h[1], np.zeros_like(h[2])) for h in args[3:5]]
-        return real(lat, lon, np.zeros_like(height), *args[:3], *halo)
+        return real(lat, lon, np.zeros_like(height), *args[:3], *halo, **kw)
 
     monkeypatch.setattr(swath, "swath_piece", on_ellipsoid)
     ea0, eb0 = _errors(assess_paths([out], cfg), truth)
