@@ -98,11 +98,18 @@ class _SwathCache:
 
 @dataclass
 class GranuleInputs:
-    """What one CrIS granule's assessment reads from disk: its GEO and SDR, and the raw VIIRS granules
-    (key -> (GEO, SDR, scan before, scan after)) not yet prepared."""
+    """What one CrIS granule's assessment needs before its VIIRS granules are prepared: its GEO and SDR,
+    their inverse geometry (fg, valid, fill: :func:`_cris_geometry`), how far from nadir its cones reach
+    (view_rad), its band BT (bt_cris_k), and the raw VIIRS granules (key -> (GEO, SDR, scan before, scan
+    after)) not yet prepared."""
 
     geo: object
     sdr: object
+    fg: object
+    valid: np.ndarray
+    fill: dict
+    view_rad: float
+    bt_cris_k: np.ndarray
     viirs: dict = field(default_factory=dict)
 
 
@@ -122,8 +129,11 @@ def _read_viirs(v: GranuleFiles, viirs_all: list):
     return geo, sdr, halo_before, halo_after
 
 
-def read_inputs(cris: GranuleFiles, viirs: list, viirs_all: list, prepared=(), timings=None) -> GranuleInputs:
-    """Read what :func:`collocate_granule` needs of *cris*, except the VIIRS granules in *prepared*."""
+def read_inputs(
+    cris: GranuleFiles, viirs: list, viirs_all: list, band, cfg: AssessConfig, prepared=(), timings=None
+) -> GranuleInputs:
+    """Read what :func:`collocate_granule` needs of *cris*, except the VIIRS granules in *prepared*, and
+    compute what depends on the CrIS granule alone (its geometry and band BT)."""
     with _stage(timings, "read"):
         geo = next(
             g
@@ -142,7 +152,19 @@ def read_inputs(cris: GranuleFiles, viirs: list, viirs_all: list, prepared=(), t
                 f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO {geo.lat_rad.shape}",
             )
         raw = {v.key: _read_viirs(v, viirs_all) for v in viirs if v.key not in prepared}
-    return GranuleInputs(geo, sdr, raw)
+    with _stage(timings, "spectral"):
+        bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
+    with _stage(timings, "geometry"):
+        fg, valid, fill = _cris_geometry(geo)
+        view_rad = collocate.view_reach_rad(
+            fg.sat_ecef_m[valid],
+            fg.sbf_to_ecef[valid],
+            fg.alpha_rad[valid],
+            fg.beta_rad[valid],
+            cfg.offsets_rad,
+            KERNELS[cfg.kernel],
+        )
+    return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, bt_cris, raw)
 
 
 def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, view_rad, timings=None, raw=None):
@@ -195,21 +217,11 @@ def collocate_granule(
     """
     viirs_all = viirs_all or viirs
     if inputs is None:
-        inputs = read_inputs(cris, viirs, viirs_all, tuple(cache.pieces), timings)
-    geo, sdr = inputs.geo, inputs.sdr
-    with _stage(timings, "spectral"):
-        bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
-    with _stage(timings, "geometry"):
-        fg, valid, fill = _cris_geometry(geo)
-        view_rad = collocate.view_reach_rad(
-            fg.sat_ecef_m[valid],
-            fg.sbf_to_ecef[valid],
-            fg.alpha_rad[valid],
-            fg.beta_rad[valid],
-            cfg.offsets_rad,
-            KERNELS[cfg.kernel],
-        )
-    pieces = _load_swath(viirs, viirs_all, band, cache, view_rad, timings, inputs.viirs)
+        inputs = read_inputs(cris, viirs, viirs_all, band, cfg, tuple(cache.pieces), timings)
+    geo, sdr, fg, valid, fill, bt_cris = (
+        inputs.geo, inputs.sdr, inputs.fg, inputs.valid, inputs.fill, inputs.bt_cris_k
+    )  # fmt: skip
+    pieces = _load_swath(viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs)
     with _stage(timings, "collocation"):
         bt_viirs, coverage = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (
@@ -470,10 +482,10 @@ def _collocate_run(
     reading = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
     def read_ahead(i):
-        """Read granule i's inputs in the background while granule i - 1 is computed (h5py and the
-        compiled kernels release the interpreter to each other)."""
+        """Read granule i's inputs (and compute its CrIS geometry) in the background while granule i - 1
+        is computed (h5py, numpy and the compiled kernels release the interpreter to each other)."""
         prepared = set(cache.pieces) | ({v.key for v in viirs[cris[i - 1].key]} if i else set())
-        return pool.submit(read_inputs, cris[i], viirs[cris[i].key], viirs_all, prepared, reading)
+        return pool.submit(read_inputs, cris[i], viirs[cris[i].key], viirs_all, band, cfg, prepared, reading)
 
     with cf.ThreadPoolExecutor(1, thread_name_prefix="crisgeo-read") as pool:
         ahead = read_ahead(0) if cris else None

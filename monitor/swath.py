@@ -222,10 +222,10 @@ def _share(pos, r, c, frame):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _weigh_scan(k, pos, radiance, first, last, step, have, area, centre, radius):
+def _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top):
     """Pass 2 for scan k: vector footprints with the scan overlap removed, radiance NaN where either is
-    unusable, and the bounding sphere (centre, radius + 1 m for the float32 rounding) of each block's
-    usable pixels (NaN where it has none)."""
+    unusable, the bounding sphere (centre, radius + 1 m for the float32 rounding) of each block's usable
+    pixels (NaN where it has none), and the height of the scan's highest usable pixel (top[k], m)."""
     cols = radiance.shape[1]
     nbc = centre.shape[1]
     frames = np.empty((cols, 9))
@@ -254,6 +254,7 @@ def _weigh_scan(k, pos, radiance, first, last, step, have, area, centre, radius)
             for r in range(br * BLOCK_PX, (br + 1) * BLOCK_PX):
                 for c in range(bc * BLOCK_PX, min((bc + 1) * BLOCK_PX, cols)):
                     if math.isfinite(radiance[r, c]):
+                        top[k] = max(top[k], h[r, c])
                         lo0, hi0 = min(lo0, pos[r, c, 0]), max(hi0, pos[r, c, 0])
                         lo1, hi1 = min(lo1, pos[r, c, 1]), max(hi1, pos[r, c, 1])
                         lo2, hi2 = min(lo2, pos[r, c, 2]), max(hi2, pos[r, c, 2])
@@ -268,10 +269,10 @@ def _weigh_scan(k, pos, radiance, first, last, step, have, area, centre, radius)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _weigh(pos, radiance, first, last, step, have, area, centre, radius):
+def _weigh(pos, h, radiance, first, last, step, have, area, centre, radius, top):
     """Pass 2 (:func:`_weigh_scan`), scans in parallel."""
     for k in numba.prange(radiance.shape[0] // DETECTORS):
-        _weigh_scan(k, pos, radiance, first, last, step, have, area, centre, radius)
+        _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
 
 def _np_half_diff(p, axis):
@@ -343,7 +344,8 @@ def swath_piece(
     else:
         view_rad = math.inf
     f32 = np.float32
-    lat, lon, h = (np.ascontiguousarray(a, f32) for a in (lat_rad, lon_rad, height_m))
+    # the kernels read the kept columns in place (a copy of them costs more than the strided reads)
+    lat, lon, h = (np.asarray(a, f32) for a in (lat_rad, lon_rad, height_m))
     rows, cols = lat.shape
     nscan = rows // DETECTORS
     pos = np.empty((rows, cols, 3), f32)
@@ -354,7 +356,7 @@ def swath_piece(
     have = np.zeros(nscan + 2, bool)
     have[1:-1] = True
     t_min, t_step, table = band.radiance_table
-    bt, good = np.ascontiguousarray(bt_k, f32), np.ascontiguousarray(good, bool)
+    bt, good = np.asarray(bt_k, f32), np.asarray(good, bool)
     with KERNEL_LOCK:
         _locate(lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, first, last, step)
     for slot, halo in ((0, before), (nscan + 1, after)):
@@ -366,10 +368,9 @@ def swath_piece(
     area = np.empty((rows, cols, 3), f32)
     centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
     radius = np.empty(centre.shape[:2])
+    top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK:
-        _weigh(pos, radiance, first, last, step, have, area, centre, radius)
-    located = np.isfinite(radiance)
-    max_height = float(np.max(h, where=located, initial=0.0))
+        _weigh(pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
     scan = pos.reshape(nscan, DETECTORS, cols, 3)
     mid = scan[nscan // 2]
@@ -390,7 +391,7 @@ def swath_piece(
         minimum_filter1d(col_spacing, SPACING_WINDOW_COLS, mode="nearest"),
         _fill_nan(advance),
         _fill_nan(det_step),
-        max(max_height, 0.0),
+        max(float(top.max()), 0.0),
         tree,
         r_idx * BLOCK_PX,
         c_idx * BLOCK_PX,
