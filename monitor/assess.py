@@ -21,7 +21,6 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
-import numba
 import numpy as np
 
 from monitor import collocate, refine, swath
@@ -36,6 +35,7 @@ from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_viirs_geo_scan
 from monitor.spectral import i5_band
+from monitor.threads import parallel_threads
 
 LOG = logging.getLogger(__name__)
 KERNELS = {"top-hat": collocate.TOP_HAT, "response": collocate.SPATIAL_RESPONSE}
@@ -518,17 +518,6 @@ def _collocate_run(
         for name, sec in reading.items():
             timings[name] = timings.get(name, 0.0) + sec
     return samples, skipped
-
-
-@contextmanager
-def parallel_threads(workers: int):
-    """Run the compiled kernels on *workers* threads (at most numba's pool) in this block."""
-    previous = numba.get_num_threads()
-    numba.set_num_threads(max(1, min(workers, numba.config.NUMBA_NUM_THREADS)))
-    try:
-        yield
-    finally:
-        numba.set_num_threads(previous)
 
 
 def assess_plan(

@@ -36,7 +36,8 @@ import numpy as np
 from monitor.constants import FOV_DIAMETER_RAD, MAX_GRID_SPREAD_RAD
 from monitor.geometry import wgs84
 from monitor.spectral import i5_band
-from monitor.swath import BLOCK_PX, DETECTORS, KERNEL_LOCK, SwathPiece, ViirsSwath, swath_piece
+from monitor.swath import BLOCK_PX, DETECTORS, SwathPiece, ViirsSwath, swath_piece
+from monitor.threads import KERNEL_LOCK
 
 TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)
 # CrIS spatial response as a staircase of concentric top hats, from the 70/50/10/3 % full widths of
@@ -224,6 +225,29 @@ def _accumulate(
                                     out[1, i, j1] -= wk
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _finish(acc, solid, mean, coverage):
+    """Each FOV's cone means and coverage from its difference arrays acc (F, 2, m, m + 1): the running
+    sums along j give weight x radiance and weight; the mean is their ratio where the cone holds a pixel
+    (NaN elsewhere), the coverage the weight over the cone's *solid* angle (0 elsewhere).
+
+    An empty cone's sum is what rounding leaves of the runs that passed it (~1e-16 of the row's weight);
+    one pixel weighs ~1e-3 of a cone's solid angle: a cone holds a pixel when its weight exceeds 1e-9 of
+    the solid angle.
+    """
+    m = mean.shape[1]
+    for f in numba.prange(acc.shape[0]):
+        for i in range(m):
+            s = 0.0
+            w = 0.0
+            for j in range(m):
+                s += acc[f, 0, i, j]
+                w += acc[f, 1, i, j]
+                occupied = w > 1e-9 * solid
+                mean[f, i, j] = s / w if occupied else np.nan
+                coverage[f, i, j] = w / solid if occupied else 0.0
+
+
 def cone_sums(
     swath: ViirsSwath,
     sat_m,
@@ -284,15 +308,11 @@ def cone_sums(
                 sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
                 np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, ring_c, order, acc,
             )  # fmt: skip
-    acc = np.cumsum(acc, axis=-1)[..., :m]
-    sums, wsum = acc[:, 0], acc[:, 1]
     solid = sum(c * 2 * np.pi * (1 - np.cos(h)) for h, c in kernel)
-    # an empty cone's sum is what rounding leaves of the runs that passed it (~1e-16 of the row's weight);
-    # one pixel weighs ~1e-3 of a cone's solid angle
-    occupied = wsum > 1e-9 * solid
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.where(occupied, sums / wsum, np.nan)
-    return mean, np.where(occupied, wsum / solid, 0.0)
+    mean, coverage = np.empty((nf, m, m)), np.empty((nf, m, m))
+    with KERNEL_LOCK:
+        _finish(acc, solid, mean, coverage)
+    return mean, coverage
 
 
 def warm_up() -> float:
@@ -312,5 +332,6 @@ def warm_up() -> float:
     x = np.cross([0.0, 0.0, 1.0], z)
     sbf = np.stack([x, np.cross(z, x), z], axis=1)
     offsets = np.array([-1e-3, 0.0, 1e-3])
-    cone_sums(ViirsSwath([piece]), sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
+    mean, _ = cone_sums(ViirsSwath([piece]), sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
+    i5_band("j01").bt_from_radiance(mean)
     return time.perf_counter() - t0

@@ -29,7 +29,6 @@ Python exception check in every loop that keeps the compiler from vectorising it
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import dataclass
 
 import numba
@@ -38,13 +37,11 @@ from scipy.ndimage import minimum_filter1d
 from scipy.spatial import cKDTree
 
 from monitor.geometry import wgs84
+from monitor.threads import KERNEL_LOCK
 
 DETECTORS = 32  # VIIRS I-band detectors per scan
 BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
 SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smallest within +-200 columns
-# numba's default (workqueue) threading layer runs one parallel region at a time in a process: every
-# parallel kernel launch takes this lock (the daemon may assess two satellites in two threads)
-KERNEL_LOCK = threading.Lock()
 
 
 @dataclass

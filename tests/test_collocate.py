@@ -7,13 +7,14 @@ import numpy as np
 import pytest
 
 from monitor import collocate, swath
-from monitor.assess import AssessConfig, _piece, _SwathCache, parallel_threads
+from monitor.assess import AssessConfig, _piece, _SwathCache
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbation_grid
 from monitor.sdr import read_file
 from monitor.sdr.pairing import plan
 from monitor.spectral import i5_band
+from monitor.threads import parallel_threads
 
 
 @pytest.fixture(scope="module")
@@ -313,7 +314,7 @@ def _two_threads():
 def test_two_threads_may_assess_at_once():
     """The daemon may run two satellites' jobs in two threads. Under numba's workqueue threading layer
     (the one left where neither OpenMP nor TBB is installed) concurrent parallel regions terminate the
-    process, unless every launch takes swath.KERNEL_LOCK: run it there, in a process of its own."""
+    process, unless every launch takes threads.KERNEL_LOCK: run it there, in a process of its own."""
     import os
     import subprocess
     import sys

@@ -37,3 +37,27 @@ def test_hamming_keeps_smooth_spectra_and_out_of_table_is_nan():
     assert np.isnan(i5_band("j01").radiance_from_bt(400.0))
     with pytest.raises(DataError, match="no I5 spectral response"):
         I5Band("metop")
+
+
+@pytest.mark.parametrize("sat", ["npp", "j01"])
+def test_bt_from_radiance_is_np_interp_bit_for_bit(sat):
+    """The compiled inversion gives np.interp's numbers: random radiances within and beyond the table, the
+    table's own points and their neighbours, NaN and infinities, in any shape."""
+    band = i5_band(sat)
+    table = band.radiance_table[2]
+    rng = np.random.default_rng(5)
+    x = np.concatenate(
+        [
+            rng.uniform(table[0] * 0.9, table[-1] * 1.1, 200_000),
+            table,
+            np.nextafter(table, 0.0),
+            np.nextafter(table, np.inf),
+            [np.nan, np.inf, -np.inf, 0.0, -1.0],
+        ]
+    )
+    t = np.arange(band.T_MIN_K, band.T_MAX_K + band.T_STEP_K / 2, band.T_STEP_K)
+    expected = np.interp(x, table, t, left=np.nan, right=np.nan)
+    np.testing.assert_array_equal(band.bt_from_radiance(x), expected)
+    grid = x[: 200 * 7].reshape(200, 7)[:, ::2]  # a strided view
+    np.testing.assert_array_equal(band.bt_from_radiance(grid), expected[: 200 * 7].reshape(200, 7)[:, ::2])
+    assert band.bt_from_radiance(float(x[0])) == expected[0] and np.ndim(band.bt_from_radiance(x[0])) == 0
