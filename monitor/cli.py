@@ -15,6 +15,7 @@ import logging
 import sys
 from pathlib import Path
 
+from monitor import allocator
 from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
 from monitor.errors import DataError
 from monitor.satellites import SATELLITES
@@ -838,6 +839,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     setup_logging(args.verbose, args.log_format)
+    allocator.reuse_freed_memory()
     logging.getLogger("urllib3").setLevel(logging.WARNING)  # its debug lines carry request paths (webhooks)
     logging.getLogger("h5py").setLevel(logging.INFO)
     try:

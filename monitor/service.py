@@ -23,6 +23,7 @@ import socket
 import threading
 from pathlib import Path
 
+from monitor import allocator
 from monitor.health import Health
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources import make_source
@@ -123,9 +124,12 @@ class Service:
             LOG.info("run %s %s", satellite, day)
             sd_notify(f"STATUS=assessing {satellite} {day}")
             with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
-                out = run_day(
-                    self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress
-                )
+                try:
+                    out = run_day(
+                        self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress
+                    )
+                finally:
+                    allocator.release_freed_memory()
             LOG.info("%s", out.summary())
             if self.metrics is not None:
                 self.metrics.record(out)
