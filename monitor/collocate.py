@@ -35,7 +35,7 @@ import numpy as np
 
 from monitor.constants import FOV_DIAMETER_RAD, MAX_GRID_SPREAD_RAD
 from monitor.geometry import wgs84
-from monitor.spectral import i5_band
+from monitor.spectral import PARALLEL_FROM, i5_band
 from monitor.swath import BLOCK_PX, DETECTORS, SwathPiece, ViirsSwath, swath_piece
 from monitor.threads import KERNEL_LOCK
 
@@ -333,5 +333,6 @@ def warm_up() -> float:
     sbf = np.stack([x, np.cross(z, x), z], axis=1)
     offsets = np.array([-1e-3, 0.0, 1e-3])
     mean, _ = cone_sums(ViirsSwath([piece]), sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
-    i5_band("j01").bt_from_radiance(mean)
+    for radiance in (mean, np.full(PARALLEL_FROM, 5.0)):  # the inversion's serial and parallel kernels
+        i5_band("j01").bt_from_radiance(radiance)
     return time.perf_counter() - t0

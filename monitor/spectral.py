@@ -25,34 +25,44 @@ C2 = 1.4387769  # hc/k, cm K
 SRF_FILES = {"npp": "npp_viirs_i05_srf.csv", "j01": "n20_viirs_i05_srf.csv", "j02": "n20_viirs_i05_srf.csv"}
 HAMMING = (0.23, 0.54, 0.23)
 GUESS_BINS = 4096  # the inverse table's index is guessed from a uniform grid of radiance
+PARALLEL_FROM = 1 << 16  # values converted at once from which the parallel kernel is worth its lock
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _interp_one(v, xp, fp, guess):
+    """``np.interp(v, xp, fp, left=NaN, right=NaN)`` bit for bit (the same slope and fall-backs). *xp*
+    ascends; guess[k] is at most the index of the last xp <= v for every v in the k-th of the uniform bins
+    between xp[0] and xp[-1], so a few steps find it."""
+    n = xp.shape[0]
+    if not (v >= xp[0] and v <= xp[n - 1]):  # NaN, or outside the table
+        return np.nan
+    nb = guess.shape[0] - 1
+    j = guess[min(int((v - xp[0]) * (nb / (xp[n - 1] - xp[0]))), nb)]
+    while j + 1 < n and xp[j + 1] <= v:
+        j += 1
+    if j == n - 1 or xp[j] == v:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    r = slope * (v - xp[j]) + fp[j]
+    if math.isnan(r):
+        r = slope * (v - xp[j + 1]) + fp[j + 1]
+        if math.isnan(r) and fp[j] == fp[j + 1]:
+            r = fp[j]
+    return r
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _interp(x, xp, fp, guess, out):
-    """``np.interp(x, xp, fp, left=NaN, right=NaN)`` bit for bit (the same slope and fall-backs), in
-    parallel, for flat *x* and *out*. *xp* ascends; guess[k] is at most the index of the last xp <= x for
-    every x in the k-th of the uniform bins between xp[0] and xp[-1], so a few steps find it."""
-    n = xp.shape[0]
-    nb = guess.shape[0] - 1
-    scale = nb / (xp[n - 1] - xp[0])
+def _interp_parallel(x, xp, fp, guess, out):
+    """:func:`_interp_one` of every value of flat *x* into *out*, in parallel."""
     for i in numba.prange(x.shape[0]):
-        v = x[i]
-        if not (v >= xp[0] and v <= xp[n - 1]):  # NaN, or outside the table
-            out[i] = np.nan
-            continue
-        j = guess[min(int((v - xp[0]) * scale), nb)]
-        while j + 1 < n and xp[j + 1] <= v:
-            j += 1
-        if j == n - 1 or xp[j] == v:
-            out[i] = fp[j]
-            continue
-        slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
-        r = slope * (v - xp[j]) + fp[j]
-        if math.isnan(r):
-            r = slope * (v - xp[j + 1]) + fp[j + 1]
-            if math.isnan(r) and fp[j] == fp[j + 1]:
-                r = fp[j]
-        out[i] = r
+        out[i] = _interp_one(x[i], xp, fp, guess)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _interp_serial(x, xp, fp, guess, out):
+    """:func:`_interp_one` of every value of flat *x* into *out*, on the calling thread."""
+    for i in range(x.shape[0]):
+        out[i] = _interp_one(x[i], xp, fp, guess)
 
 
 def planck_radiance(wavenumber_cm1, t_k):
@@ -137,8 +147,11 @@ class I5Band:
         x = np.ravel(np.asarray(radiance, np.float64))
         shape = np.shape(radiance)
         out = np.empty(shape)
-        with KERNEL_LOCK:
-            _interp(x, self._l, self._t, self._guess, out.reshape(-1))
+        if x.size >= PARALLEL_FROM:
+            with KERNEL_LOCK:
+                _interp_parallel(x, self._l, self._t, self._guess, out.reshape(-1))
+        else:  # a CrIS granule's 1080 FOVs: no lock to wait for beside a running kernel
+            _interp_serial(x, self._l, self._t, self._guess, out.reshape(-1))
         return out if shape else out[()]
 
 
