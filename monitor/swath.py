@@ -228,8 +228,13 @@ def _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radi
     frames = np.empty((cols, 9))
     for c in range(cols):
         _scan_frame(first, last, step, have, k + 1, c, frames[c])
+    lo = np.empty((nbc, 3))  # the bounding box of each block of the current band of BLOCK_PX rows
+    hi = np.empty((nbc, 3))
     for r in range(k * DETECTORS, (k + 1) * DETECTORS):
         d = r - k * DETECTORS
+        if d % BLOCK_PX == 0:
+            lo[:] = np.inf
+            hi[:] = -np.inf
         for c in range(cols):
             a0 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 0)
             a1 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 1)
@@ -244,25 +249,25 @@ def _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radi
             area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
             if not (math.isfinite(x0) and math.isfinite(x1) and math.isfinite(x2)):
                 radiance[r, c] = np.nan
-    for br in range(k * DETECTORS // BLOCK_PX, (k + 1) * DETECTORS // BLOCK_PX):
-        for bc in range(nbc):
-            lo0 = lo1 = lo2 = np.inf
-            hi0 = hi1 = hi2 = -np.inf
-            for r in range(br * BLOCK_PX, (br + 1) * BLOCK_PX):
-                for c in range(bc * BLOCK_PX, min((bc + 1) * BLOCK_PX, cols)):
-                    if math.isfinite(radiance[r, c]):
-                        top[k] = max(top[k], h[r, c])
-                        lo0, hi0 = min(lo0, pos[r, c, 0]), max(hi0, pos[r, c, 0])
-                        lo1, hi1 = min(lo1, pos[r, c, 1]), max(hi1, pos[r, c, 1])
-                        lo2, hi2 = min(lo2, pos[r, c, 2]), max(hi2, pos[r, c, 2])
-            if lo0 > hi0:
-                centre[br, bc, :] = np.nan
-                radius[br, bc] = np.nan
-                continue
-            centre[br, bc, 0] = (lo0 + hi0) / 2
-            centre[br, bc, 1] = (lo1 + hi1) / 2
-            centre[br, bc, 2] = (lo2 + hi2) / 2
-            radius[br, bc] = math.sqrt((hi0 - lo0) ** 2 + (hi1 - lo1) ** 2 + (hi2 - lo2) ** 2) / 2 + 1.0
+            if math.isfinite(radiance[r, c]):
+                top[k] = max(top[k], h[r, c])
+                bc = c // BLOCK_PX
+                for x in range(3):
+                    lo[bc, x] = min(lo[bc, x], pos[r, c, x])
+                    hi[bc, x] = max(hi[bc, x], pos[r, c, x])
+        if d % BLOCK_PX == BLOCK_PX - 1:
+            br = r // BLOCK_PX
+            for bc in range(nbc):
+                if lo[bc, 0] > hi[bc, 0]:
+                    centre[br, bc, :] = np.nan
+                    radius[br, bc] = np.nan
+                    continue
+                lo0, lo1, lo2 = lo[bc, 0], lo[bc, 1], lo[bc, 2]
+                hi0, hi1, hi2 = hi[bc, 0], hi[bc, 1], hi[bc, 2]
+                centre[br, bc, 0] = (lo0 + hi0) / 2
+                centre[br, bc, 1] = (lo1 + hi1) / 2
+                centre[br, bc, 2] = (lo2 + hi2) / 2
+                radius[br, bc] = math.sqrt((hi0 - lo0) ** 2 + (hi1 - lo1) ** 2 + (hi2 - lo2) ** 2) / 2 + 1.0
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
