@@ -10,6 +10,7 @@ import pytest
 
 from monitor.assess import AssessConfig, assess_paths
 from monitor.mapping.engpkt import load_ep
+from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
 
 REAL_DIR = Path(__file__).parent / "data" / "real"
@@ -55,6 +56,13 @@ class CaseCache:
 @pytest.fixture(scope="session")
 def cases(tmp_path_factory):
     return CaseCache(tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def case_plan(cases):
+    """The plan (paired CrIS and VIIRS granules) of the default simulated case."""
+    out, _, _ = cases.get()
+    return plan([out])
 
 
 def truth_arrays(truth):

@@ -12,15 +12,8 @@ from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbation_grid
 from monitor.sdr import read_file
-from monitor.sdr.pairing import plan
 from monitor.spectral import i5_band
 from monitor.threads import parallel_threads
-
-
-@pytest.fixture(scope="module")
-def case_plan(cases):
-    out, _, _ = cases.get()
-    return plan([out])
 
 
 @pytest.fixture(scope="module")

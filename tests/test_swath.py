@@ -11,16 +11,10 @@ from monitor.assess import AssessConfig, _piece, _SwathCache
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.sdr import read_file
-from monitor.sdr.pairing import neighbours, plan
+from monitor.sdr.pairing import neighbours
 from monitor.sdr.readers import read_viirs_geo_scan
 from monitor.spectral import i5_band
 from monitor.threads import parallel_threads
-
-
-@pytest.fixture(scope="module")
-def case_plan(cases):
-    out, _, _ = cases.get()
-    return plan([out])
 
 
 @pytest.fixture(scope="module")
