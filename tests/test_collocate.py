@@ -26,6 +26,17 @@ def scene(case_plan):
     return fg, swath.ViirsSwath(pieces)
 
 
+def _one_fov(viirs, fg, idx):
+    """The first five arguments of cone_sums for the one FOV *idx* (scan, FOR, FOV) of the geometry fg."""
+    return (
+        viirs,
+        fg.sat_ecef_m[idx][None],
+        fg.sbf_to_ecef[idx][None],
+        fg.alpha_rad[idx][None],
+        fg.beta_rad[idx][None],
+    )
+
+
 def _brute(viirs, sat, m, alpha, beta, offsets, half_angle):
     pos = np.concatenate([p.ecef_m.reshape(-1, 3) for p in viirs.pieces]).astype(float)
     rad = np.concatenate([p.radiance.reshape(-1) for p in viirs.pieces])
@@ -55,11 +66,7 @@ def test_interval_method_equals_brute_force(scene, scan, for_, fov):
     offsets = perturbation_grid(4, 900e-6)
     idx = (scan, for_, fov)
     mean, cover = collocate.cone_sums(
-        viirs,
-        fg.sat_ecef_m[idx][None],
-        fg.sbf_to_ecef[idx][None],
-        fg.alpha_rad[idx][None],
-        fg.beta_rad[idx][None],
+        *_one_fov(viirs, fg, idx),
         offsets,
     )
     bm, bc = _brute(
@@ -97,11 +104,7 @@ def test_spatial_response_kernel_is_a_weighted_stack_of_top_hats(scene):
     fg, viirs = scene
     idx = (1, 10, 4)
     args = (
-        viirs,
-        fg.sat_ecef_m[idx][None],
-        fg.sbf_to_ecef[idx][None],
-        fg.alpha_rad[idx][None],
-        fg.beta_rad[idx][None],
+        *_one_fov(viirs, fg, idx),
         perturbation_grid(1, 450e-6),
     )
     resp, cov = collocate.cone_sums(*args, kernel=collocate.SPATIAL_RESPONSE)
@@ -138,11 +141,7 @@ def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):
     cut = swath.ViirsSwath([piece])
     offsets = perturbation_grid(2, 900e-6)
     mean, cover = collocate.cone_sums(
-        cut,
-        fg.sat_ecef_m[idx][None],
-        fg.sbf_to_ecef[idx][None],
-        fg.alpha_rad[idx][None],
-        fg.beta_rad[idx][None],
+        *_one_fov(cut, fg, idx),
         offsets,
     )
     bm, bc = _brute(
@@ -264,11 +263,7 @@ def test_a_grid_beyond_the_kernels_reach_is_refused(scene):
     idx = (0, 14, 4)
     with pytest.raises(ValueError, match="n\\^2 s exceeds"):
         collocate.cone_sums(
-            viirs,
-            fg.sat_ecef_m[idx][None],
-            fg.sbf_to_ecef[idx][None],
-            fg.alpha_rad[idx][None],
-            fg.beta_rad[idx][None],
+            *_one_fov(viirs, fg, idx),
             perturbation_grid(30, 450e-6),
         )
 
