@@ -18,12 +18,12 @@ Search blocks. Each prepared granule keeps, per 4 x 4 block of pixels (blocks ne
 a sphere holding its usable pixels, and a KD-tree of the block centres to find where a FOV lands.
 
 Columns. VIIRS scans to 56 deg from nadir, CrIS's cones reach ~51 deg: the columns no cone can reach
-(~14 % of a granule) are not prepared when the caller gives the reach (:func:`view_columns`).
+(~15 % of a granule) are not prepared when the caller gives the reach (:func:`view_columns`).
 
 A granule is prepared once per run (about 10 million pixels): the per-pixel work is compiled (numba) and
 runs scan by scan in parallel; only the one-scan statistics and the KD-tree are numpy/scipy. The kernels
 use numba's numpy error model: a division by zero gives inf or NaN, which they test for, instead of a
-Python exception check in every loop that keeps the compiler from vectorising it (15 % of the time).
+Python exception check in every loop that keeps the compiler from vectorising it (~8 % of the time).
 """
 
 from __future__ import annotations
