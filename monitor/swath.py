@@ -41,6 +41,9 @@ from monitor.threads import KERNEL_LOCK
 
 DETECTORS = 32  # VIIRS I-band detectors per scan
 BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
+# the passes' threads take scans one at a time as they come free, not in equal shares fixed in advance:
+# the read-ahead thread takes turns on the cores, and a share fixed in advance waits for the slowest
+SCANS_PER_TASK = 1
 SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smallest within +-200 columns
 
 
@@ -359,7 +362,7 @@ def swath_piece(
     have[1:-1] = True
     t_min, t_step, table = band.radiance_table
     bt, good = np.asarray(bt_k, f32), np.asarray(good, bool)
-    with KERNEL_LOCK:
+    with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
         _locate(lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, first, last, step)
     for slot, halo in ((0, before), (nscan + 1, after)):
         if halo is not None:
@@ -371,7 +374,7 @@ def swath_piece(
     centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
     radius = np.empty(centre.shape[:2])
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
-    with KERNEL_LOCK:
+    with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
         _weigh(pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
     scan = pos.reshape(nscan, DETECTORS, cols, 3)
