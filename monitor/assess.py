@@ -90,18 +90,40 @@ def _stage(timings, name):
 
 @dataclass
 class _SwathCache:
-    """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept."""
+    """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept. *spans* holds, by key,
+    the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`_scan_spans`)."""
 
     pieces: dict = field(default_factory=dict)
     keep: int = 3
+    spans: dict = field(default_factory=dict)
+
+
+def _widen(span, other):
+    """The IET span covering both *span* and *other* (either may be None)."""
+    if span is None or other is None:
+        return other if span is None else span
+    return (min(span[0], other[0]), max(span[1], other[1]))
+
+
+def _scan_spans(cris: list, viirs: dict) -> dict:
+    """Per VIIRS granule key, the IET span (us) of the scans the CrIS granules *cris* using it need (by
+    their nominal bounds, +- collocate.SCAN_TIME_MARGIN_US): so that each is prepared once per run."""
+    spans = {}
+    margin = collocate.SCAN_TIME_MARGIN_US
+    for g in cris:
+        need = (g.geo_meta.start_iet_us - margin, g.geo_meta.end_iet_us + margin)
+        for v in viirs[g.key]:
+            spans[v.key] = _widen(spans.get(v.key), need)
+    return spans
 
 
 @dataclass
 class GranuleInputs:
     """What one CrIS granule's assessment needs before its VIIRS granules are prepared: its GEO and SDR,
     their inverse geometry (fg, valid, fill: :func:`_cris_geometry`), how far from nadir its cones reach
-    (view_rad), its band BT (bt_cris_k), and the raw VIIRS granules (key -> (GEO, SDR, scan before, scan
-    after)) not yet prepared."""
+    (view_rad), the IET span (us) of the VIIRS scans they may reach (span_us: its observation times +-
+    collocate.SCAN_TIME_MARGIN_US; None when it has none), its band BT (bt_cris_k), and the raw VIIRS
+    granules (key -> (GEO, SDR, scan before, scan after)) not yet prepared."""
 
     geo: object
     sdr: object
@@ -109,6 +131,7 @@ class GranuleInputs:
     valid: np.ndarray
     fill: dict
     view_rad: float
+    span_us: tuple | None
     bt_cris_k: np.ndarray
     viirs: dict = field(default_factory=dict)
 
@@ -164,23 +187,32 @@ def read_inputs(
             cfg.offsets_rad,
             KERNELS[cfg.kernel],
         )
-    return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, bt_cris, raw)
+        seen = geo.for_time_us[geo.for_time_us > 0]
+        margin = collocate.SCAN_TIME_MARGIN_US
+        span_us = (int(seen.min()) - margin, int(seen.max()) + margin) if seen.size else None
+    return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, span_us, bt_cris, raw)
 
 
-def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, view_rad, timings=None, raw=None):
-    """The granule prepared out to at least *view_rad* from nadir: from the cache, or prepared out to
-    view_rad + VIEW_MARGIN_RAD (so that the next CrIS granule's slightly wider reach finds it ready)."""
-    if v.key in cache.pieces and cache.pieces[v.key].view_rad >= view_rad:
-        return cache.pieces[v.key]
+def _piece(
+    v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, view_rad, timings=None, raw=None, span_us=None
+):
+    """The granule prepared out to at least *view_rad* from nadir, with its scans of the IET span
+    *span_us* (None: all): from the cache, or prepared out to view_rad + VIEW_MARGIN_RAD (so that the next
+    CrIS granule's slightly wider reach finds it ready) with the scans the whole run needs."""
+    cached = cache.pieces.get(v.key)
+    if cached is not None and cached.view_rad >= view_rad and (span_us is None or cached.covers(*span_us)):
+        return cached
     cache.pieces.pop(v.key, None)
     if raw is None:
         with _stage(timings, "read"):
             raw = _read_viirs(v, viirs_all)
     geo, sdr, halo_before, halo_after = raw
+    run_span = _widen(cache.spans.get(v.key), span_us) if span_us is not None else None
     with _stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
             sat_m=geo.sc_position_m, view_rad=view_rad + collocate.VIEW_MARGIN_RAD,
+            scan_start_us=geo.start_time_us, span_us=run_span,
         )  # fmt: skip
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))
@@ -189,13 +221,21 @@ def _piece(v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, view_rad,
 
 
 def _load_swath(
-    viirs: list[GranuleFiles], viirs_all: list, band, cache: _SwathCache, view_rad, timings=None, raw=None
+    viirs: list[GranuleFiles],
+    viirs_all: list,
+    band,
+    cache: _SwathCache,
+    view_rad,
+    timings=None,
+    raw=None,
+    span_us=None,
 ) -> swath.ViirsSwath:
     """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*) out
-    to *view_rad* from nadir, from the raw granules in *raw* (key -> :func:`_read_viirs`) or read here."""
+    to *view_rad* from nadir and over the IET span *span_us*, from the raw granules in *raw* (key ->
+    :func:`_read_viirs`) or read here."""
     raw = raw or {}
     return swath.ViirsSwath(
-        [_piece(v, viirs_all, band, cache, view_rad, timings, raw.get(v.key)) for v in viirs]
+        [_piece(v, viirs_all, band, cache, view_rad, timings, raw.get(v.key), span_us) for v in viirs]
     )
 
 
@@ -221,7 +261,9 @@ def collocate_granule(
     geo, sdr, fg, valid, fill, bt_cris = (
         inputs.geo, inputs.sdr, inputs.fg, inputs.valid, inputs.fill, inputs.bt_cris_k
     )  # fmt: skip
-    pieces = _load_swath(viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs)
+    pieces = _load_swath(
+        viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs, inputs.span_us
+    )
     with _stage(timings, "collocation"):
         bt_viirs, coverage = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (
@@ -477,7 +519,7 @@ def _collocate_run(
 ):
     """Collocate a time-ordered run of CrIS granules; returns (samples, skipped)."""
     band = i5_band(satellite)
-    cache = _SwathCache()
+    cache = _SwathCache(spans=_scan_spans(cris, viirs))
     samples, skipped = [], []
     reading = {}  # the read-ahead thread's seconds, added to *timings* at the end
 

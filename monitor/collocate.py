@@ -55,6 +55,10 @@ FOVS_PER_TASK = 8
 # VIIRS columns are prepared out to the farthest view angle a cone reaches plus this: the two instruments
 # see a ground point from spacecraft positions seconds apart (its cross-track angle differs by far less)
 VIEW_MARGIN_RAD = math.radians(0.5)
+# VIIRS scans are prepared from this long before a CrIS granule's first observation to this long after its
+# last: the instruments see a ground point within seconds of each other (a corner FOV lies ~1.1 deg, a cone
+# reaches ~0.9 deg, from the FOR's LOS: ~55 km or 9 s of flight along the track at the swath edge)
+SCAN_TIME_MARGIN_US = 16_000_000
 
 
 def reach_rad(offsets_rad, kernel=TOP_HAT) -> float:

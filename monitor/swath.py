@@ -17,8 +17,11 @@ covers counts half). The sum of the weights inside a cone over the cone's solid 
 Search blocks. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans),
 a sphere holding its usable pixels, and a KD-tree of the block centres to find where a FOV lands.
 
-Columns. VIIRS scans to 56 deg from nadir, CrIS's cones reach ~51 deg: the columns no cone can reach
-(~15 % of a granule) are not prepared when the caller gives the reach (:func:`view_columns`).
+Columns and scans. VIIRS scans to 56 deg from nadir, CrIS's cones reach ~51 deg: the columns no cone can
+reach (~15 % of a granule) are not prepared when the caller gives the reach (:func:`view_columns`). Nor
+are the scans observed long before or after every CrIS granule that uses the VIIRS granule, when the
+caller gives that time span (:func:`scans_between`): a CrIS granule (32 s) needs a third of one VIIRS
+granule (86 s), or parts of two.
 
 A granule is prepared once per run (about 10 million pixels): the per-pixel work is compiled (numba) and
 runs scan by scan in parallel; only the one-scan statistics and the KD-tree are numpy/scipy. The kernels
@@ -58,7 +61,8 @@ class SwathPiece:
     +-200 columns (col_spacing_m), the along-track advance of a scan (advance_m) and the detector step
     (det_step_m), all m; max_height_m the highest usable pixel. They size the search windows.
     The piece holds the granule's columns from *first_column* on that are seen within *view_rad* of nadir
-    (inf: all columns).
+    (inf: all columns), and its scans from *first_scan* on that cover the IET span *span_us* (start of the
+    first scan, start of the scan after the last; -inf and inf at the granule's ends).
     """
 
     ecef_m: np.ndarray
@@ -75,10 +79,16 @@ class SwathPiece:
     tree_cols: np.ndarray
     first_column: int = 0
     view_rad: float = math.inf
+    first_scan: int = 0
+    span_us: tuple = (-math.inf, math.inf)
 
     @property
     def shape(self):
         return self.radiance.shape
+
+    def covers(self, t0_us, t1_us) -> bool:
+        """Whether the piece holds every scan observed between IET t0_us and t1_us."""
+        return self.span_us[0] <= t0_us and t1_us < self.span_us[1]
 
     def nearest(self, points_m):
         """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point,
@@ -319,6 +329,18 @@ def view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad) -> slice:
     return slice(int(cols[0]) // BLOCK_PX * BLOCK_PX, int(cols[-1]) + 1) if cols.size else slice(None)
 
 
+def scans_between(scan_start_us, t0_us, t1_us) -> slice:
+    """The scans observed between IET t0_us and t1_us, from the scans' start times *scan_start_us* (IET
+    us; a scan lasts until the next starts, the last to the granule's end): all scans when those times are
+    not all set and increasing (nothing to judge by)."""
+    t = np.asarray(scan_start_us, np.int64)
+    if t.size == 0 or t[0] <= 0 or np.any(np.diff(t) <= 0):
+        return slice(None)
+    first = max(int(np.searchsorted(t, t0_us, side="right")) - 1, 0)
+    stop = int(np.searchsorted(t, t1_us, side="right"))
+    return slice(first, max(stop, first + 1))
+
+
 def swath_piece(
     lat_rad,
     lon_rad,
@@ -330,6 +352,8 @@ def swath_piece(
     after=None,
     sat_m=None,
     view_rad=math.inf,
+    scan_start_us=None,
+    span_us=None,
 ) -> SwathPiece:
     """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
 
@@ -338,8 +362,28 @@ def swath_piece(
     *before* and *after* are optional (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent
     scan, so that the scan overlap at the granule's first and last scan is counted as inside a continuous
     swath. Given *sat_m*, the spacecraft position of each scan (ECEF m), only the columns seen within
-    *view_rad* of nadir are prepared (:func:`view_columns`).
+    *view_rad* of nadir are prepared (:func:`view_columns`); given *span_us* (t0, t1) and the start time
+    of each scan *scan_start_us* (IET us), only the scans observed between t0 and t1
+    (:func:`scans_between`), each with the same weights as in the whole granule (the scans next to those
+    kept are their halos).
     """
+    scans = slice(None)
+    if scan_start_us is not None and span_us is not None:
+        scans = scans_between(scan_start_us, *span_us)
+    if scans != slice(None):
+        first, stop, _ = scans.indices(len(scan_start_us))
+        r0, r1 = first * DETECTORS, stop * DETECTORS
+        geo = (lat_rad, lon_rad, height_m)
+        if first > 0:
+            before = tuple(a[r0 - DETECTORS : r0] for a in geo)
+        if r1 < np.shape(lat_rad)[0]:
+            after = tuple(a[r1 : r1 + DETECTORS] for a in geo)
+        lat_rad, lon_rad, height_m, bt_k, good = (a[r0:r1] for a in (*geo, bt_k, good))
+        sat_m = None if sat_m is None else sat_m[first:stop]
+        t = np.asarray(scan_start_us, np.int64)
+        span_us = (t[first] if first > 0 else -math.inf, t[stop] if stop < len(t) else math.inf)
+    else:
+        span_us = (-math.inf, math.inf)
     kept = slice(None)
     if sat_m is not None and view_rad < math.pi / 2:
         kept = view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad)
@@ -403,4 +447,6 @@ def swath_piece(
         c_idx * BLOCK_PX,
         kept.start or 0,
         view_rad,
+        scans.start or 0,
+        span_us,
     )

@@ -1,5 +1,5 @@
-"""VIIRS granules prepared for the cone test: the same on any number of threads, and only the columns no
-cone can reach left out."""
+"""VIIRS granules prepared for the cone test: the same on any number of threads, and only the columns and
+scans no cone can reach left out."""
 
 import math
 
@@ -86,6 +86,52 @@ def test_columns_no_cone_reaches_change_no_cone_sum(case_plan):
         c.radiance.shape[1] < f.radiance.shape[1] for f, c in zip(full.pieces, cut.pieces, strict=True)
     )
     assert all(c.first_column > 0 and c.view_rad < math.pi for c in cut.pieces)
+    a, b = (collocate.cone_sums(sw, *sel, cfg.offsets_rad) for sw in (full, cut))
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[1], b[1])
+    assert np.isfinite(a[0]).mean() > 0.9
+
+
+def test_scans_between_picks_the_scans_observed_in_a_span():
+    start = 1_000_000 + 1_786_000 * np.arange(10)  # IET us, one scan every 1.786 s
+    assert swath.scans_between(start, start[2] + 5, start[5]) == slice(2, 6)
+    assert swath.scans_between(start, start[2], start[5] - 1) == slice(2, 5)
+    assert swath.scans_between(start, 0, start[-1] + 10**9) == slice(0, 10)  # beyond both ends: all
+    assert swath.scans_between(start, 0, 1) == slice(0, 1)  # before the granule: its first scan at least
+    unusable = start.copy()
+    unusable[4] = -993  # a fill time: nothing to judge by
+    assert swath.scans_between(unusable, start[2], start[5]) == slice(None)
+    assert swath.scans_between(start[::-1], start[2], start[5]) == slice(None)
+
+
+def test_scans_no_cone_reaches_change_no_cone_sum(case_plan):
+    """Prepared for one CrIS granule's observation times (+- the margin), a VIIRS granule keeps fewer
+    scans, and every FOV's cone sums are the same, bit for bit, as with every scan prepared."""
+    g = case_plan.cris[-1]
+    (geo,) = read_file(g.geo, kinds=("cris_geo",))
+    fg, valid = granule_geometry(geo), geo.valid
+    cfg, band = AssessConfig(), i5_band(case_plan.satellite)
+    sel = (fg.sat_ecef_m[valid], fg.sbf_to_ecef[valid], fg.alpha_rad[valid], fg.beta_rad[valid])
+    seen = geo.for_time_us[geo.for_time_us > 0]
+    margin = collocate.SCAN_TIME_MARGIN_US
+    span = (int(seen.min()) - margin, int(seen.max()) + margin)
+    full, cut = (
+        swath.ViirsSwath(
+            [
+                _piece(v, case_plan.viirs_all, band, _SwathCache(), 1.0, span_us=s)
+                for v in case_plan.viirs[g.key]
+            ]
+        )
+        for s in (None, span)
+    )
+    assert sum(c.shape[0] for c in cut.pieces) < sum(f.shape[0] for f in full.pieces)
+    assert all(c.covers(*span) for c in cut.pieces)
+    assert not any(c.covers(span[0] - 10**9, span[1] + 10**9) for c in cut.pieces if c.first_scan)
+    for f, c in zip(full.pieces, cut.pieces, strict=True):  # the kept scans weigh as in the whole granule
+        rows = slice(c.first_scan * swath.DETECTORS, c.first_scan * swath.DETECTORS + c.shape[0])
+        cols = slice(c.first_column - f.first_column, c.first_column - f.first_column + c.shape[1])
+        np.testing.assert_array_equal(c.area_vec_m2, f.area_vec_m2[rows, cols])
+        np.testing.assert_array_equal(c.radiance, f.radiance[rows, cols])
     a, b = (collocate.cone_sums(sw, *sel, cfg.offsets_rad) for sw in (full, cut))
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_array_equal(a[1], b[1])
