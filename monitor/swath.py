@@ -176,17 +176,14 @@ def _locate(lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, firs
         _locate_scan(k, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _half_diff(pos, r, c, dr, dc, has_prev, has_next, x):
-    """Half the difference of the two neighbours (r -+ dr, c -+ dc) of pixel (r, c) in component x,
-    one-sided where one is missing (outside the scan or NaN)."""
-    here = np.float64(pos[r, c, x])
-    fwd = np.float64(pos[r + dr, c + dc, x]) - here if has_next else np.nan
-    bwd = here - np.float64(pos[r - dr, c - dc, x]) if has_prev else np.nan
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _centred(here, nxt, prv):
+    """Half the difference of a pixel's two neighbours *nxt* and *prv* (one coordinate, m), one-sided
+    where one is missing (NaN)."""
+    fwd = nxt - here
+    bwd = here - prv
     both = (fwd + bwd) * 0.5
-    if math.isfinite(both):
-        return both
-    return fwd if math.isfinite(fwd) else bwd
+    return both if math.isfinite(both) else (fwd if math.isfinite(fwd) else bwd)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -212,9 +209,9 @@ def _scan_frame(first, last, step, have, k, c, out):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _share(pos, r, c, frame):
-    """The share (0.5..1) of the footprint of pixel (r, c) that is its own, in its column's *frame*
-    (:func:`_scan_frame`).
+def _share(p0, p1, p2, frames, c):
+    """The share (0.5..1) of the footprint of the pixel at (p0, p1, p2) (ECEF m) in column c that is its
+    own, in its column's frame (frames[:, c], :func:`_scan_frame`).
 
     Along the track each pixel spans one detector step centred on it, each neighbouring scan its
     first-to-last valid detector span plus half a step each side; an overlap of a fraction f of the
@@ -222,43 +219,68 @@ def _share(pos, r, c, frame):
     weight in stripes at the scan edges near nadir, where the overlap is a fraction of a detector, and
     biases the in-track minimum there.) A neighbour with no valid pixel in the column overlaps nothing.
     """
-    s_pix = pos[r, c, 0] * frame[0] + pos[r, c, 1] * frame[1] + pos[r, c, 2] * frame[2] - frame[3]
-    half = frame[4]
-    share = 1.0
-    for slot in (5, 7):
-        overlap = min(s_pix + half, frame[slot + 1]) - max(s_pix - half, frame[slot])
-        share -= min(max(overlap / (2 * half), 0.0), 1.0) / 2
-    return share
+    s_pix = p0 * frames[0, c] + p1 * frames[1, c] + p2 * frames[2, c] - frames[3, c]
+    half = frames[4, c]
+    before = min(s_pix + half, frames[6, c]) - max(s_pix - half, frames[5, c])
+    after = min(s_pix + half, frames[8, c]) - max(s_pix - half, frames[7, c])
+    return 1.0 - min(max(before / (2 * half), 0.0), 1.0) / 2 - min(max(after / (2 * half), 0.0), 1.0) / 2
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _load_row(pos, r, inside, out):
+    """Row r of *pos* (cols, 3) into out (3, cols + 2) as float64, one coordinate per line, with a NaN
+    column at each end; all NaN when the row is not *inside* the scan."""
+    out[:, 0] = np.nan
+    out[:, -1] = np.nan
+    if not inside:
+        out[:] = np.nan
+        return
+    for c in range(pos.shape[1]):
+        for x in range(3):
+            out[x, c + 1] = pos[r, c, x]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top):
     """Pass 2 for scan k: vector footprints with the scan overlap removed, radiance NaN where either is
     unusable, the bounding sphere (centre, radius + 1 m for the float32 rounding) of each block's usable
-    pixels (NaN where it has none), and the height of the scan's highest usable pixel (top[k], m)."""
+    pixels (NaN where it has none), and the height of the scan's highest usable pixel (top[k], m).
+
+    Each footprint is the cross product of half the differences of the pixel's neighbours along the scan
+    and across the detectors; the rows it needs are held as float64 lines of coordinates padded with NaN
+    (a missing neighbour), so that the loop over a row's pixels has no branches and vectorises.
+    """
     cols = radiance.shape[1]
     nbc = centre.shape[1]
-    frames = np.empty((cols, 9))
+    frames = np.empty((9, cols))
     for c in range(cols):
-        _scan_frame(first, last, step, have, k + 1, c, frames[c])
+        _scan_frame(first, last, step, have, k + 1, c, frames[:, c])
+    prev, here, after = np.empty((3, cols + 2)), np.empty((3, cols + 2)), np.empty((3, cols + 2))
+    foot = np.empty((3, cols))
     lo = np.empty((nbc, 3))  # the bounding box of each block of the current band of BLOCK_PX rows
     hi = np.empty((nbc, 3))
     for r in range(k * DETECTORS, (k + 1) * DETECTORS):
         d = r - k * DETECTORS
+        _load_row(pos, r - 1, d > 0, prev)
+        _load_row(pos, r, True, here)
+        _load_row(pos, r + 1, d + 1 < DETECTORS, after)
         if d % BLOCK_PX == 0:
             lo[:] = np.inf
             hi[:] = -np.inf
         for c in range(cols):
-            a0 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 0)
-            a1 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 1)
-            a2 = _half_diff(pos, r, c, 0, 1, c > 0, c + 1 < cols, 2)
-            b0 = _half_diff(pos, r, c, 1, 0, d > 0, d + 1 < DETECTORS, 0)
-            b1 = _half_diff(pos, r, c, 1, 0, d > 0, d + 1 < DETECTORS, 1)
-            b2 = _half_diff(pos, r, c, 1, 0, d > 0, d + 1 < DETECTORS, 2)
-            s = _share(pos, r, c, frames[c])
-            x0 = (a1 * b2 - a2 * b1) * s
-            x1 = (a2 * b0 - a0 * b2) * s
-            x2 = (a0 * b1 - a1 * b0) * s
+            p0, p1, p2 = here[0, c + 1], here[1, c + 1], here[2, c + 1]
+            a0 = _centred(p0, here[0, c + 2], here[0, c])
+            a1 = _centred(p1, here[1, c + 2], here[1, c])
+            a2 = _centred(p2, here[2, c + 2], here[2, c])
+            b0 = _centred(p0, after[0, c + 1], prev[0, c + 1])
+            b1 = _centred(p1, after[1, c + 1], prev[1, c + 1])
+            b2 = _centred(p2, after[2, c + 1], prev[2, c + 1])
+            s = _share(p0, p1, p2, frames, c)
+            foot[0, c] = (a1 * b2 - a2 * b1) * s
+            foot[1, c] = (a2 * b0 - a0 * b2) * s
+            foot[2, c] = (a0 * b1 - a1 * b0) * s
+        for c in range(cols):
+            x0, x1, x2 = foot[0, c], foot[1, c], foot[2, c]
             area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
             if not (math.isfinite(x0) and math.isfinite(x1) and math.isfinite(x2)):
                 radiance[r, c] = np.nan
