@@ -5,9 +5,10 @@ import threading
 
 import pytest
 
+from monitor import allocator
 from monitor.config import load_config
 from monitor.pipeline import run_day
-from monitor.reprocess import period_days, reprocess
+from monitor.reprocess import _client, day_task, period_days, reprocess
 from monitor.sources.local import LocalSource
 from monitor.store.sqlite import Store
 
@@ -94,3 +95,33 @@ def test_days_found_empty_for_good_are_done(tmp_path):
     assert first.statuses == {"no_data_final": 3}  # long past: no retry
     again = reprocess(cfg, *DAYS, ["j01"], workers=1)
     assert again.skipped_done == 3 and again.finished == 0
+
+
+@pytest.mark.skipif(allocator._glibc() is None, reason="the settings are glibc's")
+def test_a_worker_reuses_freed_memory_once_it_runs_a_day(tmp_path):
+    """Dask starts workers that hand every freed array back to the system; a satellite-day sets the
+    allocator as every crisgeo command does, so that the next arrays reuse the memory."""
+
+    def refault_count():  # a local function: sent to the worker by value
+        import resource
+
+        import numpy as np
+
+        a = np.ones(50_000_000)  # 400 MB written, then freed
+        del a
+        f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        np.ones(50_000_000)
+        return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0
+
+    (tmp_path / "none").mkdir()
+    cfg = _config(tmp_path, "empty", f"{{kind: local, path: {tmp_path / 'none'}}}")
+    client, cluster = _client(None, 1)
+    try:
+        (before,) = client.run(refault_count).values()
+        client.submit(day_task, cfg, "j01", DAYS[0], pure=False).result()
+        (after,) = client.run(refault_count).values()
+    finally:
+        client.close()
+        cluster.close()
+    assert before > 150  # 400 MB of fresh pages (2 MB huge pages at the least)
+    assert after < before / 10
