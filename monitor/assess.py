@@ -105,13 +105,17 @@ def _widen(span, other):
     return (min(span[0], other[0]), max(span[1], other[1]))
 
 
+def _reach_us(first_us: int, last_us: int) -> tuple:
+    """The IET span (us) of the VIIRS scans that CrIS observations from first_us to last_us may reach."""
+    return (first_us - collocate.SCAN_TIME_MARGIN_US, last_us + collocate.SCAN_TIME_MARGIN_US)
+
+
 def _scan_spans(cris: list, viirs: dict) -> dict:
     """Per VIIRS granule key, the IET span (us) of the scans the CrIS granules *cris* using it need (by
-    their nominal bounds, +- collocate.SCAN_TIME_MARGIN_US): so that each is prepared once per run."""
+    their nominal bounds, :func:`_reach_us`): so that each is prepared once per run."""
     spans = {}
-    margin = collocate.SCAN_TIME_MARGIN_US
     for g in cris:
-        need = (g.geo_meta.start_iet_us - margin, g.geo_meta.end_iet_us + margin)
+        need = _reach_us(g.geo_meta.start_iet_us, g.geo_meta.end_iet_us)
         for v in viirs[g.key]:
             spans[v.key] = _widen(spans.get(v.key), need)
     return spans
@@ -121,8 +125,8 @@ def _scan_spans(cris: list, viirs: dict) -> dict:
 class GranuleInputs:
     """What one CrIS granule's assessment needs before its VIIRS granules are prepared: its GEO and SDR,
     their inverse geometry (fg, valid, fill: :func:`_cris_geometry`), how far from nadir its cones reach
-    (view_rad), the IET span (us) of the VIIRS scans they may reach (span_us: its observation times +-
-    collocate.SCAN_TIME_MARGIN_US; None when it has none), its band BT (bt_cris_k), and the raw VIIRS
+    (view_rad), the IET span (us) of the VIIRS scans they may reach (span_us, from its observation
+    times: :func:`_reach_us`; None when it has none), its band BT (bt_cris_k), and the raw VIIRS
     granules (key -> (GEO, SDR, scan before, scan after)) not yet prepared."""
 
     geo: object
@@ -188,8 +192,7 @@ def read_inputs(
             KERNELS[cfg.kernel],
         )
         seen = geo.for_time_us[geo.for_time_us > 0]
-        margin = collocate.SCAN_TIME_MARGIN_US
-        span_us = (int(seen.min()) - margin, int(seen.max()) + margin) if seen.size else None
+        span_us = _reach_us(int(seen.min()), int(seen.max())) if seen.size else None
     return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, span_us, bt_cris, raw)
 
 

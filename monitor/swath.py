@@ -230,11 +230,11 @@ def _share(p0, p1, p2, frames, c):
 def _load_row(pos, r, inside, out):
     """Row r of *pos* (cols, 3) into out (3, cols + 2) as float64, one coordinate per line, with a NaN
     column at each end; all NaN when the row is not *inside* the scan."""
-    out[:, 0] = np.nan
-    out[:, -1] = np.nan
     if not inside:
         out[:] = np.nan
         return
+    out[:, 0] = np.nan
+    out[:, -1] = np.nan
     for c in range(pos.shape[1]):
         for x in range(3):
             out[x, c + 1] = pos[r, c, x]
@@ -403,9 +403,9 @@ def swath_piece(
         lat_rad, lon_rad, height_m, bt_k, good = (a[r0:r1] for a in (*geo, bt_k, good))
         sat_m = None if sat_m is None else sat_m[first:stop]
         t = np.asarray(scan_start_us, np.int64)
-        span_us = (t[first] if first > 0 else -math.inf, t[stop] if stop < len(t) else math.inf)
+        covered_us = (t[first] if first > 0 else -math.inf, t[stop] if stop < len(t) else math.inf)
     else:
-        span_us = (-math.inf, math.inf)
+        covered_us = (-math.inf, math.inf)
     kept = slice(None)
     if sat_m is not None and view_rad < math.pi / 2:
         kept = view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad)
@@ -470,5 +470,5 @@ def swath_piece(
         kept.start or 0,
         view_rad,
         scans.start or 0,
-        span_us,
+        covered_us,
     )

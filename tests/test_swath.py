@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from monitor import collocate, swath
-from monitor.assess import AssessConfig, _piece, _SwathCache
+from monitor.assess import AssessConfig, _piece, _reach_us, _SwathCache
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.sdr import read_file
@@ -113,8 +113,7 @@ def test_scans_no_cone_reaches_change_no_cone_sum(case_plan):
     cfg, band = AssessConfig(), i5_band(case_plan.satellite)
     sel = (fg.sat_ecef_m[valid], fg.sbf_to_ecef[valid], fg.alpha_rad[valid], fg.beta_rad[valid])
     seen = geo.for_time_us[geo.for_time_us > 0]
-    margin = collocate.SCAN_TIME_MARGIN_US
-    span = (int(seen.min()) - margin, int(seen.max()) + margin)
+    span = _reach_us(int(seen.min()), int(seen.max()))
     full, cut = (
         swath.ViirsSwath(
             [
