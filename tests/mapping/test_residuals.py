@@ -4,10 +4,13 @@ import json
 import subprocess
 import sys
 
+import h5py
 import numpy as np
 import pytest
 
 from monitor import fingerprint as fpr
+from monitor.constants import URAD
+from monitor.geometry.instrument import fov5_angles
 from monitor.mapping import residuals
 from monitor.mapping.engpkt import load_ep
 from monitor.mapping.regeolocate import compare_with_files
@@ -30,9 +33,9 @@ def test_learned_on_five_real_granules_reproduces_the_next_five(real_geo_files, 
     """Real NOAA-20: the EP alone leaves 28 m median and 88-131 m p99 at FOR 1-3; with the residual table
     learned from granules 1-5, granules 6-10 come within ~5 m median. Granules 6 and 7 come within 18 m p99
     at every FOR. From granule 8 (00:27:43 UTC) the scene-mirror servo has moved: FORs 1-3 and 28-30 shift
-    by 10-25 urad cross-track against granules 1-7 (the per-granule residuals show it), which no table
-    learned before the shift can know; it is seen at the scan edges as p99 of 52-75 m at FOR 1, 2 and 30.
-    :class:`residuals.OwnResiduals` follows such shifts (next test)."""
+    by 10-25 urad cross-track against granules 1-7 (scan by scan in the next test), which no table learned
+    before the shift can know; it is seen at the scan edges as p99 of 52-75 m at FOR 1, 2 and 30.
+    :class:`residuals.OwnResiduals` follows such shifts (last test)."""
     table = _table(real_geo_files[:5], v115)
     before = compare_with_files(v115, real_geo_files[5:])
     after = compare_with_files(v115, real_geo_files[5:], table)
@@ -43,8 +46,26 @@ def test_learned_on_five_real_granules_reproduces_the_next_five(real_geo_files, 
     assert all(r.p99_m <= 80 for r in after)
     before_shift = compare_with_files(v115, real_geo_files[5:7], table)
     assert all(r.p99_m <= 25 for r in before_shift)
-    shift = _table(real_geo_files[7:], v115).d_beta_urad - table.d_beta_urad
-    assert shift[0] < -15 and shift[29] < -10 and abs(shift[14]) < 6
+
+
+def test_the_servo_moves_within_the_ten_real_granules(real_geo_files, v115):
+    """Scan by scan (40 scans of 8 s), the FOV-5 cross-track residual against V115 holds still for granules
+    1-7, moves between 00:27:44 and ~00:28:16 UTC (granule 8) and holds still again from granule 9: at FOR 1
+    from ~26 to ~4 urad, FOR 2 ~44 to ~26, FOR 30 ~-1 to ~-17, FOR 15 by ~-3. A move, not scatter: each side
+    stays within 9 urad of its own median. Nothing in GCRSO foretells it (QF1_CRISSDRGEO is 0 throughout)."""
+    beta = (
+        np.concatenate([fpr.granule_print(g).scan_beta_urad for f in real_geo_files for g in read_file(f)])
+        - fov5_angles(v115)[1] / URAD
+    )
+    assert beta.shape == (40, 30)
+    before, after = beta[:28], beta[32:]
+    move = np.median(after, axis=0) - np.median(before, axis=0)
+    assert move[0] < -15 and move[1] < -12 and move[29] < -10 and abs(move[14]) < 6
+    for side in (before, after):
+        assert np.all(np.abs(side[:, [0, 1, 29]] - np.median(side[:, [0, 1, 29]], axis=0)) < 9)
+    for path in real_geo_files:
+        with h5py.File(path) as h5:
+            assert not np.any(h5["All_Data/CrIS-SDR-GEO_All/QF1_CRISSDRGEO"][()])
 
 
 def test_table_file_round_trip_and_cli(real_geo_files, v115, tmp_path):
