@@ -60,24 +60,19 @@ def _brute(viirs, sat, m, alpha, beta, offsets, half_angle):
     return mean, cover
 
 
+def _brute_fov(viirs, fg, idx, offsets):
+    """Brute-force top-hat cone sums of the one FOV *idx* (scan, FOR, FOV) of the geometry fg."""
+    sat, m = fg.sat_ecef_m[idx], fg.sbf_to_ecef[idx]
+    return _brute(viirs, sat, m, fg.alpha_rad[idx], fg.beta_rad[idx], offsets, collocate.TOP_HAT[0][0])
+
+
 @pytest.mark.parametrize("scan,for_,fov", [(1, 14, 4), (2, 29, 8), (0, 0, 0)])
 def test_interval_method_equals_brute_force(scene, scan, for_, fov):
     fg, viirs = scene
     offsets = perturbation_grid(4, 900e-6)
     idx = (scan, for_, fov)
-    mean, cover = collocate.cone_sums(
-        *_one_fov(viirs, fg, idx),
-        offsets,
-    )
-    bm, bc = _brute(
-        viirs,
-        fg.sat_ecef_m[idx],
-        fg.sbf_to_ecef[idx],
-        fg.alpha_rad[idx],
-        fg.beta_rad[idx],
-        offsets,
-        collocate.TOP_HAT[0][0],
-    )
+    mean, cover = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets)
+    bm, bc = _brute_fov(viirs, fg, idx, offsets)
     np.testing.assert_allclose(mean[0], bm, rtol=1e-9)
     np.testing.assert_allclose(cover[0], bc, rtol=1e-9)
     # solid-angle weights fill the cone: coverage 1 inside the swath, also at nadir (FOR 15), where the
@@ -140,19 +135,8 @@ def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):
     assert piece.block_radius_m.shape[1] == -(-ncol // swath.BLOCK_PX)
     cut = swath.ViirsSwath([piece])
     offsets = perturbation_grid(2, 900e-6)
-    mean, cover = collocate.cone_sums(
-        *_one_fov(cut, fg, idx),
-        offsets,
-    )
-    bm, bc = _brute(
-        cut,
-        fg.sat_ecef_m[idx],
-        fg.sbf_to_ecef[idx],
-        fg.alpha_rad[idx],
-        fg.beta_rad[idx],
-        offsets,
-        collocate.TOP_HAT[0][0],
-    )
+    mean, cover = collocate.cone_sums(*_one_fov(cut, fg, idx), offsets)
+    bm, bc = _brute_fov(cut, fg, idx, offsets)
     assert 0.05 < bc.min() and bc.max() < 0.95  # the cut runs through the cones
     np.testing.assert_allclose(mean[0], bm, rtol=1e-9)
     np.testing.assert_allclose(cover[0], bc, rtol=1e-9)
