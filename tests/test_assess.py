@@ -3,6 +3,7 @@ import pytest
 
 from monitor.assess import AssessConfig, find_minimum
 from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult
+from tests.cli import run_crisgeo
 from tests.conftest import truth_arrays
 
 
@@ -77,8 +78,6 @@ def test_too_few_usable_fovs_is_an_error_naming_the_files(cases, tmp_path):
     """VIIRS scale factors of 1e30 used to give a table of NaN with exit 0: now the granule is refused and
     the assessment, left with nothing, exits 2 naming the files."""
     import shutil
-    import subprocess
-    import sys
 
     import h5py
 
@@ -92,9 +91,7 @@ def test_too_few_usable_fovs_is_an_error_naming_the_files(cases, tmp_path):
                 h5["All_Data/VIIRS-I5-SDR_All/BrightnessTemperatureFactors"][0] = 1e30
         else:
             (work / f.name).symlink_to(f)
-    r = subprocess.run(
-        [sys.executable, "-m", "monitor.cli", "assess", str(work)], capture_output=True, text=True
-    )
+    r = run_crisgeo("assess", work)
     last = r.stderr.strip().splitlines()[-1]  # the log lines before it say which granule was skipped and why
     assert r.returncode == 2 and last.startswith("crisgeo assess: too few usable FOVs to assess: 0"), r.stderr
     assert "SVI05_j01" in last and "scale 1e+30" in last

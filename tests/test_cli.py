@@ -4,6 +4,7 @@ import pytest
 
 from monitor.cli import main
 from monitor.simulate.case import simulate_case
+from tests.cli import run_crisgeo
 from tests.conftest import tree_with_truncated
 
 
@@ -80,20 +81,8 @@ def test_simulate_cli_rejects_bad_profile(tmp_path, capsys):
 def test_bench_prints_every_stage_and_the_assessment_memory():
     """`crisgeo bench` on a one-granule simulated case, in its own process so its memory is its own."""
     import re
-    import subprocess
-    import sys
 
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            "from monitor.cli import main; raise SystemExit(main("
-            "['bench', '--granules', '1', '--workers', '1']))",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
+    run = run_crisgeo("bench", "--granules", "1", "--workers", "1")
     assert run.returncode == 0, run.stderr
     out = run.stdout
     assert "case: 1 CrIS granules, 1080 FOVs x 441 perturbations" in out
@@ -106,10 +95,8 @@ def test_bench_prints_every_stage_and_the_assessment_memory():
 
 
 def test_version_and_verbose_after_the_subcommand(capsys):
-    import subprocess
-    import sys
 
-    r = subprocess.run([sys.executable, "-m", "monitor.cli", "--version"], capture_output=True, text=True)
+    r = run_crisgeo("--version")
     assert r.returncode == 0 and r.stdout.startswith("crisgeo ")
     from monitor.cli import build_parser
 
@@ -185,8 +172,6 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
 
 def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
     import os
-    import subprocess
-    import sys
 
     data, _, _ = cases.get()
     cfg = tmp_path / "c.yaml"
@@ -194,21 +179,14 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
         f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
         f"assessment: {{workers: 2}}\n"
     )
-    r = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "monitor.cli",
-            "run",
-            "--config",
-            str(cfg),
-            "--date",
-            "2024-06-01",
-            "--log-format",
-            "json",
-        ],
-        capture_output=True,
-        text=True,
+    r = run_crisgeo(
+        "run",
+        "--config",
+        cfg,
+        "--date",
+        "2024-06-01",
+        "--log-format",
+        "json",
         env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"},
     )
     assert r.returncode == 0, r.stderr
@@ -225,18 +203,13 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
 
 def test_under_systemd_lines_carry_no_second_timestamp(tmp_path):
     import os
-    import subprocess
-    import sys
 
     cfg = tmp_path / "c.yaml"
     cfg.write_text(
         f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
     )
-    r = subprocess.run(
-        [sys.executable, "-m", "monitor.cli", "run", "--config", str(cfg), "--date", "2024-06-01"],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "JOURNAL_STREAM": "8:1234"},
+    r = run_crisgeo(
+        "run", "--config", cfg, "--date", "2024-06-01", env={**os.environ, "JOURNAL_STREAM": "8:1234"}
     )
     assert r.returncode == 0, r.stderr
     log = [line for line in r.stderr.splitlines() if line.strip()]

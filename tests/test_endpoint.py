@@ -6,7 +6,6 @@ import os
 import signal
 import socket
 import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -16,12 +15,11 @@ import requests
 from prometheus_client.parser import text_string_to_metric_families
 
 from monitor.store.sqlite import Store
+from tests.cli import CRISGEO, ROOT, run_crisgeo
 from tests.servers import chromium_driver, free_port, wait_for
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
-ROOT = Path(__file__).resolve().parent.parent
-CRISGEO = [sys.executable, "-m", "monitor.cli"]
 DAY = "2024-06-01"
 
 
@@ -72,13 +70,7 @@ def served(cases, tmp_path_factory):
         f"assessment: {{workers: 1}}\nschedule: {{catch_up_days: 1}}\nreport_dir: {tmp / 'report'}\n"
         f"report_url: https://crisgeo.example.org/report/\n"
     )
-    r = subprocess.run(
-        CRISGEO + ["run", "--config", str(cfg), "--date", DAY],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=600,
-    )
+    r = run_crisgeo("run", "--config", cfg, "--date", DAY)
     assert r.returncode == 0, r.stderr
     (tmp / "report" / "empty").mkdir()
     sock, notify = _notify_socket(tmp)
@@ -236,26 +228,14 @@ def test_a_run_over_its_budget_makes_the_daemon_unhealthy_and_starves_the_watchd
 def test_listen_is_checked(tmp_path):
     cfg = tmp_path / "c.yaml"
     cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: simulated}}\n")
-    r = subprocess.run(
-        CRISGEO + ["daemon", "--config", str(cfg), "--listen", "nonsense"],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=60,
-    )
+    r = run_crisgeo("daemon", "--config", cfg, "--listen", "nonsense", timeout=60)
     assert r.returncode == 2 and "--listen: 'nonsense' is not HOST:PORT" in r.stderr
     taken = socket.socket()
     taken.bind(("127.0.0.1", 0))
     taken.listen()
     port = taken.getsockname()[1]
     try:
-        r = subprocess.run(
-            CRISGEO + ["daemon", "--config", str(cfg), "--listen", f"127.0.0.1:{port}"],
-            capture_output=True,
-            text=True,
-            cwd=ROOT,
-            timeout=60,
-        )
+        r = run_crisgeo("daemon", "--config", cfg, "--listen", f"127.0.0.1:{port}", timeout=60)
     finally:
         taken.close()
     assert r.returncode == 1 and f"http.listen 127.0.0.1:{port}: cannot listen" in r.stderr, r.stderr

@@ -12,12 +12,11 @@ from pathlib import Path
 import pytest
 
 from monitor.store.sqlite import Store
+from tests.cli import CRISGEO, ROOT, run_crisgeo
 from tests.servers import wait_for
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
-ROOT = Path(__file__).resolve().parent.parent
-CRISGEO = [sys.executable, "-m", "monitor.cli"]
 DAY = "2024-06-01"
 
 
@@ -65,13 +64,7 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0  # nothing half-written
     s.close()
     cfg = _config(tmp_path, data)
-    r = subprocess.run(
-        CRISGEO + ["run", "--config", str(cfg), "--date", DAY],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=600,
-    )
+    r = run_crisgeo("run", "--config", cfg, "--date", DAY)
     assert r.returncode == 0, r.stderr
     s = Store(db)
     assert [r.status for r in s.runs()] == ["interrupted", "ok"]
@@ -123,7 +116,7 @@ def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
         # the catch-up runs at start and records the days without data
         assert wait_for(lambda: _status(tmp_path / "state" / "crisgeo.sqlite").count("no_data") == 2, 60)
         # a second instance on the same state directory is refused
-        r = subprocess.run(CRISGEO + ["run", "--config", str(cfg)], capture_output=True, text=True, cwd=ROOT)
+        r = run_crisgeo("run", "--config", cfg)
         assert (
             r.returncode == 75 and "another crisgeo process (pid" in r.stderr and "systemctl stop" in r.stderr
         )
@@ -170,7 +163,7 @@ def test_status_command(cases, tmp_path):
     data, _, _ = cases.get()
     cfg = _config(tmp_path, tmp_path / "none")
     (tmp_path / "none").mkdir()
-    r = subprocess.run(CRISGEO + ["status", "--config", str(cfg)], capture_output=True, text=True, cwd=ROOT)
+    r = run_crisgeo("status", "--config", cfg)
     assert r.returncode == 0 and "j01: no run yet" in r.stdout and "outbox: 0" in r.stdout
 
 

@@ -5,6 +5,7 @@ import pytest
 from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
 from alerts.settings import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
+from tests.cli import run_crisgeo
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
@@ -161,8 +162,6 @@ def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
     are kept out."""
     import datetime as dt
     import os
-    import subprocess
-    import sys
 
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
@@ -181,12 +180,7 @@ def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
         dt.datetime.now(dt.timezone.utc) - dt.timedelta(minutes=1),
     )
     store.close()
-    r = subprocess.run(
-        [sys.executable, "-m", "monitor.cli", "-v", "alerts", "evaluate", "--config", str(cfg)],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "T_SLACK": webhook.url},
-    )
+    r = run_crisgeo("-v", "alerts", "evaluate", "--config", cfg, env={**os.environ, "T_SLACK": webhook.url})
     assert r.returncode == 0, r.stderr
     assert len(webhook.received) >= 1  # it was sent
     assert "secret-token" not in r.stderr + r.stdout and "DEBUG" in r.stderr

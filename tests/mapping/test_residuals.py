@@ -1,8 +1,6 @@
 """The per-FOR LOS residual table: learned from GEO files, applied by geolocate/regeolocate."""
 
 import json
-import subprocess
-import sys
 
 import h5py
 import numpy as np
@@ -15,6 +13,7 @@ from monitor.mapping import residuals
 from monitor.mapping.engpkt import load_ep
 from monitor.mapping.regeolocate import compare_with_files
 from monitor.sdr import read_file
+from tests.cli import run_crisgeo
 from tests.conftest import EP_CONFIGS
 
 V115 = EP_CONFIGS.parents[1] / "monitor" / "data" / "ep" / "JPSS1_side1_V115_EngPkt.xml"
@@ -77,39 +76,10 @@ def test_table_file_round_trip_and_cli(real_geo_files, v115, tmp_path):
     turned = back.apply(los)
     assert np.allclose(np.arctan2(turned[:, 0, 1], turned[:, 0, 2]), back.d_beta_urad * 1e-6)
     out = tmp_path / "cli.json"
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "monitor.cli",
-            "fingerprint",
-            *map(str, real_geo_files[:2]),
-            "--ep",
-            str(V115),
-            "--write-residuals",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-    )
+    run = run_crisgeo("fingerprint", *real_geo_files[:2], "--ep", V115, "--write-residuals", out)
     assert run.returncode == 0 and "wrote residual table against EP V115" in run.stdout
     assert np.allclose(residuals.load(out).d_beta_urad, back.d_beta_urad, atol=1e-3)
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "monitor.cli",
-            "geolocate",
-            "--ep",
-            str(V115),
-            "--residuals",
-            str(out),
-            "--json",
-            str(real_geo_files[5]),
-        ],
-        capture_output=True,
-        text=True,
-    )
+    run = run_crisgeo("geolocate", "--ep", V115, "--residuals", out, "--json", real_geo_files[5])
     assert run.returncode == 0 and json.loads(run.stdout)["fors"][14]["median_m"] < 15
 
 
@@ -140,22 +110,8 @@ def test_own_residuals_reproduce_the_operational_geolocation(real_geo_files, v11
     that minute's servo corrections: median 2 m, p99 <= 16 m at every FOR on granules 6-10."""
     rows = compare_with_files(v115, real_geo_files[5:], residuals.OwnResiduals(v115))
     assert np.median([r.median_m for r in rows]) < 4 and max(r.p99_m for r in rows) < 20
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "monitor.cli",
-            "regeolocate",
-            "--ep",
-            str(V115),
-            "--own-residuals",
-            str(V115),
-            "--out",
-            str(tmp_path),
-            str(real_geo_files[6]),
-        ],
-        capture_output=True,
-        text=True,
+    run = run_crisgeo(
+        "regeolocate", "--ep", V115, "--own-residuals", V115, "--out", tmp_path, real_geo_files[6]
     )
     assert run.returncode == 0, run.stderr
     (g,) = read_file(tmp_path / real_geo_files[6].name)

@@ -4,6 +4,7 @@ import sqlite3
 import pytest
 
 from monitor.store.sqlite import MIGRATIONS, Store
+from tests.cli import run_crisgeo
 
 DAY = dt.date(2024, 6, 1)
 
@@ -104,8 +105,6 @@ def test_a_foreign_sqlite_file_is_refused(tmp_path):
 
 
 def test_cli_reports_a_corrupt_store_in_one_line(tmp_path):
-    import subprocess
-    import sys
 
     (tmp_path / "state").mkdir()
     (tmp_path / "state" / "crisgeo.sqlite").write_bytes(b"garbage" * 500)
@@ -113,14 +112,8 @@ def test_cli_reports_a_corrupt_store_in_one_line(tmp_path):
     cfg.write_text(
         f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
     )
-    r = subprocess.run(
-        [sys.executable, "-m", "monitor.cli", "alerts", "list", "--config", str(cfg)],
-        capture_output=True,
-        text=True,
-    )
+    r = run_crisgeo("alerts", "list", "--config", cfg)
     assert r.returncode == 1 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "crisgeo.sqlite: not a usable crisgeo store" in r.stderr
-    r = subprocess.run(
-        [sys.executable, "-m", "monitor.cli", "status", "--config", str(cfg)], capture_output=True, text=True
-    )
+    r = run_crisgeo("status", "--config", cfg)
     assert r.returncode == 3 and "UNKNOWN" in r.stderr  # status speaks Nagios
