@@ -58,6 +58,7 @@ class AssessConfig:
 
     @property
     def offsets_rad(self) -> np.ndarray:
+        """The perturbation angles (rad) of one axis of the grid, -half_steps..+half_steps steps."""
         return perturbation_grid(self.half_steps, self.step_rad)
 
 

@@ -41,14 +41,17 @@ class ForOffset:
 
     @property
     def d_alpha_pct_fov(self) -> float:
+        """The in-track offset as a percentage of the FOV diameter."""
         return 100.0 * self.d_alpha_urad / FOV_DIAMETER_URAD
 
     @property
     def d_beta_pct_fov(self) -> float:
+        """The cross-track offset as a percentage of the FOV diameter."""
         return 100.0 * self.d_beta_urad / FOV_DIAMETER_URAD
 
     @property
     def reliable(self) -> bool:
+        """Whether no flag of RELIABILITY_FLAGS is set: the offset may be trusted and alerted on."""
         return not any(f in RELIABILITY_FLAGS for f in self.flags)
 
     def to_dict(self) -> dict:

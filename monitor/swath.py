@@ -84,6 +84,7 @@ class SwathPiece:
 
     @property
     def shape(self):
+        """(rows, columns) of the prepared piece."""
         return self.radiance.shape
 
     def covers(self, t0_us, t1_us) -> bool:

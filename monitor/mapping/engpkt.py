@@ -174,6 +174,7 @@ def packaged_ep(satellite: str) -> EngineeringPacket:
 
 
 def packaged_path(satellite: str) -> Path:
+    """Where the real EP shipped for *satellite* lies in the installed package."""
     return Path(str(resources.files("monitor.data.ep") / PACKAGED[satellite]))
 
 

@@ -34,10 +34,12 @@ class AngleRow:
 
     @property
     def d_roll_urad(self) -> float:
+        """Change of the cross-track (roll) mirror angle, new minus old (urad)."""
         return self.new_roll_urad - self.old_roll_urad
 
     @property
     def d_pitch_urad(self) -> float:
+        """Change of the in-track (pitch) mirror angle, new minus old (urad)."""
         return self.new_pitch_urad - self.old_pitch_urad
 
     def to_dict(self) -> dict:
@@ -64,6 +66,7 @@ class Optimization:
 
     @property
     def kept(self) -> list:
+        """The rows whose old angles were kept, with why (``kept`` names the reason)."""
         return [r for r in self.rows if r.kept]
 
     def table(self) -> str:

@@ -44,10 +44,12 @@ class GranuleFiles:
 
     @property
     def start(self) -> dt.datetime:
+        """Start of the granule (UTC, from its GEO metadata)."""
         return self.geo_meta.start
 
     @property
     def end(self) -> dt.datetime:
+        """End of the granule (UTC, from its GEO metadata)."""
         return self.geo_meta.end
 
 

@@ -70,6 +70,8 @@ IET_LIMITS_US = (1.6e15, 2.8e15)  # IET of 2008 ... 2046: a time outside is not 
 
 @dataclass(frozen=True)
 class Product:
+    """One JPSS product: file-name prefix, HDF5 collection, reader kind and its fields (a Field by name)."""
+
     prefix: str
     collection: str
     kind: str
@@ -79,6 +81,7 @@ class Product:
 
     @property
     def data_group(self) -> str:
+        """The HDF5 group that holds the product's arrays."""
         return f"All_Data/{self.collection}_All"
 
 

@@ -185,11 +185,13 @@ class Simulator:
         return (base + drift) * frames.ARCSEC_RAD
 
     def state(self, unix_s):
+        """Satellite position (m) and velocity (m/s) in ECEF and the SBF-to-ECEF matrix at unix times."""
         r, v = self.orbit.state_ecef(unix_s)
         return r, v, frames.sbf_to_ecef(r, v, self.attitude_rad(unix_s))
 
     # ------------------------------------------------------------------ CrIS
     def cris_granule(self, k: int, out: Path) -> list[str]:
+        """Write CrIS granule *k* (SDR and GEO files) into *out*; the names of the files written."""
         spec = self.spec
         g0 = self.t0 + k * CRIS_GRANULE_S
         scan_start = g0 + np.arange(4) * ins.CRIS_SCAN_US * 1e-6
@@ -309,6 +311,8 @@ class Simulator:
 
     # ------------------------------------------------------------------ VIIRS
     def viirs_granule(self, g0: float, out: Path, scans_per_chunk: int = 6) -> list[str]:
+        """Write the VIIRS I5 granule starting at unix time *g0* (SDR and GEO files) into *out*, a few
+        scans at a time; the names of the files written."""
         spec = self.spec
         theta, col_dt = ins.viirs_column_geometry()
         a_det = ins.viirs_detector_angles_rad()

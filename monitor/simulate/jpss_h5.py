@@ -30,6 +30,7 @@ def texts_attr(values) -> np.ndarray:
 
 
 def number_attr(value, dtype) -> np.ndarray:
+    """A numeric HDF5 attribute shaped (1, 1), as IDPS writes them."""
     return np.array([[value]], dtype=dtype)
 
 
@@ -42,6 +43,7 @@ def _attr(value):
 
 
 def date_time_attrs(prefix: str, when: dt.datetime) -> dict:
+    """The IDPS pair ``{prefix}_Date`` (YYYYMMDD) and ``{prefix}_Time`` (HHMMSS.ffffffZ) for *when*."""
     return {f"{prefix}_Date": when.strftime("%Y%m%d"), f"{prefix}_Time": when.strftime("%H%M%S.%fZ")}
 
 
