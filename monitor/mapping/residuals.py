@@ -11,14 +11,22 @@ Learned from a set of GEO granules, the table turns every FOV of FOR k by (d_alp
 an EP's LOS; geolocating with a proposed EP plus the table then reproduces the operational geolocation
 except for the EP change itself.
 
+The servo corrections also move with time (on the real NOAA-20 granules by 10-25 urad within a minute,
+README). A table cannot know a move after it was learned, but each granule it is applied to shows its own
+FOV-5 angles: where they depart from the learning granules' by more than :data:`STALE_URAD` at some FOR,
+the table is stale for that granule and a warning says so (the FORs, the departures, and the remedy,
+:class:`OwnResiduals`).
+
 File (JSON): ``{"satellite", "ep_version", "granules": [...], "created", "fors": [{"for", "d_alpha_urad",
-"d_beta_urad"}, ...]}``, 30 rows.
+"d_beta_urad", "fov5_alpha_urad", "fov5_beta_urad"}, ...]}``, 30 rows; the measured FOV-5 angles (null
+where a FOR was not measured) may be absent in tables written before they were recorded.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import json
+import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -28,6 +36,14 @@ from monitor.constants import N_FOR, URAD
 from monitor.errors import DataError
 from monitor.geometry.frames import los_angles, los_from_angles
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles
+
+log = logging.getLogger(__name__)
+
+# Departure (urad) of a granule's own FOV-5 angles from the learning granules' beyond which the table no
+# longer describes it. Real NOAA-20: granules 1-7 depart at most 3.4 urad from the median of 1-5 (the
+# scan-to-scan scatter is ~2 urad), those after the servo's move 10-25 urad.
+STALE_URAD = 10.0
+_FOV5_LIMIT_URAD = 1.0e6  # |a FOV-5 angle| in the spacecraft frame stays below ~0.9 rad
 
 
 class ResidualError(DataError):
@@ -46,6 +62,8 @@ class ResidualTable:
     created: str = field(
         default_factory=lambda: dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
     )
+    fov5_alpha_urad: np.ndarray | None = None  # FOV-5 angles the learning granules showed (spacecraft frame)
+    fov5_beta_urad: np.ndarray | None = None
 
     def apply(self, los_spacecraft) -> np.ndarray:
         """The LOS (30, 9, 3) (spacecraft frame) with every FOV of FOR k turned by the FOR's residual."""
@@ -54,20 +72,54 @@ class ResidualTable:
             alpha + self.d_alpha_urad[:, None] * URAD, beta + self.d_beta_urad[:, None] * URAD
         )
 
+    def departure_urad(self, granule) -> tuple[np.ndarray, np.ndarray] | None:
+        """Per FOR, the FOV-5 angles (in-track, cross-track; urad) *granule* shows minus those of the learning
+        granules (NaN where either was not measured); None for a table written without them."""
+        if self.fov5_alpha_urad is None:
+            return None
+        from monitor.fingerprint import granule_print
+
+        p = granule_print(granule)
+        return p.alpha_urad - self.fov5_alpha_urad, p.beta_urad - self.fov5_beta_urad
+
     def table_for(self, granule) -> "ResidualTable":
-        """The table to apply to *granule*: this one, whatever the granule."""
+        """The table to apply to *granule*: this one. Warns when the granule departs from the learning
+        granules by more than :data:`STALE_URAD` at some FOR, naming the FORs and the departures."""
+        departure = self.departure_urad(granule)
+        if departure is not None:
+            da, db = departure
+            with np.errstate(invalid="ignore"):
+                stale = np.nonzero((np.abs(da) > STALE_URAD) | (np.abs(db) > STALE_URAD))[0]
+            if stale.size:
+                fors = ", ".join(f"{k + 1} ({da[k]:+.1f}/{db[k]:+.1f})" for k in stale)
+                log.warning(
+                    "%s: the residual table (learned from %d granule(s)) no longer describes this granule: "
+                    "its FOV-5 angles depart by more than %g urad (in-track/cross-track) at FOR %s; the "
+                    "scene-mirror servo has moved since, and the residual learned from the granule itself "
+                    "(--own-residuals) follows such moves",
+                    granule.meta.path,
+                    len(self.granules),
+                    STALE_URAD,
+                    fors,
+                )
         return self
 
     def to_dict(self) -> dict:
+        """The table as the JSON document of the module docstring."""
+        rows = [
+            {"for": k + 1, "d_alpha_urad": round(float(a), 3), "d_beta_urad": round(float(b), 3)}
+            for k, (a, b) in enumerate(zip(self.d_alpha_urad, self.d_beta_urad, strict=True))
+        ]
+        if self.fov5_alpha_urad is not None:
+            for row, a, b in zip(rows, self.fov5_alpha_urad, self.fov5_beta_urad, strict=True):
+                row["fov5_alpha_urad"] = round(float(a), 3) if np.isfinite(a) else None
+                row["fov5_beta_urad"] = round(float(b), 3) if np.isfinite(b) else None
         return {
             "satellite": self.satellite,
             "ep_version": self.ep_version,
             "granules": list(self.granules),
             "created": self.created,
-            "fors": [
-                {"for": k + 1, "d_alpha_urad": round(float(a), 3), "d_beta_urad": round(float(b), 3)}
-                for k, (a, b) in enumerate(zip(self.d_alpha_urad, self.d_beta_urad, strict=True))
-            ],
+            "fors": rows,
         }
 
     def write(self, path) -> Path:
@@ -89,6 +141,8 @@ def learn(day, ep: EngineeringPacket) -> ResidualTable:
         np.nan_to_num(day.alpha_urad - alpha / URAD),
         np.nan_to_num(day.beta_urad - beta / URAD),
         tuple(day.granules),
+        fov5_alpha_urad=np.asarray(day.alpha_urad, float),
+        fov5_beta_urad=np.asarray(day.beta_urad, float),
     )
 
 
@@ -134,6 +188,8 @@ def load(path) -> ResidualTable:
             f"{len(rows) if isinstance(rows, list) else type(rows).__name__}"
         )
     values = {"d_alpha_urad": np.empty(N_FOR), "d_beta_urad": np.empty(N_FOR)}
+    measured = {"fov5_alpha_urad": np.empty(N_FOR), "fov5_beta_urad": np.empty(N_FOR)}
+    has_measured = isinstance(rows[0], dict) and "fov5_alpha_urad" in rows[0]
     for i, row in enumerate(rows):
         if not isinstance(row, dict) or row.get("for") != i + 1:
             raise ResidualError(
@@ -141,10 +197,10 @@ def load(path) -> ResidualTable:
                 f"{row.get('for') if isinstance(row, dict) else row!r}"
             )
         for key, out in values.items():
-            v = row.get(key)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or abs(v) > 5000:
-                raise ResidualError(f"{path}: fors[{i}].{key}: {v!r} is not a number within +-5000 urad")
-            out[i] = v
+            out[i] = _number(path, i, key, row.get(key), 5000.0)
+        for key, out in measured.items() if has_measured else ():
+            v = row.get(key, "missing")
+            out[i] = np.nan if v is None else _number(path, i, key, v, _FOV5_LIMIT_URAD)
     return ResidualTable(
         str(doc["satellite"]),
         str(doc["ep_version"]),
@@ -152,4 +208,12 @@ def load(path) -> ResidualTable:
         values["d_beta_urad"],
         tuple(doc.get("granules", ())),
         str(doc.get("created", "")),
+        measured["fov5_alpha_urad"] if has_measured else None,
+        measured["fov5_beta_urad"] if has_measured else None,
     )
+
+
+def _number(path, i: int, key: str, v, limit_urad: float) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or abs(v) > limit_urad:
+        raise ResidualError(f"{path}: fors[{i}].{key}: {v!r} is not a number within +-{limit_urad:g} urad")
+    return float(v)

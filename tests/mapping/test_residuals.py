@@ -1,6 +1,8 @@
 """The per-FOR LOS residual table: learned from GEO files, applied by geolocate/regeolocate."""
 
+import dataclasses
 import json
+import logging
 
 import h5py
 import numpy as np
@@ -79,8 +81,38 @@ def test_table_file_round_trip_and_cli(real_geo_files, v115, tmp_path):
     run = run_crisgeo("fingerprint", *real_geo_files[:2], "--ep", V115, "--write-residuals", out)
     assert run.returncode == 0 and "wrote residual table against EP V115" in run.stdout
     assert np.allclose(residuals.load(out).d_beta_urad, back.d_beta_urad, atol=1e-3)
+    assert np.allclose(residuals.load(out).fov5_beta_urad, back.fov5_beta_urad, atol=1e-3)
     run = run_crisgeo("geolocate", "--ep", V115, "--residuals", out, "--json", real_geo_files[5])
     assert run.returncode == 0 and json.loads(run.stdout)["fors"][14]["median_m"] < 15
+    assert "no longer describes" not in run.stderr
+    run = run_crisgeo("geolocate", "--ep", V115, "--residuals", out, real_geo_files[9])
+    assert run.returncode == 0 and f"{real_geo_files[9]}: the residual table" in run.stderr, run.stderr
+
+
+def test_a_stale_table_says_so_where_the_servo_has_moved(real_geo_files, v115, caplog):
+    """Applied to each of granules 6-10, the table learned from 1-5 warns on the granules after the servo's
+    move (9 and 10: FOR 1, 2 and 30 among those named, FOR 15 not) and on none before it (6 and 7, which
+    depart by at most ~3 urad). A table written without the measured FOV-5 angles applies without a check."""
+    table = _table(real_geo_files[:5], v115)
+    named = {}
+    for path in real_geo_files[5:]:
+        (g,) = read_file(path)
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="monitor.mapping.residuals"):
+            assert table.table_for(g) is table
+        named[path.name] = [r.getMessage() for r in caplog.records]
+    quiet = [m for f in real_geo_files[5:7] for m in named[f.name]]
+    assert quiet == []
+    for f in real_geo_files[8:]:
+        (message,) = named[f.name]
+        fors = [int(x.split(" (")[0]) for x in message.split(" at FOR ")[1].split(";")[0].split(", ")]
+        assert {1, 2, 30} <= set(fors) and 15 not in fors, message
+    old = dataclasses.replace(table, fov5_alpha_urad=None, fov5_beta_urad=None)
+    assert old.departure_urad(g) is None
+    caplog.clear()
+    with caplog.at_level(logging.WARNING):
+        old.table_for(g)
+    assert not caplog.records
 
 
 @pytest.mark.parametrize(
@@ -91,6 +123,12 @@ def test_table_file_round_trip_and_cli(real_geo_files, v115, tmp_path):
         (lambda d: d["fors"][3].update(d_beta_urad="x"), "fors\\[3\\].d_beta_urad: 'x' is not a number"),
         (lambda d: d["fors"][3].update(d_alpha_urad=float("nan")), "fors\\[3\\].d_alpha_urad: nan"),
         (lambda d: d["fors"][5].update({"for": 9}), "fors\\[5\\].for: expected 6, found 9"),
+        (
+            lambda d: d["fors"][2].update(fov5_beta_urad="x"),
+            "fors\\[2\\].fov5_beta_urad: 'x' is not a number",
+        ),
+        (lambda d: d["fors"][4].pop("fov5_alpha_urad"), "fors\\[4\\].fov5_alpha_urad: 'missing'"),
+        (lambda d: d["fors"][4].update(fov5_alpha_urad=2e6), "fors\\[4\\].fov5_alpha_urad: 2000000.0"),
     ],
 )
 def test_bad_tables_name_file_and_field(real_geo_files, v115, tmp_path, edit, field):
