@@ -53,10 +53,14 @@ def test_the_servo_moves_within_the_ten_real_granules(real_geo_files, v115):
     """Scan by scan (40 scans of 8 s), the FOV-5 cross-track residual against V115 holds still for granules
     1-7, moves between 00:27:44 and ~00:28:16 UTC (granule 8) and holds still again from granule 9: at FOR 1
     from ~26 to ~4 urad, FOR 2 ~44 to ~26, FOR 30 ~-1 to ~-17, FOR 15 by ~-3. A move, not scatter: each side
-    stays within 9 urad of its own median. Nothing in GCRSO foretells it (QF1_CRISSDRGEO is 0 throughout)."""
+    stays within 9 urad of its own median. The move repeats every 10 FORs (2 s: -22 .. +4 urad in each
+    third of the scan), a pattern locked to the scan, not that of an attitude error, which would move every
+    FOR alike; and while the roll swings by 8 urad in the quiet scans, their mean residual does not follow
+    it (so the attitude is applied as IDPS applies it). Nothing in GCRSO foretells the move
+    (QF1_CRISSDRGEO is 0 throughout)."""
+    granules = [g for f in real_geo_files for g in read_file(f)]
     beta = (
-        np.concatenate([fpr.granule_print(g).scan_beta_urad for f in real_geo_files for g in read_file(f)])
-        - fov5_angles(v115)[1] / URAD
+        np.concatenate([fpr.granule_print(g).scan_beta_urad for g in granules]) - fov5_angles(v115)[1] / URAD
     )
     assert beta.shape == (40, 30)
     before, after = beta[:28], beta[32:]
@@ -64,6 +68,11 @@ def test_the_servo_moves_within_the_ten_real_granules(real_geo_files, v115):
     assert move[0] < -15 and move[1] < -12 and move[29] < -10 and abs(move[14]) < 6
     for side in (before, after):
         assert np.all(np.abs(side[:, [0, 1, 29]] - np.median(side[:, [0, 1, 29]], axis=0)) < 9)
+    thirds = move.reshape(3, 10)
+    assert np.ptp(thirds, axis=0).max() < 6 and np.ptp(thirds.mean(axis=0)) > 20
+    roll_urad = np.concatenate([g.sc_attitude_rad[:, 0] for g in granules])[:28] / URAD
+    mean_urad = (before - np.median(before, axis=0)).mean(axis=1)
+    assert np.ptp(roll_urad) > 7 and abs(np.polyfit(roll_urad, mean_urad, 1)[0]) < 0.5
     for path in real_geo_files:
         with h5py.File(path) as h5:
             assert not np.any(h5["All_Data/CrIS-SDR-GEO_All/QF1_CRISSDRGEO"][()])
