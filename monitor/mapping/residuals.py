@@ -199,7 +199,9 @@ def load(path) -> ResidualTable:
         for key, out in values.items():
             out[i] = _number(path, i, key, row.get(key), 5000.0)
         for key, out in measured.items() if has_measured else ():
-            v = row.get(key, "missing")
+            if key not in row:
+                raise ResidualError(f"{path}: fors[{i}].{key}: missing (FOR 1 has it)")
+            v = row[key]
             out[i] = np.nan if v is None else _number(path, i, key, v, _FOV5_LIMIT_URAD)
     return ResidualTable(
         str(doc["satellite"]),

@@ -136,7 +136,7 @@ def test_a_stale_table_says_so_where_the_servo_has_moved(real_geo_files, v115, c
             lambda d: d["fors"][2].update(fov5_beta_urad="x"),
             "fors\\[2\\].fov5_beta_urad: 'x' is not a number",
         ),
-        (lambda d: d["fors"][4].pop("fov5_alpha_urad"), "fors\\[4\\].fov5_alpha_urad: 'missing'"),
+        (lambda d: d["fors"][4].pop("fov5_alpha_urad"), "fors\\[4\\].fov5_alpha_urad: missing \\(FOR 1"),
         (lambda d: d["fors"][4].update(fov5_alpha_urad=2e6), "fors\\[4\\].fov5_alpha_urad: 2000000.0"),
     ],
 )
