@@ -44,7 +44,8 @@ class SourceConfig:
     max_list_pages: int = 100  # per listing (a day of one product is ~3 pages of 1000 keys)
     max_listed_keys: int = 20000
     max_retry_after_s: float = 120.0  # a server asking to wait longer ends the attempt
-    min_rate_kb_s: float = 50.0  # a download slower than this on average is cut
+    min_rate_kb_s: float = 50.0  # a download slower than this over any stall window is cut
+    stall_window_s: float = 30.0
     granules: int = 4
     profile: str = "paper"
     seed: int = 0
@@ -385,6 +386,7 @@ def load_config(path) -> Config:
         run_deadline_min=float,
         max_retry_after_s=float,
         min_rate_kb_s=float,
+        stall_window_s=float,
         max_list_pages=int,
         max_listed_keys=int,
         retries=int,
@@ -528,6 +530,7 @@ LIMITS = {
     "source.max_listed_keys": (1, 10**6),
     "source.max_retry_after_s": (1, 3600),
     "source.min_rate_kb_s": (1, 1e6),
+    "source.stall_window_s": (1, 3600),
     "source.granules": (1, 100),
     "source.seed": (0, 2**31 - 1),
     "schedule.catch_up_days": (1, 366),

@@ -30,7 +30,8 @@ MEANING = {
     "source.path": "Root of the local tree (kind local); every *.h5 below it is considered.",
     "source.endpoint": "NODD URL template; {bucket} is replaced by the satellite's bucket.",
     "source.buckets": "NODD bucket per satellite (mapping); keys not given keep the published buckets.",
-    "source.timeout_s": "Timeout of one HTTP request.",
+    "source.timeout_s": "Wall-clock bound of a listing page (body included) and of the headers of any "
+    "answer; also the socket timeout.",
     "source.retries": "Retries of a failed request (backoff doubling from backoff_s).",
     "source.backoff_s": "First wait between retries.",
     "source.daily_budget_mb": "Most bytes downloaded in one satellite-day run; further files are skipped "
@@ -42,7 +43,10 @@ MEANING = {
     "source.max_list_pages": "Most pages of one listing (a day of one product is ~3 pages of 1000 keys).",
     "source.max_listed_keys": "Most keys of one listing.",
     "source.max_retry_after_s": "A server asking to wait longer than this (Retry-After) ends the attempt.",
-    "source.min_rate_kb_s": "A download slower than this on average is cut.",
+    "source.min_rate_kb_s": "A download that brings less than this over any stall_window_s is cut (and "
+    "retried).",
+    "source.stall_window_s": "The sliding window over which a download must keep up min_rate_kb_s; a "
+    "silence this long cuts it too.",
     "source.granules": "Consecutive CrIS granules simulated per satellite-day (kind simulated).",
     "source.profile": "Error profile injected by the simulator (paper, random, zero; kind simulated).",
     "source.seed": "Seed of the simulator (kind simulated).",

@@ -166,7 +166,9 @@ class S3Server:
     ``corrupt_once`` (keys whose first download has one byte changed), ``extra_keys`` (listed keys that do
     not exist, with ``extra_sizes`` giving their <Size> text), ``endless_tokens`` (every page is truncated,
     with a new token), ``repeat_token`` (every page is truncated, with the same token), ``slow_drip_s``
-    (downloads trickle 64 bytes per interval), ``retry_after`` (every request: 503 and this Retry-After),
+    (downloads trickle ``drip_bytes`` bytes per interval), ``slow_list_s`` (listing pages trickle one byte
+    per interval), ``slow_headers_s`` (every answer's status line and headers trickle one byte per interval),
+    ``retry_after`` (every request: 503 and this Retry-After),
     ``lying_size`` (the listing says this many bytes), ``gzip`` (downloads are gzip-encoded), and
     ``redirect_to`` (the next download answers 302 to this base URL).
     """
@@ -178,6 +180,8 @@ class S3Server:
         self.extra_keys, self.extra_sizes = [], {}
         self.endless_tokens = self.repeat_token = self.gzip = False
         self.slow_drip_s = self.retry_after = self.lying_size = self.redirect_to = None
+        self.slow_list_s = self.slow_headers_s = None
+        self.drip_bytes = 64
         self.requests = []
         server = self
 
@@ -187,6 +191,16 @@ class S3Server:
 
             def do_GET(self):
                 server.requests.append(self.path)
+                if server.slow_headers_s is not None:
+                    head = b"HTTP/1.1 200 OK\r\nContent-Type: application/xml\r\nContent-Length: 10\r\n\r\n"
+                    try:
+                        for i in range(len(head)):
+                            self.wfile.write(head[i : i + 1])
+                            self.wfile.flush()
+                            time.sleep(server.slow_headers_s)
+                    except (BrokenPipeError, ConnectionResetError, OSError):
+                        pass  # the client gave up, as it should
+                    return
                 if server.retry_after is not None:
                     self.send_response(503)
                     self.send_header("Retry-After", str(server.retry_after))
@@ -235,12 +249,12 @@ class S3Server:
                 return self.extra_sizes[k]
             if self.lying_size is not None:
                 return str(self.lying_size)
-            return str((base / k).stat().st_size) if (base / k).is_file() else "10"
+            return str((base / k).stat().st_size) if k not in self.extra_keys else "10"
 
         def etag(k):
             return (
                 f"<ETag>&quot;{hashlib.md5((base / k).read_bytes()).hexdigest()}&quot;</ETag>"
-                if (base / k).is_file()
+                if k not in self.extra_keys
                 else ""
             )
 
@@ -262,7 +276,16 @@ class S3Server:
         h.send_header("Content-Type", "application/xml")
         h.send_header("Content-Length", str(len(body)))
         h.end_headers()
-        h.wfile.write(body)
+        try:
+            if self.slow_list_s is not None:
+                for i in range(len(body)):
+                    h.wfile.write(body[i : i + 1])
+                    h.wfile.flush()
+                    time.sleep(self.slow_list_s)
+                return
+            h.wfile.write(body)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # the client gave up, as it should
 
     def _get(self, h, bucket, key):
         if self.redirect_to is not None:
@@ -299,8 +322,8 @@ class S3Server:
                 h.connection.shutdown(socket.SHUT_RDWR)
                 return
             if self.slow_drip_s is not None:
-                for i in range(0, len(data), 64):
-                    h.wfile.write(data[i : i + 64])
+                for i in range(0, len(data), self.drip_bytes):
+                    h.wfile.write(data[i : i + self.drip_bytes])
                     h.wfile.flush()
                     time.sleep(self.slow_drip_s)
                 return

@@ -12,10 +12,12 @@ import re
 from dataclasses import dataclass
 
 _PATTERN = re.compile(
-    r"^(?P<products>[A-Z0-9]+(?:-[A-Z0-9]+)*)_(?P<platform>[a-z0-9]{3})_d(?P<date>\d{8})_t(?P<start>\d{7})"
-    r"_e(?P<end>\d{7})_b(?P<orbit>\d{5,})_c(?P<created>\d{20})_(?P<origin>[a-z0-9-]{4})_(?P<domain>[a-z_]+)\.h5$",
+    r"^(?P<products>[A-Z0-9]{5}(?:-[A-Z0-9]{5}){0,15})_(?P<platform>[a-z0-9]{3})_d(?P<date>\d{8})"
+    r"_t(?P<start>\d{7})_e(?P<end>\d{7})_b(?P<orbit>\d{5,6})_c(?P<created>\d{20})_(?P<origin>[a-z0-9-]{4})"
+    r"_(?P<domain>[a-z_]{1,16})\.h5$",
     re.ASCII,
-)  # ASCII digits only: a key with other digits must not pass for a granule
+)  # ASCII digits only: a key with other digits must not pass for a granule. Every field is bounded as
+# the real names are (5-letter product IDs, 5-6 digit orbits): a longer name is no granule, nor cacheable.
 
 
 @dataclass(frozen=True)

@@ -7,15 +7,18 @@ renamed only when complete, of the listed size and, where the listing's ETag is 
 digest. A per-day byte budget bounds what one run may download, and cached files older than the
 retention go.
 
-Everything a server says is bounded, so that no listing or download hangs or grows without end: a run
-deadline (``source.run_deadline_min``) for all requests of a run; at most ``max_list_pages`` pages and
-``max_listed_keys`` keys per listing, and a continuation token seen twice is an error; Retry-After is
-honoured up to ``max_retry_after_s`` (a longer one ends the attempt); a download must keep up
-``min_rate_kb_s`` and may not bring more bytes than listed (Content-Length is checked first); a
+Everything a server says is bounded in wall-clock time and size, so that no listing or download hangs or
+grows without end (:mod:`monitor.sources.bounded` cuts a request at its deadline, body included): a
+listing page, and the headers of any answer, come within ``timeout_s``; every request of a run ends by the
+run deadline (``source.run_deadline_min``); a download must keep up ``min_rate_kb_s`` over every sliding
+window of ``stall_window_s`` and may not bring more bytes than listed (Content-Length is checked first);
+at most ``max_list_pages`` pages and ``max_listed_keys`` keys per listing, and a continuation token seen
+twice is an error; Retry-After is honoured up to ``max_retry_after_s`` (a longer one ends the attempt); a
 compressed response is refused (granules are stored as they are, never transparently decoded).
 Redirects are followed only on the endpoint's own host. Listed keys must be plain ASCII JPSS names in
-the day folder asked for (no dot segments). There is one retry layer, here: connection errors, 429
-and 5xx, ``retries`` times with exponential backoff.
+the day folder asked for (no dot segments, no field longer than the real pattern allows): a key that is
+not is logged and left out, and the rest of the listing is used. There is one retry layer, here:
+connection errors, 429 and 5xx, ``retries`` times with exponential backoff.
 """
 
 from __future__ import annotations
@@ -36,11 +39,13 @@ import urllib3
 
 from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
 from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed
+from monitor.sources.bounded import BoundedSession, DeadlinePassed, StallWatch
 
 LOG = logging.getLogger(__name__)
 S3_NS = "{http://s3.amazonaws.com/doc/2006-03-01/}"
 MAX_LISTING_PAGE_BYTES = 8 << 20  # a page of 1000 keys is ~0.3 MB
 RETRYABLE = (429, 500, 502, 503, 504)
+TIMEOUTS = (TimeoutError, urllib3.exceptions.TimeoutError)  # a socket silent for the stall window
 REDIRECTS = (301, 302, 303, 307, 308)
 _DIGITS = re.compile(r"[0-9]{1,15}", re.ASCII)
 _MD5 = re.compile(r'"?([0-9a-fA-F]{32})"?', re.ASCII)
@@ -65,8 +70,7 @@ class NoddSource:
     def __init__(self, cfg, cache_dir: Path, sleep=time.sleep):
         self.cfg = cfg
         self.cache_dir = Path(cache_dir)
-        self.session = requests.Session()  # no urllib3 Retry: the one retry layer is _get
-        self.session.headers["Accept-Encoding"] = "identity"
+        self.http = BoundedSession()
         self.spent_bytes = 0  # downloaded in this run (cache hits are free)
         self.downloaded_files = 0
         self.deadline = None
@@ -89,27 +93,44 @@ class NoddSource:
             if p.is_file() and (p.suffix == ".part" or p.stat().st_mtime < cutoff):
                 p.unlink(missing_ok=True)
 
-    def _left_s(self, what: str) -> float:
+    def _run_deadline(self) -> float:
         if self.deadline is None:
             self.deadline = time.monotonic() + self.cfg.run_deadline_min * 60
-        left = self.deadline - time.monotonic()
+        return self.deadline
+
+    def _left_s(self, what: str) -> float:
+        left = self._run_deadline() - time.monotonic()
         if left <= 0:
             raise SourceError(f"{what}: the run deadline of {self.cfg.run_deadline_min:g} min has passed")
         return left
 
-    def _get(self, url: str, what: str, params=None, stream=False) -> requests.Response:
-        """GET *url* with the one retry layer; the response is 200 (the caller closes it)."""
+    def _passed(self, what: str, request_deadline: float) -> SourceError:
+        """The error for a request cut by the watchdog: the run deadline or the request's own bound."""
+        if time.monotonic() >= self._run_deadline() or request_deadline >= self._run_deadline():
+            return SourceError(f"{what}: the run deadline of {self.cfg.run_deadline_min:g} min has passed")
+        return SourceError(f"{what}: no complete answer within {self.cfg.timeout_s:g} s (timeout_s)")
+
+    def _get(self, url: str, what: str, params=None, read_timeout_s=None) -> requests.Response:
+        """GET *url* with the one retry layer; the response is 200 with its headers read within
+        ``timeout_s`` (and the run deadline), its body still to read (the caller closes it)."""
         last = "no attempt"
         for attempt in range(self.cfg.retries + 1):
             wait = self.cfg.backoff_s * 2**attempt
+            left = self._left_s(what)
+            bound = min(self.cfg.timeout_s, left)
+            until = time.monotonic() + bound
             try:
-                r = self.session.get(
-                    url,
-                    params=params,
-                    stream=stream,
-                    allow_redirects=False,
-                    timeout=min(self.cfg.timeout_s, self._left_s(what)),
-                )
+                with self.http.guard(until):
+                    r = self.http.get(
+                        url,
+                        params=params,
+                        stream=True,
+                        timeout=(bound, read_timeout_s or bound),
+                    )
+            except DeadlinePassed:
+                if time.monotonic() >= self._run_deadline():
+                    raise self._passed(what, until) from None
+                last = f"no answer within {self.cfg.timeout_s:g} s"
             except requests.RequestException as exc:
                 last = type(exc).__name__
             else:
@@ -142,6 +163,29 @@ class NoddSource:
                 self.sleep(min(wait, self._left_s(what)))
         raise SourceError(f"{what}: {last} after {self.cfg.retries + 1} attempts")
 
+    def _page(self, url: str, what: str, params: dict) -> bytes:
+        """One listing page, whole within ``timeout_s`` (and the run deadline), at most
+        :data:`MAX_LISTING_PAGE_BYTES`."""
+        until = min(time.monotonic() + self.cfg.timeout_s, self._run_deadline())
+        r = self._get(url, what, params)
+        try:
+            with self.http.guard(until):
+                body = b""
+                while len(body) <= MAX_LISTING_PAGE_BYTES:
+                    chunk = r.raw.read1(MAX_LISTING_PAGE_BYTES + 1 - len(body), decode_content=True)
+                    if not chunk:
+                        break
+                    body += chunk
+        except DeadlinePassed:
+            raise self._passed(what, until) from None
+        except (requests.RequestException, urllib3.exceptions.HTTPError, OSError, ValueError) as exc:
+            raise SourceError(f"{what}: {type(exc).__name__} while reading") from None
+        finally:
+            r.close()
+        if len(body) > MAX_LISTING_PAGE_BYTES:
+            raise SourceError(f"{what}: a page of more than {MAX_LISTING_PAGE_BYTES >> 20} MB")
+        return body
+
     def list_prefix(self, satellite: str, prefix: str) -> list[ListedFile]:
         """Every object under *prefix* (``folder/YYYY/MM/DD/name-prefix``), following continuation tokens."""
         out, token, seen = [], None, set()
@@ -152,15 +196,7 @@ class NoddSource:
             params = {"list-type": "2", "prefix": prefix, "max-keys": "1000"}
             if token:
                 params["continuation-token"] = token
-            r = self._get(base + "/", what, params, stream=True)
-            try:
-                body = r.raw.read(MAX_LISTING_PAGE_BYTES + 1, decode_content=True)
-            except (requests.RequestException, urllib3.exceptions.HTTPError, OSError, ValueError) as exc:
-                raise SourceError(f"{what}: {type(exc).__name__} while reading") from None
-            finally:
-                r.close()
-            if len(body) > MAX_LISTING_PAGE_BYTES:
-                raise SourceError(f"{what}: a page of more than {MAX_LISTING_PAGE_BYTES >> 20} MB")
+            body = self._page(base + "/", what, params)
             try:
                 root = ET.fromstring(body)
             except ET.ParseError as exc:
@@ -219,10 +255,13 @@ class NoddSource:
     def fetch(self, f: ListedFile) -> Path:
         """The cached copy of *f*, downloaded (bounded, checked against the listing) if missing."""
         folder = self.cache_dir / f.product
-        folder.mkdir(parents=True, exist_ok=True)
         target = folder / f.name  # f.name is a checked base name: it cannot leave the cache
-        if target.exists() and (f.size is None or target.stat().st_size == f.size):
-            return target
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            if target.exists() and (f.size is None or target.stat().st_size == f.size):
+                return target
+        except OSError as exc:
+            raise SourceError(f"{f.name}: cache {folder}: {exc.strerror or exc}") from None
         if f.size is not None and self.spent_bytes + f.size > self.cfg.daily_budget_mb * 1e6:
             raise BudgetExceeded(
                 f"{f.name}: the day's download budget of {self.cfg.daily_budget_mb:.0f} MB is spent"
@@ -233,6 +272,7 @@ class NoddSource:
         for attempt in range(self.cfg.retries + 1):
             try:
                 n = self._download(url, f, part)
+                os.replace(part, target)
             except SourceError as exc:
                 last = exc
                 part.unlink(missing_ok=True)
@@ -241,15 +281,19 @@ class NoddSource:
                     self.sleep(min(self.cfg.backoff_s * 2**attempt, self._left_s(f.name)))
                     continue
                 break
+            except OSError as exc:  # the cache cannot hold it (disk full, a name too long): not retried
+                part.unlink(missing_ok=True)
+                raise SourceError(f"{f.name}: cannot write to the cache ({exc.strerror or exc})") from None
             self.spent_bytes += n
             self.downloaded_files += 1
-            os.replace(part, target)
             return target
         raise SourceError(f"{f.name}: download failed ({last})")
 
     def _download(self, url: str, f: ListedFile, part: Path) -> int:
-        """One download into *part*: bounded in bytes and time, checked against the listing."""
-        r = self._get(url, f.name, stream=True)
+        """One download into *part*: bounded in bytes, stalls and the run deadline, checked against the
+        listing."""
+        window = min(self.cfg.stall_window_s, self.cfg.timeout_s)
+        r = self._get(url, f.name, read_timeout_s=window)
         try:
             encoding = r.headers.get("Content-Encoding", "identity").strip().lower()
             if encoding not in ("", "identity"):
@@ -257,10 +301,9 @@ class NoddSource:
             length = r.headers.get("Content-Length")
             if f.size is not None and length is not None and length.strip() != str(f.size):
                 raise SourceError(f"{f.name}: Content-Length {length[:20]}, the listing says {f.size}")
-            slowest = time.monotonic() + 30.0 + (f.size or 0) / (self.cfg.min_rate_kb_s * 1e3)
+            watch = StallWatch(self.cfg.min_rate_kb_s * 1e3, self.cfg.stall_window_s)
             md5 = hashlib.md5() if f.md5 else None
-            n = 0
-            with open(part, "wb") as out:
+            with open(part, "wb") as out, self.http.guard(self._run_deadline()):
                 while True:
                     try:
                         chunk = r.raw.read1(1 << 20, decode_content=False)
@@ -270,29 +313,39 @@ class NoddSource:
                         OSError,
                         ValueError,
                     ) as exc:
-                        raise SourceError(f"{f.name}: {type(exc).__name__} after {n} bytes") from None
+                        if watch.stalled() or isinstance(exc, TIMEOUTS):
+                            raise self._stalled(f, watch) from None
+                        raise SourceError(f"{f.name}: {type(exc).__name__} after {watch.total} B") from None
                     if not chunk:
                         break
-                    n += len(chunk)
-                    if f.size is not None and n > f.size:
+                    watch.add(len(chunk))
+                    if f.size is not None and watch.total > f.size:
                         raise SourceError(f"{f.name}: more than the {f.size} bytes listed")
-                    if time.monotonic() > slowest:
-                        raise SourceError(
-                            f"{f.name}: slower than {self.cfg.min_rate_kb_s:g} kB/s ({n} bytes received)"
-                        )
-                    self._left_s(f.name)
+                    if watch.stalled():
+                        raise self._stalled(f, watch)
                     out.write(chunk)
                     if md5 is not None:
                         md5.update(chunk)
                 out.flush()
                 os.fsync(out.fileno())
+        except DeadlinePassed:
+            raise SourceError(
+                f"{f.name}: the run deadline of {self.cfg.run_deadline_min:g} min has passed"
+            ) from None
         finally:
             r.close()
+        n = watch.total
         if f.size is not None and n != f.size:
             raise SourceError(f"{f.name}: got {n} bytes, the listing says {f.size}")
         if md5 is not None and md5.hexdigest() != f.md5:
             raise SourceError(f"{f.name}: MD5 {md5.hexdigest()} differs from the listing's ETag {f.md5}")
         return n
+
+    def _stalled(self, f: ListedFile, watch: StallWatch) -> SourceError:
+        return SourceError(
+            f"{f.name}: slower than {self.cfg.min_rate_kb_s:g} kB/s over {self.cfg.stall_window_s:g} s "
+            f"({watch.total} bytes received)"
+        )
 
 
 def _newest_per_granule(files: list[ListedFile]) -> list[ListedFile]:

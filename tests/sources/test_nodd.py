@@ -7,9 +7,11 @@ import time
 
 import pytest
 
-from monitor.config import SourceConfig
-from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
+from monitor.config import SourceConfig, load_config
+from monitor.pipeline import compute_day
+from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed, make_source
 from monitor.sources.nodd import NoddSource
+from monitor.store.sqlite import RunStatus
 from tests.servers import S3Server
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
@@ -31,10 +33,7 @@ def bucket(cases, tmp_path_factory):
         product = f.name.split("_")[0]
         d = root / "noaa-nesdis-n20-pds" / FOLDER[product] / "2024/06/01"
         d.mkdir(parents=True, exist_ok=True)
-        if product in ("GCRSO", "SCRIF"):
-            shutil.copy(f, d / f.name)
-        else:
-            (d / f.name).symlink_to(f)
+        os.link(f, d / f.name)  # the server serves only files inside its root (no symlinks out)
     # more keys than one listing page, and a reprocessed copy of a granule with a newer creation time
     d = root / "noaa-nesdis-n20-pds" / "CrIS-SDR-GEO/2024/06/01"
     first = sorted(d.glob("GCRSO_*.h5"))[0]
@@ -153,12 +152,13 @@ def test_a_huge_retry_after_is_not_waited_for(bucket, tmp_path):
 @pytest.mark.parametrize(
     "bound,reason,limit_s",
     [
-        ({"min_rate_kb_s": 1000.0}, "slower than 1000 kB/s", 45),
-        ({"run_deadline_min": 0.02}, "run deadline of 0.02 min has passed", 5),
+        ({"min_rate_kb_s": 1000.0, "stall_window_s": 2.0}, "slower than 1000 kB/s over 2 s", 2 + 10),
+        ({"run_deadline_min": 0.05}, "run deadline of 0.05 min has passed", 3 + 10),
     ],
 )
 def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s):
-    """By the minimum rate of each download, or by the run deadline, whichever comes first."""
+    """By the minimum rate over the stall window, or by the run deadline, whichever comes first: each
+    within its bound + 10 s."""
     with S3Server(bucket) as s3:
         src = _source(s3.url, tmp_path, retries=0, **bound)
         f = src.list_day("j01", DAY, ("SCRIF",))[0]
@@ -166,6 +166,73 @@ def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s):
         secs, peak, why = _timed(lambda: src.fetch(f))
         assert reason in why and secs < limit_s and peak < 20e6
         assert not list((tmp_path / "cache").rglob("*.h5*"))  # no partial granule left
+
+
+def test_one_byte_a_second_is_a_stall_not_a_budget(bucket, tmp_path):
+    """A drip of one byte at a time is cut after one stall window (before: a budget of 30 s + size / rate,
+    ~2600 s for a GITCO); retried, each attempt is cut the same way."""
+    with S3Server(bucket) as s3:
+        src = _source(s3.url, tmp_path, retries=1, stall_window_s=2.0, min_rate_kb_s=1.0)
+        f = src.list_day("j01", DAY, ("SCRIF",))[0]
+        s3.slow_drip_s, s3.drip_bytes = 0.02, 1
+        secs, _, why = _timed(lambda: src.fetch(f))
+        assert "slower than 1 kB/s over 2 s" in why and secs < 2 * 2 + 10
+        assert sum(f.name in r for r in s3.requests) == 2
+
+
+def test_a_slow_listing_ends_within_the_request_bound(bucket, tmp_path):
+    """A listing page sent at one byte per 0.2 s (~90 s for the page) is cut at timeout_s, body included;
+    before, only each read had a timeout and the page took as long as the server liked."""
+    with S3Server(bucket) as s3:
+        s3.slow_list_s = 0.2
+        secs, _, why = _timed(lambda: _source(s3.url, tmp_path, timeout_s=3).list_day("j01", DAY, ("GCRSO",)))
+        assert "no complete answer within 3 s" in why and secs < 3 + 10
+        assert len(s3.requests) == 1
+
+
+def test_slow_headers_end_within_the_request_bound(bucket, tmp_path):
+    """Headers trickled one byte at a time are cut at timeout_s, and the retries are bounded the same."""
+    with S3Server(bucket) as s3:
+        s3.slow_headers_s = 0.2
+        secs, _, why = _timed(
+            lambda: _source(s3.url, tmp_path, timeout_s=2, retries=1).list_day("j01", DAY, ("GCRSO",))
+        )
+        assert "no answer within 2 s after 2 attempts" in why and secs < 2 * 2 + 10
+
+
+def test_the_run_deadline_cuts_a_listing_in_flight(bucket, tmp_path):
+    with S3Server(bucket) as s3:
+        s3.slow_list_s = 0.2
+        src = _source(s3.url, tmp_path, timeout_s=60, run_deadline_min=0.05)
+        src.start_day()
+        secs, _, why = _timed(lambda: src.list_day("j01", DAY, ("GCRSO",)))
+        assert "run deadline of 0.05 min has passed" in why and secs < 3 + 10
+
+
+def test_a_name_longer_than_the_pattern_is_left_out_and_the_day_goes_on(bucket, tmp_path):
+    """A listed name with a 300-digit orbit number: before, it passed the name check, its cache write
+    failed with 'File name too long' and the whole day was recorded failed."""
+    folder = "CrIS-SDR-GEO/2024/06/01/"
+    with S3Server(bucket) as s3:
+        genuine = _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",))
+        g = genuine[0].name
+        b = g.split("_b", 1)[1].split("_", 1)[0]
+        long_orbit = g.replace(f"_b{b}_", f"_b{'7' * 300}_")
+        s3.extra_keys = [folder + long_orbit, folder + g.replace("GCRSO", "GCRSO" * 40, 1)]
+        files = _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",))
+    assert sorted(f.name for f in files) == sorted(f.name for f in genuine)
+
+
+def test_a_cache_that_cannot_hold_a_file_is_a_source_error(bucket, tmp_path):
+    """An OSError of the cache (here: a file where the product folder should be) names the file; it is not
+    retried and does not escape as an OSError (which failed the whole day)."""
+    with S3Server(bucket) as s3:
+        src = _source(s3.url, tmp_path)
+        f = src.list_day("j01", DAY, ("GCRSO",))[0]
+        (tmp_path / "cache").mkdir()
+        (tmp_path / "cache" / "GCRSO").write_text("not a folder")
+        with pytest.raises(SourceError, match=f"{f.name}: cache"):
+            src.fetch(f)
 
 
 def test_a_lying_size_and_a_gzip_response_are_refused(bucket, tmp_path):
@@ -232,3 +299,23 @@ def test_one_retry_layer(bucket, tmp_path):
         s3.retry_after = 0
         secs, _, why = _timed(lambda: _source(s3.url, tmp_path, retries=3).list_day("j01", DAY, ("GCRSO",)))
         assert "HTTP 503 after 4 attempts" in why and len(s3.requests) == 4
+
+
+def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_path):
+    """End to end: the listing also holds a name with a 300-digit orbit and a name that leaves the folder;
+    the day is still assessed from its genuine granules, and recorded ok."""
+    folder = "CrIS-SDR-GEO/2024/06/01/"
+    with S3Server(bucket) as s3:
+        good = _source(s3.url, tmp_path).list_day("j01", DAY, ("GCRSO",))[0].name
+        b = good.split("_b", 1)[1].split("_", 1)[0]
+        s3.extra_keys = [folder + good.replace(f"_b{b}_", f"_b{'7' * 300}_"), folder + "../../x/" + good]
+        config = tmp_path / "nodd.yaml"
+        config.write_text(
+            f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
+            f"source: {{kind: nodd, endpoint: '{s3.url}/{{bucket}}', retries: 1, backoff_s: 0.01}}\n"
+            "scenes: {min_inhomogeneity_k: 0}\nfingerprint: {granules: 2}\n"
+        )
+        cfg = load_config(config)
+        work = compute_day(cfg, make_source(cfg), "j01", DAY)
+    assert work.status == RunStatus.OK, work.reason
+    assert work.counts["assessed"] == 2 and len(work.result.fors) == 30
