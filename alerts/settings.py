@@ -138,6 +138,12 @@ def load_alert_settings(
     s = AlertSettings(rules=rules, report_dir=report_dir, dashboard_url=dashboard_url, report_url=report_url)
     s.log = path("log")
     s.events_file = path("events_file")
+    if s.events_file is not None and not s.events_file.is_file():
+        # read as empty, a missing calendar would lose jump attribution without a word
+        raise AlertConfigError(
+            f"alerts.events_file: {s.events_file} does not exist (copy configs/events.yaml there, or "
+            "remove the key)"
+        )
     if doc.get("email"):
         e = _mapping(doc, "email")
         w = "alerts.email."

@@ -324,14 +324,18 @@ def cmd_assess(args) -> int:
     return EXIT_OK
 
 
-def _load(args):
+def _load(args, writes: bool = False):
+    """The configuration of *args*; with *writes*, its state directory made (the commands that write)."""
     import os
 
-    from monitor.config import ConfigError, load_config
+    from monitor.config import ConfigError, load_config, make_state_dir
 
     args.config = args.config or os.environ.get("CRISGEO_CONFIG") or DEFAULT_CONFIG
     try:
-        return load_config(args.config)
+        cfg = load_config(args.config)
+        if writes:
+            make_state_dir(cfg)
+        return cfg
     except ConfigError as exc:
         msg = str(exc)
         raise BadInput(msg if msg.startswith(str(args.config)) else f"{args.config}: {msg}") from None
@@ -427,7 +431,7 @@ def cmd_run(args) -> int:
     from monitor.service import AlreadyRunning, Service
     from monitor.store.sqlite import RunStatus
 
-    cfg = _load(args)
+    cfg = _load(args, writes=True)
     sats = _satellites(cfg, args.satellite)
     bar = None
     if sys.stderr.isatty():
@@ -472,7 +476,7 @@ def cmd_reprocess(args) -> int:
     from monitor.service import AlreadyRunning
     from monitor.store.sqlite import RunStatus
 
-    cfg = _load(args)
+    cfg = _load(args, writes=True)
     sats = _satellites(cfg, args.satellite)
     if args.until < args.since:
         raise BadInput(f"--until {args.until} is before --since {args.since}")
@@ -502,7 +506,7 @@ def cmd_daemon(args) -> int:
     """crisgeo daemon: the long-running service."""
     from monitor.service import AlreadyRunning, Service
 
-    cfg = _load(args)
+    cfg = _load(args, writes=True)
     if args.listen is not None:
         from monitor.config import ConfigError, check_listen
 
@@ -591,7 +595,7 @@ def cmd_alerts(args) -> int:
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
 
-    cfg = _load(args)
+    cfg = _load(args, writes=True)
     settings = cfg.alert_settings
     now = dt.datetime.now(dt.timezone.utc)
     with Store(cfg.store.sqlite) as store:
@@ -632,7 +636,7 @@ def cmd_events(args) -> int:
     from alerts.changes import Change, add_to_calendar, all_changes
     from monitor.store.sqlite import Store
 
-    cfg = _load(args)
+    cfg = _load(args, writes=True)
     if cfg.events_file is None:
         raise BadInput("alerts.events_file is not set in the configuration")
     if args.action == "add":

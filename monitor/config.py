@@ -206,6 +206,28 @@ def _get(doc: dict, key: str, typ, where: str, default=None, required=False):
     return value
 
 
+def _check_creatable(path: Path, where: str) -> None:
+    """*path* is a directory, or can be made one: its nearest existing ancestor is a writable directory
+    on a file system that holds files (not /proc or /sys). Nothing is created."""
+    probe = path
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    if probe == path and not path.is_dir():
+        raise ConfigError(f"{where}: {path} exists and is not a directory")
+    if not probe.is_dir() or not os.access(probe, os.W_OK | os.X_OK):
+        raise ConfigError(f"{where}: {path} cannot be created ({probe} is not a writable directory)")
+    if probe != path and os.statvfs(probe).f_blocks == 0:  # proc, sysfs and the like: no room for files
+        raise ConfigError(f"{where}: {path} cannot be created ({probe} is a virtual file system)")
+
+
+def make_state_dir(cfg: Config) -> None:
+    """Create the state directory (for the commands that write state); a ConfigError naming the key."""
+    try:
+        cfg.state_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"state_dir: cannot create {cfg.state_dir} ({exc.strerror or exc})") from None
+
+
 def _within(value, lo, hi, where):
     """*value* within lo..hi (inclusive), or a ConfigError naming the key."""
     if not lo <= value <= hi:
@@ -222,15 +244,17 @@ def _fill(obj, doc: dict, where: str, **types):
 
 
 def _known(doc: dict, allowed: set, where: str):
-    unknown = sorted(set(doc) - allowed)
+    unknown = sorted(str(k) for k in doc if k not in allowed)  # keys may be of any YAML type
     if unknown:
         raise ConfigError(f"{where}{unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
 
 
 def _section(doc, key):
-    value = doc.get(key) or {}
+    value = doc.get(key)
+    if value is None:
+        return {}
     if not isinstance(value, dict):
-        raise ConfigError(f"{key}: expected a mapping")
+        raise ConfigError(f"{key}: expected a mapping, got {type(value).__name__} {str(value)[:60]!r}")
     return value
 
 
@@ -282,6 +306,20 @@ class _Loader(yaml.SafeLoader):
             )
         return super().compose_node(parent, index)
 
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            if isinstance(key, (list, dict)):
+                raise ConfigError(f"line {key_node.start_mark.line + 1}: a mapping key must be a scalar")
+            if key in seen:
+                raise ConfigError(
+                    f"line {key_node.start_mark.line + 1}: key {str(key)[:60]!r} is given twice in one "
+                    "mapping"
+                )
+            seen.add(key)
+        return super().construct_mapping(node, deep)
+
 
 def read_yaml(path: Path):
     """The YAML document at *path*: at most 1 MiB, safe types only, no anchors or aliases."""
@@ -299,7 +337,15 @@ def read_yaml(path: Path):
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
     except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML ({str(exc)[:300]})") from None
+        raise ConfigError(f"{path}: {yaml_problem(exc)}") from None
+
+
+def yaml_problem(exc: yaml.YAMLError) -> str:
+    """A YAML error as one line: where (line, column) and what."""
+    mark = getattr(exc, "problem_mark", None)
+    problem = " ".join(str(getattr(exc, "problem", None) or exc).split())[:200]
+    where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""
+    return f"not valid YAML: {where}{problem}"
 
 
 def check_url(url: str, where: str, placeholder: str | None = None) -> str:
@@ -367,6 +413,7 @@ def load_config(path) -> Config:
     if not sats:
         raise ConfigError("satellites: empty")
     state_dir = rel(_get(doc, "state_dir", str, "", required=True))
+    _check_creatable(state_dir, "state_dir")
 
     s = _section(doc, "source")
     _known(s, set(SourceConfig.__dataclass_fields__), "source.")
@@ -376,6 +423,8 @@ def load_config(path) -> Config:
     source = SourceConfig(kind=kind)
     if kind == "local":
         source.path = rel(_get(s, "path", str, "source.", required=True))
+        if not source.path.is_dir():
+            raise ConfigError(f"source.path: {source.path} is not a directory")
     _fill(
         source,
         s,

@@ -10,6 +10,9 @@ N_FOV = 9  # CrIS fields of view per FOR (3 x 3)
 FOV_DIAMETER_URAD = 16807.5  # CrIS FOV size, 0.963 deg (Wang et al. 2017; the EP files carry 16808)
 FOV_DIAMETER_RAD = FOV_DIAMETER_URAD * URAD
 
+CRIS_SCAN_US = 8_000_000  # CrIS scan period (IET microseconds)
+VIIRS_SCAN_US = 1_786_400  # VIIRS scan period, 1.7864 s
+
 SPEC_KM = 1.5  # the CrIS geolocation specification (each of in-track and cross-track), km
 
 VIIRS_I_PIXEL_M = 375.0  # VIIRS I-band pixel at nadir

@@ -8,6 +8,11 @@ NOAA-20 rephasing of April 2024: NOAA-21 a quarter orbit ahead of S-NPP, NOAA-20
 NOAA-21 (a quarter orbit behind S-NPP). The phase reference itself (S-NPP at the ascending node at
 ``PHASE_EPOCH_UNIX_S``, advancing with the shared ``NODAL_PERIOD_S``) is illustrative: the simulator needs
 consistent, not operational, ephemerides.
+
+Launch times (UTC, the day's orbit count starts there): S-NPP 2011-10-28 09:48:01, NOAA-20 2017-11-18
+09:47:36, NOAA-21 2022-11-10 09:49:25 (NASA/NOAA mission pages). A granule's orbit number is the orbits
+flown since launch; checked on real names: NOAA-20 b04790 on 2018-10-22 00:24 (4790.0 from this table),
+S-NPP b25538 on 2016-10-01 09:30 (25537.8).
 """
 
 from __future__ import annotations
@@ -29,14 +34,19 @@ class Satellite:
     inclination_deg: float
     ltan_h: float  # local solar time of the ascending node, hours
     phase_deg: float  # mean argument of latitude ahead of S-NPP
+    launch_unix_s: float  # launch, UTC seconds since 1970
+
+    def orbit_number(self, unix_s: float) -> int:
+        """The orbit number IDPS gives a granule starting at *unix_s*: whole orbits since launch, plus one."""
+        return int((unix_s - self.launch_unix_s) // NODAL_PERIOD_S) + 1
 
 
 SATELLITES = {
     s.short: s
     for s in (
-        Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0),
-        Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0),
-        Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0),
+        Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0, 1319795281.0),
+        Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0, 1510998456.0),
+        Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0, 1668073765.0),
     )
 }
 PHASE_EPOCH_UNIX_S = 1704067200.0  # 2024-01-01T00:00:00Z

@@ -7,10 +7,20 @@ from monitor.config import ConfigError, load_config
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
 
-def test_shipped_configs_load():
+def test_shipped_configs_load(tmp_path):
     demo = load_config(CONFIGS / "demo.yaml")
     assert demo.source.kind == "simulated" and demo.store.publish == [] and demo.satellites == ["j01"]
-    prod = load_config(CONFIGS / "monitor.yaml")
+    # the production file names /var/lib/crisgeo and /etc/crisgeo: here, folders of the test's own
+    (tmp_path / "events.yaml").write_text((CONFIGS / "events.yaml").read_text())
+    text = (CONFIGS / "monitor.yaml").read_text()
+    assert "/var/lib/crisgeo" in text and "/etc/crisgeo/events.yaml" in text
+    prod_file = tmp_path / "monitor.yaml"
+    prod_file.write_text(
+        text.replace("/var/lib/crisgeo", str(tmp_path / "state")).replace(
+            "/etc/crisgeo/events.yaml", str(tmp_path / "events.yaml")
+        )
+    )
+    prod = load_config(prod_file)
     assert prod.source.kind == "nodd" and prod.satellites == ["npp", "j01", "j02"]
     assert (
         prod.store.publish[0].kind == "influx1"
@@ -235,3 +245,41 @@ def test_check_config_masks_secrets(tmp_path, capsys, monkeypatch):
     out = capsys.readouterr().out
     assert "token_env: T (set)" in out and "webhook_env: SLACK (not set)" in out
     assert "the-token-value" not in out and "catch_up_days: 7" in out and "spec_km: 1.5" in out
+
+
+GOOD_TEXT = "satellites: [j01]\nstate_dir: state\nsource: {kind: simulated}\n"
+SEVEN = [  # (file text, the key or place the one-line error names): what slipped through before
+    (GOOD_TEXT.replace("state_dir: state", "state_dir: /proc/crisgeo-state"), "state_dir:"),
+    (GOOD_TEXT.replace("state_dir: state", "state_dir: /sys/crisgeo"), "state_dir:"),
+    (GOOD_TEXT + "schedule: {1: a, b: 2}\n", "schedule.1: unknown key"),
+    (GOOD_TEXT + "schedule: []\n", "schedule: expected a mapping, got list"),
+    (GOOD_TEXT + "alerts: {events_file: nowhere.yaml}\n", "alerts.events_file:"),
+    (GOOD_TEXT + "scenes: {keep: 3}\nscenes: {keep: 4}\n", "line 5: key 'scenes' is given twice"),
+    (GOOD_TEXT + "scenes: {keep: 3, candidates: 5, keep: 4}\n", "line 4: key 'keep' is given twice"),
+    (GOOD_TEXT + "scenes: {keep: 3\n", "not valid YAML: line 5, column 1:"),
+    (GOOD_TEXT + "scenes:\n  keep: 3\n    candidates: 4\n", "not valid YAML: line 6, column 15:"),
+    ("satellites: [j01]\nstate_dir: state\nsource: {kind: local, path: nowhere}\n", "source.path:"),
+]
+
+
+@pytest.mark.parametrize("text,named", SEVEN, ids=[n.split(":")[0] for _, n in SEVEN])
+def test_the_cases_that_slipped_through_are_refused_in_one_line(tmp_path, text, named):
+    """A traceback, an acceptance or a several-line message before; now one line naming the file and the
+    key (or the YAML line), exit 2, and nothing created."""
+    from tests.cli import run_crisgeo
+
+    p = _write(tmp_path, text)
+    r = run_crisgeo("check-config", "--config", p, timeout=60)
+    err = r.stderr.strip().splitlines()
+    assert r.returncode == 2 and len(err) == 1, r.stderr
+    assert err[0].startswith(f"crisgeo check-config: {p}: ") and named in err[0], err[0]
+    assert "Traceback" not in r.stderr and not (tmp_path / "state").exists()
+
+
+def test_a_state_dir_that_cannot_be_made_stops_a_run_in_one_line(tmp_path):
+    from tests.cli import run_crisgeo
+
+    (tmp_path / "file").write_text("x")
+    p = _write(tmp_path, GOOD_TEXT.replace("state_dir: state", "state_dir: file/state"))
+    r = run_crisgeo("run", "--config", p, timeout=60)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "state_dir:" in r.stderr

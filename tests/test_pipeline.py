@@ -109,7 +109,10 @@ def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_p
 
 
 def test_source_failure_is_a_failed_run_and_an_event(tmp_path):
+    """The tree is gone at run time (an unmounted archive): a failed run, not a crash."""
+    (tmp_path / "missing").mkdir()
     cfg = make_config(tmp_path, tmp_path / "missing")
+    (tmp_path / "missing").rmdir()
     store = Store(cfg.store.sqlite)
     out = run_day(cfg, store, LocalSource(tmp_path / "missing"), "j01", DAY)
     assert out.status == "failed" and "no such directory" in out.reason

@@ -16,6 +16,7 @@ import h5py
 import numpy as np
 
 from monitor.satellites import SATELLITES
+from monitor.sdr import consistency
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.iet import iet_to_datetime
 from monitor.sdr.names import parse_name
@@ -197,6 +198,10 @@ def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform:
     for key in ("N_Beginning_Time_IET", "N_Ending_Time_IET", "N_Number_Of_Scans"):
         if key not in a:
             raise GranuleError(path, f"{name}/{key}", "missing attribute")
+    for key in ("N_Beginning_Time_IET", "N_Ending_Time_IET"):
+        kind = np.asarray(a[key]).dtype.kind
+        if kind in "fc":  # a float time has lost its microseconds (float64 holds 15.95 digits of 16)
+            raise GranuleError(path, f"{name}/{key}", f"{_text(a[key])[:40]} is a float, not an integer time")
     start_iet = _number(path, f"{name}/N_Beginning_Time_IET", a["N_Beginning_Time_IET"])
     end_iet = _number(path, f"{name}/N_Ending_Time_IET", a["N_Ending_Time_IET"])
     n_scans = _number(path, f"{name}/N_Number_Of_Scans", a["N_Number_Of_Scans"])
@@ -213,16 +218,19 @@ def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform:
     if not 1 <= n_scans <= limit:
         raise GranuleError(path, f"{name}/N_Number_Of_Scans", f"{n_scans} is not within 1..{limit}")
     try:
-        start = _when(_text(a["Beginning_Date"]), _text(a["Beginning_Time"]))
-        end = _when(_text(a["Ending_Date"]), _text(a["Ending_Time"]))
-    except (KeyError, ValueError):
-        start, end = iet_to_datetime(start_iet), iet_to_datetime(end_iet)
+        text_times = (
+            _when(_text(a["Beginning_Date"]), _text(a["Beginning_Time"])),
+            _when(_text(a["Ending_Date"]), _text(a["Ending_Time"])),
+        )
+    except (KeyError, ValueError):  # the IET times are the granule's; the text is a copy of them
+        text_times = None
+    start, end = text_times or (iet_to_datetime(start_iet), iet_to_datetime(end_iet))
     asc = a.get("Ascending/Descending_Indicator")
     orbit = a.get("N_Beginning_Orbit_Number")
     granule_id = _text(a.get("N_Granule_ID", b""))
     if granule_id and not granule_id.upper().startswith(platform.upper()):
         raise GranuleError(path, f"{name}/N_Granule_ID", f"{granule_id!r} is not a granule of {platform}")
-    return GranuleMeta(
+    meta = GranuleMeta(
         path=str(path),
         product=product.prefix,
         collection=product.collection,
@@ -240,12 +248,20 @@ def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform:
         aux_files=_texts(a.get("N_Aux_Filename")),
         anc_files=_texts(a.get("N_Anc_Filename")),
     )
+    parsed = parse_name(path.name)
+    consistency.check_identity(path, name, meta, text_times, parsed.orbit if parsed and k == 0 else None)
+    if product.kind in ("cris_geo", "cris_sdr"):
+        consistency.check_cris_span(path, name, meta)
+    return meta
 
 
 def _check_raw(path, name: str, raw: np.ndarray, f, rows: int) -> None:
     """Dtype family and full shape of a dataset against the product table."""
     kinds = {"float": "f", "scaled": "uf", "time": "i", "flags": "u"}[f.kind]
-    if raw.dtype.kind not in kinds or (raw.dtype.kind == "f" and raw.dtype.itemsize < 4):
+    if (
+        raw.dtype.kind not in kinds
+        or raw.dtype.itemsize < {"f": 4, "u": 2 if f.kind == "scaled" else 1, "i": 1}[raw.dtype.kind]
+    ):
         raise GranuleError(path, name, f"dtype {raw.dtype} is not a {f.kind} dataset")
     expected = (rows,) + tuple(f.dims)
     if raw.shape != expected:
@@ -337,6 +353,8 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
         if not isinstance(raw, np.ndarray) or raw.ndim == 0:
             raise GranuleError(path, name, "not an array")
         _check_raw(path, name, raw, f, int(bounds[-1] * per))
+        if f.kind == "scaled" and raw.dtype.kind == "u":
+            consistency.check_raw_zeros(path, name, raw)
         data = _clean(path, name, raw, f)
         fac = _factors(path, h5, group, f, n_gran) if f.factors else None
         parts = []
@@ -357,8 +375,25 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
         granule = _GRANULE_TYPES[product.kind](meta=meta, **kwargs)
         _check_not_all_fill(path, product, granule)
         _check_times(path, product, granule)
+        _check_physics(path, product, granule)
         out.append(granule)
     return out
+
+
+def _check_physics(path, product: Product, granule) -> None:
+    """The relations between fields a genuine granule obeys (:mod:`monitor.sdr.consistency`)."""
+    key = _MAIN_FIELD[product.kind]
+    if product.scans_reserved:
+        consistency.check_viirs_scan_count(path, product, granule, key)
+    if product.kind not in ("cris_geo", "viirs_geo"):
+        return
+    has_data = np.isfinite(granule.lat_rad).reshape(len(granule.start_time_us), -1).any(axis=1)  # per scan
+    consistency.check_scan_times(path, product, granule, has_data)
+    consistency.check_ephemeris(path, product, granule, has_data)
+    if product.kind == "cris_geo":
+        consistency.check_line_of_sight(path, product, granule)
+    else:
+        consistency.check_nadir(path, product, granule, has_data)
 
 
 def _check_times(path, product: Product, granule) -> None:

@@ -17,11 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
+from monitor.constants import CRIS_SCAN_US
 from monitor.errors import DataError
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
 from monitor.satellites import satellite as satellite_info
 from monitor.sdr import iet
+from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
 from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
 from monitor.simulate import instrument as ins
@@ -34,10 +36,8 @@ from monitor.spectral import i5_band, planck_radiance
 
 UTC = dt.timezone.utc
 DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)
-GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # docs/jpss-formats.md 1.2
 CRIS_GRANULE_S = 32.0
 VIIRS_GRANULE_S = ins.VIIRS_SCANS * ins.VIIRS_SCAN_S
-ORBIT_PERIOD_S = 6080.0
 CONE_SAMPLES = 512
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
@@ -115,10 +115,6 @@ def _granule_id(platform: str, nominal_start_iet_us: int) -> str:
     return f"{platform.upper()}{(nominal_start_iet_us - GRANULE_ID_EPOCH_IET_US) // 100000:012d}"
 
 
-def _orbit_number(unix_s: float) -> int:
-    return 4790 + int((unix_s - 1540167839.0) // ORBIT_PERIOD_S)
-
-
 def _utc(unix_s: float) -> dt.datetime:
     """Timezone-aware UTC datetime of UTC seconds since 1970."""
     return dt.datetime.fromtimestamp(unix_s, UTC)
@@ -194,7 +190,7 @@ class Simulator:
         """Write CrIS granule *k* (SDR and GEO files) into *out*; the names of the files written."""
         spec = self.spec
         g0 = self.t0 + k * CRIS_GRANULE_S
-        scan_start = g0 + np.arange(4) * ins.CRIS_SCAN_US * 1e-6
+        scan_start = g0 + np.arange(4) * CRIS_SCAN_US * 1e-6
         for_unix = scan_start[:, None] + np.arange(ins.N_FOR) * ins.CRIS_FOR_DT_US * 1e-6
         r, v, m = self.state(for_unix)  # (4, 30, ...)
         true_ecef = np.einsum("skij,kfj->skfi", m, self.los_true)
@@ -437,7 +433,7 @@ class Simulator:
             "N_Algorithm_Version": "2.O.000.001",
             "N_Aux_Filename": [a.format(p=p) for a in aux],
             "N_Anc_Filename": ["Terrain-Eco-ANC-Tile_20030125000000Z_ee00000000000000Z_NA_NA_S0388_1.O.0.0"],
-            "N_Beginning_Orbit_Number": _orbit_number(begin),
+            "N_Beginning_Orbit_Number": satellite_info(p).orbit_number(begin),
             "N_Beginning_Time_IET": begin_iet,
             "N_Ending_Time_IET": end_iet,
             "N_Granule_ID": gid,

@@ -8,20 +8,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from monitor.constants import DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, N_FOV
+from monitor.constants import DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, N_FOV, VIIRS_SCAN_US
 from monitor.geometry.frames import rot_x, unit
 
 CRIS_FOR_STEP_RAD = np.radians(3.3333)
 CRIS_FOV_SPACING_RAD = 19.1e-3  # FOV centre spacing, ~1.1 deg (EP offsets, docs/jpss-formats.md 2.1)
 CRIS_FOV_HALF_ANGLE_RAD = FOV_DIAMETER_RAD / 2
 CRIS_FOR_DT_US = 200_000
-CRIS_SCAN_US = 8_000_000
 CRIS_MID_OFFSET_US = 2_899_989
 
 VIIRS_DETECTORS = 32
 VIIRS_SCANS = 48
 VIIRS_COLUMNS = 6400
-VIIRS_SCAN_S = 1.7864
+VIIRS_SCAN_S = VIIRS_SCAN_US * 1e-6
 VIIRS_ZONE_COLUMNS = (1280, 736, 2368, 736, 1280)  # aggregation zones, output columns (VcstGeoParameters.h)
 VIIRS_ZONE_AGGREGATION = (1, 2, 3, 2, 1)
 VIIRS_NATIVE_RAD = 155.2e-6  # along-scan native sample; 12608 samples span +-56 deg

@@ -1,0 +1,295 @@
+"""What a genuine IDPS granule obeys beyond the types, shapes and ranges of its product table.
+
+A file can pass every per-field check and still be wrong: a constant Latitude, a MidTime a day late, an
+attitude a thousand times too large, another granule's ID, an S-NPP granule under a NOAA-20 name. These
+checks tie fields together by the physics and bookkeeping of the instruments; each failure is a
+:class:`GranuleError` naming the file, the field and the relation it breaks. Margins, measured on the ten
+real NOAA-20 GCRSO granules of tests/data/real and on the simulator (docs/jpss-formats.md):
+
+* **Identity.** The granule ID is the platform and the tenths of a second since the IDPS granule epoch
+  (IET 1.698019238e15 us), so ``N_Beginning_Time_IET - ID x 1e5 us`` is that epoch to within a granule
+  (real: the same to 1 us; allowed 10 s, a CrIS granule is 32 s). The orbit number (file name and
+  attribute) counts orbits since the satellite's launch (:meth:`monitor.satellites.Satellite.orbit_number`;
+  real: 4790 for 4790.0, allowed 0.5 % + 20); S-NPP and NOAA-20 differ by ~31 000 orbits. The text dates
+  agree with the IET times (1 s).
+* **Scans.** CrIS scans are 8 s apart and a granule spans ``(n-1) x 8 < span <= n x 8`` s (real: 29.8 s for
+  4 scans). VIIRS arrays always hold 48 scans: those past ``N_Number_Of_Scans`` are fill, the counted
+  ones are not all fill.
+* **Scan times.** StartTime and MidTime exist for every scan that holds data, increase in whole scan
+  periods (within 2 %), MidTime follows StartTime by less than a period, and all lie within the granule.
+* **Ephemeris.** ``|SCPosition|`` is the satellite's orbit radius within 30 km (real: 1.2 km off) and
+  ``|SCVelocity|`` (ECEF) 7.3 .. 7.7 km/s (real: 7.53).
+* **Attitude.** Roll, pitch and yaw within 300 arcsec (real: < 2), consecutive scans within 30 arcsec
+  (real: < 1.3), and not exactly zero everywhere (a measured attitude never is).
+* **Line of sight (CrIS GEO).** The FOV's ground point (lat, lon, h = 0) plus SatelliteRange along the
+  zenith/azimuth direction is the spacecraft at the FOR time (Wang et al. 2017, section 2.2 steps 1-2;
+  real: within 2.0 m, allowed 200 m).
+* **Nadir (VIIRS GEO).** The middle pixel of each scan lies below the spacecraft: its distance equals the
+  spacecraft's height above it within 20 km (simulator: 0.1 km; a wrong position, time or pixel is
+  hundreds of km off).
+* **VIIRS BT.** At most 0.5 % of the pixels at raw count 0 (the scaled minimum, 150 K and below: no scene
+  piles up there).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from monitor.constants import CRIS_SCAN_US, VIIRS_SCAN_US
+from monitor.geometry import orbit, wgs84
+from monitor.geometry.inverse import satellite_from_fov
+from monitor.satellites import SATELLITES
+from monitor.sdr.errors import GranuleError
+from monitor.sdr.iet import iet_to_datetime
+
+GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # docs/jpss-formats.md 1.2
+SCAN_US = {
+    "cris_geo": CRIS_SCAN_US,
+    "cris_sdr": CRIS_SCAN_US,
+    "viirs_geo": VIIRS_SCAN_US,
+    "viirs_sdr": VIIRS_SCAN_US,
+}
+ID_TOLERANCE_US = 10_000_000
+TEXT_TIME_TOLERANCE_S = 1.0
+ORBIT_TOLERANCE = (0.005, 20)  # relative, absolute
+RADIUS_TOLERANCE_M = 30e3
+SPEED_LIMITS_M_S = (7.3e3, 7.7e3)
+ATTITUDE_LIMIT_ARCSEC = 300.0
+ATTITUDE_STEP_ARCSEC = 30.0
+ARCSEC_RAD = np.pi / (180.0 * 3600.0)
+LOS_CLOSURE_M = 200.0
+NADIR_TOLERANCE_M = 20e3
+RAW_ZERO_SHARE = 0.005
+
+
+def granule_id_time_us(granule_id: str) -> int | None:
+    """The IET (us) a granule ID stands for, or None if it is not ``<3 letters><12 digits>``."""
+    digits = granule_id[3:]
+    if len(granule_id) != 15 or not digits.isascii() or not digits.isdigit():
+        return None
+    return GRANULE_ID_EPOCH_IET_US + int(digits) * 100_000
+
+
+def check_identity(path, name: str, meta, text_times, file_orbit: int | None) -> None:
+    """Granule ID, orbit number, text dates and scan count against the IET times (*name* is the
+    ``_Gran_k`` group; *text_times* the (start, end) parsed from the text attributes, or None)."""
+    sat = SATELLITES[meta.platform]
+    if not meta.granule_id:
+        raise GranuleError(path, f"{name}/N_Granule_ID", "missing: a granule without an ID cannot be paired")
+    id_us = granule_id_time_us(meta.granule_id)
+    if id_us is None:
+        raise GranuleError(path, f"{name}/N_Granule_ID", f"{meta.granule_id!r} is not PLATFORM + 12 digits")
+    if abs(meta.start_iet_us - id_us) > ID_TOLERANCE_US:
+        raise GranuleError(
+            path,
+            f"{name}/N_Granule_ID",
+            f"{meta.granule_id} stands for IET {id_us}, the granule begins at {meta.start_iet_us} "
+            f"({(meta.start_iet_us - id_us) / 1e6:+.0f} s): another granule's ID",
+        )
+    expected = sat.orbit_number(meta.start.timestamp())
+    allowed = ORBIT_TOLERANCE[0] * expected + ORBIT_TOLERANCE[1]
+    for field, value in ((f"{name}/N_Beginning_Orbit_Number", meta.orbit), ("(file name)", file_orbit)):
+        if value is not None and abs(value - expected) > allowed:
+            raise GranuleError(
+                path,
+                field,
+                f"orbit {value}, but {sat.name} flies orbit ~{expected} on {meta.start:%Y-%m-%d} "
+                f"(orbits since its launch): not a granule of {sat.name}",
+            )
+    if text_times is not None:
+        for which, text, iet_us in (
+            ("Beginning", text_times[0], meta.start_iet_us),
+            ("Ending", text_times[1], meta.end_iet_us),
+        ):
+            if abs((text - iet_to_datetime(iet_us)).total_seconds()) > TEXT_TIME_TOLERANCE_S:
+                raise GranuleError(
+                    path,
+                    f"{name}/{which}_Time",
+                    f"{text:%Y-%m-%d %H:%M:%S.%f} differs from N_{which}_Time_IET {iet_us} "
+                    f"({iet_to_datetime(iet_us):%Y-%m-%d %H:%M:%S.%f})",
+                )
+
+
+def check_cris_span(path, name: str, meta) -> None:
+    """A CrIS granule of n scans spans more than n - 1 and at most n scan periods."""
+    span = meta.end_iet_us - meta.start_iet_us
+    if not (meta.n_scans - 1) * CRIS_SCAN_US < span <= meta.n_scans * CRIS_SCAN_US:
+        raise GranuleError(
+            path,
+            f"{name}/N_Number_Of_Scans",
+            f"{meta.n_scans} scans of 8 s, but the granule spans {span / 1e6:.1f} s",
+        )
+
+
+def _scans_with_data(granule, key: str, rows_per_scan: int) -> np.ndarray:
+    data = getattr(granule, key)
+    finite = np.isfinite(data).reshape(data.shape[0] // rows_per_scan, -1)
+    return finite.any(axis=1)
+
+
+def check_viirs_scan_count(path, product, granule, key: str) -> None:
+    """VIIRS arrays hold 48 scans: those past N_Number_Of_Scans are fill, the last counted one is not."""
+    has = _scans_with_data(granule, key, product.rows_per_scan)
+    n = granule.meta.n_scans
+    name = f"{product.data_group}/{product.fields[key].dataset}"
+    if has[n:].any():
+        first = n + int(np.argmax(has[n:]))
+        raise GranuleError(path, name, f"scan {first + 1} holds data, but N_Number_Of_Scans is {n}")
+
+
+def check_scan_times(path, product, granule, has_data: np.ndarray) -> None:
+    """StartTime and MidTime of every scan with data: present, increasing by whole scan periods, MidTime
+    within a period after StartTime, inside the granule."""
+    period = SCAN_US[product.kind]
+    meta = granule.meta
+    lo, hi = meta.start_iet_us - 10_000_000, meta.end_iet_us + 10_000_000
+    start, mid = granule.start_time_us[has_data], granule.mid_time_us[has_data]
+    for field, t in (("StartTime", start), ("MidTime", mid)):
+        name = f"{product.data_group}/{field}"
+        if (t <= 0).any():
+            i = int(np.flatnonzero(has_data)[np.argmax(t <= 0)])
+            raise GranuleError(path, name, f"scan {i + 1} holds data but its time is {int(t[t <= 0][0])}")
+        if t.min() < lo or t.max() > hi:
+            bad = int(t.min() if t.min() < lo else t.max())
+            raise GranuleError(
+                path, name, f"time {bad} (IET us) outside the granule {meta.start_iet_us}..{meta.end_iet_us}"
+            )
+        steps = np.diff(t) / period
+        off = np.abs(steps - np.round(steps)) > 0.02
+        if ((steps < 0.98) | off).any():
+            i = int(np.argmax((steps < 0.98) | off))
+            raise GranuleError(
+                path,
+                name,
+                f"scans {i + 1} and {i + 2} are {np.diff(t)[i] / 1e6:.4f} s apart, not a multiple of "
+                f"the {period / 1e6:g} s scan period",
+            )
+    lag = mid - start
+    if ((lag <= 0) | (lag >= period)).any():
+        i = int(np.argmax((lag <= 0) | (lag >= period)))
+        raise GranuleError(
+            path,
+            f"{product.data_group}/MidTime",
+            f"MidTime - StartTime is {lag[i] / 1e6:.3f} s in a scan, not within 0..{period / 1e6:g} s",
+        )
+
+
+def check_ephemeris(path, product, granule, has_data: np.ndarray) -> None:
+    """Orbit radius and speed of the named satellite; attitude small, smooth and measured."""
+    sat = SATELLITES[granule.meta.platform]
+    g = product.data_group
+    radius_m = wgs84.A_M + sat.altitude_m  # the mean altitude is above the equatorial radius
+    r = np.linalg.norm(granule.sc_position_m[has_data], axis=-1)
+    r = r[np.isfinite(r)]
+    if r.size and np.abs(r - radius_m).max() > RADIUS_TOLERANCE_M:
+        bad = r[np.argmax(np.abs(r - radius_m))]
+        raise GranuleError(
+            path,
+            f"{g}/SCPosition",
+            f"orbit radius {bad / 1e3:.1f} km, {sat.name} flies at {radius_m / 1e3:.0f} km",
+        )
+    v = np.linalg.norm(granule.sc_velocity_m_s[has_data], axis=-1)
+    v = v[np.isfinite(v)]
+    if v.size and (v.min() < SPEED_LIMITS_M_S[0] or v.max() > SPEED_LIMITS_M_S[1]):
+        bad = v.min() if v.min() < SPEED_LIMITS_M_S[0] else v.max()
+        raise GranuleError(
+            path,
+            f"{g}/SCVelocity",
+            f"speed {bad:.0f} m/s, not the {SPEED_LIMITS_M_S[0]:.0f}..{SPEED_LIMITS_M_S[1]:.0f} m/s of "
+            f"{sat.name}",
+        )
+    att = granule.sc_attitude_rad[has_data] / ARCSEC_RAD
+    att = att[np.isfinite(att).all(axis=-1)]
+    name = f"{g}/SCAttitude"
+    if att.size:
+        if np.abs(att).max() > ATTITUDE_LIMIT_ARCSEC:
+            raise GranuleError(
+                path,
+                name,
+                f"{np.abs(att).max():.4g} arcsec, more than the {ATTITUDE_LIMIT_ARCSEC:g} of normal "
+                "operations",
+            )
+        if len(att) > 1 and np.abs(np.diff(att, axis=0)).max() > ATTITUDE_STEP_ARCSEC:
+            raise GranuleError(
+                path,
+                name,
+                f"jumps {np.abs(np.diff(att, axis=0)).max():.4g} arcsec from one scan to the next (at most "
+                f"{ATTITUDE_STEP_ARCSEC:g})",
+            )
+        if not att.any():
+            raise GranuleError(path, name, "exactly zero in every scan: not a measured attitude")
+
+
+def check_line_of_sight(path, product, granule) -> None:
+    """CrIS GEO: ground point + range along zenith/azimuth = the spacecraft at the FOR time."""
+    valid = granule.valid
+    if not valid.any():
+        return
+    lat, lon, zen, az, rng = (
+        np.where(valid, getattr(granule, k), v)
+        for k, v in (
+            ("lat_rad", 0.0),
+            ("lon_rad", 0.0),
+            ("zenith_rad", 0.0),
+            ("azimuth_rad", 0.0),
+            ("range_m", 1e6),
+        )
+    )
+    _, implied = satellite_from_fov(lat, lon, zen, az, rng)
+    scans = np.isfinite(granule.sc_position_m).all(axis=-1) & (granule.mid_time_us > 0)
+    if not scans.any():
+        return
+    r, _ = orbit.state_at(
+        granule.for_time_us,
+        granule.mid_time_us[scans],
+        granule.sc_position_m[scans],
+        np.nan_to_num(granule.sc_velocity_m_s[scans]),
+    )
+    miss = np.where(valid, np.linalg.norm(implied - r[..., None, :], axis=-1), 0.0)
+    if miss.max() > LOS_CLOSURE_M:
+        s, f, v = np.unravel_index(np.argmax(miss), miss.shape)
+        raise GranuleError(
+            path,
+            f"{product.data_group}/Latitude, Longitude, SatelliteRange, SatelliteZenith/AzimuthAngle",
+            f"scan {s + 1} FOR {f + 1} FOV {v + 1}: the ground point plus the range along the view "
+            f"direction misses the spacecraft (SCPosition at FORTime) by {miss.max() / 1e3:.3g} km (at most "
+            f"{LOS_CLOSURE_M:g} m)",
+        )
+
+
+def check_nadir(path, product, granule, has_data: np.ndarray) -> None:
+    """VIIRS GEO: the middle pixel of each scan lies below the spacecraft at the scan's MidTime."""
+    rows = product.rows_per_scan
+    centre = granule.lat_rad.shape[1] // 2
+    scans = np.flatnonzero(has_data & np.isfinite(granule.sc_position_m).all(axis=-1))
+    if not scans.size:
+        return
+    row = scans * rows + rows // 2
+    lat, lon = granule.lat_rad[row, centre], granule.lon_rad[row, centre]
+    h = granule.height_m[row, centre]
+    ok = np.isfinite(lat) & np.isfinite(lon)
+    if not ok.any():
+        return
+    pixel = wgs84.geodetic_to_ecef(lat[ok], lon[ok], np.nan_to_num(h[ok]))
+    sat = granule.sc_position_m[scans[ok]]
+    _, _, sat_h = wgs84.ecef_to_geodetic(sat)
+    off = np.abs(np.linalg.norm(sat - pixel, axis=-1) - (sat_h - np.nan_to_num(h[ok])))
+    if off.max() > NADIR_TOLERANCE_M:
+        i = int(np.argmax(off))
+        raise GranuleError(
+            path,
+            f"{product.data_group}/Latitude, Longitude, SCPosition",
+            f"scan {scans[ok][i] + 1}: the middle pixel is not below the spacecraft "
+            f"({off[i] / 1e3:.0f} km off)",
+        )
+
+
+def check_raw_zeros(path, name: str, raw: np.ndarray) -> None:
+    """Scaled VIIRS BT: raw count 0 is the scaled minimum, which no scene fills."""
+    zeros = np.count_nonzero(raw == 0)
+    if zeros > RAW_ZERO_SHARE * raw.size:
+        raise GranuleError(
+            path,
+            name,
+            f"{zeros} values ({100 * zeros / raw.size:.1f} %) at raw count 0, the bottom of the scale",
+        )
