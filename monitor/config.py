@@ -40,6 +40,7 @@ class SourceConfig:
     backoff_s: float = 1.5
     daily_budget_mb: float = 6000.0
     retention_days: int = 7
+    cache_max_mb: float = 20000.0  # the download cache is cut to this before every run (LRU)
     run_deadline_min: float = 180.0  # every request of one satellite-day's run ends by then
     max_list_pages: int = 100  # per listing (a day of one product is ~3 pages of 1000 keys)
     max_listed_keys: int = 20000
@@ -432,6 +433,7 @@ def load_config(path) -> Config:
         timeout_s=float,
         backoff_s=float,
         daily_budget_mb=float,
+        cache_max_mb=float,
         run_deadline_min=float,
         max_retry_after_s=float,
         min_rate_kb_s=float,
@@ -574,6 +576,7 @@ LIMITS = {
     "source.backoff_s": (0.01, 600),
     "source.daily_budget_mb": (1, 1e6),
     "source.retention_days": (0, 3650),
+    "source.cache_max_mb": (0, 1e8),
     "source.run_deadline_min": (1, 1440),
     "source.max_list_pages": (1, 10000),
     "source.max_listed_keys": (1, 10**6),

@@ -37,7 +37,9 @@ MEANING = {
     "source.daily_budget_mb": "Most bytes downloaded in one satellite-day run; further files are skipped "
     "with the reason.",
     "source.retention_days": "Downloaded files older than this are removed from the cache at the start of a "
-    "run.",
+    "run (kind simulated: this many simulated days are kept).",
+    "source.cache_max_mb": "Before every run the least recently used downloads go until the cache holds at"
+    " most this (a run adds at most daily_budget_mb).",
     "source.run_deadline_min": "Every request of one satellite-day run ends by this time after the run "
     "started.",
     "source.max_list_pages": "Most pages of one listing (a day of one product is ~3 pages of 1000 keys).",

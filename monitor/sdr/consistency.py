@@ -28,7 +28,9 @@ real NOAA-20 GCRSO granules of tests/data/real and on the simulator (docs/jpss-f
   spacecraft's height above it within 20 km (simulator: 0.1 km; a wrong position, time or pixel is
   hundreds of km off).
 * **VIIRS BT.** At most 0.5 % of the pixels at raw count 0 (the scaled minimum, 150 K and below: no scene
-  piles up there).
+  piles up there), and no other raw count holding more than 1 % of the pixels (the noise alone, 0.4 K,
+  spreads a uniform scene over ~250 counts of 0.003 K; a value stamped over the array piles up).
+* **CrIS spectra.** No FOV's long-wave spectrum exactly zero in every channel (no scene radiates nothing).
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from monitor.geometry.inverse import satellite_from_fov
 from monitor.satellites import SATELLITES
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.iet import iet_to_datetime
+from monitor.sdr.products import UINT16_FILL_MIN
 
 GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # docs/jpss-formats.md 1.2
 SCAN_US = {
@@ -60,6 +63,7 @@ ARCSEC_RAD = np.pi / (180.0 * 3600.0)
 LOS_CLOSURE_M = 200.0
 NADIR_TOLERANCE_M = 20e3
 RAW_ZERO_SHARE = 0.005
+RAW_ONE_COUNT_SHARE = 0.01
 
 
 def granule_id_time_us(granule_id: str) -> int | None:
@@ -284,12 +288,31 @@ def check_nadir(path, product, granule, has_data: np.ndarray) -> None:
         )
 
 
-def check_raw_zeros(path, name: str, raw: np.ndarray) -> None:
-    """Scaled VIIRS BT: raw count 0 is the scaled minimum, which no scene fills."""
-    zeros = np.count_nonzero(raw == 0)
-    if zeros > RAW_ZERO_SHARE * raw.size:
+def check_raw_counts(path, name: str, raw: np.ndarray) -> None:
+    """Scaled VIIRS BT (uint16): raw count 0 is the scaled minimum, which no scene fills, and no real scene
+    piles up on one count."""
+    counts = np.bincount(raw.ravel(), minlength=UINT16_FILL_MIN)[:UINT16_FILL_MIN]  # fills left out
+    valid = int(counts.sum())
+    if counts[0] > RAW_ZERO_SHARE * raw.size:
         raise GranuleError(
             path,
             name,
-            f"{zeros} values ({100 * zeros / raw.size:.1f} %) at raw count 0, the bottom of the scale",
+            f"{counts[0]} values ({100 * counts[0] / raw.size:.1f} %) at raw count 0, the bottom of the scale",
+        )
+    top = int(np.argmax(counts))
+    if valid and counts[top] > RAW_ONE_COUNT_SHARE * valid:
+        raise GranuleError(
+            path,
+            name,
+            f"{counts[top]} values ({100 * counts[top] / valid:.1f} % of the valid ones) at the one raw count "
+            f"{top}: stamped, not measured",
+        )
+
+
+def check_spectra(path, name: str, radiance: np.ndarray) -> None:
+    """CrIS: no FOV spectrum exactly zero in every channel."""
+    dead = np.all(radiance == 0, axis=-1)
+    if dead.any():
+        raise GranuleError(
+            path, name, f"the spectra of {int(dead.sum())} FOV(s) are exactly zero in every channel"
         )

@@ -150,7 +150,26 @@ def granule_files(key: str, sdr: Path, geo: Path, sdr_meta=None) -> GranuleFiles
                 path, "(file)", f"holds {len(found)} granules; one granule per file is expected"
             )
         metas.append(found[0])
+    problem = partners_differ(metas[0], metas[1])
+    if problem:
+        raise GranuleError(sdr, "N_Granule_ID", f"{problem} (its GEO file {Path(geo).name})")
     return GranuleFiles(key, Path(sdr), Path(geo), metas[0], metas[1])
+
+
+def partners_differ(sdr_meta, geo_meta) -> str | None:
+    """Why an SDR granule and the GEO granule paired with it by name are not the same granule, or None:
+    IDPS gives both the same granule ID and the same beginning and end (docs/jpss-formats.md 1.1)."""
+    if sdr_meta.granule_id != geo_meta.granule_id:
+        return f"granule {sdr_meta.granule_id!r}, its GEO holds {geo_meta.granule_id!r}"
+    if (
+        abs(sdr_meta.start_iet_us - geo_meta.start_iet_us) > 1_000_000
+        or abs(sdr_meta.end_iet_us - geo_meta.end_iet_us) > 1_000_000
+    ):
+        return (
+            f"IET {sdr_meta.start_iet_us}..{sdr_meta.end_iet_us}, its GEO "
+            f"{geo_meta.start_iet_us}..{geo_meta.end_iet_us}"
+        )
+    return None
 
 
 def _pair(by_prefix, sdr_prefixes, geo_prefixes, skipped) -> list[GranuleFiles]:
@@ -169,5 +188,9 @@ def _pair(by_prefix, sdr_prefixes, geo_prefixes, skipped) -> list[GranuleFiles]:
         elif key not in sdrs:
             skipped.append((str(geos[key][0]), f"no matching {'/'.join(sdr_prefixes)} file"))
         else:
+            problem = partners_differ(sdrs[key][1], geos[key][1])
+            if problem:
+                skipped.append((str(sdrs[key][0]), f"not the granule of its GEO file: {problem}"))
+                continue
             out.append(GranuleFiles(key, sdrs[key][0], geos[key][0], sdrs[key][1], geos[key][1]))
     return out

@@ -354,7 +354,7 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
             raise GranuleError(path, name, "not an array")
         _check_raw(path, name, raw, f, int(bounds[-1] * per))
         if f.kind == "scaled" and raw.dtype.kind == "u":
-            consistency.check_raw_zeros(path, name, raw)
+            consistency.check_raw_counts(path, name, raw)
         data = _clean(path, name, raw, f)
         fac = _factors(path, h5, group, f, n_gran) if f.factors else None
         parts = []
@@ -383,6 +383,10 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
 def _check_physics(path, product: Product, granule) -> None:
     """The relations between fields a genuine granule obeys (:mod:`monitor.sdr.consistency`)."""
     key = _MAIN_FIELD[product.kind]
+    if product.kind == "cris_sdr":
+        consistency.check_spectra(
+            path, f"{product.data_group}/{product.fields[key].dataset}", granule.radiance_lw
+        )
     if product.scans_reserved:
         consistency.check_viirs_scan_count(path, product, granule, key)
     if product.kind not in ("cris_geo", "viirs_geo"):

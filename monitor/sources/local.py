@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+import os
+import shutil
+import time
 from pathlib import Path
 
 from monitor.sdr.products import CRIS_PRODUCTS
 from monitor.sources import ListedFile, listed, on_day
 
 LOG = logging.getLogger(__name__)
+IN_USE_S = 600.0  # a simulated day listed this recently may still be read by a run
 
 
 class LocalSource:
@@ -47,7 +51,10 @@ class LocalSource:
 
 
 class SimulatedSource(LocalSource):
-    """The offline default: each satellite-day is simulated once (paper error profile) into *root*."""
+    """The offline default: each satellite-day is simulated once (paper error profile) into *root*; the
+    ``source.retention_days`` most recently listed days are kept, and any listed in the last
+    :data:`IN_USE_S` (a run elsewhere, e.g. another reprocessing worker, may still read it): a catch-up of
+    months would otherwise fill the disk, ~0.2 GB a day."""
 
     def __init__(self, root, source_cfg):
         super().__init__(root)
@@ -58,7 +65,9 @@ class SimulatedSource(LocalSource):
         from monitor.simulate.case import simulate_case
 
         target = self.root / satellite / day.isoformat()
-        if not (target / "truth.json").exists():
+        if (target / "truth.json").exists():
+            os.utime(target)  # listed now: in use
+        else:
             LOG.info(
                 "simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target
             )
@@ -72,4 +81,14 @@ class SimulatedSource(LocalSource):
                 start=start,
             )
         self.root.mkdir(parents=True, exist_ok=True)
+        self._forget_old_days(keep=target)
         return LocalSource(target).list_day(satellite, day, products)
+
+    def _forget_old_days(self, keep: Path) -> None:
+        days = sorted(
+            (d for d in self.root.glob("*/*") if d.is_dir() and d != keep), key=lambda d: d.stat().st_mtime
+        )
+        recent = time.time() - IN_USE_S
+        for d in days[: max(0, len(days) + 1 - max(self.cfg.retention_days, 1))]:
+            if d.stat().st_mtime < recent:
+                shutil.rmtree(d, ignore_errors=True)

@@ -83,15 +83,28 @@ class NoddSource:
         return self.cfg.endpoint.format(bucket=bucket).rstrip("/")
 
     def start_day(self):
-        """Start a run: reset the day's budget and the run deadline, apply the cache retention."""
+        """Start a run: reset the day's budget and the run deadline, apply the cache retention (age, then
+        size: the least recently used files go until the cache holds at most ``cache_max_mb``)."""
         self.spent_bytes = 0
         self.downloaded_files = 0
         self.deadline = time.monotonic() + self.cfg.run_deadline_min * 60
         self.cache_dir.mkdir(parents=True, exist_ok=True)
         cutoff = time.time() - self.cfg.retention_days * 86400
+        kept = []
         for p in self.cache_dir.rglob("*"):
-            if p.is_file() and (p.suffix == ".part" or p.stat().st_mtime < cutoff):
+            if not p.is_file():
+                continue
+            st = p.stat()
+            if p.suffix == ".part" or st.st_mtime < cutoff:
                 p.unlink(missing_ok=True)
+            else:
+                kept.append((max(st.st_atime, st.st_mtime), st.st_size, p))
+        total = sum(size for _, size, _ in kept)
+        for _, size, p in sorted(kept):
+            if total <= self.cfg.cache_max_mb * 1e6:
+                break
+            p.unlink(missing_ok=True)
+            total -= size
 
     def _run_deadline(self) -> float:
         if self.deadline is None:
@@ -259,6 +272,7 @@ class NoddSource:
         try:
             folder.mkdir(parents=True, exist_ok=True)
             if target.exists() and (f.size is None or target.stat().st_size == f.size):
+                os.utime(target)  # used now: the size bound evicts the least recently used first
                 return target
         except OSError as exc:
             raise SourceError(f"{f.name}: cache {folder}: {exc.strerror or exc}") from None

@@ -273,3 +273,22 @@ def test_longitudes_all_fill_under_set_latitudes_are_refused(cases, tmp_path):
     _edit(bad, "Longitude", lambda a: np.full_like(a, np.nan))
     with pytest.raises(GranuleError, match=f"{bad.name}: .*/Longitude: fill at .* where Latitude is set"):
         read_file(bad)
+
+
+def test_an_sdr_and_a_geo_of_different_granules_are_not_paired(cases, tmp_path):
+    """A GEO file of the next granule under the name of this granule's GEO: each file is consistent in
+    itself (its ID is its own time's, its name 32 s from its content is within the 60 s allowed), but the
+    two are not one granule."""
+    from monitor.sdr.pairing import granule_files, plan
+
+    base, _, _ = cases.get()
+    for f in base.glob("*.h5"):
+        (tmp_path / f.name).symlink_to(f)
+    first, second = sorted(base.glob("GCRSO_*.h5"))[:2]
+    (tmp_path / first.name).unlink()
+    shutil.copyfile(second, tmp_path / first.name)
+    skipped = dict(plan([tmp_path]).skipped)
+    sdr = next(p for p in skipped if "SCRIF" in p)
+    assert "not the granule of its GEO file" in skipped[sdr] and "its GEO holds" in skipped[sdr]
+    with pytest.raises(GranuleError, match="N_Granule_ID: granule .* its GEO holds"):
+        granule_files("k", sdr, tmp_path / first.name)

@@ -36,3 +36,45 @@ def test_a_fast_start_does_not_pay_for_a_later_stall():
     clock.t += 2
     w.add(1)
     assert w.stalled()
+
+
+def test_the_simulated_source_keeps_only_its_newest_days(tmp_path, monkeypatch):
+    """A catch-up of months must not keep every simulated day (~0.2 GB each)."""
+    import datetime as dt
+    import os
+    import time
+
+    import monitor.simulate.case
+    from monitor.config import SourceConfig
+    from monitor.sources.local import IN_USE_S, SimulatedSource
+
+    def fake_case(target, **kw):
+        target.mkdir(parents=True)
+        (target / "truth.json").write_text("{}")
+
+    monkeypatch.setattr(monitor.simulate.case, "simulate_case", fake_case)
+    src = SimulatedSource(tmp_path, SourceConfig(kind="simulated", retention_days=3))
+    for k in range(6):
+        src.list_day("j01", dt.date(2024, 6, 1) + dt.timedelta(days=k), ("GCRSO",))
+        for d in (tmp_path / "j01").iterdir():  # listed long ago, except the one just listed
+            if d.name != (dt.date(2024, 6, 1) + dt.timedelta(days=k)).isoformat():
+                os.utime(d, (time.time() - IN_USE_S - 60,) * 2)
+    assert sorted(d.name for d in (tmp_path / "j01").iterdir()) == ["2024-06-04", "2024-06-05", "2024-06-06"]
+
+
+def test_the_download_cache_is_cut_to_its_size_least_recently_used_first(tmp_path):
+    import os
+    import time
+
+    from monitor.config import SourceConfig
+    from monitor.sources.nodd import NoddSource
+
+    src = NoddSource(SourceConfig(kind="nodd", cache_max_mb=2.5), tmp_path / "cache")
+    folder = tmp_path / "cache" / "GITCO"
+    folder.mkdir(parents=True)
+    for k in range(5):  # 1 MB each, used k hours ago
+        f = folder / f"g{k}.h5"
+        f.write_bytes(b"x" * 1_000_000)
+        os.utime(f, (time.time() - 3600 * k,) * 2)
+    src.start_day()
+    assert sorted(p.name for p in folder.iterdir()) == ["g0.h5", "g1.h5"]

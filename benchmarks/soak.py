@@ -1,0 +1,386 @@
+"""Soak: one ``crisgeo daemon`` process works through months of simulated days while its world fails.
+
+The daemon starts with a catch-up window of ``--days`` days and reads them from NODD as it would in
+production, here an S3 server on loopback that simulates each satellite-day when it is first listed (and
+keeps only the last three on disk). While the days go by, the harness breaks what the service depends on,
+by the day the daemon is working on:
+
+* the time-series database (VictoriaMetrics, real) is down for a week of days, then back;
+* SMTP (aiosmtpd) answers 451 and the Slack webhook 500 for ten days;
+* the archive answers 503 to every request for one day (its run fails; the next daily run redoes it).
+
+The daily run time is set after the expected end of the catch-up, so that the daemon's own schedule redoes
+the failed day. Every ``--every`` seconds the harness samples the daemon's RSS, open files and threads
+(/proc) and the store's size. At the end it checks: every day recorded ok exactly once in the results;
+every outbox point in VictoriaMetrics exactly once (each series holds one sample per ok day); every alert
+delivery sent exactly once (the messages the SMTP and Slack servers accepted equal the deliveries the store
+marks sent, and none is left pending or failed). It prints the samples and the verdicts, and exits 1 if a
+check fails.
+
+    .venv/bin/python benchmarks/soak.py [--days 90] [--seconds-per-day 20] [--keep DIR]
+
+Needs the Debian package victoria-metrics (as the tests do). It runs about ``days x seconds-per-day``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from contextlib import ExitStack
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+
+from aiosmtpd.controller import Controller
+
+from monitor.store.alerts import AlertState
+from monitor.store.sqlite import RunStatus, Store
+from tests.servers import S3Server, free_port, victoria_metrics, vm_export
+
+ROOT = Path(__file__).resolve().parent.parent
+BUCKET = "noaa-nesdis-n20-pds"
+FOLDER = {
+    "GCRSO": "CrIS-SDR-GEO",
+    "SCRIF": "CrIS-FS-SDR",
+    "SVI05": "VIIRS-I5-SDR",
+    "GITCO": "VIIRS-IMG-GEO-TC",
+}
+DAY_IN_PREFIX = re.compile(r"/(\d{4})/(\d{2})/(\d{2})/")
+
+
+class SimulatingS3(S3Server):
+    """An S3 server whose bucket fills itself: listing a day simulates it (one CrIS granule) and drops
+    days older than three; requests for the CrIS files of a day in ``failing`` answer 503 (that day's run
+    fails; its neighbours, which list its VIIRS granules, do not)."""
+
+    def __init__(self, root: Path, granules: int):
+        super().__init__(root, page_size=1000)
+        self.granules = granules
+        self.failing: set = set()
+        self.lock = threading.Lock()
+        self.made: list = []
+
+    def _list(self, h, bucket, q):
+        prefix = q.get("prefix", [""])[0]
+        if self._fails(prefix):
+            return self._unavailable(h)
+        m = DAY_IN_PREFIX.search("/" + prefix)
+        if m:
+            self._simulate(dt.date(int(m[1]), int(m[2]), int(m[3])))
+        return super()._list(h, bucket, q)
+
+    def _get(self, h, bucket, key):
+        if self._fails(key):
+            return self._unavailable(h)
+        return super()._get(h, bucket, key)
+
+    def _fails(self, key: str) -> bool:
+        m = DAY_IN_PREFIX.search("/" + key)
+        cris = key.startswith((FOLDER["GCRSO"] + "/", FOLDER["SCRIF"] + "/"))
+        return bool(m) and cris and dt.date(int(m[1]), int(m[2]), int(m[3])) in self.failing
+
+    @staticmethod
+    def _unavailable(h):
+        h.send_response(503)
+        h.send_header("Content-Length", "0")
+        h.end_headers()
+
+    def _simulate(self, day: dt.date):
+        from monitor.simulate.case import simulate_case
+
+        with self.lock:
+            if day in self.made:
+                return
+            work = self.root / "work" / day.isoformat()
+            start = dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc)
+            simulate_case(
+                work,
+                satellite="j01",
+                granules=self.granules,
+                profile="paper",
+                seed=day.toordinal() % 97,
+                start=start,
+            )
+            for f in work.glob("*.h5"):
+                product = f.name.split("_")[0]
+                when = dt.datetime.strptime(f.name.split("_d")[1][:8], "%Y%m%d").date()
+                d = self.root / BUCKET / FOLDER[product] / f"{when:%Y/%m/%d}"
+                d.mkdir(parents=True, exist_ok=True)
+                os.replace(f, d / f.name)
+            shutil.rmtree(work)
+            self.made.append(day)
+            for old in self.made[:-3]:  # the bucket holds three days: the disk stays bounded
+                for folder in FOLDER.values():
+                    shutil.rmtree(self.root / BUCKET / folder / f"{old:%Y/%m/%d}", ignore_errors=True)
+
+
+class Smtp:
+    """An SMTP server that accepts (and counts) messages, or answers 451 while ``failing``."""
+
+    def __init__(self):
+        self.messages = []
+        self.refused = 0
+        self.failing = False
+        self.port = free_port()
+        self.controller = Controller(self, hostname="127.0.0.1", port=self.port)
+
+    async def handle_DATA(self, server, session, envelope):
+        if self.failing:
+            self.refused += 1
+            return "451 4.3.0 try again later"
+        self.messages.append(envelope.content)
+        return "250 accepted"
+
+
+class Slack:
+    """A Slack webhook that accepts (and counts) posts, or answers 500 while ``failing``."""
+
+    def __init__(self):
+        self.posts, self.refused, self.failing = [], 0, False
+        hook = self
+
+        class H(BaseHTTPRequestHandler):
+            def log_message(self, *a):
+                pass
+
+            def do_POST(self):
+                body = self.rfile.read(int(self.headers["Content-Length"]))
+                status = 500 if hook.failing else 200
+                if hook.failing:
+                    hook.refused += 1
+                else:
+                    hook.posts.append(json.loads(body))
+                self.send_response(status)
+                self.send_header("Content-Length", "2")
+                self.end_headers()
+                self.wfile.write(b"ok")
+
+        self.httpd = ThreadingHTTPServer(("127.0.0.1", 0), H)
+        self.url = f"http://127.0.0.1:{self.httpd.server_address[1]}/services/T/B/soak"
+        threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
+
+
+def proc_sample(pid: int) -> dict:
+    """RSS (MB), open files and threads of process *pid*."""
+    status = Path(f"/proc/{pid}/status").read_text()
+    rss_kb = int(re.search(r"VmRSS:\s+(\d+)", status)[1])
+    return {
+        "rss_mb": rss_kb / 1024,
+        "open_files": len(os.listdir(f"/proc/{pid}/fd")),
+        "threads": int(re.search(r"Threads:\s+(\d+)", status)[1]),
+    }
+
+
+def write_config(
+    work: Path, s3_url: str, vm_url: str, smtp_port: int, days: int, run_at: dt.datetime
+) -> Path:
+    events = work / "events.yaml"
+    events.write_text((ROOT / "configs" / "events.yaml").read_text())
+    path = work / "soak.yaml"
+    path.write_text(
+        f"""satellites: [j01]
+state_dir: {work / "state"}
+source:
+  kind: nodd
+  endpoint: "{s3_url}/{{bucket}}"
+  timeout_s: 120
+  retries: 2
+  backoff_s: 1
+  cache_max_mb: 1000
+schedule:
+  time_utc: "{run_at:%H:%M}"
+  catch_up_days: {days}
+  lag_days: 1
+scenes: {{candidates: 4, keep: 4}}
+fingerprint: {{granules: 2}}
+store:
+  publish: [{{kind: influx1, url: "{vm_url}"}}]
+  drain_minutes: 0.5
+report_dir: {work / "state" / "report"}
+http: {{listen: "127.0.0.1:0"}}
+alerts:
+  log: {work / "state" / "alerts.log"}
+  events_file: {events}
+  email: {{host: 127.0.0.1, port: {smtp_port}, starttls: false, to: [team@example.org]}}
+  slack: {{webhook_env: SOAK_SLACK}}
+"""
+    )
+    return path
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--days", type=int, default=90)
+    ap.add_argument("--granules", type=int, default=1, help="CrIS granules simulated per day")
+    ap.add_argument("--seconds-per-day", type=float, default=20.0, help="expected wall time of one day")
+    ap.add_argument("--every", type=float, default=5.0, help="seconds between samples")
+    ap.add_argument("--keep", type=Path, help="work directory to keep (default: a temporary one)")
+    args = ap.parse_args(argv)
+    work = args.keep or Path(tempfile.mkdtemp(prefix="crisgeo-soak-"))
+    work.mkdir(parents=True, exist_ok=True)
+    today = dt.datetime.now(dt.timezone.utc).date()
+    first = today - dt.timedelta(days=args.days)
+    days = [first + dt.timedelta(days=k) for k in range(args.days)]
+    at = [days[int(f * args.days)] for f in (0.2, 0.28, 0.4, 0.51, 0.6)]  # of 90: days 19, 26, 37, 46, 55
+    vm_down, vm_up = at[0], at[1]  # a week without the time-series database
+    mail_down, mail_up = at[2], at[3]  # ten days without SMTP and Slack
+    s3 = SimulatingS3(work / "s3", args.granules)
+    s3.failing = {at[4]}  # the archive answers 503 for one day
+    smtp, slack = Smtp(), Slack()
+    run_at = dt.datetime.now(dt.timezone.utc) + dt.timedelta(
+        seconds=args.days * args.seconds_per_day * 1.4 + 180
+    )
+    samples, store_mb = [], {}
+    vm_port, vm_data = free_port(), work / "vm"
+    with ExitStack() as stack:
+        stack.enter_context(s3)
+        smtp.controller.start()
+        stack.callback(smtp.controller.stop)
+        vm = ExitStack()
+        vm_url = vm.enter_context(victoria_metrics(vm_data, vm_port))
+        give_up = run_at + dt.timedelta(hours=1)
+        config = write_config(work, s3.url, vm_url, smtp.port, args.days, run_at)
+        env = {**os.environ, "SOAK_SLACK": slack.url, "PYTHONPATH": str(ROOT)}
+        log = open(work / "daemon.log", "w")
+        daemon = subprocess.Popen(
+            [sys.executable, "-m", "monitor.cli", "daemon", "--config", str(config)],
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            env=env,
+            cwd=ROOT,
+        )
+        print(f"soak: {args.days} days {first}..{days[-1]}, daemon pid {daemon.pid}, work {work}")
+        print(f"soak: the daily run (redoing the failed day) is at {run_at:%H:%M} UTC")
+        t0 = time.monotonic()
+        state = work / "state" / "crisgeo.sqlite"
+        phase = "running"
+        try:
+            while daemon.poll() is None:
+                time.sleep(args.every)
+                if not state.exists():
+                    continue
+                with Store(state) as store:
+                    runs = store.runs("j01")
+                    outbox = store.outbox_size()
+                    pending = len(AlertState(store).deliveries("pending"))
+                finished = [r for r in runs if r.finished]
+                current = dt.date.fromisoformat(runs[-1].day) if runs else first
+                ok_days = {r.day for r in runs if r.status == RunStatus.OK}
+                s = proc_sample(daemon.pid)
+                s.update(t_s=round(time.monotonic() - t0), runs=len(finished), ok_days=len(ok_days))
+                s["store_mb"] = state.stat().st_size / 1e6
+                samples.append(s)
+                store_mb[len(finished)] = s["store_mb"]
+                if current >= vm_down and current < vm_up and phase == "running":
+                    vm.close()
+                    phase = "vm down"
+                    print(f"soak: {current}: VictoriaMetrics stopped")
+                elif current >= vm_up and phase == "vm down":
+                    vm = ExitStack()
+                    vm.enter_context(victoria_metrics(vm_data, vm_port))
+                    phase = "running"
+                    print(f"soak: {current}: VictoriaMetrics back")
+                smtp.failing = slack.failing = mail_down <= current < mail_up
+                if len(samples) % 12 == 0:
+                    print(
+                        f"soak: t={s['t_s']} s day {current} runs {s['runs']} ok {s['ok_days']} "
+                        f"rss {s['rss_mb']:.0f} MB fds {s['open_files']} threads {s['threads']} "
+                        f"store {s['store_mb']:.1f} MB outbox {outbox} "
+                        f"alerts pending {pending}"
+                    )
+                done = len(ok_days) == args.days and outbox == 0 and pending == 0
+                if done and not any(r.finished is None for r in runs):
+                    break
+                if dt.datetime.now(dt.timezone.utc) > give_up:
+                    print("soak: giving up an hour after the daily run")
+                    break
+        finally:
+            daemon.send_signal(signal.SIGTERM)
+            daemon.wait(timeout=120)
+            log.close()
+        # the checks
+        failures = []
+        with Store(state) as store:
+            runs = store.runs("j01")
+            deliveries = AlertState(store).deliveries()
+        ok = [r for r in runs if r.status == RunStatus.OK]
+        per_day = {}
+        for r in ok:
+            per_day[r.day] = per_day.get(r.day, 0) + 1
+        if sorted(per_day) != [d.isoformat() for d in days]:
+            failures.append(f"days recorded ok: {len(per_day)} of {args.days}")
+        if any(n != 1 for n in per_day.values()):
+            failures.append(f"days recorded ok more than once: {[d for d, n in per_day.items() if n != 1]}")
+        failed = [r for r in runs if r.status == RunStatus.FAILED]
+        if phase != "running":
+            vm = ExitStack()
+            vm.enter_context(victoria_metrics(vm_data, vm_port))
+        stored = vm_export(vm_url, "cris_geolocation_total_km")
+        counts = [len(x["timestamps"]) for x in stored]
+        unique = [len(set(x["timestamps"])) for x in stored]
+        if len(stored) != 30 or any(c != args.days for c in counts) or counts != unique:
+            failures.append(
+                f"VictoriaMetrics: {len(stored)} series with {sorted(set(counts))} samples "
+                f"({sorted(set(unique))} distinct)"
+            )
+        sent = [d for d in deliveries if d.status == "sent"]
+        by_channel = {c: sum(1 for d in sent if d.channel == c) for c in ("email", "slack")}
+        left = [d for d in deliveries if d.status != "sent" and d.channel in ("email", "slack")]
+        if by_channel["email"] != len(smtp.messages) or by_channel["slack"] != len(slack.posts) or left:
+            failures.append(
+                f"alerts: sent email {by_channel['email']} / received {len(smtp.messages)}, "
+                f"slack {by_channel['slack']} "
+                f"/ received {len(slack.posts)}, not sent {len(left)}"
+            )
+        vm.close()
+    # the report
+    print(
+        f"\nsoak: {args.days} days in {samples[-1]['t_s'] if samples else 0} s; "
+        f"{len(failed)} failed run(s) redone"
+    )
+    print(
+        f"soak: alerts sent by email {len(smtp.messages)} (refused while down {smtp.refused}), "
+        f"Slack {len(slack.posts)} (refused {slack.refused})"
+    )
+    by_runs = {}
+    for s in samples:
+        by_runs.setdefault(s["runs"], s)
+    print("runs  t_s   rss_mb  open_files  threads  store_mb")
+    for n in sorted(by_runs):
+        if n % 10 == 0 or n == max(by_runs):
+            s = by_runs[n]
+            print(
+                f"{n:4d} {s['t_s']:5d} {s['rss_mb']:8.1f} {s['open_files']:10d} {s['threads']:8d} "
+                f"{s['store_mb']:9.2f}"
+            )
+    at10 = next((s for s in samples if s["runs"] >= 10), None)
+    at_end = next((s for s in reversed(samples) if s["runs"] >= args.days), samples[-1] if samples else None)
+    if at10 and at_end:
+        growth = at_end["rss_mb"] / at10["rss_mb"] - 1
+        print(
+            f"soak: RSS day 10 {at10['rss_mb']:.0f} MB, day {at_end['runs']} {at_end['rss_mb']:.0f} MB "
+            f"({100 * growth:+.1f} %); open files {at10['open_files']} -> {at_end['open_files']}; "
+            f"threads {at10['threads']} -> {at_end['threads']}"
+        )
+        if growth > 0.10:
+            failures.append(f"RSS grew {100 * growth:.1f} % from day 10 to the end")
+        if at_end["open_files"] > at10["open_files"] or at_end["threads"] > at10["threads"]:
+            failures.append("open files or threads grew")
+    (work / "samples.json").write_text(json.dumps(samples))
+    for f in failures:
+        print("soak: FAIL:", f)
+    print("soak: PASS" if not failures else "soak: FAILED")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
