@@ -297,15 +297,15 @@ def check_raw_counts(path, name: str, raw: np.ndarray) -> None:
         raise GranuleError(
             path,
             name,
-            f"{counts[0]} values ({100 * counts[0] / raw.size:.1f} %) at raw count 0, the bottom of the scale",
+            f"{counts[0]} values ({100 * counts[0] / raw.size:.1f} %) at raw count 0, the scale's bottom",
         )
     top = int(np.argmax(counts))
     if valid and counts[top] > RAW_ONE_COUNT_SHARE * valid:
         raise GranuleError(
             path,
             name,
-            f"{counts[top]} values ({100 * counts[top] / valid:.1f} % of the valid ones) at the one raw count "
-            f"{top}: stamped, not measured",
+            f"{counts[top]} values ({100 * counts[top] / valid:.1f} % of the valid ones) at one raw "
+            f"count, {top}: stamped, not measured",
         )
 
 
