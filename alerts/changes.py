@@ -81,10 +81,21 @@ def load_calendar(path) -> list[Change]:
 
 
 def add_to_calendar(path, change: Change) -> None:
-    """Append *change* to the calendar YAML at *path* (created if missing)."""
+    """Append *change* to the calendar YAML at *path* (created if missing). The file is edited as a
+    round trip (ruamel.yaml): its comments, order and quoting stay as the team wrote them."""
+    from ruamel.yaml import YAML
+
     path = Path(path)
-    doc = (yaml.safe_load(path.read_text()) if path.exists() else None) or {}
-    doc.setdefault("events", []).append(
+    rt = YAML()  # round-trip mode
+    rt.preserve_quotes = True
+    rt.width = 4096  # long descriptions stay on their lines
+    rt.indent(mapping=2, sequence=4, offset=2)
+    doc = (rt.load(path.read_text()) if path.exists() else None) or {}
+    if not isinstance(doc, dict) or not isinstance(doc.get("events", []) or [], list):
+        raise ValueError(f"{path}: expected a mapping with an events list")
+    if doc.get("events") is None:
+        doc["events"] = []
+    doc["events"].append(
         {
             "satellite": change.satellite,
             "time": change.time.strftime("%Y-%m-%dT%H:%M:%SZ"),
@@ -94,7 +105,10 @@ def add_to_calendar(path, change: Change) -> None:
         }
     )
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(yaml.safe_dump(doc, sort_keys=False))
+    tmp = path.with_name(path.name + ".part")
+    with open(tmp, "w") as fh:
+        rt.dump(doc, fh)
+    tmp.replace(path)
 
 
 def _lut_kinds(names) -> dict:

@@ -13,6 +13,7 @@ import logging
 
 import numpy as np
 
+from alerts.alertmanager import post_state
 from alerts.changes import all_changes
 from alerts.channels import Permanent, Transient, make_channels
 from alerts.rules import (
@@ -204,6 +205,7 @@ def evaluate_and_deliver(store, settings, satellites, now=None) -> dict:
     queued = evaluate(store, settings, satellites, now)
     counts = deliver(store, settings, now)
     counts["queued"] = len(queued)
+    post_state(store, settings, now)
     return counts
 
 
@@ -234,7 +236,7 @@ def alerts_view(store, now: dt.datetime) -> dict:
             }
         )
     silences = [
-        {"rule": s.rule, "satellite": s.satellite, "until": s.until, "reason": s.reason}
+        {"id": s.id, "rule": s.rule, "satellite": s.satellite, "until": s.until, "reason": s.reason}
         for s in state.silences(now)
     ]
     return {"alerts": alerts, "silences": silences, "pending_deliveries": len(state.deliveries("pending"))}
@@ -249,9 +251,17 @@ def fmt_alerts(view: dict) -> str:
         for a in view["alerts"]
     ]
     lines += [
-        f"silence   rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: "
+        f"silence {s['id']:<3} rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: "
         f"{s['reason']}"
         for s in view["silences"]
     ]
     lines.append(f"{view['pending_deliveries']} message(s) waiting for delivery")
-    return "\n".join(lines) if view["alerts"] or view["pending_deliveries"] else "no alerts"
+    return (
+        "\n".join(lines) if view["alerts"] or view["pending_deliveries"] or view["silences"] else "no alerts"
+    )
+
+
+def fmt_counts(counts: dict) -> str:
+    """Delivery counts as words: ``queued 1, sent 3, to retry 0, failed 0``."""
+    names = {"queued": "queued", "sent": "sent", "retry": "to retry", "failed": "failed"}
+    return ", ".join(f"{names[k]} {counts[k]}" for k in names if k in counts)

@@ -6,6 +6,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from alerts.rules import RuleSettings
 
@@ -40,6 +41,15 @@ class SlackSettings:
 
 
 @dataclass
+class AlertmanagerSettings:
+    """The ``alerts.alertmanager`` section: where the service posts its alerts (Alertmanager API v2)."""
+
+    url: str
+    timeout_s: float = 10.0
+    validity_hours: float = 3.0  # a firing alert not posted again within this ends by itself
+
+
+@dataclass
 class AlertSettings:
     """The ``alerts`` section, validated."""
 
@@ -47,6 +57,7 @@ class AlertSettings:
     log: Path | None = None
     email: EmailSettings | None = None
     slack: SlackSettings | None = None
+    alertmanager: AlertmanagerSettings | None = None
     events_file: Path | None = None
     report_dir: Path | None = None
     dashboard_url: str | None = None
@@ -59,7 +70,8 @@ class AlertSettings:
 
 
 # the keys of the alerts section; email "from" is EmailSettings.sender
-ALERT_KEYS = set(RuleSettings.__dataclass_fields__) | {"log", "email", "slack", "events_file"}
+ALERT_KEYS = set(RuleSettings.__dataclass_fields__) | {"log", "email", "slack", "alertmanager", "events_file"}
+ALERTMANAGER_KEYS = set(AlertmanagerSettings.__dataclass_fields__)
 EMAIL_KEYS = {"host", "port", "from", "to", "starttls", "username_env", "password_env", "cafile", "timeout_s"}
 SLACK_KEYS = set(SlackSettings.__dataclass_fields__)
 
@@ -182,6 +194,22 @@ def load_alert_settings(
             retries=_typed(sl, "retries", int, w, d.retries, (0, 20)),
             max_wait_s=_typed(sl, "max_wait_s", float, w, d.max_wait_s, (0.0, 3600.0)),
             timeout_s=_typed(sl, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)),
+        )
+    if doc.get("alertmanager"):
+        am = _mapping(doc, "alertmanager")
+        w = "alerts.alertmanager."
+        _only(am, ALERTMANAGER_KEYS, w)
+        url = _typed(am, "url", str, w, None)
+        parts = urlsplit(url or "")
+        if parts.scheme not in ("http", "https") or not parts.netloc or "@" in parts.netloc:
+            raise AlertConfigError(
+                f"{w}url: {url!r} is not an http(s) URL without credentials (e.g. http://127.0.0.1:9093)"
+            )
+        d = AlertmanagerSettings(url=url)
+        s.alertmanager = AlertmanagerSettings(
+            url=url.rstrip("/"),
+            timeout_s=_typed(am, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)),
+            validity_hours=_typed(am, "validity_hours", float, w, d.validity_hours, (1.5, 168.0)),
         )
     return s
 

@@ -290,6 +290,9 @@ def main(argv=None) -> int:
                     phase = "running"
                     print(f"soak: {current}: VictoriaMetrics back")
                 smtp.failing = slack.failing = mail_down <= current < mail_up
+                if current > at[4] and s3.failing:
+                    s3.failing = set()  # the archive is back the next day
+                    print(f"soak: {current}: the archive answers again")
                 if len(samples) % 12 == 0:
                     print(
                         f"soak: t={s['t_s']} s day {current} runs {s['runs']} ok {s['ok_days']} "

@@ -24,8 +24,9 @@ def __getattr__(name):  # the public API, imported when first used (keeps ``impo
     raise AttributeError(f"module 'monitor' has no attribute {name!r}")
 
 
-def open_store(path):
-    """The service's SQLite store at *path*, e.g. ``open_store(p).to_xarray("j01")`` in a notebook."""
+def open_store(path, create: bool = False):
+    """The service's SQLite store at *path*, e.g. ``open_store(p).to_xarray("j01")`` in a notebook. A
+    missing store is an error (a typo must not start an empty history) unless *create*."""
     from monitor.store.sqlite import Store
 
-    return Store(path)
+    return Store(path, create=create)

@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
-import logging
 import sys
 from pathlib import Path
 
-from monitor import allocator
+from monitor import allocator, logs
 from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
 from monitor.errors import DataError
 from monitor.satellites import SATELLITES
@@ -369,7 +368,7 @@ def cmd_check_config(args) -> int:
     """crisgeo check-config: validate and print the effective configuration, or the reference."""
     import yaml
 
-    from monitor.config import effective
+    from monitor.config import effective, secret_status
 
     if args.reference:
         from monitor.config_reference import reference
@@ -377,7 +376,9 @@ def cmd_check_config(args) -> int:
         print(reference(), end="")
         return EXIT_OK
     cfg = _load(args)
-    print(f"# {args.config}: valid")
+    print(f"# {args.config}: valid; with every default (this output loads as a configuration)")
+    for line in secret_status(cfg):
+        print(f"# secret {line}")
     print(yaml.safe_dump(effective(cfg), sort_keys=False, default_flow_style=False), end="")
     return EXIT_OK
 
@@ -394,22 +395,34 @@ def cmd_check_config(args) -> int:
 )
 def cmd_export(args) -> int:
     """crisgeo export: the results as NetCDF or CSV."""
-    from monitor.export import export
-    from monitor.store.sqlite import Store
+    from monitor.export import NothingToExport, export
 
     cfg = _load(args)
-    sats = [args.satellite] if args.satellite else cfg.satellites
+    sats = _satellites(cfg, args.satellite)
     if len(sats) > 1:
         raise BadInput(f"--satellite: one of {', '.join(sats)} (a file holds one satellite)")
-    with Store(cfg.store.sqlite) as store:
+    if args.since and args.until and args.since > args.until:
+        raise BadInput(f"--since {args.since} is after --until {args.until}")
+    with _open_store(cfg) as store:
         try:
             path = export(store, sats[0], args.out, args.format, args.since, args.until)
         except ImportError as exc:
             raise BadInput(
                 f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
             ) from None
+        except NothingToExport as exc:
+            raise BadInput(str(exc)) from None
+        except OSError as exc:
+            raise BadInput(f"--out {args.out}: {exc.strerror or exc}") from None
     print(f"wrote {path}")
     return EXIT_OK
+
+
+def _open_store(cfg):
+    """The configured store for a command that only reads: never created (a missing one is an error)."""
+    from monitor.store.sqlite import Store
+
+    return Store(cfg.store.sqlite, create=False)
 
 
 def _satellites(cfg, satellite: str | None) -> list[str]:
@@ -529,6 +542,7 @@ def cmd_daemon(args) -> int:
     "status",
     "last run per satellite, latest per-FOR table, next run, outbox size",
     CONFIG,
+    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--json", action="store_true", help="machine-readable status"),
 )
 def cmd_status(args) -> int:
@@ -541,14 +555,15 @@ def cmd_status(args) -> int:
 
     try:
         cfg = _load(args)
-        store = Store(cfg.store.sqlite)
+        sats = _satellites(cfg, args.satellite)
+        store = Store(cfg.store.sqlite, create=False)
     except (BadInput, ConfigError, StoreError) as exc:
         if args.json:
             print(json.dumps({"state": "UNKNOWN", "exit": NAGIOS_UNKNOWN, "error": str(exc)}))
         print(f"crisgeo status: UNKNOWN: {exc}", file=sys.stderr)
         return NAGIOS_UNKNOWN
     with store:
-        rep = status_report(cfg, store)
+        rep = status_report(cfg, store, sats)
     if args.json:
         print(json.dumps(rep, indent=1, default=str))
         return rep["exit"]
@@ -580,24 +595,43 @@ def cmd_status(args) -> int:
 
 @command(
     "alerts",
-    "list firing, silenced and resolved alerts; silence; evaluate now",
-    arg("action", choices=("list", "silence", "evaluate"), nargs="?", default="list"),
+    "the alerts: list them, silence or unsilence a rule, evaluate the rules now",
+    arg(
+        "action",
+        choices=("list", "silence", "unsilence", "evaluate"),
+        nargs="?",
+        default="list",
+        help="list (default): firing, silenced and recently resolved alerts and the silences in force; "
+        "silence: quiet --rule/--satellite until --until, with --reason; unsilence: end silence --id; "
+        "evaluate: evaluate the rules and deliver now",
+    ),
     CONFIG,
-    arg("--rule", choices=RULES),
-    arg("--satellite", choices=tuple(SATELLITES)),
-    arg("--until", type=_iso, help="end of the silence (ISO 8601, UTC)"),
-    arg("--reason", default=""),
-    arg("--json", action="store_true", help="list as JSON"),
+    arg("--rule", choices=RULES, help="silence: the rule (default: every rule)"),
+    arg("--satellite", choices=tuple(SATELLITES), help="silence: the satellite (default: every one)"),
+    arg("--until", type=_iso, help="silence: its end (ISO 8601, UTC)"),
+    arg("--reason", default="", help="silence: why (shown with the silence)"),
+    arg("--id", type=int, help="unsilence: the silence's number (crisgeo alerts list shows it)"),
+    arg("--json", action="store_true", help="list: as JSON"),
 )
 def cmd_alerts(args) -> int:
-    """crisgeo alerts: list, silence, evaluate."""
-    from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts
+    """crisgeo alerts: list, silence, unsilence, evaluate."""
+    from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts, fmt_counts
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
 
-    cfg = _load(args, writes=True)
-    settings = cfg.alert_settings
     now = dt.datetime.now(dt.timezone.utc)
+    if args.action == "list":
+        cfg = _load(args)
+        with _open_store(cfg) as store:
+            view = alerts_view(store, now)
+        if args.json:
+            import json
+
+            print(json.dumps(view, indent=1))
+        else:
+            print(fmt_alerts(view))
+        return EXIT_OK
+    cfg = _load(args, writes=True)
     with Store(cfg.store.sqlite) as store:
         if args.action == "silence":
             if args.until is None or not args.reason:
@@ -609,46 +643,55 @@ def cmd_alerts(args) -> int:
                 f"silenced rule={args.rule or '*'} satellite={args.satellite or '*'} until "
                 f"{args.until:%Y-%m-%d %H:%M} UTC"
             )
-        elif args.action == "evaluate":
-            print(evaluate_and_deliver(store, settings, cfg.satellites, now))
-        elif args.json:
-            import json
-
-            print(json.dumps(alerts_view(store, now), indent=1))
+        elif args.action == "unsilence":
+            if args.id is None:
+                raise BadInput("alerts unsilence needs --id (crisgeo alerts list shows the silences)")
+            if not AlertState(store).lift(args.id, now):
+                raise BadInput(f"--id {args.id}: no silence in force has that number")
+            print(f"silence {args.id} lifted")
         else:
-            print(fmt_alerts(alerts_view(store, now)))
+            print(fmt_counts(evaluate_and_deliver(store, cfg.alert_settings, cfg.satellites, now)))
     return EXIT_OK
 
 
 @command(
     "events",
     "list the known changes, or add one to the events calendar",
-    arg("action", choices=("list", "add"), nargs="?", default="list"),
+    arg(
+        "action",
+        choices=("list", "add"),
+        nargs="?",
+        default="list",
+        help="list (default): the calendar's changes and those found in the data; add: a change to the "
+        "calendar (its comments are kept)",
+    ),
     CONFIG,
-    arg("--satellite", choices=tuple(SATELLITES)),
-    arg("--time", type=_iso),
-    arg("--instrument", choices=("cris", "viirs", "common")),
-    arg("--kind", default="change", help="ep_upload, lut_change, software, ..."),
-    arg("--description"),
+    arg("--satellite", choices=tuple(SATELLITES), help="add: the satellite"),
+    arg("--time", type=_iso, help="add: when (ISO 8601, UTC)"),
+    arg("--instrument", choices=("cris", "viirs", "common"), help="add: the instrument changed"),
+    arg("--kind", default="change", help="add: ep_upload, lut_change, software, ..."),
+    arg("--description", help="add: what changed"),
 )
 def cmd_events(args) -> int:
     """crisgeo events: list the known changes, or add one to the calendar."""
     from alerts.changes import Change, add_to_calendar, all_changes
-    from monitor.store.sqlite import Store
 
-    cfg = _load(args, writes=True)
+    cfg = _load(args)
     if cfg.events_file is None:
         raise BadInput("alerts.events_file is not set in the configuration")
     if args.action == "add":
         if not (args.satellite and args.time and args.instrument and args.description):
             raise BadInput("events add needs --satellite, --time, --instrument and --description")
-        add_to_calendar(
-            cfg.events_file,
-            Change(args.time, args.satellite, args.instrument, args.kind, args.description, "calendar"),
-        )
+        try:
+            add_to_calendar(
+                cfg.events_file,
+                Change(args.time, args.satellite, args.instrument, args.kind, args.description, "calendar"),
+            )
+        except (OSError, ValueError) as exc:
+            raise BadInput(f"{cfg.events_file}: {exc}") from None
         print(f"added to {cfg.events_file}")
         return EXIT_OK
-    with Store(cfg.store.sqlite) as store:
+    with _open_store(cfg) as store:
         for sat in cfg.satellites:
             for c in all_changes(store, sat, cfg.events_file):
                 print(f"{sat} {c.label()}")
@@ -740,7 +783,6 @@ def cmd_report(args) -> int:
 
     from alerts.settings import AlertConfigError
     from monitor.report.html import build_report, options_from_config
-    from monitor.store.sqlite import Store
 
     cfg = _load(args)
     _satellites(cfg, args.satellite)
@@ -751,7 +793,7 @@ def cmd_report(args) -> int:
     except AlertConfigError as exc:
         raise BadInput(f"{cfg.path}: {exc}") from None
     t0 = time.perf_counter()
-    with Store(cfg.store.sqlite) as store:
+    with _open_store(cfg) as store:
         index = build_report(store, args.out or cfg.report_dir or "report", opts)
     print(f"wrote {Path(index).resolve()} ({', '.join(opts.satellites)}) in {time.perf_counter() - t0:.1f} s")
     return EXIT_OK
@@ -772,45 +814,12 @@ def cmd_bench(args) -> int:
     return run_bench(args)
 
 
-class JsonFormatter(logging.Formatter):
-    """One JSON object per line: time (UTC, ISO 8601), level, logger, message (and the exception)."""
-
-    def format(self, record):
-        """One JSON object per record: time, level, logger, message (and the exception)."""
-        import json
-
-        doc = {
-            "time": dt.datetime.fromtimestamp(record.created, dt.timezone.utc).isoformat(
-                timespec="milliseconds"
-            ),
-            "level": record.levelname,
-            "logger": record.name,
-            "message": record.getMessage(),
-        }
-        if record.exc_info:
-            doc["exception"] = self.formatException(record.exc_info)
-        return json.dumps(doc)
-
-
-def setup_logging(verbose: bool, log_format: str) -> None:
-    """Text with a timestamp on a terminal or in a file; without one under systemd, whose journal stamps
-    every line itself (it sets JOURNAL_STREAM); or JSON lines."""
-    import os
-
-    handler = logging.StreamHandler()
-    if log_format == "json":
-        handler.setFormatter(JsonFormatter())
-    elif os.environ.get("JOURNAL_STREAM"):
-        handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
-    else:
-        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
-    logging.basicConfig(level=logging.DEBUG if verbose else logging.INFO, handlers=[handler])
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser: the global options and one subparser per entry of :data:`COMMANDS`."""
     p = argparse.ArgumentParser(
-        prog="crisgeo", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="crisgeo",
+        description=__doc__.replace("``", ""),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     p.add_argument("--version", action="version", version=f"crisgeo {__version__}")
@@ -842,10 +851,8 @@ def main(argv=None) -> int:
 
     parser = build_parser()
     args = parser.parse_args(argv)
-    setup_logging(args.verbose, args.log_format)
+    logs.setup(args.verbose, args.log_format)
     allocator.reuse_freed_memory()
-    logging.getLogger("urllib3").setLevel(logging.WARNING)  # its debug lines carry request paths (webhooks)
-    logging.getLogger("h5py").setLevel(logging.INFO)
     try:
         return args.func(args)
     except BadInput as exc:

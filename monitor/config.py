@@ -631,36 +631,71 @@ def _check_limits(cfg: Config) -> None:
 
 
 def effective(cfg: Config) -> dict:
-    """The configuration as loaded (defaults filled in), for ``crisgeo check-config``: no secret values,
-    only the names of the variables that hold them and whether each is set."""
+    """The configuration as loaded, defaults filled in, under the keys the loader reads: written out as
+    YAML it loads back to the same configuration (``crisgeo check-config`` prints it). Secrets are never in
+    it: the ``*_env`` keys name variables (see :func:`secret_status`)."""
     import dataclasses
 
-    def plain(v, key=""):
+    def plain(v):
         if dataclasses.is_dataclass(v):
-            return {
-                f.name: plain(getattr(v, f.name), f.name)
-                for f in dataclasses.fields(v)
-                if f.name not in ("path", "alerts", "report_dir", "report_url", "dashboard_url")
-                or v is not cfg
-            }
+            return {f.name: plain(getattr(v, f.name)) for f in dataclasses.fields(v)}
         if isinstance(v, dict):
-            return {str(k): plain(x, str(k)) for k, x in v.items()}
+            return {str(k): plain(x) for k, x in v.items()}
         if isinstance(v, (list, tuple)):
-            return [plain(x, key) for x in v]
+            return [plain(x) for x in v]
         if isinstance(v, Path):
             return str(v)
         if isinstance(v, dt.time):
             return v.strftime("%H:%M")
-        if key.endswith("_env") and v:
-            return f"{v} ({'set' if os.environ.get(v) else 'not set'})"
-        if key in ("url", "endpoint", "dashboard_url") and isinstance(v, str):
-            return redact_url(v)
         return v
 
-    out = plain(cfg)
-    out["alerts"] = plain(cfg.alert_settings)
-    out.pop("alert_settings", None)
-    out["report_dir"] = str(cfg.report_dir) if cfg.report_dir else None
-    for key in ("report_url", "dashboard_url"):
-        out[key] = redact_url(getattr(cfg, key)) if getattr(cfg, key) else None
+    source = plain(cfg.source)
+    if cfg.source.kind != "local":
+        source.pop("path")
+    out = {
+        "satellites": list(cfg.satellites),
+        "state_dir": str(cfg.state_dir),
+        "source": source,
+        "schedule": plain(cfg.schedule),
+        "scenes": plain(cfg.scenes),
+        "assessment": plain(cfg.assessment),
+        "fingerprint": plain(cfg.fingerprint),
+        "http": plain(cfg.http),
+        "store": {**plain(cfg.store), "publish": [plain(p) for p in cfg.store.publish]},
+    }
+    for key in ("report_dir", "report_url", "dashboard_url"):
+        value = getattr(cfg, key)
+        if value is not None:
+            out[key] = str(value)
+    a = cfg.alert_settings
+    alerts = plain(a.rules)
+    for key in ("log", "events_file"):
+        if getattr(a, key) is not None:
+            alerts[key] = str(getattr(a, key))
+    if a.email is not None:
+        email = plain(a.email)
+        email["from"] = email.pop("sender")  # the file's key (a Python keyword in the dataclass)
+        alerts["email"] = {k: v for k, v in email.items() if v is not None}
+    for key in ("slack", "alertmanager"):
+        if getattr(a, key) is not None:
+            alerts[key] = plain(getattr(a, key))
+    out["alerts"] = alerts
     return out
+
+
+def secret_status(cfg: Config) -> list[str]:
+    """``KEY: VARIABLE (set | not set)`` for every ``*_env`` key of the configuration."""
+    lines = []
+
+    def walk(doc, where):
+        if isinstance(doc, dict):
+            for k, v in doc.items():
+                if k.endswith("_env") and v:
+                    lines.append(f"{where}{k}: {v} ({'set' if os.environ.get(v) else 'not set'})")
+                walk(v, f"{where}{k}.")
+        elif isinstance(doc, list):
+            for i, v in enumerate(doc):
+                walk(v, f"{where[:-1]}[{i}].")
+
+    walk(effective(cfg), "")
+    return lines

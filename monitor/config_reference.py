@@ -13,7 +13,16 @@ import datetime as dt
 from pathlib import Path
 
 from alerts.rules import RuleSettings
-from alerts.settings import ALERT_KEYS, EMAIL_KEYS, RULE_LIMITS, SLACK_KEYS, EmailSettings, SlackSettings
+from alerts.settings import (
+    ALERT_KEYS,
+    ALERTMANAGER_KEYS,
+    EMAIL_KEYS,
+    RULE_LIMITS,
+    SLACK_KEYS,
+    AlertmanagerSettings,
+    EmailSettings,
+    SlackSettings,
+)
 from monitor import config as C
 
 MEANING = {
@@ -122,6 +131,13 @@ MEANING = {
     "alerts.email.cafile": "Extra CA bundle (e.g. a site CA) to verify the server with.",
     "alerts.email.timeout_s": "Timeout of one SMTP conversation.",
     "alerts.slack": "Slack channel (mapping below); absent: none.",
+    "alerts.alertmanager": "Alertmanager (mapping below): the alerts are posted to its API v2 with labels "
+    "alertname, service, satellite, rule, severity and resolved there, so that Alertmanager routes, "
+    "groups and silences them; absent: none.",
+    "alerts.alertmanager.url": "Base URL of Alertmanager, e.g. http://127.0.0.1:9093. Required.",
+    "alerts.alertmanager.timeout_s": "Timeout of one post.",
+    "alerts.alertmanager.validity_hours": "A firing alert is posted again at every evaluation (hourly, "
+    "and after each run) with this end; if the service stops posting, Alertmanager ends it then.",
     "alerts.slack.webhook_env": "Environment variable holding the incoming-webhook URL. Required.",
     "alerts.slack.retries": "Retries when Slack answers 429 or 5xx.",
     "alerts.slack.max_wait_s": "Longest wait honoured from a Retry-After header.",
@@ -156,6 +172,8 @@ _ALERT_LIMITS = {
     "alerts.slack.retries": (0, 20),
     "alerts.slack.max_wait_s": (0.0, 3600.0),
     "alerts.slack.timeout_s": (0.1, 600.0),
+    "alerts.alertmanager.timeout_s": (0.1, 600.0),
+    "alerts.alertmanager.validity_hours": (1.5, 168.0),
     "store.publish[].timeout_s": (0.1, 600),
 }
 
@@ -184,6 +202,7 @@ def model_keys() -> dict:
         {f"alerts.email.{k}": _default(EmailSettings, "sender" if k == "from" else k) for k in EMAIL_KEYS}
     )
     keys.update({f"alerts.slack.{k}": _default(SlackSettings, k) for k in SLACK_KEYS})
+    keys.update({f"alerts.alertmanager.{k}": _default(AlertmanagerSettings, k) for k in ALERTMANAGER_KEYS})
     return keys
 
 

@@ -1,9 +1,13 @@
-"""Results as data for scientists: the store's per-FOR offsets as a CF-style xarray Dataset, NetCDF or CSV.
+"""Results as data for scientists: the store's per-FOR offsets as a CF-1.8 / ACDD-1.3 xarray Dataset,
+NetCDF or CSV.
 
-Dimensions ``time`` (the assessed day, 00:00 UTC) x ``for`` (scan position 1..30); one variable per stored
-quantity with its unit and long name, the reliability flags as a CF bit mask (``flag_masks`` and
-``flag_meanings``), and global attributes for the satellite, the method and the software version.
-xarray and h5netcdf are an optional extra: ``pip install 'crisgeo-monitor[export]'``.
+Dimensions ``time`` (the assessed day: its start, with ``time_bnds`` the whole UTC day) x ``scan_position``
+(the CrIS field of regard, 1..30; a name Python accepts: ``ds.sel(scan_position=1)``); one variable per
+stored quantity with its unit and long name, the reliability flags as a CF bit mask (``flag_masks`` and
+``flag_meanings``), and the ACDD global attributes (title, summary, references to the method paper,
+history, date_created, time coverage, platform, instrument, source). The compliance checker's CF-1.8
+check passes (tests/test_export.py). xarray and h5netcdf are an optional extra:
+``pip install 'crisgeo-monitor[export]'``.
 """
 
 from __future__ import annotations
@@ -45,24 +49,24 @@ def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.dat
     n_samples = series.values["n_samples"].astype(np.int32)
     bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int8])
     flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
-    coords = {
-        "time": np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]"),
-        "for": np.arange(1, N_FOR + 1, dtype=np.int16),
-    }
+    days = np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]")
+    coords = {"time": days, "scan_position": np.arange(1, N_FOR + 1, dtype=np.int16)}
+    dims = ("time", "scan_position")  # written scan_position first: CF puts other dimensions left of T
     ds = xr.Dataset(
         {
-            name: (("time", "for"), data[name], {"units": unit, "long_name": long})
+            name: (dims, data[name], {"units": unit, "long_name": long})
             for name, (unit, long) in VARIABLES.items()
         },
         coords=coords,
     )
+    ds["time_bnds"] = (("time", "nv"), np.stack([days, days + np.timedelta64(1, "D")], axis=-1))
     ds["n_samples"] = (
-        ("time", "for"),
+        dims,
         n_samples,
         {"units": "1", "long_name": "CrIS FOVs in the cost function"},
     )
     ds["flags"] = (
-        ("time", "for"),
+        dims,
         flags,
         {
             "long_name": "reliability flags (any set: not reliable)",
@@ -70,30 +74,70 @@ def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.dat
             "flag_meanings": " ".join(FLAG_BITS),
         },
     )
-    ds["for"].attrs.update(long_name="CrIS field of regard (scan position)", units="1")
-    ds["time"].attrs.update(long_name="assessed day (00:00 UTC)")
+    ds["scan_position"].attrs.update(long_name="CrIS field of regard (scan position, 1 = first of the scan)")
+    ds["time"].attrs.update(
+        standard_name="time", axis="T", long_name="assessed UTC day (its start)", bounds="time_bnds"
+    )
+    ds["time"].encoding.update(units="days since 1970-01-01 00:00:00", calendar="standard", dtype="int32")
+    ds["time_bnds"].encoding.update(
+        units="days since 1970-01-01 00:00:00", calendar="standard", dtype="int32"
+    )
     info = satellite_info(satellite)
+    now = f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ}"
     ds.attrs.update(
-        Conventions="CF-1.8",
+        Conventions="CF-1.8, ACDD-1.3",
         title=f"CrIS geolocation assessed against VIIRS I5, {info.name}",
-        satellite=satellite,
+        summary=(
+            "Daily per-field-of-regard offsets of the CrIS line of sight (in-track alpha, cross-track beta, "
+            "urad) and the geolocation errors on the ground (km), found by perturbing the CrIS line of sight "
+            "21 x 21 times per FOV, collocating VIIRS I5 pixels in each perturbed footprint and minimising "
+            "the standard deviation of the CrIS minus VIIRS brightness temperature differences."
+        ),
+        references=(
+            "Wang, L., B. Zhang, D. Tremblay, and Y. Han (2017), Improved scheme for Cross-track Infrared "
+            "Sounder geolocation assessment and optimization, J. Geophys. Res. Atmos., 122, 519-536, "
+            "doi:10.1002/2016JD025812"
+        ),
+        keywords="CrIS, VIIRS, geolocation, line of sight, JPSS, calibration",
         platform=info.name,
+        instrument="CrIS, VIIRS",
+        satellite=satellite,
         method="LOS perturbation assessment, Wang et al. 2017, JGR 122:519",
         source=f"crisgeo-monitor {__version__}",
-        history=f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ} exported from {store.path.name}",
+        processing_level="L2 monitoring product (from CrIS SDR/GEO and VIIRS I5 SDR/GEO)",
+        date_created=now,
+        history=f"{now} exported from {store.path.name} by crisgeo-monitor {__version__}",
+        product_version=__version__,
     )
-    return ds
+    if series.days:
+        ds.attrs.update(
+            time_coverage_start=f"{series.days[0]:%Y-%m-%d}T00:00:00Z",
+            time_coverage_end=f"{series.days[-1] + dt.timedelta(days=1):%Y-%m-%d}T00:00:00Z",
+        )
+    # CF 2.4: a dimension that is not space or time goes left of T
+    return ds.transpose("scan_position", "time", "nv")
+
+
+class NothingToExport(ValueError):
+    """The store holds no results in the period asked for."""
 
 
 def export(store, satellite: str, out, fmt: str, since=None, until=None) -> Path:
-    """Write the results of *satellite* to *out* as ``netcdf`` or ``csv``; returns the path."""
+    """Write the results of *satellite* to *out* as ``netcdf`` or ``csv``; returns the path.
+    :class:`NothingToExport` (and no file) when the period holds no results; :class:`OSError` when *out*
+    cannot be written."""
     out = Path(out)
+    if not out.parent.is_dir():
+        raise FileNotFoundError(f"--out {out}: the folder {out.parent} does not exist")
     ds = to_xarray(store, satellite, since, until)
+    if ds.sizes["time"] == 0:
+        period = f"{since or 'the beginning'} .. {until or 'the end'}"
+        raise NothingToExport(f"no results of {satellite} in {period}: nothing written")
     tmp = out.with_name(out.name + ".part")
     if fmt == "netcdf":
         ds.to_netcdf(tmp, engine="h5netcdf")
     elif fmt == "csv":
-        ds.to_dataframe().reset_index().to_csv(tmp, index=False)
+        ds.drop_vars("time_bnds").to_dataframe().reset_index().to_csv(tmp, index=False)
     else:
         raise ValueError(f"export format {fmt!r} is not netcdf or csv")
     tmp.replace(out)

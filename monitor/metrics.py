@@ -4,8 +4,10 @@ What lives in the store (the run ledger, the latest per-FOR offsets, the alerts 
 at each scrape, so it survives restarts and agrees with ``crisgeo status``; what only the process knows
 (stage durations of the last run, downloads since start) is kept in its own gauges and counters.
 
-    crisgeo_last_success_timestamp_seconds{satellite}     end of the latest ok run (dead-man's switch)
-    crisgeo_runs_total{satellite,outcome}                 runs in the ledger by outcome
+    crisgeo_last_success_timestamp_seconds{satellite}     end of the latest ok run, 0 if none yet
+    crisgeo_watched_since_timestamp_seconds{satellite}    start of its first run (or of this process)
+    crisgeo_runs_total{satellite,outcome}                 finished runs in the ledger by outcome (only grows)
+    crisgeo_runs_in_progress{satellite}                   runs under way
     crisgeo_run_duration_seconds{satellite,stage}         stages of the latest run of this process
     crisgeo_downloaded_granules_total{satellite}          files downloaded by this process
     crisgeo_downloaded_bytes_total{satellite}             bytes downloaded by this process
@@ -17,6 +19,9 @@ at each scrape, so it survives restarts and agrees with ``crisgeo status``; what
     crisgeo_latest_day_timestamp_seconds{satellite}       00:00 UTC of the latest assessed day
     crisgeo_healthy                                       1 when /healthz is ok
     crisgeo_build_info{version}                           always 1
+
+The dead-man's rule (configs/prometheus/crisgeo-rules.yml) takes the last success, or for a satellite that
+never succeeded the time it has been watched since: a deployment that never works fires too.
 """
 
 from __future__ import annotations
@@ -29,22 +34,24 @@ from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 
 from monitor.store.sqlite import RunStatus
 
-OUTCOMES = tuple(RunStatus)
+OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run row changes to one once
 
 
 class _StoreCollector:
     """Reads the store at each scrape (a new connection each time: scrapes come on the server's thread)."""
 
-    def __init__(self, open_store, satellites, health):
+    def __init__(self, open_store, satellites, health, started: dt.datetime):
         self.open_store = open_store
         self.satellites = list(satellites)
         self.health = health
+        self.started = started
 
     def collect(self):
         from monitor.store.alerts import AlertState
 
         with self.open_store() as store:
             success = store.last_success()
+            first = store.first_runs()
             counts = store.run_counts()
             outbox = store.outbox_sizes()
             firing = AlertState(store).firing()
@@ -52,19 +59,29 @@ class _StoreCollector:
             fors = {s: store.day_result(s, d) for s, d in latest.items() if d is not None}
         g = GaugeMetricFamily(
             "crisgeo_last_success_timestamp_seconds",
-            "End of the latest successful run (Unix time)",
+            "End of the latest successful run (Unix time), 0 before the first",
             labels=["satellite"],
         )
-        for sat, t in success.items():
-            g.add_metric([sat], t.timestamp())
-        yield g
-        c = CounterMetricFamily(
-            "crisgeo_runs", "Runs in the ledger by outcome", labels=["satellite", "outcome"]
+        since = GaugeMetricFamily(
+            "crisgeo_watched_since_timestamp_seconds",
+            "Start of the satellite's first run, or of this process before any run (Unix time)",
+            labels=["satellite"],
         )
+        for sat in self.satellites:
+            g.add_metric([sat], success[sat].timestamp() if sat in success else 0.0)
+            since.add_metric([sat], first.get(sat, self.started).timestamp())
+        yield g
+        yield since
+        c = CounterMetricFamily(
+            "crisgeo_runs", "Finished runs in the ledger by outcome", labels=["satellite", "outcome"]
+        )
+        running = GaugeMetricFamily("crisgeo_runs_in_progress", "Runs under way", labels=["satellite"])
         for sat in self.satellites:
             for outcome in OUTCOMES:
                 c.add_metric([sat, outcome], counts.get((sat, outcome), 0))
+            running.add_metric([sat], counts.get((sat, RunStatus.RUNNING), 0))
         yield c
+        yield running
         g = GaugeMetricFamily(
             "crisgeo_outbox_points", "Time-series points waiting to be sent", labels=["target"]
         )
@@ -133,7 +150,9 @@ class ServiceMetrics:
 
     def __init__(self, open_store, satellites, health, version: str):
         self.registry = CollectorRegistry()
-        self.registry.register(_StoreCollector(open_store, satellites, health))
+        self.registry.register(
+            _StoreCollector(open_store, satellites, health, dt.datetime.now(dt.timezone.utc))
+        )
         self.duration = Gauge(
             "crisgeo_run_duration_seconds",
             "Wall time of each stage of the latest run",

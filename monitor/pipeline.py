@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor import fingerprint as fpr
+from monitor import logs
 from monitor.assess import AssessConfig, assess_plan
 from monitor.errors import DataError, StopRequested
 from monitor.mapping.engpkt import load_library
@@ -212,6 +213,7 @@ def compute_day(
     w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}
     t0 = time.perf_counter()
     try:
+        logs.stage("list")
         source.start_day()
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
         w.timings["list"] = time.perf_counter() - t0
@@ -225,9 +227,11 @@ def compute_day(
         if stop():
             raise StopRequested
         t1 = time.perf_counter()
+        logs.stage("fingerprint")
         w.prints = day_prints(cfg, source, day, listing)
         w.timings["fingerprint"] = time.perf_counter() - t1
         t1 = time.perf_counter()
+        logs.stage("select")
         chosen, w.decisions = select_scenes(
             listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep, cfg.scenes.min_inhomogeneity_k
         )
@@ -238,6 +242,7 @@ def compute_day(
             w.reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in w.decisions}))[:500]
             return w
         t1 = time.perf_counter()
+        logs.stage("fetch")
         case = fetch_plan(
             source, satellite, chosen, stop, ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
         )
@@ -245,6 +250,7 @@ def compute_day(
         w.counts["downloaded"], w.counts["bytes"] = source.downloaded_files, source.spent_bytes
         t1 = time.perf_counter()
         a = cfg.assessment
+        logs.stage("assess")
         w.result = assess_plan(
             case,
             AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6, kernel=a.kernel),
@@ -313,4 +319,7 @@ def run_day(
     """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`); every outcome
     is recorded in the ledger, an unexpected exception too (``failed`` with its type and message)."""
     run_id = store.begin_run(satellite, day)
-    return record_day(cfg, store, run_id, compute_day(cfg, source, satellite, day, should_stop, progress))
+    with logs.context(satellite=satellite, day=day.isoformat(), run_id=run_id):
+        work = compute_day(cfg, source, satellite, day, should_stop, progress)
+        logs.stage("record")
+        return record_day(cfg, store, run_id, work)

@@ -23,11 +23,11 @@ import socket
 import threading
 from pathlib import Path
 
-from monitor import allocator
+from monitor import allocator, logs
 from monitor.health import Health
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources import make_source
-from monitor.store.sqlite import Store
+from monitor.store.sqlite import RunStatus, Store
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
@@ -120,7 +120,7 @@ class Service:
 
     def run(self, satellite: str, day: dt.date):
         """Run one satellite-day (health-tracked), then evaluate the alerts and regenerate the report."""
-        with self.store() as store:
+        with self.store() as store, logs.context(satellite=satellite, day=day.isoformat()):
             LOG.info("run %s %s", satellite, day)
             sd_notify(f"STATUS=assessing {satellite} {day}")
             with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
@@ -130,7 +130,8 @@ class Service:
                     )
                 finally:
                     allocator.release_freed_memory()
-            LOG.info("%s", out.summary())
+            level = {RunStatus.FAILED: logging.ERROR, RunStatus.INTERRUPTED: logging.WARNING}
+            LOG.log(level.get(out.status, logging.INFO), "%s", out.summary())
             if self.metrics is not None:
                 self.metrics.record(out)
             self._after_run(store, out)
@@ -155,7 +156,8 @@ class Service:
     def check_alerts(self, store=None, report: bool = False):
         """Evaluate the alert rules for every satellite and deliver the queue (regenerating the report in
         between when *report*); a broken channel never stops the service."""
-        from alerts.engine import deliver, evaluate
+        from alerts.alertmanager import post_state
+        from alerts.engine import deliver, evaluate, fmt_counts
 
         own = store is None
         store = store or self.store()
@@ -165,8 +167,9 @@ class Service:
             if report:
                 self.regenerate_report(store)
             counts = deliver(store, settings)
+            post_state(store, settings)
             if queued or counts["sent"] or counts["failed"]:
-                LOG.info("alerts: %d queued, %s", len(queued), counts)
+                LOG.info("alerts: %s", fmt_counts({"queued": len(queued), **counts}))
         finally:
             if own:
                 store.close()

@@ -11,13 +11,15 @@ from monitor.store.sqlite import RunStatus
 NAGIOS_OK, NAGIOS_WARNING, NAGIOS_CRITICAL, NAGIOS_UNKNOWN = 0, 1, 2, 3
 
 
-def status_report(cfg, store) -> dict:
-    """What ``crisgeo status`` shows, as data: per satellite the last run, the latest per-FOR offsets and
-    the alerts firing; the next run; the outbox size; and the Nagios state of it all."""
+def status_report(cfg, store, satellites=None) -> dict:
+    """What ``crisgeo status`` shows, as data: per satellite (*satellites*, default: the configured ones)
+    the last run, the latest per-FOR offsets and the alerts firing; the next run; the outbox size; and the
+    Nagios state of it all."""
     runs = {r.satellite: r for r in store.last_runs()}
-    firing = AlertState(store).firing()
+    chosen = list(satellites or cfg.satellites)
+    firing = [a for a in AlertState(store).firing() if a.satellite in chosen or a.satellite is None]
     sats = {}
-    for sat in cfg.satellites:
+    for sat in chosen:
         r = runs.get(sat)
         day = store.latest_day(sat)
         sats[sat] = {

@@ -112,6 +112,34 @@ def victoria_metrics(tmp: Path, port: int | None = None, flags=()):
         yield url
 
 
+@contextmanager
+def alertmanager(tmp: Path, webhook_url: str):
+    """Alertmanager (Debian's prometheus-alertmanager) on 127.0.0.1, no cluster, routing every alert to
+    *webhook_url* within about a second (resolved ones too); yields its base URL."""
+    exe = require("prometheus-alertmanager")
+    port = free_port()
+    tmp.mkdir(parents=True, exist_ok=True)
+    conf = tmp / "alertmanager.yml"
+    conf.write_text(
+        "route: {receiver: hook, group_by: [alertname, satellite], group_wait: 1s, group_interval: 1s, "
+        "repeat_interval: 1h}\n"
+        f"receivers: [{{name: hook, webhook_configs: [{{url: '{webhook_url}', send_resolved: true}}]}}]\n"
+    )
+    with _running(
+        [
+            exe,
+            f"--config.file={conf}",
+            f"--storage.path={tmp / 'data'}",
+            f"--web.listen-address=127.0.0.1:{port}",
+            "--cluster.listen-address=",
+            "--log.level=error",
+        ],
+        f"http://127.0.0.1:{port}",
+        "/-/ready",
+    ) as url:
+        yield url
+
+
 def vm_export(url: str, metric_regex: str) -> list[dict]:
     """Every stored series matching *metric_regex*, after forcing VictoriaMetrics to flush."""
     import json

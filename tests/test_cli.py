@@ -123,10 +123,13 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
 
     cfg = _status_config(tmp_path)
     monkeypatch.setenv("CRISGEO_CONFIG", str(cfg))  # the default when --config is not given
-    assert main(["status", "--json"]) == 0
+    assert main(["status", "--json"]) == 3  # no store yet (the daemon makes it): UNKNOWN, and none made
+    assert "no crisgeo store here yet" in json.loads(capsys.readouterr().out)["error"]
+    assert not (tmp_path / "state" / "crisgeo.sqlite").exists()
+    store = Store(tmp_path / "state" / "crisgeo.sqlite")
+    assert main(["status", "--json", "--satellite", "j01"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["state"] == "OK" and doc["satellites"]["j01"]["last_run"] is None and doc["outbox"] == 0
-    store = Store(tmp_path / "state" / "crisgeo.sqlite")
     now = dt.datetime.now(dt.timezone.utc)
     AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), "firing", now, True)
     assert main(["status", "--json"]) == 1 and json.loads(capsys.readouterr().out)["state"] == "WARNING"
@@ -158,6 +161,14 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     view = json.loads(capsys.readouterr().out)
     assert view["alerts"][0]["status"] == "silenced" and view["silences"][0]["reason"] == "known step"
     assert main(["alerts"]) == 0 and "silenced  warning" in capsys.readouterr().out
+    silence_id = view["silences"][0]["id"]
+    assert main(["alerts", "unsilence", "--id", str(silence_id)]) == 0
+    assert f"silence {silence_id} lifted" in capsys.readouterr().out
+    assert main(["alerts", "list", "--json"]) == 0
+    view = json.loads(capsys.readouterr().out)
+    assert view["silences"] == [] and view["alerts"][0]["status"] == "firing"
+    assert main(["alerts", "unsilence", "--id", str(silence_id)]) == 2  # no longer in force
+    assert "no silence in force" in capsys.readouterr().err
     run = store.begin_run("j01", dt.date(2024, 6, 1))
     store.finish_run(run, "failed", "HTTP 503")
     assert main(["status"]) == 2
@@ -192,7 +203,13 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
     assert r.returncode == 0, r.stderr
     lines = [json.loads(line) for line in r.stderr.splitlines() if line.startswith("{")]
     assert lines and all({"time", "level", "logger", "message"} <= set(d) for d in lines)
-    (summary,) = [d["message"] for d in lines if d["message"].startswith("run j01 2024-06-01: ok")]
+    (summary,) = [d for d in lines if d["message"].startswith("run j01 2024-06-01: ok")]
+    assert summary["satellite"] == "j01" and summary["day"] == "2024-06-01" and summary["priority"] == 6
+    assert {"stage": "assess", "day": "2024-06-01"}.items() <= next(
+        d for d in lines if "assessed granules" in d["message"]
+    ).items()
+    assert all("run_id" in d for d in lines if " after " in d["message"])
+    summary = summary["message"]
     assert "granules listed 6, selected 2, assessed 2" in summary and "reliable FORs" in summary
     assert "worst" in summary and "stages list" in summary
     # not on a terminal: progress as log lines, the granules as they finish
@@ -201,7 +218,8 @@ def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
     assert any(m.startswith("j01 2024-06-01: assessed granules: 2/2") for m in progress), progress
 
 
-def test_under_systemd_lines_carry_no_second_timestamp(tmp_path):
+def test_under_systemd_lines_carry_their_priority_and_no_second_timestamp(tmp_path):
+    """The journal reads the <N> prefix as the line's priority (journalctl -p) and stamps the time."""
     import os
 
     cfg = tmp_path / "c.yaml"
@@ -213,7 +231,8 @@ def test_under_systemd_lines_carry_no_second_timestamp(tmp_path):
     )
     assert r.returncode == 0, r.stderr
     log = [line for line in r.stderr.splitlines() if line.strip()]
-    assert log and all(line.split()[0] in ("INFO", "WARNING", "ERROR", "DEBUG") for line in log), log
+    prefixes = ("<6>INFO", "<4>WARNING", "<3>ERROR", "<7>DEBUG")
+    assert log and all(line.split()[0] in prefixes for line in log), log
 
 
 @pytest.mark.parametrize(

@@ -243,8 +243,39 @@ def test_check_config_masks_secrets(tmp_path, capsys, monkeypatch):
     p.write_text(yaml.safe_dump(GOOD))
     assert main(["check-config", "--config", str(p)]) == 0
     out = capsys.readouterr().out
-    assert "token_env: T (set)" in out and "webhook_env: SLACK (not set)" in out
+    assert "# secret store.publish[0].token_env: T (set)" in out
+    assert "# secret alerts.slack.webhook_env: SLACK (not set)" in out
     assert "the-token-value" not in out and "catch_up_days: 7" in out and "spec_km: 1.5" in out
+
+
+def test_what_check_config_prints_loads_back_as_the_same_configuration(tmp_path, capsys):
+    """Before, it printed alerts.dashboard_url (an unknown key there), sender for from, report_dir twice."""
+    import yaml
+
+    from monitor.cli import main
+    from monitor.config import effective
+
+    doc = {
+        **GOOD,
+        "report_dir": "report",
+        "dashboard_url": "http://grafana.example/d/crisgeo-monitor",
+        "alerts": {
+            **GOOD["alerts"],
+            "email": {"host": "smtp.example.org", "from": "me@example.org", "to": ["a@example.org"]},
+            "alertmanager": {"url": "http://127.0.0.1:9093"},
+        },
+    }
+    first = tmp_path / "c.yaml"
+    first.write_text(yaml.safe_dump(doc))
+    assert main(["check-config", "--config", str(first)]) == 0
+    printed = capsys.readouterr().out
+    assert printed.count("report_dir:") == 1 and "sender" not in printed and "from: me@example.org" in printed
+    second = tmp_path / "again" / "c.yaml"
+    second.parent.mkdir()
+    second.write_text(printed)
+    assert main(["check-config", "--config", str(second)]) == 0, capsys.readouterr().err
+    assert capsys.readouterr().out.split("\n", 1)[1] == printed.split("\n", 1)[1]
+    assert effective(load_config(second)) == effective(load_config(first))
 
 
 GOOD_TEXT = "satellites: [j01]\nstate_dir: state\nsource: {kind: simulated}\n"

@@ -113,6 +113,10 @@ def test_metrics_after_a_run(served):
         for s in _samples(fams["crisgeo_runs"], "crisgeo_runs_total", satellite="j01")
     }
     assert runs["ok"] == 1 and runs["no_data"] >= 1 and runs["failed"] == 0
+    assert "running" not in runs  # a counter only grows: runs under way are a gauge of their own
+    assert {s.value for s in _samples(fams["crisgeo_runs_in_progress"], satellite="j01")} <= {0.0, 1.0}
+    (since,) = _samples(fams["crisgeo_watched_since_timestamp_seconds"], satellite="j01")
+    assert since.value <= last.value
     stages = {s.labels["stage"] for s in _samples(fams["crisgeo_run_duration_seconds"], satellite="j01")}
     assert "list" in stages
     assert (
@@ -239,3 +243,27 @@ def test_listen_is_checked(tmp_path):
     finally:
         taken.close()
     assert r.returncode == 1 and f"http.listen 127.0.0.1:{port}: cannot listen" in r.stderr, r.stderr
+
+
+def test_a_satellite_that_never_succeeded_is_visible_to_the_dead_mans_rule(tmp_path):
+    """Its last success is 0 and it is watched since its first run (or the process start): the rule's
+    `(last > 0) or watched_since` then counts the time without success."""
+    import datetime as dt
+
+    from prometheus_client import generate_latest
+
+    from monitor.health import Health
+    from monitor.metrics import ServiceMetrics
+
+    db = tmp_path / "s.sqlite"
+    with Store(db) as store:
+        run = store.begin_run("j01", dt.date(2024, 6, 1))
+        store.finish_run(run, "failed", "HTTP 503")
+    m = ServiceMetrics(lambda: Store(db), ["j01", "npp"], Health(60), "test")
+    fams = {f.name: f for f in text_string_to_metric_families(generate_latest(m.registry).decode())}
+    last = {s.labels["satellite"]: s.value for s in fams["crisgeo_last_success_timestamp_seconds"].samples}
+    since = {s.labels["satellite"]: s.value for s in fams["crisgeo_watched_since_timestamp_seconds"].samples}
+    assert last == {"j01": 0.0, "npp": 0.0}
+    assert abs(since["j01"] - time.time()) < 600 and abs(since["npp"] - time.time()) < 600
+    runs = {(s.labels["satellite"], s.labels["outcome"]): s.value for s in fams["crisgeo_runs"].samples}
+    assert runs[("j01", "failed")] == 1 and ("j01", "running") not in runs

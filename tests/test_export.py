@@ -18,7 +18,7 @@ def store_with_days(tmp_path):
         f"satellites: [j01, npp]\nstate_dir: {tmp_path / 'state'}\n"
         f"source: {{kind: local, path: {tmp_path}}}\n"
     )
-    store = open_store(tmp_path / "state" / "crisgeo.sqlite")
+    store = open_store(tmp_path / "state" / "crisgeo.sqlite", create=True)
     fill_store(store, ["j01"], dt.date(2025, 3, 1), 12, step_day=6, seed=3)
     return cfg, store
 
@@ -47,16 +47,19 @@ def test_netcdf_export_reads_back_with_xarray(store_with_days, tmp_path):
         == 0
     )
     ds = xr.open_dataset(out, engine="h5netcdf")
-    assert ds.sizes == {"time": 8, "for": 30} and str(ds.time.values[0])[:10] == "2025-03-03"
+    assert (
+        ds.sizes == {"time": 8, "scan_position": 30, "nv": 2} and str(ds.time.values[0])[:10] == "2025-03-03"
+    )
     day = dt.date(2025, 3, 5)
     want = {f.for_index: f for f in store.day_result("j01", day)}
     got = ds.sel(time=np.datetime64(day, "ns"))
-    assert got.d_beta_urad.sel(**{"for": 21}).item() == pytest.approx(want[21].d_beta_urad)
-    assert got.n_samples.sel(**{"for": 7}).item() == want[7].n_samples
+    assert got.d_beta_urad.sel(scan_position=21).item() == pytest.approx(want[21].d_beta_urad)
+    assert got.n_samples.sel(scan_position=7).item() == want[7].n_samples
+    assert ds.sel(scan_position=1).total_km.sizes == {"time": 8}
     assert ds.d_alpha_urad.attrs["units"] == "urad" and ds.total_km.attrs["units"] == "km"
     meanings = ds.flags.attrs["flag_meanings"].split()
     masks = dict(zip(meanings, ds.flags.attrs["flag_masks"], strict=True))
-    bits = ds.flags.values
+    bits = ds.flags.transpose("time", "scan_position").values
     series = store.series("j01", dt.date(2025, 3, 3), dt.date(2025, 3, 10))
     assert series.days[0] == dt.date(2025, 3, 3) and bits.shape == series.flags.shape
     for (i, k), names in np.ndenumerate(series.flags):
@@ -81,6 +84,32 @@ def test_csv_export_and_the_public_api(store_with_days, tmp_path):
         == 0
     )
     rows = list(csv.DictReader(out.open()))
-    assert len(rows) == 12 * 30 and {"time", "for", "d_alpha_urad", "flags"} <= set(rows[0])
+    assert len(rows) == 12 * 30 and {"time", "scan_position", "d_alpha_urad", "flags"} <= set(rows[0])
     ds = open_store(store.path).to_xarray("j01", since=dt.date(2025, 3, 12))
     assert ds.sizes["time"] == 1 and callable(monitor.assess_paths)
+
+
+def test_the_netcdf_is_cf_1_8_and_acdd(store_with_days, tmp_path):
+    """The IOOS compliance checker's CF-1.8 check passes with no high- or medium-priority failure; the ACDD
+    attributes, the time axis and its bounds are there."""
+    cc = pytest.importorskip("compliance_checker.runner")
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    from monitor.export import export
+
+    _, store = store_with_days
+    out = export(store, "j01", tmp_path / "j01.nc", "netcdf")
+    CheckSuite.load_all_available_checkers()
+    report = tmp_path / "cf.json"
+    ok, errors = ComplianceChecker.run_checker(
+        str(out), ["cf:1.8"], verbose=0, criteria="normal", output_filename=str(report), output_format="json"
+    )
+    assert cc is not None and ok and not errors, report.read_text()[:3000]
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert ds.time.attrs["standard_name"] == "time" and ds.time.attrs["axis"] == "T"
+    assert ds.time.attrs["bounds"] == "time_bnds"
+    assert (ds.time_bnds.values[:, 1] - ds.time_bnds.values[:, 0] == np.timedelta64(1, "D")).all()
+    for key in ("title", "summary", "references", "history", "date_created", "source", "Conventions"):
+        assert ds.attrs[key], key
+    assert "doi:10.1002/2016JD025812" in ds.attrs["references"] and "ACDD-1.3" in ds.attrs["Conventions"]
+    assert ds.attrs["time_coverage_start"] == "2025-03-01T00:00:00Z"

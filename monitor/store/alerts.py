@@ -141,6 +141,14 @@ class AlertState:
                 (rule, satellite, iso(until), reason, iso(now)),
             )
 
+    def lift(self, silence_id: int, now: dt.datetime) -> bool:
+        """End the silence *silence_id* now (kept, as history); False if no such silence is in force."""
+        with self.store.transaction():
+            cur = self.db.execute(
+                "UPDATE silences SET until=? WHERE id=? AND until > ?", (iso(now), silence_id, iso(now))
+            )
+        return cur.rowcount == 1
+
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None:
         """The silence in force for *rule* and *satellite* at *now*, or None."""
         r = self.db.execute(

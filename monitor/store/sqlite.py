@@ -253,10 +253,17 @@ class Store:
     never re-initialised: it holds the history and the alert state.
     """
 
-    def __init__(self, path):
+    def __init__(self, path, create: bool = True):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         if not self.path.exists():
+            if not create:
+                raise StoreError(
+                    f"{self.path}: no crisgeo store here yet (crisgeo run or the daemon creates it)"
+                )
+            try:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise StoreError(f"{self.path}: cannot create its folder ({exc.strerror or exc})") from None
             self._create()
         elif self.path.stat().st_size == 0:
             raise StoreError(
@@ -396,6 +403,13 @@ class Store:
             for r in self.db.execute(
                 "SELECT satellite, status, COUNT(*) FROM runs GROUP BY satellite, status"
             )
+        }
+
+    def first_runs(self) -> dict:
+        """{satellite: start time (aware UTC datetime) of its first run}: since when it is monitored."""
+        return {
+            r[0]: dt.datetime.fromisoformat(r[1])
+            for r in self.db.execute("SELECT satellite, MIN(started) FROM runs GROUP BY satellite")
         }
 
     def last_success(self) -> dict:

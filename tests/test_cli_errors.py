@@ -1,0 +1,114 @@
+"""What a newcomer meets first: every error path is one line with the right exit code, no empty product is
+written silently, and commands that only read never create a store."""
+
+import datetime as dt
+
+import pytest
+
+from monitor.cli import main
+from tests.cli import run_crisgeo
+
+
+@pytest.fixture
+def config_with_history(tmp_path):
+    """A configuration of j01 and a store holding 12 simulated days from 2025-03-01."""
+    from monitor import open_store
+    from monitor.simulate.history import fill_store
+
+    (tmp_path / "events.yaml").write_text("# the team's calendar\nevents:\n  # none yet\n  []\n")
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+        f"alerts: {{events_file: {tmp_path / 'events.yaml'}}}\n"
+    )
+    with open_store(tmp_path / "state" / "crisgeo.sqlite", create=True) as store:
+        fill_store(store, ["j01"], dt.date(2025, 3, 1), 12, step_day=6, seed=3)
+    return cfg
+
+
+def _one_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+@pytest.mark.parametrize(
+    "extra,message",
+    [
+        (
+            ["--out", "/nonexistent/dir/x.nc"],
+            "--out /nonexistent/dir/x.nc: the folder /nonexistent/dir does not",
+        ),
+        (["--since", "2027-01-01"], "no results of j01 in 2027-01-01 .. the end: nothing written"),
+        (["--satellite", "npp"], "satellite 'npp' is not in the configuration (j01)"),
+        (
+            ["--since", "2025-03-09", "--until", "2025-03-02"],
+            "--since 2025-03-09 is after --until 2025-03-02",
+        ),
+    ],
+)
+def test_export_refuses_in_one_line_and_writes_nothing(config_with_history, tmp_path, capsys, extra, message):
+    out = tmp_path / "x.nc"
+    argv = [
+        "export",
+        "--config",
+        str(config_with_history),
+        *(["--out", str(out)] if "--out" not in extra else []),
+    ]
+    assert main([*argv, *extra]) == 2
+    assert message in _one_line(capsys)
+    assert not out.exists() and not list(tmp_path.glob("*.part"))
+
+
+def test_read_only_commands_never_create_a_store(tmp_path, capsys):
+    from monitor import open_store
+    from monitor.store.sqlite import StoreError
+
+    (tmp_path / "events.yaml").write_text("events: []\n")
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+        f"alerts: {{events_file: {tmp_path / 'events.yaml'}}}\n"
+    )
+    for argv in (
+        ["events", "list"],
+        ["alerts", "list"],
+        ["export", "--out", str(tmp_path / "x.nc")],
+        ["report"],
+    ):
+        assert main([argv[0], "--config", str(cfg), *argv[1:]]) == 1, argv
+        assert "no crisgeo store here yet" in _one_line(capsys)
+    with pytest.raises(StoreError, match="typo.sqlite: no crisgeo store here yet"):
+        open_store(tmp_path / "typo.sqlite")
+    assert not list(tmp_path.rglob("*.sqlite*"))
+
+
+def test_events_add_keeps_the_calendars_comments(config_with_history, tmp_path, capsys):
+    calendar = tmp_path / "events.yaml"
+    calendar.write_text(
+        "# the team's calendar: who changed what, when\nevents:\n"
+        "  # the 2019 EP upload\n  - satellite: j01\n    time: 2019-01-02T00:00:00Z\n"
+        "    instrument: cris\n    kind: ep_upload   # from the EP log\n    description: EP v115\n"
+    )
+    argv = ["events", "add", "--config", str(config_with_history), "--satellite", "j01"]
+    argv += ["--time", "2025-03-04T00:00Z", "--instrument", "viirs", "--description", "LUT update"]
+    assert main(argv) == 0
+    text = calendar.read_text()
+    for comment in ("# the team's calendar", "# the 2019 EP upload", "# from the EP log"):
+        assert comment in text
+    assert main(["events", "list", "--config", str(config_with_history)]) == 0
+    out = capsys.readouterr().out
+    assert "EP v115" in out and "LUT update" in out
+
+
+def test_alerts_evaluate_prints_words_not_a_dict(config_with_history, capsys):
+    assert main(["alerts", "evaluate", "--config", str(config_with_history)]) == 0
+    out = capsys.readouterr().out.strip()
+    assert out.startswith("queued ") and "sent " in out and "{" not in out
+
+
+def test_help_has_no_markup():
+    r = run_crisgeo("--help", timeout=60)
+    assert r.returncode == 0 and "``" not in r.stdout and "The crisgeo command line." in r.stdout
+    r = run_crisgeo("alerts", "--help", timeout=60)
+    assert "unsilence" in r.stdout and "--id" in r.stdout and "the silence's number" in r.stdout

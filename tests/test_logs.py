@@ -1,0 +1,102 @@
+"""Log lines for the journal (priorities, no library chatter) and as JSON (with the satellite-day)."""
+
+import io
+import json
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from monitor import logs
+from tests.cli import ROOT
+
+
+@pytest.fixture
+def captured(monkeypatch):
+    """The root logger set up by :func:`monitor.logs.setup` writing into a buffer; restored after."""
+    root = logging.getLogger()
+    saved = root.handlers[:], root.level
+    buffer = io.StringIO()
+
+    def setup(fmt, journal=False):
+        if journal:
+            monkeypatch.setenv("JOURNAL_STREAM", "8:1234")
+        else:
+            monkeypatch.delenv("JOURNAL_STREAM", raising=False)
+        logs.setup(False, fmt)
+        root.handlers[0].stream = buffer
+        return buffer
+
+    yield setup
+    root.handlers[:], _ = saved
+    root.setLevel(saved[1])
+
+
+def test_journal_lines_carry_syslog_priorities_and_libraries_stay_quiet(captured):
+    out = captured("text", journal=True)
+    log = logging.getLogger("monitor.service")
+    log.error("run j01 2024-06-01: failed (SourceError: ...)")
+    log.warning("retrying")
+    log.info("run j01 2024-06-01: ok")
+    logging.getLogger("apscheduler.executors.default").info('Running job "heartbeat"')
+    try:
+        raise ValueError("boom")
+    except ValueError:
+        log.exception("unexpected")
+    lines = out.getvalue().splitlines()
+    assert lines[0] == "<3>ERROR monitor.service: run j01 2024-06-01: failed (SourceError: ...)"
+    assert lines[1].startswith("<4>WARNING") and lines[2].startswith("<6>INFO")
+    assert not any("heartbeat" in line for line in lines)  # a 30 s job leaves no line at INFO
+    assert lines[3].startswith("<3>ERROR") and all(line.startswith("<3>") for line in lines[3:])  # traceback
+
+
+def test_json_lines_carry_the_satellite_day_they_belong_to(captured):
+    out = captured("json")
+    log = logging.getLogger("monitor.pipeline")
+    with logs.context(satellite="j01", day="2024-06-01", run_id=7):
+        logs.stage("fetch")
+        log.info("fetched")
+    log.info("outside")
+    inside, outside = (json.loads(line) for line in out.getvalue().splitlines())
+    assert inside["satellite"] == "j01" and inside["day"] == "2024-06-01" and inside["run_id"] == "7"
+    assert inside["stage"] == "fetch" and inside["priority"] == 6
+    assert not {"satellite", "day", "stage", "run_id"} & set(outside)
+
+
+@pytest.mark.servers
+def test_the_daemon_under_systemd_marks_a_failed_run_as_an_error_and_does_not_flood(tmp_path):
+    """A daemon whose archive cannot be reached: its failed run is a <3> line (journalctl -p err finds it);
+    its heartbeat and scheduler lines are not logged at INFO."""
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
+        "source: {kind: nodd, endpoint: 'http://127.0.0.1:9/{bucket}', retries: 0, timeout_s: 2}\n"
+        "http: {listen: 'off'}\n"
+    )
+    env = {**os.environ, "JOURNAL_STREAM": "8:1234", "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "monitor.cli", "daemon", "--config", str(cfg)],
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        cwd=ROOT,
+    )
+    lines = []
+    deadline = time.monotonic() + 60
+    try:
+        for line in proc.stderr:  # until the failed run is logged (the catch-up runs at start)
+            lines.append(line.rstrip("\n"))
+            if ": failed (" in line or time.monotonic() > deadline:
+                break
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        _, rest = proc.communicate(timeout=60)
+    lines += rest.splitlines()
+    failed = [line for line in lines if ": failed (" in line]
+    assert failed and all(line.startswith("<3>ERROR") for line in failed), lines
+    assert all(line.startswith("<") for line in lines if line.strip()), lines
+    assert not [line for line in lines if line.startswith("<6>") and "apscheduler" in line], lines
