@@ -112,3 +112,14 @@ def test_help_has_no_markup():
     assert r.returncode == 0 and "``" not in r.stdout and "The crisgeo command line." in r.stdout
     r = run_crisgeo("alerts", "--help", timeout=60)
     assert "unsilence" in r.stdout and "--id" in r.stdout and "the silence's number" in r.stdout
+
+
+def test_the_cli_reference_is_generated_and_complete():
+    from pathlib import Path
+
+    from monitor.cli import COMMANDS
+
+    r = run_crisgeo("--cli-reference", timeout=60)
+    doc = (Path(__file__).resolve().parent.parent / "docs" / "cli.md").read_text()
+    assert r.returncode == 0 and r.stdout == doc, "regenerate: crisgeo --cli-reference > docs/cli.md"
+    assert all(f"## crisgeo {name}\n" in doc for name in COMMANDS)

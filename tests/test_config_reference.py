@@ -35,6 +35,7 @@ def test_every_documented_key_is_one_the_loader_knows(tmp_path, key):
         "alerts": {
             "email": {"host": "smtp.example.org", "to": ["sdr@example.org"]},
             "slack": {"webhook_env": "HOOK"},
+            "alertmanager": {"url": "http://127.0.0.1:9093"},
         },
     }
     node = doc
