@@ -37,14 +37,13 @@ import tempfile
 import threading
 import time
 from contextlib import ExitStack
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
 from aiosmtpd.controller import Controller
 
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import RunStatus, Store
-from tests.servers import S3Server, free_port, victoria_metrics, vm_export
+from tests.servers import S3Server, Webhook, free_port, victoria_metrics, vm_export
 
 ROOT = Path(__file__).resolve().parent.parent
 BUCKET = "noaa-nesdis-n20-pds"
@@ -141,34 +140,6 @@ class Smtp:
         return "250 accepted"
 
 
-class Slack:
-    """A Slack webhook that accepts (and counts) posts, or answers 500 while ``failing``."""
-
-    def __init__(self):
-        self.posts, self.refused, self.failing = [], 0, False
-        hook = self
-
-        class H(BaseHTTPRequestHandler):
-            def log_message(self, *a):
-                pass
-
-            def do_POST(self):
-                body = self.rfile.read(int(self.headers["Content-Length"]))
-                status = 500 if hook.failing else 200
-                if hook.failing:
-                    hook.refused += 1
-                else:
-                    hook.posts.append(json.loads(body))
-                self.send_response(status)
-                self.send_header("Content-Length", "2")
-                self.end_headers()
-                self.wfile.write(b"ok")
-
-        self.httpd = ThreadingHTTPServer(("127.0.0.1", 0), H)
-        self.url = f"http://127.0.0.1:{self.httpd.server_address[1]}/services/T/B/soak"
-        threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
-
-
 def proc_sample(pid: int) -> dict:
     """RSS (MB), open files and threads of process *pid*."""
     status = Path(f"/proc/{pid}/status").read_text()
@@ -178,6 +149,60 @@ def proc_sample(pid: int) -> dict:
         "open_files": len(os.listdir(f"/proc/{pid}/fd")),
         "threads": int(re.search(r"Threads:\s+(\d+)", status)[1]),
     }
+
+
+def windows(samples: list, days: int, width: int = 10) -> list[dict]:
+    """Per window of *width* finished runs: RSS (MB) at its lowest, median and highest, and the most open
+    files and threads. A sample's RSS depends on where in a run it falls (a run's arrays come and go, the
+    allocator hands freed memory back after each run), so the lowest of a window is the resting level."""
+    import statistics
+
+    out = []
+    for lo in range(0, days + 1, width):
+        w = [s for s in samples if lo <= s["runs"] < lo + width]
+        if w:
+            rss = [s["rss_mb"] for s in w]
+            out.append(
+                {
+                    "runs": f"{lo}-{lo + width - 1}",
+                    "rss_min": min(rss),
+                    "rss_median": statistics.median(rss),
+                    "rss_max": max(rss),
+                    "open_files": max(s["open_files"] for s in w),
+                    "threads": max(s["threads"] for s in w),
+                    "store_mb": max(s["store_mb"] for s in w),
+                }
+            )
+    return out
+
+
+def memory_verdict(samples: list, days: int) -> list[str]:
+    """Print the windows; the failures: resting RSS (window minimum) of the last window more than 10 %
+    above that of runs 10-19, or more open files or threads."""
+    rows = windows(samples, days)
+    print("runs     rss_min  rss_median  rss_max  open_files  threads  store_mb")
+    for r in rows:
+        print(
+            f"{r['runs']:<8} {r['rss_min']:7.0f} {r['rss_median']:11.0f} {r['rss_max']:8.0f} "
+            f"{r['open_files']:11d} {r['threads']:8d} {r['store_mb']:9.2f}"
+        )
+    first = next((r for r in rows if r["runs"].startswith("10-")), None)
+    last = rows[-1] if rows else None
+    if first is None or last is None or last is first:
+        return ["too few samples for the memory verdict"]
+    failures = []
+    growth = last["rss_min"] / first["rss_min"] - 1
+    print(
+        f"soak: resting RSS runs 10-19 {first['rss_min']:.0f} MB, runs {last['runs']} "
+        f"{last['rss_min']:.0f} MB ({100 * growth:+.1f} %); "
+        f"open files {first['open_files']} -> {last['open_files']}; "
+        f"threads {first['threads']} -> {last['threads']}"
+    )
+    if growth > 0.10:
+        failures.append(f"resting RSS grew {100 * growth:.1f} % from runs 10-19 to {last['runs']}")
+    if last["open_files"] > first["open_files"] or last["threads"] > first["threads"]:
+        failures.append("open files or threads grew")
+    return failures
 
 
 def write_config(
@@ -235,7 +260,7 @@ def main(argv=None) -> int:
     mail_down, mail_up = at[2], at[3]  # ten days without SMTP and Slack
     s3 = SimulatingS3(work / "s3", args.granules)
     s3.failing = {at[4]}  # the archive answers 503 for one day
-    smtp, slack = Smtp(), Slack()
+    smtp, slack = Smtp(), Webhook()
     run_at = dt.datetime.now(dt.timezone.utc) + dt.timedelta(
         seconds=args.days * args.seconds_per_day * 1.4 + 180
     )
@@ -338,11 +363,11 @@ def main(argv=None) -> int:
         sent = [d for d in deliveries if d.status == "sent"]
         by_channel = {c: sum(1 for d in sent if d.channel == c) for c in ("email", "slack")}
         left = [d for d in deliveries if d.status != "sent" and d.channel in ("email", "slack")]
-        if by_channel["email"] != len(smtp.messages) or by_channel["slack"] != len(slack.posts) or left:
+        if by_channel["email"] != len(smtp.messages) or by_channel["slack"] != len(slack.received) or left:
             failures.append(
                 f"alerts: sent email {by_channel['email']} / received {len(smtp.messages)}, "
                 f"slack {by_channel['slack']} "
-                f"/ received {len(slack.posts)}, not sent {len(left)}"
+                f"/ received {len(slack.received)}, not sent {len(left)}"
             )
         vm.close()
     # the report
@@ -352,32 +377,9 @@ def main(argv=None) -> int:
     )
     print(
         f"soak: alerts sent by email {len(smtp.messages)} (refused while down {smtp.refused}), "
-        f"Slack {len(slack.posts)} (refused {slack.refused})"
+        f"Slack {len(slack.received)} (refused {slack.refused})"
     )
-    by_runs = {}
-    for s in samples:
-        by_runs.setdefault(s["runs"], s)
-    print("runs  t_s   rss_mb  open_files  threads  store_mb")
-    for n in sorted(by_runs):
-        if n % 10 == 0 or n == max(by_runs):
-            s = by_runs[n]
-            print(
-                f"{n:4d} {s['t_s']:5d} {s['rss_mb']:8.1f} {s['open_files']:10d} {s['threads']:8d} "
-                f"{s['store_mb']:9.2f}"
-            )
-    at10 = next((s for s in samples if s["runs"] >= 10), None)
-    at_end = next((s for s in reversed(samples) if s["runs"] >= args.days), samples[-1] if samples else None)
-    if at10 and at_end:
-        growth = at_end["rss_mb"] / at10["rss_mb"] - 1
-        print(
-            f"soak: RSS day 10 {at10['rss_mb']:.0f} MB, day {at_end['runs']} {at_end['rss_mb']:.0f} MB "
-            f"({100 * growth:+.1f} %); open files {at10['open_files']} -> {at_end['open_files']}; "
-            f"threads {at10['threads']} -> {at_end['threads']}"
-        )
-        if growth > 0.10:
-            failures.append(f"RSS grew {100 * growth:.1f} % from day 10 to the end")
-        if at_end["open_files"] > at10["open_files"] or at_end["threads"] > at10["threads"]:
-            failures.append("open files or threads grew")
+    failures += memory_verdict(samples, args.days)
     (work / "samples.json").write_text(json.dumps(samples))
     for f in failures:
         print("soak: FAIL:", f)

@@ -36,6 +36,16 @@ def real_geo_files():
     return files
 
 
+class Clock:
+    """A monotonic clock the test turns by hand: call it for the time, set ``t`` to move it."""
+
+    def __init__(self, t: float = 1000.0):
+        self.t = t
+
+    def __call__(self) -> float:
+        return self.t
+
+
 class CaseCache:
     """Simulated cases and their assessments, made once per test session."""
 

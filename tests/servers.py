@@ -7,6 +7,7 @@ installs. Without them a test is skipped locally but fails under CI (``CI=true``
 from __future__ import annotations
 
 import base64
+import json
 import os
 import shutil
 import socket
@@ -186,6 +187,56 @@ def influxql(url: str, db: str, q: str) -> list:
     return res.get("series", [])
 
 
+class Webhook:
+    """An HTTP endpoint that takes JSON posts (a Slack incoming webhook, an Alertmanager receiver): each
+    body in ``received``; the answer from ``script`` (a list of (status, body, headers), popped in turn),
+    else 500 while ``failing`` (those posts are counted in ``refused``, not received), else 200."""
+
+    def __init__(self, path: str = "/services/T000/B000/secret-token"):
+        self.script, self.received = [], []
+        self.failing, self.refused = False, 0
+        hook = self
+
+        class H(BaseHTTPRequestHandler):
+            def log_message(self, *a):
+                pass
+
+            def do_POST(self):
+                body = self.rfile.read(int(self.headers["Content-Length"]))
+                if hook.script:
+                    status, text, headers = hook.script.pop(0)
+                    hook.received.append(json.loads(body))
+                elif hook.failing:
+                    (status, text, headers), hook.refused = (500, "down", {}), hook.refused + 1
+                else:
+                    (status, text, headers) = (200, "ok", {})
+                    hook.received.append(json.loads(body))
+                data = text.encode()
+                self.send_response(status)
+                for k, v in headers.items():
+                    self.send_header(k, v)
+                self.send_header("Content-Length", str(len(data)))
+                self.end_headers()
+                self.wfile.write(data)
+
+        self.httpd = ThreadingHTTPServer(("127.0.0.1", 0), H)
+        self.url = f"http://127.0.0.1:{self.httpd.server_address[1]}{path}"
+        threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
+
+    def close(self):
+        """Stop serving."""
+        self.httpd.shutdown()
+        self.httpd.server_close()
+
+
+def _drip(wfile, data: bytes, size: int, pause_s: float) -> None:
+    """Write *data* *size* bytes at a time, *pause_s* apart."""
+    for i in range(0, len(data), size):
+        wfile.write(data[i : i + size])
+        wfile.flush()
+        time.sleep(pause_s)
+
+
 class S3Server:
     """A minimal S3-style server (path style: /<bucket>/<key>) over a directory of buckets.
 
@@ -222,10 +273,7 @@ class S3Server:
                 if server.slow_headers_s is not None:
                     head = b"HTTP/1.1 200 OK\r\nContent-Type: application/xml\r\nContent-Length: 10\r\n\r\n"
                     try:
-                        for i in range(len(head)):
-                            self.wfile.write(head[i : i + 1])
-                            self.wfile.flush()
-                            time.sleep(server.slow_headers_s)
+                        _drip(self.wfile, head, 1, server.slow_headers_s)
                     except (BrokenPipeError, ConnectionResetError, OSError):
                         pass  # the client gave up, as it should
                     return
@@ -306,11 +354,7 @@ class S3Server:
         h.end_headers()
         try:
             if self.slow_list_s is not None:
-                for i in range(len(body)):
-                    h.wfile.write(body[i : i + 1])
-                    h.wfile.flush()
-                    time.sleep(self.slow_list_s)
-                return
+                return _drip(h.wfile, body, 1, self.slow_list_s)
             h.wfile.write(body)
         except (BrokenPipeError, ConnectionResetError):
             pass  # the client gave up, as it should
@@ -350,11 +394,7 @@ class S3Server:
                 h.connection.shutdown(socket.SHUT_RDWR)
                 return
             if self.slow_drip_s is not None:
-                for i in range(0, len(data), self.drip_bytes):
-                    h.wfile.write(data[i : i + self.drip_bytes])
-                    h.wfile.flush()
-                    time.sleep(self.slow_drip_s)
-                return
+                return _drip(h.wfile, data, self.drip_bytes, self.slow_drip_s)
             h.wfile.write(data)
         except (BrokenPipeError, ConnectionResetError):
             pass  # the client gave up, as it should

@@ -3,14 +3,7 @@
 import threading
 
 from monitor.health import Health
-
-
-class Clock:
-    def __init__(self):
-        self.t = 1000.0
-
-    def __call__(self):
-        return self.t
+from tests.conftest import Clock
 
 
 def test_a_job_over_its_budget_is_a_problem_until_it_ends():

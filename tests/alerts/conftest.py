@@ -1,16 +1,13 @@
 """Real SMTP (aiosmtpd with STARTTLS and authentication) and Slack-webhook (HTTP) servers on loopback."""
 
-import json
 import ssl
 import subprocess
-import threading
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 
 import pytest
 from aiosmtpd.controller import Controller
 from aiosmtpd.smtp import AuthResult, LoginPassword
 
-from tests.servers import free_port
+from tests.servers import Webhook, free_port
 
 USER, PASSWORD = "crisgeo", "not-a-real-password"
 
@@ -85,40 +82,11 @@ def smtp_server(tls_cert):
         ctl.stop()
 
 
-class Webhook:
-    """A Slack incoming-webhook stand-in: answers from a script of (status, body, headers)."""
-
-    def __init__(self):
-        self.script = []
-        self.received = []
-        hook = self
-
-        class H(BaseHTTPRequestHandler):
-            def log_message(self, *a):
-                pass
-
-            def do_POST(self):
-                body = self.rfile.read(int(self.headers["Content-Length"]))
-                hook.received.append(json.loads(body))
-                status, text, headers = hook.script.pop(0) if hook.script else (200, "ok", {})
-                data = text.encode()
-                self.send_response(status)
-                for k, v in headers.items():
-                    self.send_header(k, v)
-                self.send_header("Content-Length", str(len(data)))
-                self.end_headers()
-                self.wfile.write(data)
-
-        self.httpd = ThreadingHTTPServer(("127.0.0.1", 0), H)
-        self.url = f"http://127.0.0.1:{self.httpd.server_address[1]}/services/T000/B000/secret-token"
-        threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
-
-
 @pytest.fixture
 def webhook():
+    """A Slack incoming-webhook stand-in (:class:`tests.servers.Webhook`)."""
     w = Webhook()
     try:
         yield w
     finally:
-        w.httpd.shutdown()
-        w.httpd.server_close()
+        w.close()
