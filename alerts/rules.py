@@ -14,7 +14,7 @@ import numpy as np
 
 from alerts.changes import preceding_change
 from monitor.constants import N_FOR, SPEC_KM
-from monitor.store.sqlite import DONE, SCHEDULER_KINDS, EventKind, RunStatus
+from monitor.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 
 UTC = dt.timezone.utc
 COMPONENTS = (("in_track_km", "in-track"), ("cross_track_km", "cross-track"))
@@ -99,7 +99,7 @@ def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
         rows.append((f, over, critical))
     if not rows:
         return None
-    severity = "critical" if any(c for _, _, c in rows) else "warning"
+    severity = Severity.CRITICAL if any(c for _, _, c in rows) else Severity.WARNING
     fors = [f.for_index for f, _, _ in rows]
     lines = [
         f"FOR {f.for_index:2d}: in-track {f.in_track_km:+.2f} +- {f.sigma_in_track_km:.2f} km, cross-track "
@@ -108,7 +108,7 @@ def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
         for f, _, c in rows
     ]
     return Finding(
-        "spec",
+        Rule.SPEC,
         satellite,
         severity,
         f"{satellite}: {len(rows)} FOR(s) beyond the {s.spec_km} km specification on {day}: "
@@ -227,9 +227,9 @@ def jump_findings(store, satellite: str, changes: list, s: RuleSettings, today: 
         ]
         out.append(
             Finding(
-                "jump",
+                Rule.JUMP,
                 satellite,
-                "warning",
+                Severity.WARNING,
                 f"{satellite}: geolocation jump from {j['split']} ({who} change before it)"
                 if change
                 else f"{satellite}: geolocation jump from {j['split']} with no known change before it",
@@ -262,9 +262,9 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
         else "no successful assessment yet"
     )
     return Finding(
-        "stale",
+        Rule.STALE,
         satellite,
-        "critical",
+        Severity.CRITICAL,
         f"{satellite}: no successful assessment for {age:.0f} h",
         [what, f"latest run: {runs[-1].day} {runs[-1].status} {runs[-1].reason or ''}".strip()],
     )
@@ -289,7 +289,11 @@ def failure_finding(store, satellite: str) -> Finding | None:
         for e in jobs
     ]
     return Finding(
-        "failure", satellite, "critical", f"{satellite}: {len(lines)} failed or missed run(s)", lines
+        Rule.FAILURE,
+        satellite,
+        Severity.CRITICAL,
+        f"{satellite}: {len(lines)} failed or missed run(s)",
+        lines,
     )
 
 
@@ -307,9 +311,9 @@ def processing_change_findings(store, satellite: str, s: RuleSettings, today: dt
             continue
         out.append(
             Finding(
-                "processing",
+                Rule.PROCESSING,
                 satellite,
-                "warning",
+                Severity.WARNING,
                 f"{satellite}: {d['description']}",
                 [f"seen in the GEO files from {when:%Y-%m-%d %H:%M:%S} UTC, before any VIIRS comparison"],
                 group=when.date().isoformat(),

@@ -6,8 +6,9 @@ keeps only the last three on disk). While the days go by, the harness breaks wha
 by the day the daemon is working on:
 
 * the time-series database (VictoriaMetrics, real) is down for a week of days, then back;
-* SMTP (aiosmtpd) answers 451 and the Slack webhook 500 for ten days;
-* the archive answers 503 to every request for one day (its run fails; the next daily run redoes it).
+* SMTP (aiosmtpd) answers 451 and the Slack webhook 500 for two weeks of days;
+* in the middle of those, the archive answers 503 to the CrIS requests of one day: its run fails, the
+  failure alert waits for SMTP and Slack, and the next daily run redoes the day.
 
 The daily run time is set after the expected end of the catch-up, so that the daemon's own schedule redoes
 the failed day. Every ``--every`` seconds the harness samples the daemon's RSS, open files and threads
@@ -42,7 +43,8 @@ from pathlib import Path
 from aiosmtpd.controller import Controller
 
 from monitor.store.alerts import AlertState
-from monitor.store.sqlite import RunStatus, Store
+from monitor.store.sqlite import Store
+from monitor.vocabulary import RunStatus
 from tests.servers import S3Server, Webhook, free_port, victoria_metrics, vm_export
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -255,11 +257,11 @@ def main(argv=None) -> int:
     today = dt.datetime.now(dt.timezone.utc).date()
     first = today - dt.timedelta(days=args.days)
     days = [first + dt.timedelta(days=k) for k in range(args.days)]
-    at = [days[int(f * args.days)] for f in (0.2, 0.28, 0.4, 0.51, 0.6)]  # of 90: days 19, 26, 37, 46, 55
+    at = [days[int(f * args.days)] for f in (0.2, 0.28, 0.4, 0.5, 0.6)]  # of 90: days 18, 25, 36, 45, 54
     vm_down, vm_up = at[0], at[1]  # a week without the time-series database
-    mail_down, mail_up = at[2], at[3]  # ten days without SMTP and Slack
+    mail_down, mail_up = at[2], at[4]  # SMTP and Slack fail for days, while...
     s3 = SimulatingS3(work / "s3", args.granules)
-    s3.failing = {at[4]}  # the archive answers 503 for one day
+    s3.failing = {at[3]}  # ...the archive answers 503 for one day: its failure alert waits for them
     smtp, slack = Smtp(), Webhook()
     run_at = dt.datetime.now(dt.timezone.utc) + dt.timedelta(
         seconds=args.days * args.seconds_per_day * 1.4 + 180
@@ -315,7 +317,7 @@ def main(argv=None) -> int:
                     phase = "running"
                     print(f"soak: {current}: VictoriaMetrics back")
                 smtp.failing = slack.failing = mail_down <= current < mail_up
-                if current > at[4] and s3.failing:
+                if current > at[3] and s3.failing:
                     s3.failing = set()  # the archive is back the next day
                     print(f"soak: {current}: the archive answers again")
                 if len(samples) % 12 == 0:

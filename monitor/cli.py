@@ -20,6 +20,7 @@ from monitor.errors import DataError
 from monitor.satellites import SATELLITES
 from monitor.simulate.orbit import PASSES
 from monitor.version import __version__
+from monitor.vocabulary import Rule
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
@@ -59,7 +60,7 @@ RESIDUAL_ARGS = (
         help="learn each granule's residual from itself, against the EP it was made with",
     ),
 )
-RULES = ("spec", "jump", "stale", "failure", "processing")
+RULES = tuple(Rule)
 COMMANDS: dict = {}  # name -> (handler, help, arguments), in the order of ``crisgeo --help``
 
 
@@ -442,7 +443,7 @@ def _satellites(cfg, satellite: str | None) -> list[str]:
 def cmd_run(args) -> int:
     """crisgeo run: one run of the daily job, then exit."""
     from monitor.service import AlreadyRunning, Service
-    from monitor.store.sqlite import RunStatus
+    from monitor.vocabulary import RunStatus
 
     cfg = _load(args, writes=True)
     sats = _satellites(cfg, args.satellite)
@@ -487,7 +488,7 @@ def cmd_reprocess(args) -> int:
     """crisgeo reprocess: a period on Dask; this process alone writes the store."""
     from monitor.reprocess import run_reprocess
     from monitor.service import AlreadyRunning
-    from monitor.store.sqlite import RunStatus
+    from monitor.vocabulary import RunStatus
 
     cfg = _load(args, writes=True)
     sats = _satellites(cfg, args.satellite)

@@ -32,7 +32,7 @@ import math
 from prometheus_client import CollectorRegistry, Counter, Gauge
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 
-from monitor.store.sqlite import RunStatus
+from monitor.vocabulary import RunStatus
 
 OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run row changes to one once
 

@@ -24,8 +24,8 @@ from monitor.sdr import read_file
 from monitor.sdr.pairing import CasePlan, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 from monitor.sources import ALL_PRODUCTS, Source, SourceError
-from monitor.store.sqlite import EventKind, RunStatus
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
+from monitor.vocabulary import EventKind, RunStatus
 
 LOG = logging.getLogger(__name__)
 

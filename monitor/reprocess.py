@@ -22,7 +22,8 @@ from monitor.allocator import reuse_freed_memory
 from monitor.pipeline import DayWork, ProgressLines, compute_day, no_data_horizon, record_day
 from monitor.service import InstanceLock
 from monitor.sources import make_source
-from monitor.store.sqlite import RunStatus, Store
+from monitor.store.sqlite import Store
+from monitor.vocabulary import RunStatus
 
 LOG = logging.getLogger(__name__)
 

@@ -27,7 +27,8 @@ from monitor import allocator, logs
 from monitor.health import Health
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources import make_source
-from monitor.store.sqlite import RunStatus, Store
+from monitor.store.sqlite import Store
+from monitor.vocabulary import RunStatus
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
@@ -320,7 +321,7 @@ class Service:
     def _job_event(self, event):
         from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MISSED
 
-        from monitor.store.sqlite import EventKind
+        from monitor.vocabulary import EventKind
 
         kind = {EVENT_JOB_ERROR: EventKind.JOB_ERROR, EVENT_JOB_MISSED: EventKind.JOB_MISSED}.get(
             event.code, EventKind.JOB_SKIPPED

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from monitor.service import next_run
 from monitor.store.alerts import AlertState
-from monitor.store.sqlite import RunStatus
+from monitor.vocabulary import RunStatus
 
 NAGIOS_OK, NAGIOS_WARNING, NAGIOS_CRITICAL, NAGIOS_UNKNOWN = 0, 1, 2, 3
 

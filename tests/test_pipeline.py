@@ -9,7 +9,8 @@ import pytest
 from monitor.config import load_config
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources.local import LocalSource
-from monitor.store.sqlite import EventKind, Store
+from monitor.store.sqlite import Store
+from monitor.vocabulary import EventKind
 from tests.conftest import tree_with_truncated
 
 DAY = dt.date(2024, 6, 1)

@@ -31,7 +31,7 @@ from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
 from monitor.store.alerts import AlertState
-from monitor.store.sqlite import RunStatus
+from monitor.vocabulary import RunStatus
 
 UTC = dt.timezone.utc
 CSS = """

@@ -11,17 +11,16 @@ replaced in one transaction, so a re-run never duplicates and a crash never leav
 from __future__ import annotations
 
 import datetime as dt
-import enum
 import json
 import sqlite3
 from dataclasses import dataclass
-from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
 
 from monitor.constants import N_FOR
 from monitor.result import MEASURED_FIELDS, RELIABILITY_FLAGS, AssessmentResult, ForOffset
+from monitor.vocabulary import DONE, EventKind, RunStatus
 
 UTC = dt.timezone.utc
 
@@ -94,25 +93,6 @@ def _num(v):
     return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
 
 
-class EventKind(str, enum.Enum):
-    """What an ``events`` row records."""
-
-    RUN_FAILED = "run_failed"  # detail: day, reason
-    JOB_ERROR = "job_error"  # detail: job, error, scheduled (a scheduler job raised)
-    JOB_MISSED = "job_missed"  # ... was missed (the host was down past the misfire grace)
-    JOB_SKIPPED = "job_skipped"  # ... was skipped (the previous instance still ran)
-    CHANGE_CRIS = "change:cris"  # detail: time, kind, description, origin (a CrIS processing change)
-    CHANGE_VIIRS = "change:viirs"  # the same for VIIRS
-
-    @property
-    def is_change(self) -> bool:
-        """Whether the event records a processing change (change:<instrument>)."""
-        return self.value.startswith("change:")
-
-
-SCHEDULER_KINDS = (EventKind.JOB_ERROR, EventKind.JOB_MISSED, EventKind.JOB_SKIPPED)
-
-
 @dataclass(frozen=True)
 class Event:
     """One ``events`` row; *detail* is the decoded JSON (rows of older versions, plain text, become
@@ -134,20 +114,6 @@ class Event:
         if not isinstance(detail, dict):
             detail = {"text": r["detail"]}
         return cls(r["id"], r["time"], EventKind(r["kind"]), r["satellite"], detail)
-
-
-class RunStatus(StrEnum):
-    """The status of a run in the ledger (the string stored)."""
-
-    RUNNING = "running"
-    OK = "ok"  # results stored
-    NO_DATA = "no_data"  # nothing to assess yet: tried again for schedule.no_data_retry_days
-    NO_DATA_FINAL = "no_data_final"  # nothing to assess, for good
-    FAILED = "failed"
-    INTERRUPTED = "interrupted"  # a stop request or a killed process: redone at the next run
-
-
-DONE = (RunStatus.OK, RunStatus.NO_DATA, RunStatus.NO_DATA_FINAL)  # a day with one of these is not redone
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from monitor.config import SourceConfig, load_config
 from monitor.pipeline import compute_day
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed, make_source
 from monitor.sources.nodd import NoddSource
-from monitor.store.sqlite import RunStatus
+from monitor.vocabulary import RunStatus
 from tests.servers import S3Server
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)

@@ -5,7 +5,8 @@ import sqlite3
 
 from alerts.rules import Finding
 from monitor.store.alerts import AlertState
-from monitor.store.sqlite import MIGRATIONS, EventKind, Store
+from monitor.store.sqlite import MIGRATIONS, Store
+from monitor.vocabulary import EventKind
 
 T0 = dt.datetime(2026, 11, 22, 6, 0, tzinfo=dt.timezone.utc)
 

@@ -1,0 +1,60 @@
+"""The service's shared words, at the ground floor: every module that speaks of runs, events, rules or
+severities imports them from here (the store, the alerts, the pipeline, the metrics, the CLI).
+
+Each is a ``StrEnum``: its members are the strings stored in SQLite, written in messages and labels, and
+compared with plain strings where those come back.
+"""
+
+from __future__ import annotations
+
+from enum import StrEnum
+
+
+class RunStatus(StrEnum):
+    """The status of a run in the ledger (the string stored)."""
+
+    RUNNING = "running"
+    OK = "ok"  # results stored
+    NO_DATA = "no_data"  # nothing to assess yet: tried again for schedule.no_data_retry_days
+    NO_DATA_FINAL = "no_data_final"  # nothing to assess, for good
+    FAILED = "failed"
+    INTERRUPTED = "interrupted"  # a stop request or a killed process: redone at the next run
+
+
+DONE = (RunStatus.OK, RunStatus.NO_DATA, RunStatus.NO_DATA_FINAL)  # a day with one of these is not redone
+
+
+class EventKind(StrEnum):
+    """What an ``events`` row records."""
+
+    RUN_FAILED = "run_failed"  # detail: day, reason
+    JOB_ERROR = "job_error"  # detail: job, error, scheduled (a scheduler job raised)
+    JOB_MISSED = "job_missed"  # ... was missed (the host was down past the misfire grace)
+    JOB_SKIPPED = "job_skipped"  # ... was skipped (the previous instance still ran)
+    CHANGE_CRIS = "change:cris"  # detail: time, kind, description, origin (a CrIS processing change)
+    CHANGE_VIIRS = "change:viirs"  # the same for VIIRS
+
+    @property
+    def is_change(self) -> bool:
+        """Whether the event records a processing change (change:<instrument>)."""
+        return self.value.startswith("change:")
+
+
+SCHEDULER_KINDS = (EventKind.JOB_ERROR, EventKind.JOB_MISSED, EventKind.JOB_SKIPPED)
+
+
+class Rule(StrEnum):
+    """The alert rules (alerts/rules.py), by the name stored, shown and silenced."""
+
+    SPEC = "spec"  # an error beyond the specification
+    JUMP = "jump"  # a step in the offsets, attributed to a known change where there is one
+    STALE = "stale"  # no successful assessment for too long
+    FAILURE = "failure"  # failed or missed runs
+    PROCESSING = "processing"  # a change seen in the GEO files' LOS fingerprint
+
+
+class Severity(StrEnum):
+    """How urgent an alert is."""
+
+    WARNING = "warning"
+    CRITICAL = "critical"
