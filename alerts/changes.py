@@ -112,7 +112,7 @@ def add_to_calendar(path, change: Change) -> None:
 
 
 def _lut_kinds(names) -> dict:
-    out = {}
+    out: dict[str, set[str]] = {}
     for n in names:
         m = KIND_RE.match(n)
         if m:
@@ -122,7 +122,7 @@ def _lut_kinds(names) -> dict:
 
 def metadata_changes(store, satellite: str) -> list[Change]:
     """Changes of LUTs and SDR software between consecutive days of stored granule metadata."""
-    days = {}
+    days: dict[str, dict[str, set[str]]] = {}
     for g in store.granules(satellite):
         d = days.setdefault(g.day, {"cris": set(), "viirs": set(), "cris_sw": set(), "viirs_sw": set()})
         d["cris"].update(g.cris_aux)
@@ -157,7 +157,7 @@ def metadata_changes(store, satellite: str) -> list[Change]:
                         "metadata",
                     )
                 )
-    unique = {}
+    unique: dict[tuple, Change] = {}
     for c in out:  # a common LUT appears in both instruments' lists
         unique.setdefault((c.time, c.instrument, c.description), c)
     return list(unique.values())

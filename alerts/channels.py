@@ -148,7 +148,7 @@ class SlackChannel:
 
 def make_channels(settings) -> dict:
     """The channels the settings configure, by name."""
-    out = {}
+    out: dict[str, LogChannel | EmailChannel | SlackChannel] = {}
     if settings.log:
         out["log"] = LogChannel(settings.log)
     if settings.email:

@@ -61,7 +61,7 @@ def _trend(store, satellite: str, days: int = 7) -> list[str]:
 
 def build_message(store, satellite: str, items: list, settings) -> dict:
     """One message for a satellite: every alert that started, repeats or resolved, with evidence."""
-    counts = {}
+    counts: dict[str, int] = {}
     for kind, _ in items:
         counts[kind] = counts.get(kind, 0) + 1
     head = ", ".join(f"{n} {k}" for k, n in counts.items())
@@ -154,7 +154,7 @@ def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> lis
                                 Finding(
                                     prev.rule,
                                     sat,
-                                    prev.severity,
+                                    prev.severity or "",
                                     f"resolved: {prev.summary}",
                                     [],
                                     prev.grp or "",

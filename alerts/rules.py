@@ -171,7 +171,7 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
                 if t and abs(t[0]) >= s.min_jump_km and abs(t[1]) >= threshold:
                     hits.append((g, label, t[0], t[1]))
         if hits:
-            fors = {}
+            fors: dict[int, list] = {}
             for comp, label in COMPONENTS:
                 if not any(h[1] == label for h in hits):
                     continue
@@ -190,7 +190,7 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
             )
     # a blind step is seen at several neighbouring split days: keep the strongest of each cluster
     found.sort(key=lambda j: j["split"])
-    kept = []
+    kept: list[dict] = []
     for j in found:
         if kept and (j["split"] - kept[-1]["split"]).days <= 3 and not (j["known"] and not kept[-1]["known"]):
             if j["score"] > kept[-1]["score"] and not kept[-1]["known"]:

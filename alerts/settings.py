@@ -188,12 +188,12 @@ def load_alert_settings(
             raise AlertConfigError(
                 "alerts.slack.webhook_env: missing (the name of the variable holding the URL)"
             )
-        d = SlackSettings(webhook_env=sl["webhook_env"])
+        ds = SlackSettings(webhook_env=sl["webhook_env"])
         s.slack = SlackSettings(
             webhook_env=_typed(sl, "webhook_env", str, w, None),
-            retries=_typed(sl, "retries", int, w, d.retries, (0, 20)),
-            max_wait_s=_typed(sl, "max_wait_s", float, w, d.max_wait_s, (0.0, 3600.0)),
-            timeout_s=_typed(sl, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)),
+            retries=_typed(sl, "retries", int, w, ds.retries, (0, 20)),
+            max_wait_s=_typed(sl, "max_wait_s", float, w, ds.max_wait_s, (0.0, 3600.0)),
+            timeout_s=_typed(sl, "timeout_s", float, w, ds.timeout_s, (0.1, 600.0)),
         )
     if doc.get("alertmanager"):
         am = _mapping(doc, "alertmanager")
@@ -205,11 +205,11 @@ def load_alert_settings(
             raise AlertConfigError(
                 f"{w}url: {url!r} is not an http(s) URL without credentials (e.g. http://127.0.0.1:9093)"
             )
-        d = AlertmanagerSettings(url=url)
+        da = AlertmanagerSettings(url=url)
         s.alertmanager = AlertmanagerSettings(
             url=url.rstrip("/"),
-            timeout_s=_typed(am, "timeout_s", float, w, d.timeout_s, (0.1, 600.0)),
-            validity_hours=_typed(am, "validity_hours", float, w, d.validity_hours, (1.5, 168.0)),
+            timeout_s=_typed(am, "timeout_s", float, w, da.timeout_s, (0.1, 600.0)),
+            validity_hours=_typed(am, "validity_hours", float, w, da.validity_hours, (1.5, 168.0)),
         )
     return s
 

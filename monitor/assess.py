@@ -28,10 +28,10 @@ from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR
 from monitor.errors import AssessmentError, StopRequested
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
-from monitor.geometry.inverse import granule_geometry
+from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
 from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult, ForOffset
-from monitor.sdr import GranuleError, read_file
+from monitor.sdr import CrisGeoGranule, CrisSdrGranule, GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_viirs_geo_scan
 from monitor.spectral import i5_band
@@ -114,7 +114,7 @@ def _reach_us(first_us: int, last_us: int) -> tuple:
 def _scan_spans(cris: list, viirs: dict) -> dict:
     """Per VIIRS granule key, the IET span (us) of the scans the CrIS granules *cris* using it need (by
     their nominal bounds, :func:`_reach_us`): so that each is prepared once per run."""
-    spans = {}
+    spans: dict[str, tuple[int, int]] = {}
     for g in cris:
         need = _reach_us(g.geo_meta.start_iet_us, g.geo_meta.end_iet_us)
         for v in viirs[g.key]:
@@ -130,9 +130,9 @@ class GranuleInputs:
     times: :func:`_reach_us`; None when it has none), its band BT (bt_cris_k), and the raw VIIRS
     granules (key -> (GEO, SDR, scan before, scan after)) not yet prepared."""
 
-    geo: object
-    sdr: object
-    fg: object
+    geo: CrisGeoGranule
+    sdr: CrisSdrGranule
+    fg: FovGeometry
     valid: np.ndarray
     fill: dict
     view_rad: float
@@ -420,7 +420,7 @@ def for_minimum(d, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
     m = d.shape[1]
     g = _stdev(d)
     x, y, flags = find_minimum(g, cfg.flat_contrast)
-    i0, j0 = np.unravel_index(np.argmin(g), g.shape)
+    i0, j0 = (int(k) for k in np.unravel_index(np.argmin(g), g.shape))
     fine = FLAG_EDGE not in flags and FLAG_FLAT not in flags and refine.refinable(i0, j0, m)
     if fine:
         dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0))
@@ -525,7 +525,7 @@ def _collocate_run(
     band = i5_band(satellite)
     cache = _SwathCache(spans=_scan_spans(cris, viirs))
     samples, skipped = [], []
-    reading = {}  # the read-ahead thread's seconds, added to *timings* at the end
+    reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
     def read_ahead(i):
         """Read granule i's inputs (and compute its CrIS geometry) in the background while granule i - 1
@@ -547,7 +547,15 @@ def _collocate_run(
             try:
                 samples.append(
                     collocate_granule(
-                        g, viirs[g.key], cfg, band, cache, timings, viirs_all, should_stop, current.result()
+                        g,
+                        viirs[g.key],
+                        cfg,
+                        band,
+                        cache,
+                        timings,
+                        viirs_all,
+                        should_stop,
+                        current.result() if current is not None else None,
                     )
                 )
             except StopRequested:

@@ -329,7 +329,8 @@ def warm_up() -> float:
     lat, lon = np.radians(0.004 * r).astype(np.float32), np.radians(0.004 * c).astype(np.float32)
     zeros = np.zeros((rows, cols), np.float32)
     fields = (lat, lon, zeros, zeros + 280.0, zeros == 0)
-    swath_piece(*(a[:, 2:] for a in fields), i5_band("j01"))  # the kept columns of a granule: strided views
+    kept = [a[:, 2:] for a in fields]  # the kept columns of a granule: strided views
+    swath_piece(kept[0], kept[1], kept[2], kept[3], kept[4], i5_band("j01"))
     piece = swath_piece(*fields, i5_band("j01"))
     ground = wgs84.geodetic_to_ecef(np.radians(0.06), np.radians(0.03), 0.0)
     sat = ground * (1 + 833e3 / np.linalg.norm(ground))

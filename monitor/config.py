@@ -12,6 +12,7 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 from urllib.parse import urlsplit, urlunsplit
 
 import yaml
@@ -19,6 +20,9 @@ import yaml.events
 
 from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, MAX_GRID_SPREAD_RAD, URAD
 from monitor.satellites import SATELLITES
+
+if TYPE_CHECKING:
+    from alerts.settings import AlertSettings
 
 NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
 
@@ -149,7 +153,7 @@ class Config:
     report_dir: Path | None = None
     report_url: str | None = None
     dashboard_url: str | None = None
-    alert_settings: object = None  # alerts.settings.AlertSettings, parsed and validated with the rest
+    alert_settings: AlertSettings | None = None  # parsed and validated with the rest
 
     @property
     def events_file(self) -> Path | None:
@@ -668,6 +672,8 @@ def effective(cfg: Config) -> dict:
         if value is not None:
             out[key] = str(value)
     a = cfg.alert_settings
+    if a is None:
+        return out
     alerts = plain(a.rules)
     for key in ("log", "events_file"):
         if getattr(a, key) is not None:

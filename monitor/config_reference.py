@@ -191,7 +191,7 @@ def model_keys() -> dict:
     """{key: default} for every key the loader accepts (mappings and lists are keys themselves)."""
     keys = {k: None for k in C.TOP_KEYS - set(C.SECTIONS) - {"store", "alerts"}}
     for section, cls in C.SECTIONS.items():
-        keys.update({f"{section}.{name}": _default(cls, name) for name in cls.__dataclass_fields__})
+        keys.update({f"{section}.{f.name}": _default(cls, f.name) for f in dataclasses.fields(cls)})
     keys.update({f"store.{k}": _default(C.StoreConfig, k) if k != "sqlite" else None for k in C.STORE_KEYS})
     keys.update(
         {f"store.publish[].{k}": _default(C.PublishConfig, k) for k in C.PublishConfig.__dataclass_fields__}

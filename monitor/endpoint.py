@@ -112,6 +112,7 @@ class Endpoint:
     def address(self) -> str:
         """HOST:PORT actually listened on (port 0 resolved)."""
         host, port = self.server.server_address[:2]
+        host = host.decode() if isinstance(host, bytes) else str(host)
         return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
 
     def start(self) -> "Endpoint":

@@ -19,9 +19,10 @@ from monitor import logs
 from monitor.assess import AssessConfig, assess_plan
 from monitor.errors import DataError, StopRequested
 from monitor.mapping.engpkt import load_library
+from monitor.result import AssessmentResult
 from monitor.scenes import select_scenes
 from monitor.sdr import read_file
-from monitor.sdr.pairing import CasePlan, assemble, granule_files
+from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 from monitor.sources import ALL_PRODUCTS, Source, SourceError
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
@@ -53,10 +54,10 @@ class RunOutcome:
 
     satellite: str
     day: dt.date
-    status: str
+    status: RunStatus
     reason: str | None = None
     run_id: int | None = None
-    result: object = None
+    result: AssessmentResult | None = None
     timings: dict = field(default_factory=dict)
     counts: dict = field(default_factory=dict)  # granules listed, selected, assessed; files, bytes downloaded
 
@@ -170,7 +171,8 @@ def fetch_plan(source, satellite: str, chosen: list, stop=lambda: False, progres
     """The assessment plan of the chosen scenes: their CrIS files as selection read them (no second
     reading, no second pairing) with the VIIRS granules covering them, each fetched and its metadata read
     once; a VIIRS granule that cannot be fetched or read is skipped with its reason."""
-    viirs, skipped = {}, []
+    viirs: dict[str, GranuleFiles] = {}
+    skipped: list[tuple[str, str]] = []
     for c in chosen:
         if stop():
             raise StopRequested
@@ -196,7 +198,7 @@ class DayWork:
     day: dt.date
     status: RunStatus  # ok, no_data, failed or interrupted
     reason: str | None = None
-    result: object = None
+    result: AssessmentResult | None = None
     decisions: list = field(default_factory=list)
     prints: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
@@ -285,7 +287,7 @@ def record_day(cfg, store, run_id: int, w: DayWork) -> RunOutcome:
             except (DataError, OSError, ValueError) as exc:
                 LOG.warning("fingerprint of %s %s not recorded: %s", w.satellite, w.day, exc)
         out = RunOutcome(w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts)
-        if w.status == RunStatus.OK:
+        if w.status == RunStatus.OK and w.result is not None:  # an ok day always has its result
             lines = {
                 target_name(p): result_lines(p.measurement, w.satellite, w.day, w.result.fors)
                 for p in cfg.store.publish
@@ -298,7 +300,7 @@ def record_day(cfg, store, run_id: int, w: DayWork) -> RunOutcome:
             if w.day < no_data_horizon(today, s.lag_days, s.no_data_retry_days):
                 out.status = RunStatus.NO_DATA_FINAL
             else:
-                out.reason += f" (tried again for {s.no_data_retry_days} day(s) after it is due)"
+                out.reason = f"{out.reason} (tried again for {s.no_data_retry_days} day(s) after it is due)"
             summary = {"selection": w.decisions[:50]} if w.decisions else None
             store.finish_run(run_id, out.status, out.reason, summary=summary)
         elif w.status == RunStatus.FAILED:

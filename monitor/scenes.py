@@ -20,7 +20,7 @@ from monitor.errors import DataError
 from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import GranuleFiles, granule_files
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
-from monitor.sources import BudgetExceeded, SourceError
+from monitor.sources import BudgetExceeded, ListedFile, SourceError
 from monitor.spectral import i5_band
 
 LOG = logging.getLogger(__name__)
@@ -33,8 +33,8 @@ class Candidate:
     and, once fetched and read, its :class:`monitor.sdr.pairing.GranuleFiles` (paths and metadata)."""
 
     key: str
-    sdr: object
-    geo: object
+    sdr: ListedFile
+    geo: ListedFile
     viirs: list  # [(sdr, geo)] listed VIIRS pairs covering it
     score_k: float = float("nan")
     files: GranuleFiles | None = None
@@ -108,7 +108,7 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
             continue
         pool.append(Candidate(key, sdr, geo, cover, score, files))
     pool.sort(key=lambda c: -c.score_k)
-    chosen = []
+    chosen: list[Candidate] = []
     for c in pool:
         if not np.isfinite(c.score_k) or c.score_k < min_score_k:
             decisions.append(

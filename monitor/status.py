@@ -4,6 +4,8 @@ firing; the next run; the outbox; and the Nagios state of it all (0 OK, 1 WARNIN
 
 from __future__ import annotations
 
+from typing import Any
+
 from monitor.service import next_run
 from monitor.store.alerts import AlertState
 from monitor.vocabulary import RunStatus
@@ -18,7 +20,7 @@ def status_report(cfg, store, satellites=None) -> dict:
     runs = {r.satellite: r for r in store.last_runs()}
     chosen = list(satellites or cfg.satellites)
     firing = [a for a in AlertState(store).firing() if a.satellite in chosen or a.satellite is None]
-    sats = {}
+    sats: dict[str, dict[str, Any]] = {}
     for sat in chosen:
         r = runs.get(sat)
         day = store.latest_day(sat)

@@ -422,27 +422,27 @@ def swath_piece(
     nscan = rows // DETECTORS
     pos = np.empty((rows, cols, 3), f32)
     radiance = np.empty((rows, cols), f32)
-    first = np.full((nscan + 2, cols, 3), np.nan)
-    last = np.full_like(first, np.nan)
+    ends_first = np.full((nscan + 2, cols, 3), np.nan)  # each scan's first and last row
+    ends_last = np.full_like(ends_first, np.nan)
     step = np.full((nscan + 2, cols), np.nan)
     have = np.zeros(nscan + 2, bool)
     have[1:-1] = True
     t_min, t_step, table = band.radiance_table
     bt, good = np.asarray(bt_k, f32), np.asarray(good, bool)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
-        _locate(lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, first, last, step)
+        _locate(lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, ends_first, ends_last, step)
     for slot, halo in ((0, before), (nscan + 1, after)):
         if halo is not None:
             hp = np.empty(np.shape(halo[0]) + (3,), f32)
             _ecef(*(np.ascontiguousarray(a, f32) for a in halo), hp)
-            _scan_ends(hp, first[slot], last[slot], step[slot])
+            _scan_ends(hp, ends_first[slot], ends_last[slot], step[slot])
             have[slot] = True
     area = np.empty((rows, cols, 3), f32)
     centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
     radius = np.empty(centre.shape[:2])
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
-        _weigh(pos, h, radiance, first, last, step, have, area, centre, radius, top)
+        _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
 
     scan = pos.reshape(nscan, DETECTORS, cols, 3)
     mid = scan[nscan // 2]

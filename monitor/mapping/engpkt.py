@@ -154,11 +154,11 @@ def load_ep(path, satellite: str | None = None) -> EngineeringPacket:
         raise EngPktError(path, "YAML", str(exc).splitlines()[0]) from None
     if not isinstance(doc, dict):
         raise EngPktError(path, "document", "not an EP mapping (FovParam, MappingParameters, ScToSbf)")
-    src = _YamlSource(path, doc)
-    kw = _read_angles(src, path)
+    ysrc = _YamlSource(path, doc)
+    kw = _read_angles(ysrc, path)
     group, parts = _MOUNTING
     kw["sc_to_sbf_rad"] = (
-        np.asarray([_numbers(path, f"{group}/{p}", src.get(f"{group}/{p}"), None) for p in parts]) * URAD
+        np.asarray([_numbers(path, f"{group}/{p}", ysrc.get(f"{group}/{p}"), None) for p in parts]) * URAD
     )
     sat = satellite or doc.get("satellite")
     if sat not in SATELLITES:

@@ -89,7 +89,7 @@ def compare_with_files(
 ) -> list[ForDistance]:
     """Per-FOR statistics of the distance between *ep*'s geolocation (with *residuals*, if given) and the
     files' latitude/longitude."""
-    per_for = [[] for _ in range(N_FOR)]
+    per_for: list[list] = [[] for _ in range(N_FOR)]
     for path in paths:
         for g in _geo_granules(path):
             view = geolocate_granule(ep, g, residuals)

@@ -106,11 +106,11 @@ class ResidualTable:
 
     def to_dict(self) -> dict:
         """The table as the JSON document of the module docstring."""
-        rows = [
+        rows: list[dict[str, float | None]] = [
             {"for": k + 1, "d_alpha_urad": round(float(a), 3), "d_beta_urad": round(float(b), 3)}
             for k, (a, b) in enumerate(zip(self.d_alpha_urad, self.d_beta_urad, strict=True))
         ]
-        if self.fov5_alpha_urad is not None:
+        if self.fov5_alpha_urad is not None and self.fov5_beta_urad is not None:
             for row, a, b in zip(rows, self.fov5_alpha_urad, self.fov5_beta_urad, strict=True):
                 row["fov5_alpha_urad"] = round(float(a), 3) if np.isfinite(a) else None
                 row["fov5_beta_urad"] = round(float(b), 3) if np.isfinite(b) else None

@@ -87,8 +87,8 @@ def plan(paths) -> CasePlan:
     if not files:
         raise PlanError(f"no .h5 files in {', '.join(map(str, paths))}")
     skipped = []
-    by_prefix = defaultdict(dict)  # prefix -> key -> (path, meta)
-    platforms = defaultdict(int)
+    by_prefix: defaultdict[str, dict] = defaultdict(dict)  # prefix -> key -> (path, meta)
+    platforms: defaultdict[str, int] = defaultdict(int)
     for path in files:
         name = parse_name(path.name)
         if name is None:
@@ -173,11 +173,11 @@ def partners_differ(sdr_meta, geo_meta) -> str | None:
 
 
 def _pair(by_prefix, sdr_prefixes, geo_prefixes, skipped) -> list[GranuleFiles]:
-    sdrs = {}
+    sdrs: dict[str, tuple] = {}
     for p in sdr_prefixes:
         for key, v in by_prefix.get(p, {}).items():
             sdrs.setdefault(key, v)
-    geos = {}
+    geos: dict[str, tuple] = {}
     for p in geo_prefixes:
         for key, v in by_prefix.get(p, {}).items():
             geos.setdefault(key, v)

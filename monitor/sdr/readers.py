@@ -337,7 +337,7 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
     metas = [_granule_meta(path, h5, product, k, platform) for k in range(n_gran)]
     scans = [product.scans_reserved or m.n_scans for m in metas]
     bounds = np.concatenate([[0], np.cumsum(scans)])
-    arrays = {}
+    arrays: dict[str, list[np.ndarray] | None] = {}
     for key, f in product.fields.items():
         name = f"{group}/{f.dataset}"
         if name not in h5:
@@ -370,8 +370,9 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
     out = []
     for k, meta in enumerate(metas):
         kwargs = {key: (v[k] if v is not None else None) for key, v in arrays.items()}
-        if product.kind == "cris_sdr":
-            kwargs["wavenumber_cm1"] = cris_lw_wavenumbers_cm1(kwargs["radiance_lw"].shape[-1])
+        radiance = kwargs.get("radiance_lw")
+        if product.kind == "cris_sdr" and radiance is not None:  # a required field: never None here
+            kwargs["wavenumber_cm1"] = cris_lw_wavenumbers_cm1(radiance.shape[-1])
         granule = _GRANULE_TYPES[product.kind](meta=meta, **kwargs)
         _check_not_all_fill(path, product, granule)
         _check_times(path, product, granule)
@@ -575,7 +576,7 @@ def read_metadata(path) -> list[GranuleMeta]:
     path = Path(path)
     with _open(path) as h5, _reading(path):
         platform = _platform(path, h5)
-        metas = []
+        metas: list[GranuleMeta] = []
         for product in products_in(path, h5):
             aggr = f"Data_Products/{product.collection}/{product.collection}_Aggr"
             n = 1
@@ -598,7 +599,7 @@ def read_viirs_geo_scan(path, scan: int):
         product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
         if product is None:
             raise GranuleError(path, "All_Data", "no VIIRS geolocation product")
-        out = []
+        out: list[np.ndarray] = []
         for key in ("lat_rad", "lon_rad", "height_m"):
             if key not in product.fields:
                 out.append(np.zeros_like(out[0]))

@@ -167,7 +167,7 @@ class Simulator:
         self.planck_table = table
         self.band_table = (tau * table + atm) @ self.band.weights
         self.rng = rng
-        if spec.true_ep is not None:
+        if spec.true_ep is not None and spec.ground_ep is not None:
             self.los_true, self.los_geo = los_spacecraft(spec.true_ep), los_spacecraft(spec.ground_ep)
         else:
             self.los_true = ins.cris_los_sbf()
@@ -506,7 +506,7 @@ def simulate_case(
         "pass_lon_deg": spec.pass_lon_deg,
         "terrain": spec.terrain,
         "engineering_packets": None
-        if spec.true_ep is None
+        if spec.true_ep is None or spec.ground_ep is None
         else {"true": spec.true_ep.version, "ground": spec.ground_ep.version},
         "fors": [
             {"for": k + 1, "d_alpha_urad": float(a), "d_beta_urad": float(b)}

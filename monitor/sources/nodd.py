@@ -73,7 +73,7 @@ class NoddSource:
         self.http = BoundedSession()
         self.spent_bytes = 0  # downloaded in this run (cache hits are free)
         self.downloaded_files = 0
-        self.deadline = None
+        self.deadline: float | None = None
         self.sleep = sleep
 
     def _base(self, satellite: str) -> str:
@@ -364,7 +364,7 @@ class NoddSource:
 
 def _newest_per_granule(files: list[ListedFile]) -> list[ListedFile]:
     """Reprocessed granules reappear with a newer creation time: keep the newest of each."""
-    best = {}
+    best: dict[tuple[str, str], ListedFile] = {}
     for f in files:
         key = (f.product, f.parsed.granule_key)
         if key not in best or best[key].parsed.created < f.parsed.created:

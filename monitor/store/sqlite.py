@@ -15,6 +15,7 @@ import json
 import sqlite3
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -507,7 +508,7 @@ class Store:
         ).fetchall()
         out = []
         for r in rows:
-            kw = {k: (float("nan") if r[k] is None else r[k]) for k in RESULT_FIELDS}
+            kw: dict[str, Any] = {k: (float("nan") if r[k] is None else r[k]) for k in RESULT_FIELDS}
             kw["n_samples"] = int(r["n_samples"] or 0)
             out.append(ForOffset(for_index=r["for_index"], flags=tuple(json.loads(r["flags"])), **kw))
         return out

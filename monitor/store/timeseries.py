@@ -152,7 +152,10 @@ class Influx1Writer:
         pass
 
 
-WRITERS = {"influx2": Influx2Writer, "influx1": Influx1Writer}
+WRITERS: dict[str, type[Influx2Writer] | type[Influx1Writer]] = {
+    "influx2": Influx2Writer,
+    "influx1": Influx1Writer,
+}
 
 
 def drain_outbox(store, publish_cfgs, batch: int = 5000) -> dict:
@@ -160,7 +163,7 @@ def drain_outbox(store, publish_cfgs, batch: int = 5000) -> dict:
     report = {}
     for cfg in publish_cfgs:
         target = target_name(cfg)
-        writer = WRITERS[cfg.kind](cfg)
+        writer: Influx2Writer | Influx1Writer = WRITERS[cfg.kind](cfg)
         sent = 0
         try:
             while True:
