@@ -163,6 +163,10 @@ def test_status_command(cases, tmp_path):
     data, _, _ = cases.get()
     cfg = _config(tmp_path, tmp_path / "none")
     (tmp_path / "none").mkdir()
+    r = run_crisgeo("status", "--config", cfg)  # before the daemon's first start: no store, none made
+    assert r.returncode == 3 and "no crisgeo store here yet" in r.stderr
+    assert not (tmp_path / "state" / "crisgeo.sqlite").exists()
+    Store(tmp_path / "state" / "crisgeo.sqlite").close()  # as the daemon does when it starts
     r = run_crisgeo("status", "--config", cfg)
     assert r.returncode == 0 and "j01: no run yet" in r.stdout and "outbox: 0" in r.stdout
 
