@@ -99,8 +99,9 @@ class SimulatingS3(S3Server):
         from monitor.simulate.case import simulate_case
 
         with self.lock:
-            if day in self.made:
-                return
+            cris = self.root / BUCKET / FOLDER["GCRSO"] / f"{day:%Y/%m/%d}"
+            if cris.is_dir() and any(cris.iterdir()):
+                return  # on disk (a day dropped from the three kept is simulated again: NODD keeps all)
             work = self.root / "work" / day.isoformat()
             start = dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc)
             simulate_case(
@@ -118,7 +119,7 @@ class SimulatingS3(S3Server):
                 d.mkdir(parents=True, exist_ok=True)
                 os.replace(f, d / f.name)
             shutil.rmtree(work)
-            self.made.append(day)
+            self.made = [d for d in self.made if d != day] + [day]
             for old in self.made[:-3]:  # the bucket holds three days: the disk stays bounded
                 for folder in FOLDER.values():
                     shutil.rmtree(self.root / BUCKET / folder / f"{old:%Y/%m/%d}", ignore_errors=True)
@@ -142,10 +143,16 @@ class Smtp:
         return "250 accepted"
 
 
-def proc_sample(pid: int) -> dict:
-    """RSS (MB), open files and threads of process *pid*."""
-    status = Path(f"/proc/{pid}/status").read_text()
-    rss_kb = int(re.search(r"VmRSS:\s+(\d+)", status)[1])
+def proc_sample(pid: int) -> dict | None:
+    """RSS (MB), open files and threads of process *pid*; None once it has ended."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return None
+    rss = re.search(r"VmRSS:\s+(\d+)", status)
+    if rss is None:  # exiting
+        return None
+    rss_kb = int(rss[1])
     return {
         "rss_mb": rss_kb / 1024,
         "open_files": len(os.listdir(f"/proc/{pid}/fd")),
@@ -302,7 +309,10 @@ def main(argv=None) -> int:
                 finished = [r for r in runs if r.finished]
                 current = dt.date.fromisoformat(runs[-1].day) if runs else first
                 ok_days = {r.day for r in runs if r.status == RunStatus.OK}
-                s = proc_sample(daemon.pid)
+                sample = proc_sample(daemon.pid)
+                if sample is None:
+                    break
+                s = sample
                 s.update(t_s=round(time.monotonic() - t0), runs=len(finished), ok_days=len(ok_days))
                 s["store_mb"] = state.stat().st_size / 1e6
                 samples.append(s)
