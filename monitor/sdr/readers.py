@@ -402,14 +402,12 @@ def _check_physics(path, product: Product, granule) -> None:
 
 
 def _check_times(path, product: Product, granule) -> None:
-    """Observation times increase and lie within the granule (10 s of margin: the IDPS granule bounds
-    are nominal)."""
+    """CrIS FOR times increase and lie within the granule (10 s of margin: the IDPS granule bounds are
+    nominal); the per-scan times of both GEO products are checked with the physics
+    (:func:`monitor.sdr.consistency.check_scan_times`)."""
     t = getattr(granule, "for_time_us", None)
     name = f"{product.data_group}/FORTime"
-    if t is None:
-        t = getattr(granule, "start_time_us", None)
-        name = f"{product.data_group}/StartTime"
-    if t is None:  # SDR files: their times are their GEO's
+    if t is None:  # VIIRS GEO: per-scan times only; SDR files: their times are their GEO's
         return
     t = t.ravel()
     t = t[t > 0]
