@@ -41,7 +41,10 @@ def context(**fields) -> Iterator[None]:
 
 
 def stage(name: str) -> None:
-    """Name the stage of the satellite-day under way (inside :func:`context`, which ends it)."""
+    """Name the stage of the satellite-day under way; only inside :func:`context`, which ends it (outside
+    one the name would stay on every later line of the thread)."""
+    if _context.get() is None:
+        raise RuntimeError("logs.stage outside logs.context")
     _context.set({**_fields(), "stage": name})
 
 

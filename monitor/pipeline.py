@@ -209,7 +209,13 @@ def compute_day(
     cfg, source: Source, satellite: str, day: dt.date, should_stop=None, progress=None
 ) -> DayWork:
     """List, fingerprint, select, fetch and assess one satellite-day, touching no store. Never raises for
-    a problem of the day's data or source: it becomes the work's status and reason."""
+    a problem of the day's data or source: it becomes the work's status and reason. Its log lines carry
+    the satellite, day and stage (and only its own: the context ends with it)."""
+    with logs.context(satellite=satellite, day=day.isoformat()):
+        return _compute_day(cfg, source, satellite, day, should_stop, progress)
+
+
+def _compute_day(cfg, source: Source, satellite: str, day: dt.date, should_stop, progress) -> DayWork:
     stop = should_stop or (lambda: False)
     w = DayWork(satellite, day, RunStatus.OK)
     w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}
@@ -323,5 +329,5 @@ def run_day(
     run_id = store.begin_run(satellite, day)
     with logs.context(satellite=satellite, day=day.isoformat(), run_id=run_id):
         work = compute_day(cfg, source, satellite, day, should_stop, progress)
-        logs.stage("record")
-        return record_day(cfg, store, run_id, work)
+        with logs.context(stage="record"):
+            return record_day(cfg, store, run_id, work)

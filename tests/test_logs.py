@@ -100,3 +100,22 @@ def test_the_daemon_under_systemd_marks_a_failed_run_as_an_error_and_does_not_fl
     assert failed and all(line.startswith("<3>ERROR") for line in failed), lines
     assert all(line.startswith("<") for line in lines if line.strip()), lines
     assert not [line for line in lines if line.startswith("<6>") and "apscheduler" in line], lines
+
+
+def test_a_day_computed_alone_leaves_no_context_behind(tmp_path, captured):
+    """compute_day (as the reprocessing workers call it) names its stages in its own context only."""
+    from monitor.config import load_config
+    from monitor.pipeline import compute_day
+    from monitor.sources.local import LocalSource
+
+    out = captured("json")
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 's'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+    )
+    import datetime as dt
+
+    work = compute_day(load_config(cfg), LocalSource(tmp_path), "j01", dt.date(2024, 6, 1))
+    assert work.status == "no_data"
+    logging.getLogger("monitor.pipeline").info("after")
+    assert "stage" not in json.loads(out.getvalue().splitlines()[-1])
