@@ -21,11 +21,12 @@ import os
 import signal
 import socket
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 from monitor import allocator, logs
 from monitor.health import Health
-from monitor.pipeline import days_to_run, run_day
+from monitor.pipeline import RunOutcome, days_to_run, run_day
 from monitor.sources import make_source
 from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
@@ -121,22 +122,24 @@ class Service:
 
     def run(self, satellite: str, day: dt.date):
         """Run one satellite-day (health-tracked), then evaluate the alerts and regenerate the report."""
-        with self.store() as store, logs.context(satellite=satellite, day=day.isoformat()):
-            LOG.info("run %s %s", satellite, day)
-            sd_notify(f"STATUS=assessing {satellite} {day}")
-            with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
-                try:
+        try:
+            with self.store() as store, logs.context(satellite=satellite, day=day.isoformat()):
+                LOG.info("run %s %s", satellite, day)
+                sd_notify(f"STATUS=assessing {satellite} {day}")
+                with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
                     out = run_day(
                         self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress
                     )
-                finally:
-                    allocator.release_freed_memory()
-            level = {RunStatus.FAILED: logging.ERROR, RunStatus.INTERRUPTED: logging.WARNING}
-            LOG.log(level.get(out.status, logging.INFO), "%s", out.summary())
-            if self.metrics is not None:
-                self.metrics.record(out)
-            self._after_run(store, out)
-            return out
+                level = {RunStatus.FAILED: logging.ERROR, RunStatus.INTERRUPTED: logging.WARNING}
+                LOG.log(level.get(out.status, logging.INFO), "%s", out.summary())
+                if self.metrics is not None:
+                    self.metrics.record(out)
+                self._after_run(store, out)
+                return out
+        finally:
+            # after the report and the alerts too: what they freed (their share grows with the history
+            # they plot) would otherwise stay with the daemon until the next day
+            allocator.release_freed_memory()
 
     def _after_run(self, store, outcome):
         """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the
@@ -172,8 +175,9 @@ class Service:
             if queued or counts["sent"] or counts["failed"]:
                 LOG.info("alerts: %s", fmt_counts({"queued": len(queued), **counts}))
         finally:
-            if own:
+            if own:  # the hourly timer: hand back what the evaluation freed
                 store.close()
+                allocator.release_freed_memory()
 
     def drain_outbox(self) -> dict:
         """Send the time-series points waiting in the outbox (after an outage they need not wait for the
@@ -198,32 +202,32 @@ class Service:
         for sig in (signal.SIGTERM, signal.SIGINT):
             signal.signal(sig, self._on_signal)
 
-    def catch_up(self, satellite: str, today: dt.date | None = None) -> list:
-        """Run the days of the catch-up window that have no completed run, oldest first."""
+    def catch_up(self, satellite: str, today: dt.date | None = None) -> Iterator[RunOutcome]:
+        """Run the days of the catch-up window that have no completed run, oldest first, yielding each
+        outcome as its day ends (the daemon keeps none: a 90-day catch-up holds no 90 results)."""
         today = today or dt.datetime.now(UTC).date()
         with self.store() as store:
             sch = self.cfg.schedule
             days = days_to_run(
                 store, satellite, today, sch.catch_up_days, sch.lag_days, sch.no_data_retry_days
             )
-        outcomes = []
         for day in days:
             if self.stop_event.is_set():
                 break
-            outcomes.append(self.run(satellite, day))
-        return outcomes
+            yield self.run(satellite, day)
 
     def daily_job(self, satellite: str):
         """The scheduled job of *satellite*: the days of its catch-up window."""
-        self.catch_up(satellite)
+        for _ in self.catch_up(satellite):
+            pass
 
-    def run_once(self, satellites, day: dt.date | None = None) -> list:
+    def run_once(self, satellites, day: dt.date | None = None) -> list[RunOutcome]:
         """``crisgeo run``: under the instance lock, recover what a killed process left, then per satellite
         the given *day* or the days of the catch-up window; the outcomes. :class:`AlreadyRunning` when the
         daemon (or another run) holds the state directory."""
         with InstanceLock(self.cfg.state_dir):
             self.recover()
-            outcomes = []
+            outcomes: list[RunOutcome] = []
             for sat in satellites:
                 if self.stop_event.is_set():
                     break

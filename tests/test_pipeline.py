@@ -150,7 +150,7 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
         return real(case, *args, **kw)
 
     monkeypatch.setattr(pipeline, "assess_plan", poison)
-    outcomes = Service(cfg).catch_up("j01", today=DAY + dt.timedelta(days=2))
+    outcomes = list(Service(cfg).catch_up("j01", today=DAY + dt.timedelta(days=2)))
     assert [(o.day, o.status) for o in outcomes][-2:] == [(DAY, "failed"), (DAY + dt.timedelta(days=1), "ok")]
     assert outcomes[-2].reason == "unexpected RuntimeError: poison granule"
     store = Store(cfg.store.sqlite)
