@@ -56,18 +56,18 @@ def alertmanager_alerts(store, settings, now: dt.datetime) -> list[dict]:
         if a.grp:
             labels["group"] = a.grp
         annotations = {"summary": a.summary or a.rule, "description": "\n".join(a.lines or [])}
-        if settings.report_url:
-            annotations["report"] = f"{settings.report_url.rstrip('/')}/{a.satellite}/"
-        if settings.dashboard_url:
-            annotations["dashboard"] = settings.dashboard_url
+        if settings.links.report_url:
+            annotations["report"] = f"{settings.links.report_url.rstrip('/')}/{a.satellite}/"
+        if settings.links.dashboard_url:
+            annotations["dashboard"] = settings.links.dashboard_url
         alert = {
             "labels": labels,
             "annotations": annotations,
             "startsAt": _iso(dt.datetime.fromisoformat(a.started) if a.started else now),
             "endsAt": _iso(ends),
         }
-        if settings.dashboard_url:
-            alert["generatorURL"] = settings.dashboard_url
+        if settings.links.dashboard_url:
+            alert["generatorURL"] = settings.links.dashboard_url
         out.append(alert)
     return out
 

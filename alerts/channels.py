@@ -18,7 +18,7 @@ from pathlib import Path
 
 import requests
 
-from alerts.settings import secret
+from monitor.config import env_secret
 
 LOG = logging.getLogger(__name__)
 
@@ -74,11 +74,13 @@ class EmailChannel:
             p = Path(path)
             if p.is_file():
                 m.add_attachment(p.read_bytes(), maintype="image", subtype="png", filename=p.name)
-        user, password = secret(s.username_env), secret(s.password_env)
+        user, password = env_secret(s.username_env), env_secret(s.password_env)
         try:
             with smtplib.SMTP(s.host, s.port, timeout=s.timeout_s) as smtp:
                 if s.starttls:
-                    smtp.starttls(context=ssl.create_default_context(cafile=s.cafile))
+                    smtp.starttls(
+                        context=ssl.create_default_context(cafile=str(s.cafile) if s.cafile else None)
+                    )
                 if user:
                     smtp.login(user, password or "")
                 smtp.send_message(m)
@@ -106,7 +108,7 @@ class SlackChannel:
 
     def send(self, msg):
         """Post *message* to the webhook; raises on failure (the queue retries)."""
-        url = secret(self.s.webhook_env)
+        url = env_secret(self.s.webhook_env)
         if not url:
             raise Permanent(f"Slack webhook: environment variable {self.s.webhook_env} is not set")
         payload = {

@@ -31,7 +31,7 @@ UTC = dt.timezone.utc
 
 def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
     """Every rule's findings for *satellite* at *now*."""
-    s = settings.rules
+    s = settings
     out = [
         f
         for f in (
@@ -87,21 +87,23 @@ def build_message(store, satellite: str, items: list, settings) -> dict:
     if trend:
         text += ["trend (last days):"] + [f"  {t}" for t in trend]
     where = []
-    if settings.report_url:
-        where.append(f"report: {settings.report_url.rstrip('/')}/{satellite}/")
-    elif settings.report_dir:
+    if settings.links.report_url:
+        where.append(f"report: {settings.links.report_url.rstrip('/')}/{satellite}/")
+    elif settings.links.report_dir:
         where.append(
-            f"report: {settings.report_dir / satellite / 'index.html'} (on the server; set report_url)"
+            f"report: {settings.links.report_dir / satellite / 'index.html'} (on the server; set report_url)"
         )
-    if settings.dashboard_url:
-        where.append(f"dashboard: {settings.dashboard_url}")
+    if settings.links.dashboard_url:
+        where.append(f"dashboard: {settings.links.dashboard_url}")
     text += where
     if trend or where:
         blocks.append(_slack_escape("\n".join(["trend:"] + trend + where)))
     body = "\n".join(text)
     # the report is regenerated between evaluation and delivery; the e-mail attaches the plot if it exists
     # then
-    attachments = [str(settings.report_dir / satellite / "trend.png")] if settings.report_dir else []
+    attachments = (
+        [str(settings.links.report_dir / satellite / "trend.png")] if settings.links.report_dir else []
+    )
     return {
         "subject": subject,
         "text": body,
@@ -119,7 +121,7 @@ def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> lis
     """Update alert state from the rules and queue the messages; returns [(satellite, message)] queued."""
     now = now or dt.datetime.now(UTC)
     state = AlertState(store)
-    repeat = dt.timedelta(hours=settings.rules.repeat_hours)
+    repeat = dt.timedelta(hours=settings.repeat_hours)
     queued = []
     for sat in satellites:
         found = findings_for(store, sat, settings, now)

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from alerts.changes import preceding_change
-from monitor.constants import N_FOR, SPEC_KM
+from monitor.config import RuleSettings
+from monitor.constants import N_FOR
 from monitor.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 
 UTC = dt.timezone.utc
@@ -24,26 +25,6 @@ GROUPS = {
     "FOR 21-30": range(20, N_FOR),
     "all FORs": range(N_FOR),
 }
-
-
-@dataclass
-class RuleSettings:
-    """The rule parameters (docs/configuration.md, alerts.*)."""
-
-    spec_km: float = SPEC_KM
-    min_jump_km: float = 0.25
-    jump_z: float = 5.0  # blind search, any day of the recent window
-    jump_z_at_change: float = 3.5  # at the date of a known change
-    pre_days: int = 21
-    min_pre_days: int = 7
-    min_post_days: int = 2
-    post_days: int = 14
-    blind_window_days: int = 7
-    change_window_days: int = 30
-    attribution_days: int = 10
-    active_days: int = 14
-    stale_hours: float = 36.0
-    repeat_hours: float = 24.0
 
 
 @dataclass

@@ -23,7 +23,8 @@ import sys
 import numpy as np
 
 from alerts.changes import Change, preceding_change
-from alerts.rules import COMPONENTS, RuleSettings, detect_jumps
+from alerts.rules import COMPONENTS, detect_jumps
+from monitor.config import RuleSettings
 from monitor.simulate.profiles import paper_profile
 
 START = dt.date(2023, 1, 1)

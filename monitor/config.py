@@ -1,28 +1,46 @@
-"""The service configuration: one YAML file, validated on load; secrets only from the environment.
+"""The service configuration, declared once: one model per section, alerts included.
 
-Every error names the key and the problem (``ConfigError: store.publish[0].url: missing``). Keys whose
-value is a secret end in ``_env`` and hold the *name* of an environment variable, never the secret.
+Each key is a typed field with its default, its range (``ge``/``le``, in the unit its name ends in) and its
+meaning (the field's description). The same model validates a file (:func:`load_config`), prints one
+(:func:`effective`, ``crisgeo check-config``), writes the reference (``docs/configuration.md``,
+:mod:`monitor.config_reference`) and the JSON Schema editors validate YAML with (:func:`json_schema`).
+Adding a key is adding a field.
+
+Every error names the key and the problem in one line (``ConfigError: store.publish[0].url: missing``).
+Keys whose value is a secret end in ``_env`` and hold the *name* of an environment variable, never the
+secret. Relative paths are relative to the file.
 """
 
 from __future__ import annotations
 
 import datetime as dt
-import math
+import json
 import os
 import re
-from dataclasses import dataclass, field
+from enum import StrEnum
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Annotated, Any
 from urllib.parse import urlsplit, urlunsplit
 
 import yaml
 import yaml.events
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    PlainSerializer,
+    PrivateAttr,
+    ValidationError,
+    ValidationInfo,
+    WithJsonSchema,
+    model_validator,
+)
 
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, MAX_GRID_SPREAD_RAD, URAD
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, MAX_GRID_SPREAD_RAD, SPEC_KM, URAD
 from monitor.satellites import SATELLITES
-
-if TYPE_CHECKING:
-    from alerts.settings import AlertSettings
+from monitor.vocabulary import Kernel, PublishKind, SourceKind
 
 NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
 
@@ -31,134 +49,572 @@ class ConfigError(ValueError):
     """A configuration problem, naming the key."""
 
 
-@dataclass
-class SourceConfig:
-    """The ``source`` section (docs/configuration.md)."""
+class KeyProblem(ValueError):
+    """Raised by a section's own checks: the problem of *key* (relative to the section)."""
 
-    kind: str  # simulated | local | nodd
-    path: Path | None = None
-    endpoint: str = "https://{bucket}.s3.amazonaws.com"
-    buckets: dict = field(default_factory=lambda: dict(NODD_BUCKETS))
-    timeout_s: float = 60.0
-    retries: int = 5
-    backoff_s: float = 1.5
-    daily_budget_mb: float = 6000.0
-    retention_days: int = 7
-    cache_max_mb: float = 20000.0  # the download cache is cut to this before every run (LRU)
-    run_deadline_min: float = 180.0  # every request of one satellite-day's run ends by then
-    max_list_pages: int = 100  # per listing (a day of one product is ~3 pages of 1000 keys)
-    max_listed_keys: int = 20000
-    max_retry_after_s: float = 120.0  # a server asking to wait longer ends the attempt
-    min_rate_kb_s: float = 50.0  # a download slower than this over any stall window is cut
-    stall_window_s: float = 30.0
-    granules: int = 4
-    profile: str = "paper"
-    seed: int = 0
+    def __init__(self, key: str, problem: str):
+        super().__init__(problem)
+        self.key = key
 
 
-@dataclass
-class ScheduleConfig:
-    """The ``schedule`` section."""
-
-    time_utc: dt.time = dt.time(3, 30)
-    catch_up_days: int = 7
-    misfire_grace_hours: float = 6.0
-    lag_days: int = 1  # assess the day that ended this many days ago
-    no_data_retry_days: int = 3  # a day found empty is tried again this many days, then recorded as final
-    run_budget_min: float = 240.0  # a satellite-day run longer than this makes the daemon unhealthy
+# -- value types: what a key may hold, checked where it is read
 
 
-@dataclass
-class SceneConfig:
-    """The ``scenes`` section."""
-
-    candidates: int = 40
-    keep: int = 14
-    min_inhomogeneity_k: float = 0.5
+def _no_nul(text: str) -> str:
+    if "\x00" in text:
+        raise ValueError("contains a NUL character")
+    return text
 
 
-@dataclass
-class FingerprintConfig:
-    """The ``fingerprint`` section."""
-
-    granules: int = 100  # GEO granules per day, spread over the day
-    threshold_urad: float = 10.0
-    ep_library: tuple = ()  # EP files/directories to identify the EP from; empty: the packaged real EPs
-
-
-@dataclass
-class AssessmentConfig:
-    """The ``assessment`` section."""
-
-    half_steps: int = DEFAULT_HALF_STEPS
-    step_urad: float = DEFAULT_STEP_URAD
-    kernel: str = "top-hat"
-    workers: int = 2
+def _path(value: Any, info: ValidationInfo) -> Path:
+    """A path from the file: ``~`` and ``$VARS`` expanded, relative to the file's folder."""
+    if not isinstance(value, str):
+        raise ValueError(f"expected a path, got {type(value).__name__} {str(value)[:60]!r}")
+    _no_nul(value)
+    p = Path(os.path.expandvars(value)).expanduser()
+    base = (info.context or {}).get("base")
+    return p if p.is_absolute() or base is None else base / p
 
 
-@dataclass
-class PublishConfig:
-    """One entry of ``store.publish``."""
-
-    kind: str  # influx2 | influx1
-    url: str
-    measurement: str = "cris_geolocation"
-    bucket: str = "crisgeo"
-    org: str = "-"
-    token_env: str | None = None
-    database: str = "crisgeo"
-    username_env: str | None = None
-    password_env: str | None = None
-    timeout_s: float = 30.0
-
-    def secret(self, key: str) -> str | None:
-        """The value of the environment variable named by *key* (e.g. token_env), or None."""
-        name = getattr(self, key)
-        return os.environ.get(name) if name else None
+def _url(value: str) -> str:
+    """An http(s) URL without credentials in it (secrets come from *_env variables)."""
+    try:
+        parts = urlsplit(value)
+    except ValueError:
+        raise ValueError(f"{value!r} is not a URL") from None
+    if parts.scheme not in ("http", "https") or not parts.netloc:
+        raise ValueError(f"{redact_url(value)!r} is not an http(s) URL")
+    if parts.username or parts.password or "@" in parts.netloc:
+        raise ValueError(
+            "credentials may not be written in a URL; name environment variables with the *_env keys"
+        )
+    return value.rstrip("/")
 
 
-@dataclass
-class HttpConfig:
-    """The ``http`` section."""
+ENV_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}", re.ASCII)
 
-    listen: str = (
-        "127.0.0.1:9782"  # HOST:PORT of /metrics, /healthz, /report/ ("off": none; port 0: any free)
+
+def _env_name(value: str) -> str:
+    if not ENV_NAME.fullmatch(value):
+        raise ValueError("a value is not the name of an environment variable")
+    return value
+
+
+def _hhmm(value: Any) -> dt.time:
+    m = re.fullmatch(r"(\d{1,2}):(\d{2})", value, re.ASCII) if isinstance(value, str) else None
+    if not m or int(m[1]) > 23 or int(m[2]) > 59:
+        raise ValueError(f"{value!r} is not HH:MM")
+    return dt.time(int(m[1]), int(m[2]))
+
+
+def _address(value: str) -> str:
+    if "@" not in value:
+        raise ValueError(f"{value!r} is not an address")
+    return value
+
+
+Text = Annotated[str, AfterValidator(_no_nul)]
+FilePath = Annotated[Path, BeforeValidator(_path), WithJsonSchema({"type": "string"})]
+Url = Annotated[
+    str, AfterValidator(_no_nul), AfterValidator(_url), WithJsonSchema({"type": "string", "format": "uri"})
+]
+EnvName = Annotated[
+    str, AfterValidator(_env_name), WithJsonSchema({"type": "string", "pattern": ENV_NAME.pattern})
+]
+Address = Annotated[str, AfterValidator(_no_nul), AfterValidator(_address)]
+TimeOfDay = Annotated[
+    dt.time,
+    BeforeValidator(_hhmm),
+    PlainSerializer(lambda t: t.strftime("%H:%M"), return_type=str),
+    WithJsonSchema({"type": "string", "pattern": r"^\d{1,2}:\d{2}$"}),
+]
+
+
+def key(default: Any, meaning: str, lo: float | None = None, hi: float | None = None, **kw: Any) -> Any:
+    """A configuration key: its default (``...``: required; a section class: that section's defaults), its
+    meaning, its accepted range lo..hi (inclusive, in the unit its name ends in)."""
+    if isinstance(default, type):
+        return Field(default_factory=default, description=meaning, **kw)
+    if isinstance(default, StrEnum):
+        kw.setdefault("strict", False)  # the file holds the member's string
+    return Field(default, description=meaning, ge=lo, le=hi, **kw)
+
+
+class Section(BaseModel):
+    """A section of the file: known keys only, exact types (no '5' for 5, no true for 1), finite numbers."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, validate_assignment=False)
+
+
+def parse_listen(text: str) -> tuple[str, int]:
+    """``HOST:PORT`` (``[::1]:PORT`` for IPv6) as (host, port); ValueError naming the value otherwise."""
+    host, sep, port = str(text).rpartition(":")
+    host = host[1:-1] if host.startswith("[") and host.endswith("]") else host
+    if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
+        raise ValueError(f"{text!r} is not HOST:PORT")
+    return host, int(port)
+
+
+def check_listen(text: str) -> str:
+    """``off`` or ``HOST:PORT`` (the daemon's HTTP endpoint)."""
+    if text != "off":
+        try:
+            parse_listen(text)
+        except ValueError as exc:
+            raise ValueError(f"{exc} (or off)") from None
+    return text
+
+
+BUCKET = re.compile(r"[a-z0-9][a-z0-9.-]{1,61}[a-z0-9]", re.ASCII)
+
+
+def _buckets(value: Any) -> Any:
+    """The published bucket of every satellite, those given replacing theirs."""
+    return {**NODD_BUCKETS, **value} if isinstance(value, dict) else value
+
+
+class SourceConfig(Section):
+    """The ``source`` section: where granules come from, and the bounds of every request to NODD."""
+
+    kind: SourceKind = key(
+        ...,
+        strict=False,
+        meaning="Where granules come from: nodd (NOAA's archive on S3), local (a directory tree) "
+        "or simulated (the offline demo).",
+    )
+    path: FilePath | None = key(
+        None, "Root of the local tree (kind local); every *.h5 below it is considered."
+    )
+    endpoint: Url = key(
+        "https://{bucket}.s3.amazonaws.com",
+        "NODD URL template; {bucket} is replaced by the satellite's bucket.",
+    )
+    buckets: Annotated[dict[str, Text], BeforeValidator(_buckets)] = key(
+        dict(NODD_BUCKETS), "NODD bucket per satellite (mapping); keys not given keep the published buckets."
+    )
+    timeout_s: float = key(
+        60.0,
+        "Wall-clock bound of a listing page (body included) and of the headers of any "
+        "answer; also the socket timeout.",
+        0.1,
+        3600,
+    )
+    retries: int = key(5, "Retries of a failed request (backoff doubling from backoff_s).", 0, 20)
+    backoff_s: float = key(1.5, "First wait between retries.", 0.01, 600)
+    daily_budget_mb: float = key(
+        6000.0,
+        "Most bytes downloaded in one satellite-day run; further files are skipped with the reason.",
+        1,
+        1e6,
+    )
+    retention_days: int = key(
+        7,
+        "Downloaded files older than this are removed from the cache at the start of a "
+        "run (kind simulated: this many simulated days are kept).",
+        0,
+        3650,
+    )
+    cache_max_mb: float = key(
+        20000.0,
+        "Before every run the least recently used downloads go until the cache "
+        "holds at most this (a run adds at most daily_budget_mb).",
+        0,
+        1e8,
+    )
+    run_deadline_min: float = key(
+        180.0, "Every request of one satellite-day run ends by this time after the run started.", 1, 1440
+    )
+    max_list_pages: int = key(
+        100, "Most pages of one listing (a day of one product is ~3 pages of 1000 keys).", 1, 10000
+    )
+    max_listed_keys: int = key(20000, "Most keys of one listing.", 1, 10**6)
+    max_retry_after_s: float = key(
+        120.0, "A server asking to wait longer than this (Retry-After) ends the attempt.", 1, 3600
+    )
+    min_rate_kb_s: float = key(
+        50.0, "A download that brings less than this over any stall_window_s is cut (and retried).", 1, 1e6
+    )
+    stall_window_s: float = key(
+        30.0,
+        "The sliding window over which a download must keep up min_rate_kb_s; a "
+        "silence this long cuts it too.",
+        1,
+        3600,
+    )
+    granules: int = key(4, "Consecutive CrIS granules simulated per satellite-day (kind simulated).", 1, 100)
+    profile: Text = key(
+        "paper", "Error profile injected by the simulator (paper, random, zero or a file; kind simulated)."
+    )
+    seed: int = key(0, "Seed of the simulator (kind simulated).", 0, 2**31 - 1)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> SourceConfig:
+        if "{bucket}" not in self.endpoint:
+            raise KeyProblem("endpoint", f"{self.endpoint!r} has no {{bucket}} placeholder")
+        for sat, bucket in self.buckets.items():
+            if sat not in SATELLITES:
+                raise KeyProblem(f"buckets.{sat}", f"not one of {', '.join(SATELLITES)}")
+            if not BUCKET.fullmatch(bucket):
+                raise KeyProblem(f"buckets.{sat}", f"{bucket!r} is not a bucket name")
+        if self.kind == SourceKind.LOCAL:
+            if self.path is None:
+                raise KeyProblem("path", "missing")
+            if not self.path.is_dir():
+                raise KeyProblem("path", f"{self.path} is not a directory")
+        return self
+
+
+class ScheduleConfig(Section):
+    """The ``schedule`` section: when the daemon runs and which days it (re)assesses."""
+
+    time_utc: TimeOfDay = key(dt.time(3, 30), "Time of the daily run, HH:MM UTC.")
+    catch_up_days: int = key(
+        7, "Days back (ending lag_days ago) that are assessed when they have no completed run.", 1, 366
+    )
+    misfire_grace_hours: float = key(
+        6.0, "A daily run missed by less than this (e.g. host asleep) still runs.", 0.01, 72
+    )
+    lag_days: int = key(
+        1, "The daily run assesses the day that ended this many days ago (archive latency).", 0, 30
+    )
+    no_data_retry_days: int = key(
+        3,
+        "A day found empty is tried again for this many days after it is due, then "
+        "recorded as no_data_final.",
+        0,
+        366,
+    )
+    run_budget_min: float = key(
+        240.0,
+        "A satellite-day run longer than this makes /healthz unhealthy and stops "
+        "feeding the systemd watchdog (a restart follows). Keep it above "
+        "source.run_deadline_min.",
+        0.01,
+        10080,
     )
 
 
-@dataclass
-class StoreConfig:
+class SceneConfig(Section):
+    """The ``scenes`` section: which CrIS granules of a day are assessed."""
+
+    candidates: int = key(
+        40, "CrIS granules of the day scored for inhomogeneity (spread over the day).", 1, 1000
+    )
+    keep: int = key(14, "Most inhomogeneous granules assessed (the paper uses 14).", 1, 200)
+    min_inhomogeneity_k: float = key(0.5, "A granule whose VIIRS-BT spread is below this is not used.", 0, 50)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> SceneConfig:
+        if self.keep > self.candidates:
+            raise KeyProblem("keep", f"{self.keep} is more than scenes.candidates ({self.candidates})")
+        return self
+
+
+class AssessmentConfig(Section):
+    """The ``assessment`` section: the perturbation grid and the collocation."""
+
+    half_steps: int = key(
+        DEFAULT_HALF_STEPS,
+        "Perturbations on each side of zero per direction: the grid is (2n+1)^2 (21 x 21).",
+        1,
+        40,
+    )
+    step_urad: float = key(
+        DEFAULT_STEP_URAD,
+        "Perturbation step (375 m at nadir from 833 km); half_steps^2 x step_urad <= 200000.",
+        10,
+        5000,
+    )
+    kernel: Kernel = key(
+        Kernel.TOP_HAT, "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response)."
+    )
+    workers: int = key(2, "Threads of the compiled VIIRS preparation and collocation kernels.", 1, 64)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> AssessmentConfig:
+        spread = self.half_steps**2 * self.step_urad * URAD
+        if spread > MAX_GRID_SPREAD_RAD:
+            raise KeyProblem(
+                "half_steps",
+                f"{self.half_steps} with step_urad {self.step_urad:g}: half_steps^2 x step_urad = "
+                f"{spread / URAD:.0f} urad is more than {MAX_GRID_SPREAD_RAD / URAD:.0f} (the widest grid of "
+                "the compiled collocation)",
+            )
+        return self
+
+
+def _paths(value: Any) -> Any:
+    """One path or a list of paths."""
+    if isinstance(value, str):
+        return (value,)
+    if not isinstance(value, list):
+        raise ValueError(f"expected a list of paths, got {value!r}")
+    return tuple(value)
+
+
+class FingerprintConfig(Section):
+    """The ``fingerprint`` section: the LOS fingerprint of the GEO files and the EP it points to."""
+
+    granules: int = key(
+        100, "GEO granules per day sampled (spread over the day) for the LOS fingerprint.", 1, 2000
+    )
+    threshold_urad: float = key(
+        10.0, "A FOR whose fingerprint angle moves more than this is a processing change.", 0.1, 10000
+    )
+    ep_library: Annotated[tuple[FilePath, ...], BeforeValidator(_paths)] = key(
+        (), "EP files or directories to identify the EP in use from; empty: the packaged real EPs."
+    )
+
+
+class HttpConfig(Section):
+    """The ``http`` section."""
+
+    listen: Annotated[Text, AfterValidator(check_listen)] = key(
+        "127.0.0.1:9782",
+        "HOST:PORT of /metrics, /healthz and /report/ (loopback by default; port 0: any free "
+        "port; off: no endpoint). crisgeo daemon --listen overrides it.",
+    )
+
+
+class PublishConfig(Section):
+    """One entry of ``store.publish``: a time-series database the results are written to."""
+
+    kind: PublishKind = key(
+        ...,
+        strict=False,
+        meaning="influx2 (InfluxDB 2 API: token) or influx1 (InfluxDB 1 / VictoriaMetrics: user, password).",
+    )
+    url: Url = key(..., "Base URL of the database (no credentials in it).")
+    measurement: Text = key("cris_geolocation", "Measurement name of the points.")
+    bucket: Text = key("crisgeo", "Bucket (influx2).")
+    org: Text = key("-", "Organisation (influx2).")
+    token_env: EnvName | None = key(None, "Environment variable holding the token (influx2).")
+    database: Text = key("crisgeo", "Database (influx1).")
+    username_env: EnvName | None = key(None, "Environment variable holding the user name (influx1).")
+    password_env: EnvName | None = key(None, "Environment variable holding the password (influx1).")
+    timeout_s: float = key(30.0, "Timeout of one write.", 0.1, 600)
+
+    def secret(self, name: str) -> str | None:
+        """The value of the environment variable named by the key *name* (e.g. token_env), or None."""
+        return env_secret(getattr(self, name))
+
+
+class StoreConfig(Section):
     """The ``store`` section."""
 
-    sqlite: Path
-    publish: list = field(default_factory=list)
-    drain_minutes: float = 10.0  # the daemon sends what waits in the outbox this often, between daily runs
+    sqlite: FilePath | None = key(
+        None, "The SQLite store (history, alert state, outbox). Default: state_dir/crisgeo.sqlite."
+    )
+    publish: list[PublishConfig] = key(
+        [], "Time-series databases the results are written to (list of the mappings below)."
+    )
+    drain_minutes: float = key(
+        10.0, "The daemon sends the time-series points waiting in the outbox this often.", 0.01, 1440
+    )
+
+    @property
+    def path(self) -> Path:
+        """The store's file (filled in by :class:`Config`)."""
+        assert self.sqlite is not None, "store.sqlite is filled in when the configuration is loaded"
+        return self.sqlite
 
 
-@dataclass
-class Config:
-    """The whole configuration, validated; ``alert_settings`` is its alerts section parsed."""
+class RuleSettings(Section):
+    """The alert rules' parameters: the top-level keys of the ``alerts`` section."""
 
-    path: Path
-    satellites: list
-    state_dir: Path
-    source: SourceConfig
-    schedule: ScheduleConfig
-    scenes: SceneConfig
-    assessment: AssessmentConfig
-    store: StoreConfig
-    alerts: dict = field(default_factory=dict)
-    fingerprint: FingerprintConfig = field(default_factory=FingerprintConfig)
-    http: HttpConfig = field(default_factory=HttpConfig)
+    spec_km: float = key(
+        SPEC_KM,
+        "Specification of the geolocation error on the ground; a reliable FOR beyond it "
+        "fires the spec rule (critical when value - 2 sigma is beyond it).",
+        0.01,
+        100.0,
+    )
+    min_jump_km: float = key(
+        0.25, "Smallest step (median after minus median before) that counts as a jump.", 0.001, 100.0
+    )
+    jump_z: float = key(
+        5.0,
+        "Step size in units of its standard error that counts as a jump, on any day of the "
+        "recent window (blind search).",
+        1.0,
+        100.0,
+    )
+    jump_z_at_change: float = key(
+        3.5, "The same at the date of a known change (events calendar, fingerprint).", 1.0, 100.0
+    )
+    pre_days: int = key(21, "Days before a candidate step that form the reference.", 2, 365)
+    min_pre_days: int = key(7, "Fewest assessed days before a step for the test to run.", 2, 365)
+    min_post_days: int = key(2, "Fewest assessed days after a step for the test to run.", 1, 365)
+    post_days: int = key(14, "Days after a candidate step compared with the reference.", 1, 365)
+    blind_window_days: int = key(7, "Recent days tried as step dates without a known change.", 1, 365)
+    change_window_days: int = key(30, "Known changes this recent are tried as step dates.", 1, 3650)
+    attribution_days: int = key(
+        10, "A jump is attributed to a known change at most this many days before it.", 0, 365
+    )
+    active_days: int = key(14, "A jump or processing change older than this no longer fires.", 1, 3650)
+    stale_hours: float = key(36.0, "No completed run for this long fires the stale rule.", 1.0, 8760.0)
+    repeat_hours: float = key(24.0, "A firing alert is notified again after this long.", 0.1, 8760.0)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> RuleSettings:
+        if self.min_pre_days > self.pre_days:
+            raise KeyProblem(
+                "min_pre_days", f"{self.min_pre_days} is more than alerts.pre_days ({self.pre_days})"
+            )
+        return self
+
+
+class EmailSettings(Section):
+    """The ``alerts.email`` section."""
+
+    model_config = ConfigDict(populate_by_name=True, serialize_by_alias=True)
+
+    host: Text = key(..., "SMTP server.")
+    port: int = key(587, "SMTP port.", 1, 65535)
+    sender: Address = key("crisgeo@localhost", "Sender address.", alias="from")
+    to: Annotated[list[Address], Field(min_length=1)] = key(..., "Recipient addresses (list).")
+    starttls: bool = key(True, "Use STARTTLS (certificate verified against the system store, or cafile).")
+    username_env: EnvName | None = key(None, "Environment variable holding the SMTP user name.")
+    password_env: EnvName | None = key(None, "Environment variable holding the SMTP password.")
+    cafile: FilePath | None = key(None, "Extra CA bundle (e.g. a site CA) to verify the server with.")
+    timeout_s: float = key(30.0, "Timeout of one SMTP conversation.", 0.1, 600.0)
+
+
+class SlackSettings(Section):
+    """The ``alerts.slack`` section."""
+
+    webhook_env: EnvName = key(..., "Environment variable holding the incoming-webhook URL.")
+    retries: int = key(3, "Retries when Slack answers 429 or 5xx.", 0, 20)
+    max_wait_s: float = key(30.0, "Longest wait honoured from a Retry-After header.", 0.0, 3600.0)
+    timeout_s: float = key(15.0, "Timeout of one request.", 0.1, 600.0)
+
+
+class AlertmanagerSettings(Section):
+    """The ``alerts.alertmanager`` section: where the service posts its alerts (Alertmanager API v2)."""
+
+    url: Url = key(..., "Base URL of Alertmanager, e.g. http://127.0.0.1:9093.")
+    timeout_s: float = key(10.0, "Timeout of one post.", 0.1, 600.0)
+    validity_hours: float = key(
+        3.0,
+        "A firing alert is posted again at every evaluation (hourly, and after each "
+        "run) with this end; if the service stops posting, Alertmanager ends it then.",
+        1.5,
+        168.0,
+    )
+
+
+class Links(BaseModel):
+    """Where readers of a message find more: the top-level report_dir, report_url and dashboard_url."""
+
     report_dir: Path | None = None
     report_url: str | None = None
     dashboard_url: str | None = None
-    alert_settings: AlertSettings | None = None  # parsed and validated with the rest
+
+
+class AlertSettings(RuleSettings):
+    """The ``alerts`` section: the rule parameters, the channels and the events calendar."""
+
+    log: FilePath | None = key(None, "File the alert messages are appended to (a channel that cannot fail).")
+    events_file: FilePath | None = key(
+        None, "The events calendar (EP uploads, LUT changes) used to attribute jumps and annotate plots."
+    )
+    email: EmailSettings | None = key(None, "E-mail channel (mapping below); absent: none.")
+    slack: SlackSettings | None = key(None, "Slack channel (mapping below); absent: none.")
+    alertmanager: AlertmanagerSettings | None = key(
+        None,
+        "Alertmanager (mapping below): the alerts are posted to its API v2 with labels alertname, service, "
+        "satellite, rule, severity and resolved there, so that Alertmanager routes, groups and silences "
+        "them; absent: none.",
+    )
+    _links: Links = PrivateAttr(default_factory=Links)
+
+    @model_validator(mode="after")
+    def _calendar_exists(self) -> AlertSettings:
+        if self.events_file is not None and not self.events_file.is_file():
+            # read as empty, a missing calendar would lose jump attribution without a word
+            raise KeyProblem(
+                "events_file",
+                f"{self.events_file} does not exist (copy configs/events.yaml there, or remove the key)",
+            )
+        return self
+
+    def linked(self, links: Links) -> AlertSettings:
+        """These settings, pointing their messages at *links*."""
+        self._links = links
+        return self
+
+    @property
+    def links(self) -> Links:
+        """The report and dashboard the messages point to (the top-level keys)."""
+        return self._links
+
+    @property
+    def channels(self) -> list[str]:
+        """The names of the configured channels."""
+        return [n for n in ("log", "email", "slack") if getattr(self, n)]
+
+
+def _satellite(value: str) -> str:
+    if value not in SATELLITES:
+        raise ValueError(f"{value!r} is not one of {', '.join(SATELLITES)}")
+    return value
+
+
+class Config(Section):
+    """The whole configuration, validated."""
+
+    satellites: Annotated[list[Annotated[str, AfterValidator(_satellite)]], Field(min_length=1)] = key(
+        ..., "Satellites to monitor, short names (npp, j01, j02)."
+    )
+    state_dir: FilePath = key(
+        ...,
+        "Directory of the service's state: store, download cache, simulated granules, "
+        "lock. Relative paths in the file are relative to the file.",
+    )
+    source: SourceConfig = key(..., "Where granules come from (the keys below).")
+    schedule: ScheduleConfig = key(ScheduleConfig, "When the daemon runs (the keys below).")
+    scenes: SceneConfig = key(SceneConfig, "Which granules are assessed (the keys below).")
+    assessment: AssessmentConfig = key(
+        AssessmentConfig, "The perturbation grid and collocation (the keys below)."
+    )
+    fingerprint: FingerprintConfig = key(FingerprintConfig, "The LOS fingerprint (the keys below).")
+    http: HttpConfig = key(HttpConfig, "The daemon's HTTP endpoint (the key below).")
+    store: StoreConfig = key(StoreConfig, "Where results are kept and published (the keys below).")
+    alerts: AlertSettings = key(AlertSettings, "Alert rules and channels (the keys below).")
+    report_dir: FilePath | None = key(
+        None,
+        "Where the HTML report is regenerated after every run (and served under /report/). None: no report.",
+    )
+    report_url: Url | None = key(
+        None,
+        "The address at which readers open report_dir (e.g. behind a reverse "
+        "proxy); messages link REPORT_URL/SATELLITE/. Without it they name the path on "
+        "the server.",
+    )
+    dashboard_url: Url | None = key(None, "Link to the Grafana dashboard, added to every message.")
+    _file: Path | None = PrivateAttr(default=None)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Config:
+        if len(set(self.satellites)) != len(self.satellites):
+            raise KeyProblem("satellites", "a satellite is listed twice")
+        _check_creatable(self.state_dir, "state_dir")
+        if self.store.sqlite is None:
+            self.store.sqlite = self.state_dir / "crisgeo.sqlite"
+        self.alerts.linked(
+            Links(report_dir=self.report_dir, report_url=self.report_url, dashboard_url=self.dashboard_url)
+        )
+        return self
+
+    @property
+    def path(self) -> Path | None:
+        """The file the configuration was loaded from."""
+        return self._file
 
     @property
     def events_file(self) -> Path | None:
         """The events calendar (``alerts.events_file``): attribution of jumps, annotations, the report."""
-        return self.alert_settings.events_file if self.alert_settings else None
+        return self.alerts.events_file
 
     @property
     def cache_dir(self) -> Path:
@@ -166,49 +622,114 @@ class Config:
         return self.state_dir / "cache"
 
 
-TOP_KEYS = {
-    "satellites",
-    "state_dir",
-    "source",
-    "schedule",
-    "scenes",
-    "assessment",
-    "store",
-    "alerts",
-    "fingerprint",
-    "http",
-    "report_dir",
-    "report_url",
-    "dashboard_url",
-}
-SECTIONS = {
-    "source": SourceConfig,
-    "schedule": ScheduleConfig,
-    "scenes": SceneConfig,
-    "assessment": AssessmentConfig,
-    "fingerprint": FingerprintConfig,
-    "http": HttpConfig,
-}
-STORE_KEYS = {"sqlite", "publish", "drain_minutes"}
+# -- loading
 
 
-def _get(doc: dict, key: str, typ, where: str, default=None, required=False):
-    if key not in doc or doc[key] is None:
-        if required:
-            raise ConfigError(f"{where}{key}: missing")
-        return default
-    value = doc[key]
-    if typ is float and isinstance(value, int) and not isinstance(value, bool):
-        value = float(value)
-    if not isinstance(value, typ) or (typ in (int, float) and isinstance(value, bool)):
-        raise ConfigError(
-            f"{where}{key}: expected {typ.__name__}, got {type(value).__name__} {str(value)[:60]!r}"
-        )
-    if typ is float and not math.isfinite(value):
-        raise ConfigError(f"{where}{key}: {value} is not a finite number")
-    if typ is str and "\x00" in value:
-        raise ConfigError(f"{where}{key}: contains a NUL character")
-    return value
+def load_config(path: str | Path) -> Config:
+    """Load and validate the YAML configuration at *path*; relative paths are relative to the file. Any
+    problem is a :class:`ConfigError` naming the key, in one line."""
+    path = Path(path)
+    doc = read_yaml(path)
+    if not isinstance(doc, dict):
+        raise ConfigError(f"{path}: expected a mapping at the top level")
+    _check_secrets(doc)
+    try:
+        cfg = Config.model_validate(doc, context={"base": path.resolve().parent})
+    except ValidationError as exc:
+        raise ConfigError(_one_line(exc)) from None
+    cfg._file = path
+    return cfg
+
+
+def _one_line(exc: ValidationError) -> str:
+    """The first problem of a validation, as ``KEY: PROBLEM``."""
+    err = exc.errors(include_url=False)[0]
+    loc = list(err["loc"])
+    if err["type"] == "invalid_key":  # a key that is not a string (YAML reads 1: as an int)
+        loc[-1] = str(loc[-1])
+    problem = _problem(err, loc)
+    cause = (err.get("ctx") or {}).get("error")
+    if isinstance(cause, KeyProblem):
+        loc += cause.key.split(".")
+    return f"{_dotted(loc)}: {problem}" if loc else problem
+
+
+def _dotted(loc: list) -> str:
+    out = ""
+    for part in loc:
+        out += f"[{part}]" if isinstance(part, int) else f".{part}" if out else str(part)
+    return out
+
+
+_EXPECTED = {
+    "int_type": "int",
+    "float_type": "float",
+    "string_type": "str",
+    "bool_type": "bool",
+    "list_type": "list",
+    "tuple_type": "list",
+}
+
+
+def _problem(err: Any, loc: list) -> str:
+    kind, value = err["type"], err.get("input")
+    shown = f"{type(value).__name__} {str(value)[:60]!r}"
+    if kind == "missing":
+        return "missing"
+    if kind in ("extra_forbidden", "invalid_key"):
+        return f"unknown key (allowed: {', '.join(sorted(_model_at(loc[:-1]).model_fields))})"
+    if kind in _EXPECTED:
+        return f"expected {_EXPECTED[kind]}, got {shown}"
+    if kind in ("dict_type", "model_type", "model_attributes_type"):
+        return f"expected a mapping, got {shown}"
+    if kind in ("greater_than_equal", "less_than_equal"):
+        lo, hi = _bounds(loc)
+        return f"{value} is not within {lo if lo is None else f'{lo:g}'}..{hi if hi is None else f'{hi:g}'}"
+    if kind == "finite_number":
+        return f"{value} is not a finite number"
+    if kind == "too_short":
+        return "empty" if not value else f"needs at least {err['ctx']['min_length']}"
+    if kind == "enum":
+        return f"{value!r} is not one of {err['ctx']['expected'].replace(chr(39), '').replace(' or ', ', ')}"
+    if kind == "value_error":
+        return str(err["ctx"]["error"])
+    return str(err["msg"])
+
+
+def _model_at(loc: list) -> type[BaseModel]:
+    """The section model a location points into (list indices skipped)."""
+    model: type[BaseModel] = Config
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        field = next(f for n, f in model.model_fields.items() if part in (n, f.alias))
+        model = _section_type(field.annotation)
+    return model
+
+
+def _section_type(annotation: Any) -> type[BaseModel]:
+    """The section model in an annotation (``X``, ``X | None``, ``list[X]``)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in getattr(annotation, "__args__", ()):
+        try:
+            return _section_type(arg)
+        except TypeError:
+            continue
+    raise TypeError(f"no section in {annotation!r}")
+
+
+def _bounds(loc: list) -> tuple[float | None, float | None]:
+    """(lo, hi) of the key at *loc*."""
+    field = _model_at(loc[:-1]).model_fields[str(loc[-1])]
+    return key_range(field)
+
+
+def key_range(field: Any) -> tuple[float | None, float | None]:
+    """The range lo..hi declared for a key (``key(..., lo, hi)``)."""
+    lo = next((m.ge for m in field.metadata if getattr(m, "ge", None) is not None), None)
+    hi = next((m.le for m in field.metadata if getattr(m, "le", None) is not None), None)
+    return lo, hi
 
 
 def _check_creatable(path: Path, where: str) -> None:
@@ -218,11 +739,11 @@ def _check_creatable(path: Path, where: str) -> None:
     while not probe.exists() and probe != probe.parent:
         probe = probe.parent
     if probe == path and not path.is_dir():
-        raise ConfigError(f"{where}: {path} exists and is not a directory")
+        raise KeyProblem(where, f"{path} exists and is not a directory")
     if not probe.is_dir() or not os.access(probe, os.W_OK | os.X_OK):
-        raise ConfigError(f"{where}: {path} cannot be created ({probe} is not a writable directory)")
+        raise KeyProblem(where, f"{path} cannot be created ({probe} is not a writable directory)")
     if probe != path and os.statvfs(probe).f_blocks == 0:  # proc, sysfs and the like: no room for files
-        raise ConfigError(f"{where}: {path} cannot be created ({probe} is a virtual file system)")
+        raise KeyProblem(where, f"{path} cannot be created ({probe} is a virtual file system)")
 
 
 def make_state_dir(cfg: Config) -> None:
@@ -233,42 +754,12 @@ def make_state_dir(cfg: Config) -> None:
         raise ConfigError(f"state_dir: cannot create {cfg.state_dir} ({exc.strerror or exc})") from None
 
 
-def _within(value, lo, hi, where):
-    """*value* within lo..hi (inclusive), or a ConfigError naming the key."""
-    if not lo <= value <= hi:
-        raise ConfigError(f"{where}: {value} is not within {lo:g}..{hi:g}")
-    return value
-
-
-def _fill(obj, doc: dict, where: str, **types):
-    """Set each named field of the section dataclass *obj* from *doc*, checking its type; the default is
-    the dataclass's own (one default per key). Ranges are checked afterwards (:data:`LIMITS`)."""
-    for name, typ in types.items():
-        setattr(obj, name, _get(doc, name, typ, where, getattr(obj, name)))
-    return obj
-
-
-def _known(doc: dict, allowed: set, where: str):
-    unknown = sorted(str(k) for k in doc if k not in allowed)  # keys may be of any YAML type
-    if unknown:
-        raise ConfigError(f"{where}{unknown[0]}: unknown key (allowed: {', '.join(sorted(allowed))})")
-
-
-def _section(doc, key):
-    value = doc.get(key)
-    if value is None:
-        return {}
-    if not isinstance(value, dict):
-        raise ConfigError(f"{key}: expected a mapping, got {type(value).__name__} {str(value)[:60]!r}")
-    return value
-
-
 SECRET_WORDS = re.compile(r"(token|password|secret|webhook)$", re.I)
 
 
-def _check_secrets(doc, where=""):
-    """No secret written in the file (a key named like one), and every *_env value the name of an
-    environment variable (an identifier, not a secret pasted in)."""
+def _check_secrets(doc: Any, where: str = "") -> None:
+    """No secret written in the file: a key named like one (token, password, webhook) with a value is refused
+    before anything else, whatever section it is in."""
     if isinstance(doc, dict):
         for k, v in doc.items():
             if SECRET_WORDS.search(str(k)) and v not in (None, ""):
@@ -276,23 +767,72 @@ def _check_secrets(doc, where=""):
                     f"{where}{k}: secrets may not be written in the file; "
                     f"name an environment variable with {k}_env"
                 )
-            if (
-                str(k).endswith("_env")
-                and v is not None
-                and not (isinstance(v, str) and ENV_NAME.fullmatch(v))
-            ):
-                raise ConfigError(
-                    f"{where}{k}: {'a value' if isinstance(v, str) else repr(v)} is not the name "
-                    f"of an environment variable"
-                )
             _check_secrets(v, f"{where}{k}.")
     elif isinstance(doc, list):
         for i, v in enumerate(doc):
             _check_secrets(v, f"{where[:-1]}[{i}].")
 
 
+def env_secret(name: str | None) -> str | None:
+    """The value of the environment variable *name* (a ``*_env`` key's value), or None."""
+    return os.environ.get(name) if name else None
+
+
+def redact_url(url: str) -> str:
+    """*url* with any user:password and query string masked, for logs and messages."""
+    try:
+        p = urlsplit(str(url))
+    except ValueError:
+        return "<unparsable URL>"
+    netloc = p.netloc.rsplit("@", 1)[-1]
+    if "@" in p.netloc:
+        netloc = "***@" + netloc
+    return urlunsplit((p.scheme, netloc, p.path, "***" if p.query else "", ""))
+
+
+# -- printing
+
+
+def effective(cfg: Config) -> dict:
+    """The configuration as loaded, defaults filled in, under the file's keys: written out as YAML it loads
+    back to the same configuration (``crisgeo check-config`` prints it). Secrets are never in it: the
+    ``*_env`` keys name variables (see :func:`secret_status`)."""
+    out = cfg.model_dump(mode="json", by_alias=True, exclude_none=True)
+    if cfg.source.kind != SourceKind.LOCAL:
+        out["source"].pop("path", None)
+    return out
+
+
+def secret_status(cfg: Config) -> list[str]:
+    """``KEY: VARIABLE (set | not set)`` for every ``*_env`` key of the configuration."""
+    lines = []
+
+    def walk(doc: Any, where: str) -> None:
+        if isinstance(doc, dict):
+            for k, v in doc.items():
+                if k.endswith("_env") and v:
+                    lines.append(f"{where}{k}: {v} ({'set' if env_secret(v) else 'not set'})")
+                walk(v, f"{where}{k}.")
+        elif isinstance(doc, list):
+            for i, v in enumerate(doc):
+                walk(v, f"{where[:-1]}[{i}].")
+
+    walk(effective(cfg), "")
+    return lines
+
+
+def json_schema() -> str:
+    """The JSON Schema of the file (``docs/crisgeo-config.schema.json``; editors validate YAML with it)."""
+    schema = Config.model_json_schema(by_alias=True, mode="validation")
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "crisgeo-monitor configuration"
+    return json.dumps(schema, indent=2, sort_keys=True) + "\n"
+
+
+# -- the file
+
+
 MAX_CONFIG_BYTES = 1 << 20
-ENV_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}", re.ASCII)
 
 
 class _Loader(yaml.SafeLoader):
@@ -369,339 +909,3 @@ def check_url(url: str, where: str, placeholder: str | None = None) -> str:
     if placeholder and placeholder not in url:
         raise ConfigError(f"{where}: {url!r} has no {placeholder} placeholder")
     return url
-
-
-def check_listen(text: str, where: str) -> str:
-    """``off`` or ``HOST:PORT`` (the daemon's HTTP endpoint)."""
-    if text == "off":
-        return text
-    from monitor.endpoint import parse_listen
-
-    try:
-        parse_listen(text)
-    except ValueError as exc:
-        raise ConfigError(f"{where}: {exc} (or off)") from None
-    return text
-
-
-def redact_url(url: str) -> str:
-    """*url* with any user:password and query string masked, for logs and messages."""
-    try:
-        p = urlsplit(str(url))
-    except ValueError:
-        return "<unparsable URL>"
-    netloc = p.netloc.rsplit("@", 1)[-1]
-    if "@" in p.netloc:
-        netloc = "***@" + netloc
-    return urlunsplit((p.scheme, netloc, p.path, "***" if p.query else "", ""))
-
-
-def load_config(path) -> Config:
-    """Load and validate the YAML configuration at *path*, the alerts section included; relative paths are
-    relative to the file. Any problem is a :class:`ConfigError` naming the key."""
-    path = Path(path)
-    doc = read_yaml(path)
-    if not isinstance(doc, dict):
-        raise ConfigError(f"{path}: expected a mapping at the top level")
-    _check_secrets(doc)
-    _known(doc, TOP_KEYS, "")
-    base = path.resolve().parent
-
-    def rel(p):
-        p = Path(os.path.expandvars(p)).expanduser()
-        return p if p.is_absolute() else base / p
-
-    sats = _get(doc, "satellites", list, "", required=True)
-    for i, s in enumerate(sats):
-        if s not in SATELLITES:
-            raise ConfigError(f"satellites[{i}]: {s!r} is not one of {', '.join(SATELLITES)}")
-    if not sats:
-        raise ConfigError("satellites: empty")
-    state_dir = rel(_get(doc, "state_dir", str, "", required=True))
-    _check_creatable(state_dir, "state_dir")
-
-    s = _section(doc, "source")
-    _known(s, set(SourceConfig.__dataclass_fields__), "source.")
-    kind = _get(s, "kind", str, "source.", required=True)
-    if kind not in ("simulated", "local", "nodd"):
-        raise ConfigError(f"source.kind: {kind!r} is not one of simulated, local, nodd")
-    source = SourceConfig(kind=kind)
-    if kind == "local":
-        source.path = rel(_get(s, "path", str, "source.", required=True))
-        if not source.path.is_dir():
-            raise ConfigError(f"source.path: {source.path} is not a directory")
-    _fill(
-        source,
-        s,
-        "source.",
-        timeout_s=float,
-        backoff_s=float,
-        daily_budget_mb=float,
-        cache_max_mb=float,
-        run_deadline_min=float,
-        max_retry_after_s=float,
-        min_rate_kb_s=float,
-        stall_window_s=float,
-        max_list_pages=int,
-        max_listed_keys=int,
-        retries=int,
-        retention_days=int,
-        granules=int,
-        seed=int,
-        profile=str,
-        endpoint=str,
-    )
-    buckets = _get(s, "buckets", dict, "source.", None)
-    if buckets:
-        for k, v in buckets.items():
-            if not isinstance(v, str):
-                raise ConfigError(f"source.buckets.{k}: expected a bucket name, got {v!r}")
-        source.buckets.update({str(k): v for k, v in buckets.items()})
-
-    sc = _section(doc, "schedule")
-    _known(sc, set(ScheduleConfig.__dataclass_fields__), "schedule.")
-    schedule = _fill(
-        ScheduleConfig(),
-        sc,
-        "schedule.",
-        catch_up_days=int,
-        lag_days=int,
-        no_data_retry_days=int,
-        misfire_grace_hours=float,
-        run_budget_min=float,
-    )
-    t = _get(sc, "time_utc", str, "schedule.", schedule.time_utc.strftime("%H:%M"))
-    m = re.fullmatch(r"(\d{1,2}):(\d{2})", t, re.ASCII)
-    if not m or int(m[1]) > 23 or int(m[2]) > 59:
-        raise ConfigError(f"schedule.time_utc: {t!r} is not HH:MM")
-    schedule.time_utc = dt.time(int(m[1]), int(m[2]))
-
-    se = _section(doc, "scenes")
-    _known(se, set(SceneConfig.__dataclass_fields__), "scenes.")
-    scenes = _fill(SceneConfig(), se, "scenes.", candidates=int, keep=int, min_inhomogeneity_k=float)
-
-    a = _section(doc, "assessment")
-    _known(a, set(AssessmentConfig.__dataclass_fields__), "assessment.")
-    assessment = _fill(
-        AssessmentConfig(), a, "assessment.", half_steps=int, step_urad=float, kernel=str, workers=int
-    )
-    if assessment.kernel not in ("top-hat", "response"):
-        raise ConfigError(f"assessment.kernel: {assessment.kernel!r} is not top-hat or response")
-
-    st = _section(doc, "store")
-    _known(st, STORE_KEYS, "store.")
-    store = _fill(
-        StoreConfig(sqlite=rel(_get(st, "sqlite", str, "store.", str(state_dir / "crisgeo.sqlite")))),
-        st,
-        "store.",
-        drain_minutes=float,
-    )
-    for i, p in enumerate(_get(st, "publish", list, "store.", [])):
-        where = f"store.publish[{i}]."
-        if not isinstance(p, dict):
-            raise ConfigError(f"{where[:-1]}: expected a mapping")
-        _known(p, set(PublishConfig.__dataclass_fields__), where)
-        pk = _get(p, "kind", str, where, required=True)
-        if pk not in ("influx2", "influx1"):
-            raise ConfigError(f"{where}kind: {pk!r} is not influx2 or influx1")
-        url = check_url(_get(p, "url", str, where, required=True), f"{where}url")
-        store.publish.append(
-            _fill(
-                PublishConfig(kind=pk, url=url.rstrip("/")),
-                p,
-                where,
-                measurement=str,
-                bucket=str,
-                org=str,
-                database=str,
-                token_env=str,
-                username_env=str,
-                password_env=str,
-                timeout_s=float,
-            )
-        )
-
-    fp = _section(doc, "fingerprint")
-    _known(fp, set(FingerprintConfig.__dataclass_fields__), "fingerprint.")
-    library = fp.get("ep_library") or []
-    if isinstance(library, str):
-        library = [library]
-    if not isinstance(library, list) or not all(isinstance(x, str) and "\x00" not in x for x in library):
-        raise ConfigError(f"fingerprint.ep_library: expected a list of paths, got {library!r}")
-    fingerprint = _fill(
-        FingerprintConfig(ep_library=tuple(rel(x) for x in library)),
-        fp,
-        "fingerprint.",
-        granules=int,
-        threshold_urad=float,
-    )
-    h = _section(doc, "http")
-    _known(h, set(HttpConfig.__dataclass_fields__), "http.")
-    http = _fill(HttpConfig(), h, "http.", listen=str)
-    check_listen(http.listen, "http.listen")
-    alerts = _section(doc, "alerts")
-    report_dir = _get(doc, "report_dir", str, "", None)
-    report_url, dashboard_url = (_get(doc, k, str, "", None) for k in ("report_url", "dashboard_url"))
-    for key, url in (("report_url", report_url), ("dashboard_url", dashboard_url)):
-        if url:
-            check_url(url, key)
-    cfg = Config(
-        path=path,
-        satellites=list(sats),
-        state_dir=state_dir,
-        source=source,
-        schedule=schedule,
-        scenes=scenes,
-        assessment=assessment,
-        store=store,
-        alerts=alerts,
-        fingerprint=fingerprint,
-        http=http,
-        report_dir=rel(report_dir) if report_dir else None,
-        report_url=report_url,
-        dashboard_url=dashboard_url,
-    )
-    _check_limits(cfg)
-    from alerts.settings import AlertConfigError, load_alert_settings
-
-    try:
-        cfg.alert_settings = load_alert_settings(
-            alerts, base, cfg.report_dir, cfg.dashboard_url, cfg.report_url
-        )
-    except AlertConfigError as exc:
-        raise ConfigError(str(exc)) from None
-    return cfg
-
-
-# The accepted range of every bounded number: (lowest, highest), in the key's unit.
-LIMITS = {
-    "source.timeout_s": (0.1, 3600),
-    "source.retries": (0, 20),
-    "source.backoff_s": (0.01, 600),
-    "source.daily_budget_mb": (1, 1e6),
-    "source.retention_days": (0, 3650),
-    "source.cache_max_mb": (0, 1e8),
-    "source.run_deadline_min": (1, 1440),
-    "source.max_list_pages": (1, 10000),
-    "source.max_listed_keys": (1, 10**6),
-    "source.max_retry_after_s": (1, 3600),
-    "source.min_rate_kb_s": (1, 1e6),
-    "source.stall_window_s": (1, 3600),
-    "source.granules": (1, 100),
-    "source.seed": (0, 2**31 - 1),
-    "schedule.catch_up_days": (1, 366),
-    "schedule.lag_days": (0, 30),
-    "schedule.no_data_retry_days": (0, 366),
-    "schedule.misfire_grace_hours": (0.01, 72),
-    "schedule.run_budget_min": (0.01, 10080),
-    "scenes.candidates": (1, 1000),
-    "scenes.keep": (1, 200),
-    "scenes.min_inhomogeneity_k": (0, 50),
-    "assessment.half_steps": (1, 40),
-    "assessment.step_urad": (10, 5000),
-    "assessment.workers": (1, 64),
-    "store.drain_minutes": (0.01, 1440),
-    "fingerprint.granules": (1, 2000),
-    "fingerprint.threshold_urad": (0.1, 10000),
-}
-BUCKET = re.compile(r"[a-z0-9][a-z0-9.-]{1,61}[a-z0-9]", re.ASCII)
-
-
-def _check_limits(cfg: Config) -> None:
-    for key, (lo, hi) in LIMITS.items():
-        section, name = key.split(".")
-        _within(getattr(getattr(cfg, section), name), lo, hi, key)
-    if cfg.scenes.keep > cfg.scenes.candidates:
-        raise ConfigError(
-            f"scenes.keep: {cfg.scenes.keep} is more than scenes.candidates ({cfg.scenes.candidates})"
-        )
-    spread = cfg.assessment.half_steps**2 * cfg.assessment.step_urad * URAD
-    if spread > MAX_GRID_SPREAD_RAD:
-        raise ConfigError(
-            f"assessment.half_steps: {cfg.assessment.half_steps} with step_urad "
-            f"{cfg.assessment.step_urad:g}: half_steps^2 x step_urad = {spread / URAD:.0f} urad is more "
-            f"than {MAX_GRID_SPREAD_RAD / URAD:.0f} (the widest grid of the compiled collocation)"
-        )
-    if len(set(cfg.satellites)) != len(cfg.satellites):
-        raise ConfigError("satellites: a satellite is listed twice")
-    check_url(cfg.source.endpoint, "source.endpoint", "{bucket}")
-    for sat, bucket in cfg.source.buckets.items():
-        if sat not in SATELLITES:
-            raise ConfigError(f"source.buckets.{sat}: not one of {', '.join(SATELLITES)}")
-        if not BUCKET.fullmatch(bucket):
-            raise ConfigError(f"source.buckets.{sat}: {bucket!r} is not a bucket name")
-    for i, p in enumerate(cfg.store.publish):
-        _within(p.timeout_s, 0.1, 600, f"store.publish[{i}].timeout_s")
-
-
-def effective(cfg: Config) -> dict:
-    """The configuration as loaded, defaults filled in, under the keys the loader reads: written out as
-    YAML it loads back to the same configuration (``crisgeo check-config`` prints it). Secrets are never in
-    it: the ``*_env`` keys name variables (see :func:`secret_status`)."""
-    import dataclasses
-
-    def plain(v):
-        if dataclasses.is_dataclass(v):
-            return {f.name: plain(getattr(v, f.name)) for f in dataclasses.fields(v)}
-        if isinstance(v, dict):
-            return {str(k): plain(x) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            return [plain(x) for x in v]
-        if isinstance(v, Path):
-            return str(v)
-        if isinstance(v, dt.time):
-            return v.strftime("%H:%M")
-        return v
-
-    source = plain(cfg.source)
-    if cfg.source.kind != "local":
-        source.pop("path")
-    out = {
-        "satellites": list(cfg.satellites),
-        "state_dir": str(cfg.state_dir),
-        "source": source,
-        "schedule": plain(cfg.schedule),
-        "scenes": plain(cfg.scenes),
-        "assessment": plain(cfg.assessment),
-        "fingerprint": plain(cfg.fingerprint),
-        "http": plain(cfg.http),
-        "store": {**plain(cfg.store), "publish": [plain(p) for p in cfg.store.publish]},
-    }
-    for key in ("report_dir", "report_url", "dashboard_url"):
-        value = getattr(cfg, key)
-        if value is not None:
-            out[key] = str(value)
-    a = cfg.alert_settings
-    if a is None:
-        return out
-    alerts = plain(a.rules)
-    for key in ("log", "events_file"):
-        if getattr(a, key) is not None:
-            alerts[key] = str(getattr(a, key))
-    if a.email is not None:
-        email = plain(a.email)
-        email["from"] = email.pop("sender")  # the file's key (a Python keyword in the dataclass)
-        alerts["email"] = {k: v for k, v in email.items() if v is not None}
-    for key in ("slack", "alertmanager"):
-        if getattr(a, key) is not None:
-            alerts[key] = plain(getattr(a, key))
-    out["alerts"] = alerts
-    return out
-
-
-def secret_status(cfg: Config) -> list[str]:
-    """``KEY: VARIABLE (set | not set)`` for every ``*_env`` key of the configuration."""
-    lines = []
-
-    def walk(doc, where):
-        if isinstance(doc, dict):
-            for k, v in doc.items():
-                if k.endswith("_env") and v:
-                    lines.append(f"{where}{k}: {v} ({'set' if os.environ.get(v) else 'not set'})")
-                walk(v, f"{where}{k}.")
-        elif isinstance(doc, list):
-            for i, v in enumerate(doc):
-                walk(v, f"{where[:-1]}[{i}].")
-
-    walk(effective(cfg), "")
-    return lines

@@ -24,15 +24,6 @@ from prometheus_client import CONTENT_TYPE_LATEST, generate_latest
 LOG = logging.getLogger(__name__)
 
 
-def parse_listen(text: str) -> tuple[str, int]:
-    """``HOST:PORT`` (``[::1]:PORT`` for IPv6) as (host, port); ValueError naming the value otherwise."""
-    host, sep, port = str(text).rpartition(":")
-    host = host[1:-1] if host.startswith("[") and host.endswith("]") else host
-    if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
-        raise ValueError(f"{text!r} is not HOST:PORT")
-    return host, int(port)
-
-
 class _Handler(SimpleHTTPRequestHandler):
     server_version = "crisgeo"
     sys_version = ""

@@ -10,7 +10,6 @@ still queued or running; what finished is recorded.
 
 from __future__ import annotations
 
-import dataclasses
 import datetime as dt
 import logging
 import signal
@@ -112,7 +111,7 @@ def reprocess(
     stop = stop or threading.Event()
     summary = ReprocessSummary()
     t0 = time.monotonic()
-    task_cfg = dataclasses.replace(cfg, assessment=dataclasses.replace(cfg.assessment, workers=1))
+    task_cfg = cfg.model_copy(update={"assessment": cfg.assessment.model_copy(update={"workers": 1})})
     with InstanceLock(cfg.state_dir), Store(cfg.store.sqlite) as store:
         store.interrupt_stale_runs()
         todo = []

@@ -166,7 +166,7 @@ class Service:
         own = store is None
         store = store or self.store()
         try:
-            settings = self.cfg.alert_settings
+            settings = self.cfg.alerts
             queued = evaluate(store, settings, self.cfg.satellites)
             if report:
                 self.regenerate_report(store)
@@ -271,7 +271,8 @@ class Service:
         """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
         if listen == "off":
             return None
-        from monitor.endpoint import Endpoint, parse_listen
+        from monitor.config import parse_listen
+        from monitor.endpoint import Endpoint
         from monitor.metrics import ServiceMetrics
         from monitor.version import __version__
 

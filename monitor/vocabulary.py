@@ -58,3 +58,25 @@ class Severity(StrEnum):
 
     WARNING = "warning"
     CRITICAL = "critical"
+
+
+class Kernel(StrEnum):
+    """The CrIS footprint weighting of the collocation (``assessment.kernel``)."""
+
+    TOP_HAT = "top-hat"  # the paper: every VIIRS pixel inside the FOV's circle counts alike
+    RESPONSE = "response"  # the measured FOV spatial response
+
+
+class SourceKind(StrEnum):
+    """Where granules come from (``source.kind``)."""
+
+    NODD = "nodd"  # NOAA's archive on S3
+    LOCAL = "local"  # a directory tree
+    SIMULATED = "simulated"  # the offline demo
+
+
+class PublishKind(StrEnum):
+    """The protocol of a time-series database (``store.publish[].kind``)."""
+
+    INFLUX2 = "influx2"  # InfluxDB 2 API, token
+    INFLUX1 = "influx1"  # InfluxDB 1 API (also VictoriaMetrics), user and password

@@ -167,7 +167,7 @@ BAD = [  # (where, value or a function of the document, the key the one-line err
     ("alerts.email", "smtp.example.org", "alerts.email"),
     ("alerts.email.port", 70000, "alerts.email.port"),
     ("alerts.email.to", "a@example.org", "alerts.email.to"),
-    ("alerts.email.to", ["nobody"], "alerts.email.to"),
+    ("alerts.email.to", ["nobody"], "alerts.email.to[0]"),
     ("alerts.email.starttls", "yes", "alerts.email.starttls"),
     ("alerts.email.password", "x", "alerts.email.password"),
     ("alerts.email.tls", True, "alerts.email.tls"),
@@ -195,7 +195,7 @@ def test_the_good_document_is_good(tmp_path):
 
     p = tmp_path / "c.yaml"
     p.write_text(yaml.safe_dump(GOOD))
-    assert load_config(p).alert_settings.channels == ["log", "email", "slack"]
+    assert load_config(p).alerts.channels == ["log", "email", "slack"]
 
 
 @pytest.mark.parametrize("where,value,key", BAD, ids=[f"{w}={v!r}"[:60] for w, v, _ in BAD])

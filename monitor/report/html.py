@@ -59,9 +59,8 @@ class ReportOptions:
 
 def options_from_config(cfg, satellites=None, since=None, until=None) -> ReportOptions:
     """Report options of a service configuration: the spec of its alert rules, its events calendar."""
-    settings = cfg.alert_settings
     return ReportOptions(
-        spec_km=settings.rules.spec_km,
+        spec_km=cfg.alerts.spec_km,
         since=since,
         until=until,
         calendar=cfg.events_file,

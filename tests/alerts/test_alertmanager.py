@@ -8,7 +8,7 @@ import requests
 
 from alerts.alertmanager import post_state
 from alerts.rules import Finding
-from alerts.settings import load_alert_settings
+from monitor.config import AlertSettings, Links
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
 from tests.servers import Webhook, alertmanager, wait_for
@@ -31,8 +31,8 @@ def statuses(receiver) -> list:
 def test_alerts_are_posted_routed_and_resolved(tmp_path, receiver):
     now = dt.datetime.now(dt.timezone.utc)
     with alertmanager(tmp_path / "am", receiver.url) as am, Store(tmp_path / "s.sqlite") as store:
-        settings = load_alert_settings(
-            {"alertmanager": {"url": am}}, tmp_path, dashboard_url="http://grafana/d/x"
+        settings = AlertSettings.model_validate({"alertmanager": {"url": am}}).linked(
+            Links(dashboard_url="http://grafana/d/x")
         )
         state = AlertState(store)
         finding = Finding("spec", "j01", "critical", "FOR 1 error 1.9 km > 1.5 km", ["FOR 1: 1.9 km"])
@@ -63,8 +63,8 @@ def test_alerts_are_posted_routed_and_resolved(tmp_path, receiver):
 
 def test_an_unreachable_alertmanager_costs_nothing_but_a_warning(tmp_path, caplog):
     with Store(tmp_path / "s.sqlite") as store:
-        settings = load_alert_settings(
-            {"alertmanager": {"url": "http://127.0.0.1:9", "timeout_s": 2}}, tmp_path
+        settings = AlertSettings.model_validate(
+            {"alertmanager": {"url": "http://127.0.0.1:9", "timeout_s": 2.0}}
         )
         AlertState(store).upsert(
             Finding("stale", "j01", "warning", "no run for 30 h"),

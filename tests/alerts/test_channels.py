@@ -3,7 +3,7 @@ import email
 import pytest
 
 from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
-from alerts.settings import EmailSettings, SlackSettings
+from monitor.config import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
 from tests.cli import run_crisgeo
 
@@ -119,12 +119,12 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     import time
 
     from alerts.engine import deliver
-    from alerts.settings import AlertSettings, RuleSettings
+    from monitor.config import AlertSettings
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
 
     monkeypatch.setenv("T_SLACK", webhook.url)
-    settings = AlertSettings(rules=RuleSettings(), slack=SlackSettings(webhook_env="T_SLACK", timeout_s=5))
+    settings = AlertSettings(slack=SlackSettings(webhook_env="T_SLACK", timeout_s=5))
     path = tmp_path / "s.sqlite"
     now = dt.datetime(2026, 1, 1, tzinfo=dt.timezone.utc)
     store = Store(path)

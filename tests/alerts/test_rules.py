@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from alerts.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
-from alerts.rules import RuleSettings, failure_finding, spec_finding, stale_finding
+from alerts.rules import failure_finding, spec_finding, stale_finding
 from benchmarks.jump_detection import false_alarms, jump_trial
+from monitor.config import RuleSettings
 from monitor.result import AssessmentResult, ForOffset
 from monitor.store.sqlite import Store
 
