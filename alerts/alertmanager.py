@@ -21,7 +21,8 @@ import logging
 
 import requests
 
-from monitor.store.alerts import AlertState
+from monitor.config import AlertSettings
+from monitor.records import History
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
@@ -31,10 +32,12 @@ def _iso(t: dt.datetime) -> str:
     return t.astimezone(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
 
 
-def alertmanager_alerts(store, settings, now: dt.datetime) -> list[dict]:
+def alertmanager_alerts(store: History, settings: AlertSettings, now: dt.datetime) -> list[dict]:
     """The Alertmanager API v2 alert objects of the service's current state (see the module docstring)."""
     am = settings.alertmanager
-    state = AlertState(store)
+    if am is None:
+        return []
+    state = store.alert_state()
     horizon = now - dt.timedelta(hours=am.validity_hours)
     out = []
     for a in state.all():
@@ -72,7 +75,7 @@ def alertmanager_alerts(store, settings, now: dt.datetime) -> list[dict]:
     return out
 
 
-def post_state(store, settings, now: dt.datetime | None = None) -> int | None:
+def post_state(store: History, settings: AlertSettings, now: dt.datetime | None = None) -> int | None:
     """Post the alert state to Alertmanager; the number of alerts posted, or None when the post failed
     (logged: the next evaluation posts the state again). Never raises."""
     if settings.alertmanager is None:

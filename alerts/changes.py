@@ -20,6 +20,8 @@ from pathlib import Path
 
 import yaml
 
+from monitor.records import History
+
 UTC = dt.timezone.utc
 INSTRUMENTS = ("cris", "viirs", "common")
 KIND_RE = re.compile(r"^(?P<kind>.+?-LUT)_(?P<plat>npp|j0\d)_")
@@ -120,7 +122,7 @@ def _lut_kinds(names) -> dict:
     return out
 
 
-def metadata_changes(store, satellite: str) -> list[Change]:
+def metadata_changes(store: History, satellite: str) -> list[Change]:
     """Changes of LUTs and SDR software between consecutive days of stored granule metadata."""
     days: dict[str, dict[str, set[str]]] = {}
     for g in store.granules(satellite):
@@ -163,7 +165,7 @@ def metadata_changes(store, satellite: str) -> list[Change]:
     return list(unique.values())
 
 
-def stored_changes(store, satellite: str) -> list[Change]:
+def stored_changes(store: History, satellite: str) -> list[Change]:
     """Change events the service itself recorded (``events`` rows of kind ``change:<instrument>``)."""
     out = []
     for e in store.events():
@@ -182,7 +184,7 @@ def stored_changes(store, satellite: str) -> list[Change]:
     return out
 
 
-def all_changes(store, satellite: str, calendar_path=None) -> list[Change]:
+def all_changes(store: History, satellite: str, calendar_path=None) -> list[Change]:
     """Every known change of *satellite*, in time order: the calendar, the metadata, the recorded events."""
     cal = [c for c in load_calendar(calendar_path) if c.satellite == satellite] if calendar_path else []
     return sorted(

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import requests
 
-from monitor.config import env_secret
+from monitor.config import AlertSettings, env_secret
 
 LOG = logging.getLogger(__name__)
 
@@ -148,7 +148,7 @@ class SlackChannel:
         raise Transient("Slack: retries exhausted")
 
 
-def make_channels(settings) -> dict:
+def make_channels(settings: AlertSettings) -> dict:
     """The channels the settings configure, by name."""
     out: dict[str, LogChannel | EmailChannel | SlackChannel] = {}
     if settings.log:

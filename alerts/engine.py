@@ -23,13 +23,14 @@ from alerts.rules import (
     spec_finding,
     stale_finding,
 )
-from monitor.store.alerts import AlertState
+from monitor.config import AlertSettings
+from monitor.records import History
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
 
 
-def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
+def findings_for(store: History, satellite: str, settings: AlertSettings, now: dt.datetime) -> list:
     """Every rule's findings for *satellite* at *now*."""
     s = settings
     out = [
@@ -49,7 +50,7 @@ def findings_for(store, satellite: str, settings, now: dt.datetime) -> list:
     return out
 
 
-def _trend(store, satellite: str, days: int = 7) -> list[str]:
+def _trend(store: History, satellite: str, days: int = 7) -> list[str]:
     series = store.series(satellite)
     total = series.values["total_km"]
     lines = []
@@ -59,7 +60,7 @@ def _trend(store, satellite: str, days: int = 7) -> list[str]:
     return lines
 
 
-def build_message(store, satellite: str, items: list, settings) -> dict:
+def build_message(store: History, satellite: str, items: list, settings: AlertSettings) -> dict:
     """One message for a satellite: every alert that started, repeats or resolved, with evidence."""
     counts: dict[str, int] = {}
     for kind, _ in items:
@@ -117,10 +118,10 @@ def _slack_escape(s: str) -> str:
     return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> list:
+def evaluate(store: History, settings: AlertSettings, satellites, now: dt.datetime | None = None) -> list:
     """Update alert state from the rules and queue the messages; returns [(satellite, message)] queued."""
     now = now or dt.datetime.now(UTC)
-    state = AlertState(store)
+    state = store.alert_state()
     repeat = dt.timedelta(hours=settings.repeat_hours)
     queued = []
     for sat in satellites:
@@ -171,10 +172,10 @@ def evaluate(store, settings, satellites, now: dt.datetime | None = None) -> lis
     return queued
 
 
-def deliver(store, settings, now: dt.datetime | None = None, channels=None) -> dict:
+def deliver(store: History, settings: AlertSettings, now: dt.datetime | None = None, channels=None) -> dict:
     """Try every due delivery once; returns counts by outcome. Never raises for a channel."""
     now = now or dt.datetime.now(UTC)
-    state = AlertState(store)
+    state = store.alert_state()
     channels = channels if channels is not None else make_channels(settings)
     counts = {"sent": 0, "retry": 0, "failed": 0}
     for d in state.due(now):
@@ -202,7 +203,7 @@ def deliver(store, settings, now: dt.datetime | None = None, channels=None) -> d
     return counts
 
 
-def evaluate_and_deliver(store, settings, satellites, now=None) -> dict:
+def evaluate_and_deliver(store: History, settings: AlertSettings, satellites, now=None) -> dict:
     """Evaluate the rules, queue, deliver; the counts (queued, sent, failed)."""
     queued = evaluate(store, settings, satellites, now)
     counts = deliver(store, settings, now)
@@ -211,10 +212,10 @@ def evaluate_and_deliver(store, settings, satellites, now=None) -> dict:
     return counts
 
 
-def alerts_view(store, now: dt.datetime) -> dict:
+def alerts_view(store: History, now: dt.datetime) -> dict:
     """What ``crisgeo alerts list`` shows, as data: the alerts (firing, silenced, resolved in the last 7
     days), the silences in force and the number of messages waiting for delivery."""
-    state = AlertState(store)
+    state = store.alert_state()
     alerts = []
     for r in state.all():
         if (

@@ -15,6 +15,7 @@ import numpy as np
 from alerts.changes import preceding_change
 from monitor.config import RuleSettings
 from monitor.constants import N_FOR
+from monitor.records import History
 from monitor.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 
 UTC = dt.timezone.utc
@@ -49,7 +50,7 @@ def _f(x):
     return x is not None and math.isfinite(x)
 
 
-def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
+def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | None:
     """FORs of the latest day whose in-track, cross-track or total error exceeds the specification.
 
     Critical when the breach holds beyond the uncertainty (value - 2 sigma > spec), warning otherwise.
@@ -99,7 +100,7 @@ def spec_finding(store, satellite: str, s: RuleSettings) -> Finding | None:
     )
 
 
-def _series(store, satellite: str):
+def _series(store: History, satellite: str):
     series = store.series(satellite)
     reliable = series.reliable()
     return series.days, {c: np.where(reliable, series.values[c], np.nan) for c, _ in COMPONENTS}
@@ -181,7 +182,9 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
     return kept
 
 
-def jump_findings(store, satellite: str, changes: list, s: RuleSettings, today: dt.date) -> list[Finding]:
+def jump_findings(
+    store: History, satellite: str, changes: list, s: RuleSettings, today: dt.date
+) -> list[Finding]:
     """A finding per recent step in the FOR-group series, attributed to the change before it."""
     days, values = _series(store, satellite)
     jumps = detect_jumps(days, values, sorted({c.time.date() for c in changes}), s)
@@ -227,13 +230,13 @@ def jump_findings(store, satellite: str, changes: list, s: RuleSettings, today: 
     return out
 
 
-def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> Finding | None:
+def stale_finding(store: History, satellite: str, s: RuleSettings, now: dt.datetime) -> Finding | None:
     """No successful assessment for longer than the limit (counted from the first run if none succeeded)."""
     runs = store.runs(satellite)
     if not runs:
         return None
     ok = [r for r in runs if r.status == RunStatus.OK]
-    since = dt.datetime.fromisoformat((ok[-1].finished if ok else runs[0].started))
+    since = dt.datetime.fromisoformat((ok[-1].finished or ok[-1].started) if ok else runs[0].started)
     age = (now - since).total_seconds() / 3600
     if age <= s.stale_hours:
         return None
@@ -251,7 +254,7 @@ def stale_finding(store, satellite: str, s: RuleSettings, now: dt.datetime) -> F
     )
 
 
-def failure_finding(store, satellite: str) -> Finding | None:
+def failure_finding(store: History, satellite: str) -> Finding | None:
     """The latest run failed, or the scheduler reported a failed or missed job since the last good run."""
     runs = store.runs(satellite)
     last_ok = max((r.id for r in runs if r.status in DONE), default=0)
@@ -278,7 +281,9 @@ def failure_finding(store, satellite: str) -> Finding | None:
     )
 
 
-def processing_change_findings(store, satellite: str, s: RuleSettings, today: dt.date) -> list[Finding]:
+def processing_change_findings(
+    store: History, satellite: str, s: RuleSettings, today: dt.date
+) -> list[Finding]:
     """CrIS geolocation processing changes found by the LOS fingerprint in the last ``active_days``."""
     out = []
     for e in store.events(EventKind.CHANGE_CRIS):

@@ -28,10 +28,10 @@ import numpy as np
 from monitor.assess import AssessConfig, assess_paths
 from monitor.constants import URAD
 from monitor.geometry.instrument import EngineeringPacket
-from monitor.mapping.engpkt import load_ep
 from monitor.mapping.optimize import Optimization, optimize
 from monitor.mapping.regeolocate import regeolocate_file
 from monitor.result import AssessmentResult
+from monitor.sdr.engpkt import load_ep
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import CRIS_GEO
 from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor import collocate, refine, swath
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR, URAD
 from monitor.errors import AssessmentError, StopRequested
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
@@ -55,6 +55,12 @@ class AssessConfig:
     bootstrap: int = 100
     seed: int = 0
     sigma_floor_urad: float = 5.0  # in quadrature with the bootstrap: the estimator's own error (calibrated)
+
+    @classmethod
+    def of(cls, half_steps: int, step_urad: float, kernel: str) -> AssessConfig:
+        """The assessment of a configuration's (or the command line's) grid and kernel, the rest the
+        paper's."""
+        return cls(half_steps=half_steps, step_rad=step_urad * URAD, kernel=kernel)
 
     @property
     def offsets_rad(self) -> np.ndarray:

@@ -15,12 +15,15 @@ import sys
 from pathlib import Path
 
 from monitor import allocator, logs
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
+from monitor.config import AssessmentConfig
 from monitor.errors import DataError
 from monitor.satellites import SATELLITES
 from monitor.simulate.orbit import PASSES
 from monitor.version import __version__
-from monitor.vocabulary import Rule
+from monitor.vocabulary import Kernel, Rule
+
+# the defaults of the assessment keys, for the commands that take them as flags
+ASSESSMENT = AssessmentConfig()
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
@@ -136,7 +139,7 @@ def cmd_simulate(args) -> int:
 
 
 def _ep(path, satellite=None):
-    from monitor.mapping.engpkt import load_ep
+    from monitor.sdr.engpkt import load_ep
 
     try:
         return load_ep(path, satellite)
@@ -172,9 +175,9 @@ def cmd_optimize(args) -> int:
     """crisgeo optimize: new scene-mirror angles from an assessment."""
     import json
 
-    from monitor.mapping.engpkt import save_ep
     from monitor.mapping.optimize import optimize
     from monitor.result import AssessmentResult
+    from monitor.sdr.engpkt import save_ep
 
     try:
         result = AssessmentResult.from_json(Path(args.result).read_text())
@@ -294,17 +297,17 @@ def format_table(result) -> str:
     arg(
         "--steps",
         type=int,
-        default=DEFAULT_HALF_STEPS,
+        default=ASSESSMENT.half_steps,
         help="perturbation steps each side of zero (grid 2n+1)",
     ),
-    arg("--step-urad", type=float, default=DEFAULT_STEP_URAD, help="perturbation step, urad"),
+    arg("--step-urad", type=float, default=ASSESSMENT.step_urad, help="perturbation step, urad"),
     arg(
         "--kernel",
-        choices=("top-hat", "response"),
-        default="top-hat",
+        choices=tuple(Kernel),
+        default=ASSESSMENT.kernel,
         help="FOV weighting: top-hat cone or the CrIS spatial response",
     ),
-    arg("--workers", type=int, default=1, help="threads of the compiled kernels"),
+    arg("--workers", type=int, default=ASSESSMENT.workers, help="threads of the compiled kernels"),
 )
 def cmd_assess(args) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
@@ -312,7 +315,7 @@ def cmd_assess(args) -> int:
 
     if args.steps < 1 or args.step_urad <= 0:
         raise BadInput("--steps must be >= 1 and --step-urad > 0")
-    cfg = AssessConfig(half_steps=args.steps, step_rad=args.step_urad * 1e-6, kernel=args.kernel)
+    cfg = AssessConfig.of(args.steps, args.step_urad, args.kernel)
     try:
         result = assess_paths(args.paths, cfg, workers=args.workers)
     except DataError as exc:
@@ -446,7 +449,8 @@ def _satellites(cfg, satellite: str | None) -> list[str]:
 )
 def cmd_run(args) -> int:
     """crisgeo run: one run of the daily job, then exit."""
-    from monitor.service import AlreadyRunning, Service
+    from monitor.lock import AlreadyRunning
+    from monitor.service import Service
     from monitor.vocabulary import RunStatus
 
     cfg = _load(args, writes=True)
@@ -490,8 +494,8 @@ def cmd_run(args) -> int:
 )
 def cmd_reprocess(args) -> int:
     """crisgeo reprocess: a period on Dask; this process alone writes the store."""
+    from monitor.lock import AlreadyRunning
     from monitor.reprocess import run_reprocess
-    from monitor.service import AlreadyRunning
     from monitor.vocabulary import RunStatus
 
     cfg = _load(args, writes=True)
@@ -522,7 +526,8 @@ def cmd_reprocess(args) -> int:
 )
 def cmd_daemon(args) -> int:
     """crisgeo daemon: the long-running service."""
-    from monitor.service import AlreadyRunning, Service
+    from monitor.lock import AlreadyRunning
+    from monitor.service import Service
 
     cfg = _load(args, writes=True)
     if args.listen is not None:
@@ -736,20 +741,20 @@ def cmd_fingerprint(args) -> int:
     if args.json:
         print(json.dumps(fp.to_dict(), indent=1))
     else:
-        print(fpr.format_print(fp.day))
+        print(fpr.format_print(fp.verdict.day))
         for s in fp.skipped:
             print(f"skipped {s}")
-        c = fp.change
+        c = fp.verdict.change
         print(
             "no step within these granules"
             if c is None
             else f"step from granule {c.granule} at FOR {', '.join(map(str, c.fors))}"
         )
-        print(fpr.format_matches(fp.matches))
+        print(fpr.format_matches(fp.verdict.matches))
         for p in fp.problems:
             print(f"EP library: {p}")
     if args.write_residuals:
-        _write_residuals(args, fp.day, fp.matches, fp.library)
+        _write_residuals(args, fp.verdict.day, fp.verdict.matches, fp.library)
     return EXIT_OK
 
 

@@ -293,6 +293,23 @@ class ScheduleConfig(Section):
         10080,
     )
 
+    def no_data_horizon(self, today: dt.date) -> dt.date:
+        """Days before this one that were found empty are not tried again (their no_data is final)."""
+        return today - dt.timedelta(days=self.lag_days + self.no_data_retry_days)
+
+    def days_to_run(self, done: set[dt.date], today: dt.date) -> list[dt.date]:
+        """The days of the catch-up window (ending lag_days before *today*) not in *done*, oldest first."""
+        last = today - dt.timedelta(days=self.lag_days)
+        return sorted(
+            d for d in (last - dt.timedelta(days=k) for k in range(self.catch_up_days)) if d not in done
+        )
+
+    def next_run(self, now: dt.datetime | None = None) -> dt.datetime:
+        """The next scheduled daily run (UTC) after *now*."""
+        now = now or dt.datetime.now(dt.timezone.utc)
+        nxt = now.replace(hour=self.time_utc.hour, minute=self.time_utc.minute, second=0, microsecond=0)
+        return nxt if nxt > now else nxt + dt.timedelta(days=1)
+
 
 class SceneConfig(Section):
     """The ``scenes`` section: which CrIS granules of a day are assessed."""

@@ -25,6 +25,10 @@ from monitor.constants import URAD
 from monitor.errors import DataError
 from monitor.geometry.instrument import FOV5, fov5_angles
 from monitor.geometry.inverse import granule_geometry
+from monitor.sdr import GranuleError, read_file
+from monitor.sdr.engpkt import load_library
+from monitor.sdr.names import parse_name
+from monitor.sdr.pairing import find_files
 
 
 @dataclass
@@ -321,24 +325,51 @@ def format_print(day: DayPrint) -> str:
 
 
 @dataclass
-class FilesPrint:
-    """The fingerprint of a set of GEO files (``crisgeo fingerprint``): the day's print, the files that
-    could not be read (with the reason), the library EPs ranked against it, and a step within the files."""
+class DayVerdict:
+    """What one day's GEO files say about CrIS geolocation processing: the day's print, the library EPs
+    ranked against it (best first), and the processing change found (within the files or against the
+    previous day's print), or None."""
 
     day: DayPrint
-    skipped: list
-    matches: list
-    library: dict
-    problems: list
+    matches: list[EpMatch]
     change: ProcessingChange | None
+
+
+def day_verdict(
+    prints: list[GranulePrint],
+    library: dict,
+    platform: str | None,
+    threshold_urad: float,
+    reference: DayPrint | None = None,
+    day: dt.date | None = None,
+) -> DayVerdict:
+    """The fingerprint of a day from its granule *prints*: the day print, the EPs of *library* matched
+    against it (those of *platform* only, when known), and the change (:func:`detect_change`). The daily
+    run and ``crisgeo fingerprint`` both come here."""
+    prints = sorted(prints, key=lambda p: p.start)
+    today = day_print(prints)
+    return DayVerdict(
+        today, identify_ep(today, library, platform), detect_change(prints, threshold_urad, reference, day)
+    )
+
+
+@dataclass
+class FilesPrint:
+    """The fingerprint of a set of GEO files (``crisgeo fingerprint``): the day's verdict, the files that
+    could not be read (with the reason), the EP library (name -> EngineeringPacket) and its problems."""
+
+    verdict: DayVerdict
+    skipped: list[str]
+    library: dict
+    problems: list[str]
 
     def to_dict(self) -> dict:
         """The JSON document of ``crisgeo fingerprint --json``."""
-        doc = self.day.to_dict()
+        doc = self.verdict.day.to_dict()
         doc["skipped"] = self.skipped
-        c = self.change
+        c = self.verdict.change
         doc["change_within"] = None if c is None else {"first_granule": c.granule, "fors": c.fors}
-        doc["ep_match"] = [m.to_dict() for m in self.matches]
+        doc["ep_match"] = [m.to_dict() for m in self.verdict.matches]
         doc["ep_library_problems"] = self.problems
         return doc
 
@@ -347,11 +378,6 @@ def fingerprint_files(paths, ep_library=(), threshold_urad: float = 10.0) -> Fil
     """Fingerprint the CrIS GEO files under *paths*, rank the EPs of *ep_library* (files or directories;
     empty: the packaged real EPs) against it and look for a step within the files. A
     :class:`~monitor.errors.DataError` when no file can be read."""
-    from monitor.mapping.engpkt import load_library
-    from monitor.sdr import GranuleError, read_file
-    from monitor.sdr.names import parse_name
-    from monitor.sdr.pairing import find_files
-
     files = find_files(paths)
     prints, skipped = [], []
     for f in files:
@@ -361,9 +387,7 @@ def fingerprint_files(paths, ep_library=(), threshold_urad: float = 10.0) -> Fil
             skipped.append(str(exc))
     if not prints:
         raise DataError("no readable CrIS GEO granule" + (f" ({skipped[0]})" if skipped else ""))
-    prints.sort(key=lambda p: p.start)
-    day = day_print(prints)
     library, problems = load_library(list(ep_library))
     platforms = {p.platform for p in map(parse_name, (f.name for f in files)) if p}
-    matches = identify_ep(day, library, platforms.pop() if len(platforms) == 1 else None)
-    return FilesPrint(day, skipped, matches, library, problems, detect_change(prints, threshold_urad))
+    platform = platforms.pop() if len(platforms) == 1 else None
+    return FilesPrint(day_verdict(prints, library, platform, threshold_urad), skipped, library, problems)

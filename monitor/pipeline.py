@@ -17,14 +17,16 @@ import numpy as np
 from monitor import fingerprint as fpr
 from monitor import logs
 from monitor.assess import AssessConfig, assess_plan
+from monitor.config import Config, ScheduleConfig
 from monitor.errors import DataError, StopRequested
-from monitor.mapping.engpkt import load_library
 from monitor.result import AssessmentResult
 from monitor.scenes import select_scenes
 from monitor.sdr import read_file
+from monitor.sdr.engpkt import load_library
 from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 from monitor.sources import ALL_PRODUCTS, Source, SourceError
+from monitor.store.sqlite import Store
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 from monitor.vocabulary import EventKind, RunStatus
 
@@ -82,21 +84,11 @@ class RunOutcome:
         return "; ".join(parts)
 
 
-def days_to_run(
-    store, satellite: str, today: dt.date, catch_up_days: int, lag_days: int = 1, no_data_retry_days: int = 3
-) -> list[dt.date]:
-    """The days of the catch-up window (ending *lag_days* before *today*) without a completed run, oldest
-    first. A day found empty (archive outage, late ingest) is tried again for *no_data_retry_days* after
+def days_to_run(store: Store, satellite: str, schedule: ScheduleConfig, today: dt.date) -> list[dt.date]:
+    """The days of the catch-up window (ending ``lag_days`` before *today*) without a completed run, oldest
+    first. A day found empty (archive outage, late ingest) is tried again for ``no_data_retry_days`` after
     it became due; then its empty listing is final."""
-    done = store.done_days(satellite, no_data_horizon(today, lag_days, no_data_retry_days))
-    last = today - dt.timedelta(days=lag_days)
-    window = [last - dt.timedelta(days=k) for k in range(max(catch_up_days, 1))]
-    return sorted(d for d in window if d not in done)
-
-
-def no_data_horizon(today: dt.date, lag_days: int, no_data_retry_days: int) -> dt.date:
-    """Days before this one that were found empty are not tried again (their no_data is final)."""
-    return today - dt.timedelta(days=lag_days + no_data_retry_days)
+    return schedule.days_to_run(store.done_days(satellite, schedule.no_data_horizon(today)), today)
 
 
 def day_prints(cfg, source, day: dt.date, listing) -> list:
@@ -128,19 +120,18 @@ def record_fingerprint(cfg, store, satellite: str, day: dt.date, prints: list) -
     """
     if not prints:
         return None
-    today = fpr.day_print(prints)
     prev = store.fingerprint(satellite, day)
     reference = fpr.DayPrint.from_dict(prev[1]) if prev else None
-    body = today.to_dict()
     library, problems = load_library(cfg.fingerprint.ep_library)
     for problem in problems:
         LOG.warning("fingerprint: EP library: %s", problem)
-    matches = fpr.identify_ep(today, library, satellite)
-    if matches:
-        body["ep_match"] = [m.to_dict() for m in matches[:3]]
-    change = fpr.detect_change(prints, cfg.fingerprint.threshold_urad, reference, day)
+    verdict = fpr.day_verdict(prints, library, satellite, cfg.fingerprint.threshold_urad, reference, day)
+    body = verdict.day.to_dict()
+    if verdict.matches:
+        body["ep_match"] = [m.to_dict() for m in verdict.matches[:3]]
+    change = verdict.change
     if change is not None:
-        desc = change.describe(matches)
+        desc = change.describe(verdict.matches)
         body["change"] = change.to_dict()
         store.add_event(
             EventKind.CHANGE_CRIS,
@@ -261,7 +252,7 @@ def _compute_day(cfg, source: Source, satellite: str, day: dt.date, should_stop,
         logs.stage("assess")
         w.result = assess_plan(
             case,
-            AssessConfig(half_steps=a.half_steps, step_rad=a.step_urad * 1e-6, kernel=a.kernel),
+            AssessConfig.of(a.half_steps, a.step_urad, a.kernel),
             progress=progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris)),
             should_stop=stop,
             workers=a.workers,
@@ -281,7 +272,7 @@ def _compute_day(cfg, source: Source, satellite: str, day: dt.date, should_stop,
     return w
 
 
-def record_day(cfg, store, run_id: int, w: DayWork) -> RunOutcome:
+def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.date) -> RunOutcome:
     """Write what :func:`compute_day` produced under the ledger row *run_id*: the fingerprint, then the
     day's results and their outbox lines in one transaction (ok), or the empty, failed or interrupted
     run with its reason; then drain the outbox."""
@@ -302,8 +293,7 @@ def record_day(cfg, store, run_id: int, w: DayWork) -> RunOutcome:
             publish_changes(cfg, store, w.satellite)
         elif w.status == RunStatus.NO_DATA:
             s = cfg.schedule
-            today = dt.datetime.now(dt.timezone.utc).date()
-            if w.day < no_data_horizon(today, s.lag_days, s.no_data_retry_days):
+            if w.day < s.no_data_horizon(today):
                 out.status = RunStatus.NO_DATA_FINAL
             else:
                 out.reason = f"{out.reason} (tried again for {s.no_data_retry_days} day(s) after it is due)"
@@ -322,12 +312,20 @@ def record_day(cfg, store, run_id: int, w: DayWork) -> RunOutcome:
 
 
 def run_day(
-    cfg, store, source: Source, satellite: str, day: dt.date, should_stop=None, progress=None
+    cfg: Config,
+    store: Store,
+    source: Source,
+    satellite: str,
+    day: dt.date,
+    today: dt.date,
+    should_stop=None,
+    progress=None,
 ) -> RunOutcome:
-    """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`); every outcome
-    is recorded in the ledger, an unexpected exception too (``failed`` with its type and message)."""
+    """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`) as of *today*
+    (the no-data horizon); every outcome is recorded in the ledger, an unexpected exception too
+    (``failed`` with its type and message)."""
     run_id = store.begin_run(satellite, day)
     with logs.context(satellite=satellite, day=day.isoformat(), run_id=run_id):
         work = compute_day(cfg, source, satellite, day, should_stop, progress)
         with logs.context(stage="record"):
-            return record_day(cfg, store, run_id, work)
+            return record_day(cfg, store, run_id, work, today)

@@ -18,8 +18,8 @@ import time
 from dataclasses import dataclass, field
 
 from monitor.allocator import reuse_freed_memory
-from monitor.pipeline import DayWork, ProgressLines, compute_day, no_data_horizon, record_day
-from monitor.service import InstanceLock
+from monitor.lock import InstanceLock
+from monitor.pipeline import DayWork, ProgressLines, compute_day, record_day
 from monitor.sources import make_source
 from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
@@ -116,7 +116,8 @@ def reprocess(
         store.interrupt_stale_runs()
         todo = []
         s = cfg.schedule
-        horizon = no_data_horizon(dt.datetime.now(dt.timezone.utc).date(), s.lag_days, s.no_data_retry_days)
+        today = dt.datetime.now(dt.timezone.utc).date()
+        horizon = s.no_data_horizon(today)
         for sat in satellites:
             done = store.done_days(sat, horizon)  # as the daily run: ok, or no data for good
             for day in period_days(since, until):
@@ -147,7 +148,7 @@ def reprocess(
                         work = DayWork(
                             sat, day, RunStatus.FAILED, f"worker: {type(exc).__name__}: {exc}"[:1000]
                         )
-                    out = record_day(cfg, store, store.begin_run(sat, day), work)
+                    out = record_day(cfg, store, store.begin_run(sat, day), work, today)
                     summary.statuses[out.status] = summary.statuses.get(out.status, 0) + 1
                     LOG.info("%s", out.summary())
                     if progress is not None:

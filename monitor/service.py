@@ -15,17 +15,16 @@
 from __future__ import annotations
 
 import datetime as dt
-import fcntl
 import logging
 import os
 import signal
 import socket
 import threading
 from collections.abc import Iterator
-from pathlib import Path
 
 from monitor import allocator, logs
 from monitor.health import Health
+from monitor.lock import InstanceLock
 from monitor.pipeline import RunOutcome, days_to_run, run_day
 from monitor.sources import make_source
 from monitor.store.sqlite import Store
@@ -57,53 +56,6 @@ def sd_notify(message: str) -> bool:
         return False
 
 
-def next_run(schedule, now: dt.datetime | None = None) -> dt.datetime:
-    """The next scheduled daily run (UTC) of a :class:`monitor.config.ScheduleConfig`."""
-    now = now or dt.datetime.now(UTC)
-    nxt = now.replace(hour=schedule.time_utc.hour, minute=schedule.time_utc.minute, second=0, microsecond=0)
-    return nxt if nxt > now else nxt + dt.timedelta(days=1)
-
-
-class AlreadyRunning(RuntimeError):
-    """Another crisgeo process holds the state directory's lock."""
-
-
-class InstanceLock:
-    """An exclusive flock on ``state_dir/crisgeo.lock``, held for the life of the process."""
-
-    def __init__(self, state_dir: Path):
-        self.path = Path(state_dir) / "crisgeo.lock"
-        self.fh = None
-
-    def __enter__(self):
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.fh = open(self.path, "a+")
-        try:
-            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            self.fh.seek(0)
-            holder = self.fh.read().strip()[:20] or "?"
-            self.fh.close()
-            raise AlreadyRunning(
-                f"{self.path}: another crisgeo process (pid {holder}) is running on this state directory. "
-                "The "
-                "daemon assesses the missed days of its catch-up window itself at its next daily run; to "
-                "redo "
-                "a day now, stop it (systemctl stop crisgeo), run 'crisgeo run --date YYYY-MM-DD', and "
-                "start "
-                f"it again"
-            ) from None
-        self.fh.seek(0)
-        self.fh.truncate()
-        self.fh.write(str(os.getpid()))
-        self.fh.flush()
-        return self
-
-    def __exit__(self, *exc):
-        fcntl.flock(self.fh, fcntl.LOCK_UN)
-        self.fh.close()
-
-
 class Service:
     """Runs satellite-days for a configuration; the daemon adds the scheduler and signals."""
 
@@ -120,15 +72,24 @@ class Service:
         """A new connection to the configured store (close it, or use it in ``with``)."""
         return Store(self.cfg.store.sqlite)
 
-    def run(self, satellite: str, day: dt.date):
-        """Run one satellite-day (health-tracked), then evaluate the alerts and regenerate the report."""
+    def run(self, satellite: str, day: dt.date, today: dt.date | None = None) -> RunOutcome:
+        """Run one satellite-day (health-tracked) as of *today* (default: the date now, UTC), then evaluate
+        the alerts and regenerate the report."""
+        today = today or dt.datetime.now(UTC).date()
         try:
             with self.store() as store, logs.context(satellite=satellite, day=day.isoformat()):
                 LOG.info("run %s %s", satellite, day)
                 sd_notify(f"STATUS=assessing {satellite} {day}")
                 with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
                     out = run_day(
-                        self.cfg, store, self.source, satellite, day, self.stop_event.is_set, self.progress
+                        self.cfg,
+                        store,
+                        self.source,
+                        satellite,
+                        day,
+                        today,
+                        self.stop_event.is_set,
+                        self.progress,
                     )
                 level = {RunStatus.FAILED: logging.ERROR, RunStatus.INTERRUPTED: logging.WARNING}
                 LOG.log(level.get(out.status, logging.INFO), "%s", out.summary())
@@ -207,14 +168,11 @@ class Service:
         outcome as its day ends (the daemon keeps none: a 90-day catch-up holds no 90 results)."""
         today = today or dt.datetime.now(UTC).date()
         with self.store() as store:
-            sch = self.cfg.schedule
-            days = days_to_run(
-                store, satellite, today, sch.catch_up_days, sch.lag_days, sch.no_data_retry_days
-            )
+            days = days_to_run(store, satellite, self.cfg.schedule, today)
         for day in days:
             if self.stop_event.is_set():
                 break
-            yield self.run(satellite, day)
+            yield self.run(satellite, day, today)
 
     def daily_job(self, satellite: str):
         """The scheduled job of *satellite*: the days of its catch-up window."""

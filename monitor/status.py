@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from monitor.service import next_run
 from monitor.store.alerts import AlertState
 from monitor.vocabulary import RunStatus
 
@@ -44,6 +43,6 @@ def status_report(cfg, store, satellites=None) -> dict:
         "state": ["OK", "WARNING", "CRITICAL"][state],
         "exit": state,
         "satellites": sats,
-        "next_run_utc": f"{next_run(cfg.schedule):%Y-%m-%dT%H:%MZ}",
+        "next_run_utc": f"{cfg.schedule.next_run():%Y-%m-%dT%H:%MZ}",
         "outbox": store.outbox_size(),
     }

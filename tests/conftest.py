@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from monitor.assess import AssessConfig, assess_paths
-from monitor.mapping.engpkt import load_ep
+from monitor.sdr.engpkt import load_ep
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
 

@@ -14,6 +14,7 @@ from monitor.vocabulary import EventKind
 from tests.conftest import tree_with_truncated
 
 DAY = dt.date(2024, 6, 1)
+TODAY = dt.datetime.now(dt.timezone.utc).date()  # the runs' date: DAY is long past its no-data horizon
 
 
 def make_config(tmp_path, data_dir, extra=""):
@@ -43,7 +44,7 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
 
     monkeypatch.setattr(pairing, "read_metadata", counting)
     monkeypatch.setattr(pairing, "find_files", lambda paths: pytest.fail("the daily run paired files again"))
-    first = run_day(cfg, store, src, "j01", DAY)
+    first = run_day(cfg, store, src, "j01", DAY, TODAY)
     monkeypatch.undo()
     # two CrIS granules (their GEO metadata read once each, the SDR's came with selection's reading), and one
     # VIIRS granule covering both, fetched and read once
@@ -51,7 +52,7 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
     # the same numbers as assessing the files directly (crisgeo assess)
     assert [f.d_beta_urad for f in first.result.fors] == [f.d_beta_urad for f in reference.fors]
     assert first.status == "ok" and len(first.result.fors) == 30
-    second = run_day(cfg, store, src, "j01", DAY)
+    second = run_day(cfg, store, src, "j01", DAY, TODAY)
     assert second.status == "ok"
     assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
     assert store.db.execute("SELECT COUNT(DISTINCT run_id) FROM results").fetchone()[0] == 1
@@ -66,13 +67,14 @@ def test_a_day_without_data_is_recorded(cases, tmp_path):
     data, _, _ = cases.get()
     cfg = make_config(tmp_path, data)
     store = Store(cfg.store.sqlite)
-    out = run_day(cfg, store, LocalSource(data), "j01", DAY + dt.timedelta(days=3))
+    out = run_day(cfg, store, LocalSource(data), "j01", DAY + dt.timedelta(days=3), TODAY)
     assert (
         out.status == "no_data_final" and "no CrIS GEO granule" in out.reason
     )  # long past its retry horizon
     assert store.runs()[0].status == "no_data_final"
     assert DAY + dt.timedelta(days=3) in store.done_days("j01")
-    assert days_to_run(store, "j01", DAY + dt.timedelta(days=5), 4) == [
+    window = cfg.schedule.model_copy(update={"catch_up_days": 4})
+    assert days_to_run(store, "j01", window, DAY + dt.timedelta(days=5)) == [
         DAY + dt.timedelta(days=k) for k in (1, 2, 4)
     ]
 
@@ -83,13 +85,14 @@ def test_an_empty_day_is_tried_again_until_its_horizon(cases, tmp_path):
     data, _, _ = cases.get()
     cfg = make_config(tmp_path, data)
     store = Store(cfg.store.sqlite)
-    today = dt.datetime.now(dt.timezone.utc).date()
+    today = TODAY
     yesterday = today - dt.timedelta(days=1)
-    out = run_day(cfg, store, LocalSource(data), "j01", yesterday)
+    out = run_day(cfg, store, LocalSource(data), "j01", yesterday, today)
     assert out.status == "no_data" and "tried again for 3 day(s)" in out.reason
+    week = cfg.schedule.model_copy(update={"catch_up_days": 7})
     for later in range(4):  # due on today; tried again on the next three days
-        assert yesterday in days_to_run(store, "j01", today + dt.timedelta(days=later), 7, 1, 3), later
-    assert yesterday not in days_to_run(store, "j01", today + dt.timedelta(days=4), 7, 1, 3)
+        assert yesterday in days_to_run(store, "j01", week, today + dt.timedelta(days=later)), later
+    assert yesterday not in days_to_run(store, "j01", week, today + dt.timedelta(days=4))
 
 
 def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_path):
@@ -98,7 +101,7 @@ def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_p
     work = tree_with_truncated(data, tmp_path / "data", sdr, keep_bytes=4000)
     cfg = make_config(tmp_path, work)
     store = Store(cfg.store.sqlite)
-    out = run_day(cfg, store, LocalSource(work), "j01", DAY)
+    out = run_day(cfg, store, LocalSource(work), "j01", DAY, TODAY)
     assert out.status == "ok" and len(out.result.granules) == 1
     rejected = [d for d in store.selection("j01", DAY) if d.decision == "rejected"]
     assert (
@@ -115,7 +118,7 @@ def test_source_failure_is_a_failed_run_and_an_event(tmp_path):
     cfg = make_config(tmp_path, tmp_path / "missing")
     (tmp_path / "missing").rmdir()
     store = Store(cfg.store.sqlite)
-    out = run_day(cfg, store, LocalSource(tmp_path / "missing"), "j01", DAY)
+    out = run_day(cfg, store, LocalSource(tmp_path / "missing"), "j01", DAY, TODAY)
     assert out.status == "failed" and "no such directory" in out.reason
     (event,) = store.events(EventKind.RUN_FAILED)
     assert event.satellite == "j01" and event.detail == {"day": DAY.isoformat(), "reason": out.reason}

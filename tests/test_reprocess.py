@@ -57,7 +57,9 @@ def test_each_day_once_with_the_daily_runs_numbers(reprocessed):
     daily = _config(tmp, "daily", f"{{kind: local, path: {cfg.state_dir / 'simulated' / 'j01' / middle}}}")
     with Store(daily.store.sqlite) as store:
         assert (
-            run_day(daily, store, LocalSource(daily.source.path), "j01", DAYS[0].replace(day=2)).status
+            run_day(
+                daily, store, LocalSource(daily.source.path), "j01", DAYS[0].replace(day=2), dt.date.today()
+            ).status
             == "ok"
         )
     assert _results(daily, middle)[0] == _results(cfg, middle)[0]

@@ -15,7 +15,7 @@ GCRSO from the real EPs (docs/jpss-formats.md 2.2 and 2.3, checked in ``tests/ge
 
 The spacecraft frame here is the attitude-defined body frame that :mod:`monitor.geometry.frames` calls
 SBF: the frame of the inverse geolocation and of the assessment's alpha and beta (equations 1-2).
-All angles are radians; EP files hold microradians (:mod:`monitor.mapping.engpkt` converts).
+All angles are radians; EP files hold microradians (:mod:`monitor.sdr.engpkt` converts).
 """
 
 from __future__ import annotations

@@ -34,6 +34,7 @@ import numpy as np
 
 from monitor.constants import N_FOR, URAD
 from monitor.errors import DataError
+from monitor.fingerprint import day_print, granule_print
 from monitor.geometry.frames import los_angles, los_from_angles
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles
 
@@ -77,7 +78,6 @@ class ResidualTable:
         granules (NaN where either was not measured); None for a table written without them."""
         if self.fov5_alpha_urad is None:
             return None
-        from monitor.fingerprint import granule_print
 
         p = granule_print(granule)
         return p.alpha_urad - self.fov5_alpha_urad, p.beta_urad - self.fov5_beta_urad
@@ -162,7 +162,6 @@ class OwnResiduals:
         object.__setattr__(self, "satellite", self.ep_in_force.satellite)
 
     def table_for(self, granule) -> ResidualTable:
-        from monitor.fingerprint import day_print, granule_print
 
         return learn(day_print([granule_print(granule)]), self.ep_in_force)
 

@@ -4,78 +4,8 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-from dataclasses import dataclass
 
-
-def iso(t: dt.datetime) -> str:
-    """*t* as an ISO 8601 UTC string, to the second."""
-    return t.astimezone(dt.timezone.utc).isoformat(timespec="seconds")
-
-
-@dataclass(frozen=True)
-class Alert:
-    """One alert: identified by *fingerprint* (rule:satellite:group); *status* firing or resolved; times ISO
-    8601 UTC; *lines* the finding's detail lines."""
-
-    fingerprint: str
-    rule: str
-    satellite: str
-    grp: str | None
-    severity: str | None
-    status: str
-    started: str | None
-    last_notified: str | None
-    resolved: str | None
-    summary: str | None
-    lines: list
-
-    @classmethod
-    def from_row(cls, r) -> "Alert":
-        """The Alert of a row of the store."""
-        d = {k: r[k] for k in cls.__dataclass_fields__}
-        d["lines"] = json.loads(r["lines"] or "[]")
-        return cls(**d)
-
-
-@dataclass(frozen=True)
-class Silence:
-    """A silence: *rule* and *satellite* (None: all) are quiet until *until* (ISO 8601 UTC), for *reason*."""
-
-    id: int
-    rule: str | None
-    satellite: str | None
-    until: str
-    reason: str
-    created: str | None
-
-    @classmethod
-    def from_row(cls, r) -> "Silence":
-        """The Silence of a row of the store."""
-        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
-
-
-@dataclass(frozen=True)
-class Delivery:
-    """A queued notification: *body* the message (subject, text, ...), *status* pending, sending, sent or
-    failed, after *attempts* tries; times ISO 8601 UTC."""
-
-    id: int
-    channel: str
-    satellite: str | None
-    subject: str
-    body: dict
-    created: str
-    status: str
-    attempts: int
-    next_attempt: str | None
-    last_error: str | None
-    sent: str | None
-
-    @classmethod
-    def from_row(cls, r) -> "Delivery":
-        """The Delivery of a row of the store."""
-        d = {k: r[k] for k in cls.__dataclass_fields__}
-        return cls(**{**d, "body": json.loads(d["body"]), "attempts": int(d["attempts"] or 0)})
+from monitor.records import Alert, Delivery, Silence, iso
 
 
 class AlertState:

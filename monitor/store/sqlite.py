@@ -13,14 +13,15 @@ from __future__ import annotations
 import datetime as dt
 import json
 import sqlite3
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from monitor.constants import N_FOR
-from monitor.result import MEASURED_FIELDS, RELIABILITY_FLAGS, AssessmentResult, ForOffset
+from monitor.records import Event, ForSeries, GranuleRow, Run, SelectionRow
+from monitor.result import MEASURED_FIELDS, AssessmentResult, ForOffset
+from monitor.store.alerts import AlertState
 from monitor.vocabulary import DONE, EventKind, RunStatus
 
 UTC = dt.timezone.utc
@@ -92,120 +93,6 @@ def now_iso() -> str:
 
 def _num(v):
     return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
-
-
-@dataclass(frozen=True)
-class Event:
-    """One ``events`` row; *detail* is the decoded JSON (rows of older versions, plain text, become
-    ``{"text": ...}``)."""
-
-    id: int
-    time: str
-    kind: EventKind
-    satellite: str | None
-    detail: dict
-
-    @classmethod
-    def from_row(cls, r) -> "Event":
-        """The event of an ``events`` row."""
-        try:
-            detail = json.loads(r["detail"])
-        except (TypeError, ValueError):
-            detail = None
-        if not isinstance(detail, dict):
-            detail = {"text": r["detail"]}
-        return cls(r["id"], r["time"], EventKind(r["kind"]), r["satellite"], detail)
-
-
-@dataclass(frozen=True)
-class Run:
-    """One run of the ledger; times ISO 8601 UTC (*finished* None while running); *day* YYYY-MM-DD."""
-
-    id: int
-    satellite: str
-    day: str
-    started: str
-    finished: str | None
-    status: RunStatus
-    reason: str | None
-    n_granules: int
-    summary: str | None
-
-    @classmethod
-    def from_row(cls, r) -> "Run":
-        """The Run of a row of the store."""
-        row = {k: r[k] for k in cls.__dataclass_fields__}
-        return cls(**{**row, "status": RunStatus(row["status"])})
-
-
-@dataclass(frozen=True)
-class ForSeries:
-    """The per-FOR results of one satellite over days, as arrays: *days* ascending (dates); *values* per
-    measured field an array (days, N_FOR), NaN where nothing is stored (n_samples 0); *flags* a
-    (days, N_FOR) object array of flag-name tuples; *stored* where a result is."""
-
-    days: list
-    values: dict
-    flags: np.ndarray
-    stored: np.ndarray
-
-    def __len__(self) -> int:
-        return len(self.days)
-
-    def reliable(self) -> np.ndarray:
-        """(days, N_FOR): a stored FOR without any of the reliability flags."""
-        flagged = np.vectorize(lambda f: bool(set(f) & set(RELIABILITY_FLAGS)), otypes=[bool])(self.flags)
-        return self.stored & ~flagged if self.flags.size else self.stored
-
-
-def _json_list(text) -> tuple:
-    return tuple(json.loads(text)) if text else ()
-
-
-@dataclass(frozen=True)
-class GranuleRow:
-    """One assessed CrIS granule as stored: its files and VIIRS cover, usable FOVs, and the processing
-    metadata (SDR software and algorithm versions, auxiliary files) that change attribution compares from
-    day to day; *day* YYYY-MM-DD, *start* ISO 8601."""
-
-    satellite: str
-    day: str
-    run_id: int
-    granule_id: str
-    start: str | None
-    cris_geo: str | None
-    cris_sdr: str | None
-    viirs: tuple[str, ...]
-    n_usable: int | None
-    software_version: str | None
-    algorithm_version: str | None
-    cris_aux: tuple[str, ...]
-    viirs_aux: tuple[str, ...]
-    viirs_software: str | None
-
-    @classmethod
-    def from_row(cls, r) -> "GranuleRow":
-        """The GranuleRow of a row of the store."""
-        row = {k: r[k] for k in cls.__dataclass_fields__}
-        return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
-
-
-@dataclass(frozen=True)
-class SelectionRow:
-    """One scene-selection decision: the granule, its inhomogeneity score (K), kept or rejected and why."""
-
-    satellite: str
-    day: str
-    run_id: int
-    granule: str
-    score_k: float | None
-    decision: str
-    reason: str | None
-
-    @classmethod
-    def from_row(cls, r) -> "SelectionRow":
-        """The SelectionRow of a row of the store."""
-        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
 
 class StoreError(RuntimeError):
@@ -298,9 +185,13 @@ class Store:
                     self.db.execute(stmt)
                 self.db.execute(f"PRAGMA user_version={v + 1}")
 
-    def transaction(self):
+    def transaction(self) -> _Transaction:
         """A context manager: BEGIN IMMEDIATE ... COMMIT, rolled back on an exception."""
         return _Transaction(self.db)
+
+    def alert_state(self) -> AlertState:
+        """The alert state, silences and delivery queue of this store."""
+        return AlertState(self)
 
     # -- runs (the ledger)
     def begin_run(self, satellite: str, day: dt.date) -> int:

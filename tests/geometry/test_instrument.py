@@ -8,8 +8,8 @@ from monitor.geometry import instrument as ins
 from monitor.geometry import wgs84
 from monitor.geometry.frames import los_angles, los_from_angles
 from monitor.geometry.geolocate import geolocate_fovs
-from monitor.mapping.engpkt import packaged_ep
 from monitor.sdr import read_file
+from monitor.sdr.engpkt import packaged_ep
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from monitor.mapping.engpkt import EngPktError, load_ep, packaged_ep, packaged_path, save_ep
+from monitor.sdr.engpkt import EngPktError, load_ep, packaged_ep, packaged_path, save_ep
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs" / "ep"
 

@@ -6,9 +6,9 @@ import numpy as np
 
 from monitor import fingerprint as fpr
 from monitor.cli import main
-from monitor.mapping.engpkt import load_library, packaged_ep
 from monitor.mapping.regeolocate import regeolocate_file
 from monitor.sdr import read_file
+from monitor.sdr.engpkt import load_library, packaged_ep
 
 
 def _day(files):

@@ -8,9 +8,9 @@ import pytest
 
 from monitor.cli import main
 from monitor.errors import DataError
-from monitor.mapping.engpkt import load_ep
 from monitor.mapping.optimize import optimize
 from monitor.result import AssessmentResult, ForOffset
+from monitor.sdr.engpkt import load_ep
 from monitor.simulate.case import ep_offsets_urad
 
 
@@ -82,7 +82,7 @@ def test_cli_optimize_writes_the_ep_in_the_input_format(tmp_path, nominal_ep, er
     d_alpha, d_beta = ep_offsets_urad(error_ep, nominal_ep)
     res = tmp_path / "result.json"
     res.write_text(_result(d_alpha, d_beta).to_json())
-    from monitor.mapping.engpkt import packaged_path
+    from monitor.sdr.engpkt import packaged_path
 
     assert (
         main(
@@ -108,7 +108,7 @@ def test_cli_optimize_writes_the_ep_in_the_input_format(tmp_path, nominal_ep, er
 
 
 def test_cli_optimize_bad_inputs(tmp_path, capsys):
-    from monitor.mapping.engpkt import packaged_path
+    from monitor.sdr.engpkt import packaged_path
 
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
@@ -126,7 +126,7 @@ def test_cli_optimize_bad_inputs(tmp_path, capsys):
 
 
 def test_cli_simulate_in_ep_terms_checks_its_inputs(tmp_path, capsys):
-    from monitor.mapping.engpkt import packaged_path
+    from monitor.sdr.engpkt import packaged_path
 
     v115, v37 = str(packaged_path("j01")), str(packaged_path("npp"))
     assert main(["simulate", "--out", str(tmp_path / "a"), "--true-ep", v115]) == 2

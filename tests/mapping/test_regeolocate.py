@@ -66,7 +66,7 @@ def test_fills_are_kept_and_inputs_refused_in_place(ep_geo_case, nominal_ep, tmp
 
 
 def test_cli_geolocate_json_on_real_granules(real_geo_files, capsys):
-    from monitor.mapping.engpkt import packaged_path
+    from monitor.sdr.engpkt import packaged_path
 
     assert main(["geolocate", "--ep", str(packaged_path("j01")), "--json", *map(str, real_geo_files)]) == 0
     doc = json.loads(capsys.readouterr().out)
@@ -77,7 +77,7 @@ def test_cli_geolocate_json_on_real_granules(real_geo_files, capsys):
 def test_cli_regeolocate_and_wrong_satellite(ep_geo_case, tmp_path, capsys):
     case, _ = ep_geo_case
     files = list(map(str, _geo_files(case)))
-    from monitor.mapping.engpkt import packaged_path
+    from monitor.sdr.engpkt import packaged_path
 
     assert main(["regeolocate", "--ep", str(packaged_path("npp")), "--out", str(tmp_path / "o"), *files]) == 2
     assert "granule of j01, EP V37 of npp" in capsys.readouterr().err

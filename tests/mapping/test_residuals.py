@@ -12,9 +12,9 @@ from monitor import fingerprint as fpr
 from monitor.constants import URAD
 from monitor.geometry.instrument import fov5_angles
 from monitor.mapping import residuals
-from monitor.mapping.engpkt import load_ep
 from monitor.mapping.regeolocate import compare_with_files
 from monitor.sdr import read_file
+from monitor.sdr.engpkt import load_ep
 from tests.cli import run_crisgeo
 from tests.conftest import EP_CONFIGS
 
