@@ -17,6 +17,7 @@ from alerts.alertmanager import post_state
 from alerts.changes import all_changes
 from alerts.channels import Permanent, Transient, make_channels
 from alerts.rules import (
+    Finding,
     failure_finding,
     jump_findings,
     processing_change_findings,
@@ -149,8 +150,6 @@ def evaluate(store: History, settings: AlertSettings, satellites, now: dt.dateti
                 if prev.fingerprint not in current:
                     state.resolve(prev.fingerprint, now)
                     if state.silenced(prev.rule, sat, now) is None:
-                        from alerts.rules import Finding
-
                         items.append(
                             (
                                 "resolved",

@@ -319,7 +319,7 @@ def _cris_geometry(geo):
     return granule_geometry(geo), valid, fill
 
 
-def _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop=None):
+def _collocate_fors(pieces, geo, fg, valid, fill, cfg: AssessConfig, band, should_stop=None):
     """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone and the worst coverage per FOV (all FOVs of the
     granule in one call of the parallel kernel)."""
     if should_stop is not None and should_stop():

@@ -32,7 +32,7 @@ def reset_peak_rss() -> bool:
         return False
 
 
-def _pyresample_reference(case, cfg, max_granules=1):
+def _pyresample_reference(case, cfg: AssessConfig, max_granules=1):
     """Time the zero-offset and all-perturbation collocation with pyresample's radius neighbour search.
 
     For each perturbed LOS the ground point is computed and pyresample finds the VIIRS pixels within

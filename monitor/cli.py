@@ -13,6 +13,7 @@ import argparse
 import datetime as dt
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from monitor import allocator, logs
 from monitor.config import AssessmentConfig
@@ -21,6 +22,10 @@ from monitor.satellites import SATELLITES
 from monitor.simulate.orbit import PASSES
 from monitor.version import __version__
 from monitor.vocabulary import Kernel, Rule
+
+if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
+    from monitor.config import Config
+    from monitor.store.sqlite import Store
 
 # the defaults of the assessment keys, for the commands that take them as flags
 ASSESSMENT = AssessmentConfig()
@@ -426,14 +431,14 @@ def cmd_export(args) -> int:
     return EXIT_OK
 
 
-def _open_store(cfg):
+def _open_store(cfg: Config) -> Store:
     """The configured store for a command that only reads: never created (a missing one is an error)."""
     from monitor.store.sqlite import Store
 
     return Store(cfg.store.sqlite, create=False)
 
 
-def _satellites(cfg, satellite: str | None) -> list[str]:
+def _satellites(cfg: Config, satellite: str | None) -> list[str]:
     """The configured satellites, or the one asked for (which must be configured)."""
     if satellite and satellite not in cfg.satellites:
         raise BadInput(f"satellite {satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.constants import N_FOR
+from monitor.records import History
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import satellite as satellite_info
 
@@ -38,7 +39,7 @@ VARIABLES = {
 FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
 
 
-def to_xarray(store, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
+def to_xarray(store: History, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
     """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset."""
     import xarray as xr
 
@@ -122,7 +123,7 @@ class NothingToExport(ValueError):
     """The store holds no results in the period asked for."""
 
 
-def export(store, satellite: str, out, fmt: str, since=None, until=None) -> Path:
+def export(store: History, satellite: str, out, fmt: str, since=None, until=None) -> Path:
     """Write the results of *satellite* to *out* as ``netcdf`` or ``csv``; returns the path.
     :class:`NothingToExport` (and no file) when the period holds no results; :class:`OSError` when *out*
     cannot be written."""

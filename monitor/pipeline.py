@@ -91,7 +91,7 @@ def days_to_run(store: Store, satellite: str, schedule: ScheduleConfig, today: d
     return schedule.days_to_run(store.done_days(satellite, schedule.no_data_horizon(today)), today)
 
 
-def day_prints(cfg, source, day: dt.date, listing) -> list:
+def day_prints(cfg: Config, source, day: dt.date, listing) -> list:
     """LOS fingerprints (:func:`monitor.fingerprint.granule_print`) of a sample of the day's GEO granules;
     a granule that cannot be fetched or read is logged and left out."""
     geos = sorted(
@@ -113,7 +113,7 @@ def day_prints(cfg, source, day: dt.date, listing) -> list:
     return prints
 
 
-def record_fingerprint(cfg, store, satellite: str, day: dt.date, prints: list) -> dict | None:
+def record_fingerprint(cfg: Config, store: Store, satellite: str, day: dt.date, prints: list) -> dict | None:
     """Store the day's fingerprint and compare it with the previous day's and within the day.
 
     A step becomes a ``change:cris`` event (used for jump attribution and notified by the alerts).
@@ -143,7 +143,7 @@ def record_fingerprint(cfg, store, satellite: str, day: dt.date, prints: list) -
     return body
 
 
-def publish_changes(cfg, store, satellite: str) -> None:
+def publish_changes(cfg: Config, store: Store, satellite: str) -> None:
     """Queue every known change of *satellite* for the time-series stores (dashboard annotations)."""
     if not cfg.store.publish:
         return
@@ -206,7 +206,7 @@ def compute_day(
         return _compute_day(cfg, source, satellite, day, should_stop, progress)
 
 
-def _compute_day(cfg, source: Source, satellite: str, day: dt.date, should_stop, progress) -> DayWork:
+def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, should_stop, progress) -> DayWork:
     stop = should_stop or (lambda: False)
     w = DayWork(satellite, day, RunStatus.OK)
     w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}

@@ -11,6 +11,7 @@ import datetime as dt
 import json
 from contextlib import AbstractContextManager
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
@@ -229,7 +230,9 @@ class AlertLedger(Protocol):
 
 
 class History(Protocol):
-    """What the alert rules read of the store (:class:`monitor.store.sqlite.Store`)."""
+    """What the alert rules and the export read of the store (:class:`monitor.store.sqlite.Store`)."""
+
+    path: Path  # the store's file
 
     def alert_state(self) -> AlertLedger: ...
     def transaction(self) -> AbstractContextManager[Any]: ...

@@ -18,6 +18,7 @@ import time
 from dataclasses import dataclass, field
 
 from monitor.allocator import reuse_freed_memory
+from monitor.config import Config
 from monitor.lock import InstanceLock
 from monitor.pipeline import DayWork, ProgressLines, compute_day, record_day
 from monitor.sources import make_source
@@ -27,7 +28,7 @@ from monitor.vocabulary import RunStatus
 LOG = logging.getLogger(__name__)
 
 
-def day_task(cfg, satellite: str, day: dt.date) -> DayWork:
+def day_task(cfg: Config, satellite: str, day: dt.date) -> DayWork:
     """One satellite-day on a worker: its own source (a NODD source shares ``cache_dir`` when that is on
     a shared file system), no store. The worker's allocator keeps freed memory for the next array, as in
     every crisgeo command (Dask starts its workers with MALLOC_TRIM_THRESHOLD_ = 64 KiB, which has the
@@ -164,7 +165,9 @@ def reprocess(
     return summary
 
 
-def run_reprocess(cfg, since, until, satellites, scheduler=None, workers=2, force=False) -> ReprocessSummary:
+def run_reprocess(
+    cfg: Config, since, until, satellites, scheduler=None, workers=2, force=False
+) -> ReprocessSummary:
     """``crisgeo reprocess``: :func:`reprocess` with SIGINT/SIGTERM as a clean stop and a progress bar on a
     terminal (log lines otherwise)."""
     import sys

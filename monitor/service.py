@@ -22,13 +22,24 @@ import socket
 import threading
 from collections.abc import Iterator
 
+from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED
+from apscheduler.schedulers.blocking import BlockingScheduler
+from apscheduler.triggers.cron import CronTrigger
+
+from alerts.alertmanager import post_state
+from alerts.engine import deliver, evaluate, fmt_counts
 from monitor import allocator, logs
+from monitor.config import Config, parse_listen
+from monitor.endpoint import Endpoint
 from monitor.health import Health
 from monitor.lock import InstanceLock
+from monitor.metrics import ServiceMetrics
 from monitor.pipeline import RunOutcome, days_to_run, run_day
 from monitor.sources import make_source
 from monitor.store.sqlite import Store
-from monitor.vocabulary import RunStatus
+from monitor.store.timeseries import drain_outbox
+from monitor.version import __version__
+from monitor.vocabulary import EventKind, RunStatus
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
@@ -59,14 +70,14 @@ def sd_notify(message: str) -> bool:
 class Service:
     """Runs satellite-days for a configuration; the daemon adds the scheduler and signals."""
 
-    def __init__(self, cfg, progress=None):
+    def __init__(self, cfg: Config, progress=None):
         self.cfg = cfg
         self.stop_event = threading.Event()
         self.progress = progress
         self.source = make_source(cfg)
-        self.scheduler = None
+        self.scheduler: BlockingScheduler | None = None
         self.health = Health(STALL_S)
-        self.metrics = None  # monitor.metrics.ServiceMetrics, while the daemon serves /metrics
+        self.metrics: ServiceMetrics | None = None  # while the daemon serves /metrics
 
     def store(self) -> Store:
         """A new connection to the configured store (close it, or use it in ``with``)."""
@@ -102,12 +113,12 @@ class Service:
             # they plot) would otherwise stay with the daemon until the next day
             allocator.release_freed_memory()
 
-    def _after_run(self, store, outcome):
+    def _after_run(self, store: Store, outcome: RunOutcome) -> None:
         """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the
         e-mails attach its trend plot), deliver what is queued."""
         self.check_alerts(store, report=True)
 
-    def regenerate_report(self, store):
+    def regenerate_report(self, store: Store) -> None:
         """Rewrite the HTML report into ``report_dir``; a report problem never stops the service."""
         if not self.cfg.report_dir:
             return
@@ -118,11 +129,9 @@ class Service:
         except Exception:  # noqa: BLE001 - matplotlib, disk or data surprises are logged, not fatal
             LOG.exception("report: could not regenerate %s", self.cfg.report_dir)
 
-    def check_alerts(self, store=None, report: bool = False):
+    def check_alerts(self, store: Store | None = None, report: bool = False) -> None:
         """Evaluate the alert rules for every satellite and deliver the queue (regenerating the report in
         between when *report*); a broken channel never stops the service."""
-        from alerts.alertmanager import post_state
-        from alerts.engine import deliver, evaluate, fmt_counts
 
         own = store is None
         store = store or self.store()
@@ -143,7 +152,6 @@ class Service:
     def drain_outbox(self) -> dict:
         """Send the time-series points waiting in the outbox (after an outage they need not wait for the
         next daily run); returns {target: (sent, left)}."""
-        from monitor.store.timeseries import drain_outbox
 
         with self.store() as store:
             report = drain_outbox(store, self.cfg.store.publish)
@@ -196,8 +204,6 @@ class Service:
     def add_jobs(self, scheduler):
         """The daemon's jobs: per satellite the daily run (catching up at start), the hourly alert
         evaluation, and (with publishing) the outbox timer."""
-        from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED
-        from apscheduler.triggers.cron import CronTrigger
 
         sch = self.cfg.schedule
         now = dt.datetime.now(UTC)
@@ -229,10 +235,6 @@ class Service:
         """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
         if listen == "off":
             return None
-        from monitor.config import parse_listen
-        from monitor.endpoint import Endpoint
-        from monitor.metrics import ServiceMetrics
-        from monitor.version import __version__
 
         self.metrics = ServiceMetrics(self.store, self.cfg.satellites, self.health, __version__)
         report = self.cfg.report_dir if self.cfg.report_dir else None
@@ -240,8 +242,6 @@ class Service:
 
     def daemon(self, listen: str | None = None):
         """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``."""
-        from apscheduler.schedulers.blocking import BlockingScheduler
-
         sch = self.cfg.schedule
         with InstanceLock(self.cfg.state_dir):
             endpoint = self.start_endpoint(listen or self.cfg.http.listen)
@@ -282,9 +282,6 @@ class Service:
             self.scheduler.shutdown(wait=False)
 
     def _job_event(self, event):
-        from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MISSED
-
-        from monitor.vocabulary import EventKind
 
         kind = {EVENT_JOB_ERROR: EventKind.JOB_ERROR, EVENT_JOB_MISSED: EventKind.JOB_MISSED}.get(
             event.code, EventKind.JOB_SKIPPED

@@ -6,13 +6,15 @@ from __future__ import annotations
 
 from typing import Any
 
+from monitor.config import Config
 from monitor.store.alerts import AlertState
+from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
 
 NAGIOS_OK, NAGIOS_WARNING, NAGIOS_CRITICAL, NAGIOS_UNKNOWN = 0, 1, 2, 3
 
 
-def status_report(cfg, store, satellites=None) -> dict:
+def status_report(cfg: Config, store: Store, satellites=None) -> dict:
     """What ``crisgeo status`` shows, as data: per satellite (*satellites*, default: the configured ones)
     the last run, the latest per-FOR offsets and the alerts firing; the next run; the outbox size; and the
     Nagios state of it all."""

@@ -22,15 +22,18 @@ import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from alerts.changes import all_changes
+from monitor.config import Config
 from monitor.constants import SPEC_KM
 from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
 from monitor.store.alerts import AlertState
+from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
 
 UTC = dt.timezone.utc
@@ -57,7 +60,7 @@ class ReportOptions:
     satellites: list = field(default_factory=list)
 
 
-def options_from_config(cfg, satellites=None, since=None, until=None) -> ReportOptions:
+def options_from_config(cfg: Config, satellites=None, since=None, until=None) -> ReportOptions:
     """Report options of a service configuration: the spec of its alert rules, its events calendar."""
     return ReportOptions(
         spec_km=cfg.alerts.spec_km,
@@ -150,7 +153,7 @@ def _img(name, alt) -> str:
     return f'<img src="{name}" alt="{_e(alt)}">'
 
 
-def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dict:
+def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions) -> dict:
     """Write ``out/<satellite>/`` and return a summary for the index."""
     sat_dir = out / satellite
     sat_dir.mkdir(parents=True, exist_ok=True)
@@ -173,7 +176,7 @@ def satellite_page(store, satellite: str, out: Path, opts: ReportOptions) -> dic
         '<p><a href="../index.html">all satellites</a></p><h1>CrIS geolocation against VIIRS I5: '
         f"{_e(name)}</h1>"
     ]
-    summary = {
+    summary: dict[str, Any] = {
         "satellite": satellite,
         "name": name,
         "latest": None,
@@ -314,7 +317,7 @@ def _drop_figures_except(sat_dir: Path, keep: set) -> None:
             old.unlink(missing_ok=True)
 
 
-def build_report(store, out_dir, opts: ReportOptions) -> Path:
+def build_report(store: Store, out_dir, opts: ReportOptions) -> Path:
     """Write the report for *opts.satellites* into *out_dir*; returns the index path.
 
     Pages are written under temporary names and moved into place, so a reader never sees half a page.

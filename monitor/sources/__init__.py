@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
+from monitor.config import Config
 from monitor.sdr.names import JpssName, parse_name
 from monitor.sdr.products import PRODUCTS
 
@@ -72,7 +73,7 @@ class Source(Protocol):
         """A local path holding *f* (downloaded if need be); :class:`SourceError` on failure."""
 
 
-def make_source(cfg) -> Source:
+def make_source(cfg: Config) -> Source:
     """The source named by the configuration's ``source.kind``."""
     from monitor.sources.local import LocalSource, SimulatedSource
     from monitor.sources.nodd import NoddSource

@@ -37,6 +37,7 @@ from urllib.parse import urljoin, urlsplit
 import requests
 import urllib3
 
+from monitor.config import SourceConfig
 from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
 from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed
 from monitor.sources.bounded import BoundedSession, DeadlinePassed, StallWatch
@@ -67,7 +68,7 @@ def _retry_after_s(value: str | None) -> float | None:
 class NoddSource:
     """Granules of the NODD bucket of each satellite, cached under *cache_dir*."""
 
-    def __init__(self, cfg, cache_dir: Path, sleep=time.sleep):
+    def __init__(self, cfg: SourceConfig, cache_dir: Path, sleep=time.sleep):
         self.cfg = cfg
         self.cache_dir = Path(cache_dir)
         self.http = BoundedSession()

@@ -4,14 +4,18 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+from typing import TYPE_CHECKING
 
 from monitor.records import Alert, Delivery, Silence, iso
+
+if TYPE_CHECKING:
+    from monitor.store.sqlite import Store
 
 
 class AlertState:
     """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries."""
 
-    def __init__(self, store):
+    def __init__(self, store: Store):
         self.store = store
         self.db = store.db
 

@@ -31,7 +31,9 @@ from influxdb_client import InfluxDBClient, Point, WritePrecision
 from influxdb_client.client.exceptions import InfluxDBError
 from influxdb_client.client.write_api import SYNCHRONOUS
 
+from monitor.config import PublishConfig
 from monitor.result import MEASURED_FIELDS
+from monitor.store.sqlite import Store
 
 LOG = logging.getLogger(__name__)
 # the published float fields: the measured ones but the sample count (an integer field) and the sigmas in km
@@ -80,7 +82,7 @@ def change_lines(measurement: str, changes) -> list[str]:
     return lines
 
 
-def target_name(cfg) -> str:
+def target_name(cfg: PublishConfig) -> str:
     """Outbox target of a publisher (kind and URL; never a credential)."""
     return f"{cfg.kind}:{cfg.url}"
 
@@ -88,7 +90,7 @@ def target_name(cfg) -> str:
 class Influx2Writer:
     """v2 write API through influxdb-client, synchronous so that every failure is seen."""
 
-    def __init__(self, cfg):
+    def __init__(self, cfg: PublishConfig):
         self.cfg = cfg
         self.client = InfluxDBClient(
             url=cfg.url, token=cfg.secret("token_env") or "", org=cfg.org, timeout=int(cfg.timeout_s * 1000)
@@ -99,7 +101,10 @@ class Influx2Writer:
         """Write line-protocol *lines*; raises on any failure (the outbox keeps them)."""
         try:
             self.api.write(
-                bucket=self.cfg.bucket, org=self.cfg.org, record=lines, write_precision=WritePrecision.S
+                bucket=self.cfg.bucket,
+                org=self.cfg.org,
+                record=lines,
+                write_precision=WritePrecision.S,  # type: ignore[arg-type]
             )
         except InfluxDBError as exc:
             raise PublishError(
@@ -116,10 +121,10 @@ class Influx2Writer:
 class Influx1Writer:
     """InfluxDB 1.x ``/write`` with line protocol; creates the database once if it is missing."""
 
-    def __init__(self, cfg):
+    def __init__(self, cfg: PublishConfig):
         self.cfg = cfg
         user, password = cfg.secret("username_env"), cfg.secret("password_env")
-        self.auth = (user, password) if user else None
+        self.auth = (user, password or "") if user else None
 
     def _post(self, lines):
         return requests.post(
@@ -158,7 +163,7 @@ WRITERS: dict[str, type[Influx2Writer] | type[Influx1Writer]] = {
 }
 
 
-def drain_outbox(store, publish_cfgs, batch: int = 5000) -> dict:
+def drain_outbox(store: Store, publish_cfgs: list[PublishConfig], batch: int = 5000) -> dict:
     """Send every queued point to its server; returns {target: (sent, left)}. Never raises for a server."""
     report = {}
     for cfg in publish_cfgs:
