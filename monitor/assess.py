@@ -448,7 +448,7 @@ def cost_and_offsets(
     """The cost cube, per-FOR minimum, bootstrap uncertainty and km offsets of collocated *samples*."""
     offsets = cfg.offsets_rad
     m = len(offsets)
-    step_urad = cfg.step_rad * 1e6
+    step_urad = cfg.step_rad / URAD
     rng = np.random.default_rng(cfg.seed)
     cube = np.full((N_FOR, m, m), np.nan)
     fors = []

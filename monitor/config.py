@@ -38,7 +38,14 @@ from pydantic import (
     model_validator,
 )
 
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, MAX_GRID_SPREAD_RAD, SPEC_KM, URAD
+from monitor.constants import (
+    DEFAULT_HALF_STEPS,
+    DEFAULT_STEP_URAD,
+    MAX_GRID_SPREAD_RAD,
+    PROCESSING_CHANGE_URAD,
+    SPEC_KM,
+    URAD,
+)
 from monitor.satellites import SATELLITES
 from monitor.vocabulary import Kernel, PublishKind, SourceKind
 
@@ -376,7 +383,10 @@ class FingerprintConfig(Section):
         100, "GEO granules per day sampled (spread over the day) for the LOS fingerprint.", 1, 2000
     )
     threshold_urad: float = key(
-        10.0, "A FOR whose fingerprint angle moves more than this is a processing change.", 0.1, 10000
+        PROCESSING_CHANGE_URAD,
+        "A FOR whose fingerprint angle moves more than this is a processing change.",
+        0.1,
+        10000,
     )
     ep_library: Annotated[tuple[FilePath, ...], BeforeValidator(_paths)] = key(
         (), "EP files or directories to identify the EP in use from; empty: the packaged real EPs."

@@ -19,6 +19,11 @@ VIIRS_I_PIXEL_M = 375.0  # VIIRS I-band pixel at nadir
 REFERENCE_ALTITUDE_M = 833000.0  # the JPSS orbit altitude the paper's grid step is defined at
 DEFAULT_STEP_RAD = VIIRS_I_PIXEL_M / REFERENCE_ALTITUDE_M  # one I-band pixel seen from 833 km, ~450 urad
 DEFAULT_STEP_URAD = DEFAULT_STEP_RAD / URAD
+# A FOV-5 angle of the LOS fingerprint moving more than this (urad) is a geolocation processing change (real
+# NOAA-20: granules 1-7 depart at most 3.4 urad from the median of 1-5, the scan-to-scan scatter is ~2 urad;
+# those after the servo's move, 10-25). The fingerprint's change test and the residual table's staleness test
+# use it.
+PROCESSING_CHANGE_URAD = 10.0
 DEFAULT_HALF_STEPS = 10  # perturbations on each side of zero: a 21 x 21 grid
 # The widest perturbation grid the compiled cone kernel takes: half_steps^2 x step <= 0.2 rad (the paper's
 # grid: 100 x 450 urad = 0.045 rad); within it tan B_j is linear in j to 0.3 of a step at |beta| <= 55 deg.

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.constants import URAD
+from monitor.constants import PROCESSING_CHANGE_URAD, URAD
 from monitor.errors import DataError
 from monitor.geometry.instrument import FOV5, fov5_angles
 from monitor.geometry.inverse import granule_geometry
@@ -127,7 +127,7 @@ def day_print(prints: list[GranulePrint]) -> DayPrint:
 K_SIGMA = 4.0
 
 
-def thresholds(sd_alpha_urad, sd_beta_urad, threshold_urad: float = 10.0):
+def thresholds(sd_alpha_urad, sd_beta_urad, threshold_urad: float = PROCESSING_CHANGE_URAD):
     """Per-FOR step thresholds (urad): max(threshold, 4 x scan-to-scan scatter), per direction."""
     return (
         np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_alpha_urad)),
@@ -141,7 +141,7 @@ def _changed_fors(before_a, before_b, after_a, after_b, thr_a, thr_b):
     return fors, da, db
 
 
-def compare_days(previous: DayPrint, current: DayPrint, threshold_urad: float = 10.0):
+def compare_days(previous: DayPrint, current: DayPrint, threshold_urad: float = PROCESSING_CHANGE_URAD):
     """(FORs changed, d_alpha_urad, d_beta_urad) between two daily fingerprints.
 
     Thresholds use the larger scatter of the two days: a step between days does not widen either.
@@ -161,7 +161,7 @@ def compare_days(previous: DayPrint, current: DayPrint, threshold_urad: float = 
 
 def change_within(
     prints: list[GranulePrint],
-    threshold_urad: float = 10.0,
+    threshold_urad: float = PROCESSING_CHANGE_URAD,
     min_side: int = 2,
     reference: DayPrint | None = None,
 ):
@@ -374,7 +374,7 @@ class FilesPrint:
         return doc
 
 
-def fingerprint_files(paths, ep_library=(), threshold_urad: float = 10.0) -> FilesPrint:
+def fingerprint_files(paths, ep_library=(), threshold_urad: float = PROCESSING_CHANGE_URAD) -> FilesPrint:
     """Fingerprint the CrIS GEO files under *paths*, rank the EPs of *ep_library* (files or directories;
     empty: the packaged real EPs) against it and look for a step within the files. A
     :class:`~monitor.errors.DataError` when no file can be read."""

@@ -35,6 +35,11 @@ class Satellite:
     ltan_h: float  # local solar time of the ascending node, hours
     phase_deg: float  # mean argument of latitude ahead of S-NPP
     launch_unix_s: float  # launch, UTC seconds since 1970
+    mission: str  # HDF5 Mission_Name of its granules
+    srf_file: str  # VIIRS I5 spectral response, monitor/data/srf (NOAA-21 has none public: NOAA-20's)
+    ep_file: str | None  # the real CrIS engineering packet shipped, monitor/data/ep
+    cris_instrument_id: int | None  # InstrumentId of its CrIS in EP XML files
+    pct_mounting_urad: tuple[float, float, float] | None  # CrIS PCT mounting roll, pitch, yaw (LW-GEO)
 
     def orbit_number(self, unix_s: float) -> int:
         """The orbit number IDPS gives a granule starting at *unix_s*: whole orbits since launch, plus one."""
@@ -44,9 +49,54 @@ class Satellite:
 SATELLITES = {
     s.short: s
     for s in (
-        Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0, 1319795281.0),
-        Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0, 1510998456.0),
-        Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0, 1668073765.0),
+        Satellite(
+            short="npp",
+            idps="NPP",
+            name="S-NPP",
+            bucket="noaa-nesdis-snpp-pds",
+            altitude_m=838.8e3,
+            inclination_deg=98.67,
+            ltan_h=13.5,
+            phase_deg=0.0,
+            launch_unix_s=1319795281.0,
+            mission="NPP",
+            srf_file="npp_viirs_i05_srf.csv",
+            ep_file="SNPP_side1_V37_EngPkt.xml",
+            cris_instrument_id=1,
+            pct_mounting_urad=(-518.45683, -77.760702, 46.109524),
+        ),
+        Satellite(
+            short="j01",
+            idps="J01",
+            name="NOAA-20",
+            bucket="noaa-nesdis-n20-pds",
+            altitude_m=833.0e3,
+            inclination_deg=98.7,
+            ltan_h=13.5,
+            phase_deg=-90.0,
+            launch_unix_s=1510998456.0,
+            mission="S-NPP/JPSS",
+            srf_file="n20_viirs_i05_srf.csv",
+            ep_file="JPSS1_side1_V115_EngPkt.xml",
+            cris_instrument_id=4,
+            pct_mounting_urad=(-145.84994, 267.42417, 594.61832),
+        ),
+        Satellite(
+            short="j02",
+            idps="J02",
+            name="NOAA-21",
+            bucket="noaa-nesdis-n21-pds",
+            altitude_m=833.0e3,
+            inclination_deg=98.8,
+            ltan_h=13.5,
+            phase_deg=90.0,
+            launch_unix_s=1668073765.0,
+            mission="S-NPP/JPSS",
+            srf_file="n20_viirs_i05_srf.csv",
+            ep_file=None,
+            cris_instrument_id=None,
+            pct_mounting_urad=None,
+        ),
     )
 }
 PHASE_EPOCH_UNIX_S = 1704067200.0  # 2024-01-01T00:00:00Z

@@ -17,12 +17,13 @@ import numba
 import numpy as np
 
 from monitor.errors import DataError
+from monitor.satellites import SATELLITES
 from monitor.sdr.products import cris_lw_wavenumbers_cm1
 from monitor.threads import KERNEL_LOCK
 
 C1 = 1.191042972e-5  # 2hc^2, mW/(m2 sr cm-4)
 C2 = 1.4387769  # hc/k, cm K
-SRF_FILES = {"npp": "npp_viirs_i05_srf.csv", "j01": "n20_viirs_i05_srf.csv", "j02": "n20_viirs_i05_srf.csv"}
+SRF_FILES = {s.short: s.srf_file for s in SATELLITES.values()}
 HAMMING = (0.23, 0.54, 0.23)
 GUESS_BINS = 4096  # the inverse table's index is guessed from a uniform grid of radiance
 PARALLEL_FROM = 1 << 16  # values converted at once from which the parallel kernel is worth its lock

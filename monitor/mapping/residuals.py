@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.constants import N_FOR, URAD
+from monitor.constants import N_FOR, PROCESSING_CHANGE_URAD, URAD
 from monitor.errors import DataError
 from monitor.fingerprint import day_print, granule_print
 from monitor.geometry.frames import los_angles, los_from_angles
@@ -41,9 +41,8 @@ from monitor.geometry.instrument import EngineeringPacket, fov5_angles
 log = logging.getLogger(__name__)
 
 # Departure (urad) of a granule's own FOV-5 angles from the learning granules' beyond which the table no
-# longer describes it. Real NOAA-20: granules 1-7 depart at most 3.4 urad from the median of 1-5 (the
-# scan-to-scan scatter is ~2 urad), those after the servo's move 10-25 urad.
-STALE_URAD = 10.0
+# longer describes it: a processing change, as the fingerprint counts one.
+STALE_URAD = PROCESSING_CHANGE_URAD
 _FOV5_LIMIT_URAD = 1.0e6  # |a FOV-5 angle| in the spacecraft frame stays below ~0.9 rad
 
 

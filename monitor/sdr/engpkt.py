@@ -41,11 +41,11 @@ _ANGLES = (
 _TIME_STAMP_BIAS = "MappingParameters/TimeStampBias"  # milliseconds
 _MOUNTING = ("ScToSbf", ("Roll", "Pitch", "Yaw"))
 
-# InstrumentId -> satellite, and the PCT mounting (roll, pitch, yaw) in urad (LW-GEO cris_sensor_info).
-INSTRUMENT_SATELLITE = {1: "npp", 4: "j01"}
-MOUNTING_URAD = {"npp": (-518.45683, -77.760702, 46.109524), "j01": (-145.84994, 267.42417, 594.61832)}
-
-PACKAGED = {"npp": "SNPP_side1_V37_EngPkt.xml", "j01": "JPSS1_side1_V115_EngPkt.xml"}
+# InstrumentId -> satellite, the PCT mounting (roll, pitch, yaw) in urad (LW-GEO cris_sensor_info) and the
+# packaged real EPs: from the satellite table
+INSTRUMENT_SATELLITE = {s.cris_instrument_id: s.short for s in SATELLITES.values() if s.cris_instrument_id}
+MOUNTING_URAD = {s.short: s.pct_mounting_urad for s in SATELLITES.values() if s.pct_mounting_urad}
+PACKAGED = {s.short: s.ep_file for s in SATELLITES.values() if s.ep_file}
 
 
 class EngPktError(DataError):

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.constants import CRIS_SCAN_US
+from monitor.constants import CRIS_SCAN_US, URAD
 from monitor.errors import DataError
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
@@ -100,7 +100,7 @@ def ep_offsets_urad(true_ep: EngineeringPacket, ground_ep: EngineeringPacket):
     """Per-FOR (d_alpha, d_beta) (urad) of FOV 5 from the ground-processing LOS to the true one."""
     a_true, b_true = fov5_angles(true_ep)
     a_geo, b_geo = fov5_angles(ground_ep)
-    return (a_true - a_geo) * 1e6, (b_true - b_geo) * 1e6
+    return (a_true - a_geo) / URAD, (b_true - b_geo) / URAD
 
 
 def _unix_s(when: dt.datetime) -> float:
@@ -171,7 +171,7 @@ class Simulator:
             self.los_true, self.los_geo = los_spacecraft(spec.true_ep), los_spacecraft(spec.ground_ep)
         else:
             self.los_true = ins.cris_los_sbf()
-            self.los_geo = ins.cris_los_sbf(-spec.d_alpha_urad * 1e-6, -spec.d_beta_urad * 1e-6)
+            self.los_geo = ins.cris_los_sbf(-spec.d_alpha_urad * URAD, -spec.d_beta_urad * URAD)
 
     def attitude_rad(self, unix_s):
         """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift."""

@@ -10,11 +10,12 @@ from dataclasses import dataclass, field
 import h5py
 import numpy as np
 
+from monitor.satellites import SATELLITES
 from monitor.sdr.products import Product
 
 USERBLOCK = 1024
-PLATFORM_ATTR = {"npp": "NPP", "j01": "J01", "j02": "J02"}
-MISSION = {"npp": "NPP", "j01": "S-NPP/JPSS", "j02": "S-NPP/JPSS"}
+PLATFORM_ATTR = {s.short: s.idps for s in SATELLITES.values()}
+MISSION = {s.short: s.mission for s in SATELLITES.values()}
 
 
 def text_attr(value: str) -> np.ndarray:
