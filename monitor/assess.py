@@ -30,7 +30,15 @@ from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
-from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult, ForOffset
+from monitor.result import (
+    FLAG_EDGE,
+    FLAG_FEW_SAMPLES,
+    FLAG_FLAT,
+    FLAG_UNCERTAIN,
+    AssessmentResult,
+    ForOffset,
+    GranuleInfo,
+)
 from monitor.sdr import CrisGeoGranule, CrisSdrGranule, GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_viirs_geo_scan
@@ -73,7 +81,7 @@ class GranuleSamples:
     """Collocated samples of one CrIS granule: per FOV the VIIRS BT of every perturbed cone."""
 
     key: str
-    info: dict
+    info: GranuleInfo
     bt_viirs_k: np.ndarray  # (nscan, 30, 9, m, m)
     bt_cris_k: np.ndarray  # (nscan, 30, 9)
     usable: np.ndarray  # (nscan, 30, 9)
@@ -283,18 +291,18 @@ def collocate_granule(
         & (coverage >= cfg.min_coverage)
         & np.all(np.isfinite(bt_viirs), axis=(-2, -1))
     )
-    info = {
-        "granule_id": geo.meta.granule_id,
-        "start": geo.meta.start.isoformat(),
-        "end": geo.meta.end.isoformat(),
-        "cris_geo": cris.geo.name,
-        "cris_sdr": cris.sdr.name,
-        "viirs": [v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
-        "n_fovs": int(valid.sum()),
-        "n_usable": int(usable.sum()),
-        "cris_meta": geo.meta.to_dict(),
-        "viirs_meta": viirs[0].geo_meta.to_dict(),
-    }
+    info = GranuleInfo(
+        granule_id=geo.meta.granule_id,
+        start=geo.meta.start.isoformat(),
+        end=geo.meta.end.isoformat(),
+        cris_geo=cris.geo.name,
+        cris_sdr=cris.sdr.name,
+        viirs=[v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
+        n_fovs=int(valid.sum()),
+        n_usable=int(usable.sum()),
+        cris_meta=geo.meta.to_dict(),
+        viirs_meta=viirs[0].geo_meta.to_dict(),
+    )
     s5 = (slice(None), slice(None), FOV5)
     return GranuleSamples(
         cris.key,
@@ -458,11 +466,16 @@ def cost_and_offsets(
             use = s.usable[:, k]  # (nscan, 9)
             d = s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]
             diffs.append(d.astype(np.float64))
-            units.append(g_i * 1000 + np.nonzero(use)[0])
+            scans = np.nonzero(use)[0]  # the scan of each sample
+            units.append(np.column_stack([np.full(scans.size, g_i), scans]))
         d = np.concatenate(diffs) if diffs else np.empty((0, m, m))
+        # the scans (granule, scan) the samples come from, in order, and each sample's scan among them
         scan_keys, unit_ids = (
-            np.unique(np.concatenate(units), return_inverse=True) if diffs else (np.empty(0), [])
+            np.unique(np.concatenate(units), axis=0, return_inverse=True)
+            if diffs
+            else (np.empty((0, 2), int), np.empty(0, int))
         )
+        unit_ids = unit_ids.reshape(-1)
         n = len(d)
         flags = []
         if n < max(cfg.min_samples, 3):
@@ -471,7 +484,7 @@ def cost_and_offsets(
         sig_a = sig_b = np.nan
         g = np.full((m, m), np.nan)
         if n >= 3:
-            g, x, y, (sig_a, sig_b), fl = for_minimum(d, unit_ids, scan_keys // 1000, cfg, rng)
+            g, x, y, (sig_a, sig_b), fl = for_minimum(d, unit_ids, scan_keys[:, 0], cfg, rng)
             cube[k] = g
             flags += fl
             sig_a, sig_b = (
@@ -502,8 +515,8 @@ def cost_and_offsets(
                 flags=tuple(sorted(set(flags))),
             )
         )
-    starts = [s.info["start"] for s in samples]
-    ends = [s.info["end"] for s in samples]
+    starts = [s.info.start for s in samples]
+    ends = [s.info.end for s in samples]
     return AssessmentResult(
         satellite=satellite,
         start=min(starts) if starts else "",
@@ -606,7 +619,7 @@ def assess_plan(
     usable = sum(int(s.usable.sum()) for s in samples)
     stopped = should_stop is not None and should_stop()  # the caller records an interruption, not bad data
     if usable < cfg.min_samples and not stopped:
-        files = ", ".join(sorted({s.info["cris_geo"] for s in samples} | {str(k) for k, _ in skipped}))[:800]
+        files = ", ".join(sorted({s.info.cris_geo for s in samples} | {str(k) for k, _ in skipped}))[:800]
         why = "; ".join(f"{k}: {r}" for k, r in skipped[:3])
         raise AssessmentError(
             f"too few usable FOVs to assess: {usable} (at least {cfg.min_samples}) in "

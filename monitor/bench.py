@@ -88,7 +88,7 @@ def run_bench(args) -> int:
         timings["read"] = time.perf_counter() - t0
         result = assess_plan(case, cfg, timings=timings, workers=args.workers)
         wall = time.perf_counter() - t0
-        n_fov = sum(gr["n_fovs"] for gr in result.granules)
+        n_fov = sum(gr.n_fovs for gr in result.granules)
         print(
             f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(cfg.offsets_rad) ** 2} "
             f"perturbations (simulation {t_sim:.1f} s and kernel compile/load {t_jit:.1f} s, not counted)"

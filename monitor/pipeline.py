@@ -10,7 +10,7 @@ from __future__ import annotations
 import datetime as dt
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from monitor import logs
 from monitor.assess import AssessConfig, assess_plan
 from monitor.config import Config, ScheduleConfig
 from monitor.errors import DataError, StopRequested
+from monitor.records import SceneDecision
 from monitor.result import AssessmentResult
 from monitor.scenes import select_scenes
 from monitor.sdr import read_file
@@ -190,7 +191,7 @@ class DayWork:
     status: RunStatus  # ok, no_data, failed or interrupted
     reason: str | None = None
     result: AssessmentResult | None = None
-    decisions: list = field(default_factory=list)
+    decisions: list[SceneDecision] = field(default_factory=list)
     prints: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
     counts: dict = field(default_factory=dict)
@@ -238,7 +239,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
         w.counts["selected"] = len(chosen)
         if not chosen:
             w.status = RunStatus.NO_DATA
-            w.reason = "no usable scene: " + "; ".join(sorted({d["reason"] for d in w.decisions}))[:500]
+            w.reason = "no usable scene: " + "; ".join(sorted({d.reason for d in w.decisions}))[:500]
             return w
         t1 = time.perf_counter()
         logs.stage("fetch")
@@ -297,7 +298,7 @@ def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.dat
                 out.status = RunStatus.NO_DATA_FINAL
             else:
                 out.reason = f"{out.reason} (tried again for {s.no_data_retry_days} day(s) after it is due)"
-            summary = {"selection": w.decisions[:50]} if w.decisions else None
+            summary = {"selection": [asdict(d) for d in w.decisions[:50]]} if w.decisions else None
             store.finish_run(run_id, out.status, out.reason, summary=summary)
         elif w.status == RunStatus.FAILED:
             store.finish_run(run_id, RunStatus.FAILED, w.reason)

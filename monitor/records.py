@@ -17,7 +17,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from monitor.result import RELIABILITY_FLAGS, ForOffset
-from monitor.vocabulary import EventKind, RunStatus
+from monitor.vocabulary import Decision, EventKind, RunStatus
 
 
 def iso(t: dt.datetime) -> str:
@@ -185,6 +185,17 @@ class GranuleRow:
         """The GranuleRow of a row of the store."""
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
+
+
+@dataclass(frozen=True)
+class SceneDecision:
+    """What scene selection decided for one CrIS granule, why, and its inhomogeneity score (K) where it was
+    scored."""
+
+    granule: str
+    decision: Decision
+    reason: str
+    score_k: float | None = None
 
 
 @dataclass(frozen=True)

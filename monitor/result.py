@@ -75,6 +75,29 @@ class ForOffset:
 MEASURED_FIELDS = tuple(f.name for f in fields(ForOffset) if f.name not in ("for_index", "flags"))
 
 
+@dataclass(frozen=True)
+class GranuleInfo:
+    """One assessed CrIS granule: its ID and times (ISO 8601), its files and the VIIRS files that covered it,
+    the FOVs with geolocation and the FOVs used, and the processing metadata of its CrIS GEO and of the
+    first VIIRS GEO (software and algorithm versions, auxiliary files: what change attribution compares)."""
+
+    granule_id: str
+    start: str
+    end: str
+    cris_geo: str
+    cris_sdr: str
+    viirs: list[str]
+    n_fovs: int
+    n_usable: int
+    cris_meta: dict = field(default_factory=dict)
+    viirs_meta: dict = field(default_factory=dict)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GranuleInfo:
+        """A granule of a result file."""
+        return cls(**{k: d[k] for k in cls.__dataclass_fields__ if k in d})
+
+
 @dataclass
 class AssessmentResult:
     """One assessment of one satellite over a set of granules; all 30 FORs, in FOR order."""
@@ -83,7 +106,7 @@ class AssessmentResult:
     start: str
     end: str
     fors: list
-    granules: list = field(default_factory=list)
+    granules: list[GranuleInfo] = field(default_factory=list)
     skipped: list = field(default_factory=list)
     half_steps: int = DEFAULT_HALF_STEPS
     step_urad: float = DEFAULT_STEP_URAD
@@ -96,7 +119,7 @@ class AssessmentResult:
             "end": self.end,
             "half_steps": self.half_steps,
             "step_urad": self.step_urad,
-            "granules": self.granules,
+            "granules": [asdict(g) for g in self.granules],
             "skipped": self.skipped,
             "fors": [f.to_dict() for f in self.fors],
         }
@@ -115,7 +138,7 @@ class AssessmentResult:
             start=d["start"],
             end=d["end"],
             fors=[ForOffset.from_dict(f) for f in d["fors"]],
-            granules=d.get("granules", []),
+            granules=[GranuleInfo.from_dict(g) for g in d.get("granules", [])],
             skipped=d.get("skipped", []),
             half_steps=int(d.get("half_steps", DEFAULT_HALF_STEPS)),
             step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),

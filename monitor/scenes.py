@@ -17,11 +17,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from monitor.errors import DataError
+from monitor.records import SceneDecision
 from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import GranuleFiles, granule_files
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
 from monitor.sources import BudgetExceeded, ListedFile, SourceError
 from monitor.spectral import i5_band
+from monitor.vocabulary import Decision
 
 LOG = logging.getLogger(__name__)
 COVER_MARGIN = dt.timedelta(seconds=10)
@@ -56,25 +58,23 @@ def inhomogeneity_k(radiance_lw, satellite: str) -> float:
 
 
 def select_scenes(listing, source, satellite: str, candidates: int, keep: int, min_score_k: float):
-    """(chosen candidates, decisions) for one satellite-day; decisions are dicts of granule, score_k,
-    decision, reason."""
-    decisions = []
+    """(chosen candidates, decisions) for one satellite-day: every granule of the listing is chosen,
+    rejected or not considered, with the reason."""
+    decisions: list[SceneDecision] = []
     cris, unpaired = _pairs(listing, CRIS_SDR, CRIS_GEO)
     for key in unpaired:
-        decisions.append(
-            {"granule": key, "decision": "rejected", "reason": "SDR or GEO file missing in the listing"}
-        )
+        decisions.append(SceneDecision(key, Decision.REJECTED, "SDR or GEO file missing in the listing"))
     viirs, _ = _pairs(listing, VIIRS_SDR, VIIRS_GEO)
     if len(cris) > candidates:
         picks = set(np.round(np.linspace(0, len(cris) - 1, candidates)).astype(int))
         for i, (key, _, _) in enumerate(cris):
             if i not in picks:
                 decisions.append(
-                    {
-                        "granule": key,
-                        "decision": "not considered",
-                        "reason": f"outside the {candidates} candidates spread over the day",
-                    }
+                    SceneDecision(
+                        key,
+                        Decision.NOT_CONSIDERED,
+                        f"outside the {candidates} candidates spread over the day",
+                    )
                 )
         cris = [c for i, c in enumerate(cris) if i in picks]
     pool = []
@@ -86,9 +86,7 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
             if vg.parsed.start <= end + COVER_MARGIN and vg.parsed.end >= start - COVER_MARGIN
         ]
         if not cover:
-            decisions.append(
-                {"granule": key, "decision": "rejected", "reason": "no VIIRS I5 + GEO granule covers it"}
-            )
+            decisions.append(SceneDecision(key, Decision.REJECTED, "no VIIRS I5 + GEO granule covers it"))
             continue
         try:
             sdr_path, geo_path = source.fetch(sdr), source.fetch(geo)
@@ -99,12 +97,10 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
             files = granule_files(key, sdr_path, geo_path, sdr_meta=granule.meta)
             score = inhomogeneity_k(np.where(granule.good[..., None], granule.radiance_lw, np.nan), satellite)
         except BudgetExceeded as exc:
-            decisions.append({"granule": key, "decision": "rejected", "reason": str(exc)})
+            decisions.append(SceneDecision(key, Decision.REJECTED, str(exc)))
             break
         except (SourceError, DataError) as exc:
-            decisions.append(
-                {"granule": key, "decision": "rejected", "reason": f"unusable CrIS granule: {exc}"}
-            )
+            decisions.append(SceneDecision(key, Decision.REJECTED, f"unusable CrIS granule: {exc}"))
             continue
         pool.append(Candidate(key, sdr, geo, cover, score, files))
     pool.sort(key=lambda c: -c.score_k)
@@ -112,31 +108,25 @@ def select_scenes(listing, source, satellite: str, candidates: int, keep: int, m
     for c in pool:
         if not np.isfinite(c.score_k) or c.score_k < min_score_k:
             decisions.append(
-                {
-                    "granule": c.key,
-                    "score_k": c.score_k,
-                    "decision": "rejected",
-                    "reason": f"too homogeneous ({c.score_k:.2f} K < {min_score_k} K)",
-                }
+                SceneDecision(
+                    c.key,
+                    Decision.REJECTED,
+                    f"too homogeneous ({c.score_k:.2f} K < {min_score_k} K)",
+                    c.score_k,
+                )
             )
         elif len(chosen) >= keep:
             decisions.append(
-                {
-                    "granule": c.key,
-                    "score_k": c.score_k,
-                    "decision": "rejected",
-                    "reason": f"the {keep} more inhomogeneous granules were kept",
-                }
+                SceneDecision(
+                    c.key, Decision.REJECTED, f"the {keep} more inhomogeneous granules were kept", c.score_k
+                )
             )
         else:
             chosen.append(c)
             decisions.append(
-                {
-                    "granule": c.key,
-                    "score_k": c.score_k,
-                    "decision": "chosen",
-                    "reason": f"inhomogeneity {c.score_k:.2f} K, rank {len(chosen)}",
-                }
+                SceneDecision(
+                    c.key, Decision.CHOSEN, f"inhomogeneity {c.score_k:.2f} K, rank {len(chosen)}", c.score_k
+                )
             )
     chosen.sort(key=lambda c: c.geo.parsed.start)
     return chosen, decisions

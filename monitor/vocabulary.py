@@ -80,3 +80,11 @@ class PublishKind(StrEnum):
 
     INFLUX2 = "influx2"  # InfluxDB 2 API, token
     INFLUX1 = "influx1"  # InfluxDB 1 API (also VictoriaMetrics), user and password
+
+
+class Decision(StrEnum):
+    """What scene selection decided for a CrIS granule of the day."""
+
+    CHOSEN = "chosen"
+    REJECTED = "rejected"
+    NOT_CONSIDERED = "not considered"  # outside the candidates spread over the day

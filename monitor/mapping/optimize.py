@@ -129,8 +129,8 @@ def optimize(result: AssessmentResult, ep: EngineeringPacket, source: str = "") 
             "start": result.start,
             "end": result.end,
             "n_granules": len(granules),
-            "first_granule": granules[0] if granules else None,
-            "last_granule": granules[-1] if granules else None,
+            "first_granule": granules[0].granule_id if granules else None,
+            "last_granule": granules[-1].granule_id if granules else None,
         },
         "fors_kept": {str(f.for_index): r for f, r in zip(result.fors, reasons, strict=True) if r},
     }

@@ -321,19 +321,19 @@ class Store:
                     ),
                 )
             for g in result.granules:
-                cm, vm = g.get("cris_meta", {}), g.get("viirs_meta", {})
+                cm, vm = g.cris_meta, g.viirs_meta
                 self.db.execute(
                     "INSERT OR REPLACE INTO granules VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                     (
                         satellite,
                         d,
                         run_id,
-                        g["granule_id"],
-                        g["start"],
-                        g["cris_geo"],
-                        g["cris_sdr"],
-                        json.dumps(g["viirs"]),
-                        g["n_usable"],
+                        g.granule_id,
+                        g.start,
+                        g.cris_geo,
+                        g.cris_sdr,
+                        json.dumps(g.viirs),
+                        g.n_usable,
                         cm.get("software_version"),
                         cm.get("algorithm_version"),
                         json.dumps(cm.get("aux_files", [])),
@@ -348,10 +348,10 @@ class Store:
                         satellite,
                         d,
                         run_id,
-                        s["granule"],
-                        _num(s.get("score_k")),
-                        s["decision"],
-                        s.get("reason"),
+                        s.granule,
+                        _num(s.score_k),
+                        s.decision,
+                        s.reason,
                     ),
                 )
             for s in result.skipped:

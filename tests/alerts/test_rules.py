@@ -7,7 +7,7 @@ from alerts.changes import Change, add_to_calendar, load_calendar, metadata_chan
 from alerts.rules import failure_finding, spec_finding, stale_finding
 from benchmarks.jump_detection import false_alarms, jump_trial
 from monitor.config import RuleSettings
-from monitor.result import AssessmentResult, ForOffset
+from monitor.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.store.sqlite import Store
 
 DAY = dt.date(2024, 6, 1)
@@ -25,16 +25,18 @@ def _result(fors, granules=()):
 
 
 def _granule(gid, cris_aux, viirs_aux, sw="I2.1.03.00"):
-    return {
-        "granule_id": gid,
-        "start": "t",
-        "cris_geo": "g",
-        "cris_sdr": "s",
-        "viirs": [],
-        "n_usable": 1,
-        "cris_meta": {"aux_files": cris_aux, "software_version": sw, "algorithm_version": "2.O"},
-        "viirs_meta": {"aux_files": viirs_aux, "software_version": "I2.0"},
-    }
+    return GranuleInfo(
+        granule_id=gid,
+        start="t",
+        end="t",
+        cris_geo="g",
+        cris_sdr="s",
+        viirs=[],
+        n_fovs=1,
+        n_usable=1,
+        cris_meta={"aux_files": cris_aux, "software_version": sw, "algorithm_version": "2.O"},
+        viirs_meta={"aux_files": viirs_aux, "software_version": "I2.0"},
+    )
 
 
 def test_spec_severity_uses_the_uncertainty(tmp_path):

@@ -9,7 +9,7 @@ import pytest
 from monitor.cli import main
 from monitor.errors import DataError
 from monitor.mapping.optimize import optimize
-from monitor.result import AssessmentResult, ForOffset
+from monitor.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.sdr.engpkt import load_ep
 from monitor.simulate.case import ep_offsets_urad
 
@@ -40,7 +40,7 @@ def _result(d_alpha, d_beta, satellite="j01", flags=None):
         "2024-06-01T12:00:00",
         "2024-06-01T12:07:28",
         fors,
-        granules=[{"granule_id": "J01001"}, {"granule_id": "J01002"}],
+        granules=[GranuleInfo(g, "", "", "", "", [], 0, 0) for g in ("J01001", "J01002")],
     )
 
 

@@ -3,7 +3,9 @@ import sqlite3
 
 import pytest
 
+from monitor.records import SceneDecision
 from monitor.store.sqlite import MIGRATIONS, Store
+from monitor.vocabulary import Decision
 from tests.cli import run_crisgeo
 
 DAY = dt.date(2024, 6, 1)
@@ -35,7 +37,7 @@ def test_save_day_replaces_and_queues(cases, tmp_path):
             "j01",
             DAY,
             result,
-            [{"granule": "g", "score_k": 1.0, "decision": "chosen"}],
+            [SceneDecision("g", Decision.CHOSEN, "rank 1", 1.0)],
             {"influx2:http://x": ["m f=1 1"] * 30},
         )
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
@@ -55,7 +57,7 @@ def test_failed_transaction_leaves_nothing(cases, tmp_path):
     s = Store(tmp_path / "d.sqlite")
     run = s.begin_run("j01", DAY)
     with pytest.raises(sqlite3.Error):
-        s.save_day(run, "j01", DAY, result, [{"granule": None, "decision": None}], {})  # NOT NULL violated
+        s.save_day(run, "j01", DAY, result, [SceneDecision(None, None, None)], {})  # NOT NULL violated
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0
     assert s.runs()[0].status == "running"
     assert s.interrupt_stale_runs() == 1 and s.runs()[0].status == "interrupted"
