@@ -251,6 +251,9 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
         t1 = time.perf_counter()
         a = cfg.assessment
         logs.stage("assess")
+        LOG.info(
+            "assessing %d CrIS granule(s) against %d VIIRS granule(s)", len(case.cris), len(case.viirs_all)
+        )
         w.result = assess_plan(
             case,
             AssessConfig.of(a.half_steps, a.step_urad, a.kernel),

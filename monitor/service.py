@@ -278,7 +278,7 @@ class Service:
         LOG.info("signal %d: stopping after the current step", signum)
         sd_notify("STOPPING=1")
         self.stop_event.set()
-        if self.scheduler is not None:
+        if self.scheduler is not None and self.scheduler.running:  # a second signal finds it stopped
             self.scheduler.shutdown(wait=False)
 
     def _job_event(self, event):

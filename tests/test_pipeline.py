@@ -54,8 +54,8 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
     assert first.status == "ok" and len(first.result.fors) == 30
     second = run_day(cfg, store, src, "j01", DAY, TODAY)
     assert second.status == "ok"
-    assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
-    assert store.db.execute("SELECT COUNT(DISTINCT run_id) FROM results").fetchone()[0] == 1
+    assert len(store.day_result("j01", DAY)) == 30  # replaced, not added
+    assert {g.run_id for g in store.granules("j01", DAY)} == {second.run_id}
     decisions = store.selection("j01", DAY)
     assert len(decisions) == 2 and all(d.decision == "chosen" and d.score_k > 0.5 for d in decisions)
     assert [f.d_beta_urad for f in store.day_result("j01", DAY)] == [
@@ -109,7 +109,7 @@ def test_corrupt_granule_is_skipped_with_reason_and_the_run_goes_on(cases, tmp_p
         and "unusable CrIS granule" in rejected[0].reason
         and sdr.name in rejected[0].reason
     )
-    assert store.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
+    assert len(store.day_result("j01", DAY)) == 30
 
 
 def test_source_failure_is_a_failed_run_and_an_event(tmp_path):

@@ -1,6 +1,7 @@
 """``crisgeo reprocess`` on a real Dask LocalCluster (2 worker processes) over simulated days."""
 
 import datetime as dt
+import math
 import threading
 
 import pytest
@@ -15,7 +16,15 @@ from monitor.store.sqlite import Store
 pytestmark = pytest.mark.servers
 
 DAYS = (dt.date(2024, 3, 1), dt.date(2024, 3, 3))
-FIELDS = "for_index, d_alpha_urad, d_beta_urad, sigma_alpha_urad, in_track_km, cross_track_km, n_samples"
+FIELDS = (
+    "for_index",
+    "d_alpha_urad",
+    "d_beta_urad",
+    "sigma_alpha_urad",
+    "in_track_km",
+    "cross_track_km",
+    "n_samples",
+)
 
 
 def _config(tmp_path, name, source):
@@ -27,14 +36,24 @@ def _config(tmp_path, name, source):
     return load_config(p)
 
 
+def _plain(v):
+    """NaN as None, so that rows compare equal when they hold the same values."""
+    return None if isinstance(v, float) and math.isnan(v) else v
+
+
 def _results(cfg, day=None):
+    """(rows (day, FOR, offsets, km, samples) of the stored results, the runs (day, status)), as the store
+    gives them back."""
     with Store(cfg.store.sqlite) as s:
-        q = (
-            f"SELECT day, {FIELDS} FROM results"
-            + (" WHERE day=?" if day else "")
-            + " ORDER BY day, for_index"
+        days = (
+            [dt.date.fromisoformat(day)] if day else sorted({dt.date.fromisoformat(r.day) for r in s.runs()})
         )
-        return s.db.execute(q, (day,) if day else ()).fetchall(), [(r.day, r.status) for r in s.runs()]
+        rows = [
+            (d.isoformat(), *(_plain(getattr(f, k)) for k in FIELDS))
+            for d in days
+            for f in s.day_result("j01", d)
+        ]
+        return rows, [(r.day, r.status) for r in s.runs()]
 
 
 @pytest.fixture(scope="module")

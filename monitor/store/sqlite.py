@@ -13,6 +13,7 @@ from __future__ import annotations
 import datetime as dt
 import json
 import sqlite3
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -86,9 +87,9 @@ MIGRATIONS = [
 RESULT_FIELDS = MEASURED_FIELDS  # the results table has a column for each
 
 
-def now_iso() -> str:
-    """Now as an ISO 8601 UTC string, to the second."""
-    return dt.datetime.now(UTC).isoformat(timespec="seconds")
+def utc_now() -> dt.datetime:
+    """The time now, UTC (the store's default clock)."""
+    return dt.datetime.now(UTC)
 
 
 def _num(v):
@@ -107,8 +108,9 @@ class Store:
     never re-initialised: it holds the history and the alert state.
     """
 
-    def __init__(self, path, create: bool = True):
+    def __init__(self, path, create: bool = True, clock: Callable[[], dt.datetime] = utc_now):
         self.path = Path(path)
+        self.clock = clock  # the time stamped on what is written (runs, events, the outbox)
         if not self.path.exists():
             if not create:
                 raise StoreError(
@@ -185,6 +187,9 @@ class Store:
                     self.db.execute(stmt)
                 self.db.execute(f"PRAGMA user_version={v + 1}")
 
+    def _now(self) -> str:
+        return self.clock().astimezone(UTC).isoformat(timespec="seconds")
+
     def transaction(self) -> _Transaction:
         """A context manager: BEGIN IMMEDIATE ... COMMIT, rolled back on an exception."""
         return _Transaction(self.db)
@@ -199,7 +204,7 @@ class Store:
         with self.transaction():
             cur = self.db.execute(
                 "INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, ?)",
-                (satellite, day.isoformat(), now_iso(), RunStatus.RUNNING),
+                (satellite, day.isoformat(), self._now(), RunStatus.RUNNING),
             )
             return cur.lastrowid
 
@@ -218,7 +223,7 @@ class Store:
     def _finish(self, run_id, status, reason, n_granules, summary):
         self.db.execute(
             "UPDATE runs SET finished=?, status=?, reason=?, n_granules=?, summary=? WHERE id=?",
-            (now_iso(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id),
+            (self._now(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id),
         )
 
     def interrupt_stale_runs(self) -> int:
@@ -226,7 +231,7 @@ class Store:
         with self.transaction():
             cur = self.db.execute(
                 "UPDATE runs SET status=?, finished=?, reason='process ended during the run' WHERE status=?",
-                (RunStatus.INTERRUPTED, now_iso(), RunStatus.RUNNING),
+                (RunStatus.INTERRUPTED, self._now(), RunStatus.RUNNING),
             )
             return cur.rowcount
 
@@ -376,7 +381,7 @@ class Store:
                 for line in lines:
                     self.db.execute(
                         "INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, ?, ?, ?)",
-                        (target, satellite, d, line, now_iso()),
+                        (target, satellite, d, line, self._now()),
                     )
             self._finish(
                 run_id,
@@ -479,7 +484,7 @@ class Store:
         with self.transaction():
             self.db.execute(
                 "INSERT OR REPLACE INTO fingerprints VALUES (?, ?, ?, ?)",
-                (satellite, day.isoformat(), now_iso(), json.dumps(body)),
+                (satellite, day.isoformat(), self._now(), json.dumps(body)),
             )
 
     def fingerprint(self, satellite: str, before: dt.date):
@@ -496,7 +501,7 @@ class Store:
         with self.transaction():
             self.db.execute(
                 "INSERT INTO events (time, kind, satellite, detail) VALUES (?, ?, ?, ?)",
-                (now_iso(), EventKind(kind).value, satellite, json.dumps(detail)),
+                (self._now(), EventKind(kind).value, satellite, json.dumps(detail)),
             )
 
     def events(self, kind: "EventKind | None" = None) -> list["Event"]:
@@ -511,7 +516,7 @@ class Store:
             for line in lines:
                 self.db.execute(
                     "INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, NULL, ?, ?)",
-                    (target, satellite, line, now_iso()),
+                    (target, satellite, line, self._now()),
                 )
 
     def outbox(self, target: str, limit: int = 5000) -> list:

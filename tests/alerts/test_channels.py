@@ -116,7 +116,6 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     message; the claim lets exactly one post it, even though the webhook answers slowly."""
     import datetime as dt
     import threading
-    import time
 
     from alerts.engine import deliver
     from monitor.config import AlertSettings
@@ -130,20 +129,20 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     store = Store(path)
     AlertState(store).enqueue("slack", "j01", {"subject": "s", "text": "t", "blocks": []}, now)
     store.close()
-    import requests
+    both_saw_it = threading.Barrier(2, timeout=30)
+    real_due = AlertState.due
 
-    real_post = requests.post
+    def due_for_both(self, when):
+        """Both deliverers read the queue, and find the message due, before either goes on to claim it."""
+        found = real_due(self, when)
+        both_saw_it.wait()
+        return found
 
-    def slow_post(*a, **kw):
-        time.sleep(0.5)  # both deliverers see the message as due before either has sent it
-        return real_post(*a, **kw)
-
-    monkeypatch.setattr(requests, "post", slow_post)
-    counts, start = [], threading.Barrier(2)
+    monkeypatch.setattr(AlertState, "due", due_for_both)
+    counts = []
 
     def run():
         s = Store(path)
-        start.wait()
         counts.append(deliver(s, settings, now=now))
         s.close()
 

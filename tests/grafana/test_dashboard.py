@@ -143,13 +143,13 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
     from monitor.health import Health
     from monitor.metrics import ServiceMetrics
     from monitor.store.alerts import AlertState
-    from tests.servers import victoria_metrics
+    from tests.servers import victoria_metrics, wait_for
 
     db = tmp_path / "s.sqlite"
+    ten_hours_ago = dt.datetime.now(UTC) - dt.timedelta(hours=10)
+    with Store(db, clock=lambda: ten_hours_ago) as earlier:  # the last success, 10 h ago
+        fill_store(earlier, ["j01"], dt.date.today() - dt.timedelta(days=3), 3)
     store = Store(db)
-    fill_store(store, ["j01"], dt.date.today() - dt.timedelta(days=3), 3)
-    ten_hours_ago = (dt.datetime.now(UTC) - dt.timedelta(hours=10)).isoformat(timespec="seconds")
-    store.db.execute("UPDATE runs SET finished=?", (ten_hours_ago,))  # the last success, 10 h ago
     store.finish_run(store.begin_run("j01", dt.date.today()), "failed", "HTTP 503")
     store.queue_lines("influx2:db.example", "j01", ["m x=1 1"] * 3)
     AlertState(store).upsert(
@@ -171,12 +171,16 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
             )
             assert r.status_code == 204, r.text
         requests.get(url + "/internal/force_flush", timeout=10)
-        time.sleep(1)
+
+        def answer(panel):
+            q = panel["targets"][0]["expr"].replace('=~"$satellite"', '=~"j01"')
+            return requests.get(url + "/api/v1/query", params={"query": q, "time": now}, timeout=10).json()
+
+        assert wait_for(lambda: answer(panels[0])["data"]["result"], 30)  # the samples are searchable
         for panel in panels:
             (target,) = panel["targets"]
             assert target["datasource"]["uid"] == "${prometheus}"
-            q = target["expr"].replace('=~"$satellite"', '=~"j01"')
-            r = requests.get(url + "/api/v1/query", params={"query": q, "time": now}, timeout=10).json()
+            r = answer(panel)
             assert r["status"] == "success" and r["data"]["result"], (panel["title"], r)
             values = {tuple(sorted(x["metric"].items())): float(x["value"][1]) for x in r["data"]["result"]}
             if panel["title"].startswith("Hours since"):

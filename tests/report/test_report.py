@@ -4,16 +4,18 @@ import datetime as dt
 import json
 import os
 import shutil
-import time
 
 import pytest
 import yaml
+from selenium.webdriver.support.ui import WebDriverWait
 
+from alerts.rules import Finding
 from monitor.cli import main
 from monitor.report.html import ReportOptions, build_report
 from monitor.simulate.history import fill_store
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
+from monitor.vocabulary import Rule, Severity
 from tests.servers import chromium_driver
 
 SATS = ["npp", "j01", "j02"]
@@ -67,12 +69,14 @@ def test_single_run(store, tmp_path):
 
 def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
     days = fill_store(store, ["j01"], dt.date(2025, 1, 1), 400, step_day=300)
-    AlertState(store)  # creates its tables
-    store.db.execute(
-        "INSERT INTO alert_state VALUES ('spec:j01:x','spec','j01','x','critical','firing',"
-        "'2025-10-28T00:00:00+00:00',NULL,NULL,'FOR 30 cross-track 2.5 km over the 1.5 km spec','[]')"
+    AlertState(store).upsert(
+        Finding(
+            Rule.SPEC, "j01", Severity.CRITICAL, "FOR 30 cross-track 2.5 km over the 1.5 km spec", group="x"
+        ),
+        "firing",
+        dt.datetime(2025, 10, 28, tzinfo=dt.timezone.utc),
+        False,
     )
-    store.db.commit()
     opts = ReportOptions(satellites=["j01"], calendar=_calendar(tmp_path, days[300]))
     build_report(store, tmp_path / "rep", opts)
     page = (tmp_path / "rep" / "j01" / "index.html").read_text()
@@ -138,7 +142,9 @@ def test_report_in_headless_chromium(store, tmp_path):
         # a broken image is noticed: the check above can fail
         (tmp_path / "rep" / "j01" / "trend.png").write_bytes(b"not a png")
         driver.get((tmp_path / "rep" / "j01" / "index.html").as_uri())
-        time.sleep(0.2)
+        WebDriverWait(driver, 30).until(
+            lambda d: d.execute_script("return Array.from(document.images).every(i => i.complete);")
+        )
         widths = driver.execute_script("return Array.from(document.images).map(i => i.naturalWidth);")
         assert 0 in widths
     finally:

@@ -7,7 +7,7 @@ import pytest
 from monitor.config import PublishConfig
 from monitor.store.sqlite import Store
 from monitor.store.timeseries import Influx2Writer, PublishError, drain_outbox, result_lines, target_name
-from tests.servers import free_port, influxdb1, influxql, victoria_metrics, vm_export
+from tests.servers import free_port, influxdb1, influxql, victoria_metrics, vm_export, wait_for
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
@@ -114,7 +114,6 @@ def test_known_changes_reach_influxdb_for_annotations(tmp_path):
 def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
     """Points that waited through an outage leave without a daily run: the daemon's outbox job sends them
     as soon as the server is back."""
-    import time
 
     from apscheduler.schedulers.background import BackgroundScheduler
 
@@ -139,11 +138,7 @@ def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
                 job.remove()
         scheduler.start()
         try:
-            deadline = time.monotonic() + 30
-            while (
-                store.outbox_size(target_name(service.cfg.store.publish[0])) and time.monotonic() < deadline
-            ):
-                time.sleep(0.2)
+            wait_for(lambda: store.outbox_size(target_name(service.cfg.store.publish[0])) == 0, 30)
         finally:
             scheduler.shutdown(wait=True)
         assert store.outbox_size(target_name(service.cfg.store.publish[0])) == 0
