@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 from monitor import allocator, logs
 from monitor.config import AssessmentConfig
 from monitor.errors import DataError
+from monitor.render import result_text, status_text
 from monitor.satellites import SATELLITES
 from monitor.simulate.orbit import PASSES
 from monitor.version import __version__
@@ -268,32 +269,6 @@ def cmd_geolocate(args) -> int:
     return EXIT_OK
 
 
-def format_table(result) -> str:
-    """The per-FOR table printed by ``crisgeo assess``."""
-    head = (
-        f"{'FOR':>3} {'d_alpha':>8} {'+-':>5} {'d_beta':>8} {'+-':>5} {'in-trk':>7} {'x-trk':>7} "
-        f"{'total':>6} {'N':>5} {'G_min':>6} {'G_0':>6}  flags"
-    )
-    units = (
-        f"{'':>3} {'urad':>8} {'':>5} {'urad':>8} {'':>5} {'km':>7} {'km':>7} {'km':>6} "
-        f"{'':>5} {'K':>6} {'K':>6}"
-    )
-    lines = [
-        f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules",
-        head,
-        units,
-    ]
-    for f in result.fors:
-        lines.append(
-            f"{f.for_index:>3} {f.d_alpha_urad:8.0f} {f.sigma_alpha_urad:5.0f} {f.d_beta_urad:8.0f} "
-            f"{f.sigma_beta_urad:5.0f} {f.in_track_km:7.3f} {f.cross_track_km:7.3f} {f.total_km:6.3f} "
-            f"{f.n_samples:5d} {f.cost_min_k:6.3f} {f.cost_zero_k:6.3f}  {','.join(f.flags)}"
-        )
-    for s in result.skipped:
-        lines.append(f"skipped {s['item']}: {s['reason']}")
-    return "\n".join(lines)
-
-
 @command(
     "assess",
     "assess CrIS geolocation against VIIRS I5 for the granules given",
@@ -325,7 +300,7 @@ def cmd_assess(args) -> int:
         result = assess_paths(args.paths, cfg, workers=args.workers)
     except DataError as exc:
         raise BadInput(str(exc)) from None
-    print(format_table(result))
+    print(result_text(result))
     if args.out:
         Path(args.out).write_text(result.to_json())
         print(f"wrote {args.out}")
@@ -478,7 +453,7 @@ def cmd_run(args) -> int:
     for o in outcomes:
         print(f"{o.satellite} {o.day}: {o.status}" + (f" ({o.reason})" if o.reason else ""))
         if o.result is not None:
-            print(format_table(o.result))
+            print(result_text(o.result))
         if o.timings:
             print("wall time per stage: " + ", ".join(f"{k} {v:.1f} s" for k, v in o.timings.items()))
     if not outcomes:
@@ -582,29 +557,7 @@ def cmd_status(args) -> int:
     if args.json:
         print(json.dumps(rep, indent=1, default=str))
         return rep["exit"]
-    print(f"crisgeo status: {rep['state']}")
-    for sat, s in rep["satellites"].items():
-        r = s["last_run"]
-        if r is None:
-            print(f"{sat}: no run yet")
-            continue
-        print(
-            f"{sat}: last run {r['day']} {r['status']} (finished {r['finished'] or '-'})"
-            + (f": {r['reason']}" if r["reason"] else "")
-        )
-        for a in s["alerts"]:
-            print(f"  {a['severity']} {a['rule']}: {a['summary']} (since {a['started']})")
-        if s["latest_day"]:
-            print(f"  latest results: {s['latest_day']}")
-            print(f"  {'FOR':>3} {'d_alpha':>8} {'d_beta':>8} {'in-trk':>7} {'x-trk':>7} {'total':>6}  flags")
-            for f in s["fors"]:
-                print(
-                    f"  {f['for']:>3} {f['d_alpha_urad']:8.0f} {f['d_beta_urad']:8.0f} "
-                    f"{f['in_track_km']:7.3f} "
-                    f"{f['cross_track_km']:7.3f} {f['total_km']:6.3f}  {','.join(f['flags'])}"
-                )
-    print(f"next scheduled run: {rep['next_run_utc'].replace('T', ' ').replace('Z', '')} UTC")
-    print(f"outbox: {rep['outbox']} point(s) waiting")
+    print(status_text(rep))
     return rep["exit"]
 
 
