@@ -72,7 +72,9 @@ def build_message(store: History, satellite: str, items: list, settings: AlertSe
         if any(f.severity == "critical" and k != "resolved" for k, f in items)
         else ("resolved" if all(k == "resolved" for k, _ in items) else "warning")
     )
-    subject = f"[crisgeo] {satellite} {worst.upper()}: {head} - " + "; ".join(f.rule for _, f in items)
+    subject = f"{settings.subject_prefix} {satellite} {worst.upper()}: {head} - " + "; ".join(
+        f.rule for _, f in items
+    )
     blocks, text = [], []
     for kind, f in items:
         title = f"{kind.upper()} {f.rule} ({f.severity if kind != 'resolved' else 'resolved'}): {f.summary}"

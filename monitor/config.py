@@ -541,6 +541,11 @@ class Links(BaseModel):
 class AlertSettings(RuleSettings):
     """The ``alerts`` section: the rule parameters, the channels and the events calendar."""
 
+    subject_prefix: Text = key(
+        "[crisgeo]",
+        "Start of every message's subject (e-mail subject, Slack headline): e.g. [crisgeo test] for a test "
+        "instance, so that its messages are not taken for the operational service's.",
+    )
     log: FilePath | None = key(None, "File the alert messages are appended to (a channel that cannot fail).")
     events_file: FilePath | None = key(
         None, "The events calendar (EP uploads, LUT changes) used to attribute jumps and annotate plots."

@@ -72,3 +72,21 @@ def test_problems_name_the_key(tmp_path, doc, message):
     with pytest.raises(ConfigError) as exc:
         _load(tmp_path, doc)
     assert str(exc.value).startswith(message), str(exc.value)
+
+
+def test_the_subject_prefix_marks_every_message(tmp_path):
+    """A key added to the model (one declaration) is loaded, documented and used: a test instance's
+    messages say so in their subject."""
+    from alerts.engine import build_message
+    from alerts.rules import Finding
+    from monitor.config_reference import reference
+    from monitor.store.sqlite import Store
+
+    assert "| `alerts.subject_prefix` | [crisgeo] |" in reference()
+    settings = _load(tmp_path, {"subject_prefix": "[crisgeo test]"}).alerts
+    finding = Finding("stale", "j01", "warning", "no successful assessment for 40 h")
+    with Store(tmp_path / "s.sqlite") as store:
+        message = build_message(store, "j01", [("firing", finding)], settings)
+        assert message["subject"].startswith("[crisgeo test] j01 WARNING")
+        default = build_message(store, "j01", [("firing", finding)], AlertSettings())
+        assert default["subject"].startswith("[crisgeo] j01")
