@@ -923,21 +923,3 @@ def yaml_problem(exc: yaml.YAMLError) -> str:
     problem = " ".join(str(getattr(exc, "problem", None) or exc).split())[:200]
     where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""
     return f"not valid YAML: {where}{problem}"
-
-
-def check_url(url: str, where: str, placeholder: str | None = None) -> str:
-    """An http(s) URL without credentials in it (secrets come from *_env variables)."""
-    try:
-        parts = urlsplit(url)
-    except ValueError:
-        raise ConfigError(f"{where}: {url!r} is not a URL") from None
-    if parts.scheme not in ("http", "https") or not parts.netloc:
-        raise ConfigError(f"{where}: {redact_url(url)!r} is not an http(s) URL")
-    if parts.username or parts.password or "@" in parts.netloc:
-        raise ConfigError(
-            f"{where}: credentials may not be written in a URL; name environment variables "
-            f"with the *_env keys"
-        )
-    if placeholder and placeholder not in url:
-        raise ConfigError(f"{where}: {url!r} has no {placeholder} placeholder")
-    return url

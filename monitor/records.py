@@ -235,8 +235,8 @@ class AlertLedger(Protocol):
         delivery_id: int,
         status: str,
         now: dt.datetime,
-        error: str | None = None,
-        retry_after_s: float = 0.0,
+        error: str | None = ...,
+        retry_after_s: float = ...,
     ) -> None: ...
 
 

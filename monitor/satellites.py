@@ -46,59 +46,20 @@ class Satellite:
         return int((unix_s - self.launch_unix_s) // NODAL_PERIOD_S) + 1
 
 
-SATELLITES = {
-    s.short: s
-    for s in (
-        Satellite(
-            short="npp",
-            idps="NPP",
-            name="S-NPP",
-            bucket="noaa-nesdis-snpp-pds",
-            altitude_m=838.8e3,
-            inclination_deg=98.67,
-            ltan_h=13.5,
-            phase_deg=0.0,
-            launch_unix_s=1319795281.0,
-            mission="NPP",
-            srf_file="npp_viirs_i05_srf.csv",
-            ep_file="SNPP_side1_V37_EngPkt.xml",
-            cris_instrument_id=1,
-            pct_mounting_urad=(-518.45683, -77.760702, 46.109524),
-        ),
-        Satellite(
-            short="j01",
-            idps="J01",
-            name="NOAA-20",
-            bucket="noaa-nesdis-n20-pds",
-            altitude_m=833.0e3,
-            inclination_deg=98.7,
-            ltan_h=13.5,
-            phase_deg=-90.0,
-            launch_unix_s=1510998456.0,
-            mission="S-NPP/JPSS",
-            srf_file="n20_viirs_i05_srf.csv",
-            ep_file="JPSS1_side1_V115_EngPkt.xml",
-            cris_instrument_id=4,
-            pct_mounting_urad=(-145.84994, 267.42417, 594.61832),
-        ),
-        Satellite(
-            short="j02",
-            idps="J02",
-            name="NOAA-21",
-            bucket="noaa-nesdis-n21-pds",
-            altitude_m=833.0e3,
-            inclination_deg=98.8,
-            ltan_h=13.5,
-            phase_deg=90.0,
-            launch_unix_s=1668073765.0,
-            mission="S-NPP/JPSS",
-            srf_file="n20_viirs_i05_srf.csv",
-            ep_file=None,
-            cris_instrument_id=None,
-            pct_mounting_urad=None,
-        ),
-    )
-}
+SNPP_EP, NOAA20_EP = "SNPP_side1_V37_EngPkt.xml", "JPSS1_side1_V115_EngPkt.xml"  # real EPs, monitor/data/ep
+
+# fmt: off
+SATELLITES = {s.short: s for s in (
+    # short, IDPS, name, bucket, altitude_m, inclination_deg, ltan_h, phase_deg, launch_unix_s,
+    #   mission, srf_file, ep_file, cris_instrument_id, pct_mounting_urad
+    Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0, 1319795281.0,
+              "NPP", "npp_viirs_i05_srf.csv", SNPP_EP, 1, (-518.45683, -77.760702, 46.109524)),
+    Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0, 1510998456.0,
+              "S-NPP/JPSS", "n20_viirs_i05_srf.csv", NOAA20_EP, 4, (-145.84994, 267.42417, 594.61832)),
+    Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0, 1668073765.0,
+              "S-NPP/JPSS", "n20_viirs_i05_srf.csv", None, None, None),
+)}
+# fmt: on
 PHASE_EPOCH_UNIX_S = 1704067200.0  # 2024-01-01T00:00:00Z
 NODAL_PERIOD_S = 101.5 * 60.0  # the shared orbit's period (Lin et al. 2016): the phases keep their spacing
 
