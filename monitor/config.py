@@ -180,6 +180,17 @@ def _buckets(value: Any) -> Any:
     return {**NODD_BUCKETS, **value} if isinstance(value, dict) else value
 
 
+class CalibrationDifference(Section):
+    """A simulated CrIS-VIIRS calibration difference (``source.calibration.SATELLITE``): the BT CrIS reports
+    is T + bias_k + gain (T - 280 K) + nonlinear_k ((T - 280 K) / 30 K)^2."""
+
+    bias_k: float = key(0.0, "CrIS minus VIIRS BT at 280 K.", -5, 5)
+    gain: float = key(
+        0.0, "Relative gain difference (0.01: CrIS BT departs 1 % of T - 280 K more).", -0.1, 0.1
+    )
+    nonlinear_k: float = key(0.0, "Quadratic term, its value 30 K from 280 K.", -5, 5)
+
+
 class SourceConfig(Section):
     """The ``source`` section: where granules come from, and the bounds of every request to NODD."""
 
@@ -253,11 +264,20 @@ class SourceConfig(Section):
         "paper", "Error profile injected by the simulator (paper, random, zero or a file; kind simulated)."
     )
     seed: int = key(0, "Seed of the simulator (kind simulated).", 0, 2**31 - 1)
+    calibration: dict[str, CalibrationDifference] = key(
+        {},
+        "CrIS-VIIRS calibration difference simulated per satellite (kind simulated; mapping of the keys "
+        "below); none: the instruments agree.",
+        json_schema_extra={"x-key": "satellite"},
+    )
 
     @model_validator(mode="after")
     def _consistent(self) -> SourceConfig:
         if "{bucket}" not in self.endpoint:
             raise KeyProblem("endpoint", f"{self.endpoint!r} has no {{bucket}} placeholder")
+        for sat in self.calibration:
+            if sat not in SATELLITES:
+                raise KeyProblem(f"calibration.{sat}", f"not one of {', '.join(SATELLITES)}")
         for sat, bucket in self.buckets.items():
             if sat not in SATELLITES:
                 raise KeyProblem(f"buckets.{sat}", f"not one of {', '.join(SATELLITES)}")
@@ -729,13 +749,16 @@ def _problem(err: Any, loc: list) -> str:
 
 
 def _model_at(loc: list) -> type[BaseModel]:
-    """The section model a location points into (list indices skipped)."""
+    """The section model a location points into (list indices and mapping keys skipped)."""
     model: type[BaseModel] = Config
+    keyed = False  # the last field was a mapping of sections: the next part is its key
     for part in loc:
-        if isinstance(part, int):
+        if isinstance(part, int) or keyed:
+            keyed = False
             continue
         field = next(f for n, f in model.model_fields.items() if part in (n, f.alias))
         model = _section_type(field.annotation)
+        keyed = getattr(field.annotation, "__origin__", None) is dict
     return model
 
 

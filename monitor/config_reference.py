@@ -79,9 +79,17 @@ def model_keys(model: type[BaseModel] = Config, prefix: str = "") -> list[Key]:
     for name, field in model.model_fields.items():
         dotted = prefix + (field.alias or name)
         keys.append(Key(dotted, field))
+        origin = getattr(field.annotation, "__origin__", None)
+        extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
+        inner = (
+            "[]."
+            if origin is list
+            else f".{str(extra.get('x-key', 'key')).upper()}."
+            if origin is dict
+            else "."
+        )
         for sub in _sections(field.annotation):
-            is_list = getattr(field.annotation, "__origin__", None) is list
-            keys += model_keys(sub, dotted + ("[]." if is_list else "."))
+            keys += model_keys(sub, dotted + inner)
     return keys
 
 

@@ -32,7 +32,7 @@ from monitor.simulate.orbit import PASSES, CircularOrbit, find_pass
 from monitor.simulate.profiles import load_profile
 from monitor.simulate.scene import MAX_HEIGHT_M, Scene, spectra, transmittance
 from monitor.simulate.terrain import intersect_terrain
-from monitor.spectral import i5_band, planck_radiance
+from monitor.spectral import C1, C2, i5_band, planck_radiance
 
 UTC = dt.timezone.utc
 DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)
@@ -40,6 +40,7 @@ CRIS_GRANULE_S = 32.0
 VIIRS_GRANULE_S = ins.VIIRS_SCANS * ins.VIIRS_SCAN_S
 CONE_SAMPLES = 512
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
+CALIBRATION_REFERENCE_K = 280.0  # the BT about which a CrIS-VIIRS gain difference turns
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
 OBPT_U16, OBPT_F32 = 65533, -999.7
@@ -79,6 +80,21 @@ class SimulationSpec:
     terrain: bool = False  # ranges and plateaus of 1-4 km over land (land fraction 0.4 instead of 0.3)
     orbit_pass: str | None = None  # a key of PASSES: the case starts at that pass after *start*
     pass_lon_deg: float | None = None  # with orbit_pass: the pass nearest this longitude (16-day search)
+    # CrIS-VIIRS calibration difference, in the BT of every CrIS channel (K): bias + gain (T - 280 K)
+    # + nonlinear_k ((T - 280 K) / 30 K)^2; all zero: the two instruments agree
+    cris_bias_k: float = 0.0
+    cris_gain: float = 0.0  # relative: 0.01 is a 1 % gain difference
+    cris_nonlinear_k: float = 0.0
+
+    @property
+    def calibrated(self) -> bool:
+        """Whether CrIS and VIIRS agree radiometrically (no calibration difference)."""
+        return self.cris_bias_k == 0.0 and self.cris_gain == 0.0 and self.cris_nonlinear_k == 0.0
+
+    def cris_bt_k(self, bt_k: np.ndarray) -> np.ndarray:
+        """The BT CrIS reports for a scene of true brightness temperature *bt_k* (K)."""
+        x = bt_k - CALIBRATION_REFERENCE_K
+        return bt_k + self.cris_bias_k + self.cris_gain * x + self.cris_nonlinear_k * (x / 30.0) ** 2
 
     def __post_init__(self):
         if self.orbit_pass is not None and self.orbit_pass not in PASSES:
@@ -303,7 +319,11 @@ class Simulator:
         hist = np.bincount(rows + b0.ravel(), (1 - w1).ravel(), nfov * len(T_BINS_K))
         hist += np.bincount(rows + b0.ravel() + 1, w1.ravel(), nfov * len(T_BINS_K))
         mean_planck = hist.reshape(nfov, -1) @ self.planck_table / CONE_SAMPLES
-        return spectra(self.nu, mean_planck).reshape(sat.shape[:-1] + (len(self.nu),))
+        radiance = spectra(self.nu, mean_planck)
+        if not self.spec.calibrated:  # each channel's BT as CrIS would report it
+            bt_k = C2 * self.nu / np.log1p(C1 * self.nu**3 / radiance)
+            radiance = planck_radiance(self.nu, self.spec.cris_bt_k(bt_k))
+        return radiance.reshape(sat.shape[:-1] + (len(self.nu),))
 
     # ------------------------------------------------------------------ VIIRS
     def viirs_granule(self, g0: float, out: Path, scans_per_chunk: int = 6) -> list[str]:
@@ -469,8 +489,12 @@ def simulate_case(
     terrain: bool = False,
     orbit_pass: str | None = None,
     pass_lon_deg: float | None = None,
+    cris_bias_k: float = 0.0,
+    cris_gain: float = 0.0,
+    cris_nonlinear_k: float = 0.0,
 ) -> dict:
-    """Write a case's granules into *out_dir* and ``truth.json``; return the truth document."""
+    """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The ``cris_``
+    parameters: the CrIS-VIIRS calibration difference (:class:`SimulationSpec`)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if spec is None:
@@ -486,6 +510,9 @@ def simulate_case(
             terrain=terrain,
             orbit_pass=orbit_pass,
             pass_lon_deg=pass_lon_deg,
+            cris_bias_k=cris_bias_k,
+            cris_gain=cris_gain,
+            cris_nonlinear_k=cris_nonlinear_k,
         )
     sim = Simulator(spec)
     files = []
@@ -505,6 +532,11 @@ def simulate_case(
         "orbit_pass": spec.orbit_pass,
         "pass_lon_deg": spec.pass_lon_deg,
         "terrain": spec.terrain,
+        "cris_calibration": {
+            "bias_k": spec.cris_bias_k,
+            "gain": spec.cris_gain,
+            "nonlinear_k": spec.cris_nonlinear_k,
+        },
         "engineering_packets": None
         if spec.true_ep is None or spec.ground_ep is None
         else {"true": spec.true_ep.version, "ground": spec.ground_ep.version},

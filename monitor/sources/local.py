@@ -9,6 +9,7 @@ import shutil
 import time
 from pathlib import Path
 
+from monitor.config import CalibrationDifference
 from monitor.sdr.products import CRIS_PRODUCTS
 from monitor.sources import ListedFile, listed, on_day
 
@@ -72,6 +73,7 @@ class SimulatedSource(LocalSource):
                 "simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target
             )
             start = dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc)
+            difference = self.cfg.calibration.get(satellite) or CalibrationDifference()
             simulate_case(
                 target,
                 satellite=satellite,
@@ -79,6 +81,9 @@ class SimulatedSource(LocalSource):
                 profile=self.cfg.profile,
                 seed=self.cfg.seed + day.toordinal() % 1000,
                 start=start,
+                cris_bias_k=difference.bias_k,
+                cris_gain=difference.gain,
+                cris_nonlinear_k=difference.nonlinear_k,
             )
         self.root.mkdir(parents=True, exist_ok=True)
         self._forget_old_days(keep=target)
