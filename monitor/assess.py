@@ -44,6 +44,7 @@ from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_viirs_geo_scan
 from monitor.spectral import i5_band
 from monitor.threads import parallel_threads
+from monitor.vocabulary import Cost
 
 LOG = logging.getLogger(__name__)
 KERNELS = {"top-hat": collocate.TOP_HAT, "response": collocate.SPATIAL_RESPONSE}
@@ -56,6 +57,7 @@ class AssessConfig:
     half_steps: int = DEFAULT_HALF_STEPS
     step_rad: float = DEFAULT_STEP_RAD
     kernel: str = "top-hat"
+    cost: Cost = Cost.STDEV
     min_coverage: float = collocate.MIN_COVERAGE
     min_samples: int = 30
     flat_contrast: float = 0.03
@@ -65,10 +67,10 @@ class AssessConfig:
     sigma_floor_urad: float = 5.0  # in quadrature with the bootstrap: the estimator's own error (calibrated)
 
     @classmethod
-    def of(cls, half_steps: int, step_urad: float, kernel: str) -> AssessConfig:
-        """The assessment of a configuration's (or the command line's) grid and kernel, the rest the
-        paper's."""
-        return cls(half_steps=half_steps, step_rad=step_urad * URAD, kernel=kernel)
+    def of(cls, half_steps: int, step_urad: float, kernel: str, cost: Cost = Cost.STDEV) -> AssessConfig:
+        """The assessment of a configuration's (or the command line's) grid, kernel and cost, the rest
+        the paper's."""
+        return cls(half_steps=half_steps, step_rad=step_urad * URAD, kernel=kernel, cost=Cost(cost))
 
     @property
     def offsets_rad(self) -> np.ndarray:
@@ -363,6 +365,29 @@ def _stdev(d, weights=None):
     return np.sqrt(np.maximum(var, 0.0)).reshape(-1, m, m)
 
 
+def _regression_stdev(d, cris, weights=None):
+    """The residual STDEV of d (N, m, m) regressed on the CrIS BT *cris* (N,), per perturbation:
+    sqrt(Var d - Cov(d, C)^2 / Var C). With d = V - C this is the residual of V - beta C for the best beta
+    at each perturbation, so a CrIS gain or bias (C -> gC + b) leaves it unchanged. *weights* (B, N): one
+    surface per bootstrap replicate (B, m, m)."""
+    n, m = d.shape[0], d.shape[1]
+    flat = np.concatenate([d.reshape(n, -1), cris[:, None]], axis=1)
+    w = np.ones((1, n)) if weights is None else np.asarray(weights, float)
+    s0 = w.sum(axis=1, keepdims=True)
+    mean = (w @ flat) / s0
+    centred = flat - mean[:, None, :]  # (B, N, K+1)
+    var = np.einsum("bn,bnk,bnk->bk", w, centred, centred) / np.maximum(s0 - 1, 1)
+    cov = np.einsum("bn,bnk,bn->bk", w, centred[..., :-1], centred[..., -1]) / np.maximum(s0 - 1, 1)
+    res = var[:, :-1] - cov**2 / var[:, -1:]
+    g = np.sqrt(np.maximum(res, 0.0)).reshape(-1, m, m)
+    return g[0] if weights is None else g
+
+
+def cost_surface(d, cris, cost: Cost, weights=None):
+    """The cost over the perturbation grid of one FOR's samples (:class:`~monitor.vocabulary.Cost`)."""
+    return _stdev(d, weights) if cost == Cost.STDEV else _regression_stdev(d, cris, weights)
+
+
 def find_minimum(cost, contrast=0.03):
     """Sub-step minimum (x_i, y_j in grid steps from the centre) of a cost surface, and its flags.
 
@@ -424,28 +449,30 @@ def _scan_bootstrap_counts(rng, granule_of_unit, n_boot):
     return counts
 
 
-def for_minimum(d, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
+def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
     """Offsets (grid steps from the centre), bootstrap sigmas (steps) and flags of one FOR.
 
-    *d* (N, m, m) holds the samples' BT differences, *unit_ids* (N,) the scan each comes from and
-    *granule_of_unit* the granule of each scan. The cost surface is the standard deviation over samples;
-    its minimum is refined between grid points where the window fits (:mod:`monitor.refine`).
+    *d* (N, m, m) holds the samples' BT differences, *cris* (N,) their CrIS BT, *unit_ids* (N,) the scan
+    each comes from and *granule_of_unit* the granule of each scan. The cost surface is ``cfg.cost``'s
+    over samples; its minimum is refined between grid points where the window fits (:mod:`monitor.refine`).
     """
     m = d.shape[1]
-    g = _stdev(d)
+    regress = cris if cfg.cost == Cost.REGRESSION else None
+    g = cost_surface(d, cris, cfg.cost)
     x, y, flags = find_minimum(g, cfg.flat_contrast)
     i0, j0 = (int(k) for k in np.unravel_index(np.argmin(g), g.shape))
     fine = FLAG_EDGE not in flags and FLAG_FLAT not in flags and refine.refinable(i0, j0, m)
     if fine:
-        dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0))
+        dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0, cris=regress))
         x, y = i0 - (m - 1) // 2 + dx, j0 - (m - 1) // 2 + dy
     sig = (np.nan, np.nan)
     if cfg.bootstrap > 1 and len(granule_of_unit) >= 2:
         counts = _scan_bootstrap_counts(rng, granule_of_unit, cfg.bootstrap)[:, unit_ids]
         if fine:
-            est = refine.refined_minimum(refine.window_covariance(d, i0, j0, counts))
+            est = refine.refined_minimum(refine.window_covariance(d, i0, j0, counts, regress))
         else:
-            est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in _stdev(d, counts)])
+            replicas = cost_surface(d, cris, cfg.cost, counts)
+            est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in replicas])
         sig = tuple(np.nanstd(est, axis=0))
     return g, x, y, sig, flags
 
@@ -461,11 +488,12 @@ def cost_and_offsets(
     cube = np.full((N_FOR, m, m), np.nan)
     fors = []
     for k in range(N_FOR):
-        diffs, units = [], []
+        diffs, cris_k, units = [], [], []
         for g_i, s in enumerate(samples):
             use = s.usable[:, k]  # (nscan, 9)
             d = s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]
             diffs.append(d.astype(np.float64))
+            cris_k.append(s.bt_cris_k[:, k][use].astype(np.float64))
             scans = np.nonzero(use)[0]  # the scan of each sample
             units.append(np.column_stack([np.full(scans.size, g_i), scans]))
         d = np.concatenate(diffs) if diffs else np.empty((0, m, m))
@@ -484,7 +512,9 @@ def cost_and_offsets(
         sig_a = sig_b = np.nan
         g = np.full((m, m), np.nan)
         if n >= 3:
-            g, x, y, (sig_a, sig_b), fl = for_minimum(d, unit_ids, scan_keys[:, 0], cfg, rng)
+            g, x, y, (sig_a, sig_b), fl = for_minimum(
+                d, np.concatenate(cris_k), unit_ids, scan_keys[:, 0], cfg, rng
+            )
             cube[k] = g
             flags += fl
             sig_a, sig_b = (

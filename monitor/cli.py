@@ -22,7 +22,7 @@ from monitor.render import result_text, status_text
 from monitor.satellites import SATELLITES
 from monitor.simulate.orbit import PASSES
 from monitor.version import __version__
-from monitor.vocabulary import Kernel, Rule
+from monitor.vocabulary import Cost, Kernel, Rule
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
     from monitor.config import Config
@@ -287,6 +287,12 @@ def cmd_geolocate(args) -> int:
         default=ASSESSMENT.kernel,
         help="FOV weighting: top-hat cone or the CrIS spatial response",
     ),
+    arg(
+        "--cost",
+        choices=tuple(Cost),
+        default=ASSESSMENT.cost,
+        help="stdev (the paper's) or regression (unmoved by a CrIS-VIIRS gain or bias)",
+    ),
     arg("--workers", type=int, default=ASSESSMENT.workers, help="threads of the compiled kernels"),
 )
 def cmd_assess(args) -> int:
@@ -295,7 +301,7 @@ def cmd_assess(args) -> int:
 
     if args.steps < 1 or args.step_urad <= 0:
         raise BadInput("--steps must be >= 1 and --step-urad > 0")
-    cfg = AssessConfig.of(args.steps, args.step_urad, args.kernel)
+    cfg = AssessConfig.of(args.steps, args.step_urad, args.kernel, args.cost)
     try:
         result = assess_paths(args.paths, cfg, workers=args.workers)
     except DataError as exc:

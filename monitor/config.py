@@ -47,7 +47,7 @@ from monitor.constants import (
     URAD,
 )
 from monitor.satellites import SATELLITES
-from monitor.vocabulary import Kernel, PublishKind, SourceKind
+from monitor.vocabulary import Cost, Kernel, PublishKind, SourceKind
 
 NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
 
@@ -371,6 +371,12 @@ class AssessmentConfig(Section):
     )
     kernel: Kernel = key(
         Kernel.TOP_HAT, "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response)."
+    )
+    cost: Cost = key(
+        Cost.STDEV,
+        "The cost minimised over the perturbations: stdev (the paper's equation 8, "
+        "STDEV(BT_VIIRS - BT_CrIS)) or regression (its residual after regression on BT_CrIS: a CrIS-VIIRS "
+        "gain or bias does not move it).",
     )
     workers: int = key(2, "Threads of the compiled VIIRS preparation and collocation kernels.", 1, 64)
 

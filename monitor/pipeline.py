@@ -256,7 +256,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
         )
         w.result = assess_plan(
             case,
-            AssessConfig.of(a.half_steps, a.step_urad, a.kernel),
+            AssessConfig.of(a.half_steps, a.step_urad, a.kernel, a.cost),
             progress=progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris)),
             should_stop=stop,
             workers=a.workers,

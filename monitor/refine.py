@@ -1,4 +1,5 @@
-"""Sub-step minimum of the cost G = STDEV(BT_VIIRS - BT_CrIS) between the perturbation grid points.
+"""Sub-step minimum of the cost G = STDEV(BT_VIIRS - BT_CrIS) (or its regression form) between the
+perturbation grid points.
 
 A quadratic surface through the 3 x 3 neighbourhood of the grid minimum (Wang 2013) places the minimum
 to no better than ~15-30 urad on a 450 urad grid: near its minimum G is closer to a cone than to a
@@ -53,10 +54,25 @@ def refinable(i0: int, j0: int, m: int) -> bool:
     return HALF <= i0 < m - HALF and HALF <= j0 < m - HALF
 
 
-def window_covariance(d, i0: int, j0: int, counts=None):
+def window_covariance(d, i0: int, j0: int, counts=None, cris=None):
     """Covariance (49 x 49) over samples of d (N, m, m) in the window around (i0, j0); with bootstrap
-    *counts* (B, N) one covariance per replicate (B, 49, 49)."""
+    *counts* (B, N) one covariance per replicate (B, 49, 49).
+
+    With *cris* (N,), the samples' CrIS BT, the covariance of what of d the CrIS BT does not explain
+    linearly (the regression cost, :mod:`monitor.assess`): the residual of d_interp = w^T d regressed on
+    C has variance w^T S_dd w - (w^T s_dC)^2 / Var C = w^T (S_dd - s_dC s_dC^T / Var C) w, a quadratic form
+    in the same weights, with the matrix returned here (the Schur complement of Var C).
+    """
     x = d[:, i0 - HALF : i0 + HALF + 1, j0 - HALF : j0 + HALF + 1].reshape(len(d), -1)
+    if cris is None:
+        return _covariance(x, counts)
+    joint = _covariance(np.concatenate([x, np.asarray(cris, float)[:, None]], axis=1), counts)
+    s_dc = joint[..., :-1, -1]
+    return joint[..., :-1, :-1] - s_dc[..., :, None] * s_dc[..., None, :] / joint[..., -1:, -1:]
+
+
+def _covariance(x, counts=None):
+    """Covariance over samples (rows) of *x* (N, K); with *counts* (B, N) one per replicate (B, K, K)."""
     x = x - x.mean(axis=0)  # centred once: the covariance does not depend on it, rounding does
     if counts is None:
         return np.cov(x, rowvar=False)

@@ -88,3 +88,10 @@ class Decision(StrEnum):
     CHOSEN = "chosen"
     REJECTED = "rejected"
     NOT_CONSIDERED = "not considered"  # outside the candidates spread over the day
+
+
+class Cost(StrEnum):
+    """The cost whose minimum over the perturbations is the geolocation offset (``assessment.cost``)."""
+
+    STDEV = "stdev"  # the paper's equation (8): STDEV(BT_VIIRS - BT_CrIS)
+    REGRESSION = "regression"  # the residual STDEV of BT_VIIRS - BT_CrIS regressed on BT_CrIS

@@ -1,0 +1,54 @@
+"""The regression cost: a CrIS gain and bias leave it unchanged, and the refinement is exact for it."""
+
+import numpy as np
+import pytest
+
+from monitor import refine
+from monitor.assess import cost_surface
+from monitor.vocabulary import Cost
+
+
+def _samples(rng, n=300, m=21):
+    """d = V - C on a grid: V_ij a smooth shift of a textured truth T, C = T + noise."""
+    t = rng.normal(280.0, 8.0, n)
+    grad = rng.normal(0.0, 3.0, n)
+    ii, jj = np.meshgrid(np.arange(m) - 10.0, np.arange(m) - 10.0, indexing="ij")
+    v = t[:, None, None] + grad[:, None, None] * (0.3 * (ii - 1.2) ** 2 + 0.2 * (jj + 2.1) ** 2) ** 0.5 / 10
+    v += rng.normal(0.0, 0.2, v.shape)
+    return v, t + rng.normal(0.0, 0.1, n)
+
+
+def test_a_gain_and_bias_on_cris_leave_the_regression_cost_as_it_was():
+    rng = np.random.default_rng(1)
+    v, c = _samples(rng)
+    before = cost_surface(v - c[:, None, None], c, Cost.REGRESSION)
+    c2 = 1.03 * (c - 280.0) + 280.0 + 1.5
+    after = cost_surface(v - c2[:, None, None], c2, Cost.REGRESSION)
+    assert np.allclose(after, before, rtol=1e-9)
+    stdev = cost_surface(v - c2[:, None, None], c2, Cost.STDEV)  # the paper's cost does change
+    assert not np.allclose(stdev, cost_surface(v - c[:, None, None], c, Cost.STDEV), rtol=1e-3)
+
+
+def test_the_refinement_is_exact_for_the_regression_cost():
+    """On the grid nodes the refinement's quadratic form w^T S' w equals the regression cost squared, and
+    the bootstrap replicates' surfaces agree with the same counts."""
+    rng = np.random.default_rng(2)
+    v, c = _samples(rng)
+    d = v - c[:, None, None]
+    g = cost_surface(d, c, Cost.REGRESSION)
+    s = refine.window_covariance(d, 10, 10, cris=c)
+    for dx, dy in [(0, 0), (1, -1), (-1, 1)]:
+        w = np.outer(_node(dx), _node(dy)).ravel()
+        assert w @ s @ w == pytest.approx(g[10 + dx, 10 + dy] ** 2, rel=1e-9)
+    counts = rng.poisson(1.0, (3, len(d))).astype(float)
+    stacked = refine.window_covariance(d, 10, 10, counts, c)
+    replicas = cost_surface(d, c, Cost.REGRESSION, counts)
+    w = np.outer(_node(0), _node(0)).ravel()
+    assert np.allclose([w @ sb @ w for sb in stacked], replicas[:, 10, 10] ** 2, rtol=1e-9)
+
+
+def _node(k):
+    """The interpolation weights at a window node: 1 there, 0 elsewhere."""
+    w = np.zeros(2 * refine.HALF + 1)
+    w[refine.HALF + k] = 1.0
+    return w
