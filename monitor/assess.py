@@ -365,20 +365,33 @@ def _stdev(d, weights=None):
     return np.sqrt(np.maximum(var, 0.0)).reshape(-1, m, m)
 
 
+def calibration_regressors(cris):
+    """The regressors of the regression cost (N, 2): the CrIS BT and its square about its mean, so that a
+    CrIS-VIIRS difference bias + gain T + curvature T^2 is explained away."""
+    c = np.asarray(cris, float) - np.mean(cris)
+    return np.stack([c, c * c], axis=1)
+
+
 def _regression_stdev(d, cris, weights=None):
-    """The residual STDEV of d (N, m, m) regressed on the CrIS BT *cris* (N,), per perturbation:
-    sqrt(Var d - Cov(d, C)^2 / Var C). With d = V - C this is the residual of V - beta C for the best beta
-    at each perturbation, so a CrIS gain or bias (C -> gC + b) leaves it unchanged. *weights* (B, N): one
-    surface per bootstrap replicate (B, m, m)."""
+    """The residual STDEV of d (N, m, m) regressed on the CrIS BT *cris* (N,) and its square, per
+    perturbation: sqrt(Var d - s_dX S_XX^-1 s_Xd). With d = V - C this is the residual of V - f(C) for the
+    best quadratic f at each perturbation, so a CrIS-VIIRS calibration difference up to second order
+    leaves it unchanged. *weights* (B, N): one surface per bootstrap replicate (B, m, m)."""
     n, m = d.shape[0], d.shape[1]
-    flat = np.concatenate([d.reshape(n, -1), cris[:, None]], axis=1)
+    x = calibration_regressors(cris)
+    flat = np.concatenate([d.reshape(n, -1), x], axis=1)
     w = np.ones((1, n)) if weights is None else np.asarray(weights, float)
-    s0 = w.sum(axis=1, keepdims=True)
+    s0 = w.sum(axis=1)[:, None]
     mean = (w @ flat) / s0
-    centred = flat - mean[:, None, :]  # (B, N, K+1)
-    var = np.einsum("bn,bnk,bnk->bk", w, centred, centred) / np.maximum(s0 - 1, 1)
-    cov = np.einsum("bn,bnk,bn->bk", w, centred[..., :-1], centred[..., -1]) / np.maximum(s0 - 1, 1)
-    res = var[:, :-1] - cov**2 / var[:, -1:]
+    res = np.empty((len(w), m * m))
+    for b in range(len(w)):  # one replicate at a time: (N, K) products stay small
+        c = flat - mean[b]
+        wc = c * w[b][:, None]
+        var_d = np.einsum("nk,nk->k", wc[:, :-2], c[:, :-2])
+        s_dx = wc[:, :-2].T @ c[:, -2:]  # (K, 2)
+        s_xx = wc[:, -2:].T @ c[:, -2:]  # (2, 2)
+        explained = np.einsum("ka,ab,kb->k", s_dx, np.linalg.inv(s_xx), s_dx)
+        res[b] = (var_d - explained) / max(s0[b, 0] - 1, 1)
     g = np.sqrt(np.maximum(res, 0.0)).reshape(-1, m, m)
     return g[0] if weights is None else g
 
@@ -457,7 +470,7 @@ def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
     over samples; its minimum is refined between grid points where the window fits (:mod:`monitor.refine`).
     """
     m = d.shape[1]
-    regress = cris if cfg.cost == Cost.REGRESSION else None
+    regress = calibration_regressors(cris) if cfg.cost == Cost.REGRESSION else None
     g = cost_surface(d, cris, cfg.cost)
     x, y, flags = find_minimum(g, cfg.flat_contrast)
     i0, j0 = (int(k) for k in np.unravel_index(np.argmin(g), g.shape))

@@ -58,17 +58,19 @@ def window_covariance(d, i0: int, j0: int, counts=None, cris=None):
     """Covariance (49 x 49) over samples of d (N, m, m) in the window around (i0, j0); with bootstrap
     *counts* (B, N) one covariance per replicate (B, 49, 49).
 
-    With *cris* (N,), the samples' CrIS BT, the covariance of what of d the CrIS BT does not explain
-    linearly (the regression cost, :mod:`monitor.assess`): the residual of d_interp = w^T d regressed on
-    C has variance w^T S_dd w - (w^T s_dC)^2 / Var C = w^T (S_dd - s_dC s_dC^T / Var C) w, a quadratic form
-    in the same weights, with the matrix returned here (the Schur complement of Var C).
+    With *cris* (N, R), the regressors of the regression cost (:func:`monitor.assess.calibration_regressors`:
+    the CrIS BT and its square), the covariance of what of d they do not explain: the residual of
+    d_interp = w^T d regressed on X has variance w^T S_dd w - w^T S_dX S_XX^-1 S_Xd w
+    = w^T (S_dd - S_dX S_XX^-1 S_Xd) w, a quadratic form in the same weights with the matrix returned here
+    (the Schur complement of S_XX), as long as the regressors are fixed: they are the samples' own.
     """
     x = d[:, i0 - HALF : i0 + HALF + 1, j0 - HALF : j0 + HALF + 1].reshape(len(d), -1)
     if cris is None:
         return _covariance(x, counts)
-    joint = _covariance(np.concatenate([x, np.asarray(cris, float)[:, None]], axis=1), counts)
-    s_dc = joint[..., :-1, -1]
-    return joint[..., :-1, :-1] - s_dc[..., :, None] * s_dc[..., None, :] / joint[..., -1:, -1:]
+    nx = x.shape[1]
+    joint = _covariance(np.concatenate([x, np.asarray(cris, float)], axis=1), counts)
+    s_dx = joint[..., :nx, nx:]
+    return joint[..., :nx, :nx] - s_dx @ np.linalg.inv(joint[..., nx:, nx:]) @ np.swapaxes(s_dx, -1, -2)
 
 
 def _covariance(x, counts=None):

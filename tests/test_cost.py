@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from monitor import refine
-from monitor.assess import cost_surface
+from monitor.assess import calibration_regressors, cost_surface
 from monitor.vocabulary import Cost
 
 
@@ -18,14 +18,22 @@ def _samples(rng, n=300, m=21):
     return v, t + rng.normal(0.0, 0.1, n)
 
 
-def test_a_gain_and_bias_on_cris_leave_the_regression_cost_as_it_was():
+def test_a_calibration_difference_on_cris_leaves_the_regression_cost_as_it_was():
+    """A gain and a bias exactly (the regressors span the same functions); with a curvature too, to the
+    second order of a 0.5 K term over the scene's range."""
     rng = np.random.default_rng(1)
     v, c = _samples(rng)
     before = cost_surface(v - c[:, None, None], c, Cost.REGRESSION)
-    c2 = 1.03 * (c - 280.0) + 280.0 + 1.5
-    after = cost_surface(v - c2[:, None, None], c2, Cost.REGRESSION)
-    assert np.allclose(after, before, rtol=1e-9)
-    stdev = cost_surface(v - c2[:, None, None], c2, Cost.STDEV)  # the paper's cost does change
+    x = c - 280.0
+    linear = c + 1.5 + 0.03 * x
+    assert np.allclose(cost_surface(v - linear[:, None, None], linear, Cost.REGRESSION), before, rtol=1e-9)
+    curved = linear + 0.5 * (x / 30.0) ** 2  # the simulator's law (simulate/case.py)
+    after = cost_surface(v - curved[:, None, None], curved, Cost.REGRESSION)
+    assert np.allclose(after, before, rtol=1e-3)
+    assert np.unravel_index(np.argmin(after), after.shape) == np.unravel_index(
+        np.argmin(before), before.shape
+    )
+    stdev = cost_surface(v - linear[:, None, None], linear, Cost.STDEV)  # the paper's cost does change
     assert not np.allclose(stdev, cost_surface(v - c[:, None, None], c, Cost.STDEV), rtol=1e-3)
 
 
@@ -36,12 +44,12 @@ def test_the_refinement_is_exact_for_the_regression_cost():
     v, c = _samples(rng)
     d = v - c[:, None, None]
     g = cost_surface(d, c, Cost.REGRESSION)
-    s = refine.window_covariance(d, 10, 10, cris=c)
+    s = refine.window_covariance(d, 10, 10, cris=calibration_regressors(c))
     for dx, dy in [(0, 0), (1, -1), (-1, 1)]:
         w = np.outer(_node(dx), _node(dy)).ravel()
         assert w @ s @ w == pytest.approx(g[10 + dx, 10 + dy] ** 2, rel=1e-9)
     counts = rng.poisson(1.0, (3, len(d))).astype(float)
-    stacked = refine.window_covariance(d, 10, 10, counts, c)
+    stacked = refine.window_covariance(d, 10, 10, counts, calibration_regressors(c))
     replicas = cost_surface(d, c, Cost.REGRESSION, counts)
     w = np.outer(_node(0), _node(0)).ravel()
     assert np.allclose([w @ sb @ w for sb in stacked], replicas[:, 10, 10] ** 2, rtol=1e-9)
