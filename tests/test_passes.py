@@ -53,4 +53,6 @@ def test_offsets_are_recovered(case):
         np.array([f.d_alpha_urad for f in result.fors])[ok] - ta[ok],
         np.array([f.d_beta_urad for f in result.fors])[ok] - tb[ok],
     ]
-    assert np.sqrt(np.mean(err**2)) < 40 and np.abs(err).max() < 120  # one granule: 36 samples per FOR
+    # one granule, 36 samples per FOR. The bounds come from seeds 1-8 of each pass (2026-11-24): RMS
+    # 11.0-23.8 urad, largest error 108.9 (dateline, seed 6), 26-30 reliable FORs; seed 5 is run here
+    assert np.sqrt(np.mean(err**2)) < 40 and np.abs(err).max() < 120
