@@ -42,10 +42,10 @@ def bucket(cases, tmp_path_factory):
 
 
 def _source(url, tmp_path, **kw):
-    cfg = SourceConfig(
-        kind="nodd", endpoint=url + "/{bucket}", **{"retries": 2, "backoff_s": 0.01, "timeout_s": 10, **kw}
-    )
-    return NoddSource(cfg, tmp_path / "cache")
+    """A NODD source on the test server; *kw* may narrow bounds below what a file may set (a budget of
+    0.1 MB, a deadline of 3 s: the tests run in seconds), so they are applied after validation."""
+    cfg = SourceConfig(kind="nodd", endpoint=url + "/{bucket}", retries=2, backoff_s=0.01, timeout_s=10.0)
+    return NoddSource(cfg.model_copy(update=kw), tmp_path / "cache")
 
 
 def test_listing_follows_pages_and_keeps_newest(bucket, tmp_path):
