@@ -12,7 +12,9 @@ import numpy as np
 
 from monitor.assess import AssessConfig, assess_plan
 from monitor.collocate import warm_up
+from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
+from monitor.geometry.perturb import perturbed_los_sbf
 from monitor.sdr import read_file
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
@@ -44,8 +46,6 @@ def _pyresample_reference(case, cfg: AssessConfig, max_granules=1):
         from pyresample import kd_tree
     except ImportError:
         return None
-    from monitor.geometry import wgs84
-    from monitor.geometry.perturb import perturbed_los_sbf
 
     g = case.cris[0]
     v = case.viirs[g.key]

@@ -21,6 +21,7 @@ from monitor.constants import N_FOR
 from monitor.records import History
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import satellite as satellite_info
+from monitor.version import __version__
 
 # variable: (unit, long name); the store's column names
 VARIABLES = {
@@ -42,8 +43,6 @@ FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
 def to_xarray(store: History, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
     """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset."""
     import xarray as xr
-
-    from monitor.version import __version__
 
     series = store.series(satellite, since, until)
     data = {k: series.values[k] for k in VARIABLES}

@@ -32,6 +32,7 @@ import math
 from prometheus_client import CollectorRegistry, Counter, Gauge
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 
+from monitor.store.alerts import AlertState
 from monitor.vocabulary import RunStatus
 
 OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run row changes to one once
@@ -47,8 +48,6 @@ class _StoreCollector:
         self.started = started
 
     def collect(self):
-        from monitor.store.alerts import AlertState
-
         with self.open_store() as store:
             success = store.last_success()
             first = store.first_runs()

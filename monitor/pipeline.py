@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from alerts.changes import all_changes
 from monitor import fingerprint as fpr
 from monitor import logs
 from monitor.assess import AssessConfig, assess_plan
@@ -148,7 +149,6 @@ def publish_changes(cfg: Config, store: Store, satellite: str) -> None:
     """Queue every known change of *satellite* for the time-series stores (dashboard annotations)."""
     if not cfg.store.publish:
         return
-    from alerts.changes import all_changes
 
     try:
         changes = all_changes(store, satellite, cfg.events_file)

@@ -21,7 +21,7 @@ from monitor.allocator import reuse_freed_memory
 from monitor.config import Config
 from monitor.lock import InstanceLock
 from monitor.pipeline import DayWork, ProgressLines, compute_day, record_day
-from monitor.sources import make_source
+from monitor.sources.configured import make_source
 from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
 

@@ -35,7 +35,7 @@ from monitor.health import Health
 from monitor.lock import InstanceLock
 from monitor.metrics import ServiceMetrics
 from monitor.pipeline import RunOutcome, days_to_run, run_day
-from monitor.sources import make_source
+from monitor.sources.configured import make_source
 from monitor.store.sqlite import Store
 from monitor.store.timeseries import drain_outbox
 from monitor.version import __version__
@@ -122,7 +122,7 @@ class Service:
         """Rewrite the HTML report into ``report_dir``; a report problem never stops the service."""
         if not self.cfg.report_dir:
             return
-        from monitor.report.html import build_report, options_from_config
+        from monitor.report.html import build_report, options_from_config  # matplotlib: when first needed
 
         try:
             build_report(store, self.cfg.report_dir, options_from_config(self.cfg))

@@ -11,7 +11,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
-from monitor.config import Config
 from monitor.sdr.names import JpssName, parse_name
 from monitor.sdr.products import PRODUCTS
 
@@ -71,16 +70,3 @@ class Source(Protocol):
 
     def fetch(self, f: ListedFile) -> Path:
         """A local path holding *f* (downloaded if need be); :class:`SourceError` on failure."""
-
-
-def make_source(cfg: Config) -> Source:
-    """The source named by the configuration's ``source.kind``."""
-    from monitor.sources.local import LocalSource, SimulatedSource
-    from monitor.sources.nodd import NoddSource
-
-    kind = cfg.source.kind
-    if kind == "local":
-        return LocalSource(cfg.source.path)
-    if kind == "simulated":
-        return SimulatedSource(cfg.state_dir / "simulated", cfg.source)
-    return NoddSource(cfg.source, Path(cfg.cache_dir))

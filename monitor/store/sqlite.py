@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from monitor.constants import N_FOR
+from monitor.export import to_xarray
 from monitor.records import Event, ForSeries, GranuleRow, Run, SelectionRow
 from monitor.result import MEASURED_FIELDS, AssessmentResult, ForOffset
 from monitor.store.alerts import AlertState
@@ -416,7 +417,6 @@ class Store:
 
     def to_xarray(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
         """The per-FOR results of *satellite* as a CF-style xarray Dataset (:mod:`monitor.export`)."""
-        from monitor.export import to_xarray
 
         return to_xarray(self, satellite, since, until)
 

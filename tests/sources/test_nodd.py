@@ -9,7 +9,8 @@ import pytest
 
 from monitor.config import SourceConfig, load_config
 from monitor.pipeline import compute_day
-from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed, make_source
+from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
+from monitor.sources.configured import make_source
 from monitor.sources.nodd import NoddSource
 from monitor.vocabulary import RunStatus
 from tests.servers import S3Server

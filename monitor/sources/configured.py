@@ -1,0 +1,20 @@
+"""The source a configuration names (``source.kind``): the one place that knows every kind."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from monitor.config import Config
+from monitor.sources import Source
+from monitor.sources.local import LocalSource, SimulatedSource
+from monitor.sources.nodd import NoddSource
+
+
+def make_source(cfg: Config) -> Source:
+    """The source named by the configuration's ``source.kind``."""
+    kind = cfg.source.kind
+    if kind == "local":
+        return LocalSource(cfg.source.path)
+    if kind == "simulated":
+        return SimulatedSource(cfg.state_dir / "simulated", cfg.source)
+    return NoddSource(cfg.source, Path(cfg.cache_dir))
