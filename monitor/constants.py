@@ -15,6 +15,11 @@ VIIRS_SCAN_US = 1_786_400  # VIIRS scan period, 1.7864 s
 
 SPEC_KM = 1.5  # the CrIS geolocation specification (each of in-track and cross-track), km
 
+# CrIS-VIIRS intercalibration: the BT about which a gain difference turns (the bias is reported there) and
+# the width of the BT bins of the difference against the CrIS BT (the paper's Figure 15)
+CALIBRATION_REFERENCE_K = 280.0
+CALIBRATION_BIN_K = 10.0
+
 VIIRS_I_PIXEL_M = 375.0  # VIIRS I-band pixel at nadir
 REFERENCE_ALTITUDE_M = 833000.0  # the JPSS orbit altitude the paper's grid step is defined at
 DEFAULT_STEP_RAD = VIIRS_I_PIXEL_M / REFERENCE_ALTITUDE_M  # one I-band pixel seen from 833 km, ~450 urad

@@ -51,6 +51,14 @@ def ecef_to_geodetic(xyz_m, iterations=5):
     return lat, lon, h
 
 
+def surface_to_geodetic(xyz_m):
+    """Geodetic (lat_rad, lon_rad) of ECEF points on the ellipsoid (h = 0), where the normal's slope is
+    closed-form: tan(lat) = z / ((1 - e^2) p), p = sqrt(x^2 + y^2); no iteration."""
+    xyz = np.asarray(xyz_m, float)
+    x, y, z = xyz[..., 0], xyz[..., 1], xyz[..., 2]
+    return np.arctan2(z, np.hypot(x, y) * (1.0 - E2)), np.arctan2(y, x)
+
+
 def enu_basis(lat_rad, lon_rad):
     """Unit vectors east, north, up (each (..., 3), ECEF) at geodetic *lat_rad*, *lon_rad*."""
     lat = np.asarray(lat_rad, float)

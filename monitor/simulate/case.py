@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.constants import CRIS_SCAN_US, URAD
+from monitor.constants import CALIBRATION_REFERENCE_K, CRIS_SCAN_US, URAD
 from monitor.errors import DataError
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
@@ -40,7 +40,6 @@ CRIS_GRANULE_S = 32.0
 VIIRS_GRANULE_S = ins.VIIRS_SCANS * ins.VIIRS_SCAN_S
 CONE_SAMPLES = 512
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
-CALIBRATION_REFERENCE_K = 280.0  # the BT about which a CrIS-VIIRS gain difference turns
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
 OBPT_U16, OBPT_F32 = 65533, -999.7
@@ -296,7 +295,8 @@ class Simulator:
         one."""
         if not self.spec.terrain:
             pts = origin + wgs84.intersect_ellipsoid(origin, los)[..., None] * los
-            return wgs84.ecef_to_geodetic(pts)
+            lat, lon = wgs84.surface_to_geodetic(pts)
+            return lat, lon, np.zeros(lat.shape)
         return intersect_terrain(origin, los, self.scene.height_m, MAX_HEIGHT_M)[1:]
 
     def _cris_spectra(self, sat, los_ecef):

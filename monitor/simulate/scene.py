@@ -20,6 +20,7 @@ Spectra add a simple atmosphere: R(nu) = tau(nu) B(nu, T) + (1 - tau(nu)) B(nu, 
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from monitor.spectral import planck_radiance
@@ -53,43 +54,57 @@ def _unit_vectors(lat_rad, lon_rad):
     return c * np.cos(lon), c * np.sin(lon), np.sin(lat)
 
 
+@numba.njit(cache=True, nogil=True)
+def _triplanar_samples(x, y, z, flat, n, scale, out):
+    """out (P, C) = the triplanar blend at unit vectors (x, y, z) (P,) of the fields *flat* (3, n * n, C):
+    for each plane the bilinear sample at the point's two in-plane coordinates (times *scale*), weighted
+    by the fourth power of the direction cosine normal to the plane over their root sum of squares.
+    One pass per point: the arithmetic of the array form, without its (P, C) temporaries."""
+    mask = n - 1  # n is a power of two: modulo by mask
+    nc = flat.shape[2]
+    for k in range(x.shape[0]):
+        c = (x[k], y[k], z[k])
+        w = (c[0] ** 4, c[1] ** 4, c[2] ** 4)
+        norm = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+        for ch in range(nc):
+            out[k, ch] = 0.0
+        for p in range(3):
+            u = c[(p + 1) % 3] * scale
+            v = c[(p + 2) % 3] * scale
+            u0 = np.floor(u)
+            v0 = np.floor(v)
+            fu = u - u0
+            fv = v - v0
+            i0 = np.int32(u0) & mask
+            j0 = np.int32(v0) & mask
+            i1 = ((i0 + 1) & mask) * n
+            j1 = (j0 + 1) & mask
+            i0 *= n
+            wp = w[p] / norm
+            for ch in range(nc):
+                a = flat[p, i0 + j0, ch]
+                a += (flat[p, i0 + j1, ch] - a) * fv
+                b = flat[p, i1 + j0, ch]
+                b += (flat[p, i1 + j1, ch] - b) * fv
+                a += (b - a) * fu
+                out[k, ch] += a * wp
+
+
 class _Triplanar:
     """Bilinear samples of stacked periodic fields (3 planes, n, n, channels) blended over the three
-    planes."""
+    planes (:func:`_triplanar_samples`)."""
 
     def __init__(self, fields, cell_km):
         self.n = fields.shape[1]
-        self.flat = [np.ascontiguousarray(f.reshape(self.n * self.n, -1)) for f in fields]
+        self.flat = np.ascontiguousarray(fields.reshape(3, self.n * self.n, -1), np.float32)
         self.scale = np.float32(EARTH_RADIUS_KM / cell_km)
 
     def __call__(self, xyz):
-        x, y, z = (np.asarray(c, np.float32) for c in xyz)
-        w = [x**4, y**4, z**4]
-        norm = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-        out = None
-        for p, (u, v) in enumerate(((y, z), (z, x), (x, y))):
-            term = self._bilinear(p, u * self.scale, v * self.scale)
-            term *= (w[p] / norm)[..., None]
-            out = term if out is None else out + term
-        return out
-
-    def _bilinear(self, p, u, v):
-        n, mask = self.n, self.n - 1  # n is a power of two: modulo by mask
-        u0, v0 = np.floor(u), np.floor(v)
-        fu = (u - u0)[..., None]
-        fv = (v - v0)[..., None]
-        i0 = u0.astype(np.int32) & mask
-        j0 = v0.astype(np.int32) & mask
-        i1 = ((i0 + 1) & mask) * n
-        j1 = (j0 + 1) & mask
-        i0 *= n
-        f = self.flat[p]
-        a = f.take(i0 + j0, axis=0)
-        a += (f.take(i0 + j1, axis=0) - a) * fv
-        b = f.take(i1 + j0, axis=0)
-        b += (f.take(i1 + j1, axis=0) - b) * fv
-        a += (b - a) * fu
-        return a
+        x, y, z = (np.ascontiguousarray(c, np.float32) for c in xyz)
+        shape = x.shape
+        out = np.empty((x.size, self.flat.shape[2]), np.float32)
+        _triplanar_samples(x.ravel(), y.ravel(), z.ravel(), self.flat, self.n, self.scale, out)
+        return out.reshape(shape + (self.flat.shape[2],))
 
 
 class Scene:
@@ -120,7 +135,7 @@ class Scene:
         probe = self.shape(
             _unit_vectors(*np.radians(np.meshgrid(np.linspace(-80, 80, 161), np.linspace(-180, 180, 361))))
         )
-        self.cloud_threshold = float(np.quantile(self.cloud.flat[0][::61, 0], 1.0 - cloud_fraction))
+        self.cloud_threshold = float(np.quantile(self.cloud.flat[0, ::61, 0], 1.0 - cloud_fraction))
         self.land_threshold = float(np.quantile(probe[..., 0], 1.0 - land_fraction))
         self.relief_gain = 1.0
         if terrain:

@@ -27,7 +27,8 @@ def intersect_terrain(origin_m, los, height_fn, top_m, iterations=12):
     d = np.asarray(los, float).reshape(-1, 3)
     shape = np.shape(los)[:-1]
     t = wgs84.intersect_ellipsoid(o, d)
-    lat, lon, h = wgs84.ecef_to_geodetic(o + t[:, None] * d, NEAR_SURFACE_ITERATIONS)
+    lat, lon = wgs84.surface_to_geodetic(o + t[:, None] * d)
+    h = np.zeros(lat.shape)
     ground = np.nan_to_num(height_fn(lat, lon)).astype(float)
     act = np.flatnonzero(np.isfinite(t) & (ground > 0))
     if act.size:

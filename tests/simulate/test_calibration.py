@@ -4,8 +4,9 @@ instruments' by the bias and gain injected (what the intercalibration of issue 2
 import numpy as np
 import pytest
 
+from monitor.constants import CALIBRATION_REFERENCE_K
 from monitor.sdr import read_file
-from monitor.simulate.case import CALIBRATION_REFERENCE_K, SimulationSpec, simulate_case
+from monitor.simulate.case import SimulationSpec, simulate_case
 from monitor.spectral import i5_band
 
 
