@@ -17,6 +17,7 @@ from alerts.alertmanager import post_state
 from alerts.changes import all_changes
 from alerts.channels import Permanent, Transient, make_channels
 from alerts.rules import (
+    CALIBRATION,
     Finding,
     failure_finding,
     jump_findings,
@@ -47,6 +48,7 @@ def findings_for(store: History, satellite: str, settings: AlertSettings, now: d
     if latest is not None:
         changes = all_changes(store, satellite, settings.events_file)
         out += jump_findings(store, satellite, changes, s, latest)
+        out += jump_findings(store, satellite, changes, s, latest, CALIBRATION)
     out += processing_change_findings(store, satellite, s, latest or now.date())
     return out
 

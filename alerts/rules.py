@@ -1,4 +1,5 @@
-"""Alert rules: specification breach, jump (with the change that preceded it), stale data, failed runs.
+"""Alert rules: specification breach, jumps of the offsets or of the CrIS-VIIRS bias (with the change that
+preceded them), stale data, failed runs.
 
 Each rule turns what the store holds into findings, one per satellite (and per jump). A finding is
 identified by rule + satellite + group, which is what the alert state tracks.
@@ -19,7 +20,38 @@ from monitor.records import History
 from monitor.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 
 UTC = dt.timezone.utc
-COMPONENTS = (("in_track_km", "in-track"), ("cross_track_km", "cross-track"))
+
+
+@dataclass(frozen=True)
+class Watched:
+    """A daily per-FOR quantity a jump rule watches: its stored *components* (field, label), *unit*, the
+    smallest step that counts (the RuleSettings key *min_step_key*) and the floor of its day-to-day scatter
+    (*floor*, in *unit*: a series quieter than that is not made oversensitive)."""
+
+    rule: Rule
+    what: str
+    components: tuple
+    unit: str
+    min_step_key: str
+    floor: float
+
+    def min_step(self, s: RuleSettings) -> float:
+        return float(getattr(s, self.min_step_key))
+
+
+GEOLOCATION = Watched(
+    Rule.JUMP,
+    "geolocation",
+    (("in_track_km", "in-track"), ("cross_track_km", "cross-track")),
+    "km",
+    "min_jump_km",
+    0.02,
+)
+# the CrIS-VIIRS BT bias at 280 K (monitor/intercal.py): a VIIRS LUT or a CrIS calibration change moves it
+CALIBRATION = Watched(
+    Rule.CALIBRATION_JUMP, "CrIS-VIIRS calibration", (("bias_k", "bias"),), "K", "min_bias_jump_k", 0.01
+)
+COMPONENTS = GEOLOCATION.components
 GROUPS = {
     "FOR 1-10": range(0, 10),
     "FOR 11-20": range(10, 20),
@@ -100,17 +132,18 @@ def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | N
     )
 
 
-def _series(store: History, satellite: str):
+def _series(store: History, satellite: str, watched: Watched):
     series = store.series(satellite)
     reliable = series.reliable()
-    return series.days, {c: np.where(reliable, series.values[c], np.nan) for c, _ in COMPONENTS}
+    return series.days, {c: np.where(reliable, series.values[c], np.nan) for c, _ in watched.components}
 
 
-def step_test(y: np.ndarray, days: list, split: dt.date, s: RuleSettings):
-    """(delta_km, z) of a step at *split* in the daily series *y*, or None when the windows are too short.
+def step_test(y: np.ndarray, days: list, split: dt.date, s: RuleSettings, floor: float = GEOLOCATION.floor):
+    """(delta, z) of a step at *split* in the daily series *y*, or None when the windows are too short.
 
     Robust two-sample comparison: difference of medians after/before the split, scaled by the MAD of
-    the pre-split days (floored at 20 m) with the sampling error of a median (sqrt(pi/2) / sqrt(n)).
+    the pre-split days (floored at *floor*, 20 m for the offsets) with the sampling error of a median
+    (sqrt(pi/2) / sqrt(n)).
     """
     d = np.array([x.toordinal() for x in days])
     k = split.toordinal()
@@ -119,13 +152,16 @@ def step_test(y: np.ndarray, days: list, split: dt.date, s: RuleSettings):
     if len(pre) < s.min_pre_days or len(post) < s.min_post_days:
         return None
     delta = float(np.median(post) - np.median(pre))
-    scale = max(1.4826 * float(np.median(np.abs(pre - np.median(pre)))), 0.02)
+    scale = max(1.4826 * float(np.median(np.abs(pre - np.median(pre)))), floor)
     se = scale * math.sqrt(math.pi / 2) * math.sqrt(1 / len(pre) + 1 / len(post))
     return delta, delta / se
 
 
-def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -> list[dict]:
-    """Steps in the FOR-group series, at known change days (lower threshold) and blind in the recent window.
+def detect_jumps(
+    days: list, values: dict, change_days: list, s: RuleSettings, watched: Watched = GEOLOCATION
+) -> list[dict]:
+    """Steps in the FOR-group series of the *watched* quantity, at known change days (lower threshold) and
+    blind in the recent window.
 
     Returns one dict per split day found: split, groups [(group, component, delta, z)], fors (per-FOR
     deltas of the components that jumped), known (whether the split is a change day).
@@ -143,23 +179,23 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
     for split, known in sorted(candidates.items()):
         threshold = s.jump_z_at_change if known else s.jump_z
         hits = []
-        for comp, label in COMPONENTS:
+        for comp, label in watched.components:
             for g, idx in GROUPS.items():
                 sub = values[comp][:, list(idx)]
                 ok = np.sum(np.isfinite(sub), axis=1) >= len(idx) / 2
                 with np.errstate(all="ignore"):
                     y = np.where(ok, np.nanmean(sub, axis=1), np.nan)
-                t = step_test(y, days, split, s)
-                if t and abs(t[0]) >= s.min_jump_km and abs(t[1]) >= threshold:
+                t = step_test(y, days, split, s, watched.floor)
+                if t and abs(t[0]) >= watched.min_step(s) and abs(t[1]) >= threshold:
                     hits.append((g, label, t[0], t[1]))
         if hits:
             fors: dict[int, list] = {}
-            for comp, label in COMPONENTS:
+            for comp, label in watched.components:
                 if not any(h[1] == label for h in hits):
                     continue
                 for i in range(N_FOR):
-                    t = step_test(values[comp][:, i], days, split, s)
-                    if t and abs(t[0]) >= s.min_jump_km:
+                    t = step_test(values[comp][:, i], days, split, s, watched.floor)
+                    if t and abs(t[0]) >= watched.min_step(s):
                         fors.setdefault(i + 1, []).append((label, t[0]))
             found.append(
                 {
@@ -170,12 +206,13 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
                     "score": max(abs(h[3]) for h in hits),
                 }
             )
-    # a blind step is seen at several neighbouring split days: keep the strongest of each cluster
+    # one step is seen at every split day whose windows straddle it (a sharp step, days after it too, while
+    # the reference median is still the old level): one per cluster, a known change first, else the strongest
     found.sort(key=lambda j: j["split"])
     kept: list[dict] = []
     for j in found:
-        if kept and (j["split"] - kept[-1]["split"]).days <= 3 and not (j["known"] and not kept[-1]["known"]):
-            if j["score"] > kept[-1]["score"] and not kept[-1]["known"]:
+        if kept and (j["split"] - kept[-1]["split"]).days < s.post_days:
+            if (j["known"], j["score"]) > (kept[-1]["known"], kept[-1]["score"]):
                 kept[-1] = j
             continue
         kept.append(j)
@@ -183,11 +220,18 @@ def detect_jumps(days: list, values: dict, change_days: list, s: RuleSettings) -
 
 
 def jump_findings(
-    store: History, satellite: str, changes: list, s: RuleSettings, today: dt.date
+    store: History,
+    satellite: str,
+    changes: list,
+    s: RuleSettings,
+    today: dt.date,
+    watched: Watched = GEOLOCATION,
 ) -> list[Finding]:
-    """A finding per recent step in the FOR-group series, attributed to the change before it."""
-    days, values = _series(store, satellite)
-    jumps = detect_jumps(days, values, sorted({c.time.date() for c in changes}), s)
+    """A finding per recent step in the FOR-group series of the *watched* quantity (the offsets, or the
+    CrIS-VIIRS bias: :data:`CALIBRATION`), attributed to the change before it."""
+    days, values = _series(store, satellite, watched)
+    jumps = detect_jumps(days, values, sorted({c.time.date() for c in changes}), s, watched)
+    u = watched.unit
     out = []
     for j in jumps:
         if (today - j["split"]).days > s.active_days:
@@ -203,20 +247,20 @@ def jump_findings(
             if change
             else "unknown"
         )
-        groups = "; ".join(f"{g} {label} {d:+.2f} km (z {z:+.1f})" for g, label, d, z in j["groups"])
+        groups = "; ".join(f"{g} {label} {d:+.2f} {u} (z {z:+.1f})" for g, label, d, z in j["groups"])
         lines = [f"step from {j['split']}: {groups}", f"attribution: {cause}"]
         lines += [
-            f"FOR {k:2d}: " + ", ".join(f"{label} {d:+.2f} km" for label, d in v)
+            f"FOR {k:2d}: " + ", ".join(f"{label} {d:+.2f} {u}" for label, d in v)
             for k, v in sorted(j["fors"].items())
         ]
         out.append(
             Finding(
-                Rule.JUMP,
+                watched.rule,
                 satellite,
                 Severity.WARNING,
-                f"{satellite}: geolocation jump from {j['split']} ({who} change before it)"
+                f"{satellite}: {watched.what} jump from {j['split']} ({who} change before it)"
                 if change
-                else f"{satellite}: geolocation jump from {j['split']} with no known change before it",
+                else f"{satellite}: {watched.what} jump from {j['split']} with no known change before it",
                 lines,
                 group=j["split"].isoformat(),
                 data={

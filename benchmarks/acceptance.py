@@ -10,17 +10,24 @@ Calibration of the reported sigma (the bootstrap over scans within granules plus
 ``AssessConfig.sigma_floor_urad`` in quadrature): over all cases, the share of FOR-directions whose
 |error| <= 2 sigma (target >= 90 %) and, per case, the median sigma over the RMS error (target <= 3).
 It also prints the floor that would give 90 % coverage with the bootstrap part as measured.
+CrIS-VIIRS calibration differences (``--mismatch``, issue 27): the CrIS BT departs from VIIRS's by a gain
+about 280 K, a bias and a curvature (:data:`MISMATCHES`); ``--cost`` picks the cost (assessment.cost). Each
+row also holds the intercalibration recovered per FOR (bias at 280 K, gain), printed against the injected
+values (the curvature-free cases: every reliable FOR within 0.05 K and 0.2 %).
+
 Slow (~2-5 min per 14-granule case); not part of the test suite. ``--rows FILE`` appends one JSON line per
 case and resumes from the cases already in the file; ``benchmarks/results/acceptance_2026-11-22.jsonl`` holds
 the 25 cases of 2026-11-22 (print their tables with ``--from-rows``).
 
     .venv/bin/python benchmarks/acceptance.py [--sizes 14 6] [--seeds 1 2] [--profiles paper random zero]
-        [--ground flat terrain] [--passes day night] [--keep DIR] [--rows FILE]
+        [--ground flat terrain] [--passes day night] [--mismatch none gain+3 ...] [--cost regression]
+        [--keep DIR] [--rows FILE]
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import shutil
 import sys
@@ -33,15 +40,30 @@ import numpy as np
 from monitor.assess import AssessConfig, assess_paths
 from monitor.simulate.case import simulate_case
 from monitor.simulate.orbit import PASSES
+from monitor.vocabulary import Cost
 
+# name: (gain, bias K, curvature K at 250/310 K) of CrIS against VIIRS (SimulationSpec.cris_*): the issue's
+# range, gains -3..+3 %, biases up to 2 K, curvatures up to 0.5 K over 250-310 K
+MISMATCHES = {
+    "none": (0.0, 0.0, 0.0),
+    "gain+3": (0.03, 0.0, 0.0),
+    "gain-3,bias+1.5": (-0.03, 1.5, 0.0),
+    "gain+1,curve+0.5": (0.01, 0.0, 0.5),
+    "bias+2,curve-0.5": (0.0, 2.0, -0.5),
+    "gain-1,bias-2": (-0.01, -2.0, 0.0),
+}
+RECOVERY = (0.05, 0.2)  # the intercalibration's bound: bias K, gain per cent (curvature-free cases)
 BOUNDS = {14: (10.0, 25.0)}  # granules: (RMS, worst FOR) urad; smaller cases get SMALL_BOUNDS
 SMALL_BOUNDS = (12.0, 30.0)
 EXTRA_PASSES = {"dateline": ("night", 180.0)}
 
 
-def run_case(root: Path, size, profile, ground, pass_name, seed, workers, keep):
+def run_case(
+    root: Path, size, profile, ground, pass_name, seed, workers, keep, mismatch="none", cost="stdev"
+):
     orbit_pass, lon = EXTRA_PASSES.get(pass_name, (pass_name, None))
-    case = root / f"{profile}_{ground}_{pass_name}_{seed}_{size}"
+    gain, bias_k, curve_k = MISMATCHES[mismatch]
+    case = root / f"{profile}_{ground}_{pass_name}_{seed}_{size}_{mismatch}"
     truth = simulate_case(
         case,
         granules=size,
@@ -50,9 +72,12 @@ def run_case(root: Path, size, profile, ground, pass_name, seed, workers, keep):
         terrain=ground == "terrain",
         orbit_pass=orbit_pass,
         pass_lon_deg=lon,
+        cris_gain=gain,
+        cris_bias_k=bias_k,
+        cris_nonlinear_k=curve_k,
     )
     t0 = time.perf_counter()
-    cfg = AssessConfig()
+    cfg = AssessConfig(cost=Cost(cost))
     result = assess_paths([case], cfg, workers=workers)
     secs = time.perf_counter() - t0
     (case / "result.json").write_text(result.to_json(with_cube=False))
@@ -73,7 +98,41 @@ def run_case(root: Path, size, profile, ground, pass_name, seed, workers, keep):
         "sigma_alpha_urad": [f.sigma_alpha_urad for f in result.fors],
         "sigma_beta_urad": [f.sigma_beta_urad for f in result.fors],
         "reliable": [f.reliable for f in result.fors],
+        "mismatch": mismatch,
+        "cost": cost,
+        "bias_k": [f.bias_k for f in result.fors],
+        "sigma_bias_k": [f.sigma_bias_k for f in result.fors],
+        "gain_pct": [f.gain_pct for f in result.fors],
+        "sigma_gain_pct": [f.sigma_gain_pct for f in result.fors],
     }
+
+
+def _key(r) -> tuple:
+    return (
+        r["size"],
+        r["ground"],
+        r["pass"],
+        r["profile"],
+        r["seed"],
+        r.get("mismatch", "none"),
+        r.get("cost", "stdev"),
+    )
+
+
+def recovery(row) -> str:
+    """The intercalibration of a row against the injected values: median and worst reliable FOR."""
+    if "bias_k" not in row:
+        return ""
+    gain, bias_k, curve_k = MISMATCHES[row["mismatch"]]
+    ok = np.array(row["reliable"])
+    db = np.array(row["bias_k"], float)[ok] - bias_k
+    dg = np.array(row["gain_pct"], float)[ok] - 100 * gain
+    within = np.nanmax(np.abs(db)) <= RECOVERY[0] and np.nanmax(np.abs(dg)) <= RECOVERY[1]
+    verdict = "" if curve_k else ("  within" if within else "  OUT")
+    return (
+        f"  bias {np.nanmedian(db):+.3f} (worst {db[np.nanargmax(np.abs(db))]:+.3f}) K, gain "
+        f"{np.nanmedian(dg):+.3f} (worst {dg[np.nanargmax(np.abs(dg))]:+.3f}) %{verdict}"
+    )
 
 
 def verdict(row) -> tuple[bool, str]:
@@ -83,9 +142,10 @@ def verdict(row) -> tuple[bool, str]:
     worst = np.nanmax(np.abs(ea)), np.nanmax(np.abs(eb))
     ok = max(rms) <= rms_max and max(worst) <= abs_max and np.all(np.isfinite(ea + eb))
     line = (
+        f"{row.get('mismatch', 'none'):<17} {row.get('cost', 'stdev'):<10} "
         f"{row['profile']:<7} {row['ground']:<8} {row['pass']:<9} {row['seed']:>4} {row['size']:>4} "
         f"{rms[0]:6.1f} {worst[0]:6.1f} {rms[1]:6.1f} {worst[1]:6.1f} {row['reliable'].count(False):>7} "
-        f"{row['assess_s']:8.1f}  {'pass' if ok else 'FAIL'}"
+        f"{row['assess_s']:8.1f}  {'pass' if ok else 'FAIL'}{recovery(row)}"
     )
     return ok, line
 
@@ -124,6 +184,8 @@ def main() -> int:
     p.add_argument("--profiles", nargs="+", default=["paper", "random", "zero"])
     p.add_argument("--ground", nargs="+", choices=("flat", "terrain"), default=["flat", "terrain"])
     p.add_argument("--passes", nargs="+", choices=(*PASSES, *EXTRA_PASSES), default=["day", "night"])
+    p.add_argument("--mismatch", nargs="+", choices=MISMATCHES, default=["none"])
+    p.add_argument("--cost", choices=[c.value for c in Cost], default=Cost.STDEV.value)
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--keep", help="directory to keep the cases and results in")
     p.add_argument("--rows", help="append one JSON line per case here (errors and sigmas per FOR)")
@@ -137,9 +199,8 @@ def main() -> int:
         return 0
     root = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="crisgeo-acceptance-"))
     print(
-        f"{'profile':<7} {'ground':<8} {'pass':<9} {'seed':>4} {'gran':>4} {'rms_a':>6} {'max_a':>6} "
-        f"{'rms_b':>6} "
-        f"{'max_b':>6} {'flagged':>7} {'assess_s':>8}  verdict",
+        f"{'mismatch':<17} {'cost':<10} {'profile':<7} {'ground':<8} {'pass':<9} {'seed':>4} {'gran':>4} "
+        f"{'rms_a':>6} {'max_a':>6} {'rms_b':>6} {'max_b':>6} {'flagged':>7} {'assess_s':>8}  verdict",
         flush=True,
     )
     rows, failures = [], 0
@@ -148,24 +209,24 @@ def main() -> int:
         for line in Path(args.rows).read_text().splitlines():
             if line.strip():
                 r = json.loads(line)
-                done[(r["size"], r["ground"], r["pass"], r["profile"], r["seed"])] = r
-    for size in args.sizes:
-        for ground in args.ground:
-            for pass_name in args.passes:
-                for profile in args.profiles:
-                    for seed in args.seeds:
-                        row = done.get((size, ground, pass_name, profile, seed))
-                        if row is None:
-                            row = run_case(
-                                root, size, profile, ground, pass_name, seed, args.workers, args.keep
-                            )
-                        rows.append(row)
-                        if args.rows and (size, ground, pass_name, profile, seed) not in done:
-                            with open(args.rows, "a") as fh:
-                                fh.write(json.dumps(row) + "\n")
-                        ok, line = verdict(row)
-                        failures += not ok
-                        print(line, flush=True)
+                done[_key(r)] = r
+    for case in itertools.product(
+        args.sizes, args.ground, args.passes, args.profiles, args.seeds, args.mismatch
+    ):
+        size, ground, pass_name, profile, seed, mismatch = case
+        key = (size, ground, pass_name, profile, seed, mismatch, args.cost)
+        row = done.get(key)
+        if row is None:
+            row = run_case(
+                root, size, profile, ground, pass_name, seed, args.workers, args.keep, mismatch, args.cost
+            )
+            if args.rows:
+                with open(args.rows, "a") as fh:
+                    fh.write(json.dumps(row) + "\n")
+        rows.append(row)
+        ok, line = verdict(row)
+        failures += not ok
+        print(line, flush=True)
     print(calibration(rows))
     print(f"{failures} case(s) out of bounds")
     return 1 if failures else 0

@@ -30,6 +30,7 @@ from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
+from monitor.intercal import NO_FIT, difference_bins, intercalibrate
 from monitor.result import (
     FLAG_EDGE,
     FLAG_FEW_SAMPLES,
@@ -44,7 +45,7 @@ from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_viirs_geo_scan
 from monitor.spectral import i5_band
 from monitor.threads import parallel_threads
-from monitor.vocabulary import Cost
+from monitor.vocabulary import DEFAULT_COST, Cost
 
 LOG = logging.getLogger(__name__)
 KERNELS = {"top-hat": collocate.TOP_HAT, "response": collocate.SPATIAL_RESPONSE}
@@ -52,12 +53,13 @@ KERNELS = {"top-hat": collocate.TOP_HAT, "response": collocate.SPATIAL_RESPONSE}
 
 @dataclass
 class AssessConfig:
-    """Settings of one assessment. The defaults are the paper's."""
+    """Settings of one assessment. The defaults are the paper's but the cost's (``DEFAULT_COST``: the
+    regression form of equation 8, chosen by measurement)."""
 
     half_steps: int = DEFAULT_HALF_STEPS
     step_rad: float = DEFAULT_STEP_RAD
     kernel: str = "top-hat"
-    cost: Cost = Cost.STDEV
+    cost: Cost = DEFAULT_COST
     min_coverage: float = collocate.MIN_COVERAGE
     min_samples: int = 30
     flat_contrast: float = 0.03
@@ -67,7 +69,7 @@ class AssessConfig:
     sigma_floor_urad: float = 5.0  # in quadrature with the bootstrap: the estimator's own error (calibrated)
 
     @classmethod
-    def of(cls, half_steps: int, step_urad: float, kernel: str, cost: Cost = Cost.STDEV) -> AssessConfig:
+    def of(cls, half_steps: int, step_urad: float, kernel: str, cost: Cost = DEFAULT_COST) -> AssessConfig:
         """The assessment of a configuration's (or the command line's) grid, kernel and cost, the rest
         the paper's."""
         return cls(half_steps=half_steps, step_rad=step_urad * URAD, kernel=kernel, cost=Cost(cost))
@@ -462,12 +464,30 @@ def _scan_bootstrap_counts(rng, granule_of_unit, n_boot):
     return counts
 
 
-def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
-    """Offsets (grid steps from the centre), bootstrap sigmas (steps) and flags of one FOR.
+@dataclass
+class ForMinimum:
+    """The minimum of one FOR's cost surface *cost* (m, m): the offsets *x*, *y* (grid steps from the
+    centre), their bootstrap sigmas (steps), flags; *d_opt* (N,) the samples' BT difference at the
+    optimum, *refined* whether it lies between grid points (:mod:`monitor.refine`), *counts* (B, N) the
+    bootstrap's resampling (None without one)."""
+
+    cost: np.ndarray
+    x: float
+    y: float
+    sigma: tuple
+    flags: list
+    d_opt: np.ndarray
+    refined: bool
+    counts: np.ndarray | None
+
+
+def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng) -> ForMinimum:
+    """Offsets, bootstrap sigmas and flags of one FOR, and its samples' BT difference at the optimum.
 
     *d* (N, m, m) holds the samples' BT differences, *cris* (N,) their CrIS BT, *unit_ids* (N,) the scan
     each comes from and *granule_of_unit* the granule of each scan. The cost surface is ``cfg.cost``'s
-    over samples; its minimum is refined between grid points where the window fits (:mod:`monitor.refine`).
+    over samples; its minimum is refined between grid points where the window fits (:mod:`monitor.refine`),
+    and d is interpolated there with the refinement's own weights.
     """
     m = d.shape[1]
     regress = calibration_regressors(cris) if cfg.cost == Cost.REGRESSION else None
@@ -475,10 +495,13 @@ def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
     x, y, flags = find_minimum(g, cfg.flat_contrast)
     i0, j0 = (int(k) for k in np.unravel_index(np.argmin(g), g.shape))
     fine = FLAG_EDGE not in flags and FLAG_FLAT not in flags and refine.refinable(i0, j0, m)
+    d_opt = d[:, i0, j0]
     if fine:
         dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0, cris=regress))
         x, y = i0 - (m - 1) // 2 + dx, j0 - (m - 1) // 2 + dy
+        d_opt = refine.window_values(d, i0, j0, dx, dy)
     sig = (np.nan, np.nan)
+    counts = None
     if cfg.bootstrap > 1 and len(granule_of_unit) >= 2:
         counts = _scan_bootstrap_counts(rng, granule_of_unit, cfg.bootstrap)[:, unit_ids]
         if fine:
@@ -487,7 +510,7 @@ def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng):
             replicas = cost_surface(d, cris, cfg.cost, counts)
             est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in replicas])
         sig = tuple(np.nanstd(est, axis=0))
-    return g, x, y, sig, flags
+    return ForMinimum(g, x, y, sig, flags, d_opt, fine, counts)
 
 
 def cost_and_offsets(
@@ -500,6 +523,7 @@ def cost_and_offsets(
     rng = np.random.default_rng(cfg.seed)
     cube = np.full((N_FOR, m, m), np.nan)
     fors = []
+    pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR: Figure 15's bins
     for k in range(N_FOR):
         diffs, cris_k, units = [], [], []
         for g_i, s in enumerate(samples):
@@ -524,12 +548,17 @@ def cost_and_offsets(
         x = y = np.nan
         sig_a = sig_b = np.nan
         g = np.full((m, m), np.nan)
+        cal = NO_FIT
         if n >= 3:
-            g, x, y, (sig_a, sig_b), fl = for_minimum(
-                d, np.concatenate(cris_k), unit_ids, scan_keys[:, 0], cfg, rng
-            )
+            c = np.concatenate(cris_k)
+            best = for_minimum(d, c, unit_ids, scan_keys[:, 0], cfg, rng)
+            g, x, y, (sig_a, sig_b) = best.cost, best.x, best.y, best.sigma
             cube[k] = g
-            flags += fl
+            flags += best.flags
+            # the intercalibration at the optimum: V = d + C there
+            cal = intercalibrate(c, best.d_opt + c, best.counts)
+            if best.refined:
+                pooled.append((c, best.d_opt + c))
             sig_a, sig_b = (
                 np.hypot(sig_a * step_urad, cfg.sigma_floor_urad),
                 np.hypot(sig_b * step_urad, cfg.sigma_floor_urad),
@@ -555,6 +584,10 @@ def cost_and_offsets(
                 n_samples=int(n),
                 cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
                 cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan,
+                bias_k=cal.bias_k,
+                sigma_bias_k=cal.sigma_bias_k,
+                gain_pct=cal.gain_pct,
+                sigma_gain_pct=cal.sigma_gain_pct,
                 flags=tuple(sorted(set(flags))),
             )
         )
@@ -570,6 +603,9 @@ def cost_and_offsets(
         half_steps=cfg.half_steps,
         step_urad=step_urad,
         cost_cube_k=cube,
+        difference_bins=difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True)))
+        if pooled
+        else [],
     )
 
 

@@ -18,6 +18,7 @@ from monitor.geometry.perturb import perturbed_los_sbf
 from monitor.sdr import read_file
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
+from monitor.vocabulary import Cost
 
 
 def peak_rss_mb(who=resource.RUSAGE_SELF) -> float:
@@ -72,7 +73,7 @@ def _pyresample_reference(case, cfg: AssessConfig, max_granules=1):
 
 def run_bench(args) -> int:
     """``crisgeo bench``: simulate (or take --data), warm the kernels, time each stage, print; exit status."""
-    cfg = AssessConfig()
+    cfg = AssessConfig(cost=Cost(args.cost))
     with tempfile.TemporaryDirectory() as tmp:
         data = Path(args.data) if args.data else Path(tmp)
         t0 = time.perf_counter()
@@ -91,7 +92,8 @@ def run_bench(args) -> int:
         n_fov = sum(gr.n_fovs for gr in result.granules)
         print(
             f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(cfg.offsets_rad) ** 2} "
-            f"perturbations (simulation {t_sim:.1f} s and kernel compile/load {t_jit:.1f} s, not counted)"
+            f"perturbations, cost {cfg.cost} (simulation {t_sim:.1f} s and kernel compile/load "
+            f"{t_jit:.1f} s, not counted)"
         )
         for stage in ("read", "geometry", "spectral", "collocation", "cost"):
             t = timings.get(stage, 0.0)

@@ -776,6 +776,7 @@ def cmd_report(args) -> int:
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
     arg("--workers", type=int, default=2, help="threads of the compiled kernels (default 2)"),
+    arg("--cost", choices=tuple(Cost), default=ASSESSMENT.cost, help="the cost to time (assessment.cost)"),
 )
 def cmd_bench(args) -> int:
     """crisgeo bench: time each stage on a simulated case."""

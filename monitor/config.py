@@ -47,7 +47,7 @@ from monitor.constants import (
     URAD,
 )
 from monitor.satellites import SATELLITES
-from monitor.vocabulary import Cost, Kernel, PublishKind, SourceKind
+from monitor.vocabulary import DEFAULT_COST, Cost, Kernel, PublishKind, SourceKind
 
 NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
 
@@ -373,7 +373,7 @@ class AssessmentConfig(Section):
         Kernel.TOP_HAT, "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response)."
     )
     cost: Cost = key(
-        Cost.STDEV,
+        DEFAULT_COST,
         "The cost minimised over the perturbations: stdev (the paper's equation 8, "
         "STDEV(BT_VIIRS - BT_CrIS)) or regression (its residual after regression on BT_CrIS: a CrIS-VIIRS "
         "gain or bias does not move it).",
@@ -484,6 +484,13 @@ class RuleSettings(Section):
     )
     min_jump_km: float = key(
         0.25, "Smallest step (median after minus median before) that counts as a jump.", 0.001, 100.0
+    )
+    min_bias_jump_k: float = key(
+        0.1,
+        "Smallest step of the daily CrIS-VIIRS BT bias at 280 K that counts as a calibration jump (the "
+        "calibration_jump rule: a VIIRS LUT or CrIS calibration change).",
+        0.001,
+        100.0,
     )
     jump_z: float = key(
         5.0,

@@ -34,8 +34,19 @@ VARIABLES = {
     "total_km": ("km", "total geolocation error on the ground"),
     "sigma_in_track_km": ("km", "uncertainty (1 sigma) of the in-track error"),
     "sigma_cross_track_km": ("km", "uncertainty (1 sigma) of the cross-track error"),
-    "cost_min_k": ("K", "minimum of the cost STDEV(BT_VIIRS - BT_CrIS) over the perturbations"),
-    "cost_zero_k": ("K", "cost STDEV(BT_VIIRS - BT_CrIS) of the unperturbed LOS"),
+    "cost_min_k": (
+        "K",
+        "minimum over the perturbations of the cost (STDEV of BT_VIIRS - BT_CrIS, or its "
+        "residual after the calibration regression: assessment.cost)",
+    ),
+    "cost_zero_k": ("K", "cost of the unperturbed LOS"),
+    "bias_k": ("K", "CrIS minus VIIRS I5 brightness temperature at 280 K, at the optimum"),
+    "sigma_bias_k": ("K", "uncertainty (1 sigma) of the CrIS minus VIIRS bias"),
+    "gain_pct": (
+        "percent",
+        "CrIS minus VIIRS I5 gain difference (per cent of the BT departure from 280 K)",
+    ),
+    "sigma_gain_pct": ("percent", "uncertainty (1 sigma) of the gain difference"),
 }
 FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
 

@@ -119,6 +119,16 @@ class _StoreCollector:
             "Latest offset per FOR on the ground",
             labels=["satellite", "for", "direction"],
         )
+        bias = GaugeMetricFamily(
+            "crisgeo_for_calibration_bias_kelvin",
+            "Latest CrIS minus VIIRS I5 BT at the reference temperature (280 K) per FOR, at the optimum",
+            labels=["satellite", "for"],
+        )
+        gain = GaugeMetricFamily(
+            "crisgeo_for_calibration_gain_percent",
+            "Latest CrIS minus VIIRS I5 gain difference per FOR (per cent of the BT's departure from 280 K)",
+            labels=["satellite", "for"],
+        )
         ok = GaugeMetricFamily(
             "crisgeo_for_reliable",
             "1 when the FOR's latest offset carries no reliability flag",
@@ -140,8 +150,11 @@ class _StoreCollector:
                 ):
                     if math.isfinite(v):
                         km.add_metric([sat, k, direction], v)
+                for family, v in ((bias, f.bias_k), (gain, f.gain_pct)):
+                    if math.isfinite(v):
+                        family.add_metric([sat, k], v)
                 ok.add_metric([sat, k], 1 if f.reliable else 0)
-        yield from (day, urad, km, ok)
+        yield from (day, urad, km, bias, gain, ok)
 
 
 class ServiceMetrics:

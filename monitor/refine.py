@@ -73,6 +73,13 @@ def window_covariance(d, i0: int, j0: int, counts=None, cris=None):
     return joint[..., :nx, :nx] - s_dx @ np.linalg.inv(joint[..., nx:, nx:]) @ np.swapaxes(s_dx, -1, -2)
 
 
+def window_values(d, i0: int, j0: int, x: float, y: float):
+    """The samples' d (N, m, m) interpolated at (x, y) grid steps from the window centre (i0, j0), with the
+    weights the minimum was found with: d_n(x, y) = w(x, y)^T d_n (N,)."""
+    win = d[:, i0 - HALF : i0 + HALF + 1, j0 - HALF : j0 + HALF + 1]
+    return np.einsum("nab,a,b->n", win, keys_weights(x), keys_weights(y))
+
+
 def _covariance(x, counts=None):
     """Covariance over samples (rows) of *x* (N, K); with *counts* (B, N) one per replicate (B, K, K)."""
     x = x - x.mean(axis=0)  # centred once: the covariance does not depend on it, rounding does

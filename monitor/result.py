@@ -21,7 +21,9 @@ class ForOffset:
     """Offsets of one scan position (FOR 1..30): the turn to apply to the CrIS LOS to best match VIIRS.
 
     Angles in microradians (in-track alpha, cross-track beta), distances in km on the ground (in-track
-    positive along the flight direction, cross-track positive to the right), cost in kelvin.
+    positive along the flight direction, cross-track positive to the right), cost in kelvin. At the optimum,
+    the CrIS-VIIRS intercalibration (:mod:`monitor.intercal`): the BT bias (K) at the reference temperature
+    and the gain (per cent), NaN where none was fitted.
     """
 
     for_index: int
@@ -38,6 +40,10 @@ class ForOffset:
     cost_min_k: float
     cost_zero_k: float
     flags: tuple = ()
+    bias_k: float = float("nan")
+    sigma_bias_k: float = float("nan")
+    gain_pct: float = float("nan")
+    sigma_gain_pct: float = float("nan")
 
     @property
     def d_alpha_pct_fov(self) -> float:
@@ -76,6 +82,17 @@ MEASURED_FIELDS = tuple(f.name for f in fields(ForOffset) if f.name not in ("for
 
 
 @dataclass(frozen=True)
+class DifferenceBin:
+    """CrIS minus VIIRS BT (K) at the optimum of the samples whose CrIS BT lies in [low_k, low_k + width);
+    the paper's Figure 15 (:func:`monitor.intercal.difference_bins`)."""
+
+    low_k: float
+    n: int
+    mean_k: float
+    std_k: float
+
+
+@dataclass(frozen=True)
 class GranuleInfo:
     """One assessed CrIS granule: its ID and times (ISO 8601), its files and the VIIRS files that covered it,
     the FOVs with geolocation and the FOVs used, and the processing metadata of its CrIS GEO and of the
@@ -111,6 +128,7 @@ class AssessmentResult:
     half_steps: int = DEFAULT_HALF_STEPS
     step_urad: float = DEFAULT_STEP_URAD
     cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
+    difference_bins: list[DifferenceBin] = field(default_factory=list)  # the FORs refined, pooled
 
     def to_dict(self, with_cube: bool = False) -> dict:
         d = {
@@ -122,6 +140,7 @@ class AssessmentResult:
             "granules": [asdict(g) for g in self.granules],
             "skipped": self.skipped,
             "fors": [f.to_dict() for f in self.fors],
+            "difference_bins": [asdict(b) for b in self.difference_bins],
         }
         if with_cube and self.cost_cube_k is not None:
             d["cost_cube_k"] = np.round(self.cost_cube_k, 5).tolist()
@@ -143,6 +162,7 @@ class AssessmentResult:
             half_steps=int(d.get("half_steps", DEFAULT_HALF_STEPS)),
             step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),
             cost_cube_k=None if cube is None else np.asarray(cube, float),
+            difference_bins=[DifferenceBin(**b) for b in d.get("difference_bins", [])],
         )
 
     @classmethod

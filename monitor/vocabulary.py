@@ -48,6 +48,7 @@ class Rule(StrEnum):
 
     SPEC = "spec"  # an error beyond the specification
     JUMP = "jump"  # a step in the offsets, attributed to a known change where there is one
+    CALIBRATION_JUMP = "calibration_jump"  # a step in the CrIS-VIIRS BT bias, attributed the same way
     STALE = "stale"  # no successful assessment for too long
     FAILURE = "failure"  # failed or missed runs
     PROCESSING = "processing"  # a change seen in the GEO files' LOS fingerprint
@@ -95,3 +96,8 @@ class Cost(StrEnum):
 
     STDEV = "stdev"  # the paper's equation (8): STDEV(BT_VIIRS - BT_CrIS)
     REGRESSION = "regression"  # the residual STDEV of BT_VIIRS - BT_CrIS regressed on BT_CrIS
+
+
+# chosen by measurement (README, issue 27): equal to the paper's where CrIS and VIIRS agree, unmoved where
+# their calibrations differ
+DEFAULT_COST = Cost.REGRESSION

@@ -1,10 +1,13 @@
-"""The regression cost: a CrIS gain and bias leave it unchanged, and the refinement is exact for it."""
+"""The regression cost: a CrIS gain and bias leave it and the offsets unchanged, the refinement is exact for
+it, and the intercalibration at its optimum recovers them."""
 
 import numpy as np
 import pytest
 
 from monitor import refine
-from monitor.assess import calibration_regressors, cost_surface
+from monitor.assess import AssessConfig, calibration_regressors, cost_surface, for_minimum
+from monitor.constants import DEFAULT_STEP_URAD
+from monitor.intercal import intercalibrate
 from monitor.vocabulary import Cost
 
 
@@ -60,3 +63,30 @@ def _node(k):
     w = np.zeros(2 * refine.HALF + 1)
     w[refine.HALF + k] = 1.0
     return w
+
+
+def _minimum(d, c, seed=0):
+    units = np.arange(len(c)) // 3  # three samples a scan, two granules
+    granule_of_unit = (np.arange(units.max() + 1) >= (units.max() + 1) // 2).astype(int)
+    cfg = AssessConfig(cost=Cost.REGRESSION, bootstrap=20)
+    return for_minimum(d, c, units, granule_of_unit, cfg, np.random.default_rng(seed))
+
+
+def test_a_calibration_difference_leaves_the_offsets_and_sigmas_and_is_recovered_at_the_optimum():
+    """Offsets and their bootstrap sigmas within 1 urad of the agreeing instruments'; the bias and gain
+    fitted at the optimum are the injected ones (the truth's V at the optimum is T + noise)."""
+    rng = np.random.default_rng(5)
+    v, c = _samples(rng)
+    agree = _minimum(v - c[:, None, None], c)
+    assert agree.refined
+    law = c + 1.5 + 0.03 * (c - 280.0)  # a 3 % gain and a 1.5 K bias on every CrIS BT
+    differ = _minimum(v - law[:, None, None], law)
+    step = DEFAULT_STEP_URAD
+    assert abs(differ.x - agree.x) * step < 1.0 and abs(differ.y - agree.y) * step < 1.0
+    assert np.allclose(np.array(differ.sigma) * step, np.array(agree.sigma) * step, atol=1.0)
+    # the optimum's VIIRS BT: interpolated with the refinement's weights, d + C
+    viirs = differ.d_opt + law
+    assert np.allclose(viirs, agree.d_opt + c)
+    cal = intercalibrate(law, viirs, differ.counts)
+    assert cal.bias_k == pytest.approx(1.5, abs=0.05) and cal.gain_pct == pytest.approx(3.0, abs=0.2)
+    assert 0 < cal.sigma_bias_k < 0.05 and 0 < cal.sigma_gain_pct < 0.2

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+import numpy as np
 import pytest
 import requests
 from prometheus_client.parser import text_string_to_metric_families
@@ -141,6 +142,15 @@ def test_metrics_after_a_run(served):
     assert sorted(alpha) == list(range(1, 31))
     assert all(abs(alpha[f.for_index] - f.d_alpha_urad) < 1e-6 for f in fors)
     assert len(_samples(fams["crisgeo_for_offset_km"], satellite="j01", direction="total")) == 30
+    for family, name in (
+        ("crisgeo_for_calibration_bias_kelvin", "bias_k"),
+        ("crisgeo_for_calibration_gain_percent", "gain_pct"),
+    ):
+        got = {int(s.labels["for"]): s.value for s in _samples(fams[family], satellite="j01")}
+        assert got and all(
+            abs(got[f.for_index] - getattr(f, name)) < 1e-9 for f in fors if f.for_index in got
+        )
+        assert len(got) == sum(np.isfinite(getattr(f, name)) for f in fors)
     reliable = {
         int(s.labels["for"]): s.value for s in _samples(fams["crisgeo_for_reliable"], satellite="j01")
     }

@@ -57,6 +57,11 @@ def test_netcdf_export_reads_back_with_xarray(store_with_days, tmp_path):
     assert got.n_samples.sel(scan_position=7).item() == want[7].n_samples
     assert ds.sel(scan_position=1).total_km.sizes == {"time": 8}
     assert ds.d_alpha_urad.attrs["units"] == "urad" and ds.total_km.attrs["units"] == "km"
+    # the CrIS-VIIRS intercalibration at the optimum
+    assert got.bias_k.sel(scan_position=3).item() == pytest.approx(want[3].bias_k)
+    assert got.gain_pct.sel(scan_position=3).item() == pytest.approx(want[3].gain_pct)
+    assert ds.bias_k.attrs["units"] == "K" and ds.gain_pct.attrs["units"] == "percent"
+    assert np.isfinite(ds.sigma_bias_k).all() and np.isfinite(ds.sigma_gain_pct).all()
     meanings = ds.flags.attrs["flag_meanings"].split()
     masks = dict(zip(meanings, ds.flags.attrs["flag_masks"], strict=True))
     bits = ds.flags.transpose("time", "scan_position").values

@@ -28,7 +28,7 @@ import numpy as np
 
 from alerts.changes import all_changes
 from monitor.config import Config
-from monitor.constants import SPEC_KM
+from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
 from monitor.report import plots
 from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
@@ -255,9 +255,11 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         alert_days,
         span,
     )
+    calibration_html = _calibration(store, satellite, name, series, marks, span, sat_dir)
     stored = store.cost_cube(satellite, latest)
     cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
     figures = {"latest_km.png", "latest_urad.png", "heatmap.png", "trend.png"}
+    figures |= {f for f in ("calibration_bins.png", "calibration_trend.png") if f in calibration_html}
     if stored is not None and worst is not None:
         cube, step = stored
         runs = [r for r in store.runs(satellite) if r.day == latest.isoformat() and r.status == RunStatus.OK]
@@ -300,6 +302,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         "<p class=note>Dotted vertical lines: known changes (purple CrIS, green VIIRS, brown common); "
         "red triangles: alerts.</p>",
         "<h2>Cost surface of the worst FOR</h2>" + cost_html,
+        "<h2>CrIS-VIIRS intercalibration</h2>" + calibration_html,
         "<h2>Latest values</h2>" + _latest_table(fors, opts.spec_km),
         "<h2>Known changes</h2>" + _changes_table(changes),
         f"<p class=note>Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} UTC by crisgeo report.</p>",
@@ -307,6 +310,44 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
     _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))
     _drop_figures_except(sat_dir, figures)
     return summary
+
+
+def _calibration(store: Store, satellite: str, name: str, series, marks, span: str, sat_dir: Path) -> str:
+    """The intercalibration section: the latest day's CrIS - VIIRS against the CrIS BT (the paper's
+    Figure 15) and the bias and gain over time; what is shown, as HTML."""
+    out = []
+    latest = series.days[-1]
+    bins = store.difference_bins(satellite, latest)
+    if bins:
+        plots.calibration_bins(
+            sat_dir / "calibration_bins.png",
+            [b.low_k for b in bins],
+            [b.n for b in bins],
+            [b.mean_k for b in bins],
+            [b.std_k for b in bins],
+            CALIBRATION_BIN_K,
+            f"{name}, {latest.isoformat()}: CrIS - VIIRS I5 at the optimum, all refined FORs",
+        )
+        out.append(_img("calibration_bins.png", "CrIS minus VIIRS against CrIS BT"))
+    reliable = series.reliable()
+    bias = np.where(reliable, series.values["bias_k"], np.nan)
+    if np.isfinite(bias).any():
+        plots.calibration_trend(
+            sat_dir / "calibration_trend.png",
+            series.days,
+            bias,
+            np.where(reliable, series.values["gain_pct"], np.nan),
+            marks,
+            span,
+        )
+        out.append(_img("calibration_trend.png", "CrIS minus VIIRS bias and gain over time"))
+    if not out:
+        return "<p class=note>No intercalibration stored for this period (assessed before it was kept).</p>"
+    return "".join(out) + (
+        f"<p class=note>At each FOR's optimum: CrIS - VIIRS = bias + gain (VIIRS BT - "
+        f"{CALIBRATION_REFERENCE_K:g} K), fitted over the FOR's samples; the trend shows the median over "
+        "the reliable FORs and their quartiles. A step fires the calibration_jump alert.</p>"
+    )
 
 
 def _drop_figures_except(sat_dir: Path, keep: set) -> None:

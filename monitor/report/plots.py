@@ -1,4 +1,4 @@
-"""The report's figures (matplotlib, Agg): the paper's figures 5c, 7 and 8, and their evolution over time.
+"""The report's figures (matplotlib, Agg): the paper's figures 5c, 7, 8 and 15, and their evolution over time.
 
 Every function takes plain arrays and writes one PNG; none reads the store.
 """
@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import datetime as dt
 import os
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -183,4 +184,43 @@ def cost_contour(path, cube_k, for_index, step_urad, d_alpha_urad, d_beta_urad, 
     ax.set_title(f"FOR {for_index}", fontsize=10)
     ax.legend(fontsize=8, loc="lower right")
     fig.suptitle(title, fontsize=9)
+    return _save(fig, Path(path))
+
+
+def calibration_bins(path, low_k, n, mean_k, std_k, width_k, title):
+    """CrIS minus VIIRS I5 BT against the CrIS BT in bins *width_k* wide at the optimum, with the bins'
+    standard deviation and sample count (Wang et al. 2017 figure 15)."""
+    low_k, n, mean_k, std_k = (np.asarray(a, float) for a in (low_k, n, mean_k, std_k))
+    centre = low_k + width_k / 2
+    fig, ax = plt.subplots(figsize=(7.5, 3.8), constrained_layout=True)
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.errorbar(centre, mean_k, yerr=np.nan_to_num(std_k), fmt="o-", capsize=3, color="tab:blue")
+    for x, y, k in zip(centre, mean_k, n, strict=True):
+        ax.annotate(f"{int(k)}", (x, y), textcoords="offset points", xytext=(0, 8), ha="center", fontsize=7)
+    ax.set_xlabel(f"CrIS BT (K), {width_k:g} K bins")
+    ax.set_ylabel("CrIS - VIIRS BT (K)")
+    ax.grid(alpha=0.3)
+    ax.set_title(title, fontsize=10)
+    return _save(fig, Path(path))
+
+
+def calibration_trend(path, days, bias_k, gain_pct, changes, title):
+    """The daily CrIS-VIIRS bias at the reference temperature and the gain difference (median over the
+    reliable FORs, the band between their quartiles), with the known changes."""
+    days = [dt.datetime(d.year, d.month, d.day) for d in days]
+    fig, axes = plt.subplots(2, 1, figsize=(11, 5.0), sharex=True, constrained_layout=True)
+    for ax, v, label in ((axes[0], bias_k, "bias at 280 K (K)"), (axes[1], gain_pct, "gain (%)")):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # days without a fitted FOR: NaN
+            q1, med, q3 = np.nanpercentile(v, [25, 50, 75], axis=1)
+        ax.fill_between(days, q1, q3, color="tab:blue", alpha=0.2, lw=0)
+        ax.plot(days, med, "-", marker="." if len(days) < 60 else None, color="tab:blue", lw=1.2)
+        _mark_changes(ax, changes, label=ax is axes[0])
+        ax.set_ylabel(label)
+        ax.set_title(f"CrIS - VIIRS {label}", fontsize=10)
+        ax.grid(alpha=0.3)
+    if changes:
+        axes[0].legend(loc="upper left", fontsize=8)
+    axes[1].xaxis.set_major_formatter(mdates.ConciseDateFormatter(axes[1].xaxis.get_major_locator()))
+    fig.suptitle(title, fontsize=10)
     return _save(fig, Path(path))

@@ -10,11 +10,12 @@ import datetime as dt
 
 import numpy as np
 
-from monitor.constants import N_FOR
-from monitor.result import FLAG_FLAT, AssessmentResult, ForOffset
+from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, N_FOR
+from monitor.result import FLAG_FLAT, AssessmentResult, DifferenceBin, ForOffset
 from monitor.simulate.profiles import paper_profile
 
 KM_PER_URAD = 0.00083  # at nadir; enough for a picture
+BIAS_K, GAIN_PCT = 0.15, -0.3  # CrIS - VIIRS: a small bias and gain, as the seeds' intercalibration shows
 
 
 def day_result(
@@ -46,6 +47,10 @@ def day_result(
                 0.8,
                 1.2,
                 (FLAG_FLAT,) if rng.random() < 0.01 else (),
+                bias_k=float(BIAS_K + rng.normal(0, 0.02)),
+                sigma_bias_k=0.01,
+                gain_pct=float(GAIN_PCT + rng.normal(0, 0.05)),
+                sigma_gain_pct=0.03,
             )
         )
     cube = None
@@ -55,7 +60,17 @@ def day_result(
             (off[:, None] - d_alpha[:, None, None]) ** 2 + (off[None, :] - d_beta[:, None, None]) ** 2
         )
     start = dt.datetime(day.year, day.month, day.day, 12, tzinfo=dt.timezone.utc).isoformat()
-    return AssessmentResult(satellite, start, start, fors, cost_cube_k=cube)
+    lows = np.arange(200.0, 310.0, CALIBRATION_BIN_K)
+    bins = [
+        DifferenceBin(
+            float(low),
+            int(n),
+            float(BIAS_K + GAIN_PCT / 100 * (low + CALIBRATION_BIN_K / 2 - CALIBRATION_REFERENCE_K)),
+            0.4,
+        )
+        for low, n in zip(lows, rng.integers(20, 900, lows.size), strict=True)
+    ]
+    return AssessmentResult(satellite, start, start, fors, cost_cube_k=cube, difference_bins=bins)
 
 
 def fill_store(

@@ -22,7 +22,7 @@ import numpy as np
 from monitor.constants import N_FOR
 from monitor.export import to_xarray
 from monitor.records import Event, ForSeries, GranuleRow, Run, SelectionRow
-from monitor.result import MEASURED_FIELDS, AssessmentResult, ForOffset
+from monitor.result import MEASURED_FIELDS, AssessmentResult, DifferenceBin, ForOffset
 from monitor.store.alerts import AlertState
 from monitor.vocabulary import DONE, EventKind, RunStatus
 
@@ -82,6 +82,17 @@ MIGRATIONS = [
         body TEXT NOT NULL, created TEXT NOT NULL, status TEXT NOT NULL, attempts INTEGER DEFAULT 0,
         next_attempt TEXT, last_error TEXT, sent TEXT);
     DROP TABLE IF EXISTS alert_meta;
+    """,
+    # 4: the CrIS-VIIRS intercalibration at each FOR's optimum, and the day's difference against the CrIS BT
+    # (monitor/intercal.py); days stored before have none (NULL)
+    """
+    ALTER TABLE results ADD COLUMN bias_k REAL;
+    ALTER TABLE results ADD COLUMN sigma_bias_k REAL;
+    ALTER TABLE results ADD COLUMN gain_pct REAL;
+    ALTER TABLE results ADD COLUMN sigma_gain_pct REAL;
+    CREATE TABLE difference_bins (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, low_k REAL NOT NULL,
+        n INTEGER, mean_k REAL, std_k REAL, PRIMARY KEY (satellite, day, low_k));
     """,
 ]
 
@@ -310,7 +321,7 @@ class Store:
         transaction."""
         d = day.isoformat()
         with self.transaction():
-            for table in ("results", "granules", "selection", "cost_cubes", "skipped"):
+            for table in ("results", "granules", "selection", "cost_cubes", "skipped", "difference_bins"):
                 self.db.execute(f"DELETE FROM {table} WHERE satellite=? AND day=?", (satellite, d))
             for f in result.fors:
                 self.db.execute(
@@ -359,6 +370,11 @@ class Store:
                         s.decision,
                         s.reason,
                     ),
+                )
+            for b in result.difference_bins:
+                self.db.execute(
+                    "INSERT INTO difference_bins VALUES (?, ?, ?, ?, ?, ?, ?)",
+                    (satellite, d, run_id, b.low_k, b.n, _num(b.mean_k), _num(b.std_k)),
                 )
             for s in result.skipped:
                 self.db.execute(
@@ -409,6 +425,19 @@ class Store:
             kw["n_samples"] = int(r["n_samples"] or 0)
             out.append(ForOffset(for_index=r["for_index"], flags=tuple(json.loads(r["flags"])), **kw))
         return out
+
+    def difference_bins(self, satellite: str, day: dt.date) -> list[DifferenceBin]:
+        """CrIS minus VIIRS against the CrIS BT at the optimum on *satellite*'s *day* (Figure 15)."""
+        rows = self.db.execute(
+            "SELECT low_k, n, mean_k, std_k FROM difference_bins WHERE satellite=? AND day=? ORDER BY low_k",
+            (satellite, day.isoformat()),
+        ).fetchall()
+        return [
+            DifferenceBin(
+                r["low_k"], r["n"], *(float("nan") if v is None else v for v in (r["mean_k"], r["std_k"]))
+            )
+            for r in rows
+        ]
 
     def latest_day(self, satellite: str) -> dt.date | None:
         """The latest day with results for *satellite*, or None."""

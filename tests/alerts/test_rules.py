@@ -1,12 +1,14 @@
+import dataclasses
 import datetime as dt
 
 import numpy as np
 import pytest
 
 from alerts.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
-from alerts.rules import failure_finding, spec_finding, stale_finding
+from alerts.engine import findings_for
+from alerts.rules import CALIBRATION, GEOLOCATION, failure_finding, jump_findings, spec_finding, stale_finding
 from benchmarks.jump_detection import false_alarms, jump_trial
-from monitor.config import RuleSettings
+from monitor.config import AlertSettings, RuleSettings
 from monitor.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.store.sqlite import Store
 
@@ -84,6 +86,42 @@ def test_metadata_changes_name_the_instrument(tmp_path):
     assert len(changes) == 1  # the engineering-packet backup AUX changes every run and is ignored
     assert changes[0].instrument == "viirs" and "2042" in changes[0].description
     assert changes[0].time.date() == DAY + dt.timedelta(days=2)
+
+
+def test_a_bias_jump_after_a_viirs_lut_change_is_a_calibration_jump_attributed_to_viirs(tmp_path):
+    """40 days of a CrIS-VIIRS bias of 0.2 K (day-to-day scatter 0.02 K), 0.3 K more from the day a new
+    VIIRS LUT appears in the granules' metadata; the offsets do not move. One calibration finding,
+    attributed to VIIRS; no geolocation jump; the same days without the step: nothing."""
+    lut = (
+        "VIIRS-SDR-GEO-IMG-PARAM-LUT_j01_20130601000000Z_20130601000000Z_ee00000000000000Z_PS-1-O-CCR-{}_all"
+    )
+    cris = ["CrIS-SDR-CC_j01_20180426000000Z_x_ops"]
+    days = [DAY + dt.timedelta(days=i) for i in range(40)]
+    split = days[34]
+    for step_k, name in ((0.3, "step"), (0.0, "flat")):
+        s = Store(tmp_path / f"{name}.sqlite")
+        rng = np.random.default_rng(3)
+        for day in days:
+            bias = 0.2 + rng.normal(0.0, 0.02, 30) + (step_k if day >= split else 0.0)
+            fors = [
+                dataclasses.replace(_for(k, 0.1, 0.2), bias_k=float(bias[k - 1]), gain_pct=0.1)
+                for k in range(1, 31)
+            ]
+            g = _granule(f"J{day}", cris, [lut.format("2042" if day >= split else "1171")])
+            s.save_day(s.begin_run("j01", day), "j01", day, _result(fors, [g]), [], {})
+        changes = metadata_changes(s, "j01")
+        found = jump_findings(s, "j01", changes, RuleSettings(), days[-1], CALIBRATION)
+        assert jump_findings(s, "j01", changes, RuleSettings(), days[-1], GEOLOCATION) == []
+        if not step_k:
+            assert found == []
+            continue
+        (f,) = found
+        assert f.rule == "calibration_jump" and f.data["split"] == split.isoformat()
+        assert f.data["instrument"] == "viirs" and "2042" in f.data["change"]
+        assert "CrIS-VIIRS calibration jump" in f.summary and "+0.30 K" in f.lines[0]
+        assert f.data["fors"] == list(range(1, 31))
+        rules = [x.rule for x in findings_for(s, "j01", AlertSettings(), dt.datetime.now(UTC))]
+        assert "calibration_jump" in rules and "jump" not in rules
 
 
 def test_calendar_round_trip_and_attribution(tmp_path):

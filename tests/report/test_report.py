@@ -1,7 +1,9 @@
 """The HTML trend report: empty store, one run, years of runs; opened in a real headless Chromium."""
 
+import dataclasses
 import datetime as dt
 import json
+import math
 import os
 import shutil
 
@@ -12,6 +14,7 @@ from selenium.webdriver.support.ui import WebDriverWait
 from alerts.rules import Finding
 from monitor.cli import main
 from monitor.report.html import ReportOptions, build_report
+from monitor.result import AssessmentResult
 from monitor.simulate.history import fill_store
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
@@ -61,10 +64,33 @@ def test_single_run(store, tmp_path):
     fill_store(store, ["j01"], dt.date(2026, 11, 20), 1)
     build_report(store, tmp_path / "rep", ReportOptions(satellites=["j01"]))
     sat = tmp_path / "rep" / "j01"
-    for name in ("latest_km", "latest_urad", "heatmap", "trend", "cost"):
+    for name in (
+        "latest_km",
+        "latest_urad",
+        "heatmap",
+        "trend",
+        "cost",
+        "calibration_bins",
+        "calibration_trend",
+    ):
         assert (sat / f"{name}.png").read_bytes()[:8] == PNG
     page = (sat / "index.html").read_text()
+    assert "CrIS-VIIRS intercalibration" in page and "No intercalibration stored" not in page
     assert "2026-11-20" in page and "Latest values" in page and "http" not in page.split("<body>")[1]
+
+
+def test_days_stored_before_the_intercalibration_say_so_and_plot_none(store, tmp_path):
+    """A day whose result has no intercalibration (a store from before it): the section says so, and no
+    figure of an earlier report for it stays behind."""
+    (day,) = fill_store(store, ["j01"], dt.date(2026, 11, 20), 1)
+    build_report(store, tmp_path / "rep", ReportOptions(satellites=["j01"]))
+    result = store.day_result("j01", day)
+    bare = AssessmentResult("j01", "", "", [dataclasses.replace(f, bias_k=math.nan) for f in result])
+    store.save_day(store.begin_run("j01", day), "j01", day, bare, [], {})
+    build_report(store, tmp_path / "rep", ReportOptions(satellites=["j01"]))
+    sat = tmp_path / "rep" / "j01"
+    assert "No intercalibration stored" in (sat / "index.html").read_text()
+    assert not (sat / "calibration_bins.png").exists() and not (sat / "calibration_trend.png").exists()
 
 
 def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
@@ -133,7 +159,7 @@ def test_report_in_headless_chromium(store, tmp_path):
             )
             assert all(ok and width > 0 for _, ok, width in images), images
             if page != "index.html":
-                assert len(images) == 5
+                assert len(images) == 7  # km, urad, heat map, trend, cost, intercalibration x 2
             errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
             assert not errors, errors
         driver.get((tmp_path / "rep" / "j01" / "index.html").as_uri())

@@ -1,6 +1,8 @@
 import datetime as dt
 import sqlite3
+from dataclasses import astuple
 
+import numpy as np
 import pytest
 
 from monitor.records import SceneDecision
@@ -50,6 +52,43 @@ def test_save_day_replaces_and_queues(cases, tmp_path):
     g = s.granules("j01", DAY)[0]
     assert any(f.startswith("CMNGEO-PARAM-LUT") for f in g.cris_aux)  # a tuple of the file names
     assert any(f.startswith("VIIRS-SDR-GEO-IMG-PARAM-LUT") for f in g.viirs_aux)
+
+
+def test_the_intercalibration_and_its_bins_are_stored_with_the_day(cases, tmp_path):
+    _, _, result = cases.get()
+    assert result.difference_bins and all(np.isfinite(f.bias_k) for f in result.fors)
+    s = Store(tmp_path / "i.sqlite")
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, result, [], {})
+    stored = s.day_result("j01", DAY)
+    for name in ("bias_k", "sigma_bias_k", "gain_pct", "sigma_gain_pct"):
+        assert [getattr(f, name) for f in stored] == [getattr(f, name) for f in result.fors]
+        assert np.array_equal(s.series("j01").values[name][0], [getattr(f, name) for f in result.fors])
+    # a bin of one sample has no spread: NaN, stored as NULL and read back as NaN
+    np.testing.assert_equal(
+        [astuple(b) for b in s.difference_bins("j01", DAY)], [astuple(b) for b in result.difference_bins]
+    )
+    assert s.difference_bins("j01", DAY + dt.timedelta(days=1)) == []
+
+
+def test_a_store_of_schema_3_gains_the_intercalibration_and_keeps_its_rows(tmp_path):
+    """The days stored before the intercalibration read back with NaN for it, not a number."""
+    path = tmp_path / "old.sqlite"
+    db = sqlite3.connect(path)
+    for version, script in enumerate(MIGRATIONS[:3], start=1):
+        db.executescript(script)
+        db.execute(f"PRAGMA user_version={version}")
+    db.execute(
+        "INSERT INTO results (satellite, day, for_index, run_id, d_alpha_urad, n_samples, flags) "
+        "VALUES ('j01', ?, 1, 1, 12.5, 40, '[]')",
+        (DAY.isoformat(),),
+    )
+    db.commit()
+    db.close()
+    s = Store(path)
+    assert s.schema_version == len(MIGRATIONS)
+    (f,) = s.day_result("j01", DAY)
+    assert f.d_alpha_urad == 12.5 and np.isnan(f.bias_k) and np.isnan(f.gain_pct)
+    assert s.difference_bins("j01", DAY) == []
 
 
 def test_failed_transaction_leaves_nothing(cases, tmp_path):

@@ -1,0 +1,59 @@
+"""The CrIS-VIIRS intercalibration at the optimum: the fit of bias and gain, its bootstrap, the BT bins."""
+
+import numpy as np
+import pytest
+
+from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K
+from monitor.intercal import bias_and_gain, difference_bins, intercalibrate
+
+
+def _pair(rng, n=400, bias_k=0.8, gain=-0.02, noise_k=0.0):
+    """CrIS and VIIRS BT (K) of *n* scenes, CrIS = VIIRS + bias + gain (VIIRS - 280 K) + noise."""
+    v = rng.normal(275.0, 12.0, n)
+    return v + bias_k + gain * (v - CALIBRATION_REFERENCE_K) + rng.normal(0.0, noise_k, n), v
+
+
+def test_the_law_is_recovered_exactly_without_noise():
+    c, v = _pair(np.random.default_rng(1))
+    b, g = bias_and_gain(c, v)
+    assert b == pytest.approx(0.8, abs=1e-9) and g == pytest.approx(-0.02, abs=1e-12)
+
+
+def test_counts_weigh_like_repeated_samples():
+    rng = np.random.default_rng(2)
+    c, v = _pair(rng, n=50, noise_k=0.3)
+    counts = rng.integers(0, 3, (4, 50)).astype(float)
+    b, g = bias_and_gain(c, v, counts)
+    for k in range(4):
+        rep = np.repeat(np.arange(50), counts[k].astype(int))
+        assert (b[k], g[k]) == pytest.approx(bias_and_gain(c[rep], v[rep]), rel=1e-9)
+
+
+def test_the_bootstrap_sigma_matches_the_scatter_of_independent_draws():
+    """The spread of the fit over resampled samples is the spread over fresh noise (within 25 %)."""
+    rng = np.random.default_rng(3)
+    fits = np.array([bias_and_gain(*_pair(rng, noise_k=0.3)) for _ in range(200)])
+    c, v = _pair(rng, noise_k=0.3)
+    counts = rng.multinomial(len(c), np.full(len(c), 1 / len(c)), size=300).astype(float)
+    cal = intercalibrate(c, v, counts)
+    assert cal.sigma_bias_k == pytest.approx(fits[:, 0].std(), rel=0.25)
+    assert cal.sigma_gain_pct == pytest.approx(100 * fits[:, 1].std(), rel=0.25)
+    assert cal.bias_k == pytest.approx(0.8, abs=4 * cal.sigma_bias_k)
+    assert np.isnan(intercalibrate(c[:2], v[:2]).bias_k)  # too few samples: no fit
+
+
+def test_bins_are_the_difference_against_the_cris_bt():
+    rng = np.random.default_rng(4)
+    c = rng.uniform(215.0, 305.0, 2000)
+    v = c - 0.01 * (c - 250.0) + rng.normal(0.0, 0.2, c.size)
+    c[::97] = np.nan  # never counted
+    bins = difference_bins(c, v)
+    ok = np.isfinite(c)
+    assert [b.low_k for b in bins] == [210.0 + CALIBRATION_BIN_K * k for k in range(10)]
+    assert sum(b.n for b in bins) == ok.sum()
+    for b in bins:
+        sel = ok & (c >= b.low_k) & (c < b.low_k + CALIBRATION_BIN_K)
+        assert b.n == sel.sum()
+        assert b.mean_k == pytest.approx(np.mean(c[sel] - v[sel]))
+        assert b.std_k == pytest.approx(np.std(c[sel] - v[sel], ddof=1))
+    assert difference_bins([], []) == []
