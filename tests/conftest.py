@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import fcntl
 import json
+import os
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -47,19 +50,30 @@ class Clock:
 
 
 class CaseCache:
-    """Simulated cases and their assessments, made once per test session."""
+    """Simulated cases and their assessments, made once per test run: the xdist workers share them (the
+    first to ask makes a case under a file lock, the others wait for it and read it back)."""
 
     def __init__(self, factory):
-        self.factory = factory
+        base = factory.getbasetemp()
+        self.root = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "cases"
+        self.root.mkdir(exist_ok=True)
         self.cases = {}
 
     def get(self, profile="paper", seed=1, granules=2, satellite="j01"):
         key = (profile, seed, granules, satellite)
         if key not in self.cases:
-            out = self.factory.mktemp(f"case_{profile}_{seed}_{granules}_{satellite}")
-            truth = simulate_case(out, satellite=satellite, granules=granules, profile=profile, seed=seed)
-            result = assess_paths([out], AssessConfig(bootstrap=30))
-            self.cases[key] = (out, truth, result)
+            name = f"case_{profile}_{seed}_{granules}_{satellite}"
+            out, made = self.root / name, self.root / f"{name}.pickle"
+            with open(self.root / f"{name}.lock", "w") as lock:
+                fcntl.flock(lock, fcntl.LOCK_EX)
+                if not made.exists():
+                    truth = simulate_case(
+                        out, satellite=satellite, granules=granules, profile=profile, seed=seed
+                    )
+                    result = assess_paths([out], AssessConfig(bootstrap=30))
+                    made.with_suffix(".part").write_bytes(pickle.dumps((truth, result)))
+                    made.with_suffix(".part").rename(made)
+            self.cases[key] = (out, *pickle.loads(made.read_bytes()))
         return self.cases[key]
 
 
