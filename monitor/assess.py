@@ -469,7 +469,8 @@ class ForMinimum:
     """The minimum of one FOR's cost surface *cost* (m, m): the offsets *x*, *y* (grid steps from the
     centre), their bootstrap sigmas (steps), flags; *d_opt* (N,) the samples' BT difference at the
     optimum, *refined* whether it lies between grid points (:mod:`monitor.refine`), *counts* (B, N) the
-    bootstrap's resampling (None without one)."""
+    bootstrap's resampling (None without one) and *d_opt_boot* (B, N) the difference at each replicate's
+    optimum, so that what the intercalibration's sigma resamples includes where the optimum lies."""
 
     cost: np.ndarray
     x: float
@@ -479,6 +480,7 @@ class ForMinimum:
     d_opt: np.ndarray
     refined: bool
     counts: np.ndarray | None
+    d_opt_boot: np.ndarray | None  # (B, N): d at each replicate's own optimum (refined FORs), else None
 
 
 def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng) -> ForMinimum:
@@ -501,16 +503,17 @@ def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng) -> F
         x, y = i0 - (m - 1) // 2 + dx, j0 - (m - 1) // 2 + dy
         d_opt = refine.window_values(d, i0, j0, dx, dy)
     sig = (np.nan, np.nan)
-    counts = None
+    counts = d_boot = None
     if cfg.bootstrap > 1 and len(granule_of_unit) >= 2:
         counts = _scan_bootstrap_counts(rng, granule_of_unit, cfg.bootstrap)[:, unit_ids]
         if fine:
             est = refine.refined_minimum(refine.window_covariance(d, i0, j0, counts, regress))
+            d_boot = refine.window_values(d, i0, j0, est[:, 0], est[:, 1])
         else:
             replicas = cost_surface(d, cris, cfg.cost, counts)
             est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in replicas])
         sig = tuple(np.nanstd(est, axis=0))
-    return ForMinimum(g, x, y, sig, flags, d_opt, fine, counts)
+    return ForMinimum(g, x, y, sig, flags, d_opt, fine, counts, d_boot)
 
 
 def cost_and_offsets(
@@ -556,7 +559,9 @@ def cost_and_offsets(
             cube[k] = g
             flags += best.flags
             # the intercalibration at the optimum: V = d + C there
-            cal = intercalibrate(c, best.d_opt + c, best.counts)
+            cal = intercalibrate(
+                c, best.d_opt + c, best.counts, None if best.d_opt_boot is None else best.d_opt_boot + c
+            )
             if best.refined:
                 pooled.append((c, best.d_opt + c))
             sig_a, sig_b = (
@@ -588,6 +593,8 @@ def cost_and_offsets(
                 sigma_bias_k=cal.sigma_bias_k,
                 gain_pct=cal.gain_pct,
                 sigma_gain_pct=cal.sigma_gain_pct,
+                curvature_k=cal.curvature_k,
+                sigma_curvature_k=cal.sigma_curvature_k,
                 flags=tuple(sorted(set(flags))),
             )
         )

@@ -19,6 +19,8 @@ SPEC_KM = 1.5  # the CrIS geolocation specification (each of in-track and cross-
 # the width of the BT bins of the difference against the CrIS BT (the paper's Figure 15)
 CALIBRATION_REFERENCE_K = 280.0
 CALIBRATION_BIN_K = 10.0
+# a curvature of the difference is stated as its value this far from the reference (at 250 and 310 K)
+CALIBRATION_CURVATURE_SPAN_K = 30.0
 
 VIIRS_I_PIXEL_M = 375.0  # VIIRS I-band pixel at nadir
 REFERENCE_ALTITUDE_M = 833000.0  # the JPSS orbit altitude the paper's grid step is defined at

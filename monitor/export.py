@@ -47,6 +47,8 @@ VARIABLES = {
         "CrIS minus VIIRS I5 gain difference (per cent of the BT departure from 280 K)",
     ),
     "sigma_gain_pct": ("percent", "uncertainty (1 sigma) of the gain difference"),
+    "curvature_k": ("K", "curvature of CrIS minus VIIRS: what it adds at 250 and 310 K"),
+    "sigma_curvature_k": ("K", "uncertainty (1 sigma) of the curvature"),
 }
 FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
 

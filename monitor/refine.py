@@ -73,11 +73,12 @@ def window_covariance(d, i0: int, j0: int, counts=None, cris=None):
     return joint[..., :nx, :nx] - s_dx @ np.linalg.inv(joint[..., nx:, nx:]) @ np.swapaxes(s_dx, -1, -2)
 
 
-def window_values(d, i0: int, j0: int, x: float, y: float):
+def window_values(d, i0: int, j0: int, x, y):
     """The samples' d (N, m, m) interpolated at (x, y) grid steps from the window centre (i0, j0), with the
-    weights the minimum was found with: d_n(x, y) = w(x, y)^T d_n (N,)."""
+    weights the minimum was found with: d_n(x, y) = w(x, y)^T d_n, (N,); with *x*, *y* (B,), one row per
+    position (B, N)."""
     win = d[:, i0 - HALF : i0 + HALF + 1, j0 - HALF : j0 + HALF + 1]
-    return np.einsum("nab,a,b->n", win, keys_weights(x), keys_weights(y))
+    return np.einsum("nab,...a,...b->...n", win, keys_weights(x), keys_weights(y))
 
 
 def _covariance(x, counts=None):

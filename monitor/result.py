@@ -22,8 +22,8 @@ class ForOffset:
 
     Angles in microradians (in-track alpha, cross-track beta), distances in km on the ground (in-track
     positive along the flight direction, cross-track positive to the right), cost in kelvin. At the optimum,
-    the CrIS-VIIRS intercalibration (:mod:`monitor.intercal`): the BT bias (K) at the reference temperature
-    and the gain (per cent), NaN where none was fitted.
+    the CrIS-VIIRS intercalibration (:mod:`monitor.intercal`): the BT bias (K) at the reference temperature,
+    the gain there (per cent) and the curvature (K), NaN where none was fitted.
     """
 
     for_index: int
@@ -44,6 +44,8 @@ class ForOffset:
     sigma_bias_k: float = float("nan")
     gain_pct: float = float("nan")
     sigma_gain_pct: float = float("nan")
+    curvature_k: float = float("nan")
+    sigma_curvature_k: float = float("nan")
 
     @property
     def d_alpha_pct_fov(self) -> float:

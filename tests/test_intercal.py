@@ -3,43 +3,60 @@
 import numpy as np
 import pytest
 
-from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K
-from monitor.intercal import bias_and_gain, difference_bins, intercalibrate
+from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K
+from monitor.intercal import difference_bins, fit_difference, intercalibrate
 
 
-def _pair(rng, n=400, bias_k=0.8, gain=-0.02, noise_k=0.0):
-    """CrIS and VIIRS BT (K) of *n* scenes, CrIS = VIIRS + bias + gain (VIIRS - 280 K) + noise."""
+def _pair(rng, n=400, bias_k=0.8, gain=-0.02, curvature_k=0.3, noise_k=0.0):
+    """CrIS and VIIRS BT (K) of *n* scenes, CrIS = VIIRS + the law of monitor/intercal.py + noise."""
     v = rng.normal(275.0, 12.0, n)
-    return v + bias_k + gain * (v - CALIBRATION_REFERENCE_K) + rng.normal(0.0, noise_k, n), v
+    x = v - CALIBRATION_REFERENCE_K
+    law = bias_k + gain * x + curvature_k * (x / CALIBRATION_CURVATURE_SPAN_K) ** 2
+    return v + law + rng.normal(0.0, noise_k, n), v
 
 
 def test_the_law_is_recovered_exactly_without_noise():
     c, v = _pair(np.random.default_rng(1))
-    b, g = bias_and_gain(c, v)
-    assert b == pytest.approx(0.8, abs=1e-9) and g == pytest.approx(-0.02, abs=1e-12)
+    assert fit_difference(c, v) == pytest.approx([0.8, -0.02, 0.3], abs=1e-9)
+    # a straight law: no curvature found; one BT for every scene: no fit, not a number from nothing
+    c, v = _pair(np.random.default_rng(1), curvature_k=0.0)
+    assert fit_difference(c, v)[2] == pytest.approx(0.0, abs=1e-9)
+    assert np.isnan(fit_difference(np.full(50, 281.0), np.full(50, 280.0))).all()
 
 
 def test_counts_weigh_like_repeated_samples():
     rng = np.random.default_rng(2)
     c, v = _pair(rng, n=50, noise_k=0.3)
     counts = rng.integers(0, 3, (4, 50)).astype(float)
-    b, g = bias_and_gain(c, v, counts)
+    fits = fit_difference(c, v, counts)
     for k in range(4):
         rep = np.repeat(np.arange(50), counts[k].astype(int))
-        assert (b[k], g[k]) == pytest.approx(bias_and_gain(c[rep], v[rep]), rel=1e-9)
+        assert fits[k] == pytest.approx(fit_difference(c[rep], v[rep]), rel=1e-9)
+    # one V per replicate (each at its own optimum): each row its own fit
+    shifted = v[None] + rng.normal(0.0, 0.5, (4, 50))
+    rows = fit_difference(c, shifted, counts)
+    for k in range(4):
+        rep = np.repeat(np.arange(50), counts[k].astype(int))
+        assert rows[k] == pytest.approx(fit_difference(c[rep], shifted[k][rep]), rel=1e-9)
 
 
 def test_the_bootstrap_sigma_matches_the_scatter_of_independent_draws():
     """The spread of the fit over resampled samples is the spread over fresh noise (within 25 %)."""
     rng = np.random.default_rng(3)
-    fits = np.array([bias_and_gain(*_pair(rng, noise_k=0.3)) for _ in range(200)])
+    fits = np.array([fit_difference(*_pair(rng, noise_k=0.3)) for _ in range(200)])
     c, v = _pair(rng, noise_k=0.3)
     counts = rng.multinomial(len(c), np.full(len(c), 1 / len(c)), size=300).astype(float)
     cal = intercalibrate(c, v, counts)
     assert cal.sigma_bias_k == pytest.approx(fits[:, 0].std(), rel=0.25)
     assert cal.sigma_gain_pct == pytest.approx(100 * fits[:, 1].std(), rel=0.25)
+    assert cal.sigma_curvature_k == pytest.approx(fits[:, 2].std(), rel=0.25)
     assert cal.bias_k == pytest.approx(0.8, abs=4 * cal.sigma_bias_k)
-    assert np.isnan(intercalibrate(c[:2], v[:2]).bias_k)  # too few samples: no fit
+    assert cal.curvature_k == pytest.approx(0.3, abs=4 * cal.sigma_curvature_k)
+    assert np.isnan(intercalibrate(c[:3], v[:3]).bias_k)  # too few samples: no fit
+    warm = v > 285.0  # samples that do not reach 280 K: no value there from extrapolation
+    assert np.isnan(intercalibrate(c[warm], v[warm], counts[:, warm]).bias_k)
+    near = np.abs(v - 282.0) < 6.0  # around 280 K but only 12 K wide
+    assert np.isnan(intercalibrate(c[near], v[near]).gain_pct)
 
 
 def test_bins_are_the_difference_against_the_cris_bt():

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.constants import CALIBRATION_REFERENCE_K, CRIS_SCAN_US, URAD
+from monitor.constants import CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K, CRIS_SCAN_US, URAD
 from monitor.errors import DataError
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
@@ -93,7 +93,12 @@ class SimulationSpec:
     def cris_bt_k(self, bt_k: np.ndarray) -> np.ndarray:
         """The BT CrIS reports for a scene of true brightness temperature *bt_k* (K)."""
         x = bt_k - CALIBRATION_REFERENCE_K
-        return bt_k + self.cris_bias_k + self.cris_gain * x + self.cris_nonlinear_k * (x / 30.0) ** 2
+        return (
+            bt_k
+            + self.cris_bias_k
+            + self.cris_gain * x
+            + self.cris_nonlinear_k * (x / CALIBRATION_CURVATURE_SPAN_K) ** 2
+        )
 
     def __post_init__(self):
         if self.orbit_pass is not None and self.orbit_pass not in PASSES:

@@ -10,12 +10,13 @@ import datetime as dt
 
 import numpy as np
 
-from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, N_FOR
+from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K, N_FOR
 from monitor.result import FLAG_FLAT, AssessmentResult, DifferenceBin, ForOffset
 from monitor.simulate.profiles import paper_profile
 
 KM_PER_URAD = 0.00083  # at nadir; enough for a picture
-BIAS_K, GAIN_PCT = 0.15, -0.3  # CrIS - VIIRS: a small bias and gain, as the seeds' intercalibration shows
+# CrIS - VIIRS: a small bias, gain and curvature, as the seeds' intercalibration shows
+BIAS_K, GAIN_PCT, CURVATURE_K = 0.15, -0.3, 0.1
 
 
 def day_result(
@@ -51,6 +52,8 @@ def day_result(
                 sigma_bias_k=0.01,
                 gain_pct=float(GAIN_PCT + rng.normal(0, 0.05)),
                 sigma_gain_pct=0.03,
+                curvature_k=CURVATURE_K,
+                sigma_curvature_k=0.03,
             )
         )
     cube = None
@@ -65,10 +68,15 @@ def day_result(
         DifferenceBin(
             float(low),
             int(n),
-            float(BIAS_K + GAIN_PCT / 100 * (low + CALIBRATION_BIN_K / 2 - CALIBRATION_REFERENCE_K)),
+            float(BIAS_K + GAIN_PCT / 100 * x + CURVATURE_K * (x / CALIBRATION_CURVATURE_SPAN_K) ** 2),
             0.4,
         )
-        for low, n in zip(lows, rng.integers(20, 900, lows.size), strict=True)
+        for low, n, x in zip(
+            lows,
+            rng.integers(20, 900, lows.size),
+            lows + CALIBRATION_BIN_K / 2 - CALIBRATION_REFERENCE_K,
+            strict=True,
+        )
     ]
     return AssessmentResult(satellite, start, start, fors, cost_cube_k=cube, difference_bins=bins)
 

@@ -90,6 +90,8 @@ MIGRATIONS = [
     ALTER TABLE results ADD COLUMN sigma_bias_k REAL;
     ALTER TABLE results ADD COLUMN gain_pct REAL;
     ALTER TABLE results ADD COLUMN sigma_gain_pct REAL;
+    ALTER TABLE results ADD COLUMN curvature_k REAL;
+    ALTER TABLE results ADD COLUMN sigma_curvature_k REAL;
     CREATE TABLE difference_bins (
         satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, low_k REAL NOT NULL,
         n INTEGER, mean_k REAL, std_k REAL, PRIMARY KEY (satellite, day, low_k));

@@ -6,7 +6,7 @@ Measurement ``cris_geolocation`` (configurable), one point per satellite, day an
 * tags: ``satellite`` (npp, j01, j02) and ``for`` (01..30)
 * float fields: d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_urad, in_track_km,
   cross_track_km, total_km, cost_min_k, cost_zero_k, and the CrIS-VIIRS intercalibration at the optimum:
-  bias_k, sigma_bias_k, gain_pct, sigma_gain_pct
+  bias_k, sigma_bias_k, gain_pct, sigma_gain_pct, curvature_k, sigma_curvature_k
 * integer field: n_samples; boolean field: reliable
 
 Known changes (calendar, metadata, fingerprint) go to ``cris_geolocation_change`` (see :func:`change_lines`),
