@@ -42,11 +42,16 @@ def test_the_band_bt_carries_the_injected_bias_and_gain(tmp_path, bias_k, gain):
 @pytest.fixture(scope="module")
 def differing(tmp_path_factory):
     """One granule as the agreeing instruments see it, and with CrIS's calibration differing: a 2 K bias;
-    a 3 % gain and a 1.5 K bias. The VIIRS files are the agreeing case's (VIIRS is the reference)."""
+    a 3 % gain and a 1.5 K bias; a 1 % gain and a 0.5 K curvature. The VIIRS files are the agreeing case's
+    (VIIRS is the reference)."""
     root = tmp_path_factory.mktemp("calibration")
     same = {"granules": 1, "profile": "paper", "seed": 2}
     simulate_case(root / "agree", **same)
-    for name, kw in (("biased", {"cris_bias_k": 2.0}), ("gained", {"cris_gain": 0.03, "cris_bias_k": 1.5})):
+    for name, kw in (
+        ("biased", {"cris_bias_k": 2.0}),
+        ("gained", {"cris_gain": 0.03, "cris_bias_k": 1.5}),
+        ("curved", {"cris_gain": 0.01, "cris_nonlinear_k": 0.5}),
+    ):
         simulate_case(root / name, viirs=False, **kw, **same)
         for f in [*(root / "agree").glob("SVI05_*.h5"), *(root / "agree").glob("GITCO_*.h5")]:
             (root / name / f.name).symlink_to(f)
@@ -97,3 +102,21 @@ def test_the_regression_cost_keeps_the_offsets_and_recovers_the_calibration_diff
     bins = [b for b in gained.difference_bins if b.n >= 30]
     slope = np.polyfit([b.low_k for b in bins], [b.mean_k for b in bins], 1)[0]
     assert len(bins) >= 3 and slope == pytest.approx(0.03, abs=0.005)
+
+
+def test_a_curved_calibration_difference_keeps_the_offsets_and_shows_its_curvature(differing):
+    """A 1 % gain and a 0.5 K curvature (at 250 and 310 K): the offsets as the agreeing case's within half
+    their sigma (the cost's regressors, C and C^2, take a curvature in the scene's T away to second order
+    only: measured up to 1.8 urad, 0.3 sigma), and the curvature fitted at the optimum,
+    the median over the FORs within 0.1 K of 0.5 K and the bias at 280 K unmoved by it."""
+    agree, curved = (_assess(differing, name, Cost.REGRESSION) for name in ("agree", "curved"))
+    reliable = [(a, c) for a, c in zip(agree.fors, curved.fors, strict=True) if a.reliable]
+    assert len(reliable) >= 20
+    for a, c in reliable:
+        assert abs(a.d_alpha_urad - c.d_alpha_urad) < 0.5 * a.sigma_alpha_urad, (a, c)
+        assert abs(a.d_beta_urad - c.d_beta_urad) < 0.5 * a.sigma_beta_urad, (a, c)
+    fitted = [c for _, c in reliable if np.isfinite(c.curvature_k)]
+    assert len(fitted) >= 15
+    assert np.median([c.curvature_k for c in fitted]) == pytest.approx(0.5, abs=0.1)
+    assert np.median([c.gain_pct for c in fitted]) == pytest.approx(1.0, abs=0.2)
+    assert np.median([c.bias_k for c in fitted]) == pytest.approx(0.0, abs=0.05)
