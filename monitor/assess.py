@@ -42,7 +42,7 @@ from monitor.result import (
 )
 from monitor.sdr import CrisGeoGranule, CrisSdrGranule, GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
-from monitor.sdr.readers import read_viirs_geo_scan
+from monitor.sdr.readers import read_scan_start_us, read_viirs_geo_scan
 from monitor.spectral import i5_band
 from monitor.threads import parallel_threads
 from monitor.vocabulary import DEFAULT_COST, Cost
@@ -159,13 +159,24 @@ class GranuleInputs:
     viirs: dict = field(default_factory=dict)
 
 
-def _read_viirs(v: GranuleFiles, viirs_all: list):
-    """A VIIRS granule's GEO and SDR, with the adjacent scans of its neighbours (for the scan overlap)."""
+def _read_viirs(v: GranuleFiles, viirs_all: list, span_us=None):
+    """A VIIRS granule's GEO and SDR, with the adjacent scans of its neighbours (for the scan overlap).
+
+    Given *span_us* (IET us), only what :func:`swath.swath_piece` uses of that span is read: the scans
+    observed in it and one scan either side (their halos), and a neighbour's adjacent scan only where the
+    span reaches the granule's edge. The other rows hold fill; read in place, their bytes never travel."""
+    scans = slice(None)
+    if span_us is not None:
+        start_us = read_scan_start_us(v.geo)
+        first, stop, _ = swath.scans_between(start_us, *span_us).indices(len(start_us))
+        scans = slice(max(first - 1, 0), min(stop + 1, len(start_us)))
     before, after = neighbours(viirs_all, v)
-    geo = read_file(v.geo, kinds=("viirs_geo",))[0]
-    sdr = read_file(v.sdr, kinds=("viirs_sdr",))[0]
-    halo_before = read_viirs_geo_scan(before.geo, -1) if before is not None else None
-    halo_after = read_viirs_geo_scan(after.geo, 0) if after is not None else None
+    geo = read_file(v.geo, kinds=("viirs_geo",), scans=scans)[0]
+    sdr = read_file(v.sdr, kinds=("viirs_sdr",), scans=scans)[0]
+    n_scans = len(geo.start_time_us)
+    edge_before, edge_after = scans.indices(n_scans)[0] == 0, scans.indices(n_scans)[1] == n_scans
+    halo_before = read_viirs_geo_scan(before.geo, -1) if before is not None and edge_before else None
+    halo_after = read_viirs_geo_scan(after.geo, 0) if after is not None and edge_after else None
     if sdr.bt_k.shape != geo.lat_rad.shape:
         raise GranuleError(
             v.sdr,
@@ -176,10 +187,18 @@ def _read_viirs(v: GranuleFiles, viirs_all: list):
 
 
 def read_inputs(
-    cris: GranuleFiles, viirs: list, viirs_all: list, band, cfg: AssessConfig, prepared=(), timings=None
+    cris: GranuleFiles,
+    viirs: list,
+    viirs_all: list,
+    band,
+    cfg: AssessConfig,
+    prepared=(),
+    timings=None,
+    spans=None,
 ) -> GranuleInputs:
     """Read what :func:`collocate_granule` needs of *cris*, except the VIIRS granules in *prepared*, and
-    compute what depends on the CrIS granule alone (its geometry and band BT)."""
+    compute what depends on the CrIS granule alone (its geometry and band BT). A VIIRS granule is read
+    over its scans of the run (*spans*, by key: :func:`_scan_spans`) and of this granule's reach."""
     with _stage(timings, "read"):
         geo = next(
             g
@@ -197,7 +216,13 @@ def read_inputs(
                 "ES_RealLW",
                 f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO {geo.lat_rad.shape}",
             )
-        raw = {v.key: _read_viirs(v, viirs_all) for v in viirs if v.key not in prepared}
+        seen = geo.for_time_us[geo.for_time_us > 0]
+        span_us = _reach_us(int(seen.min()), int(seen.max())) if seen.size else None
+        raw = {
+            v.key: _read_viirs(v, viirs_all, _run_span(spans or {}, v.key, span_us))
+            for v in viirs
+            if v.key not in prepared
+        }
     with _stage(timings, "spectral"):
         bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
     with _stage(timings, "geometry"):
@@ -210,9 +235,13 @@ def read_inputs(
             cfg.offsets_rad,
             KERNELS[cfg.kernel],
         )
-        seen = geo.for_time_us[geo.for_time_us > 0]
-        span_us = _reach_us(int(seen.min()), int(seen.max())) if seen.size else None
     return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, span_us, bt_cris, raw)
+
+
+def _run_span(spans: dict, key: str, span_us):
+    """The IET span of VIIRS granule *key* prepared for a CrIS granule reaching *span_us*: the run's span
+    of that granule widened to it (None, every scan, when the CrIS granule has no observation time)."""
+    return _widen(spans.get(key), span_us) if span_us is not None else None
 
 
 def _piece(
@@ -225,11 +254,11 @@ def _piece(
     if cached is not None and cached.view_rad >= view_rad and (span_us is None or cached.covers(*span_us)):
         return cached
     cache.pieces.pop(v.key, None)
+    run_span = _run_span(cache.spans, v.key, span_us)
     if raw is None:
         with _stage(timings, "read"):
-            raw = _read_viirs(v, viirs_all)
+            raw = _read_viirs(v, viirs_all, run_span)
     geo, sdr, halo_before, halo_after = raw
-    run_span = _widen(cache.spans.get(v.key), span_us) if span_us is not None else None
     with _stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
@@ -279,7 +308,7 @@ def collocate_granule(
     """
     viirs_all = viirs_all or viirs
     if inputs is None:
-        inputs = read_inputs(cris, viirs, viirs_all, band, cfg, tuple(cache.pieces), timings)
+        inputs = read_inputs(cris, viirs, viirs_all, band, cfg, tuple(cache.pieces), timings, cache.spans)
     geo, sdr, fg, valid, fill, bt_cris = (
         inputs.geo, inputs.sdr, inputs.fg, inputs.valid, inputs.fill, inputs.bt_cris_k
     )  # fmt: skip
@@ -636,7 +665,9 @@ def _collocate_run(
         """Read granule i's inputs (and compute its CrIS geometry) in the background while granule i - 1
         is computed (h5py, numpy and the compiled kernels release the interpreter to each other)."""
         prepared = set(cache.pieces) | ({v.key for v in viirs[cris[i - 1].key]} if i else set())
-        return pool.submit(read_inputs, cris[i], viirs[cris[i].key], viirs_all, band, cfg, prepared, reading)
+        return pool.submit(
+            read_inputs, cris[i], viirs[cris[i].key], viirs_all, band, cfg, prepared, reading, cache.spans
+        )
 
     with cf.ThreadPoolExecutor(1, thread_name_prefix="crisgeo-read") as pool:
         ahead = read_ahead(0) if cris else None

@@ -15,7 +15,7 @@ from monitor.errors import DataError
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
-from monitor.sdr.readers import GranuleMeta, read_metadata
+from monitor.sdr.readers import GranuleMeta, GranuleRef, as_ref, read_metadata
 
 COVER_MARGIN = dt.timedelta(seconds=10)
 CONTIGUOUS = dt.timedelta(seconds=5)  # VIIRS granules this close in time form one continuous swath
@@ -34,11 +34,12 @@ def neighbours(viirs_all: list, granule) -> tuple:
 
 @dataclass
 class GranuleFiles:
-    """The files of one granule: SDR and GEO (the same file for combined products) and their metadata."""
+    """The files of one granule: SDR and GEO (the same file for combined products, on local disk or read
+    in place) and their metadata."""
 
     key: str
-    sdr: Path
-    geo: Path
+    sdr: GranuleRef
+    geo: GranuleRef
     sdr_meta: GranuleMeta
     geo_meta: GranuleMeta
 
@@ -138,10 +139,11 @@ def assemble(satellite: str, cris: list, viirs: list, skipped: list) -> CasePlan
     return result
 
 
-def granule_files(key: str, sdr: Path, geo: Path, sdr_meta=None) -> GranuleFiles:
+def granule_files(key: str, sdr: GranuleRef, geo: GranuleRef, sdr_meta=None) -> GranuleFiles:
     """The :class:`GranuleFiles` of one single-granule SDR file and its GEO file, reading the metadata not
     given (*sdr_meta*, e.g. from a granule already read). :class:`GranuleError` for a file holding other
     than one granule of its product."""
+    sdr, geo = as_ref(sdr), as_ref(geo)
     metas = []
     for path, known in ((sdr, sdr_meta), (geo, None)):
         found = [known] if known is not None else read_metadata(path)
@@ -152,8 +154,8 @@ def granule_files(key: str, sdr: Path, geo: Path, sdr_meta=None) -> GranuleFiles
         metas.append(found[0])
     problem = partners_differ(metas[0], metas[1])
     if problem:
-        raise GranuleError(sdr, "N_Granule_ID", f"{problem} (its GEO file {Path(geo).name})")
-    return GranuleFiles(key, Path(sdr), Path(geo), metas[0], metas[1])
+        raise GranuleError(sdr, "N_Granule_ID", f"{problem} (its GEO file {geo.name})")
+    return GranuleFiles(key, sdr, geo, metas[0], metas[1])
 
 
 def partners_differ(sdr_meta, geo_meta) -> str | None:

@@ -8,9 +8,12 @@ always reserves 48 scans). Every problem is raised as :class:`GranuleError` nami
 from __future__ import annotations
 
 import datetime as dt
+import os
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO, Protocol
 
 import h5py
 import numpy as np
@@ -21,6 +24,7 @@ from monitor.sdr.errors import GranuleError
 from monitor.sdr.iet import iet_to_datetime
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import (
+    FLOAT_FILLS,
     IET_LIMITS_US,
     PRODUCTS,
     UINT16_FILL_MIN,
@@ -28,6 +32,26 @@ from monitor.sdr.products import (
     cris_lw_wavenumbers_cm1,
     is_float_fill,
 )
+
+
+class RemoteGranule(Protocol):
+    """A granule file read where it lies, a range at a time (``monitor.sources.ranged``): its base name (a
+    JPSS file name), ``str()`` naming it in errors (its key), and a binary file object to read it through.
+    When a read of that object fails, its ``failure`` says why (the transport's reason, naming the key)."""
+
+    name: str
+
+    def open(self) -> BinaryIO:
+        """A seekable binary file object over the granule's bytes."""
+        ...
+
+
+GranuleRef = Path | RemoteGranule  # a granule file: on local disk, or read in place
+
+
+def as_ref(path) -> GranuleRef:
+    """A local path (str or PathLike) as a Path; a :class:`RemoteGranule` as it is."""
+    return Path(path) if isinstance(path, (str, os.PathLike)) else path
 
 
 @dataclass(frozen=True)
@@ -190,7 +214,7 @@ def _number(path, name, value, kind=int):
     return out
 
 
-def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform: str) -> GranuleMeta:
+def _granule_meta(path: GranuleRef, h5: h5py.File, product: Product, k: int, platform: str) -> GranuleMeta:
     name = f"Data_Products/{product.collection}/{product.collection}_Gran_{k}"
     if name not in h5:
         raise GranuleError(path, name, "missing granule metadata")
@@ -255,8 +279,9 @@ def _granule_meta(path: Path, h5: h5py.File, product: Product, k: int, platform:
     return meta
 
 
-def _check_raw(path, name: str, raw: np.ndarray, f, rows: int) -> None:
-    """Dtype family and full shape of a dataset against the product table."""
+def _check_raw(path, name: str, raw, f, rows: int) -> None:
+    """Dtype family and full shape of a dataset (an array, or an HDF5 dataset not yet read) against the
+    product table."""
     kinds = {"float": "f", "scaled": "uf", "time": "i", "flags": "u"}[f.kind]
     if (
         raw.dtype.kind not in kinds
@@ -323,7 +348,37 @@ def _factors(path, h5, group: str, f, n_gran: int) -> np.ndarray:
     return fac
 
 
-def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str) -> list:
+def _fill_of(f, dtype) -> float | int:
+    """The value standing for "not read" in a per-row array: a fill the field's cleaning turns to NaN
+    (floats, scaled counts) or the largest flag (never the good value 0)."""
+    if dtype.kind == "f":
+        return FLOAT_FILLS[0]
+    return UINT16_FILL_MIN if f.kind == "scaled" else np.iinfo(dtype).max
+
+
+def _read_array(path, h5: h5py.File, name: str, f, rows: int, kept: slice | None) -> np.ndarray:
+    """A dataset checked against the product table (dtype, shape) before any of its data is read; with
+    *kept* (a row slice), only those rows are read and the others hold a fill value."""
+    try:
+        ds = h5[name]
+        _check_raw(path, name, ds, f, rows)
+        if kept is None:
+            raw = ds[()]
+        else:
+            raw = np.full(ds.shape, _fill_of(f, ds.dtype), ds.dtype)
+            raw[kept] = ds[kept]
+    except GranuleError:
+        raise
+    except (OSError, ValueError, TypeError, RuntimeError, KeyError, AttributeError) as exc:
+        raise GranuleError(path, name, f"unreadable ({exc})") from None
+    if not isinstance(raw, np.ndarray) or raw.ndim == 0:
+        raise GranuleError(path, name, "not an array")
+    return raw
+
+
+def _product_granules(
+    path: GranuleRef, h5: h5py.File, product: Product, platform: str, scans: slice | None = None
+) -> list:
     group = product.data_group
     if group not in h5:
         raise GranuleError(path, group, "missing product group")
@@ -335,8 +390,11 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
     if not 1 <= n_gran <= 1000:
         raise GranuleError(path, f"{aggr}/AggregateNumberGranules", f"{n_gran} is not within 1..1000")
     metas = [_granule_meta(path, h5, product, k, platform) for k in range(n_gran)]
-    scans = [product.scans_reserved or m.n_scans for m in metas]
-    bounds = np.concatenate([[0], np.cumsum(scans)])
+    bounds = np.concatenate([[0], np.cumsum([product.scans_reserved or m.n_scans for m in metas])])
+    kept = None  # the rows of *scans*, for a single-granule product of fixed scans (VIIRS)
+    if scans is not None and product.scans_reserved and n_gran == 1 and scans != slice(None):
+        first, stop, _ = scans.indices(product.scans_reserved)
+        kept = slice(first * product.rows_per_scan, stop * product.rows_per_scan)
     arrays: dict[str, list[np.ndarray] | None] = {}
     for key, f in product.fields.items():
         name = f"{group}/{f.dataset}"
@@ -345,14 +403,8 @@ def _product_granules(path: Path, h5: h5py.File, product: Product, platform: str
                 raise GranuleError(path, name, "missing dataset")
             arrays[key] = None
             continue
-        try:
-            raw = h5[name][()]
-        except (OSError, ValueError, TypeError, RuntimeError, KeyError) as exc:
-            raise GranuleError(path, name, f"unreadable ({exc})") from None
         per = product.rows_per_scan if f.per == "row" else 1
-        if not isinstance(raw, np.ndarray) or raw.ndim == 0:
-            raise GranuleError(path, name, "not an array")
-        _check_raw(path, name, raw, f, int(bounds[-1] * per))
+        raw = _read_array(path, h5, name, f, int(bounds[-1] * per), kept if f.per == "row" else None)
         if f.kind == "scaled" and raw.dtype.kind == "u":
             consistency.check_raw_counts(path, name, raw)
         data = _clean(path, name, raw, f)
@@ -475,20 +527,38 @@ def _check_height(path, name, lat_rad, lon_rad, height_m) -> None:
         )
 
 
-def _open(path: Path) -> h5py.File:
-    try:
-        return h5py.File(path, "r")
-    except (OSError, ValueError) as exc:
-        raise GranuleError(path, "(file)", f"not a readable HDF5 file ({exc})") from None
+def _failed(path: GranuleRef, fh) -> GranuleError | None:
+    """The error for a read in place whose transport failed (its reason names the key), else None."""
+    why = getattr(fh, "failure", None)
+    return GranuleError(path, "(range read)", why) if why else None
 
 
 @contextmanager
-def _reading(path):
+def _opened(path: GranuleRef) -> Iterator[h5py.File]:
+    """The open HDF5 file of *path*; every error h5py raises on a corrupt structure, and every failed read
+    in place, becomes a GranuleError naming the file (or key)."""
+    fh = None if isinstance(path, Path) else path.open()
+    try:
+        try:
+            h5 = h5py.File(path if fh is None else fh, "r")
+        except (OSError, ValueError) as exc:
+            raise _failed(path, fh) or GranuleError(
+                path, "(file)", f"not a readable HDF5 file ({exc})"
+            ) from None
+        with h5, _reading(path, fh):
+            yield h5
+    finally:
+        if fh is not None:
+            fh.close()
+
+
+@contextmanager
+def _reading(path, fh=None):
     """Errors h5py raises on corrupt metadata once a file is open become a GranuleError naming the file."""
     try:
         yield
-    except GranuleError:
-        raise
+    except GranuleError as exc:
+        raise _failed(path, fh) or exc from None
     except (
         OSError,
         RuntimeError,
@@ -499,12 +569,12 @@ def _reading(path):
         OverflowError,
         UnicodeDecodeError,
     ) as exc:
-        raise GranuleError(
+        raise _failed(path, fh) or GranuleError(
             path, "(file)", f"corrupt or unreadable HDF5 structure ({type(exc).__name__}: {exc})"[:300]
         ) from None
 
 
-def _platform(path: Path, h5: h5py.File) -> str:
+def _platform(path: GranuleRef, h5: h5py.File) -> str:
     """The platform (npp, j01, j02) of the content; it must agree with the file name's."""
     parsed = parse_name(path.name)
     attr = h5.attrs.get("Platform_Short_Name")
@@ -526,7 +596,7 @@ def _platform(path: Path, h5: h5py.File) -> str:
     return platform
 
 
-def _check_name_time(path: Path, metas) -> None:
+def _check_name_time(path: GranuleRef, metas) -> None:
     """The file name's start time is its first granule's (to the tenth of a second; 60 s allowed)."""
     parsed = parse_name(path.name)
     if parsed is None or not metas:
@@ -540,7 +610,7 @@ def _check_name_time(path: Path, metas) -> None:
         )
 
 
-def products_in(path: Path, h5: h5py.File) -> list[Product]:
+def products_in(path: GranuleRef, h5: h5py.File) -> list[Product]:
     """Products present in an open file, from the file name or, failing that, the groups."""
     parsed = parse_name(path.name)
     if parsed is not None:
@@ -555,24 +625,27 @@ def products_in(path: Path, h5: h5py.File) -> list[Product]:
     return found
 
 
-def read_file(path, kinds=None) -> list:
+def read_file(path, kinds=None, scans: slice | None = None) -> list:
     """All granules of the supported products in *path* (optionally only those of *kinds*), every field
-    checked against the product table; any problem is a :class:`GranuleError` naming file and field."""
-    path = Path(path)
-    with _open(path) as h5, _reading(path):
+    checked against the product table; any problem is a :class:`GranuleError` naming file and field.
+
+    *scans* (VIIRS, one granule per file) reads only the pixel rows of those scans; the other rows hold
+    fill, as scans without data do (only the bytes of the scans a CrIS granule can reach travel)."""
+    path = as_ref(path)
+    with _opened(path) as h5:
         platform = _platform(path, h5)
         out = []
         for product in products_in(path, h5):
             if kinds is None or product.kind in kinds:
-                out.extend(_product_granules(path, h5, product, platform))
+                out.extend(_product_granules(path, h5, product, platform, scans))
         _check_name_time(path, [g.meta for g in out])
         return out
 
 
 def read_metadata(path) -> list[GranuleMeta]:
     """Granule metadata of every product in *path*, without reading the arrays."""
-    path = Path(path)
-    with _open(path) as h5, _reading(path):
+    path = as_ref(path)
+    with _opened(path) as h5:
         platform = _platform(path, h5)
         metas: list[GranuleMeta] = []
         for product in products_in(path, h5):
@@ -592,8 +665,8 @@ def read_metadata(path) -> list[GranuleMeta]:
 def read_viirs_geo_scan(path, scan: int):
     """(lat_rad, lon_rad, height_m) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the
     end); height_m is zero for the ellipsoid product."""
-    path = Path(path)
-    with _open(path) as h5, _reading(path):
+    path = as_ref(path)
+    with _opened(path) as h5:
         product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
         if product is None:
             raise GranuleError(path, "All_Data", "no VIIRS geolocation product")
@@ -618,3 +691,18 @@ def read_viirs_geo_scan(path, scan: int):
         if "height_m" in product.fields:
             _check_height(path, f"{product.data_group}/Height", *out)
         return tuple(out)
+
+
+def read_scan_start_us(path) -> np.ndarray:
+    """The start time (IET us) of every scan of a VIIRS GEO file, read alone (a few hundred bytes):
+    enough to choose the scans a CrIS granule can reach before any pixel is read."""
+    path = as_ref(path)
+    with _opened(path) as h5:
+        product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
+        if product is None:
+            raise GranuleError(path, "All_Data", "no VIIRS geolocation product")
+        f = product.fields["start_time_us"]
+        name = f"{product.data_group}/{f.dataset}"
+        if name not in h5:
+            raise GranuleError(path, name, "missing dataset")
+        return np.asarray(h5[name][()], np.int64).ravel()
