@@ -47,7 +47,7 @@ from monitor.constants import (
     URAD,
 )
 from monitor.satellites import SATELLITES
-from monitor.vocabulary import DEFAULT_COST, Cost, Kernel, PublishKind, SourceKind
+from monitor.vocabulary import DEFAULT_COST, Cost, Kernel, PublishKind, ReadMode, SourceKind
 
 NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
 
@@ -210,6 +210,11 @@ class SourceConfig(Section):
     buckets: Annotated[dict[str, Text], BeforeValidator(_buckets)] = key(
         dict(NODD_BUCKETS), "NODD bucket per satellite (mapping); keys not given keep the published buckets."
     )
+    read: ReadMode = key(
+        ReadMode.RANGES,
+        "How NODD granules are read: ranges (in place, only the datasets and scans the day needs, "
+        "through a block cache on disk) or whole (each file downloaded whole first).",
+    )
     timeout_s: float = key(
         60.0,
         "Wall-clock bound of a listing page (body included) and of the headers of any "
@@ -221,7 +226,8 @@ class SourceConfig(Section):
     backoff_s: float = key(1.5, "First wait between retries.", 0.01, 600)
     daily_budget_mb: float = key(
         6000.0,
-        "Most bytes downloaded in one satellite-day run; further files are skipped with the reason.",
+        "Most bytes downloaded in one satellite-day run (whole files or ranges); what would exceed it is "
+        "skipped with the reason.",
         1,
         1e6,
     )
@@ -234,8 +240,8 @@ class SourceConfig(Section):
     )
     cache_max_mb: float = key(
         20000.0,
-        "Before every run the least recently used downloads go until the cache "
-        "holds at most this (a run adds at most daily_budget_mb).",
+        "Before every run the least recently used files go until the cache holds at most this (downloads, "
+        "and the blocks of files read in place; a run adds at most daily_budget_mb).",
         0,
         1e8,
     )

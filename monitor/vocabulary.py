@@ -76,6 +76,13 @@ class SourceKind(StrEnum):
     SIMULATED = "simulated"  # the offline demo
 
 
+class ReadMode(StrEnum):
+    """How NODD granules are read (``source.read``)."""
+
+    RANGES = "ranges"  # in place: only the bytes the day needs, through a block cache on disk
+    WHOLE = "whole"  # every file downloaded whole to the cache first
+
+
 class PublishKind(StrEnum):
     """The protocol of a time-series database (``store.publish[].kind``)."""
 

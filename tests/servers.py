@@ -9,6 +9,7 @@ from __future__ import annotations
 import base64
 import json
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -248,8 +249,10 @@ class S3Server:
     (downloads trickle ``drip_bytes`` bytes per interval), ``slow_list_s`` (listing pages trickle one byte
     per interval), ``slow_headers_s`` (every answer's status line and headers trickle one byte per interval),
     ``retry_after`` (every request: 503 and this Retry-After),
-    ``lying_size`` (the listing says this many bytes), ``gzip`` (downloads are gzip-encoded), and
-    ``redirect_to`` (the next download answers 302 to this base URL).
+    ``lying_size`` (the listing says this many bytes, and a range's Content-Range another size),
+    ``gzip`` (downloads are gzip-encoded), ``redirect_to`` (the next download answers 302 to this base
+    URL) and ``short_ranges`` (a range answer holds half the bytes asked for, and says so). GET with a
+    Range header answers 206 with that range, every fault applying to it.
     """
 
     def __init__(self, root: Path, page_size: int = 3, host: str = "127.0.0.1"):
@@ -257,10 +260,11 @@ class S3Server:
         self.page_size = page_size
         self.drop_once, self.corrupt_once = set(), set()
         self.extra_keys, self.extra_sizes = [], {}
-        self.endless_tokens = self.repeat_token = self.gzip = False
+        self.endless_tokens = self.repeat_token = self.gzip = self.short_ranges = False
         self.slow_drip_s = self.retry_after = self.lying_size = self.redirect_to = None
         self.slow_list_s = self.slow_headers_s = None
         self.drip_bytes = 64
+        self.corrupt_at = 100  # the byte corrupt_once flips
         self.requests = []
         server = self
 
@@ -376,14 +380,25 @@ class S3Server:
         data = path.read_bytes()
         if key in self.corrupt_once:
             self.corrupt_once.discard(key)
-            data = data[:100] + bytes([data[100] ^ 0xFF]) + data[101:]
+            at = self.corrupt_at
+            data = data[:at] + bytes([data[at] ^ 0xFF]) + data[at + 1 :]
+        size, wanted = len(data), re.fullmatch(r"bytes=(\d+)-(\d+)", h.headers.get("Range", ""))
+        if wanted:  # a range: the faults apply to its bytes as to a whole object's
+            first, last = int(wanted[1]), min(int(wanted[2]), size - 1)
+            data = data[first : last + 1]
+            if self.short_ranges:
+                data = data[: len(data) // 2]
         if self.gzip:
             import gzip
 
             data = gzip.compress(data)
-        h.send_response(200)
+        h.send_response(206 if wanted else 200)
         if self.gzip:
             h.send_header("Content-Encoding", "gzip")
+        if wanted:
+            h.send_header(
+                "Content-Range", f"bytes {first}-{last}/{size if self.lying_size is None else 10**9}"
+            )
         h.send_header("Content-Length", str(len(data)))
         h.end_headers()
         try:

@@ -8,12 +8,13 @@ always reserves 48 scans). Every problem is raised as :class:`GranuleError` nami
 from __future__ import annotations
 
 import datetime as dt
+import io
 import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO, Protocol
+from typing import Protocol
 
 import h5py
 import numpy as np
@@ -39,9 +40,12 @@ class RemoteGranule(Protocol):
     JPSS file name), ``str()`` naming it in errors (its key), and a binary file object to read it through.
     When a read of that object fails, its ``failure`` says why (the transport's reason, naming the key)."""
 
-    name: str
+    @property
+    def name(self) -> str:
+        """The granule's file name."""
+        ...
 
-    def open(self) -> BinaryIO:
+    def open(self) -> io.RawIOBase:
         """A seekable binary file object over the granule's bytes."""
         ...
 

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import datetime as dt
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Protocol
 
 from monitor.sdr.names import JpssName, parse_name
 from monitor.sdr.products import PRODUCTS
+from monitor.sdr.readers import GranuleRef
 
 ALL_PRODUCTS = tuple(PRODUCTS)
 
@@ -68,5 +68,6 @@ class Source(Protocol):
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
         """The granule files of *satellite* for *day* whose product is in *products*."""
 
-    def fetch(self, f: ListedFile) -> Path:
-        """A local path holding *f* (downloaded if need be); :class:`SourceError` on failure."""
+    def fetch(self, f: ListedFile) -> GranuleRef:
+        """*f* to read: a local path holding it (downloaded if need be), or a granule read in place;
+        :class:`SourceError` on failure."""

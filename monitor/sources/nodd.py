@@ -39,8 +39,11 @@ import urllib3
 
 from monitor.config import SourceConfig
 from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
-from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed
+from monitor.sdr.readers import GranuleRef
+from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed, ranged
 from monitor.sources.bounded import BoundedSession, DeadlinePassed, StallWatch
+from monitor.sources.ranged import BLOCK_LIST, RANGES_FOLDER
+from monitor.vocabulary import ReadMode
 
 LOG = logging.getLogger(__name__)
 S3_NS = "{http://s3.amazonaws.com/doc/2006-03-01/}"
@@ -50,6 +53,9 @@ TIMEOUTS = (TimeoutError, urllib3.exceptions.TimeoutError)  # a socket silent fo
 REDIRECTS = (301, 302, 303, 307, 308)
 _DIGITS = re.compile(r"[0-9]{1,15}", re.ASCII)
 _MD5 = re.compile(r'"?([0-9a-fA-F]{32})"?', re.ASCII)
+
+
+_CONTENT_RANGE = re.compile(r"bytes ([0-9]{1,15})-([0-9]{1,15})/([0-9]{1,15})", re.ASCII)
 
 
 def _retry_after_s(value: str | None) -> float | None:
@@ -74,6 +80,7 @@ class NoddSource:
         self.http = BoundedSession()
         self.spent_bytes = 0  # downloaded in this run (cache hits are free)
         self.downloaded_files = 0
+        self.requests = 0  # HTTP requests sent in this run, listings included
         self.deadline: float | None = None
         self.sleep = sleep
 
@@ -88,23 +95,27 @@ class NoddSource:
         size: the least recently used files go until the cache holds at most ``cache_max_mb``)."""
         self.spent_bytes = 0
         self.downloaded_files = 0
+        self.requests = 0
         self.deadline = time.monotonic() + self.cfg.run_deadline_min * 60
         self.cache_dir.mkdir(parents=True, exist_ok=True)
         cutoff = time.time() - self.cfg.retention_days * 86400
         kept = []
         for p in self.cache_dir.rglob("*"):
-            if not p.is_file():
+            if not p.is_file() or p.suffix == BLOCK_LIST:  # a block list goes with its file
                 continue
             st = p.stat()
             if p.suffix == ".part" or st.st_mtime < cutoff:
+                ranged.forget(p)
+            else:  # a file read in place is sparse: it takes only the blocks fetched
+                kept.append((max(st.st_atime, st.st_mtime), min(st.st_size, st.st_blocks * 512), p))
+        for p in self.cache_dir.rglob(f"*{BLOCK_LIST}"):
+            if not p.with_suffix("").exists():
                 p.unlink(missing_ok=True)
-            else:
-                kept.append((max(st.st_atime, st.st_mtime), st.st_size, p))
         total = sum(size for _, size, _ in kept)
         for _, size, p in sorted(kept):
             if total <= self.cfg.cache_max_mb * 1e6:
                 break
-            p.unlink(missing_ok=True)
+            ranged.forget(p)
             total -= size
 
     def _run_deadline(self) -> float:
@@ -124,9 +135,12 @@ class NoddSource:
             return SourceError(f"{what}: the run deadline of {self.cfg.run_deadline_min:g} min has passed")
         return SourceError(f"{what}: no complete answer within {self.cfg.timeout_s:g} s (timeout_s)")
 
-    def _get(self, url: str, what: str, params=None, read_timeout_s=None) -> requests.Response:
-        """GET *url* with the one retry layer; the response is 200 with its headers read within
-        ``timeout_s`` (and the run deadline), its body still to read (the caller closes it)."""
+    def _get(
+        self, url: str, what: str, params=None, read_timeout_s=None, headers=None, expect: int = 200
+    ) -> requests.Response:
+        """GET *url* with the one retry layer; the response has status *expect* (200, or 206 for a range)
+        with its headers read within ``timeout_s`` (and the run deadline), its body still to read (the
+        caller closes it)."""
         last = "no attempt"
         for attempt in range(self.cfg.retries + 1):
             wait = self.cfg.backoff_s * 2**attempt
@@ -135,9 +149,11 @@ class NoddSource:
             until = time.monotonic() + bound
             try:
                 with self.http.guard(until):
+                    self.requests += 1
                     r = self.http.get(
                         url,
                         params=params,
+                        headers=headers,
                         stream=True,
                         timeout=(bound, read_timeout_s or bound),
                     )
@@ -148,7 +164,7 @@ class NoddSource:
             except requests.RequestException as exc:
                 last = type(exc).__name__
             else:
-                if r.status_code == 200:
+                if r.status_code == expect:
                     return r
                 r.close()
                 if r.status_code in REDIRECTS:
@@ -266,8 +282,12 @@ class NoddSource:
                 out += self.list_prefix(satellite, f"{folder}/{d:%Y/%m/%d}/{name_prefix}")
         return _newest_per_granule(out)
 
-    def fetch(self, f: ListedFile) -> Path:
-        """The cached copy of *f*, downloaded (bounded, checked against the listing) if missing."""
+    def fetch(self, f: ListedFile) -> GranuleRef:
+        """*f* to read: with ``read: ranges`` a granule read in place through the block cache (nothing is
+        fetched yet); with ``read: whole`` the cached copy, downloaded (bounded, checked against the
+        listing) if missing."""
+        if self.cfg.read == ReadMode.RANGES:
+            return ranged.RangedGranule(f, self.read_range, self.cache_dir / RANGES_FOLDER)
         folder = self.cache_dir / f.product
         target = folder / f.name  # f.name is a checked base name: it cannot leave the cache
         try:
@@ -316,9 +336,26 @@ class NoddSource:
             length = r.headers.get("Content-Length")
             if f.size is not None and length is not None and length.strip() != str(f.size):
                 raise SourceError(f"{f.name}: Content-Length {length[:20]}, the listing says {f.size}")
-            watch = StallWatch(self.cfg.min_rate_kb_s * 1e3, self.cfg.stall_window_s)
             md5 = hashlib.md5() if f.md5 else None
-            with open(part, "wb") as out, self.http.guard(self._run_deadline()):
+            with open(part, "wb") as out:
+                watch = self._body(r, f.name, f.size, out.write, md5)
+                out.flush()
+                os.fsync(out.fileno())
+        finally:
+            r.close()
+        n = watch.total
+        if f.size is not None and n != f.size:
+            raise SourceError(f"{f.name}: got {n} bytes, the listing says {f.size}")
+        if md5 is not None and md5.hexdigest() != f.md5:
+            raise SourceError(f"{f.name}: MD5 {md5.hexdigest()} differs from the listing's ETag {f.md5}")
+        return n
+
+    def _body(self, r, what: str, limit: int | None, sink, md5=None) -> StallWatch:
+        """Read the body of *r* into *sink*, at most *limit* bytes, cut by a stall (``min_rate_kb_s`` over
+        ``stall_window_s``) and by the run deadline; returns the transfer's watch (its total)."""
+        watch = StallWatch(self.cfg.min_rate_kb_s * 1e3, self.cfg.stall_window_s)
+        try:
+            with self.http.guard(self._run_deadline()):
                 while True:
                     try:
                         chunk = r.raw.read1(1 << 20, decode_content=False)
@@ -329,36 +366,79 @@ class NoddSource:
                         ValueError,
                     ) as exc:
                         if watch.stalled() or isinstance(exc, TIMEOUTS):
-                            raise self._stalled(f, watch) from None
-                        raise SourceError(f"{f.name}: {type(exc).__name__} after {watch.total} B") from None
+                            raise self._stalled(what, watch) from None
+                        raise SourceError(f"{what}: {type(exc).__name__} after {watch.total} B") from None
                     if not chunk:
-                        break
+                        return watch
                     watch.add(len(chunk))
-                    if f.size is not None and watch.total > f.size:
-                        raise SourceError(f"{f.name}: more than the {f.size} bytes listed")
+                    if limit is not None and watch.total > limit:
+                        raise SourceError(f"{what}: more than the {limit} bytes asked for or listed")
                     if watch.stalled():
-                        raise self._stalled(f, watch)
-                    out.write(chunk)
+                        raise self._stalled(what, watch)
+                    sink(chunk)
                     if md5 is not None:
                         md5.update(chunk)
-                out.flush()
-                os.fsync(out.fileno())
         except DeadlinePassed:
             raise SourceError(
-                f"{f.name}: the run deadline of {self.cfg.run_deadline_min:g} min has passed"
+                f"{what}: the run deadline of {self.cfg.run_deadline_min:g} min has passed"
             ) from None
+
+    def read_range(self, f: ListedFile, start: int, end: int) -> bytes:
+        """Bytes *start* to *end* (exclusive) of *f*, in one HTTP range request under every bound of a
+        download (the one retry layer, ``timeout_s`` for the headers, the stall window, the run deadline,
+        the day's budget, redirects only on the endpoint's host): exactly those bytes of an object of the
+        listed size, or a :class:`SourceError` naming the key and the range."""
+        what = f"{f.location} bytes {start}-{end - 1}"
+        if self.spent_bytes + (end - start) > self.cfg.daily_budget_mb * 1e6:
+            raise BudgetExceeded(
+                f"{what}: the day's download budget of {self.cfg.daily_budget_mb:.0f} MB is spent"
+            )
+        url = f"{self._base(f.parsed.platform)}/{f.location}"
+        last = None
+        for attempt in range(self.cfg.retries + 1):
+            try:
+                data = self._range(url, what, f, start, end)
+            except SourceError as exc:
+                last = exc
+                if attempt < self.cfg.retries and "refused" not in str(exc) and "deadline" not in str(exc):
+                    LOG.warning("range read failed (attempt %d): %s", attempt + 1, exc)
+                    self.sleep(min(self.cfg.backoff_s * 2**attempt, self._left_s(what)))
+                    continue
+                break
+            self.spent_bytes += len(data)
+            return data
+        raise SourceError(f"{what}: range read failed ({last})")
+
+    def _range(self, url: str, what: str, f: ListedFile, start: int, end: int) -> bytes:
+        """One range request: status 206, Content-Range and Content-Length exactly the range asked for,
+        of an object of the listed size, never content-encoded."""
+        window = min(self.cfg.stall_window_s, self.cfg.timeout_s)
+        r = self._get(
+            url, what, read_timeout_s=window, headers={"Range": f"bytes={start}-{end - 1}"}, expect=206
+        )
+        try:
+            encoding = r.headers.get("Content-Encoding", "identity").strip().lower()
+            if encoding not in ("", "identity"):
+                raise SourceError(f"{what}: compressed response (Content-Encoding {encoding[:20]}) refused")
+            span = _CONTENT_RANGE.fullmatch(r.headers.get("Content-Range", "").strip())
+            if span is None or (int(span[1]), int(span[2]) + 1) != (start, end):
+                raise SourceError(f"{what}: Content-Range {r.headers.get('Content-Range', '')[:60]!r}")
+            if f.size is not None and int(span[3]) != f.size:
+                raise SourceError(f"{what}: the object holds {span[3]} bytes, the listing says {f.size}")
+            length = r.headers.get("Content-Length")
+            if length is not None and length.strip() != str(end - start):
+                raise SourceError(f"{what}: Content-Length {length[:20]} for {end - start} bytes")
+            body = bytearray()
+            self._body(r, what, end - start, body.extend)
         finally:
             r.close()
-        n = watch.total
-        if f.size is not None and n != f.size:
-            raise SourceError(f"{f.name}: got {n} bytes, the listing says {f.size}")
-        if md5 is not None and md5.hexdigest() != f.md5:
-            raise SourceError(f"{f.name}: MD5 {md5.hexdigest()} differs from the listing's ETag {f.md5}")
-        return n
+        if len(body) != end - start:
+            raise SourceError(f"{what}: got {len(body)} bytes of {end - start}")
+        return bytes(body)
 
-    def _stalled(self, f: ListedFile, watch: StallWatch) -> SourceError:
+    def _stalled(self, what: str, watch: StallWatch) -> SourceError:
         return SourceError(
-            f"{f.name}: slower than {self.cfg.min_rate_kb_s:g} kB/s over {self.cfg.stall_window_s:g} s "
+            f"{what}: slower than {self.cfg.min_rate_kb_s:g} kB/s over {self.cfg.stall_window_s:g} s "
             f"({watch.total} bytes received)"
         )
 

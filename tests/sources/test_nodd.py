@@ -4,6 +4,7 @@ import datetime as dt
 import os
 import shutil
 import time
+from pathlib import Path
 
 import pytest
 
@@ -42,11 +43,32 @@ def bucket(cases, tmp_path_factory):
     return root
 
 
+MODES = ("whole", "ranges")  # every download bound holds for a whole file and for a range alike
+
+
 def _source(url, tmp_path, **kw):
     """A NODD source on the test server; *kw* may narrow bounds below what a file may set (a budget of
     0.1 MB, a deadline of 3 s: the tests run in seconds), so they are applied after validation."""
     cfg = SourceConfig(kind="nodd", endpoint=url + "/{bucket}", retries=2, backoff_s=0.01, timeout_s=10.0)
     return NoddSource(cfg.model_copy(update=kw), tmp_path / "cache")
+
+
+def _read(src, f) -> bytes:
+    """The bytes of *f* as the source gives them: the file downloaded whole, or every byte read in place
+    (a failed read raises the transport's error, as the readers report it)."""
+    ref = src.fetch(f)
+    if isinstance(ref, Path):
+        return ref.read_bytes()
+    with ref.open() as fh:
+        try:
+            return fh.read()
+        except OSError:
+            raise SourceError(fh.failure) from None
+
+
+def _nothing_held(cache: Path) -> bool:
+    """No partial download and no block recorded as held."""
+    return not list(cache.rglob("*.part")) + list(cache.rglob("*.blocks")) + list(cache.glob("[!r]*/*.h5"))
 
 
 def test_listing_follows_pages_and_keeps_newest(bucket, tmp_path):
@@ -60,29 +82,30 @@ def test_listing_follows_pages_and_keeps_newest(bucket, tmp_path):
     assert any("_c2025" in n for n in names)  # the reprocessed granule replaces the original
 
 
-def test_dropped_connection_is_retried_and_never_leaves_a_partial_granule(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_dropped_connection_is_retried_and_never_leaves_a_partial_granule(bucket, tmp_path, read):
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path)
+        src = _source(s3.url, tmp_path, read=read)
         f = [x for x in src.list_day("j01", DAY, ("GCRSO",))][1]
         s3.drop_once.add(f.location)
-        path = src.fetch(f)
-        assert path.read_bytes() == (bucket / "noaa-nesdis-n20-pds" / f.location).read_bytes()
+        assert _read(src, f) == (bucket / "noaa-nesdis-n20-pds" / f.location).read_bytes()
         assert not list((tmp_path / "cache").rglob("*.part"))
         assert sum(f.name in r for r in s3.requests) == 2  # the cut download, then the full one
 
 
-def test_size_mismatch_and_budget(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_size_mismatch_and_budget(bucket, tmp_path, read):
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path, daily_budget_mb=0.1)
+        src = _source(s3.url, tmp_path, daily_budget_mb=0.1, read=read)
         f = src.list_day("j01", DAY, ("GCRSO",))[1]
         wrong = type(f)(f.name, f.size + 1, f.location, f.parsed)
-        with pytest.raises(SourceError, match="listing says"):
-            src.fetch(wrong)
-        assert not (tmp_path / "cache" / "GCRSO" / f.name).exists()
+        with pytest.raises(SourceError, match="listing says" if read == "whole" else "Content-Range"):
+            _read(src, wrong)
+        assert _nothing_held(tmp_path / "cache")
         src.start_day()
         big = src.list_day("j01", DAY, ("SCRIF",))[0]
-        with pytest.raises(BudgetExceeded, match="budget"):
-            src.fetch(big)
+        with pytest.raises(BudgetExceeded if read == "whole" else SourceError, match="budget"):
+            _read(src, big)
 
 
 def test_unsafe_keys_are_ignored(bucket, tmp_path):
@@ -157,26 +180,28 @@ def test_a_huge_retry_after_is_not_waited_for(bucket, tmp_path):
         ({"run_deadline_min": 0.05}, "run deadline of 0.05 min has passed", 3 + 10),
     ],
 )
-def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s):
+@pytest.mark.parametrize("read", MODES)
+def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s, read):
     """By the minimum rate over the stall window, or by the run deadline, whichever comes first: each
     within its bound + 10 s."""
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path, retries=0, **bound)
+        src = _source(s3.url, tmp_path, retries=0, read=read, **bound)
         f = src.list_day("j01", DAY, ("SCRIF",))[0]
         s3.slow_drip_s = 0.05
-        secs, peak, why = _timed(lambda: src.fetch(f))
+        secs, peak, why = _timed(lambda: _read(src, f))
         assert reason in why and secs < limit_s and peak < 20e6
-        assert not list((tmp_path / "cache").rglob("*.h5*"))  # no partial granule left
+        assert _nothing_held(tmp_path / "cache")  # no partial granule left
 
 
-def test_one_byte_a_second_is_a_stall_not_a_budget(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_one_byte_a_second_is_a_stall_not_a_budget(bucket, tmp_path, read):
     """A drip of one byte at a time is cut after one stall window (before: a budget of 30 s + size / rate,
     ~2600 s for a GITCO); retried, each attempt is cut the same way."""
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path, retries=1, stall_window_s=2.0, min_rate_kb_s=1.0)
+        src = _source(s3.url, tmp_path, retries=1, stall_window_s=2.0, min_rate_kb_s=1.0, read=read)
         f = src.list_day("j01", DAY, ("SCRIF",))[0]
         s3.slow_drip_s, s3.drip_bytes = 0.02, 1
-        secs, _, why = _timed(lambda: src.fetch(f))
+        secs, _, why = _timed(lambda: _read(src, f))
         assert "slower than 1 kB/s over 2 s" in why and secs < 2 * 2 + 10
         assert sum(f.name in r for r in s3.requests) == 2
 
@@ -224,43 +249,51 @@ def test_a_name_longer_than_the_pattern_is_left_out_and_the_day_goes_on(bucket, 
     assert sorted(f.name for f in files) == sorted(f.name for f in genuine)
 
 
-def test_a_cache_that_cannot_hold_a_file_is_a_source_error(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_a_cache_that_cannot_hold_a_file_is_a_source_error(bucket, tmp_path, read):
     """An OSError of the cache (here: a file where the product folder should be) names the file; it is not
     retried and does not escape as an OSError (which failed the whole day)."""
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path)
+        src = _source(s3.url, tmp_path, read=read)
         f = src.list_day("j01", DAY, ("GCRSO",))[0]
-        (tmp_path / "cache").mkdir()
-        (tmp_path / "cache" / "GCRSO").write_text("not a folder")
-        with pytest.raises(SourceError, match=f"{f.name}: cache"):
-            src.fetch(f)
+        folder = tmp_path / "cache" / ("GCRSO" if read == "whole" else "ranges/GCRSO")
+        folder.parent.mkdir(parents=True)
+        folder.write_text("not a folder")
+        with pytest.raises(
+            SourceError, match=f"{f.name}: cache" if read == "whole" else f"{f.location}: block cache"
+        ):
+            _read(src, f)
 
 
-def test_a_lying_size_and_a_gzip_response_are_refused(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_a_lying_size_and_a_gzip_response_are_refused(bucket, tmp_path, read):
     with S3Server(bucket) as s3:
         s3.lying_size = 1000
-        src = _source(s3.url, tmp_path)
+        src = _source(s3.url, tmp_path, read=read)
         f = src.list_day("j01", DAY, ("SCRIF",))[0]
-        secs, peak, why = _timed(lambda: src.fetch(f))
-        assert "Content-Length" in why and "listing says 1000" in why and peak < 20e6  # the server's copy too
+        secs, peak, why = _timed(lambda: _read(src, f))
+        assert "listing says 1000" in why and peak < 20e6  # the server's copy too
+        assert ("Content-Length" if read == "whole" else "the object holds 1000000000 bytes") in why
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path)
+        src = _source(s3.url, tmp_path, read=read)
         f = src.list_day("j01", DAY, ("GCRSO",))[0]
         s3.gzip = True
-        secs, _, why = _timed(lambda: src.fetch(f))
+        secs, _, why = _timed(lambda: _read(src, f))
         assert "compressed response (Content-Encoding gzip) refused" in why
-    assert not list((tmp_path / "cache").rglob("*.h5*"))
+    assert _nothing_held(tmp_path / "cache")
 
 
-def test_md5_against_the_etag(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_md5_against_the_etag(bucket, tmp_path, read):
+    """Read in place, a granule of one block (the GCRSO) is checked whole before any byte is used."""
     with S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path, retries=0)
+        src = _source(s3.url, tmp_path, retries=0, read=read)
         f = src.list_day("j01", DAY, ("GCRSO",))[0]
         assert f.md5 is not None and len(f.md5) == 32
         s3.corrupt_once.add(f.location)
-        secs, _, why = _timed(lambda: src.fetch(f))
+        secs, _, why = _timed(lambda: _read(src, f))
         assert "MD5" in why and "differs from the listing's ETag" in why
-        assert src.fetch(f).read_bytes() == (bucket / "noaa-nesdis-n20-pds" / f.location).read_bytes()
+        assert _read(src, f) == (bucket / "noaa-nesdis-n20-pds" / f.location).read_bytes()
 
 
 def test_odd_keys_never_shadow_the_granule(bucket, tmp_path):
@@ -281,16 +314,17 @@ def test_odd_keys_never_shadow_the_granule(bucket, tmp_path):
     assert sorted(f.name for f in files) == sorted(f.name for f in genuine)
 
 
-def test_a_redirect_to_another_host_is_refused(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_a_redirect_to_another_host_is_refused(bucket, tmp_path, read):
     with S3Server(bucket, host="127.0.0.2") as other, S3Server(bucket) as s3:
-        src = _source(s3.url, tmp_path)
+        src = _source(s3.url, tmp_path, read=read)
         f = src.list_day("j01", DAY, ("GCRSO",))[0]
         s3.redirect_to = other.url
-        secs, _, why = _timed(lambda: src.fetch(f))
+        secs, _, why = _timed(lambda: _read(src, f))
         assert "redirect to http://127.0.0.2" in why and "refused" in why
         assert other.requests == []
         s3.redirect_to = s3.url  # on the same host a redirect is followed
-        assert src.fetch(f).stat().st_size == f.size
+        assert len(_read(src, f)) == f.size
 
 
 def test_one_retry_layer(bucket, tmp_path):
@@ -302,7 +336,8 @@ def test_one_retry_layer(bucket, tmp_path):
         assert "HTTP 503 after 4 attempts" in why and len(s3.requests) == 4
 
 
-def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_path):
+@pytest.mark.parametrize("read", MODES)
+def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_path, read):
     """End to end: the listing also holds a name with a 300-digit orbit and a name that leaves the folder;
     the day is still assessed from its genuine granules, and recorded ok."""
     folder = "CrIS-SDR-GEO/2024/06/01/"
@@ -313,7 +348,8 @@ def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_
         config = tmp_path / "nodd.yaml"
         config.write_text(
             f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\n"
-            f"source: {{kind: nodd, endpoint: '{s3.url}/{{bucket}}', retries: 1, backoff_s: 0.01}}\n"
+            f"source: {{kind: nodd, endpoint: '{s3.url}/{{bucket}}', retries: 1, backoff_s: 0.01, "
+            f"read: {read}}}\n"
             "scenes: {min_inhomogeneity_k: 0}\nfingerprint: {granules: 2}\n"
         )
         cfg = load_config(config)
