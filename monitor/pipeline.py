@@ -210,7 +210,7 @@ def compute_day(
 def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, should_stop, progress) -> DayWork:
     stop = should_stop or (lambda: False)
     w = DayWork(satellite, day, RunStatus.OK)
-    w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0}
+    w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0, "requests": 0}
     t0 = time.perf_counter()
     try:
         logs.stage("list")
@@ -247,7 +247,6 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
             source, satellite, chosen, stop, ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
         )
         w.timings["fetch"] = time.perf_counter() - t1
-        w.counts["downloaded"], w.counts["bytes"] = source.downloaded_files, source.spent_bytes
         t1 = time.perf_counter()
         a = cfg.assessment
         logs.stage("assess")
@@ -273,6 +272,9 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
         LOG.exception("run %s %s failed unexpectedly", satellite, day)
         w.status, w.reason = RunStatus.FAILED, f"unexpected {type(exc).__name__}: {exc}"[:1000]
         w.result = None
+    # read in place, the bytes travel while the day is assessed: counted once it ends, however it ends
+    w.counts["downloaded"], w.counts["bytes"] = source.downloaded_files, source.spent_bytes
+    w.counts["requests"] = source.requests
     return w
 
 

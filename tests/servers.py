@@ -243,8 +243,9 @@ class S3Server:
 
     ListObjectsV2 with ``page_size`` keys per page, continuation tokens and MD5 ETags; GET of objects.
     Faults, each off by default: ``drop_once`` (keys whose first download is cut half-way),
-    ``corrupt_once`` (keys whose first download has one byte changed), ``extra_keys`` (listed keys that do
-    not exist, with ``extra_sizes`` giving their <Size> text), ``endless_tokens`` (every page is truncated,
+    ``corrupt_once`` (keys whose first answer holding byte ``corrupt_at`` has it changed),
+    ``extra_keys`` (listed keys that do not exist, with ``extra_sizes`` giving their <Size> text),
+    ``endless_tokens`` (every page is truncated,
     with a new token), ``repeat_token`` (every page is truncated, with the same token), ``slow_drip_s``
     (downloads trickle ``drip_bytes`` bytes per interval), ``slow_list_s`` (listing pages trickle one byte
     per interval), ``slow_headers_s`` (every answer's status line and headers trickle one byte per interval),
@@ -378,11 +379,11 @@ class S3Server:
             h.end_headers()
             return
         data = path.read_bytes()
-        if key in self.corrupt_once:
-            self.corrupt_once.discard(key)
-            at = self.corrupt_at
-            data = data[:at] + bytes([data[at] ^ 0xFF]) + data[at + 1 :]
         size, wanted = len(data), re.fullmatch(r"bytes=(\d+)-(\d+)", h.headers.get("Range", ""))
+        at = self.corrupt_at
+        if key in self.corrupt_once and (not wanted or int(wanted[1]) <= at <= int(wanted[2])):
+            self.corrupt_once.discard(key)  # the first answer holding the byte
+            data = data[:at] + bytes([data[at] ^ 0xFF]) + data[at + 1 :]
         if wanted:  # a range: the faults apply to its bytes as to a whole object's
             first, last = int(wanted[1]), min(int(wanted[2]), size - 1)
             data = data[first : last + 1]
@@ -413,3 +414,57 @@ class S3Server:
             h.wfile.write(data)
         except (BrokenPipeError, ConnectionResetError):
             pass  # the client gave up, as it should
+
+
+class MotoS3:
+    """moto's S3 server (a real S3-compatible HTTP server, in a thread) on loopback, holding public
+    buckets as NODD's are: anonymous ListObjectsV2 and GET, range requests, MD5 ETags (every object
+    is put in one part)."""
+
+    def __init__(self):
+        from moto.server import ThreadedMotoServer
+
+        self.server = ThreadedMotoServer(ip_address="127.0.0.1", port=0, verbose=False)
+        self.url = ""
+        self.client = None
+
+    def __enter__(self):
+        import logging
+
+        import boto3
+
+        logging.getLogger("werkzeug").setLevel(logging.WARNING)  # a line per request otherwise
+        self.server.start()
+        host, port = self.server.get_host_and_port()
+        self.url = f"http://{host}:{port}"
+        self.client = boto3.client(
+            "s3",
+            endpoint_url=self.url,
+            region_name="us-east-1",
+            aws_access_key_id="test",
+            aws_secret_access_key="test",
+        )
+        return self
+
+    def __exit__(self, *exc):
+        self.server.stop()
+
+    def put_granules(self, bucket: str, files) -> list[str]:
+        """Put granule *files* under their NODD keys (``<collection>/YYYY/MM/DD/<name>``) in *bucket*
+        (made public); the keys."""
+        from boto3.s3.transfer import TransferConfig
+
+        from monitor.sdr.names import parse_name
+        from monitor.sdr.products import PRODUCTS
+
+        existing = {b["Name"] for b in self.client.list_buckets().get("Buckets", [])}
+        if bucket not in existing:
+            self.client.create_bucket(Bucket=bucket, ACL="public-read")
+        keys = []
+        one_part = TransferConfig(multipart_threshold=1 << 40)  # a plain MD5 ETag, as NODD's granules
+        for f in map(Path, files):
+            parsed = parse_name(f.name)
+            key = f"{PRODUCTS[parsed.products[0]].collection}/{parsed.start:%Y/%m/%d}/{f.name}"
+            self.client.upload_file(str(f), bucket, key, Config=one_part, ExtraArgs={"ACL": "public-read"})
+            keys.append(key)
+        return keys

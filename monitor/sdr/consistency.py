@@ -62,6 +62,7 @@ ATTITUDE_STEP_ARCSEC = 30.0
 ARCSEC_RAD = np.pi / (180.0 * 3600.0)
 LOS_CLOSURE_M = 200.0
 NADIR_TOLERANCE_M = 20e3
+PIXEL_STEP_KM = 5.0  # I-band pixels along a row lie 0.375-0.8 km apart; a corrupt value leaps far further
 RAW_ZERO_SHARE = 0.005
 RAW_ONE_COUNT_SHARE = 0.01
 
@@ -286,6 +287,32 @@ def check_nadir(path, product, granule, has_data: np.ndarray) -> None:
             f"scan {scans[ok][i] + 1}: the middle pixel is not below the spacecraft "
             f"({off[i] / 1e3:.0f} km off)",
         )
+
+
+def check_pixel_steps(path, product, granule, scans_per_pass: int = 6) -> None:
+    """VIIRS GEO: neighbouring pixels of a row lie within PIXEL_STEP_KM of each other on the ground.
+
+    A corrupt latitude or longitude (a flipped byte of a float) moves its pixel hundreds of km or more; no
+    other check sees one pixel among ten million. The step is the chord between unit vectors (float32,
+    a few scans at a time: bounded memory); pairs with a fill are skipped."""
+    lat, lon = granule.lat_rad, granule.lon_rad
+    rows = product.rows_per_scan * scans_per_pass
+    limit = PIXEL_STEP_KM / (wgs84.A_M / 1e3)
+    for r0 in range(0, lat.shape[0], rows):
+        la, lo = lat[r0 : r0 + rows].astype(np.float32), lon[r0 : r0 + rows].astype(np.float32)
+        cl = np.cos(la)
+        u = np.stack([cl * np.cos(lo), cl * np.sin(lo), np.sin(la)], axis=-1)
+        step = np.linalg.norm(np.diff(u, axis=1), axis=-1)
+        with np.errstate(invalid="ignore"):
+            bad = step > limit
+        if bad.any():
+            r, c = np.argwhere(bad)[0]
+            raise GranuleError(
+                path,
+                f"{product.data_group}/Latitude, Longitude",
+                f"row {r0 + r}, columns {c}-{c + 1}: neighbouring pixels "
+                f"{float(step[r, c]) * wgs84.A_M / 1e3:.0f} km apart (more than {PIXEL_STEP_KM:g} km)",
+            )
 
 
 def check_raw_counts(path, name: str, raw: np.ndarray) -> None:

@@ -455,6 +455,7 @@ def _check_physics(path, product: Product, granule) -> None:
         consistency.check_line_of_sight(path, product, granule)
     else:
         consistency.check_nadir(path, product, granule, has_data)
+        consistency.check_pixel_steps(path, product, granule)
 
 
 def _check_times(path, product: Product, granule) -> None:

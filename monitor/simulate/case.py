@@ -26,6 +26,7 @@ from monitor.sdr import iet
 from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
 from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
+from monitor.simulate import complete
 from monitor.simulate import instrument as ins
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
 from monitor.simulate.orbit import PASSES, CircularOrbit, find_pass
@@ -84,6 +85,15 @@ class SimulationSpec:
     cris_bias_k: float = 0.0
     cris_gain: float = 0.0  # relative: 0.01 is a 1 % gain difference
     cris_nonlinear_k: float = 0.0
+    # every dataset of the real products, also those the monitor never reads (monitor.simulate.complete)
+    complete: bool = False
+    # HDF5 layout of every dataset: "contiguous" (uncompressed IDPS files) or "gzip" (one chunk per
+    # dataset, as the real GCRSO); None: CrIS gzip, VIIRS contiguous
+    layout: str | None = None
+
+    def compressed(self, instrument: str) -> bool:
+        """Whether the datasets of *instrument* (CrIS, VIIRS) are written gzip-compressed."""
+        return self.layout == "gzip" if self.layout is not None else instrument == "CrIS"
 
     @property
     def calibrated(self) -> bool:
@@ -257,6 +267,7 @@ class Simulator:
             "SatelliteAzimuthAngle": np.degrees(az).astype(np.float32),
             "SolarZenithAngle": np.full(lat.shape, -999.3, np.float32),
             "SolarAzimuthAngle": np.full(lat.shape, -999.3, np.float32),
+            **(self._cris_solar(lat, lon, for_unix) if spec.complete else {}),
             "SCPosition": r_mid.astype(np.float32),
             "SCVelocity": v_mid.astype(np.float32),
             "SCAttitude": att_mid.astype(np.float32),
@@ -277,6 +288,11 @@ class Simulator:
                         "ES_RealSW": sw,
                         "QF1_SCAN_CRISSDR": np.zeros(4, np.uint8),
                         "QF3_CRISSDR": np.zeros((4, 30, 9, 3), np.uint8),
+                        **(
+                            complete.cris_sdr_extra({"LW": radiance, "MW": mw, "SW": sw}, self.rng)
+                            if spec.complete
+                            else {}
+                        ),
                     },
                     "SDR",
                 )
@@ -290,10 +306,21 @@ class Simulator:
                 [prefix], spec.satellite, _utc(begin), _utc(end), attrs["N_Beginning_Orbit_Number"], created
             )
             write_file(
-                out / name, spec.satellite, created, [ProductData(product, "CrIS", tag, data, [a], {})]
+                out / name,
+                spec.satellite,
+                created,
+                [ProductData(product, "CrIS", tag, data, [a], {}, compress=spec.compressed("CrIS"))],
             )
             names.append(name)
         return names
+
+    @staticmethod
+    def _cris_solar(lat_rad, lon_rad, for_unix) -> dict:
+        """GCRSO's solar angles (deg) at each FOV (fill in the reduced files: the monitor never reads
+        them)."""
+        sun = complete.sun_direction_ecef(for_unix)[..., None, :]
+        zen, az, _ = complete.view_angles(lat_rad, lon_rad, 0.0, sun, direction=True)
+        return {"SolarZenithAngle": zen.astype(np.float32), "SolarAzimuthAngle": az.astype(np.float32)}
 
     def _surface(self, origin, los):
         """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is
@@ -423,6 +450,9 @@ class Simulator:
             "QF2_SCAN_SDR": np.zeros(ins.VIIRS_SCANS, np.uint8),
             "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32),
         }
+        if spec.complete:
+            geo |= complete.viirs_geo_extra(lat_out, lon_out, h_out, r_mid, scan_start, ins.VIIRS_DETECTORS)
+            sdr |= complete.viirs_sdr_extra(ins.VIIRS_SCANS, ins.VIIRS_DETECTORS)
         names = []
         for prefix, data, tag in (("GITCO", geo, "GEO"), ("SVI05", sdr, "SDR")):
             product = PRODUCTS[prefix]
@@ -439,7 +469,7 @@ class Simulator:
                 out / name,
                 spec.satellite,
                 created,
-                [ProductData(product, "VIIRS", tag, data, [a], {}, fills={}, compress=False)],
+                [ProductData(product, "VIIRS", tag, data, [a], {}, compress=spec.compressed("VIIRS"))],
             )
             names.append(name)
         return names

@@ -59,8 +59,9 @@ def on_day(f: ListedFile, day: dt.date) -> bool:
 class Source(Protocol):
     """What the daily run needs of a source (local tree, simulator, NODD)."""
 
-    spent_bytes: int  # downloaded in this run
-    downloaded_files: int
+    spent_bytes: int  # downloaded in this run (whole files and ranges)
+    downloaded_files: int  # downloaded whole in this run
+    requests: int  # HTTP requests sent in this run
 
     def start_day(self) -> None:
         """Start a run: reset the run's budget and deadline, apply the cache retention."""

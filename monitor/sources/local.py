@@ -22,6 +22,7 @@ class LocalSource:
 
     spent_bytes = 0
     downloaded_files = 0
+    requests = 0
 
     def __init__(self, root):
         self.root = Path(root)
