@@ -63,7 +63,7 @@ class RunOutcome:
     run_id: int | None = None
     result: AssessmentResult | None = None
     timings: dict = field(default_factory=dict)
-    counts: dict = field(default_factory=dict)  # granules listed, selected, assessed; files, bytes downloaded
+    counts: dict = field(default_factory=dict)  # granules listed, selected, assessed; files, bytes, requests
 
     def summary(self) -> str:
         """The one line a run leaves in the log."""
@@ -74,8 +74,8 @@ class RunOutcome:
         if c:
             parts.append(
                 f"granules listed {c.get('listed', 0)}, selected {c.get('selected', 0)}, "
-                f"assessed {c.get('assessed', 0)}; {c.get('downloaded', 0)} files, "
-                f"{c.get('bytes', 0) / 1e6:.0f} MB downloaded"
+                f"assessed {c.get('assessed', 0)}; {c.get('downloaded', 0)} files whole, "
+                f"{c.get('bytes', 0) / 1e6:.0f} MB downloaded in {c.get('requests', 0)} requests"
             )
         if self.result is not None:
             ok = [f for f in self.result.fors if f.reliable]

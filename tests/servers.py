@@ -437,6 +437,7 @@ class MotoS3:
         self.server.start()
         host, port = self.server.get_host_and_port()
         self.url = f"http://{host}:{port}"
+        requests.post(f"{self.url}/moto-api/reset", timeout=30)  # moto's state is per process: start empty
         self.client = boto3.client(
             "s3",
             endpoint_url=self.url,

@@ -149,3 +149,22 @@ def test_a_failed_range_leaves_no_block_recorded(moto, tmp_path):
     assert not list((tmp_path / "cache").rglob(f"*{BLOCK_LIST}"))
     with pytest.raises(SourceError, match="no listed size"):
         src.fetch(type(f)(f.name, None, f.location, f.parsed)).open()
+
+
+def test_reprocessing_workers_read_their_own_ranges(moto, tmp_path, monkeypatch):
+    """On a Dask LocalCluster the worker process lists and reads the ranges; this process, the client,
+    only records (here it cannot read at all)."""
+    from monitor.reprocess import reprocess
+
+    def not_here(*_):
+        raise AssertionError("the client read a granule")
+
+    monkeypatch.setattr(NoddSource, "read_range", not_here)
+    monkeypatch.setattr(NoddSource, "fetch", not_here)
+    cfg = _config(tmp_path, moto.url, "ranges", "reprocess")
+    outcomes = []
+    summary = reprocess(cfg, DAY, DAY, ["j01"], workers=1, progress=outcomes.append)
+    assert summary.statuses == {"ok": 1}, [o.reason for o in outcomes]
+    (out,) = outcomes
+    assert out.counts["bytes"] > 0 and out.counts["requests"] > 0 and out.counts["downloaded"] == 0
+    assert list((cfg.cache_dir / "ranges").rglob(f"*{BLOCK_LIST}"))  # the worker's block cache
