@@ -35,6 +35,7 @@ from monitor.collocate import warm_up
 from monitor.config import load_config
 from monitor.pipeline import compute_day
 from monitor.satellites import SATELLITES
+from monitor.simulate import LAYOUTS
 from monitor.simulate.case import DEFAULT_START, SimulationSpec, Simulator
 from monitor.simulate.profiles import load_profile
 from monitor.sources.configured import make_source
@@ -110,7 +111,7 @@ def held_by_product(cache: Path) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--granules", type=int, nargs="+", default=[1, 14])
-    ap.add_argument("--layouts", nargs="+", default=["contiguous", "gzip"], choices=["contiguous", "gzip"])
+    ap.add_argument("--layouts", nargs="+", default=list(LAYOUTS), choices=LAYOUTS)
     ap.add_argument("--keep", help="directory for the simulated cases (kept; reused when present)")
     ap.add_argument("--out", default=str(RESULTS / f"nodd_ranges_{dt.date.today()}.jsonl"))
     args = ap.parse_args(argv)

@@ -20,6 +20,7 @@ from monitor.config import AssessmentConfig
 from monitor.errors import DataError
 from monitor.render import result_text, status_text
 from monitor.satellites import SATELLITES
+from monitor.simulate import LAYOUTS
 from monitor.simulate.orbit import PASSES
 from monitor.version import __version__
 from monitor.vocabulary import Cost, Kernel, Rule
@@ -103,12 +104,28 @@ def command(name: str, help: str, *arguments):
         "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass",
     ),
     arg("--pass-lon", type=float, help="with --pass: the pass nearest this longitude, deg (e.g. 180)"),
+    arg(
+        "--complete",
+        action="store_true",
+        help="every dataset of the real products, real size (GITCO ~325 MB uncompressed)",
+    ),
+    arg(
+        "--layout",
+        choices=LAYOUTS,
+        help="HDF5 layout of every dataset (default: CrIS gzip, VIIRS contiguous)",
+    ),
 )
 def cmd_simulate(args) -> int:
     """crisgeo simulate: write a simulated case."""
     from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
 
-    where = dict(terrain=args.terrain, orbit_pass=args.orbit_pass, pass_lon_deg=args.pass_lon)
+    where = dict(
+        terrain=args.terrain,
+        orbit_pass=args.orbit_pass,
+        pass_lon_deg=args.pass_lon,
+        complete=args.complete,
+        layout=args.layout,
+    )
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")
     try:

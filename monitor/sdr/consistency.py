@@ -293,18 +293,21 @@ def check_pixel_steps(path, product, granule, scans_per_pass: int = 6) -> None:
     """VIIRS GEO: neighbouring pixels of a row lie within PIXEL_STEP_KM of each other on the ground.
 
     A corrupt latitude or longitude (a flipped byte of a float) moves its pixel hundreds of km or more; no
-    other check sees one pixel among ten million. The step is the chord between unit vectors (float32,
-    a few scans at a time: bounded memory); pairs with a fill are skipped."""
+    other check sees one pixel among ten million. The step is the angle between the pixels on the sphere,
+    hypot(d_lat, d_lon cos(lat)) with d_lon taken across the antimeridian, a few scans at a time
+    (bounded memory; scans not read, all fill, are skipped); pairs with a fill are skipped."""
     lat, lon = granule.lat_rad, granule.lon_rad
     rows = product.rows_per_scan * scans_per_pass
-    limit = PIXEL_STEP_KM / (wgs84.A_M / 1e3)
+    limit_rad = PIXEL_STEP_KM / (wgs84.A_M / 1e3)
     for r0 in range(0, lat.shape[0], rows):
-        la, lo = lat[r0 : r0 + rows].astype(np.float32), lon[r0 : r0 + rows].astype(np.float32)
-        cl = np.cos(la)
-        u = np.stack([cl * np.cos(lo), cl * np.sin(lo), np.sin(la)], axis=-1)
-        step = np.linalg.norm(np.diff(u, axis=1), axis=-1)
+        la, lo = lat[r0 : r0 + rows], lon[r0 : r0 + rows]
+        if not np.isfinite(la[:, ::64]).any():
+            continue
+        d_lon = np.abs(np.diff(lo, axis=1))
+        d_lon = np.minimum(d_lon, np.float32(2 * np.pi) - d_lon) * np.cos(la[:, 1:])
+        step = np.hypot(np.diff(la, axis=1), d_lon)
         with np.errstate(invalid="ignore"):
-            bad = step > limit
+            bad = step > limit_rad
         if bad.any():
             r, c = np.argwhere(bad)[0]
             raise GranuleError(

@@ -4,3 +4,5 @@ Radiances come from the true lines of sight over a synthetic inhomogeneous Earth
 coastlines); the CrIS GEO is computed from the erroneous ones. The CrIS truth is the scene integrated
 over the true FOV cone, independently of the VIIRS pixel grid (no "inverse crime", docs/science.md).
 """
+
+LAYOUTS = ("contiguous", "gzip")  # of every dataset: uncompressed IDPS files; one gzip chunk per dataset

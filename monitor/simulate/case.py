@@ -87,8 +87,8 @@ class SimulationSpec:
     cris_nonlinear_k: float = 0.0
     # every dataset of the real products, also those the monitor never reads (monitor.simulate.complete)
     complete: bool = False
-    # HDF5 layout of every dataset: "contiguous" (uncompressed IDPS files) or "gzip" (one chunk per
-    # dataset, as the real GCRSO); None: CrIS gzip, VIIRS contiguous
+    # HDF5 layout of every dataset, one of LAYOUTS: "contiguous" (uncompressed IDPS files) or "gzip" (one
+    # chunk per dataset, as the real GCRSO); None: CrIS gzip, VIIRS contiguous
     layout: str | None = None
 
     def compressed(self, instrument: str) -> bool:
@@ -527,9 +527,12 @@ def simulate_case(
     cris_bias_k: float = 0.0,
     cris_gain: float = 0.0,
     cris_nonlinear_k: float = 0.0,
+    complete: bool = False,
+    layout: str | None = None,
 ) -> dict:
     """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The ``cris_``
-    parameters: the CrIS-VIIRS calibration difference (:class:`SimulationSpec`)."""
+    parameters: the CrIS-VIIRS calibration difference; *complete* and *layout*: every dataset of the real
+    products, and their HDF5 layout (:class:`SimulationSpec`)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if spec is None:
@@ -548,6 +551,8 @@ def simulate_case(
             cris_bias_k=cris_bias_k,
             cris_gain=cris_gain,
             cris_nonlinear_k=cris_nonlinear_k,
+            complete=complete,
+            layout=layout,
         )
     sim = Simulator(spec)
     files = []

@@ -29,6 +29,7 @@ import hashlib
 import logging
 import os
 import re
+import threading
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -77,12 +78,29 @@ class NoddSource:
     def __init__(self, cfg: SourceConfig, cache_dir: Path, sleep=time.sleep):
         self.cfg = cfg
         self.cache_dir = Path(cache_dir)
-        self.http = BoundedSession()
+        self._local = threading.local()
+        self._counting = threading.Lock()
         self.spent_bytes = 0  # downloaded in this run (cache hits are free)
         self.downloaded_files = 0
         self.requests = 0  # HTTP requests sent in this run, listings included
         self.deadline: float | None = None
         self.sleep = sleep
+
+    @property
+    def http(self) -> BoundedSession:
+        """This thread's session. Read in place, granules are read by the assessment's read-ahead thread
+        and its main thread at once, and a watchdog cuts every socket of its session: each thread's
+        deadline must cut only its own requests."""
+        session = getattr(self._local, "http", None)
+        if session is None:
+            session = self._local.http = BoundedSession()
+        return session
+
+    def _count(self, requests: int = 0, spent: int = 0, files: int = 0) -> None:
+        with self._counting:
+            self.requests += requests
+            self.spent_bytes += spent
+            self.downloaded_files += files
 
     def _base(self, satellite: str) -> str:
         bucket = self.cfg.buckets.get(satellite)
@@ -149,7 +167,7 @@ class NoddSource:
             until = time.monotonic() + bound
             try:
                 with self.http.guard(until):
-                    self.requests += 1
+                    self._count(requests=1)
                     r = self.http.get(
                         url,
                         params=params,
@@ -319,8 +337,7 @@ class NoddSource:
             except OSError as exc:  # the cache cannot hold it (disk full, a name too long): not retried
                 part.unlink(missing_ok=True)
                 raise SourceError(f"{f.name}: cannot write to the cache ({exc.strerror or exc})") from None
-            self.spent_bytes += n
-            self.downloaded_files += 1
+            self._count(spent=n, files=1)
             return target
         raise SourceError(f"{f.name}: download failed ({last})")
 
@@ -405,7 +422,7 @@ class NoddSource:
                     self.sleep(min(self.cfg.backoff_s * 2**attempt, self._left_s(what)))
                     continue
                 break
-            self.spent_bytes += len(data)
+            self._count(spent=len(data))
             return data
         raise SourceError(f"{what}: range read failed ({last})")
 

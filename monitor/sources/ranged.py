@@ -34,6 +34,7 @@ import hashlib
 import io
 import json
 import os
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -95,6 +96,7 @@ class RangedReader(io.RawIOBase):
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             blocks, self.verified = self._held()
+            self._create()
             self.cache = MMapCache(
                 BLOCK_BYTES, self._fetch, f.size, location=str(self.path), blocks=set(blocks)
             )
@@ -127,6 +129,22 @@ class RangedReader(io.RawIOBase):
         except (OSError, ValueError, KeyError, TypeError):
             pass
         return [], False
+
+    def _create(self) -> None:
+        """The sparse file of the object's size, made atomically: fsspec would open a missing file with
+        "wb+", truncating one that another reader has just made and mapped (its blocks would read as
+        zeros)."""
+        if self.path.exists():
+            return
+        tmp = self.path.with_name(f"{self.path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+        with open(tmp, "wb") as fh:
+            fh.truncate(self.size)
+        try:
+            os.link(tmp, self.path)
+        except FileExistsError:
+            pass  # another reader made it first: share it
+        finally:
+            tmp.unlink(missing_ok=True)
 
     def _fetch(self, start: int, end: int) -> bytes:
         if start >= end:  # fsspec asks for the block after the last when a read ends on the file's end
