@@ -35,6 +35,9 @@ real NOAA-20 GCRSO granules of tests/data/real and on the simulator (docs/jpss-f
 
 from __future__ import annotations
 
+import math
+
+import numba
 import numpy as np
 
 from monitor.constants import CRIS_SCAN_US, VIIRS_SCAN_US
@@ -289,33 +292,37 @@ def check_nadir(path, product, granule, has_data: np.ndarray) -> None:
         )
 
 
-def check_pixel_steps(path, product, granule, scans_per_pass: int = 6) -> None:
+@numba.njit(cache=True, nogil=True)
+def _first_leap(lat_rad, lon_rad, limit_rad):  # pragma: no cover - compiled
+    """(row, column, step_rad) of the first pair of neighbours in a row farther apart than *limit_rad*
+    on the sphere, (-1, -1, 0) if none. The step is hypot(d_lat, d_lon cos(lat)), d_lon across the
+    antimeridian; the cosine only where d_lon alone could exceed the limit (near a pole)."""
+    two_pi = 2.0 * np.pi
+    for r in range(lat_rad.shape[0]):
+        for c in range(lat_rad.shape[1] - 1):
+            d_lat = abs(lat_rad[r, c + 1] - lat_rad[r, c])  # NaN (fill) fails every comparison
+            d_lon = abs(lon_rad[r, c + 1] - lon_rad[r, c])
+            d_lon = min(d_lon, two_pi - d_lon)
+            if d_lat > limit_rad or d_lon > limit_rad:
+                step = math.hypot(d_lat, d_lon * math.cos(lat_rad[r, c + 1]))
+                if step > limit_rad:
+                    return r, c, step
+    return -1, -1, 0.0
+
+
+def check_pixel_steps(path, product, granule) -> None:
     """VIIRS GEO: neighbouring pixels of a row lie within PIXEL_STEP_KM of each other on the ground.
 
     A corrupt latitude or longitude (a flipped byte of a float) moves its pixel hundreds of km or more; no
-    other check sees one pixel among ten million. The step is the angle between the pixels on the sphere,
-    hypot(d_lat, d_lon cos(lat)) with d_lon taken across the antimeridian, a few scans at a time
-    (bounded memory; scans not read, all fill, are skipped); pairs with a fill are skipped."""
-    lat, lon = granule.lat_rad, granule.lon_rad
-    rows = product.rows_per_scan * scans_per_pass
-    limit_rad = PIXEL_STEP_KM / (wgs84.A_M / 1e3)
-    for r0 in range(0, lat.shape[0], rows):
-        la, lo = lat[r0 : r0 + rows], lon[r0 : r0 + rows]
-        if not np.isfinite(la[:, ::64]).any():
-            continue
-        d_lon = np.abs(np.diff(lo, axis=1))
-        d_lon = np.minimum(d_lon, np.float32(2 * np.pi) - d_lon) * np.cos(la[:, 1:])
-        step = np.hypot(np.diff(la, axis=1), d_lon)
-        with np.errstate(invalid="ignore"):
-            bad = step > limit_rad
-        if bad.any():
-            r, c = np.argwhere(bad)[0]
-            raise GranuleError(
-                path,
-                f"{product.data_group}/Latitude, Longitude",
-                f"row {r0 + r}, columns {c}-{c + 1}: neighbouring pixels "
-                f"{float(step[r, c]) * wgs84.A_M / 1e3:.0f} km apart (more than {PIXEL_STEP_KM:g} km)",
-            )
+    other check sees one pixel among ten million. Pairs with a fill (unread scans included) are skipped."""
+    r, c, step = _first_leap(granule.lat_rad, granule.lon_rad, PIXEL_STEP_KM / (wgs84.A_M / 1e3))
+    if r >= 0:
+        raise GranuleError(
+            path,
+            f"{product.data_group}/Latitude, Longitude",
+            f"row {r}, columns {c}-{c + 1}: neighbouring pixels {step * wgs84.A_M / 1e3:.0f} km apart "
+            f"(more than {PIXEL_STEP_KM:g} km)",
+        )
 
 
 def check_raw_counts(path, name: str, raw: np.ndarray) -> None:
