@@ -3,8 +3,8 @@
 Real-size simulated granules with every dataset of the real products (``SimulationSpec.complete``: GITCO
 ~325 MB, SVI05 ~49 MB, SCRIF ~19 MB, GCRSO ~0.1 MB uncompressed), in either HDF5 layout (contiguous, as
 uncompressed IDPS files; gzip with one chunk per dataset, as the real GCRSO), are put under their NODD
-keys on moto's S3 server on loopback. Each case then runs the daily job's computation
-(:func:`monitor.pipeline.compute_day`: list, fingerprint, select, assess) three times, each from an
+keys on moto's S3 server on loopback. Each case then runs the daily job
+(:func:`monitor.pipeline.run_day`: list, fingerprint, select, assess, record) three times, each into an
 empty store: whole files into an empty cache, ranges into an empty cache, and ranges again on that
 cache. It prints, per run: bytes read, their share of the bytes of the files the day used, HTTP
 requests (listings included) and wall time; per product, the bytes read in place (from the block
@@ -33,13 +33,14 @@ import numpy as np
 
 from monitor.collocate import warm_up
 from monitor.config import load_config
-from monitor.pipeline import compute_day
+from monitor.pipeline import run_day
 from monitor.satellites import SATELLITES
 from monitor.simulate import LAYOUTS
 from monitor.simulate.case import DEFAULT_START, SimulationSpec, Simulator
 from monitor.simulate.profiles import load_profile
 from monitor.sources.configured import make_source
 from monitor.sources.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
+from monitor.store.sqlite import Store
 from tests.servers import MotoS3
 
 SATELLITE = "j01"
@@ -90,8 +91,11 @@ def run(root: Path, url: str, name: str, read: str, granules: int):
     )
     cfg = load_config(config)
     t0 = time.perf_counter()
-    work = compute_day(cfg, make_source(cfg), SATELLITE, DAY)
-    return work, time.perf_counter() - t0
+    with Store(cfg.store.sqlite) as store:
+        out = run_day(cfg, store, make_source(cfg), SATELLITE, DAY, dt.date.today())
+        (recorded,) = store.runs()
+    assert recorded.status == out.status  # the run is in the ledger as it says
+    return out, time.perf_counter() - t0
 
 
 def held_by_product(cache: Path) -> dict:

@@ -252,7 +252,8 @@ class S3Server:
     ``retry_after`` (every request: 503 and this Retry-After),
     ``lying_size`` (the listing says this many bytes, and a range's Content-Range another size),
     ``gzip`` (downloads are gzip-encoded), ``redirect_to`` (the next download answers 302 to this base
-    URL) and ``short_ranges`` (a range answer holds half the bytes asked for, and says so). GET with a
+    URL), ``short_ranges`` (a range answer holds half the bytes asked for, and says so) and
+    ``ignore_ranges`` (a range request gets the whole object, 200). GET with a
     Range header answers 206 with that range, every fault applying to it.
     """
 
@@ -261,7 +262,7 @@ class S3Server:
         self.page_size = page_size
         self.drop_once, self.corrupt_once = set(), set()
         self.extra_keys, self.extra_sizes = [], {}
-        self.endless_tokens = self.repeat_token = self.gzip = self.short_ranges = False
+        self.endless_tokens = self.repeat_token = self.gzip = self.short_ranges = self.ignore_ranges = False
         self.slow_drip_s = self.retry_after = self.lying_size = self.redirect_to = None
         self.slow_list_s = self.slow_headers_s = None
         self.drip_bytes = 64
@@ -380,6 +381,8 @@ class S3Server:
             return
         data = path.read_bytes()
         size, wanted = len(data), re.fullmatch(r"bytes=(\d+)-(\d+)", h.headers.get("Range", ""))
+        if self.ignore_ranges:
+            wanted = None
         at = self.corrupt_at
         if key in self.corrupt_once and (not wanted or int(wanted[1]) <= at <= int(wanted[2])):
             self.corrupt_once.discard(key)  # the first answer holding the byte

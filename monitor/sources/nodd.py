@@ -2,16 +2,18 @@
 
 Keys are ``<product folder>/YYYY/MM/DD/<file>``, e.g. ``CrIS-SDR-GEO/2024/06/01/GCRSO_j01_...h5``
 (docs/archive.md). Listings are narrowed with a file-name prefix and followed through continuation
-tokens (a day holds more than the 1000 keys of one page). Downloads go to ``<name>.part`` and are
-renamed only when complete, of the listed size and, where the listing's ETag is a plain MD5, of that
-digest. A per-day byte budget bounds what one run may download, and cached files older than the
-retention go.
+tokens (a day holds more than the 1000 keys of one page). With ``read: ranges`` (the default) a granule
+is read in place, one HTTP range request per run of missing blocks (:mod:`monitor.sources.ranged`);
+with ``read: whole`` downloads go to ``<name>.part`` and are renamed only when complete, of the listed
+size and, where the listing's ETag is a plain MD5, of that digest. A per-day byte budget bounds what
+one run may download, and cached files older than the retention go.
 
-Everything a server says is bounded in wall-clock time and size, so that no listing or download hangs or
-grows without end (:mod:`monitor.sources.bounded` cuts a request at its deadline, body included): a
-listing page, and the headers of any answer, come within ``timeout_s``; every request of a run ends by the
-run deadline (``source.run_deadline_min``); a download must keep up ``min_rate_kb_s`` over every sliding
-window of ``stall_window_s`` and may not bring more bytes than listed (Content-Length is checked first);
+Everything a server says is bounded in wall-clock time and size, so that no listing, download or range
+hangs or grows without end (:mod:`monitor.sources.bounded` cuts a request at its deadline, body
+included): a listing page, and the headers of any answer, come within ``timeout_s``; every request of a
+run ends by the run deadline (``source.run_deadline_min``); a download or a range must keep up
+``min_rate_kb_s`` over every sliding window of ``stall_window_s`` and may not bring more bytes than
+listed or asked for (Content-Length is checked first);
 at most ``max_list_pages`` pages and ``max_listed_keys`` keys per listing, and a continuation token seen
 twice is an error; Retry-After is honoured up to ``max_retry_after_s`` (a longer one ends the attempt); a
 compressed response is refused (granules are stored as they are, never transparently decoded).
@@ -195,6 +197,8 @@ class NoddSource:
                         )
                     url, params, last = target, None, f"redirect to {there.path}"
                     continue
+                if expect == 206 and r.status_code == 200:
+                    raise SourceError(f"{what}: the server ignored the Range header (HTTP 200)")
                 if r.status_code not in RETRYABLE:
                     raise SourceError(f"{what}: HTTP {r.status_code}")
                 last = f"HTTP {r.status_code}"

@@ -102,6 +102,9 @@ class RangedReader(io.RawIOBase):
             )
             os.utime(self.path)  # used now: the cache bound evicts the least recently used first
             self.inode = os.stat(self.path).st_ino
+            if self.inode != self._held_inode:  # evicted and made anew since the record was read
+                self.cache.blocks.clear()
+                self.verified = False
         except (OSError, ValueError) as exc:
             raise SourceError(f"{f.location}: block cache {self.path}: {exc}") from None
         self.n_blocks = -(-f.size // BLOCK_BYTES)
@@ -110,6 +113,7 @@ class RangedReader(io.RawIOBase):
         """The blocks a previous reader recorded for this very file (same size, block size, MD5 and
         inode); none when there is no such record (the file's bytes are then fetched again as read)."""
         f, listing = self.granule.listed, Path(f"{self.path}{BLOCK_LIST}")
+        self._held_inode = -1
         try:
             st = os.stat(self.path)
         except FileNotFoundError:
@@ -125,6 +129,7 @@ class RangedReader(io.RawIOBase):
                 st.st_ino,
                 f.md5,
             ):
+                self._held_inode = st.st_ino
                 return [int(b) for b in held["blocks"]], bool(held["verified"])
         except (OSError, ValueError, KeyError, TypeError):
             pass

@@ -105,6 +105,16 @@ def test_a_short_range_is_an_error_naming_the_key(cases, tmp_path, bucket_dir):
     assert not list((tmp_path / "cache").rglob(f"*{BLOCK_LIST}"))  # nothing recorded as held
 
 
+def test_a_server_ignoring_the_range_is_refused_before_its_body(tmp_path, bucket_dir):
+    with S3Server(bucket_dir) as s3:
+        src = _source(s3.url, tmp_path, retries=0)
+        f = next(x for x in src.list_day("j01", DAY, ("GITCO",)))
+        s3.ignore_ranges = True
+        with pytest.raises(GranuleError, match=f"{f.location} bytes 0-1048575: the server ignored the Range"):
+            read_file(src.fetch(f), kinds=("viirs_geo",))
+    assert src.spent_bytes == 0  # the 128 MB body was never read
+
+
 def test_a_corrupt_range_is_an_error_naming_the_key_and_field(cases, tmp_path, bucket_dir):
     """A flipped sign-and-exponent byte in a GITCO latitude of a scan read: the value stays a latitude
     (12 deg becomes -0.2 deg), so the limits pass it; the pixel-step check names it."""
