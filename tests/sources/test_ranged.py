@@ -13,6 +13,8 @@ from monitor.config import SourceConfig, load_config
 from monitor.pipeline import compute_day
 from monitor.satellites import SATELLITES
 from monitor.sdr import GranuleError, read_file
+from monitor.sdr.names import parse_name
+from monitor.sdr.products import PRODUCTS
 from monitor.sources import SourceError
 from monitor.sources.configured import make_source
 from monitor.sources.nodd import NoddSource
@@ -32,6 +34,19 @@ def moto(cases):
     with MotoS3() as s3:
         s3.put_granules(BUCKET, sorted(out.glob("*.h5")))
         yield s3
+
+
+@pytest.fixture(scope="module")
+def bucket_dir(cases, tmp_path_factory):
+    """The case under NODD keys in a folder, for the hostile server."""
+    out, _, _ = cases.get()
+    root = tmp_path_factory.mktemp("s3")
+    for f in out.glob("*.h5"):
+        parsed = parse_name(f.name)
+        d = root / BUCKET / PRODUCTS[parsed.products[0]].collection / f"{parsed.start:%Y/%m/%d}"
+        d.mkdir(parents=True, exist_ok=True)
+        os.link(f, d / f.name)
+    return root
 
 
 def _config(tmp_path, url, read, name="nodd"):
@@ -94,7 +109,7 @@ def test_the_cache_bound_evicts_files_read_in_place_by_what_they_hold(moto, tmp_
     assert not held.exists() and not held.with_name(held.name + BLOCK_LIST).exists()
 
 
-def test_a_short_range_is_an_error_naming_the_key(cases, tmp_path, bucket_dir):
+def test_a_short_range_is_an_error_naming_the_key(tmp_path, bucket_dir):
     with S3Server(bucket_dir) as s3:
         src = _source(s3.url, tmp_path, retries=0)
         f = next(x for x in src.list_day("j01", DAY, ("GITCO",)))
@@ -115,7 +130,7 @@ def test_a_server_ignoring_the_range_is_refused_before_its_body(tmp_path, bucket
     assert src.spent_bytes == 0  # the 128 MB body was never read
 
 
-def test_a_corrupt_range_is_an_error_naming_the_key_and_field(cases, tmp_path, bucket_dir):
+def test_a_corrupt_range_is_an_error_naming_the_key_and_field(tmp_path, bucket_dir):
     """A flipped sign-and-exponent byte in a GITCO latitude of a scan read: the value stays a latitude
     (12 deg becomes -0.2 deg), so the limits pass it; the pixel-step check names it."""
     with S3Server(bucket_dir) as s3:
@@ -133,22 +148,6 @@ def test_a_corrupt_range_is_an_error_naming_the_key_and_field(cases, tmp_path, b
         and "Latitude" in str(err.value)
         and "neighbouring pixels" in str(err.value)
     )
-
-
-@pytest.fixture(scope="module")
-def bucket_dir(cases, tmp_path_factory):
-    """The case under NODD keys in a folder, for the hostile server."""
-    out, _, _ = cases.get()
-    root = tmp_path_factory.mktemp("s3")
-    from monitor.sdr.names import parse_name
-    from monitor.sdr.products import PRODUCTS
-
-    for f in out.glob("*.h5"):
-        parsed = parse_name(f.name)
-        d = root / BUCKET / PRODUCTS[parsed.products[0]].collection / f"{parsed.start:%Y/%m/%d}"
-        d.mkdir(parents=True, exist_ok=True)
-        os.link(f, d / f.name)
-    return root
 
 
 def test_a_failed_range_leaves_no_block_recorded(moto, tmp_path):
