@@ -9,8 +9,9 @@ at each scrape, so it survives restarts and agrees with ``crisgeo status``; what
     crisgeo_runs_total{satellite,outcome}                 finished runs in the ledger by outcome (only grows)
     crisgeo_runs_in_progress{satellite}                   runs under way
     crisgeo_run_duration_seconds{satellite,stage}         stages of the latest run of this process
-    crisgeo_downloaded_granules_total{satellite}          files downloaded by this process
-    crisgeo_downloaded_bytes_total{satellite}             bytes downloaded by this process
+    crisgeo_downloaded_granules_total{satellite}          files downloaded whole by this process
+    crisgeo_downloaded_bytes_total{satellite}             bytes downloaded by this process (files and ranges)
+    crisgeo_nodd_requests_total{satellite}                HTTP requests to NODD by this process
     crisgeo_outbox_points{target}                         time-series points waiting to be sent
     crisgeo_alerts_firing{satellite,rule,severity}        alerts firing now
     crisgeo_for_offset_urad{satellite,for,direction}      latest day's LOS offset (alpha, beta)
@@ -173,13 +174,19 @@ class ServiceMetrics:
         )
         self.granules = Counter(
             "crisgeo_downloaded_granules",
-            "Files downloaded by this process",
+            "Files downloaded whole by this process",
             ["satellite"],
             registry=self.registry,
         )
         self.bytes = Counter(
             "crisgeo_downloaded_bytes",
-            "Bytes downloaded by this process",
+            "Bytes downloaded by this process (whole files and ranges)",
+            ["satellite"],
+            registry=self.registry,
+        )
+        self.requests = Counter(
+            "crisgeo_nodd_requests",
+            "HTTP requests to NODD by this process (listings, downloads, ranges)",
             ["satellite"],
             registry=self.registry,
         )
@@ -189,6 +196,7 @@ class ServiceMetrics:
         for sat in satellites:
             self.granules.labels(sat)
             self.bytes.labels(sat)
+            self.requests.labels(sat)
 
     def record(self, outcome) -> None:
         """Take in a :class:`monitor.pipeline.RunOutcome`."""
@@ -196,3 +204,4 @@ class ServiceMetrics:
             self.duration.labels(outcome.satellite, stage).set(secs)
         self.granules.labels(outcome.satellite).inc(outcome.counts.get("downloaded", 0))
         self.bytes.labels(outcome.satellite).inc(outcome.counts.get("bytes", 0))
+        self.requests.labels(outcome.satellite).inc(outcome.counts.get("requests", 0))

@@ -127,6 +127,7 @@ def test_metrics_after_a_run(served):
         == 0
     )
     assert _samples(fams["crisgeo_downloaded_bytes"], "crisgeo_downloaded_bytes_total", satellite="j01")
+    assert _samples(fams["crisgeo_nodd_requests"], "crisgeo_nodd_requests_total", satellite="j01")
     assert fams["crisgeo_outbox_points"].type == "gauge"
     assert fams["crisgeo_alerts_firing"].type == "gauge"
     assert all(
