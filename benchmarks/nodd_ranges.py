@@ -36,8 +36,7 @@ from monitor.config import load_config
 from monitor.pipeline import run_day
 from monitor.satellites import SATELLITES
 from monitor.simulate import LAYOUTS
-from monitor.simulate.case import DEFAULT_START, SimulationSpec, Simulator
-from monitor.simulate.profiles import load_profile
+from monitor.simulate.case import DEFAULT_START, simulate_case
 from monitor.sources.configured import make_source
 from monitor.sources.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
 from monitor.store.sqlite import Store
@@ -52,28 +51,10 @@ RESULTS = Path(__file__).parent / "results"
 def simulate(root: Path, granules: int, layout: str) -> list[Path]:
     """The case's files (simulated once into *root*, then reused)."""
     out = root / f"{layout}_{granules}"
-    done = out / "files.json"
-    if not done.exists():
+    if not (out / "truth.json").exists():
         shutil.rmtree(out, ignore_errors=True)
-        out.mkdir(parents=True)
-        d_alpha, d_beta = load_profile("paper", 1)
-        spec = SimulationSpec(
-            satellite=SATELLITE,
-            granules=granules,
-            d_alpha_urad=np.asarray(d_alpha, float),
-            d_beta_urad=np.asarray(d_beta, float),
-            seed=1,
-            profile="paper",
-            complete=True,
-            layout=layout,
-        )
-        sim, names = Simulator(spec), []
-        for k in range(granules):
-            names += sim.cris_granule(k, out)
-        for g0 in sim.viirs_granule_starts():
-            names += sim.viirs_granule(float(g0), out)
-        done.write_text(json.dumps(sorted(names)))
-    return [out / n for n in json.loads(done.read_text())]
+        simulate_case(out, SATELLITE, granules, "paper", seed=1, complete=True, layout=layout)
+    return [out / n for n in json.loads((out / "truth.json").read_text())["files"]]
 
 
 def run(root: Path, url: str, name: str, read: str, granules: int):

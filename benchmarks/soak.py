@@ -42,6 +42,7 @@ from pathlib import Path
 
 from aiosmtpd.controller import Controller
 
+from monitor.sdr.products import PRODUCTS
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
@@ -49,12 +50,7 @@ from tests.servers import S3Server, Webhook, free_port, victoria_metrics, vm_exp
 
 ROOT = Path(__file__).resolve().parent.parent
 BUCKET = "noaa-nesdis-n20-pds"
-FOLDER = {
-    "GCRSO": "CrIS-SDR-GEO",
-    "SCRIF": "CrIS-FS-SDR",
-    "SVI05": "VIIRS-I5-SDR",
-    "GITCO": "VIIRS-IMG-GEO-TC",
-}
+FOLDER = {p: PRODUCTS[p].collection for p in ("GCRSO", "SCRIF", "SVI05", "GITCO")}  # NODD folders
 DAY_IN_PREFIX = re.compile(r"/(\d{4})/(\d{2})/(\d{2})/")
 
 

@@ -419,6 +419,16 @@ class S3Server:
             pass  # the client gave up, as it should
 
 
+def nodd_key(name: str) -> str:
+    """The NODD key of a granule file: ``<collection>/YYYY/MM/DD/<name>`` (docs/archive.md), the folder
+    from the product table, the day from the name."""
+    from monitor.sdr.names import parse_name
+    from monitor.sdr.products import PRODUCTS
+
+    parsed = parse_name(name)
+    return f"{PRODUCTS[parsed.products[0]].collection}/{parsed.start:%Y/%m/%d}/{name}"
+
+
 class MotoS3:
     """moto's S3 server (a real S3-compatible HTTP server, in a thread) on loopback, holding public
     buckets as NODD's are: anonymous ListObjectsV2 and GET, range requests, MD5 ETags (every object
@@ -458,17 +468,13 @@ class MotoS3:
         (made public); the keys."""
         from boto3.s3.transfer import TransferConfig
 
-        from monitor.sdr.names import parse_name
-        from monitor.sdr.products import PRODUCTS
-
         existing = {b["Name"] for b in self.client.list_buckets().get("Buckets", [])}
         if bucket not in existing:
             self.client.create_bucket(Bucket=bucket, ACL="public-read")
         keys = []
         one_part = TransferConfig(multipart_threshold=1 << 40)  # a plain MD5 ETag, as NODD's granules
         for f in map(Path, files):
-            parsed = parse_name(f.name)
-            key = f"{PRODUCTS[parsed.products[0]].collection}/{parsed.start:%Y/%m/%d}/{f.name}"
+            key = nodd_key(f.name)
             self.client.upload_file(str(f), bucket, key, Config=one_part, ExtraArgs={"ACL": "public-read"})
             keys.append(key)
         return keys

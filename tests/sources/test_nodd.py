@@ -14,17 +14,11 @@ from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
 from monitor.sources.configured import make_source
 from monitor.sources.nodd import NoddSource
 from monitor.vocabulary import RunStatus
-from tests.servers import S3Server
+from tests.servers import S3Server, nodd_key
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
 DAY = dt.date(2024, 6, 1)
-FOLDER = {
-    "GCRSO": "CrIS-SDR-GEO",
-    "SCRIF": "CrIS-FS-SDR",
-    "SVI05": "VIIRS-I5-SDR",
-    "GITCO": "VIIRS-IMG-GEO-TC",
-}
 
 
 @pytest.fixture(scope="module")
@@ -32,10 +26,9 @@ def bucket(cases, tmp_path_factory):
     out, _, _ = cases.get()
     root = tmp_path_factory.mktemp("s3")
     for f in out.glob("*.h5"):
-        product = f.name.split("_")[0]
-        d = root / "noaa-nesdis-n20-pds" / FOLDER[product] / "2024/06/01"
-        d.mkdir(parents=True, exist_ok=True)
-        os.link(f, d / f.name)  # the server serves only files inside its root (no symlinks out)
+        (root / "noaa-nesdis-n20-pds" / nodd_key(f.name)).parent.mkdir(parents=True, exist_ok=True)
+        # the server serves only files inside its root (no symlinks out)
+        os.link(f, root / "noaa-nesdis-n20-pds" / nodd_key(f.name))
     # more keys than one listing page, and a reprocessed copy of a granule with a newer creation time
     d = root / "noaa-nesdis-n20-pds" / "CrIS-SDR-GEO/2024/06/01"
     first = sorted(d.glob("GCRSO_*.h5"))[0]

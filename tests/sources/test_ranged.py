@@ -13,14 +13,12 @@ from monitor.config import SourceConfig, load_config
 from monitor.pipeline import compute_day
 from monitor.satellites import SATELLITES
 from monitor.sdr import GranuleError, read_file
-from monitor.sdr.names import parse_name
-from monitor.sdr.products import PRODUCTS
 from monitor.sources import SourceError
 from monitor.sources.configured import make_source
 from monitor.sources.nodd import NoddSource
 from monitor.sources.ranged import BLOCK_BYTES, BLOCK_LIST
 from monitor.vocabulary import RunStatus
-from tests.servers import MotoS3, S3Server
+from tests.servers import MotoS3, S3Server, nodd_key
 
 pytestmark = pytest.mark.servers
 
@@ -42,10 +40,8 @@ def bucket_dir(cases, tmp_path_factory):
     out, _, _ = cases.get()
     root = tmp_path_factory.mktemp("s3")
     for f in out.glob("*.h5"):
-        parsed = parse_name(f.name)
-        d = root / BUCKET / PRODUCTS[parsed.products[0]].collection / f"{parsed.start:%Y/%m/%d}"
-        d.mkdir(parents=True, exist_ok=True)
-        os.link(f, d / f.name)
+        (root / BUCKET / nodd_key(f.name)).parent.mkdir(parents=True, exist_ok=True)
+        os.link(f, root / BUCKET / nodd_key(f.name))
     return root
 
 
