@@ -1,16 +1,13 @@
-"""The LOS perturbation assessment of Wang et al. 2017 (sections 2.3-2.4): cost cube, minimum, uncertainty.
+"""The LOS perturbation assessment of Wang et al. 2017 (sections 2.3-2.4) of CrIS and VIIRS granules.
 
-For each CrIS granule: inverse geolocation of every FOV to the SBF, the (2n+1)^2 perturbed cones
-collocated with VIIRS I5 (:mod:`monitor.collocate`), and the CrIS I5-equivalent BT (:mod:`monitor.spectral`).
-Then per scan position k over all samples (equation 8):
-
-    G(i, j, k) = STDEV(BT_VIIRS_ij - BT_CrIS),
-
-its minimum refined between grid points by interpolating every sample's difference (:mod:`monitor.refine`;
-the quadratic surface of Wang 2013 through the 3x3 neighbourhood only where the grid minimum is too near
-the border for that), and its uncertainty: a bootstrap over scans within granules (the scatter) and a
-floor calibrated on simulated cases (what the estimator itself leaves, ``AssessConfig.sigma_floor_urad``;
-``benchmarks/acceptance.py`` measures it).
+For each CrIS granule: inverse geolocation of every FOV to the SBF, the (2n+1)^2 perturbed cones (and,
+with the ``footprint`` kernel, the annuli about them) collocated with VIIRS I5 (:mod:`monitor.collocate`),
+and the CrIS I5-equivalent BT (:mod:`monitor.spectral`). Then per scan position k over all samples the
+estimator (:mod:`monitor.estimate`): the minimum of the cost (equation 8, G(i, j, k) = STDEV(BT_VIIRS_ij -
+BT_CrIS), or its regression form), the response fitted with the ``footprint`` kernel, the jackknife
+uncertainty with a floor calibrated on simulated cases in quadrature (what the estimator itself leaves,
+``SIGMA_FLOOR_URAD``; ``benchmarks/acceptance.py`` measures it), the intercalibration; and
+here, the offsets in km on the ground.
 """
 
 from __future__ import annotations
@@ -23,32 +20,31 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor import collocate, refine, swath
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, N_FOR, URAD
+from monitor import collocate, swath
+from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, URAD
 from monitor.errors import AssessmentError, StopRequested
+from monitor.estimate import ForSamples, day_offsets
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
-from monitor.intercal import NO_FIT, difference_bins, intercalibrate
-from monitor.result import (
-    FLAG_EDGE,
-    FLAG_FEW_SAMPLES,
-    FLAG_FLAT,
-    FLAG_UNCERTAIN,
-    AssessmentResult,
-    ForOffset,
-    GranuleInfo,
-)
+from monitor.result import AssessmentResult, GranuleInfo
 from monitor.sdr import CrisGeoGranule, CrisSdrGranule, GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_scan_start_us, read_viirs_geo_scan
 from monitor.spectral import i5_band
 from monitor.threads import parallel_threads
-from monitor.vocabulary import DEFAULT_COST, Cost
+from monitor.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
 
 LOG = logging.getLogger(__name__)
-KERNELS = {"top-hat": collocate.TOP_HAT, "response": collocate.SPATIAL_RESPONSE}
+# the discs each kernel collocates; the top-hat cone is one of them either way
+KERNELS = {Kernel.TOP_HAT: collocate.TOP_HAT, Kernel.FOOTPRINT: collocate.ANNULI}
+CONE_RADIUS_RAD = FOV_DIAMETER_RAD / 2
+# The floor of the sigmas by kernel (urad): what the estimator itself leaves beside the jackknife's scatter,
+# calibrated on simulated cases (benchmarks/acceptance.py prints the floor that gives 90 % coverage). The
+# top-hat cone's is the error a plain cone leaves on a top-hat truth; the footprint's was calibrated on the
+# 6-granule smooth-response cases of seeds 1-3 and checked on the others (docs/science.md).
+SIGMA_FLOOR_URAD = {Kernel.TOP_HAT: 5.0, Kernel.FOOTPRINT: 2.0}
 
 
 @dataclass
@@ -58,21 +54,32 @@ class AssessConfig:
 
     half_steps: int = DEFAULT_HALF_STEPS
     step_rad: float = DEFAULT_STEP_RAD
-    kernel: str = "top-hat"
+    kernel: Kernel = DEFAULT_KERNEL
     cost: Cost = DEFAULT_COST
     min_coverage: float = collocate.MIN_COVERAGE
     min_samples: int = 30
     flat_contrast: float = 0.03
     max_sigma_urad: float = 250.0  # ~0.55 perturbation step, 1.5 % of the FOV
-    bootstrap: int = 100
-    seed: int = 0
-    sigma_floor_urad: float = 5.0  # in quadrature with the bootstrap: the estimator's own error (calibrated)
+    uncertainty: bool = True  # the jackknife (monitor.jackknife); off only where a test needs no sigma
+    # in quadrature with the jackknife: the estimator's own error, calibrated on simulated cases (None: the
+    # kernel's, SIGMA_FLOOR_URAD)
+    sigma_floor_urad: float | None = None
 
     @classmethod
     def of(cls, half_steps: int, step_urad: float, kernel: str, cost: Cost = DEFAULT_COST) -> AssessConfig:
         """The assessment of a configuration's (or the command line's) grid, kernel and cost, the rest
         the paper's."""
-        return cls(half_steps=half_steps, step_rad=step_urad * URAD, kernel=kernel, cost=Cost(cost))
+        return cls(half_steps=half_steps, step_rad=step_urad * URAD, kernel=Kernel(kernel), cost=Cost(cost))
+
+    @property
+    def floor_urad(self) -> float:
+        """The floor of the sigmas (urad): ``sigma_floor_urad``, or the kernel's."""
+        return SIGMA_FLOOR_URAD[self.kernel] if self.sigma_floor_urad is None else self.sigma_floor_urad
+
+    @property
+    def radii_rad(self) -> tuple[float, ...]:
+        """The radii of the discs collocated (:data:`KERNELS`)."""
+        return KERNELS[self.kernel]
 
     @property
     def offsets_rad(self) -> np.ndarray:
@@ -86,7 +93,7 @@ class GranuleSamples:
 
     key: str
     info: GranuleInfo
-    bt_viirs_k: np.ndarray  # (nscan, 30, 9, m, m)
+    bt_viirs_k: np.ndarray  # (nscan, 30, 9, m, m) through the top-hat cone
     bt_cris_k: np.ndarray  # (nscan, 30, 9)
     usable: np.ndarray  # (nscan, 30, 9)
     sat_m: np.ndarray  # FOV-5 geometry per (nscan, 30) for the km conversion
@@ -94,6 +101,7 @@ class GranuleSamples:
     alpha_rad: np.ndarray
     beta_rad: np.ndarray
     velocity_m_s: np.ndarray
+    annuli_rad: np.ndarray | None = None  # (nscan, 30, 9, K, m, m) VIIRS radiance per annulus (footprint)
 
 
 @contextmanager
@@ -233,7 +241,7 @@ def read_inputs(
             fg.alpha_rad[valid],
             fg.beta_rad[valid],
             cfg.offsets_rad,
-            KERNELS[cfg.kernel],
+            cfg.radii_rad,
         )
     return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, span_us, bt_cris, raw)
 
@@ -316,7 +324,7 @@ def collocate_granule(
         viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs, inputs.span_us
     )
     with _stage(timings, "collocation"):
-        bt_viirs, coverage = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
+        bt_viirs, coverage, annuli = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (
         valid
         & sdr.good
@@ -348,6 +356,7 @@ def collocate_granule(
         fg.alpha_rad[s5],
         fg.beta_rad[s5],
         fg.velocity_ecef_m_s[s5],
+        annuli,
     )
 
 
@@ -361,105 +370,31 @@ def _cris_geometry(geo):
 
 
 def _collocate_fors(pieces, geo, fg, valid, fill, cfg: AssessConfig, band, should_stop=None):
-    """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone and the worst coverage per FOV (all FOVs of the
-    granule in one call of the parallel kernel)."""
+    """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone, the worst coverage per FOV (of the outermost
+    disc), and with the footprint kernel the radiance per annulus (nscan, 30, 9, K, m, m), else None (all
+    FOVs of the granule in one call of the parallel kernel)."""
     if should_stop is not None and should_stop():
         raise StopRequested
     m = len(cfg.offsets_rad)
     shape = fg.alpha_rad.shape
-    mean, cov = collocate.cone_sums(
+    cones = collocate.cone_sums(
         pieces,
         fg.sat_ecef_m.reshape(-1, 3),
         fg.sbf_to_ecef.reshape(-1, 3, 3),
         fg.alpha_rad.ravel(),
         fg.beta_rad.ravel(),
         cfg.offsets_rad,
-        KERNELS[cfg.kernel],
+        cfg.radii_rad,
         fov_range_m=np.where(valid, geo.range_m, 1e6).ravel(),
         fov_cos_zen=np.cos(fill["zenith_rad"]).ravel(),
     )
-    bt_viirs = band.bt_from_radiance(mean).astype(np.float32).reshape(shape + (m, m))
-    coverage = np.nanmin(np.where(np.isfinite(cov), cov, 0.0), axis=(-2, -1)).reshape(shape)
-    return bt_viirs, coverage
-
-
-def _stdev(d, weights=None):
-    """STDEV over samples (axis 0 of d, (N, m, m)); with *weights* (B, N) one surface per row (B, m, m)."""
-    n, m = d.shape[0], d.shape[1]
-    flat = d.reshape(n, -1)
-    if weights is None:
-        return flat.std(axis=0, ddof=1).reshape(m, m)
-    s0 = weights.sum(axis=1, keepdims=True)
-    s1 = weights @ flat
-    s2 = weights @ (flat * flat)
-    var = (s2 - s1 * s1 / s0) / np.maximum(s0 - 1, 1)
-    return np.sqrt(np.maximum(var, 0.0)).reshape(-1, m, m)
-
-
-def calibration_regressors(cris):
-    """The regressors of the regression cost (N, 2): the CrIS BT and its square about its mean, so that a
-    CrIS-VIIRS difference bias + gain T + curvature T^2 is explained away."""
-    c = np.asarray(cris, float) - np.mean(cris)
-    return np.stack([c, c * c], axis=1)
-
-
-def _regression_stdev(d, cris, weights=None):
-    """The residual STDEV of d (N, m, m) regressed on the CrIS BT *cris* (N,) and its square, per
-    perturbation: sqrt(Var d - s_dX S_XX^-1 s_Xd). With d = V - C this is the residual of V - f(C) for the
-    best quadratic f at each perturbation, so a CrIS-VIIRS calibration difference up to second order
-    leaves it unchanged. *weights* (B, N): one surface per bootstrap replicate (B, m, m)."""
-    n, m = d.shape[0], d.shape[1]
-    x = calibration_regressors(cris)
-    flat = np.concatenate([d.reshape(n, -1), x], axis=1)
-    w = np.ones((1, n)) if weights is None else np.asarray(weights, float)
-    s0 = w.sum(axis=1)[:, None]
-    mean = (w @ flat) / s0
-    res = np.empty((len(w), m * m))
-    for b in range(len(w)):  # one replicate at a time: (N, K) products stay small
-        c = flat - mean[b]
-        wc = c * w[b][:, None]
-        var_d = np.einsum("nk,nk->k", wc[:, :-2], c[:, :-2])
-        s_dx = wc[:, :-2].T @ c[:, -2:]  # (K, 2)
-        s_xx = wc[:, -2:].T @ c[:, -2:]  # (2, 2)
-        explained = np.einsum("ka,ab,kb->k", s_dx, np.linalg.inv(s_xx), s_dx)
-        res[b] = (var_d - explained) / max(s0[b, 0] - 1, 1)
-    g = np.sqrt(np.maximum(res, 0.0)).reshape(-1, m, m)
-    return g[0] if weights is None else g
-
-
-def cost_surface(d, cris, cost: Cost, weights=None):
-    """The cost over the perturbation grid of one FOR's samples (:class:`~monitor.vocabulary.Cost`)."""
-    return _stdev(d, weights) if cost == Cost.STDEV else _regression_stdev(d, cris, weights)
-
-
-def find_minimum(cost, contrast=0.03):
-    """Sub-step minimum (x_i, y_j in grid steps from the centre) of a cost surface, and its flags.
-
-    A quadratic surface through the 3x3 neighbourhood of the grid minimum gives the sub-step position
-    (Wang 2013). A minimum on the grid border is flagged ``edge`` and not refined; a surface that
-    rises less than *contrast* (relative) from its minimum to the grid border, or whose fit is not
-    convex, is flagged ``flat``.
-    """
-    m = cost.shape[0]
-    n = (m - 1) // 2
-    flags = []
-    if not np.all(np.isfinite(cost)):
-        return np.nan, np.nan, [FLAG_FLAT]
-    i0, j0 = np.unravel_index(np.argmin(cost), cost.shape)
-    border = np.concatenate([cost[0], cost[-1], cost[1:-1, 0], cost[1:-1, -1]])
-    if (np.mean(border) - cost[i0, j0]) / cost[i0, j0] < contrast:
-        flags.append(FLAG_FLAT)
-    if i0 in (0, m - 1) or j0 in (0, m - 1):
-        return float(i0 - n), float(j0 - n), flags + [FLAG_EDGE]
-    x, y = np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.0, 1.0], indexing="ij")
-    a = np.stack([np.ones(9), x.ravel(), y.ravel(), x.ravel() ** 2, x.ravel() * y.ravel(), y.ravel() ** 2], 1)
-    c = np.linalg.lstsq(a, cost[i0 - 1 : i0 + 2, j0 - 1 : j0 + 2].ravel(), rcond=None)[0]
-    hess = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
-    if np.linalg.det(hess) <= 0 or hess[0, 0] <= 0:
-        return float(i0 - n), float(j0 - n), sorted(set(flags + [FLAG_FLAT]))
-    dx, dy = np.linalg.solve(hess, -c[1:3])
-    dx, dy = float(np.clip(dx, -1, 1)), float(np.clip(dy, -1, 1))
-    return i0 - n + dx, j0 - n + dy, flags
+    cone = cfg.radii_rad.index(CONE_RADIUS_RAD)
+    bt_viirs = band.bt_from_radiance(cones.mean(cone)).astype(np.float32).reshape(shape + (m, m))
+    coverage = np.min(cones.coverage(), axis=(-2, -1)).reshape(shape)
+    annuli = None
+    if len(cfg.radii_rad) > 1:
+        annuli = cones.annulus_means().reshape(shape + (len(cfg.radii_rad), m, m))
+    return bt_viirs, coverage, annuli
 
 
 def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
@@ -482,166 +417,56 @@ def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
     return float(np.mean(it)), float(np.mean(ct)), jac
 
 
-def _scan_bootstrap_counts(rng, granule_of_unit, n_boot):
-    """Bootstrap counts (B, units): each granule's scans resampled with replacement within the granule."""
-    counts = np.zeros((n_boot, len(granule_of_unit)))
-    for g in np.unique(granule_of_unit):
-        members = np.flatnonzero(granule_of_unit == g)
-        counts[:, members] = rng.multinomial(
-            len(members), np.full(len(members), 1.0 / len(members)), size=n_boot
-        )
-    return counts
-
-
-@dataclass
-class ForMinimum:
-    """The minimum of one FOR's cost surface *cost* (m, m): the offsets *x*, *y* (grid steps from the
-    centre), their bootstrap sigmas (steps), flags; *d_opt* (N,) the samples' BT difference at the
-    optimum, *refined* whether it lies between grid points (:mod:`monitor.refine`), *counts* (B, N) the
-    bootstrap's resampling (None without one) and *d_opt_boot* (B, N) the difference at each replicate's
-    optimum, so that what the intercalibration's sigma resamples includes where the optimum lies."""
-
-    cost: np.ndarray
-    x: float
-    y: float
-    sigma: tuple
-    flags: list
-    d_opt: np.ndarray
-    refined: bool
-    counts: np.ndarray | None
-    d_opt_boot: np.ndarray | None  # (B, N): d at each replicate's own optimum (refined FORs), else None
-
-
-def for_minimum(d, cris, unit_ids, granule_of_unit, cfg: AssessConfig, rng) -> ForMinimum:
-    """Offsets, bootstrap sigmas and flags of one FOR, and its samples' BT difference at the optimum.
-
-    *d* (N, m, m) holds the samples' BT differences, *cris* (N,) their CrIS BT, *unit_ids* (N,) the scan
-    each comes from and *granule_of_unit* the granule of each scan. The cost surface is ``cfg.cost``'s
-    over samples; its minimum is refined between grid points where the window fits (:mod:`monitor.refine`),
-    and d is interpolated there with the refinement's own weights.
-    """
-    m = d.shape[1]
-    regress = calibration_regressors(cris) if cfg.cost == Cost.REGRESSION else None
-    g = cost_surface(d, cris, cfg.cost)
-    x, y, flags = find_minimum(g, cfg.flat_contrast)
-    i0, j0 = (int(k) for k in np.unravel_index(np.argmin(g), g.shape))
-    fine = FLAG_EDGE not in flags and FLAG_FLAT not in flags and refine.refinable(i0, j0, m)
-    d_opt = d[:, i0, j0]
-    if fine:
-        dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0, cris=regress))
-        x, y = i0 - (m - 1) // 2 + dx, j0 - (m - 1) // 2 + dy
-        d_opt = refine.window_values(d, i0, j0, dx, dy)
-    sig = (np.nan, np.nan)
-    counts = d_boot = None
-    if cfg.bootstrap > 1 and len(granule_of_unit) >= 2:
-        counts = _scan_bootstrap_counts(rng, granule_of_unit, cfg.bootstrap)[:, unit_ids]
-        if fine:
-            est = refine.refined_minimum(refine.window_covariance(d, i0, j0, counts, regress))
-            d_boot = refine.window_values(d, i0, j0, est[:, 0], est[:, 1])
-        else:
-            replicas = cost_surface(d, cris, cfg.cost, counts)
-            est = np.array([find_minimum(s, cfg.flat_contrast)[:2] for s in replicas])
-        sig = tuple(np.nanstd(est, axis=0))
-    return ForMinimum(g, x, y, sig, flags, d_opt, fine, counts, d_boot)
+def for_samples(samples: list[GranuleSamples], k: int, cfg: AssessConfig, band=None) -> ForSamples:
+    """The estimator's input for FOR k (0-based): every usable FOV of it over the granules (*band*, the
+    satellite's I5 band, for the footprint kernel)."""
+    m = len(cfg.offsets_rad)
+    d, cris, granule, scan, annuli = [], [], [], [], []
+    for g_i, s in enumerate(samples):
+        use = s.usable[:, k]  # (nscan, 9)
+        d.append((s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]).astype(np.float64))
+        cris.append(s.bt_cris_k[:, k][use].astype(np.float64))
+        scans = np.nonzero(use)[0]  # the scan of each sample
+        granule.append(np.full(scans.size, g_i))
+        scan.append(scans)
+        if s.annuli_rad is not None:
+            annuli.append(s.annuli_rad[:, k][use])
+    footprint = len(cfg.radii_rad) > 1
+    return ForSamples(
+        np.concatenate(d) if d else np.empty((0, m, m)),
+        np.concatenate(cris) if cris else np.empty(0),
+        np.concatenate(granule) if granule else np.empty(0, int),
+        np.concatenate(scan) if scan else np.empty(0, int),
+        np.concatenate(annuli) if footprint and annuli else None,
+        cfg.radii_rad if footprint else (),
+        band,
+    )
 
 
 def cost_and_offsets(
     samples: list[GranuleSamples], cfg: AssessConfig, skipped=None, satellite=""
 ) -> AssessmentResult:
-    """The cost cube, per-FOR minimum, bootstrap uncertainty and km offsets of collocated *samples*."""
-    offsets = cfg.offsets_rad
-    m = len(offsets)
-    step_urad = cfg.step_rad / URAD
-    rng = np.random.default_rng(cfg.seed)
-    cube = np.full((N_FOR, m, m), np.nan)
-    fors = []
-    pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR: Figure 15's bins
-    for k in range(N_FOR):
-        diffs, cris_k, units = [], [], []
-        for g_i, s in enumerate(samples):
-            use = s.usable[:, k]  # (nscan, 9)
-            d = s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]
-            diffs.append(d.astype(np.float64))
-            cris_k.append(s.bt_cris_k[:, k][use].astype(np.float64))
-            scans = np.nonzero(use)[0]  # the scan of each sample
-            units.append(np.column_stack([np.full(scans.size, g_i), scans]))
-        d = np.concatenate(diffs) if diffs else np.empty((0, m, m))
-        # the scans (granule, scan) the samples come from, in order, and each sample's scan among them
-        scan_keys, unit_ids = (
-            np.unique(np.concatenate(units), axis=0, return_inverse=True)
-            if diffs
-            else (np.empty((0, 2), int), np.empty(0, int))
-        )
-        unit_ids = unit_ids.reshape(-1)
-        n = len(d)
-        flags = []
-        if n < max(cfg.min_samples, 3):
-            flags.append(FLAG_FEW_SAMPLES)
-        x = y = np.nan
-        sig_a = sig_b = np.nan
-        g = np.full((m, m), np.nan)
-        cal = NO_FIT
-        if n >= 3:
-            c = np.concatenate(cris_k)
-            best = for_minimum(d, c, unit_ids, scan_keys[:, 0], cfg, rng)
-            g, x, y, (sig_a, sig_b) = best.cost, best.x, best.y, best.sigma
-            cube[k] = g
-            flags += best.flags
-            # the intercalibration at the optimum: V = d + C there
-            cal = intercalibrate(
-                c, best.d_opt + c, best.counts, None if best.d_opt_boot is None else best.d_opt_boot + c
-            )
-            if best.refined:
-                pooled.append((c, best.d_opt + c))
-            sig_a, sig_b = (
-                np.hypot(sig_a * step_urad, cfg.sigma_floor_urad),
-                np.hypot(sig_b * step_urad, cfg.sigma_floor_urad),
-            )
-            if max(sig_a, sig_b) > cfg.max_sigma_urad:
-                flags.append(FLAG_UNCERTAIN)
-        d_alpha, d_beta = x * step_urad, y * step_urad
-        it, ct, jac = _ground_km(samples, k, d_alpha * 1e-6, d_beta * 1e-6)
-        s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * 1e-6) if np.isfinite(sig_a) else np.nan
-        s_ct = float(np.hypot(jac[1, 0] * sig_a, jac[1, 1] * sig_b) * 1e-6) if np.isfinite(sig_a) else np.nan
-        fors.append(
-            ForOffset(
-                for_index=k + 1,
-                d_alpha_urad=float(d_alpha),
-                d_beta_urad=float(d_beta),
-                sigma_alpha_urad=float(sig_a),
-                sigma_beta_urad=float(sig_b),
-                in_track_km=it,
-                cross_track_km=ct,
-                total_km=float(np.hypot(it, ct)),
-                sigma_in_track_km=s_it,
-                sigma_cross_track_km=s_ct,
-                n_samples=int(n),
-                cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
-                cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan,
-                bias_k=cal.bias_k,
-                sigma_bias_k=cal.sigma_bias_k,
-                gain_pct=cal.gain_pct,
-                sigma_gain_pct=cal.sigma_gain_pct,
-                curvature_k=cal.curvature_k,
-                sigma_curvature_k=cal.sigma_curvature_k,
-                flags=tuple(sorted(set(flags))),
-            )
-        )
+    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*."""
+    band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
+    day = day_offsets(
+        [for_samples(samples, k, cfg, band) for k in range(N_FOR)],
+        cfg,
+        cfg.step_rad / URAD,
+        lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
+    )
     starts = [s.info.start for s in samples]
     ends = [s.info.end for s in samples]
     return AssessmentResult(
         satellite=satellite,
         start=min(starts) if starts else "",
         end=max(ends) if ends else "",
-        fors=fors,
+        fors=day.fors,
         granules=[s.info for s in samples],
         skipped=[{"item": a, "reason": b} for a, b in (skipped or [])],
         half_steps=cfg.half_steps,
-        step_urad=step_urad,
-        cost_cube_k=cube,
-        difference_bins=difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True)))
-        if pooled
-        else [],
+        step_urad=cfg.step_rad / URAD,
+        cost_cube_k=day.cost_cube_k,
+        difference_bins=day.difference_bins,
     )
 
 

@@ -17,7 +17,9 @@ from typing import TYPE_CHECKING
 
 from monitor import allocator, logs
 from monitor.config import AssessmentConfig
+from monitor.constants import N_FOV
 from monitor.errors import DataError
+from monitor.footprint import SHAPES as FOOTPRINTS
 from monitor.render import result_text, status_text
 from monitor.satellites import SATELLITES
 from monitor.simulate import LAYOUTS
@@ -114,6 +116,14 @@ def command(name: str, help: str, *arguments):
         choices=LAYOUTS,
         help="HDF5 layout of every dataset (default: CrIS gzip, VIIRS contiguous)",
     ),
+    arg(
+        "--footprint",
+        nargs="+",
+        choices=tuple(FOOTPRINTS),
+        metavar="SHAPE",
+        help="the CrIS FOV's spatial response, one of " + ", ".join(FOOTPRINTS) + ": one shape for all FOVs, "
+        "or nine (FOV 1..9); default the paper's top-hat cone",
+    ),
 )
 def cmd_simulate(args) -> int:
     """crisgeo simulate: write a simulated case."""
@@ -125,6 +135,7 @@ def cmd_simulate(args) -> int:
         pass_lon_deg=args.pass_lon,
         complete=args.complete,
         layout=args.layout,
+        cris_response=_footprint(args.footprint),
     )
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")
@@ -159,6 +170,17 @@ def cmd_simulate(args) -> int:
         f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {args.seed})"
     )
     return EXIT_OK
+
+
+def _footprint(names):
+    """The spatial response of --footprint: None (the top-hat cone), one shape, or one per FOV."""
+    from monitor.footprint import shape
+
+    if not names:
+        return None
+    if len(names) not in (1, N_FOV):
+        raise BadInput(f"--footprint takes one shape or {N_FOV} (FOV 1..{N_FOV}), not {len(names)}")
+    return shape(names[0]) if len(names) == 1 else tuple(shape(n) for n in names)
 
 
 def _ep(path, satellite=None):
@@ -289,7 +311,11 @@ def cmd_geolocate(args) -> int:
 @command(
     "assess",
     "assess CrIS geolocation against VIIRS I5 for the granules given",
-    arg("paths", nargs="+", help="granule files or directories"),
+    arg(
+        "paths",
+        nargs="+",
+        help="granule files or directories; or the reference implementation's collocation files (.npz)",
+    ),
     arg("--out", help="write the result JSON here"),
     arg(
         "--steps",
@@ -319,8 +345,16 @@ def cmd_assess(args) -> int:
     if args.steps < 1 or args.step_urad <= 0:
         raise BadInput("--steps must be >= 1 and --step-urad > 0")
     cfg = AssessConfig.of(args.steps, args.step_urad, args.kernel, args.cost)
+    collocations = [p for p in args.paths if p.endswith(".npz")]
+    if collocations and len(collocations) != len(args.paths):
+        raise BadInput("give either granules or collocation files (.npz), not both")
     try:
-        result = assess_paths(args.paths, cfg, workers=args.workers)
+        if collocations:
+            from monitor.replay import assess_collocations
+
+            result = assess_collocations(collocations, cfg)
+        else:
+            result = assess_paths(args.paths, cfg, workers=args.workers)
     except DataError as exc:
         raise BadInput(str(exc)) from None
     print(result_text(result))

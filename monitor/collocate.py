@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -41,13 +42,14 @@ from monitor.spectral import PARALLEL_FROM, i5_band
 from monitor.swath import BLOCK_PX, DETECTORS, SwathPiece, ViirsSwath, swath_piece
 from monitor.threads import KERNEL_LOCK
 
-TOP_HAT = ((FOV_DIAMETER_RAD / 2, 1.0),)
-# CrIS spatial response as a staircase of concentric top hats, from the 70/50/10/3 % full widths of
-# 0.8735, 0.942, 1.100 and 1.238 deg (Wang slides, table 3): weight 1 inside 0.4368 deg, then 0.6,
-# 0.3 and 0.065 out to 0.619 deg.
-SPATIAL_RESPONSE = tuple(
-    (np.radians(r), c) for r, c in ((0.4368, 0.4), (0.471, 0.3), (0.550, 0.235), (0.619, 0.065))
-)
+# The discs (radii, rad) whose sums the kernel returns. The top-hat cone of the paper is one disc; the
+# annuli between nested discs let the estimator fit the CrIS spatial response (monitor.estimate): CrIS sees
+# a smooth, radially symmetric response, 70 % of peak at 0.437 deg from the LOS and 3 % at 0.619 deg at
+# most (Wang slides, table 3, monitor.footprint), so the annuli reach past the cone to 0.64 deg. Four discs:
+# the kernel's work grows with their number, and three (no edge inside the cone) miss the response's fall
+# from 0.42 to 0.48 deg (6-granule smooth cases: 11-12 urad RMS against 3-4 with four; six gave 3-3.5).
+TOP_HAT = (FOV_DIAMETER_RAD / 2,)
+ANNULI = (math.radians(0.42), FOV_DIAMETER_RAD / 2, math.radians(0.56), math.radians(0.64))
 MIN_COVERAGE = 0.97
 # The kernel's threads take FOVs in chunks of this many as they come free (FOVs differ in pixel count, and
 # the read-ahead thread takes turns on the cores), not in equal shares fixed in advance
@@ -61,10 +63,10 @@ VIEW_MARGIN_RAD = math.radians(0.5)
 SCAN_TIME_MARGIN_US = 16_000_000
 
 
-def reach_rad(offsets_rad, kernel=TOP_HAT) -> float:
-    """The angle (rad) from a FOV's LOS within which one of its perturbed cones (*offsets_rad*, the
-    perturbation grid; *kernel*, the (half-angle rad, weight) top hats) can hold a pixel."""
-    return max(h for h, _ in kernel) + float(np.abs(offsets_rad).max()) * math.sqrt(2.0) * 1.02
+def reach_rad(offsets_rad, radii_rad=TOP_HAT) -> float:
+    """The angle (rad) from a FOV's LOS within which one of its perturbed discs (*offsets_rad*, the
+    perturbation grid; *radii_rad*, the discs' half-angles) can hold a pixel."""
+    return max(radii_rad) + float(np.abs(offsets_rad).max()) * math.sqrt(2.0) * 1.02
 
 
 def los_ecef(sbf_to_ecef, alpha_rad, beta_rad) -> np.ndarray:
@@ -74,7 +76,7 @@ def los_ecef(sbf_to_ecef, alpha_rad, beta_rad) -> np.ndarray:
     return los / np.linalg.norm(los, axis=-1, keepdims=True)
 
 
-def view_reach_rad(sat_m, sbf_to_ecef, alpha_rad, beta_rad, offsets_rad, kernel=TOP_HAT) -> float:
+def view_reach_rad(sat_m, sbf_to_ecef, alpha_rad, beta_rad, offsets_rad, radii_rad=TOP_HAT) -> float:
     """The farthest angle from the geocentric nadir (rad) that a perturbed cone of these FOVs reaches,
     plus VIEW_MARGIN_RAD: the VIIRS columns beyond it need no preparation (:func:`swath.view_columns`).
     NaN FOVs are ignored; pi when there is none."""
@@ -83,7 +85,7 @@ def view_reach_rad(sat_m, sbf_to_ecef, alpha_rad, beta_rad, offsets_rad, kernel=
     off = np.arccos(np.clip(np.sum(los * nadir, -1), -1.0, 1.0))
     if not np.isfinite(off).any():
         return math.pi
-    return float(np.nanmax(off)) + reach_rad(offsets_rad, kernel) + VIEW_MARGIN_RAD
+    return float(np.nanmax(off)) + reach_rad(offsets_rad, radii_rad) + VIEW_MARGIN_RAD
 
 
 def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
@@ -135,16 +137,17 @@ def _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after):
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _accumulate(
     ecef, radiance, area, block_centre, block_radius, sat, mat, los0, reach0, tan_a, tan_b, box,
-    block_row, block_col, half_brows, half_bcols, ring_g2, ring_c, order, acc,
+    block_row, block_col, half_brows, half_bcols, ring_g2, order, acc,
 ):  # fmt: skip
     """Add the pixels of one prepared granule to each FOV's cone sums (difference arrays along j).
 
     Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*; *reach0* the angle (rad)
     within which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones'
     union, and the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none).
-    *ring_g2*, *ring_c* are cos^2 h and the weight of each top hat of the kernel. FOVs are taken in
-    *order*, in chunks of FOVS_PER_TASK. acc (F, m, m + 1) complex receives runs of weight x radiance
-    (real) and weight (imaginary): +w at the first j, -w after the last.
+    *ring_g2* is cos^2 h of each disc, largest first. FOVs are taken in *order*, in chunks of
+    FOVS_PER_TASK. acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (real)
+    and weight (imaginary): +w at the first j, -w after the last. The discs are nested: where a row's
+    interval of a disc is empty, so are those of the smaller discs.
     """
     nrow, ncol = radiance.shape
     nbr, nbc = block_radius.shape
@@ -207,9 +210,8 @@ def _accumulate(
                         a_dot = area[r, c, 0] * px + area[r, c, 1] * py + area[r, c, 2] * pz
                         weight = abs(a_dot) / (dist2 * dist)  # steradians seen from CrIS
                         dx, dy, dz = dx / dist, dy / dist, dz / dist
+                        wz = complex(weight * value, weight)
                         for k in range(nk):
-                            wk = weight * ring_c[k]
-                            wz = complex(wk * value, wk)
                             a2 = dy * dy - ring_g2[k]
                             inv_a2 = 1.0 / a2
                             for i in range(m):  # the interval of t = tan B per row i
@@ -221,36 +223,67 @@ def _accumulate(
                                 t_lo[i] = (sq - b1) * inv_a2 if disc >= 0.0 else np.inf
                                 t_hi[i] = -(b1 + sq) * inv_a2 if disc >= 0.0 else -np.inf
                             _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after)
+                            inside = False
                             for i in range(m):  # its run of j: +w at the first, -w after the last
                                 j0 = j_first[i]
                                 j1 = j_after[i]
                                 if j0 < j1:
-                                    out[i, j0] += wz
-                                    out[i, j1] -= wz
+                                    out[k, i, j0] += wz
+                                    out[k, i, j1] -= wz
+                                    inside = True
+                            if not inside:  # in no cone of this disc: in none of the smaller ones
+                                break
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _finish(acc, solid, mean, coverage):
-    """Each FOV's cone means and coverage from its difference arrays acc (F, m, m + 1) complex: the
-    running sums along j give weight x radiance (real) and weight (imaginary); the mean is their ratio
-    where the cone holds a pixel (NaN elsewhere), the coverage the weight over the cone's *solid* angle
-    (0 elsewhere).
-
-    An empty cone's sum is what rounding leaves of the runs that passed it (~1e-16 of the row's weight);
-    one pixel weighs ~1e-3 of a cone's solid angle: a cone holds a pixel when its weight exceeds 1e-9 of
-    the solid angle.
-    """
-    m = mean.shape[1]
+def _finish(acc, solid, sums, weights):
+    """Each FOV's disc sums from its difference arrays acc (F, discs, m, m + 1) complex: the running sums
+    along j give weight x radiance (real, into *sums*) and weight (imaginary, into *weights*); a weight
+    below 1e-9 of the disc's *solid* angle (discs,) is what rounding leaves of the runs that passed an empty
+    disc (~1e-16 of the row's weight; one pixel weighs ~1e-3 of a cone's solid angle) and is set to 0."""
+    nk = acc.shape[1]
+    m = sums.shape[2]
     for f in numba.prange(acc.shape[0]):
-        for i in range(m):
-            s = 0.0
-            w = 0.0
-            for j in range(m):
-                s += acc[f, i, j].real
-                w += acc[f, i, j].imag
-                occupied = w > 1e-9 * solid
-                mean[f, i, j] = s / w if occupied else np.nan
-                coverage[f, i, j] = w / solid if occupied else 0.0
+        for k in range(nk):
+            for i in range(m):
+                s = 0.0
+                w = 0.0
+                for j in range(m):
+                    s += acc[f, k, i, j].real
+                    w += acc[f, k, i, j].imag
+                    occupied = w > 1e-9 * solid[k]
+                    sums[f, k, i, j] = s if occupied else 0.0
+                    weights[f, k, i, j] = w if occupied else 0.0
+
+
+@dataclass(frozen=True)
+class ConeSums:
+    """Solid-angle weighted VIIRS sums in nested discs about every perturbed LOS of a batch of F FOVs:
+    *sums* (F, K, m, m) weight x radiance and *weights* (F, K, m, m) weight (sr) of disc k (radius
+    ``radii_rad[k]``, increasing), *solid_sr* (K,) each disc's solid angle."""
+
+    radii_rad: tuple[float, ...]
+    sums: np.ndarray
+    weights: np.ndarray
+    solid_sr: np.ndarray
+
+    def mean(self, k: int = 0) -> np.ndarray:
+        """The weighted mean radiance (F, m, m) in disc k; NaN where it holds no pixel."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.weights[:, k] > 0, self.sums[:, k] / self.weights[:, k], np.nan)
+
+    def coverage(self, k: int = -1) -> np.ndarray:
+        """The share (F, m, m) of disc k's solid angle that usable pixels cover (the outermost disc by
+        default)."""
+        return self.weights[:, k] / self.solid_sr[k]
+
+    def annulus_means(self) -> np.ndarray:
+        """The weighted mean radiance (F, K, m, m) in each annulus between consecutive discs (the first:
+        the innermost disc); NaN where one holds no pixel."""
+        s = np.diff(self.sums, axis=1, prepend=0.0)
+        w = np.diff(self.weights, axis=1, prepend=0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(w > 0, s / w, np.nan).astype(np.float32)
 
 
 def cone_sums(
@@ -260,29 +293,30 @@ def cone_sums(
     alpha_rad,
     beta_rad,
     offsets_rad,
-    kernel=TOP_HAT,
+    radii_rad=TOP_HAT,
     fov_range_m=None,
     fov_cos_zen=None,
-):
-    """Weighted VIIRS radiance means and coverage in every perturbed cone of a batch of FOVs.
+) -> ConeSums:
+    """Weighted VIIRS radiance sums in nested discs about every perturbed LOS of a batch of FOVs.
 
     sat_m (F, 3) and sbf_to_ecef (F, 3, 3) give each FOV's satellite position and SBF; alpha_rad,
-    beta_rad (F,) its LOS angles; offsets_rad (2n+1,) the perturbation grid; *kernel* the (half-angle rad,
-    weight) of each top hat. Returns ``(radiance (F, m, m), coverage (F, m, m))``; radiance is NaN where a
-    cone holds no pixel.
+    beta_rad (F,) its LOS angles; offsets_rad (2n+1,) the perturbation grid; *radii_rad* the discs'
+    half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`).
     """
     nf = len(alpha_rad)
     m = len(offsets_rad)
     sat_m = np.ascontiguousarray(sat_m, np.float64)
     mat = np.ascontiguousarray(sbf_to_ecef, np.float64)
-    h_max = max(h for h, _ in kernel)
+    if list(radii_rad) != sorted(radii_rad):
+        raise ValueError(f"disc radii must increase: {radii_rad}")
+    h_max = max(radii_rad)
     big = np.abs(offsets_rad).max()
     if m > 1 and big * big / (offsets_rad[1] - offsets_rad[0]) > MAX_GRID_SPREAD_RAD * (1 + 1e-9):
         raise ValueError(
             f"perturbation grid of {m} x {m} steps of {offsets_rad[1] - offsets_rad[0]:.3g} rad: n^2 s "
             f"exceeds {MAX_GRID_SPREAD_RAD} rad, beyond the compiled kernel's index guess"
         )
-    rho = reach_rad(offsets_rad, kernel)
+    rho = reach_rad(offsets_rad, radii_rad)
     los0 = los_ecef(mat, alpha_rad, beta_rad)
     t = wgs84.intersect_ellipsoid(sat_m, los0)
     ok_fov = np.isfinite(t)
@@ -295,9 +329,8 @@ def cone_sums(
     box = np.tan(np.stack([alpha_rad - half_a, alpha_rad + half_a, beta_rad - half_b, beta_rad + half_b], -1))
     tan_a = np.tan(offsets_rad[None, :] + alpha_rad[:, None])
     tan_b = np.tan(offsets_rad[None, :] + beta_rad[:, None])
-    ring_g2 = np.array([np.cos(h) ** 2 for h, _ in kernel])
-    ring_c = np.array([c for _, c in kernel], np.float64)
-    acc = np.zeros((nf, m, m + 1), np.complex128)
+    ring_g2 = np.cos(np.asarray(radii_rad[::-1], np.float64)) ** 2  # the kernel takes the largest first
+    acc = np.zeros((nf, len(radii_rad), m, m + 1), np.complex128)
     # FOVs interleaved by thread count: each thread's first share is spread over the granule (the scans
     # that a VIIRS granule reaches are a contiguous part of it)
     threads = numba.get_num_threads()
@@ -311,13 +344,13 @@ def cone_sums(
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
                 sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
-                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, ring_c, order, acc,
+                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, acc,
             )  # fmt: skip
-    solid = sum(c * 2 * np.pi * (1 - np.cos(h)) for h, c in kernel)
-    mean, coverage = np.empty((nf, m, m)), np.empty((nf, m, m))
+    solid = 2 * np.pi * (1 - np.cos(np.asarray(radii_rad[::-1], np.float64)))
+    sums, weights = np.empty((nf, len(radii_rad), m, m)), np.empty((nf, len(radii_rad), m, m))
     with KERNEL_LOCK:
-        _finish(acc, solid, mean, coverage)
-    return mean, coverage
+        _finish(acc, solid, sums, weights)
+    return ConeSums(tuple(radii_rad), sums[:, ::-1], weights[:, ::-1], solid[::-1])
 
 
 def warm_up() -> float:
@@ -338,7 +371,10 @@ def warm_up() -> float:
     x = np.cross([0.0, 0.0, 1.0], z)
     sbf = np.stack([x, np.cross(z, x), z], axis=1)
     offsets = np.array([-1e-3, 0.0, 1e-3])
-    mean, _ = cone_sums(ViirsSwath([piece]), sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
-    for radiance in (mean, np.full(PARALLEL_FROM, 5.0)):  # the inversion's serial and parallel kernels
+    cones = cone_sums(ViirsSwath([piece]), sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
+    for radiance in (
+        cones.mean(),
+        np.full(PARALLEL_FROM, 5.0),
+    ):  # the inversion's serial and parallel kernels
         i5_band("j01").bt_from_radiance(radiance)
     return time.perf_counter() - t0

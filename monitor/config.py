@@ -47,7 +47,7 @@ from monitor.constants import (
     URAD,
 )
 from monitor.satellites import SATELLITES
-from monitor.vocabulary import DEFAULT_COST, Cost, Kernel, PublishKind, ReadMode, SourceKind
+from monitor.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel, PublishKind, ReadMode, SourceKind
 
 NODD_BUCKETS = {s.short: s.bucket for s in SATELLITES.values()}
 
@@ -376,7 +376,10 @@ class AssessmentConfig(Section):
         5000,
     )
     kernel: Kernel = key(
-        Kernel.TOP_HAT, "CrIS footprint weighting: top-hat (the paper) or response (measured FOV response)."
+        DEFAULT_KERNEL,
+        "CrIS footprint weighting: footprint (the FOV's radially symmetric response fitted over four annuli "
+        "out to 0.64 deg, reported as its widths) or top-hat (the paper's 0.963 deg cone; biased by a real "
+        "FOV's smooth response).",
     )
     cost: Cost = key(
         DEFAULT_COST,

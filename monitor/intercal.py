@@ -18,9 +18,9 @@ more cloud would move it. V is the regressor because it is the better measured o
 some hundred I5 pixels against one CrIS spectrum), so least squares is not attenuated by its noise.
 :func:`difference_bins` (the paper's Figure 15: C - V against C in 10 K bins) shows the shape.
 
-The sigmas resample the same scans as the offsets' bootstrap (:func:`monitor.assess.for_minimum`): the
-weighted fit on each replicate's counts at that replicate's own optimum, the spread of the replicates; so
-a FOR whose optimum is uncertain has an uncertain intercalibration too.
+The sigmas come from the same delete-one-granule jackknife as the offsets' (:mod:`monitor.estimate`,
+:mod:`monitor.jackknife`): the fit on each replicate's samples at that replicate's own optimum; so a FOR
+whose optimum is uncertain has an uncertain intercalibration too.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K
+from monitor.jackknife import Jackknife
 from monitor.result import DifferenceBin
 
 MAX_CONDITION = 1e10  # a fit whose normal equations are worse conditioned (no BT spread) gives NaN
@@ -44,7 +45,7 @@ MIN_SPAN_K = 2 * CALIBRATION_BIN_K
 class Intercalibration:
     """CrIS minus VIIRS at one FOR: the bias (K) at ``CALIBRATION_REFERENCE_K``, the gain there (per cent of
     the BT's departure from it) and the curvature (K at ``CALIBRATION_CURVATURE_SPAN_K`` from it), with
-    their bootstrap sigmas (NaN without a bootstrap)."""
+    their jackknife sigmas (NaN without)."""
 
     bias_k: float
     sigma_bias_k: float
@@ -76,10 +77,12 @@ def fit_difference(cris_k, viirs_k, weights=None) -> np.ndarray:
     return out[0] if weights is None else out
 
 
-def intercalibrate(cris_k, viirs_k, counts=None, viirs_boot_k=None) -> Intercalibration:
-    """The bias, gain and curvature of one FOR's samples at its optimum; sigmas from the bootstrap *counts*
-    (B, N), each replicate fitted at its own optimum where *viirs_boot_k* (B, N) gives the V there. No fit
-    (NaN) from fewer than 4 samples, or from samples that do not reach T_ref (``MIN_SPAN_K``)."""
+def intercalibrate(
+    cris_k, viirs_k, jackknife: Jackknife | None = None, viirs_boot_k=None
+) -> Intercalibration:
+    """The bias, gain and curvature of one FOR's samples at its optimum; sigmas from the *jackknife*'s
+    replicates, each fitted at its own optimum where *viirs_boot_k* (G, N) gives the V there. No fit (NaN)
+    from fewer than 4 samples, or from samples that do not reach T_ref (``MIN_SPAN_K``)."""
     if len(cris_k) < 4:
         return NO_FIT
     lo, hi = np.percentile(viirs_k, [5, 95])
@@ -87,10 +90,9 @@ def intercalibrate(cris_k, viirs_k, counts=None, viirs_boot_k=None) -> Intercali
         return NO_FIT
     b, g, c = fit_difference(cris_k, viirs_k)
     sig = np.full(3, np.nan)
-    if counts is not None and len(counts) > 1:
+    if jackknife is not None:
         v = viirs_k if viirs_boot_k is None else viirs_boot_k
-        with np.errstate(invalid="ignore"):
-            sig = np.nanstd(fit_difference(cris_k, v, counts), axis=0)
+        sig = jackknife.sigma(fit_difference(cris_k, v, jackknife.counts))
     return Intercalibration(
         float(b), float(sig[0]), 100.0 * float(g), 100.0 * float(sig[1]), float(c), float(sig[2])
     )

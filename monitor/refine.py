@@ -14,7 +14,8 @@ grid points by cubic convolution (Keys 1981, a = -1/2; exact for quadratics), wi
     d_n(x, y) = sum_k w_k(x, y) d_n,k      and      G^2(x, y) = w(x, y)^T S w(x, y),
 
 where S (49 x 49) is the covariance over samples of the window's values. G^2 is then evaluated exactly on
-ever finer grids (1/4, 1/16, 1/64 and 1/256 of a step, within +-1.5 steps of the grid minimum). No further
+ever finer grids (1/4, 1/16, 1/64, 1/256 and 1/1024 of a step, within +-1.5 steps of the grid minimum; the
+last, 0.44 urad, below what the footprint fit of :mod:`monitor.estimate` tells apart). No further
 collocation is needed, and the same S, weighted by bootstrap counts, gives the bootstrap replicates.
 """
 
@@ -24,7 +25,7 @@ import numpy as np
 
 HALF = 3  # window half-width (grid steps): the search range +-1.5 needs cubic support +-3
 REACH = 1.5  # how far (grid steps) from the grid minimum the refined minimum may lie
-ZOOMS = (0.25, 1.0 / 16.0, 1.0 / 64.0, 1.0 / 256.0)
+ZOOMS = (0.25, 1.0 / 16.0, 1.0 / 64.0, 1.0 / 256.0, 1.0 / 1024.0)
 
 
 def keys_weights(x):

@@ -131,6 +131,7 @@ class AssessmentResult:
     step_urad: float = DEFAULT_STEP_URAD
     cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
     difference_bins: list[DifferenceBin] = field(default_factory=list)  # the FORs refined, pooled
+    notes: list[str] = field(default_factory=list)  # how the inputs were read, where that is not granules
 
     def to_dict(self, with_cube: bool = False) -> dict:
         d = {
@@ -143,6 +144,7 @@ class AssessmentResult:
             "skipped": self.skipped,
             "fors": [f.to_dict() for f in self.fors],
             "difference_bins": [asdict(b) for b in self.difference_bins],
+            "notes": self.notes,
         }
         if with_cube and self.cost_cube_k is not None:
             d["cost_cube_k"] = np.round(self.cost_cube_k, 5).tolist()
@@ -165,6 +167,7 @@ class AssessmentResult:
             step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),
             cost_cube_k=None if cube is None else np.asarray(cube, float),
             difference_bins=[DifferenceBin(**b) for b in d.get("difference_bins", [])],
+            notes=list(d.get("notes", [])),
         )
 
     @classmethod

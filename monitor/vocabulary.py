@@ -65,7 +65,7 @@ class Kernel(StrEnum):
     """The CrIS footprint weighting of the collocation (``assessment.kernel``)."""
 
     TOP_HAT = "top-hat"  # the paper: every VIIRS pixel inside the FOV's circle counts alike
-    RESPONSE = "response"  # the measured FOV spatial response
+    FOOTPRINT = "footprint"  # the FOV's radially symmetric response fitted over annuli (monitor.estimate)
 
 
 class SourceKind(StrEnum):
@@ -108,3 +108,6 @@ class Cost(StrEnum):
 # chosen by measurement (README, issue 27): equal to the paper's where CrIS and VIIRS agree, unmoved where
 # their calibrations differ
 DEFAULT_COST = Cost.REGRESSION
+# the default footprint weighting: the response fitted over annuli, which a real CrIS FOV's smooth response
+# cannot bias (docs/science.md, "The CrIS footprint")
+DEFAULT_KERNEL = Kernel.FOOTPRINT

@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from monitor.assess import AssessConfig, find_minimum
+from monitor.assess import AssessConfig
+from monitor.estimate import find_minimum
 from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult
 from tests.cli import run_crisgeo
 from tests.conftest import truth_arrays
@@ -71,7 +72,7 @@ def test_too_few_samples_are_flagged(cases):
     case = plan([out])
     samples, _ = _collocate_run(case.cris[:1], case.viirs, case.viirs_all, "j01", AssessConfig())
     samples[0].usable[:, :, 1:] = False  # keep FOV 1 only: 4 samples per FOR
-    result = cost_and_offsets(samples, AssessConfig(bootstrap=0), satellite="j01")
+    result = cost_and_offsets(samples, AssessConfig(uncertainty=False), satellite="j01")
     assert all(FLAG_FEW_SAMPLES in f.flags and not f.reliable for f in result.fors)
 
 
@@ -112,7 +113,7 @@ def test_reading_only_the_reachable_viirs_scans_changes_no_bit(cases, monkeypatc
         return whole_read(v, viirs_all, None)
 
     monkeypatch.setattr(assess, "_read_viirs", every_scan)
-    whole = assess.assess_paths([out], AssessConfig(bootstrap=30))  # as the case was assessed
+    whole = assess.assess_paths([out], AssessConfig())  # as the case was assessed
     assert read_scans and all(s is not None for s in read_scans)  # the partial run had spans to read by
     assert [f.to_dict() for f in whole.fors] == [f.to_dict() for f in partial.fors]
     assert np.array_equal(whole.cost_cube_k, partial.cost_cube_k)

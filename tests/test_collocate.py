@@ -63,7 +63,7 @@ def _brute(viirs, sat, m, alpha, beta, offsets, half_angle):
 def _brute_fov(viirs, fg, idx, offsets):
     """Brute-force top-hat cone sums of the one FOV *idx* (scan, FOR, FOV) of the geometry fg."""
     sat, m = fg.sat_ecef_m[idx], fg.sbf_to_ecef[idx]
-    return _brute(viirs, sat, m, fg.alpha_rad[idx], fg.beta_rad[idx], offsets, collocate.TOP_HAT[0][0])
+    return _brute(viirs, sat, m, fg.alpha_rad[idx], fg.beta_rad[idx], offsets, collocate.TOP_HAT[0])
 
 
 @pytest.mark.parametrize("scan,for_,fov", [(1, 14, 4), (2, 29, 8), (0, 0, 0)])
@@ -71,7 +71,8 @@ def test_interval_method_equals_brute_force(scene, scan, for_, fov):
     fg, viirs = scene
     offsets = perturbation_grid(4, 900e-6)
     idx = (scan, for_, fov)
-    mean, cover = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets)
+    cones = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets)
+    mean, cover = cones.mean(), cones.coverage()
     bm, bc = _brute_fov(viirs, fg, idx, offsets)
     np.testing.assert_allclose(mean[0], bm, rtol=1e-9)
     np.testing.assert_allclose(cover[0], bc, rtol=1e-9)
@@ -84,7 +85,7 @@ def test_fov_off_the_swath_has_no_coverage(scene):
     fg, viirs = scene
     idx = (0, 14, 4)
     far = fg.sat_ecef_m[idx] + np.array([3e6, 0.0, 0.0])
-    mean, cover = collocate.cone_sums(
+    cones = collocate.cone_sums(
         viirs,
         far[None],
         fg.sbf_to_ecef[idx][None],
@@ -92,21 +93,28 @@ def test_fov_off_the_swath_has_no_coverage(scene):
         fg.beta_rad[idx][None],
         perturbation_grid(2, 450e-6),
     )
-    assert np.all(np.nan_to_num(cover) < collocate.MIN_COVERAGE)
+    assert np.all(np.nan_to_num(cones.coverage()) < collocate.MIN_COVERAGE)
 
 
-def test_spatial_response_kernel_is_a_weighted_stack_of_top_hats(scene):
+def test_annuli_are_nested_discs_whose_cone_is_the_top_hat(scene):
+    """The footprint's discs: the one of the cone's radius sums exactly what the top-hat kernel sums, the
+    weights grow outwards, and the annulus means recombine into each disc's mean."""
     fg, viirs = scene
     idx = (1, 10, 4)
-    args = (
-        *_one_fov(viirs, fg, idx),
-        perturbation_grid(1, 450e-6),
-    )
-    resp, cov = collocate.cone_sums(*args, kernel=collocate.SPATIAL_RESPONSE)
-    top, _ = collocate.cone_sums(*args)
-    assert np.all(np.isfinite(resp)) and np.all(np.abs(cov - 1) < 0.03)
-    assert np.max(np.abs(resp - top)) > 0  # a different weighting of the same pixels
-    assert AssessConfig(kernel="response").kernel == "response"
+    args = (*_one_fov(viirs, fg, idx), perturbation_grid(2, 450e-6))
+    rings = collocate.cone_sums(*args, collocate.ANNULI)
+    top = collocate.cone_sums(*args)
+    cone = collocate.ANNULI.index(collocate.TOP_HAT[0])
+    np.testing.assert_array_equal(rings.sums[:, cone], top.sums[:, 0])
+    np.testing.assert_array_equal(rings.weights[:, cone], top.weights[:, 0])
+    assert np.all(np.diff(rings.weights, axis=1) > 0) and np.all(np.abs(rings.coverage() - 1) < 0.03)
+    a = rings.annulus_means().astype(float)
+    w = np.diff(rings.weights, axis=1, prepend=0.0)
+    outer = (a * w).sum(axis=1) / w.sum(axis=1)
+    np.testing.assert_allclose(outer, rings.mean(-1), rtol=1e-6)
+    with pytest.raises(ValueError, match="increase"):
+        collocate.cone_sums(*args, collocate.ANNULI[::-1])
+    assert AssessConfig(kernel="footprint").radii_rad == collocate.ANNULI
 
 
 def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):
@@ -135,7 +143,8 @@ def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):
     assert piece.block_radius_m.shape[1] == -(-ncol // swath.BLOCK_PX)
     cut = swath.ViirsSwath([piece])
     offsets = perturbation_grid(2, 900e-6)
-    mean, cover = collocate.cone_sums(*_one_fov(cut, fg, idx), offsets)
+    cones = collocate.cone_sums(*_one_fov(cut, fg, idx), offsets)
+    mean, cover = cones.mean(), cones.coverage()
     bm, bc = _brute_fov(cut, fg, idx, offsets)
     assert 0.05 < bc.min() and bc.max() < 0.95  # the cut runs through the cones
     np.testing.assert_allclose(mean[0], bm, rtol=1e-9)
@@ -182,14 +191,16 @@ def _synthetic(lat0_deg, lon0_deg, seed, rows=64, cols=160, step_m=400.0, jitter
 def test_kernel_equals_brute_force_on_random_pixels(lat0, lon0, seed, alpha, beta):
     viirs, sat, sbf = _synthetic(lat0, lon0, seed)
     offsets = perturbation_grid(5, 600e-6)
-    for kernel in (collocate.TOP_HAT, ((0.004, 1.0),)):
-        mean, cover = collocate.cone_sums(
-            viirs, sat[None], sbf[None], np.array([alpha]), np.array([beta]), offsets, kernel
+    for radii in (collocate.TOP_HAT, (0.004,), (0.003, 0.006, 0.009)):  # the nested discs each exact
+        cones = collocate.cone_sums(
+            viirs, sat[None], sbf[None], np.array([alpha]), np.array([beta]), offsets, radii
         )
-        bm, bc = _brute(viirs, sat, sbf, alpha, beta, offsets, kernel[0][0])
-        assert np.isfinite(bm).sum() > 0.3 * bm.size  # most cones hold pixels (the edge case: some)
-        np.testing.assert_allclose(mean[0], bm, rtol=1e-9)
-        np.testing.assert_allclose(cover[0], bc, rtol=1e-9, atol=1e-12)
+        for k, half_angle in enumerate(radii):
+            bm, bc = _brute(viirs, sat, sbf, alpha, beta, offsets, half_angle)
+            # most cones hold pixels (the edge case: some), at least those of the largest disc
+            assert k < len(radii) - 1 or np.isfinite(bm).sum() > 0.3 * bm.size
+            np.testing.assert_allclose(cones.mean(k)[0], bm, rtol=1e-9)
+            np.testing.assert_allclose(cones.coverage(k)[0], bc, rtol=1e-9, atol=1e-12)
 
 
 def test_threads_give_identical_sums(scene):
@@ -208,9 +219,9 @@ def test_threads_give_identical_sums(scene):
         one = collocate.cone_sums(*args)
     with parallel_threads(2):
         two = collocate.cone_sums(*args)
-    np.testing.assert_array_equal(one[0], two[0])
-    np.testing.assert_array_equal(one[1], two[1])
-    assert np.isfinite(one[0]).all()
+    np.testing.assert_array_equal(one.sums, two.sums)
+    np.testing.assert_array_equal(one.weights, two.weights)
+    assert np.isfinite(one.mean()).all()
 
 
 @pytest.mark.parametrize("beta", [-0.96, -0.4, 0.0, 0.3, 0.96])
@@ -269,8 +280,8 @@ def _two_threads():
         try:
             for _ in range(5):
                 _synthetic(20.0, 30.0, 7)  # the preparation kernels
-                mean, _ = collocate.cone_sums(viirs, sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
-                out.append(mean)
+                cones = collocate.cone_sums(viirs, sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
+                out.append(cones.mean())
         except Exception as exc:  # noqa: BLE001 - reported below
             errors.append(exc)
 

@@ -5,9 +5,8 @@ import numpy as np
 import pytest
 
 from monitor import refine
-from monitor.assess import AssessConfig, calibration_regressors, cost_surface, for_minimum
 from monitor.constants import DEFAULT_STEP_URAD
-from monitor.intercal import intercalibrate
+from monitor.estimate import ForSamples, calibration_regressors, cost_surface, estimate
 from monitor.vocabulary import Cost
 
 
@@ -65,15 +64,13 @@ def _node(k):
     return w
 
 
-def _minimum(d, c, seed=0):
-    units = np.arange(len(c)) // 3  # three samples a scan, two granules
-    granule_of_unit = (np.arange(units.max() + 1) >= (units.max() + 1) // 2).astype(int)
-    cfg = AssessConfig(cost=Cost.REGRESSION, bootstrap=20)
-    return for_minimum(d, c, units, granule_of_unit, cfg, np.random.default_rng(seed))
+def _minimum(d, c):
+    scan = np.arange(len(c)) // 3  # three samples a scan, ten scans a granule
+    return estimate(ForSamples(d, c, scan // 10, scan % 10), Cost.REGRESSION)
 
 
 def test_a_calibration_difference_leaves_the_offsets_and_sigmas_and_is_recovered_at_the_optimum():
-    """Offsets and their bootstrap sigmas within 1 urad of the agreeing instruments'; the bias and gain
+    """Offsets and their jackknife sigmas within 1 urad of the agreeing instruments'; the bias and gain
     fitted at the optimum are the injected ones (the truth's V at the optimum is T + noise)."""
     rng = np.random.default_rng(5)
     v, c = _samples(rng)
@@ -87,6 +84,6 @@ def test_a_calibration_difference_leaves_the_offsets_and_sigmas_and_is_recovered
     # the optimum's VIIRS BT: interpolated with the refinement's weights, d + C
     viirs = differ.d_opt + law
     assert np.allclose(viirs, agree.d_opt + c)
-    cal = intercalibrate(law, viirs, differ.counts)
+    cal = differ.intercalibration
     assert cal.bias_k == pytest.approx(1.5, abs=0.05) and cal.gain_pct == pytest.approx(3.0, abs=0.2)
     assert 0 < cal.sigma_bias_k < 0.05 and 0 < cal.sigma_gain_pct < 0.2

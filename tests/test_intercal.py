@@ -1,10 +1,11 @@
-"""The CrIS-VIIRS intercalibration at the optimum: the fit of bias and gain, its bootstrap, the BT bins."""
+"""The CrIS-VIIRS intercalibration at the optimum: the fit of bias and gain, its jackknife, the BT bins."""
 
 import numpy as np
 import pytest
 
 from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K
 from monitor.intercal import difference_bins, fit_difference, intercalibrate
+from monitor.jackknife import Jackknife
 
 
 def _pair(rng, n=400, bias_k=0.8, gain=-0.02, curvature_k=0.3, noise_k=0.0):
@@ -40,13 +41,14 @@ def test_counts_weigh_like_repeated_samples():
         assert rows[k] == pytest.approx(fit_difference(c[rep], shifted[k][rep]), rel=1e-9)
 
 
-def test_the_bootstrap_sigma_matches_the_scatter_of_independent_draws():
-    """The spread of the fit over resampled samples is the spread over fresh noise (within 25 %)."""
+def test_the_jackknife_sigma_matches_the_scatter_of_independent_draws():
+    """The jackknife's sigma of the fit over 80 groups of samples is the spread over fresh noise (within
+    25 %)."""
     rng = np.random.default_rng(3)
     fits = np.array([fit_difference(*_pair(rng, noise_k=0.3)) for _ in range(200)])
     c, v = _pair(rng, noise_k=0.3)
-    counts = rng.multinomial(len(c), np.full(len(c), 1 / len(c)), size=300).astype(float)
-    cal = intercalibrate(c, v, counts)
+    jack = Jackknife.of(np.arange(len(c)) % 80, np.zeros(len(c)))
+    cal = intercalibrate(c, v, jack)
     assert cal.sigma_bias_k == pytest.approx(fits[:, 0].std(), rel=0.25)
     assert cal.sigma_gain_pct == pytest.approx(100 * fits[:, 1].std(), rel=0.25)
     assert cal.sigma_curvature_k == pytest.approx(fits[:, 2].std(), rel=0.25)
@@ -54,7 +56,7 @@ def test_the_bootstrap_sigma_matches_the_scatter_of_independent_draws():
     assert cal.curvature_k == pytest.approx(0.3, abs=4 * cal.sigma_curvature_k)
     assert np.isnan(intercalibrate(c[:3], v[:3]).bias_k)  # too few samples: no fit
     warm = v > 285.0  # samples that do not reach 280 K: no value there from extrapolation
-    assert np.isnan(intercalibrate(c[warm], v[warm], counts[:, warm]).bias_k)
+    assert np.isnan(intercalibrate(c[warm], v[warm], Jackknife(jack.counts[:, warm])).bias_k)
     near = np.abs(v - 282.0) < 6.0  # around 280 K but only 12 K wide
     assert np.isnan(intercalibrate(c[near], v[near]).gain_pct)
 

@@ -25,7 +25,7 @@ def case(request, tmp_path_factory):
         request.param,
         out,
         truth,
-        assess_paths([out], AssessConfig(bootstrap=30)),
+        assess_paths([out], AssessConfig()),
     )  # low-contrast FORs: uncertain
 
 

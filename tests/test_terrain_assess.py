@@ -38,7 +38,7 @@ def test_simulated_terrain_in_the_files(mountains):
 
 def test_assessment_needs_the_height(mountains, monkeypatch):
     out, truth = mountains
-    cfg = AssessConfig(bootstrap=0)
+    cfg = AssessConfig(uncertainty=False)
     ea, eb = _errors(assess_paths([out], cfg), truth)
     assert len(ea) >= 25 and max(np.abs(ea).max(), np.abs(eb).max()) < 100
     assert np.sqrt(np.mean(np.r_[ea, eb] ** 2)) < 40

@@ -4,8 +4,12 @@ Where the case lies on the Earth is a pass of the satellite's own orbit (:data:`
 on an ascending pass, by night on a descending one, 60-81 deg N or S; optionally nearest a longitude, e.g.
 180 deg to cross the antimeridian), or by default an ascending tropical pass at a random longitude.
 With terrain, VIIRS GITCO pixels are where each line of sight meets the terrain, with their Height (as
-IDPS writes them), CrIS radiances are averaged over the true cone on the terrain, and GCRSO stays on
+IDPS writes them), CrIS radiances are averaged over the true FOV on the terrain, and GCRSO stays on
 the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 2.3 item 8).
+
+The CrIS FOV sees the scene through the paper's top-hat cone, or through a smooth radially symmetric
+spatial response (``SimulationSpec.cris_response``, :mod:`monitor.footprint`), one for all FOVs or one per
+FOV: the CrIS radiance is then the response-weighted mean of the scene out to where the response ends.
 """
 
 from __future__ import annotations
@@ -17,8 +21,15 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.constants import CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K, CRIS_SCAN_US, URAD
+from monitor.constants import (
+    CALIBRATION_CURVATURE_SPAN_K,
+    CALIBRATION_REFERENCE_K,
+    CRIS_SCAN_US,
+    N_FOV,
+    URAD,
+)
 from monitor.errors import DataError
+from monitor.footprint import RadialResponse
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
 from monitor.satellites import satellite as satellite_info
@@ -90,6 +101,9 @@ class SimulationSpec:
     # HDF5 layout of every dataset, one of LAYOUTS: "contiguous" (uncompressed IDPS files) or "gzip" (one
     # chunk per dataset, as the real GCRSO); None: CrIS gzip, VIIRS contiguous
     layout: str | None = None
+    # the CrIS FOV's spatial response: None, the top-hat cone of FOV_DIAMETER_RAD (the paper's); one
+    # response for all FOVs, or a tuple of 9 (FOV 1..9)
+    cris_response: RadialResponse | tuple[RadialResponse, ...] | None = None
 
     def compressed(self, instrument: str) -> bool:
         """Whether the datasets of *instrument* (CrIS, VIIRS) are written gzip-compressed."""
@@ -113,6 +127,8 @@ class SimulationSpec:
     def __post_init__(self):
         if self.orbit_pass is not None and self.orbit_pass not in PASSES:
             raise DataError(f"orbit pass {self.orbit_pass!r} is not one of {', '.join(PASSES)}")
+        if isinstance(self.cris_response, tuple) and len(self.cris_response) != N_FOV:
+            raise DataError(f"a response per FOV needs {N_FOV}, not {len(self.cris_response)}")
         if self.pass_lon_deg is not None and self.orbit_pass is None:
             raise DataError("a pass longitude needs an orbit pass")
         if (self.true_ep is None) != (self.ground_ep is None):
@@ -148,6 +164,9 @@ def _granule_id(platform: str, nominal_start_iet_us: int) -> str:
 def _utc(unix_s: float) -> dt.datetime:
     """Timezone-aware UTC datetime of UTC seconds since 1970."""
     return dt.datetime.fromtimestamp(unix_s, UTC)
+
+
+TOP_HAT_CONE = RadialResponse((0.0, ins.CRIS_FOV_HALF_ANGLE_RAD), (1.0, 1.0))
 
 
 def _sunflower_disk(n: int, radius: float):
@@ -331,10 +350,37 @@ class Simulator:
             return lat, lon, np.zeros(lat.shape)
         return intersect_terrain(origin, los, self.scene.height_m, MAX_HEIGHT_M)[1:]
 
+    @property
+    def _fov_disk(self):
+        """The FOV's sample points (x, y), tangents of the angle from the LOS: CONE_SAMPLES points over the
+        top-hat cone, as densely out to the reach of a spatial response."""
+        reach = max(self._responses, key=lambda r: r.reach_rad).reach_rad
+        n = 2 * round(CONE_SAMPLES * (reach / ins.CRIS_FOV_HALF_ANGLE_RAD) ** 2 / 2)
+        return _sunflower_disk(n, np.tan(reach))
+
+    @property
+    def _responses(self) -> tuple[RadialResponse, ...]:
+        """The spatial response of each FOV 1..9 (the top-hat cone's where none is given)."""
+        r = self.spec.cris_response
+        if r is None:
+            return (TOP_HAT_CONE,) * N_FOV
+        return r if isinstance(r, tuple) else (r,) * N_FOV
+
+    def _fov_weights(self) -> np.ndarray:
+        """(9, samples): each FOV's response at every sample point of :attr:`_fov_disk` (the top-hat cone:
+        1 at each)."""
+        x, _ = self._fov_disk
+        if self.spec.cris_response is None:
+            return np.ones((N_FOV, len(x)))
+        angle = np.arctan(np.hypot(*self._fov_disk))
+        return np.stack([resp(angle) for resp in self._responses])
+
     def _cris_spectra(self, sat, los_ecef):
-        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV cone on the scene, not the VIIRS
-        grid."""
-        x, y = _sunflower_disk(CONE_SAMPLES, np.tan(ins.CRIS_FOV_HALF_ANGLE_RAD))
+        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV on the scene (the top-hat cone, or
+        weighted by the spatial response out to its reach), not the VIIRS grid."""
+        weights = self._fov_weights()  # (9, samples)
+        n = weights.shape[1]
+        x, y = self._fov_disk
         helper = np.where(np.abs(los_ecef[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
         e1 = frames.unit(np.cross(los_ecef, helper))
         e2 = np.cross(los_ecef, e1)
@@ -342,15 +388,16 @@ class Simulator:
             los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :]
         )
         origin = np.broadcast_to(sat[..., None, :], dirs.shape)
-        temp = self.scene.temperature_k(*self._surface(origin, dirs)).reshape(-1, CONE_SAMPLES)
+        temp = self.scene.temperature_k(*self._surface(origin, dirs)).reshape(-1, n)
+        w = np.broadcast_to(weights, sat.shape[:-1] + weights.shape[-1:]).reshape(-1, n)
         nfov = temp.shape[0]
         pos = (np.clip(temp, T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (T_BINS_K[1] - T_BINS_K[0])
         b0 = np.floor(pos).astype(np.int64)
         w1 = pos - b0
-        rows = np.repeat(np.arange(nfov), CONE_SAMPLES) * len(T_BINS_K)
-        hist = np.bincount(rows + b0.ravel(), (1 - w1).ravel(), nfov * len(T_BINS_K))
-        hist += np.bincount(rows + b0.ravel() + 1, w1.ravel(), nfov * len(T_BINS_K))
-        mean_planck = hist.reshape(nfov, -1) @ self.planck_table / CONE_SAMPLES
+        rows = np.repeat(np.arange(nfov), n) * len(T_BINS_K)
+        hist = np.bincount(rows + b0.ravel(), (w * (1 - w1)).ravel(), nfov * len(T_BINS_K))
+        hist += np.bincount(rows + b0.ravel() + 1, (w * w1).ravel(), nfov * len(T_BINS_K))
+        mean_planck = hist.reshape(nfov, -1) @ self.planck_table / w.sum(axis=1, keepdims=True)
         radiance = spectra(self.nu, mean_planck)
         if not self.spec.calibrated:  # each channel's BT as CrIS would report it
             bt_k = C2 * self.nu / np.log1p(C1 * self.nu**3 / radiance)
@@ -529,10 +576,12 @@ def simulate_case(
     cris_nonlinear_k: float = 0.0,
     complete: bool = False,
     layout: str | None = None,
+    cris_response: RadialResponse | tuple[RadialResponse, ...] | None = None,
 ) -> dict:
     """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The ``cris_``
     parameters: the CrIS-VIIRS calibration difference; *complete* and *layout*: every dataset of the real
-    products, and their HDF5 layout (:class:`SimulationSpec`)."""
+    products, and their HDF5 layout; *cris_response*, the CrIS FOV's spatial response
+    (:class:`SimulationSpec`)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if spec is None:
@@ -553,6 +602,7 @@ def simulate_case(
             cris_nonlinear_k=cris_nonlinear_k,
             complete=complete,
             layout=layout,
+            cris_response=cris_response,
         )
     sim = Simulator(spec)
     files = []
@@ -577,6 +627,7 @@ def simulate_case(
             "gain": spec.cris_gain,
             "nonlinear_k": spec.cris_nonlinear_k,
         },
+        "cris_response": _response_doc(spec.cris_response),
         "engineering_packets": None
         if spec.true_ep is None or spec.ground_ep is None
         else {"true": spec.true_ep.version, "ground": spec.ground_ep.version},
@@ -587,3 +638,22 @@ def simulate_case(
     }
     (out / "truth.json").write_text(json.dumps(truth, indent=1))
     return truth
+
+
+def _response_doc(response) -> list | None:
+    """The truth's record of the CrIS spatial response: per FOV its full widths (deg) at 70, 50, 10 and
+    3 % and its knots; None for the top-hat cone."""
+    if response is None:
+        return None
+    each = response if isinstance(response, tuple) else (response,) * N_FOV
+    return [
+        {
+            "fov": k + 1,
+            "full_width_deg": {
+                f"{round(100 * lv)}%": float(np.degrees(r.full_width_rad(lv))) for lv in (0.7, 0.5, 0.1, 0.03)
+            },
+            "radius_rad": list(r.radius_rad),
+            "response": list(r.response),
+        }
+        for k, r in enumerate(each)
+    ]

@@ -419,7 +419,7 @@ def test_assessment_names_the_mutant_or_keeps_its_numbers(cases, tmp_path, prefi
     shutil.copyfile(victim, work / victim.name)
     what, _ = mutate(work / victim.name, prefix, family, np.random.default_rng(1000 * k + len(prefix)))
     try:
-        result = assess_paths([work], AssessConfig(bootstrap=30))
+        result = assess_paths([work], AssessConfig())
     except (GranuleError, ValueError) as exc:
         assert victim.name in str(exc), what
         return

@@ -59,7 +59,7 @@ def differing(tmp_path_factory):
 
 
 def _assess(root, name, cost):
-    return assess_paths([root / name], AssessConfig(bootstrap=10, cost=cost))
+    return assess_paths([root / name], AssessConfig(cost=cost))
 
 
 def test_a_calibration_bias_leaves_the_paper_cost_as_it_was(differing):
