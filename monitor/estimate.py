@@ -419,8 +419,15 @@ def day_offsets(
         x = y = sig_a = sig_b = np.nan
         g = np.full((m, m), np.nan)
         cal = NO_FIT
+        widths = [np.nan] * 4
         if n >= 3:
             best = estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty)
+            if best.footprint is not None:
+                fp = best.footprint
+                widths = [
+                    w / URAD
+                    for w in (fp.width_50_rad, fp.sigma_width_50_rad, fp.width_10_rad, fp.sigma_width_10_rad)
+                ]
             g, x, y, (sig_a, sig_b), cal = best.cost, best.x, best.y, best.sigma, best.intercalibration
             cube[k] = g
             flags += best.flags
@@ -458,6 +465,10 @@ def day_offsets(
                 sigma_gain_pct=cal.sigma_gain_pct,
                 curvature_k=cal.curvature_k,
                 sigma_curvature_k=cal.sigma_curvature_k,
+                response_width_50_urad=float(widths[0]),
+                sigma_response_width_50_urad=float(widths[1]),
+                response_width_10_urad=float(widths[2]),
+                sigma_response_width_10_urad=float(widths[3]),
                 flags=tuple(sorted(set(flags))),
             )
         )

@@ -49,6 +49,16 @@ VARIABLES = {
     "sigma_gain_pct": ("percent", "uncertainty (1 sigma) of the gain difference"),
     "curvature_k": ("K", "curvature of CrIS minus VIIRS: what it adds at 250 and 310 K"),
     "sigma_curvature_k": ("K", "uncertainty (1 sigma) of the curvature"),
+    "response_width_50_urad": (
+        "urad",
+        "full width at 50 % of its peak of the CrIS FOV spatial response fitted at the optimum",
+    ),
+    "sigma_response_width_50_urad": ("urad", "uncertainty (1 sigma) of the response's full width at 50 %"),
+    "response_width_10_urad": (
+        "urad",
+        "full width at 10 % of its peak of the CrIS FOV spatial response fitted at the optimum",
+    ),
+    "sigma_response_width_10_urad": ("urad", "uncertainty (1 sigma) of the response's full width at 10 %"),
 }
 FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
 

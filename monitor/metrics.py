@@ -16,6 +16,10 @@ at each scrape, so it survives restarts and agrees with ``crisgeo status``; what
     crisgeo_alerts_firing{satellite,rule,severity}        alerts firing now
     crisgeo_for_offset_urad{satellite,for,direction}      latest day's LOS offset (alpha, beta)
     crisgeo_for_offset_km{satellite,for,direction}        latest day's offset in km (in/cross-track, total)
+    crisgeo_for_calibration_bias_kelvin{satellite,for}    latest CrIS - VIIRS bias at 280 K
+    crisgeo_for_calibration_gain_percent{satellite,for}   latest CrIS - VIIRS gain difference
+    crisgeo_for_response_full_width_radians{satellite,for,level}  the CrIS FOV response's full width
+                                                          at level 0.5 / 0.1 of its peak, fitted per FOR
     crisgeo_for_reliable{satellite,for}                   1 when the FOR carries no reliability flag
     crisgeo_latest_day_timestamp_seconds{satellite}       00:00 UTC of the latest assessed day
     crisgeo_healthy                                       1 when /healthz is ok
@@ -33,6 +37,7 @@ import math
 from prometheus_client import CollectorRegistry, Counter, Gauge
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 
+from monitor.constants import URAD
 from monitor.store.alerts import AlertState
 from monitor.vocabulary import RunStatus
 
@@ -130,6 +135,11 @@ class _StoreCollector:
             "Latest CrIS minus VIIRS I5 gain difference per FOR (per cent of the BT's departure from 280 K)",
             labels=["satellite", "for"],
         )
+        width = GaugeMetricFamily(
+            "crisgeo_for_response_full_width_radians",
+            "Latest full width of the CrIS FOV spatial response fitted per FOR, at a level of its peak",
+            labels=["satellite", "for", "level"],
+        )
         ok = GaugeMetricFamily(
             "crisgeo_for_reliable",
             "1 when the FOR's latest offset carries no reliability flag",
@@ -154,8 +164,11 @@ class _StoreCollector:
                 for family, v in ((bias, f.bias_k), (gain, f.gain_pct)):
                     if math.isfinite(v):
                         family.add_metric([sat, k], v)
+                for level, v in (("0.5", f.response_width_50_urad), ("0.1", f.response_width_10_urad)):
+                    if math.isfinite(v):
+                        width.add_metric([sat, k, level], v * URAD)
                 ok.add_metric([sat, k], 1 if f.reliable else 0)
-        yield from (day, urad, km, bias, gain, ok)
+        yield from (day, urad, km, bias, gain, width, ok)
 
 
 class ServiceMetrics:

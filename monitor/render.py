@@ -39,6 +39,7 @@ FOR_COLUMNS = {
     "n": Column("N", "", 5, lambda f: f"{f.n_samples:5d}"),
     "cost_min": Column("G_min", "K", 6, _num("cost_min_k", 6, 3)),
     "cost_zero": Column("G_0", "K", 6, _num("cost_zero_k", 6, 3)),
+    "width_50": Column("FWHM", "urad", 6, _num("response_width_50_urad", 6, 0)),
 }
 FULL = tuple(FOR_COLUMNS)
 BRIEF = ("for", "d_alpha", "d_beta", "in_track", "cross_track", "total")

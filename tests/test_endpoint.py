@@ -152,6 +152,16 @@ def test_metrics_after_a_run(served):
             abs(got[f.for_index] - getattr(f, name)) < 1e-9 for f in fors if f.for_index in got
         )
         assert len(got) == sum(np.isfinite(getattr(f, name)) for f in fors)
+    # the CrIS response's widths, in radians (Prometheus' base unit), where the day fitted one
+    for level, name in (("0.5", "response_width_50_urad"), ("0.1", "response_width_10_urad")):
+        got = {
+            int(s.labels["for"]): s.value
+            for s in _samples(fams["crisgeo_for_response_full_width_radians"], satellite="j01", level=level)
+        }
+        assert got and all(
+            abs(got[f.for_index] - getattr(f, name) * 1e-6) < 1e-12 for f in fors if f.for_index in got
+        )
+        assert len(got) == sum(np.isfinite(getattr(f, name)) for f in fors)
     reliable = {
         int(s.labels["for"]): s.value for s in _samples(fams["crisgeo_for_reliable"], satellite="j01")
     }

@@ -27,9 +27,10 @@ def test_the_full_table_has_a_header_units_and_a_line_per_for():
         "N",
         "G_min",
         "G_0",
+        "FWHM",
         "flags",
     ]
-    assert lines[2].split() == ["urad", "urad", "km", "km", "km", "K", "K"]
+    assert lines[2].split() == ["urad", "urad", "km", "km", "km", "K", "K", "urad"]
     rows = lines[3:33]
     assert [int(r.split()[0]) for r in rows] == list(range(1, 31))
     f = result.fors[4]

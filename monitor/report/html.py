@@ -97,7 +97,7 @@ def _latest_table(fors, spec_km) -> str:
     head = (
         "<tr><th>FOR</th><th>d_alpha urad</th><th>+-</th><th>d_beta urad</th><th>+-</th><th>% FOV a</th>"
         "<th>% FOV b</th><th>in-track km</th><th>cross-track km</th><th>total km</th><th>N</th>"
-        "<th>G_min K</th><th>G_0 K</th><th class=l>flags</th></tr>"
+        "<th>G_min K</th><th>G_0 K</th><th>response FWHM urad</th><th class=l>flags</th></tr>"
     )
     rows = []
     for f in fors:
@@ -117,7 +117,8 @@ def _latest_table(fors, spec_km) -> str:
             f"<td>{_f(f.d_beta_pct_fov, '.1f')}</td><td>{_f(f.in_track_km, '.3f')}</td>"
             f"<td>{_f(f.cross_track_km, '.3f')}</td>"
             f"<td>{_f(f.total_km, '.3f')}</td><td>{f.n_samples}</td><td>{_f(f.cost_min_k, '.3f')}</td>"
-            f"<td>{_f(f.cost_zero_k, '.3f')}</td><td class=l>{_e(', '.join(f.flags))}</td></tr>"
+            f"<td>{_f(f.cost_zero_k, '.3f')}</td><td>{_f(f.response_width_50_urad, '.0f')}</td>"
+            f"<td class=l>{_e(', '.join(f.flags))}</td></tr>"
         )
     return f"<table>{head}{''.join(rows)}</table>"
 

@@ -96,6 +96,14 @@ MIGRATIONS = [
         satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, low_k REAL NOT NULL,
         n INTEGER, mean_k REAL, std_k REAL, PRIMARY KEY (satellite, day, low_k));
     """,
+    # 5: the CrIS spatial response seen at each FOR's optimum (kernel footprint, monitor/estimate.py); days
+    # stored before have none (NULL)
+    """
+    ALTER TABLE results ADD COLUMN response_width_50_urad REAL;
+    ALTER TABLE results ADD COLUMN sigma_response_width_50_urad REAL;
+    ALTER TABLE results ADD COLUMN response_width_10_urad REAL;
+    ALTER TABLE results ADD COLUMN sigma_response_width_10_urad REAL;
+    """,
 ]
 
 RESULT_FIELDS = MEASURED_FIELDS  # the results table has a column for each
