@@ -298,12 +298,17 @@ def _estimate(s: ForSamples, cost: Cost, contrast: float, counts=None, start=Non
     begin the alternation from (a replicate starts from the day's)."""
     keep = slice(None) if counts is None else counts > 0
     d, c = s.d_k[keep], s.cris_k[keep]
+    fit = s.footprint and len(c) >= MIN_FOOTPRINT_SAMPLES
+    sub = ForSamples(
+        d, c, s.granule[keep], s.scan[keep], s.annuli_rad[keep] if fit else None, s.radii_rad, s.band
+    )
+    if fit and start is not None:  # the day's weights: the minimum through them (not the top-hat cone's)
+        d = _with_footprint(sub, start)
     best = _minimum(d, c, cost, contrast)
-    if not s.footprint or not best.refined or len(c) < MIN_FOOTPRINT_SAMPLES:
+    if not fit or not best.refined:
         return best, None, d
-    assert s.annuli_rad is not None and s.band is not None
-    annuli = s.annuli_rad[keep]
-    sub = ForSamples(d, c, s.granule[keep], s.scan[keep], annuli, s.radii_rad, s.band)
+    assert sub.annuli_rad is not None and s.band is not None
+    annuli = sub.annuli_rad
     regress = calibration_regressors(c) if cost == Cost.REGRESSION else None
     weights = start
     for _ in range(FOOTPRINT_WINDOWS):
