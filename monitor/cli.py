@@ -321,7 +321,7 @@ def cmd_geolocate(args) -> int:
         "--steps",
         type=int,
         default=ASSESSMENT.half_steps,
-        help="perturbation steps each side of zero (grid 2n+1)",
+        help="perturbation steps each side of zero (grid 2n+1; collocation files carry their own grid)",
     ),
     arg("--step-urad", type=float, default=ASSESSMENT.step_urad, help="perturbation step, urad"),
     arg(
@@ -341,10 +341,21 @@ def cmd_geolocate(args) -> int:
 def cmd_assess(args) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assess import AssessConfig, assess_paths
+    from monitor.config import ConfigError, section_of
 
-    if args.steps < 1 or args.step_urad <= 0:
-        raise BadInput("--steps must be >= 1 and --step-urad > 0")
-    cfg = AssessConfig.of(args.steps, args.step_urad, args.kernel, args.cost)
+    try:  # the options are the assessment section's keys, checked by the configuration model
+        a = section_of(
+            "assessment",
+            half_steps=args.steps,
+            step_urad=args.step_urad,
+            kernel=args.kernel,
+            cost=args.cost,
+            workers=args.workers,
+        )
+    except ConfigError as exc:
+        raise BadInput(f"--steps/--step-urad/--workers: {exc}") from None
+    assert isinstance(a, AssessmentConfig)
+    cfg = AssessConfig.of(a.half_steps, a.step_urad, a.kernel, a.cost)
     collocations = [p for p in args.paths if p.endswith(".npz")]
     if collocations and len(collocations) != len(args.paths):
         raise BadInput("give either granules or collocation files (.npz), not both")
@@ -354,7 +365,7 @@ def cmd_assess(args) -> int:
 
             result = assess_collocations(collocations, cfg)
         else:
-            result = assess_paths(args.paths, cfg, workers=args.workers)
+            result = assess_paths(args.paths, cfg, workers=a.workers)
     except DataError as exc:
         raise BadInput(str(exc)) from None
     print(result_text(result))

@@ -715,10 +715,21 @@ def load_config(path: str | Path) -> Config:
     return cfg
 
 
-def _one_line(exc: ValidationError) -> str:
-    """The first problem of a validation, as ``KEY: PROBLEM``."""
+def section_of(name: str, **values: Any) -> BaseModel:
+    """The section *name* of the configuration from *values* alone (the command line's options), checked by
+    the same model as a file: any problem a :class:`ConfigError` naming the key (``name.key: PROBLEM``)."""
+    model = _section_type(Config.model_fields[name].annotation)
+    try:
+        return model.model_validate(values)
+    except ValidationError as exc:
+        raise ConfigError(_one_line(exc, [name])) from None
+
+
+def _one_line(exc: ValidationError, prefix: list | None = None) -> str:
+    """The first problem of a validation, as ``KEY: PROBLEM``; *prefix*, where the validated model sits in
+    the whole configuration."""
     err = exc.errors(include_url=False)[0]
-    loc = list(err["loc"])
+    loc = [*(prefix or []), *err["loc"]]
     if err["type"] == "invalid_key":  # a key that is not a string (YAML reads 1: as an int)
         loc[-1] = str(loc[-1])
     problem = _problem(err, loc)

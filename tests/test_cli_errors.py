@@ -123,3 +123,18 @@ def test_the_cli_reference_is_generated_and_complete():
     doc = (Path(__file__).resolve().parent.parent / "docs" / "cli.md").read_text()
     assert r.returncode == 0 and r.stdout == doc, "regenerate: crisgeo --cli-reference > docs/cli.md"
     assert all(f"## crisgeo {name}\n" in doc for name in COMMANDS)
+
+
+@pytest.mark.parametrize(
+    "options,message",
+    [
+        (["--steps", "40"], "assessment.half_steps: 40 with step_urad"),
+        (["--steps", "0"], "assessment.half_steps: 0 is not within 1..40"),
+        (["--kernel", "top-hat", "--workers", "100"], "assessment.workers: 100 is not within 1..64"),
+    ],
+)
+def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys, options, message):
+    """crisgeo assess takes the assessment section's keys as options: the model checks them (the grid the
+    compiled kernel takes included), one line, exit 2, before any granule is read."""
+    assert main(["assess", str(tmp_path), *options]) == 2
+    assert message in _one_line(capsys)
