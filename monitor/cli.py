@@ -488,6 +488,17 @@ def _satellites(cfg: Config, satellite: str | None) -> list[str]:
     return [satellite] if satellite else list(cfg.satellites)
 
 
+def _in_mission(sats: list[str], days: dict[str, dt.date | None]) -> None:
+    """Refuse (bad input) a day given as *days* (option -> day) that no satellite of *sats* can have data
+    of: before its launch, or after today."""
+    today = dt.datetime.now(dt.timezone.utc).date()
+    for option, day in days.items():
+        for sat in sats:
+            problem = SATELLITES[sat].outside_mission(day, today) if day is not None else None
+            if problem:
+                raise BadInput(f"{option} {day}: {problem}: no {sat} data to assess")
+
+
 @command(
     "run",
     "one run of the daily job (the missed days, or --date), then exit",
@@ -503,6 +514,7 @@ def cmd_run(args) -> int:
 
     cfg = _load(args, writes=True)
     sats = _satellites(cfg, args.satellite)
+    _in_mission(sats, {"--date": args.date})
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm
@@ -550,6 +562,7 @@ def cmd_reprocess(args) -> int:
     sats = _satellites(cfg, args.satellite)
     if args.until < args.since:
         raise BadInput(f"--until {args.until} is before --since {args.since}")
+    _in_mission(sats, {"--since": args.since, "--until": args.until})
     if args.workers < 1:
         raise BadInput(f"--workers: {args.workers}, at least 1")
     try:

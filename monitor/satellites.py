@@ -17,6 +17,7 @@ S-NPP b25538 on 2016-10-01 09:30 (25537.8).
 
 from __future__ import annotations
 
+import datetime as dt
 from dataclasses import dataclass
 
 from monitor.errors import DataError
@@ -44,6 +45,19 @@ class Satellite:
     def orbit_number(self, unix_s: float) -> int:
         """The orbit number IDPS gives a granule starting at *unix_s*: whole orbits since launch, plus one."""
         return int((unix_s - self.launch_unix_s) // NODAL_PERIOD_S) + 1
+
+    @property
+    def launch_day(self) -> dt.date:
+        """The UTC day of the launch."""
+        return dt.datetime.fromtimestamp(self.launch_unix_s, dt.timezone.utc).date()
+
+    def outside_mission(self, day: dt.date, today: dt.date) -> str | None:
+        """Why *day* can hold no data of this satellite (before its launch, after *today*), or None."""
+        if day < self.launch_day:
+            return f"before {self.name}'s launch on {self.launch_day}"
+        if day > today:
+            return f"after today ({today}, UTC)"
+        return None
 
 
 SNPP_EP, NOAA20_EP = "SNPP_side1_V37_EngPkt.xml", "JPSS1_side1_V115_EngPkt.xml"  # real EPs, monitor/data/ep

@@ -138,3 +138,31 @@ def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys,
     compiled kernel takes included), one line, exit 2, before any granule is read."""
     assert main(["assess", str(tmp_path), *options]) == 2
     assert message in _one_line(capsys)
+
+
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (["run", "--date", "2010-01-01"], "--date 2010-01-01: before NOAA-20's launch on 2017-11-18"),
+        (["run", "--date", "2030-01-01"], "--date 2030-01-01: after today"),
+        (
+            ["reprocess", "--since", "2017-11-01", "--until", "2017-12-01"],
+            "--since 2017-11-01: before NOAA-20's launch",
+        ),
+        (["reprocess", "--since", "2025-01-01", "--until", "2099-01-01"], "--until 2099-01-01: after today"),
+    ],
+)
+def test_a_day_outside_the_mission_is_bad_input_and_records_nothing(
+    config_with_history, capsys, argv, message
+):
+    """A typo'd date: exit 2, one line, no run in the ledger and no alert (nothing sent, nothing queued)."""
+    from monitor import open_store
+    from monitor.store.alerts import AlertState
+
+    state = config_with_history.parent / "state"
+    with open_store(state / "crisgeo.sqlite") as store:
+        before = store.runs("j01"), AlertState(store).all(), AlertState(store).deliveries()
+    assert main([argv[0], "--config", str(config_with_history), *argv[1:]]) == 2
+    assert message in _one_line(capsys)
+    with open_store(state / "crisgeo.sqlite") as store:
+        assert (store.runs("j01"), AlertState(store).all(), AlertState(store).deliveries()) == before
