@@ -546,10 +546,10 @@ def assess_plan(
     """Assess every CrIS granule of *case*; granules that fail are skipped with their reason. Fewer usable
     FOVs in all than ``cfg.min_samples`` is an :class:`AssessmentError` naming the files.
 
-    *progress* is called after each granule; *should_stop* is polled before each (a stop request
-    skips the rest, recorded); *timings*, a dict, collects seconds per stage. *workers* is the number of
-    threads of the compiled VIIRS preparation and collocation (granules go one after the other, each
-    VIIRS granule prepared once).
+    *progress* is called after each granule; *should_stop* is polled before each and before the cost
+    stage (a stop request ends the assessment with :class:`StopRequested`); *timings*, a dict, collects
+    seconds per stage. *workers* is the number of threads of the compiled VIIRS preparation and
+    collocation (granules go one after the other, each VIIRS granule prepared once).
     """
     cfg = cfg or AssessConfig()
     skipped = list(case.skipped)
@@ -558,9 +558,10 @@ def assess_plan(
             case.cris, case.viirs, case.viirs_all, case.satellite, cfg, progress, should_stop, timings
         )
     skipped += k
+    if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
+        raise StopRequested
     usable = sum(int(s.usable.sum()) for s in samples)
-    stopped = should_stop is not None and should_stop()  # the caller records an interruption, not bad data
-    if usable < cfg.min_samples and not stopped:
+    if usable < cfg.min_samples:
         files = ", ".join(sorted({s.info.cris_geo for s in samples} | {str(k) for k, _ in skipped}))[:800]
         why = "; ".join(f"{k}: {r}" for k, r in skipped[:3])
         raise AssessmentError(

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
+import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -377,7 +378,6 @@ def cmd_assess(args) -> int:
 
 def _load(args, writes: bool = False):
     """The configuration of *args*; with *writes*, its state directory made (the commands that write)."""
-    import os
 
     from monitor.config import ConfigError, load_config, make_state_dir
 
@@ -536,8 +536,10 @@ def cmd_run(args) -> int:
             print(result_text(o.result))
         if o.timings:
             print("wall time per stage: " + ", ".join(f"{k} {v:.1f} s" for k, v in o.timings.items()))
-    if not outcomes:
+    if not outcomes and service.stopped_by is None:
         print("nothing to do: every day of the catch-up window is done")
+    if service.stopped_by is not None:  # the shell's convention: 130 for SIGINT, 143 for SIGTERM
+        return 128 + service.stopped_by
     return EXIT_FAIL if any(o.status == RunStatus.FAILED for o in outcomes) else EXIT_OK
 
 
@@ -871,7 +873,6 @@ class _PrintReference(argparse.Action):
 
 def cli_reference(parser: argparse.ArgumentParser) -> str:
     """Every command with its usage and options, as Markdown (docs/cli.md is its output)."""
-    import os
 
     out = [
         "# The crisgeo command line",
@@ -891,7 +892,6 @@ def cli_reference(parser: argparse.ArgumentParser) -> str:
 
 
 def _plain_help(parser: argparse.ArgumentParser) -> str:
-    import os
 
     os.environ["COLUMNS"] = "110"  # the same wrapping on every terminal
     return parser.format_help().rstrip()
@@ -933,6 +933,41 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+class _PipedOutput:
+    """Standard output that a reader closing the pipe (``| head -1``) silences instead of ending the
+    command: the exit status stays the one computed (a Nagios check piped into head still says 2)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self.gone = False
+
+    def write(self, text: str) -> int:
+        if not self.gone:
+            try:
+                return self._stream.write(text)
+            except BrokenPipeError:
+                self._close()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.gone:
+            try:
+                self._stream.flush()
+            except BrokenPipeError:
+                self._close()
+
+    def _close(self) -> None:
+        self.gone = True
+        # the interpreter flushes stdout once more at exit: what is left goes to /dev/null, not to a
+        # "BrokenPipeError ignored" and exit status 120
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, self._stream.fileno())
+        os.close(null)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
     """The crisgeo command: parse, set up logging, run the subcommand; its exit status."""
     from monitor.store.sqlite import StoreError
@@ -941,8 +976,12 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logs.setup(args.verbose, args.log_format)
     allocator.reuse_freed_memory()
+    if not isinstance(sys.stdout, _PipedOutput) and sys.stdout is sys.__stdout__:
+        sys.stdout = _PipedOutput(sys.stdout)
     try:
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()
+        return code
     except BadInput as exc:
         print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -951,8 +990,6 @@ def main(argv=None) -> int:
         return EXIT_FAIL
     except KeyboardInterrupt:
         return 130
-    except BrokenPipeError:  # output piped into head and the like
-        return EXIT_OK
 
 
 if __name__ == "__main__":

@@ -298,17 +298,15 @@ def _estimate(s: ForSamples, cost: Cost, contrast: float, counts=None, start=Non
     begin the alternation from (a replicate starts from the day's)."""
     keep = slice(None) if counts is None else counts > 0
     d, c = s.d_k[keep], s.cris_k[keep]
-    fit = s.footprint and len(c) >= MIN_FOOTPRINT_SAMPLES
-    sub = ForSamples(
-        d, c, s.granule[keep], s.scan[keep], s.annuli_rad[keep] if fit else None, s.radii_rad, s.band
-    )
+    annuli = s.annuli_rad[keep] if s.annuli_rad is not None and len(c) >= MIN_FOOTPRINT_SAMPLES else None
+    fit = annuli is not None
+    sub = ForSamples(d, c, s.granule[keep], s.scan[keep], annuli, s.radii_rad, s.band)
     if fit and start is not None:  # the day's weights: the minimum through them (not the top-hat cone's)
         d = _with_footprint(sub, start)
     best = _minimum(d, c, cost, contrast)
     if not fit or not best.refined:
         return best, None, d
-    assert sub.annuli_rad is not None and s.band is not None
-    annuli = sub.annuli_rad
+    assert annuli is not None and s.band is not None
     regress = calibration_regressors(c) if cost == Cost.REGRESSION else None
     weights = start
     for _ in range(FOOTPRINT_WINDOWS):

@@ -214,7 +214,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
     t0 = time.perf_counter()
     try:
         logs.stage("list")
-        source.start_day()
+        source.start_day(stop)
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
         w.timings["list"] = time.perf_counter() - t0
         w.counts["listed"] = len(listing)

@@ -73,6 +73,7 @@ class Service:
     def __init__(self, cfg: Config, progress=None):
         self.cfg = cfg
         self.stop_event = threading.Event()
+        self.stopped_by: int | None = None  # the signal that asked for the stop (the exit status is 128 + it)
         self.progress = progress
         self.source = make_source(cfg)
         self.scheduler: BlockingScheduler | None = None
@@ -116,7 +117,7 @@ class Service:
     def _after_run(self, store: Store, outcome: RunOutcome) -> None:
         """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the
         e-mails attach its trend plot), deliver what is queued."""
-        self.check_alerts(store, report=True)
+        self.check_alerts(store, report=not self.stop_event.is_set())  # stopping: the next run rewrites it
 
     def regenerate_report(self, store: Store) -> None:
         """Rewrite the HTML report into ``report_dir``; a report problem never stops the service."""
@@ -277,6 +278,7 @@ class Service:
     def _on_signal(self, signum, frame):
         LOG.info("signal %d: stopping after the current step", signum)
         sd_notify("STOPPING=1")
+        self.stopped_by = signum
         self.stop_event.set()
         if self.scheduler is not None and self.scheduler.running:  # a second signal finds it stopped
             self.scheduler.shutdown(wait=False)

@@ -166,3 +166,24 @@ def test_a_day_outside_the_mission_is_bad_input_and_records_nothing(
     assert message in _one_line(capsys)
     with open_store(state / "crisgeo.sqlite") as store:
         assert (store.runs("j01"), AlertState(store).all(), AlertState(store).deliveries()) == before
+
+
+def test_a_closed_pipe_keeps_the_computed_exit_status(config_with_history):
+    """``crisgeo status | head -1``: a reader that closes the pipe early silences the output, not the
+    Nagios code. The pipe here is closed before crisgeo writes anything (the worst case of head)."""
+    import os
+    import subprocess
+
+    from tests.cli import CRISGEO, ROOT
+
+    argv = [*CRISGEO, "status", "--config", str(config_with_history)]
+    expected = subprocess.run(argv, capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert expected.returncode in (0, 1, 2) and expected.stdout  # a computed state, printed
+    read, write = os.pipe()
+    os.close(read)  # nobody will read: every write fails with EPIPE
+    try:
+        closed = subprocess.run(argv, stdout=write, stderr=subprocess.PIPE, text=True, cwd=ROOT, timeout=120)
+    finally:
+        os.close(write)
+    assert closed.returncode == expected.returncode, closed.stderr
+    assert "BrokenPipeError" not in closed.stderr and "Traceback" not in closed.stderr

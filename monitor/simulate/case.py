@@ -28,7 +28,7 @@ from monitor.constants import (
     N_FOV,
     URAD,
 )
-from monitor.errors import DataError
+from monitor.errors import DataError, StopRequested
 from monitor.footprint import RadialResponse
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
@@ -405,9 +405,9 @@ class Simulator:
         return radiance.reshape(sat.shape[:-1] + (len(self.nu),))
 
     # ------------------------------------------------------------------ VIIRS
-    def viirs_granule(self, g0: float, out: Path, scans_per_chunk: int = 6) -> list[str]:
+    def viirs_granule(self, g0: float, out: Path, scans_per_chunk: int = 6, should_stop=None) -> list[str]:
         """Write the VIIRS I5 granule starting at unix time *g0* (SDR and GEO files) into *out*, a few
-        scans at a time; the names of the files written."""
+        scans at a time (*should_stop* polled between them); the names of the files written."""
         spec = self.spec
         theta, col_dt = ins.viirs_column_geometry()
         a_det = ins.viirs_detector_angles_rad()
@@ -423,6 +423,8 @@ class Simulator:
         scan_start = g0 + np.arange(ins.VIIRS_SCANS) * ins.VIIRS_SCAN_S
         cwv = float(np.sum(self.band.weights * self.nu))
         for s0 in range(0, ins.VIIRS_SCANS, scans_per_chunk):
+            if should_stop is not None and should_stop():
+                raise StopRequested
             ss = slice(s0, s0 + scans_per_chunk)
             tt = scan_start[ss, None] + col_dt[None, :]
             r, _, m = self.state(tt)  # (n, 6400, 3), (n, 6400, 3, 3)
@@ -577,11 +579,13 @@ def simulate_case(
     complete: bool = False,
     layout: str | None = None,
     cris_response: RadialResponse | tuple[RadialResponse, ...] | None = None,
+    should_stop=None,
 ) -> dict:
     """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The ``cris_``
     parameters: the CrIS-VIIRS calibration difference; *complete* and *layout*: every dataset of the real
     products, and their HDF5 layout; *cris_response*, the CrIS FOV's spatial response
-    (:class:`SimulationSpec`)."""
+    (:class:`SimulationSpec`). *should_stop*, polled between granules and between a VIIRS granule's scans,
+    ends the simulation with :class:`StopRequested` (what was written stays: the caller decides)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if spec is None:
@@ -605,12 +609,15 @@ def simulate_case(
             cris_response=cris_response,
         )
     sim = Simulator(spec)
+    stop = should_stop or (lambda: False)
     files = []
     for k in range(spec.granules):
+        if stop():
+            raise StopRequested
         files += sim.cris_granule(k, out)
     if viirs:
         for g0 in sim.viirs_granule_starts():
-            files += sim.viirs_granule(float(g0), out)
+            files += sim.viirs_granule(float(g0), out, should_stop=stop)
     truth = {
         "satellite": spec.satellite,
         "profile": spec.profile,

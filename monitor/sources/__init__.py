@@ -7,6 +7,7 @@ It knows file names and transport, nothing of the science.
 from __future__ import annotations
 
 import datetime as dt
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -63,8 +64,9 @@ class Source(Protocol):
     downloaded_files: int  # downloaded whole in this run
     requests: int  # HTTP requests sent in this run
 
-    def start_day(self) -> None:
-        """Start a run: reset the run's budget and deadline, apply the cache retention."""
+    def start_day(self, should_stop: Callable[[], bool] | None = None) -> None:
+        """Start a run: reset the run's budget and deadline, apply the cache retention; *should_stop*, the
+        run's stop request, is polled between the long steps of listing (a :class:`StopRequested`)."""
 
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
         """The granule files of *satellite* for *day* whose product is in *products*."""

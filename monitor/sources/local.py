@@ -7,9 +7,11 @@ import logging
 import os
 import shutil
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from monitor.config import CalibrationDifference
+from monitor.errors import StopRequested
 from monitor.sdr.products import CRIS_PRODUCTS
 from monitor.sources import ListedFile, listed, on_day
 
@@ -26,6 +28,7 @@ class LocalSource:
 
     def __init__(self, root):
         self.root = Path(root)
+        self.should_stop: Callable[[], bool] | None = None
 
     def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
         """The granule files of *satellite* on *day* (and VIIRS of the days around it) whose product is in
@@ -48,8 +51,9 @@ class LocalSource:
         """The file itself: a local tree needs no download."""
         return Path(f.location)
 
-    def start_day(self):
-        """Nothing to reset for a local tree."""
+    def start_day(self, should_stop=None):
+        """Nothing to reset for a local tree; the run's *should_stop* is kept for a simulation."""
+        self.should_stop = should_stop
 
 
 class SimulatedSource(LocalSource):
@@ -63,7 +67,8 @@ class SimulatedSource(LocalSource):
         self.cfg = source_cfg
 
     def list_day(self, satellite, day, products):
-        """Simulate the satellite-day once (into ``root/<satellite>/<day>``), then list it."""
+        """Simulate the satellite-day once (into ``root/<satellite>/<day>``), then list it. A stop requested
+        during the simulation ends it within a granule's step, leaving no half-simulated day."""
         from monitor.simulate.case import simulate_case
 
         target = self.root / satellite / day.isoformat()
@@ -73,19 +78,23 @@ class SimulatedSource(LocalSource):
             LOG.info(
                 "simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target
             )
-            start = dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc)
             difference = self.cfg.calibration.get(satellite) or CalibrationDifference()
-            simulate_case(
-                target,
-                satellite=satellite,
-                granules=self.cfg.granules,
-                profile=self.cfg.profile,
-                seed=self.cfg.seed + day.toordinal() % 1000,
-                start=start,
-                cris_bias_k=difference.bias_k,
-                cris_gain=difference.gain,
-                cris_nonlinear_k=difference.nonlinear_k,
-            )
+            try:
+                simulate_case(
+                    target,
+                    satellite=satellite,
+                    granules=self.cfg.granules,
+                    profile=self.cfg.profile,
+                    seed=self.cfg.seed + day.toordinal() % 1000,
+                    start=dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc),
+                    cris_bias_k=difference.bias_k,
+                    cris_gain=difference.gain,
+                    cris_nonlinear_k=difference.nonlinear_k,
+                    should_stop=self.should_stop,
+                )
+            except StopRequested:  # a day half simulated is no day: simulated whole next time
+                shutil.rmtree(target, ignore_errors=True)
+                raise
         self.root.mkdir(parents=True, exist_ok=True)
         self._forget_old_days(keep=target)
         return LocalSource(target).list_day(satellite, day, products)

@@ -34,6 +34,7 @@ import re
 import threading
 import time
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from pathlib import Path
 from urllib.parse import urljoin, urlsplit
 
@@ -41,6 +42,7 @@ import requests
 import urllib3
 
 from monitor.config import SourceConfig
+from monitor.errors import StopRequested
 from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
 from monitor.sdr.readers import GranuleRef
 from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed, ranged
@@ -86,6 +88,7 @@ class NoddSource:
         self.downloaded_files = 0
         self.requests = 0  # HTTP requests sent in this run, listings included
         self.deadline: float | None = None
+        self.should_stop: Callable[[], bool] = lambda: False  # the run's stop request (start_day)
         self.sleep = sleep
 
     @property
@@ -110,9 +113,11 @@ class NoddSource:
             raise SourceError(f"no NODD bucket configured for {satellite}")
         return self.cfg.endpoint.format(bucket=bucket).rstrip("/")
 
-    def start_day(self):
+    def start_day(self, should_stop=None):
         """Start a run: reset the day's budget and the run deadline, apply the cache retention (age, then
-        size: the least recently used files go until the cache holds at most ``cache_max_mb``)."""
+        size: the least recently used files go until the cache holds at most ``cache_max_mb``); the run's
+        *should_stop* is polled between listing pages."""
+        self.should_stop = should_stop or (lambda: False)
         self.spent_bytes = 0
         self.downloaded_files = 0
         self.requests = 0
@@ -245,6 +250,8 @@ class NoddSource:
         folder = prefix.rsplit("/", 1)[0] + "/"
         what = f"listing {prefix}"
         for _ in range(self.cfg.max_list_pages):
+            if self.should_stop():
+                raise StopRequested
             params = {"list-type": "2", "prefix": prefix, "max-keys": "1000"}
             if token:
                 params["continuation-token"] = token
