@@ -78,48 +78,28 @@ class Finding:
         return f"{self.rule}:{self.satellite}:{self.group}"
 
 
-def _f(x):
-    return x is not None and math.isfinite(x)
-
-
 def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | None:
-    """FORs of the latest day whose in-track, cross-track or total error exceeds the specification.
+    """FORs of the latest day beyond the specification (:meth:`monitor.result.ForOffset.spec_breaches`:
+    in-track or cross-track, each on its own; FORs flagged unreliable never alert).
 
-    Critical when the breach holds beyond the uncertainty (value - 2 sigma > spec), warning otherwise.
-    FORs flagged unreliable never alert.
+    Critical when every breach of a FOR holds beyond the uncertainty (|error| - 2 sigma > spec), warning
+    otherwise.
     """
     day = store.latest_day(satellite)
     if day is None:
         return None
-    rows = []
-    for f in store.day_result(satellite, day):
-        if not f.reliable:
-            continue
-        sig_total = (
-            math.hypot(f.in_track_km * f.sigma_in_track_km, f.cross_track_km * f.sigma_cross_track_km)
-            / f.total_km
-            if _f(f.sigma_in_track_km) and f.total_km > 0
-            else float("nan")
-        )
-        checks = (
-            ("in-track", abs(f.in_track_km), f.sigma_in_track_km),
-            ("cross-track", abs(f.cross_track_km), f.sigma_cross_track_km),
-            ("total", f.total_km, sig_total),
-        )
-        over = [(name, v, sg) for name, v, sg in checks if _f(v) and v > s.spec_km]
-        if not over:
-            continue
-        critical = all(_f(sg) and v - 2 * sg > s.spec_km for _, v, sg in over)
-        rows.append((f, over, critical))
+    rows = [(f, f.spec_breaches(s.spec_km)) for f in store.day_result(satellite, day)]
+    rows = [(f, b) for f, b in rows if b]
     if not rows:
         return None
-    severity = Severity.CRITICAL if any(c for _, _, c in rows) else Severity.WARNING
-    fors = [f.for_index for f, _, _ in rows]
+    critical = [all(x.beyond_doubt for x in b) for _, b in rows]
+    severity = Severity.CRITICAL if any(critical) else Severity.WARNING
+    fors = [f.for_index for f, _ in rows]
     lines = [
         f"FOR {f.for_index:2d}: in-track {f.in_track_km:+.2f} +- {f.sigma_in_track_km:.2f} km, cross-track "
         f"{f.cross_track_km:+.2f} +- {f.sigma_cross_track_km:.2f} km, total {f.total_km:.2f} km "
-        f"(spec {s.spec_km} km){'' if c else ' (within 2 sigma of the spec)'}"
-        for f, _, c in rows
+        f"(spec {s.spec_km} km each way){'' if c else ' (within 2 sigma of the spec)'}"
+        for (f, _), c in zip(rows, critical, strict=True)
     ]
     return Finding(
         Rule.SPEC,

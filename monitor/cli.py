@@ -21,7 +21,7 @@ from monitor.config import AssessmentConfig
 from monitor.constants import N_FOV
 from monitor.errors import DataError
 from monitor.footprint import SHAPES as FOOTPRINTS
-from monitor.render import result_text, status_text
+from monitor.render import result_text
 from monitor.satellites import SATELLITES
 from monitor.simulate import LAYOUTS
 from monitor.simulate.orbit import PASSES
@@ -623,7 +623,7 @@ def cmd_status(args) -> int:
     import json
 
     from monitor.config import ConfigError
-    from monitor.status import NAGIOS_UNKNOWN, status_report
+    from monitor.status import NagiosState, status_report
     from monitor.store.sqlite import Store, StoreError
 
     try:
@@ -632,16 +632,14 @@ def cmd_status(args) -> int:
         store = Store(cfg.store.sqlite, create=False)
     except (BadInput, ConfigError, StoreError) as exc:
         if args.json:
-            print(json.dumps({"state": "UNKNOWN", "exit": NAGIOS_UNKNOWN, "error": str(exc)}))
-        print(f"crisgeo status: UNKNOWN: {exc}", file=sys.stderr)
-        return NAGIOS_UNKNOWN
+            print(json.dumps({"state": "UNKNOWN", "exit": NagiosState.UNKNOWN, "error": str(exc)}))
+        else:
+            print(f"UNKNOWN - {exc}")
+        return NagiosState.UNKNOWN
     with store:
-        rep = status_report(cfg, store, sats)
-    if args.json:
-        print(json.dumps(rep, indent=1, default=str))
-        return rep["exit"]
-    print(status_text(rep))
-    return rep["exit"]
+        status = status_report(cfg, store, sats)
+    print(json.dumps(status.to_dict(), indent=1, default=str) if args.json else status.text())
+    return status.state
 
 
 @command(

@@ -1,4 +1,9 @@
-"""One crisgeo process per state directory: the daemon, a run or a reprocessing each hold its lock."""
+"""One crisgeo process per state directory: the daemon, a run or a reprocessing each hold its lock.
+
+The lock file holds the holder's pid and role (``daemon``, ``run``, ``reprocess``); :func:`holder` asks the
+kernel's lock table (``/proc/locks``) whether that lock is still held, without taking it (a ``crisgeo
+status`` every few minutes must never stand in the daemon's way).
+"""
 
 from __future__ import annotations
 
@@ -15,8 +20,9 @@ class AlreadyRunning(RuntimeError):
 class InstanceLock:
     """An exclusive flock on ``state_dir/crisgeo.lock``, held for the life of the process."""
 
-    def __init__(self, state_dir: Path):
+    def __init__(self, state_dir: Path, role: str):
         self.path = Path(state_dir) / "crisgeo.lock"
+        self.role = role
         self.fh: IO[str] | None = None
 
     def __enter__(self):
@@ -26,7 +32,7 @@ class InstanceLock:
             fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             self.fh.seek(0)
-            holder = self.fh.read().strip()[:20] or "?"
+            holder = self.fh.read().split(" ")[0][:20] or "?"
             self.fh.close()
             raise AlreadyRunning(
                 f"{self.path}: another crisgeo process (pid {holder}) is running on this state directory. "
@@ -39,10 +45,28 @@ class InstanceLock:
             ) from None
         self.fh.seek(0)
         self.fh.truncate()
-        self.fh.write(str(os.getpid()))
+        self.fh.write(f"{os.getpid()} {self.role}")
         self.fh.flush()
         return self
 
     def __exit__(self, *exc):
         fcntl.flock(self.fh, fcntl.LOCK_UN)
         self.fh.close()
+
+
+def holder(state_dir: Path, role: str) -> int | None:
+    """The pid of the process of *role* holding *state_dir*'s lock, None when none does."""
+    path = Path(state_dir) / "crisgeo.lock"
+    try:
+        inode = path.stat().st_ino
+        pid, _, held_as = path.read_text().partition(" ")
+        table = Path("/proc/locks").read_text()
+    except (OSError, ValueError):
+        return None
+    if held_as.strip() != role:
+        return None
+    for line in table.splitlines():  # "1: FLOCK ADVISORY WRITE <pid> <maj>:<min>:<inode> 0 EOF"
+        fields = line.split()
+        if "FLOCK" in fields and "->" not in fields and fields[-3].endswith(f":{inode}"):
+            return int(fields[-4]) if fields[-4] == pid else None
+    return None

@@ -1,8 +1,8 @@
 """What the commands print: the per-FOR offset table, the status summary, the geolocation comparison.
 
 The command line parses its arguments and calls the service or the science; the text a person reads is
-made here, from the typed results, so that ``crisgeo assess``, ``crisgeo run`` and ``crisgeo status`` show
-FORs the same way.
+made here, from the typed results, so that ``crisgeo assess``, ``crisgeo run`` and ``crisgeo status``
+(:meth:`monitor.status.Status.text`) show FORs the same way.
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def for_table(fors: list[ForOffset], columns: tuple[str, ...] = FULL, indent: st
     """The per-FOR table: a header line, a unit line (for the full table) and a line per FOR, flags last."""
     cols = [FOR_COLUMNS[c] for c in columns]
     lines = [indent + " ".join(f"{c.header:>{c.width}}" for c in cols) + "  flags"]
-    if any(c.unit for c in cols) and columns == FULL:
+    if any(c.unit for c in cols):
         lines.append(indent + " ".join(f"{c.unit:>{c.width}}" for c in cols).rstrip())
     lines += [indent + " ".join(c.cell(f) for c in cols) + "  " + ",".join(f.flags) for f in fors]
     return lines
@@ -60,27 +60,4 @@ def result_text(result: AssessmentResult) -> str:
     lines = [f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules"]
     lines += for_table(result.fors)
     lines += [f"skipped {s['item']}: {s['reason']}" for s in result.skipped]
-    return "\n".join(lines)
-
-
-def status_text(rep: dict) -> str:
-    """What ``crisgeo status`` prints of :func:`monitor.status.status_report`."""
-    lines = [f"crisgeo status: {rep['state']}"]
-    for sat, s in rep["satellites"].items():
-        r = s["last_run"]
-        if r is None:
-            lines.append(f"{sat}: no run yet")
-            continue
-        lines.append(
-            f"{sat}: last run {r['day']} {r['status']} (finished {r['finished'] or '-'})"
-            + (f": {r['reason']}" if r["reason"] else "")
-        )
-        lines += [
-            f"  {a['severity']} {a['rule']}: {a['summary']} (since {a['started']})" for a in s["alerts"]
-        ]
-        if s["latest_day"]:
-            lines.append(f"  latest results: {s['latest_day']}")
-            lines += for_table([ForOffset.from_dict(f) for f in s["fors"]], BRIEF, indent="  ")
-    lines.append(f"next scheduled run: {rep['next_run_utc'].replace('T', ' ').replace('Z', '')} UTC")
-    lines.append(f"outbox: {rep['outbox']} point(s) waiting")
     return "\n".join(lines)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import asdict, dataclass, field, fields
 
 import numpy as np
@@ -14,6 +15,22 @@ FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
 FLAG_FLAT = "flat"  # the cost surface has no clear minimum (uniform scenes carry no information)
 FLAG_UNCERTAIN = "uncertain"  # the bootstrap spread of the offset exceeds the configured limit
 RELIABILITY_FLAGS = (FLAG_FEW_SAMPLES, FLAG_EDGE, FLAG_FLAT, FLAG_UNCERTAIN)
+
+
+@dataclass(frozen=True)
+class SpecBreach:
+    """One direction of a FOR beyond the geolocation specification: *direction* ``in-track`` or
+    ``cross-track``, the error and its sigma on the ground (km), the specification (km)."""
+
+    direction: str
+    error_km: float
+    sigma_km: float
+    spec_km: float
+
+    @property
+    def beyond_doubt(self) -> bool:
+        """The breach holds beyond the uncertainty: |error| - 2 sigma is still beyond the specification."""
+        return math.isfinite(self.sigma_km) and abs(self.error_km) - 2 * self.sigma_km > self.spec_km
 
 
 @dataclass(frozen=True)
@@ -68,6 +85,22 @@ class ForOffset:
     def reliable(self) -> bool:
         """Whether no flag of RELIABILITY_FLAGS is set: the offset may be trusted and alerted on."""
         return not any(f in RELIABILITY_FLAGS for f in self.flags)
+
+    def spec_breaches(self, spec_km: float) -> tuple[SpecBreach, ...]:
+        """The one definition of "out of spec": a reliable FOR whose in-track or cross-track error on the
+        ground exceeds *spec_km* in magnitude, each direction on its own (the specification is per
+        direction, as the paper plots it; the total is shown, never judged). Empty when within it, and
+        for an unreliable FOR (no trustworthy number to judge)."""
+        if not self.reliable:
+            return ()
+        return tuple(
+            SpecBreach(direction, error_km, sigma_km, spec_km)
+            for direction, error_km, sigma_km in (
+                ("in-track", self.in_track_km, self.sigma_in_track_km),
+                ("cross-track", self.cross_track_km, self.sigma_cross_track_km),
+            )
+            if math.isfinite(error_km) and abs(error_km) > spec_km
+        )
 
     def to_dict(self) -> dict:
         d = asdict(self)

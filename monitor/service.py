@@ -192,7 +192,7 @@ class Service:
         """``crisgeo run``: under the instance lock, recover what a killed process left, then per satellite
         the given *day* or the days of the catch-up window; the outcomes. :class:`AlreadyRunning` when the
         daemon (or another run) holds the state directory."""
-        with InstanceLock(self.cfg.state_dir):
+        with InstanceLock(self.cfg.state_dir, "run"):
             self.recover()
             outcomes: list[RunOutcome] = []
             for sat in satellites:
@@ -244,7 +244,7 @@ class Service:
     def daemon(self, listen: str | None = None):
         """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``."""
         sch = self.cfg.schedule
-        with InstanceLock(self.cfg.state_dir):
+        with InstanceLock(self.cfg.state_dir, "daemon"):
             endpoint = self.start_endpoint(listen or self.cfg.http.listen)
             self.recover()
             self.scheduler = BlockingScheduler(

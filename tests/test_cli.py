@@ -173,12 +173,15 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     store.finish_run(run, "failed", "HTTP 503")
     assert main(["status"]) == 2
     out = capsys.readouterr().out
-    assert "crisgeo status: CRITICAL" in out and "failed" in out and "warning jump" in out
+    first = out.splitlines()[0]
+    assert first == "CRITICAL - j01: run of 2024-06-01 failed: HTTP 503; a step at FOR 21-30", out
+    assert "warning jump" in out
     store.close()
     (tmp_path / "state" / "crisgeo.sqlite").write_bytes(b"garbage" * 100)
     assert main(["status", "--json"]) == 3 and json.loads(capsys.readouterr().out)["state"] == "UNKNOWN"
     monkeypatch.setenv("CRISGEO_CONFIG", str(tmp_path / "missing.yaml"))
-    assert main(["status"]) == 3 and "missing.yaml: cannot read" in capsys.readouterr().err
+    assert main(["status"]) == 3
+    assert capsys.readouterr().out.startswith("UNKNOWN - ") and "missing.yaml: cannot read"
 
 
 def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):

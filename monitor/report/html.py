@@ -101,15 +101,7 @@ def _latest_table(fors, spec_km) -> str:
     )
     rows = []
     for f in fors:
-        cls = (
-            "flag"
-            if not f.reliable
-            else (
-                "out"
-                if np.isfinite(f.total_km) and max(abs(f.in_track_km), abs(f.cross_track_km)) > spec_km
-                else ""
-            )
-        )
+        cls = "flag" if not f.reliable else "out" if f.spec_breaches(spec_km) else ""
         rows.append(
             f"<tr class='{cls}'><td>{f.for_index}</td><td>{_f(f.d_alpha_urad, '.0f')}</td>"
             f"<td>{_f(f.sigma_alpha_urad, '.0f')}</td><td>{_f(f.d_beta_urad, '.0f')}</td>"
