@@ -1,12 +1,14 @@
 """The daemon's one HTTP endpoint (``http.listen``, loopback by default): metrics, health, the report.
 
+    GET /           what is served here, as a short text
     GET /metrics    Prometheus text format (:mod:`monitor.metrics`)
     GET /healthz    200 {"status": "ok", ...} or 503 {"status": "unhealthy", "problems": [...]}
     GET /report/    the HTML report, read-only (files under ``report_dir``; no listings, no dotfiles such as
                     the temporary ``.name.part`` of a file being rewritten, nothing outside)
 
-Only GET and HEAD; any other path is 404. A stdlib threading server on its own daemon thread: a slow
-client cannot hold up the scheduler, and a scrape opens its own connection to the store.
+Only GET and HEAD (any other method is 405 with ``Allow: GET, HEAD``); any other path is 404. A stdlib
+threading server on its own daemon thread: a slow client cannot hold up the scheduler, and a scrape opens
+its own connection to the store.
 """
 
 from __future__ import annotations
@@ -22,6 +24,12 @@ from pathlib import Path
 from prometheus_client import CONTENT_TYPE_LATEST, generate_latest
 
 LOG = logging.getLogger(__name__)
+INDEX = (
+    b"crisgeo-monitor\n"
+    b"  /metrics   Prometheus metrics\n"
+    b"  /healthz   health (200 ok, 503 unhealthy), JSON\n"
+    b"  /report/   the HTML trend report\n"
+)
 
 
 class _Handler(SimpleHTTPRequestHandler):
@@ -38,9 +46,19 @@ class _Handler(SimpleHTTPRequestHandler):
     def do_HEAD(self):  # noqa: N802
         self._route(head=True)
 
+    def _not_allowed(self):
+        self.send_response(405)
+        self.send_header("Allow", "GET, HEAD")
+        self.send_header("Content-Length", "0")
+        self.end_headers()
+
+    do_POST = do_PUT = do_DELETE = do_PATCH = do_OPTIONS = _not_allowed  # noqa: N815
+
     def _route(self, head: bool):
         path = self.path.split("?", 1)[0]
-        if path == "/metrics":
+        if path == "/":
+            self._send(200, INDEX, "text/plain; charset=utf-8", head)
+        elif path == "/metrics":
             self._send(200, generate_latest(self.endpoint.metrics.registry), CONTENT_TYPE_LATEST, head)
         elif path == "/healthz":
             problems = self.endpoint.health.problems()

@@ -14,16 +14,24 @@ at each scrape, so it survives restarts and agrees with ``crisgeo status``; what
     crisgeo_nodd_requests_total{satellite}                HTTP requests to NODD by this process
     crisgeo_outbox_points{target}                         time-series points waiting to be sent
     crisgeo_alerts_firing{satellite,rule,severity}        alerts firing now
-    crisgeo_for_offset_urad{satellite,for,direction}      latest day's LOS offset (alpha, beta)
-    crisgeo_for_offset_km{satellite,for,direction}        latest day's offset in km (in/cross-track, total)
+    crisgeo_for_offset_radians{satellite,for,direction}   latest day's LOS offset (alpha, beta)
+    crisgeo_for_offset_meters{satellite,for,direction}    latest day's offset on the ground (in_track,
+                                                          cross_track, total)
+    crisgeo_for_beyond_spec{satellite,for}                1 when the FOR is beyond the specification (the
+                                                          one rule: monitor.result.ForOffset.spec_breaches)
     crisgeo_for_calibration_bias_kelvin{satellite,for}    latest CrIS - VIIRS bias at 280 K
-    crisgeo_for_calibration_gain_percent{satellite,for}   latest CrIS - VIIRS gain difference
+    crisgeo_for_calibration_gain_ratio{satellite,for}     latest CrIS - VIIRS gain difference (0.01 = 1 %)
     crisgeo_for_response_full_width_radians{satellite,for,level}  the CrIS FOV response's full width
                                                           at level 0.5 / 0.1 of its peak, fitted per FOR
     crisgeo_for_reliable{satellite,for}                   1 when the FOR carries no reliability flag
     crisgeo_latest_day_timestamp_seconds{satellite}       00:00 UTC of the latest assessed day
     crisgeo_healthy                                       1 when /healthz is ok
     crisgeo_build_info{version}                           always 1
+
+Prometheus' conventions: base units in the names (seconds, meters, radians, kelvin, ratios), ``_total``
+for counters, no ``_created`` series; the ``for`` label is zero-padded (``"01"``..``"30"``) as the
+InfluxDB tag is, so that both sort. The code's own names keep their unit suffixes (``_km``, ``_urad``):
+this is the one surface where the convention of its readers wins.
 
 The dead-man's rule (configs/prometheus/crisgeo-rules.yml) takes the last success, or for a satellite that
 never succeeded the time it has been watched since: a deployment that never works fires too.
@@ -34,12 +42,14 @@ from __future__ import annotations
 import datetime as dt
 import math
 
-from prometheus_client import CollectorRegistry, Counter, Gauge
+from prometheus_client import CollectorRegistry, Counter, Gauge, disable_created_metrics
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 
 from monitor.constants import URAD
 from monitor.store.alerts import AlertState
 from monitor.vocabulary import RunStatus
+
+disable_created_metrics()  # a counter's start time is not a series anyone graphs
 
 OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run row changes to one once
 
@@ -47,9 +57,10 @@ OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run
 class _StoreCollector:
     """Reads the store at each scrape (a new connection each time: scrapes come on the server's thread)."""
 
-    def __init__(self, open_store, satellites, health, started: dt.datetime):
+    def __init__(self, open_store, satellites, health, started: dt.datetime, spec_km: float):
         self.open_store = open_store
         self.satellites = list(satellites)
+        self.spec_km = spec_km
         self.health = health
         self.started = started
 
@@ -103,27 +114,32 @@ class _StoreCollector:
         for key, n in sorted(per.items()):
             g.add_metric(list(key), n)
         yield g
-        yield from self._offsets(latest, fors)
+        yield from self._offsets(latest, fors, self.spec_km)
         yield GaugeMetricFamily(
             "crisgeo_healthy", "1 when /healthz is ok", value=0 if self.health.problems() else 1
         )
 
     @staticmethod
-    def _offsets(latest, fors):
+    def _offsets(latest, fors, spec_km: float):
         day = GaugeMetricFamily(
             "crisgeo_latest_day_timestamp_seconds",
             "00:00 UTC of the latest assessed day",
             labels=["satellite"],
         )
-        urad = GaugeMetricFamily(
-            "crisgeo_for_offset_urad",
-            "Latest LOS offset per FOR (spacecraft frame)",
+        rad = GaugeMetricFamily(
+            "crisgeo_for_offset_radians",
+            "Latest LOS offset per FOR (spacecraft frame; the turn to apply to the CrIS LOS)",
             labels=["satellite", "for", "direction"],
         )
-        km = GaugeMetricFamily(
-            "crisgeo_for_offset_km",
+        meters = GaugeMetricFamily(
+            "crisgeo_for_offset_meters",
             "Latest offset per FOR on the ground",
             labels=["satellite", "for", "direction"],
+        )
+        beyond = GaugeMetricFamily(
+            "crisgeo_for_beyond_spec",
+            "1 when the FOR's latest in-track or cross-track error is beyond the specification",
+            labels=["satellite", "for"],
         )
         bias = GaugeMetricFamily(
             "crisgeo_for_calibration_bias_kelvin",
@@ -131,8 +147,8 @@ class _StoreCollector:
             labels=["satellite", "for"],
         )
         gain = GaugeMetricFamily(
-            "crisgeo_for_calibration_gain_percent",
-            "Latest CrIS minus VIIRS I5 gain difference per FOR (per cent of the BT's departure from 280 K)",
+            "crisgeo_for_calibration_gain_ratio",
+            "Latest CrIS minus VIIRS I5 gain difference per FOR (fraction of the BT's departure from 280 K)",
             labels=["satellite", "for"],
         )
         width = GaugeMetricFamily(
@@ -150,34 +166,35 @@ class _StoreCollector:
                 continue
             day.add_metric([sat], dt.datetime.combine(d, dt.time(), dt.timezone.utc).timestamp())
             for f in fors[sat]:
-                k = str(f.for_index)
+                k = f"{f.for_index:02d}"
                 for direction, v in (("alpha", f.d_alpha_urad), ("beta", f.d_beta_urad)):
                     if math.isfinite(v):
-                        urad.add_metric([sat, k, direction], v)
+                        rad.add_metric([sat, k, direction], v * URAD)
                 for direction, v in (
                     ("in_track", f.in_track_km),
                     ("cross_track", f.cross_track_km),
                     ("total", f.total_km),
                 ):
                     if math.isfinite(v):
-                        km.add_metric([sat, k, direction], v)
-                for family, v in ((bias, f.bias_k), (gain, f.gain_pct)):
+                        meters.add_metric([sat, k, direction], 1000.0 * v)
+                beyond.add_metric([sat, k], 1 if f.spec_breaches(spec_km) else 0)
+                for family, v in ((bias, f.bias_k), (gain, f.gain_pct / 100.0)):
                     if math.isfinite(v):
                         family.add_metric([sat, k], v)
                 for level, v in (("0.5", f.response_width_50_urad), ("0.1", f.response_width_10_urad)):
                     if math.isfinite(v):
                         width.add_metric([sat, k, level], v * URAD)
                 ok.add_metric([sat, k], 1 if f.reliable else 0)
-        yield from (day, urad, km, bias, gain, width, ok)
+        yield from (day, rad, meters, beyond, bias, gain, width, ok)
 
 
 class ServiceMetrics:
     """The daemon's registry: the store's view at each scrape plus this process's run figures."""
 
-    def __init__(self, open_store, satellites, health, version: str):
+    def __init__(self, open_store, satellites, health, version: str, spec_km: float):
         self.registry = CollectorRegistry()
         self.registry.register(
-            _StoreCollector(open_store, satellites, health, dt.datetime.now(dt.timezone.utc))
+            _StoreCollector(open_store, satellites, health, dt.datetime.now(dt.timezone.utc), spec_km)
         )
         self.duration = Gauge(
             "crisgeo_run_duration_seconds",

@@ -237,7 +237,9 @@ class Service:
         if listen == "off":
             return None
 
-        self.metrics = ServiceMetrics(self.store, self.cfg.satellites, self.health, __version__)
+        self.metrics = ServiceMetrics(
+            self.store, self.cfg.satellites, self.health, __version__, self.cfg.alerts.spec_km
+        )
         report = self.cfg.report_dir if self.cfg.report_dir else None
         return Endpoint(*parse_listen(listen), self.metrics, self.health, report).start()
 

@@ -136,20 +136,30 @@ def test_metrics_after_a_run(served):
     store = Store(db)
     fors = store.day_result("j01", store.latest_day("j01"))
     store.close()
+    # Prometheus' base units in the names, the FOR label zero-padded as the InfluxDB tag (it sorts)
     alpha = {
-        int(s.labels["for"]): s.value
-        for s in _samples(fams["crisgeo_for_offset_urad"], satellite="j01", direction="alpha")
+        s.labels["for"]: s.value
+        for s in _samples(fams["crisgeo_for_offset_radians"], satellite="j01", direction="alpha")
     }
-    assert sorted(alpha) == list(range(1, 31))
-    assert all(abs(alpha[f.for_index] - f.d_alpha_urad) < 1e-6 for f in fors)
-    assert len(_samples(fams["crisgeo_for_offset_km"], satellite="j01", direction="total")) == 30
-    for family, name in (
-        ("crisgeo_for_calibration_bias_kelvin", "bias_k"),
-        ("crisgeo_for_calibration_gain_percent", "gain_pct"),
+    assert sorted(alpha) == [f"{k:02d}" for k in range(1, 31)]
+    assert all(abs(alpha[f"{f.for_index:02d}"] - f.d_alpha_urad * 1e-6) < 1e-12 for f in fors)
+    total = {
+        int(s.labels["for"]): s.value
+        for s in _samples(fams["crisgeo_for_offset_meters"], satellite="j01", direction="total")
+    }
+    assert all(abs(total[f.for_index] - 1000 * f.total_km) < 1e-6 for f in fors)
+    beyond = {
+        int(s.labels["for"]): s.value for s in _samples(fams["crisgeo_for_beyond_spec"], satellite="j01")
+    }
+    assert beyond == {f.for_index: (1.0 if f.spec_breaches(1.5) else 0.0) for f in fors}
+    assert sum(beyond.values()) > 0  # the paper's pattern: FORs 26-30 beyond
+    for family, name, scale in (
+        ("crisgeo_for_calibration_bias_kelvin", "bias_k", 1.0),
+        ("crisgeo_for_calibration_gain_ratio", "gain_pct", 0.01),
     ):
         got = {int(s.labels["for"]): s.value for s in _samples(fams[family], satellite="j01")}
         assert got and all(
-            abs(got[f.for_index] - getattr(f, name)) < 1e-9 for f in fors if f.for_index in got
+            abs(got[f.for_index] - scale * getattr(f, name)) < 1e-9 for f in fors if f.for_index in got
         )
         assert len(got) == sum(np.isfinite(getattr(f, name)) for f in fors)
     # the CrIS response's widths, in radians (Prometheus' base unit), where the day fitted one
@@ -168,6 +178,8 @@ def test_metrics_after_a_run(served):
     assert all(reliable[f.for_index] == (1 if f.reliable else 0) for f in fors)
     assert fams["crisgeo_healthy"].samples[0].value == 1
     assert _samples(fams["crisgeo_build_info"])[0].labels["version"]
+    text = requests.get(url + "/metrics", timeout=10).text
+    assert "_created" not in text and "_km" not in text and "_urad" not in text and "percent" not in text
 
 
 def test_healthz_when_all_is_well(served):
@@ -194,10 +206,13 @@ def test_report_served_read_only(served, tmp_path):
         "/report/empty/",
         "/report/.trend.png.part",
         "/c.yaml",
-        "/",
     ):
         assert requests.get(url + bad, timeout=10).status_code == 404, bad
-    assert requests.post(url + "/metrics", timeout=10).status_code == 501
+    index = requests.get(url + "/", timeout=10)
+    assert index.status_code == 200 and all(p in index.text for p in ("/metrics", "/healthz", "/report/"))
+    for method in ("POST", "PUT", "DELETE", "PATCH"):
+        answer = requests.request(method, url + "/metrics", timeout=10)
+        assert (answer.status_code, answer.headers["Allow"]) == (405, "GET, HEAD"), method
     driver = chromium_driver(tmp_path)
     try:
         driver.get(url + "/report/j01/")
@@ -280,7 +295,7 @@ def test_a_satellite_that_never_succeeded_is_visible_to_the_dead_mans_rule(tmp_p
     with Store(db) as store:
         run = store.begin_run("j01", dt.date(2024, 6, 1))
         store.finish_run(run, "failed", "HTTP 503")
-    m = ServiceMetrics(lambda: Store(db), ["j01", "npp"], Health(60), "test")
+    m = ServiceMetrics(lambda: Store(db), ["j01", "npp"], Health(60), "test", 1.5)
     fams = {f.name: f for f in text_string_to_metric_families(generate_latest(m.registry).decode())}
     last = {s.labels["satellite"]: s.value for s in fams["crisgeo_last_success_timestamp_seconds"].samples}
     since = {s.labels["satellite"]: s.value for s in fams["crisgeo_watched_since_timestamp_seconds"].samples}

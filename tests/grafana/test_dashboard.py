@@ -156,7 +156,7 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
         Finding("spec", "j01", "critical", "FOR 30 beyond spec"), "firing", dt.datetime.now(UTC), True
     )
     store.close()
-    metrics = ServiceMetrics(lambda: Store(db), ["j01"], Health(300), "test")
+    metrics = ServiceMetrics(lambda: Store(db), ["j01"], Health(300), "test", 1.5)
     panels = [p for p in dashboard["panels"] if p.get("datasource", {}).get("type") == "prometheus"]
     assert {p["type"] for p in panels} == {"stat", "timeseries"} and len(panels) == 5
     assert any(
