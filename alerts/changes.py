@@ -84,10 +84,15 @@ def load_calendar(path) -> list[Change]:
 
 def add_to_calendar(path, change: Change) -> None:
     """Append *change* to the calendar YAML at *path* (created if missing). The file is edited as a
-    round trip (ruamel.yaml): its comments, order and quoting stay as the team wrote them."""
+    round trip (ruamel.yaml): its comments, order and quoting stay as the team wrote them. A change the
+    calendar already holds (same satellite, time, instrument and kind) is a ValueError naming it."""
     from ruamel.yaml import YAML
 
     path = Path(path)
+    same = (change.satellite, change.time, change.instrument, change.kind)
+    for old in load_calendar(path):
+        if (old.satellite, old.time, old.instrument, old.kind) == same:
+            raise ValueError(f"{path}: already in the calendar: {old.label()}")
     rt = YAML()  # round-trip mode
     rt.preserve_quotes = True
     rt.width = 4096  # long descriptions stay on their lines

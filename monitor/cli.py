@@ -715,7 +715,7 @@ def cmd_alerts(args) -> int:
         "calendar (its comments are kept)",
     ),
     CONFIG,
-    arg("--satellite", choices=tuple(SATELLITES), help="add: the satellite"),
+    arg("--satellite", choices=tuple(SATELLITES), help="list: only this satellite; add: the satellite"),
     arg("--time", type=_iso, help="add: when (ISO 8601, UTC)"),
     arg("--instrument", choices=("cris", "viirs", "common"), help="add: the instrument changed"),
     arg("--kind", default="change", help="add: ep_upload, lut_change, software, ..."),
@@ -736,15 +736,37 @@ def cmd_events(args) -> int:
                 cfg.events_file,
                 Change(args.time, args.satellite, args.instrument, args.kind, args.description, "calendar"),
             )
-        except (OSError, ValueError) as exc:
-            raise BadInput(f"{cfg.events_file}: {exc}") from None
+        except OSError as exc:
+            raise BadInput(f"{cfg.events_file}: {exc.strerror or exc}") from None
+        except ValueError as exc:  # its message names the file
+            raise BadInput(str(exc)) from None
         print(f"added to {cfg.events_file}")
         return EXIT_OK
+    calendar = _calendar(cfg.events_file)
+    known = {c.satellite for c in calendar} | set(cfg.satellites)
+    chosen = [args.satellite] if args.satellite else [s for s in SATELLITES if s in known]
+    if not cfg.store.sqlite.exists():  # before the first run: the calendar alone
+        for c in sorted(calendar, key=lambda c: c.time):
+            if c.satellite in chosen:
+                print(f"{c.satellite} {c.label()}")
+        return EXIT_OK
     with _open_store(cfg) as store:
-        for sat in cfg.satellites:
+        for sat in chosen:
             for c in all_changes(store, sat, cfg.events_file):
                 print(f"{sat} {c.label()}")
     return EXIT_OK
+
+
+def _calendar(path):
+    """The events calendar at *path*; a calendar that does not load is bad input, named."""
+    from alerts.changes import load_calendar
+
+    try:
+        return load_calendar(path)
+    except OSError as exc:
+        raise BadInput(f"{path}: {exc.strerror or exc}") from None
+    except ValueError as exc:  # its message names the file and the entry
+        raise BadInput(str(exc)) from None
 
 
 @command(
