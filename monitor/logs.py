@@ -2,7 +2,9 @@
 
 Under systemd (``JOURNAL_STREAM`` is set) every line starts with its syslog priority, ``<3>`` for an error
 (sd-daemon(3)): the journal stores it as the line's priority, so ``journalctl -u crisgeo -p err`` finds the
-failed runs, and it stamps the time itself. JSON lines carry the context of the satellite-day they belong
+failed runs, and it stamps the time itself. The journal's stream makes an entry of every line, so an event
+is kept on one line: the lines of a traceback are joined with `` | `` (one entry per event, not twenty).
+On a terminal, times are UTC and say so (``2026-11-25T03:30:01Z``), as every time the service prints. JSON lines carry the context of the satellite-day they belong
 to as fields (``satellite``, ``day``, ``stage``, ``run_id``), set by :func:`context` around the work.
 
 Libraries speak at WARNING and above: APScheduler alone would write two INFO lines for every 30 s
@@ -16,6 +18,7 @@ import datetime as dt
 import json
 import logging
 import os
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -60,9 +63,18 @@ class JournalFormatter(logging.Formatter):
         super().__init__("%(levelname)s %(name)s: %(message)s")
 
     def format(self, record):
-        """The line, its priority first (on each line of a traceback too)."""
-        prefix = f"<{priority(record.levelno)}>"
-        return "\n".join(prefix + line for line in super().format(record).splitlines())
+        """One line, its priority first; a traceback's lines follow on it, joined by `` | ``."""
+        lines = [line for line in super().format(record).splitlines() if line.strip()]
+        return f"<{priority(record.levelno)}>" + " | ".join(line.strip() for line in lines)
+
+
+class UtcFormatter(logging.Formatter):
+    """``2026-11-25T03:30:01Z LEVEL logger: message``: the time in UTC, whatever the host's zone."""
+
+    converter = time.gmtime
+
+    def __init__(self):
+        super().__init__("%(asctime)s %(levelname)s %(name)s: %(message)s", "%Y-%m-%dT%H:%M:%SZ")
 
 
 class JsonFormatter(logging.Formatter):
@@ -95,7 +107,7 @@ def setup(verbose: bool, log_format: str) -> None:
     elif os.environ.get("JOURNAL_STREAM"):
         handler.setFormatter(JournalFormatter())
     else:
-        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+        handler.setFormatter(UtcFormatter())
     logging.basicConfig(level=logging.DEBUG if verbose else logging.INFO, handlers=[handler], force=True)
     for name in QUIET_LIBRARIES:
         logging.getLogger(name).setLevel(logging.DEBUG if verbose else logging.WARNING)

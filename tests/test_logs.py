@@ -1,5 +1,6 @@
 """Log lines for the journal (priorities, no library chatter) and as JSON (with the satellite-day)."""
 
+import calendar
 import io
 import json
 import logging
@@ -51,7 +52,25 @@ def test_journal_lines_carry_syslog_priorities_and_libraries_stay_quiet(captured
     assert lines[0] == "<3>ERROR monitor.service: run j01 2024-06-01: failed (SourceError: ...)"
     assert lines[1].startswith("<4>WARNING") and lines[2].startswith("<6>INFO")
     assert not any("heartbeat" in line for line in lines)  # a 30 s job leaves no line at INFO
-    assert lines[3].startswith("<3>ERROR") and all(line.startswith("<3>") for line in lines[3:])  # traceback
+    assert len(lines) == 4  # a traceback is one journal entry: its lines joined on the event's line
+    assert lines[3].startswith("<3>ERROR monitor.service: unexpected | Traceback (most recent call last): | ")
+    assert lines[3].endswith(" | ValueError: boom")
+
+
+def test_text_lines_are_stamped_in_utc_whatever_the_zone(captured, monkeypatch):
+    monkeypatch.setenv("TZ", "America/New_York")
+    time.tzset()
+    try:
+        out = captured("text")
+        before = time.time()
+        logging.getLogger("monitor.service").info("daily at 03:30 UTC")
+        stamp = out.getvalue().split(" ", 1)[0]
+        assert stamp.endswith("Z")
+        logged = calendar.timegm(time.strptime(stamp, "%Y-%m-%dT%H:%M:%SZ"))
+        assert abs(logged - before) < 5  # read back as UTC, it is now
+    finally:
+        monkeypatch.delenv("TZ")
+        time.tzset()
 
 
 def test_json_lines_carry_the_satellite_day_they_belong_to(captured):
