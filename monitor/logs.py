@@ -6,7 +6,8 @@ failed runs, and it stamps the time itself. The journal's stream makes an entry 
 is kept on one line: the lines of a traceback are joined with `` | `` (one entry per event, not twenty).
 On a terminal, times are UTC and say so (``2026-11-25T03:30:01Z``), as every time the service prints.
 
-JSON lines carry the context of the satellite-day they belong to as fields (``satellite``, ``day``, ``stage``, ``run_id``), set by :func:`context` around the work.
+JSON lines carry the context of the satellite-day they belong to as fields (``satellite``, ``day``,
+``stage``, ``run_id``), set by :func:`context` around the work.
 
 Libraries speak at WARNING and above: APScheduler alone would write two INFO lines for every 30 s
 heartbeat, ~5,800 lines a day (``-v`` brings them back, with everything at DEBUG).
