@@ -73,7 +73,7 @@ RESIDUAL_ARGS = (
         help="learn each granule's residual from itself, against the EP it was made with",
     ),
 )
-RULES = tuple(Rule)
+RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices' repr
 COMMANDS: dict = {}  # name -> (handler, help, arguments), in the order of ``crisgeo --help``
 
 
@@ -327,14 +327,14 @@ def cmd_geolocate(args) -> int:
     arg("--step-urad", type=float, default=ASSESSMENT.step_urad, help="perturbation step, urad"),
     arg(
         "--kernel",
-        choices=tuple(Kernel),
-        default=ASSESSMENT.kernel,
+        choices=tuple(k.value for k in Kernel),
+        default=ASSESSMENT.kernel.value,
         help="FOV weighting: top-hat cone or the CrIS spatial response",
     ),
     arg(
         "--cost",
-        choices=tuple(Cost),
-        default=ASSESSMENT.cost,
+        choices=tuple(c.value for c in Cost),
+        default=ASSESSMENT.cost.value,
         help="stdev (the paper's) or regression (unmoved by a CrIS-VIIRS gain or bias)",
     ),
     arg("--workers", type=int, default=ASSESSMENT.workers, help="threads of the compiled kernels"),
@@ -389,7 +389,8 @@ def _load(args, writes: bool = False):
         return cfg
     except ConfigError as exc:
         msg = str(exc)
-        raise BadInput(msg if msg.startswith(str(args.config)) else f"{args.config}: {msg}") from None
+        named = msg.startswith((str(args.config), str(Path(args.config))))  # most errors name the file
+        raise BadInput(msg if named else f"{args.config}: {msg}") from None
 
 
 @command(
@@ -433,8 +434,10 @@ def cmd_check_config(args) -> int:
         return EXIT_OK
     cfg = _load(args)
     print(f"# {args.config}: valid; with every default (this output loads as a configuration)")
-    for line in secret_status(cfg):
-        print(f"# secret {line}")
+    for where, variable, is_set in secret_status(cfg):
+        print(f"# secret {where}: {variable} ({'set' if is_set else 'not set'})")
+        if not is_set:  # the file is valid; the service would fail to send
+            print(f"crisgeo check-config: warning: {where}: {variable} is not set", file=sys.stderr)
     print(yaml.safe_dump(effective(cfg), sort_keys=False, default_flow_style=False), end="")
     return EXIT_OK
 
@@ -873,7 +876,12 @@ def cmd_report(args) -> int:
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
     arg("--workers", type=int, default=2, help="threads of the compiled kernels (default 2)"),
-    arg("--cost", choices=tuple(Cost), default=ASSESSMENT.cost, help="the cost to time (assessment.cost)"),
+    arg(
+        "--cost",
+        choices=tuple(c.value for c in Cost),
+        default=ASSESSMENT.cost.value,
+        help="the cost to time (assessment.cost)",
+    ),
 )
 def cmd_bench(args) -> int:
     """crisgeo bench: time each stage on a simulated case."""

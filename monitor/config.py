@@ -108,6 +108,12 @@ def _env_name(value: str) -> str:
 
 
 def _hhmm(value: Any) -> dt.time:
+    if isinstance(value, int) and not isinstance(value, bool) and 0 <= value < 24 * 60:
+        # YAML 1.1 reads an unquoted 3:30 as a base-60 number
+        raise ValueError(
+            f"{value} is not HH:MM (YAML reads an unquoted {value // 60}:{value % 60:02d} as the number "
+            f"{value}: quote it, '{value // 60:02d}:{value % 60:02d}')"
+        )
     m = re.fullmatch(r"(\d{1,2}):(\d{2})", value, re.ASCII) if isinstance(value, str) else None
     if not m or int(m[1]) > 23 or int(m[2]) > 59:
         raise ValueError(f"{value!r} is not HH:MM")
@@ -891,15 +897,15 @@ def effective(cfg: Config) -> dict:
     return out
 
 
-def secret_status(cfg: Config) -> list[str]:
-    """``KEY: VARIABLE (set | not set)`` for every ``*_env`` key of the configuration."""
+def secret_status(cfg: Config) -> list[tuple[str, str, bool]]:
+    """(KEY, VARIABLE, whether it is set) for every ``*_env`` key of the configuration."""
     lines = []
 
     def walk(doc: Any, where: str) -> None:
         if isinstance(doc, dict):
             for k, v in doc.items():
                 if k.endswith("_env") and v:
-                    lines.append(f"{where}{k}: {v} ({'set' if env_secret(v) else 'not set'})")
+                    lines.append((f"{where}{k}", v, bool(env_secret(v))))
                 walk(v, f"{where}{k}.")
         elif isinstance(doc, list):
             for i, v in enumerate(doc):

@@ -151,7 +151,7 @@ def export(store: History, satellite: str, out, fmt: str, since=None, until=None
     cannot be written."""
     out = Path(out)
     if not out.parent.is_dir():
-        raise FileNotFoundError(f"--out {out}: the folder {out.parent} does not exist")
+        raise FileNotFoundError(f"the folder {out.parent} does not exist")
     ds = to_xarray(store, satellite, since, until)
     if ds.sizes["time"] == 0:
         period = f"{since or 'the beginning'} .. {until or 'the end'}"
