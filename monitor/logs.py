@@ -73,7 +73,7 @@ class JournalFormatter(logging.Formatter):
 class UtcFormatter(logging.Formatter):
     """``2026-11-25T03:30:01Z LEVEL logger: message``: the time in UTC, whatever the host's zone."""
 
-    converter = time.gmtime
+    converter = staticmethod(time.gmtime)
 
     def __init__(self):
         super().__init__("%(asctime)s %(levelname)s %(name)s: %(message)s", "%Y-%m-%dT%H:%M:%SZ")
