@@ -1016,6 +1016,10 @@ def main(argv=None) -> int:
     except StoreError as exc:
         print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
         return EXIT_FAIL
+    except OSError as exc:  # the machine's, not the input's (a full disk, a lost mount): one line naming it
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"crisgeo {args.command}: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_FAIL
     except KeyboardInterrupt:
         return 130
 

@@ -651,6 +651,14 @@ class Config(Section):
         "Directory of the service's state: store, download cache, simulated granules, "
         "lock. Relative paths in the file are relative to the file.",
     )
+    min_free_mb: int = key(
+        2000,
+        "Room a satellite-day needs on state_dir's file system (downloads, block cache, simulated granules, "
+        "the store); a run that finds less ends before it starts, recorded failed and redone once there is "
+        "room.",
+        0,
+        10**7,
+    )
     source: SourceConfig = key(..., "Where granules come from (the keys below).")
     schedule: ScheduleConfig = key(ScheduleConfig, "When the daemon runs (the keys below).")
     scenes: SceneConfig = key(SceneConfig, "Which granules are assessed (the keys below).")

@@ -7,6 +7,7 @@ status`` every few minutes must never stand in the daemon's way).
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import os
 from pathlib import Path
@@ -43,10 +44,16 @@ class InstanceLock:
                 "start "
                 f"it again"
             ) from None
-        self.fh.seek(0)
-        self.fh.truncate()
-        self.fh.write(f"{os.getpid()} {self.role}")
-        self.fh.flush()
+        try:
+            self.fh.seek(0)
+            self.fh.truncate()
+            self.fh.write(f"{os.getpid()} {self.role}")
+            self.fh.flush()
+        except OSError as exc:  # a full disk: named, and the lock let go
+            fcntl.flock(self.fh, fcntl.LOCK_UN)
+            with contextlib.suppress(OSError):  # closing flushes the same bytes again
+                self.fh.close()
+            raise OSError(exc.errno, exc.strerror, str(self.path)) from None
         return self
 
     def __exit__(self, *exc):

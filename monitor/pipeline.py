@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+import shutil
 import time
 from dataclasses import asdict, dataclass, field
 
@@ -33,6 +34,23 @@ from monitor.store.timeseries import change_lines, drain_outbox, result_lines, t
 from monitor.vocabulary import EventKind, RunStatus
 
 LOG = logging.getLogger(__name__)
+
+
+class NoRoom(OSError):
+    """The file system of the state directory has less room than a satellite-day needs."""
+
+
+def check_room(cfg: Config) -> None:
+    """:class:`NoRoom` naming the folder when the file system of ``state_dir`` (the store, the download
+    cache, simulated granules) has less than ``min_free_mb`` free: the day is not begun, and is redone
+    once there is room."""
+    probe = next(p for p in (cfg.state_dir, *cfg.state_dir.parents) if p.exists())
+    free_mb = shutil.disk_usage(probe).free / 2**20
+    if free_mb < cfg.min_free_mb:
+        raise NoRoom(
+            f"{cfg.state_dir}: {free_mb:.0f} MB free, a day needs min_free_mb {cfg.min_free_mb}; the day is "
+            "redone once there is room"
+        )
 
 
 class ProgressLines:
@@ -214,6 +232,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
     t0 = time.perf_counter()
     try:
         logs.stage("list")
+        check_room(cfg)
         source.start_day(stop)
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
         w.timings["list"] = time.perf_counter() - t0
@@ -266,6 +285,8 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
             raise StopRequested
     except StopRequested:
         w.status, w.reason, w.result = RunStatus.INTERRUPTED, "stop requested", None
+    except NoRoom as exc:
+        w.status, w.reason, w.result = RunStatus.FAILED, f"no room: {exc}", None
     except (SourceError, DataError, OSError) as exc:
         w.status, w.reason, w.result = RunStatus.FAILED, f"{type(exc).__name__}: {exc}", None
     except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run

@@ -11,7 +11,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 from monitor.config import CalibrationDifference
-from monitor.errors import StopRequested
 from monitor.sdr.products import CRIS_PRODUCTS
 from monitor.sources import ListedFile, listed, on_day
 
@@ -68,7 +67,8 @@ class SimulatedSource(LocalSource):
 
     def list_day(self, satellite, day, products):
         """Simulate the satellite-day once (into ``root/<satellite>/<day>``), then list it. A stop requested
-        during the simulation ends it within a granule's step, leaving no half-simulated day."""
+        during the simulation ends it within a granule's step; a stop or a failure (a full disk) leaves no
+        half-simulated day."""
         from monitor.simulate.case import simulate_case
 
         target = self.root / satellite / day.isoformat()
@@ -92,7 +92,9 @@ class SimulatedSource(LocalSource):
                     cris_nonlinear_k=difference.nonlinear_k,
                     should_stop=self.should_stop,
                 )
-            except StopRequested:  # a day half simulated is no day: simulated whole next time
+            except (
+                BaseException
+            ):  # stopped or out of room: a day half simulated is no day (and frees the room)
                 shutil.rmtree(target, ignore_errors=True)
                 raise
         self.root.mkdir(parents=True, exist_ok=True)

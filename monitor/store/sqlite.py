@@ -213,8 +213,9 @@ class Store:
         return self.clock().astimezone(UTC).isoformat(timespec="seconds")
 
     def transaction(self) -> _Transaction:
-        """A context manager: BEGIN IMMEDIATE ... COMMIT, rolled back on an exception."""
-        return _Transaction(self.db)
+        """A context manager: BEGIN IMMEDIATE ... COMMIT, rolled back on an exception; a file system
+        without room is a :class:`StoreError` naming the file (the transaction rolled back whole)."""
+        return _Transaction(self.db, self.path)
 
     def alert_state(self) -> AlertState:
         """The alert state, silences and delivery queue of this store."""
@@ -587,8 +588,9 @@ class Store:
 
 
 class _Transaction:
-    def __init__(self, db):
+    def __init__(self, db, path: Path):
         self.db = db
+        self.path = path
         self.depth_outer = False
 
     def __enter__(self):
@@ -598,6 +600,18 @@ class _Transaction:
         return self.db
 
     def __exit__(self, exc_type, exc, tb):
-        if self.depth_outer:
-            self.db.execute("ROLLBACK" if exc_type else "COMMIT")
+        if not self.depth_outer:
+            return False
+        try:
+            if exc_type is None:
+                self.db.execute("COMMIT")
+                return False
+        except sqlite3.OperationalError as failed:
+            exc = failed
+        if self.db.in_transaction:
+            self.db.execute("ROLLBACK")
+        if isinstance(exc, sqlite3.OperationalError) and exc.sqlite_errorcode == sqlite3.SQLITE_FULL:
+            raise StoreError(f"{self.path}: no room left on its file system ({exc}); nothing was written")
+        if exc_type is None:  # a COMMIT that failed otherwise
+            raise exc
         return False
