@@ -446,15 +446,15 @@ def cmd_check_config(args) -> int:
     "export",
     "per-FOR results as CF NetCDF (xarray) or CSV",
     CONFIG,
-    arg("--format", choices=("netcdf", "csv"), default="netcdf"),
-    arg("--out", required=True),
+    arg("--format", choices=("netcdf", "csv"), help="netcdf or csv (default: from the suffix of --out)"),
+    arg("--out", required=True, help="the file to write: FILE.nc (NetCDF) or FILE.csv"),
     arg("--satellite", choices=tuple(SATELLITES)),
     arg("--since", type=_day, help="first day, YYYY-MM-DD"),
     arg("--until", type=_day, help="last day, YYYY-MM-DD"),
 )
 def cmd_export(args) -> int:
     """crisgeo export: the results as NetCDF or CSV."""
-    from monitor.export import NothingToExport, export
+    from monitor.export import ExportFormatError, NothingToExport, export
 
     cfg = _load(args)
     sats = _satellites(cfg, args.satellite)
@@ -464,12 +464,12 @@ def cmd_export(args) -> int:
         raise BadInput(f"--since {args.since} is after --until {args.until}")
     with _open_store(cfg) as store:
         try:
-            path = export(store, sats[0], args.out, args.format, args.since, args.until)
+            path = export(store, sats[0], args.out, args.format, args.since, args.until, cfg.export)
         except ImportError as exc:
             raise BadInput(
                 f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
             ) from None
-        except NothingToExport as exc:
+        except (NothingToExport, ExportFormatError) as exc:
             raise BadInput(str(exc)) from None
         except OSError as exc:
             raise BadInput(f"--out {args.out}: {exc.strerror or exc}") from None

@@ -434,6 +434,21 @@ class FingerprintConfig(Section):
     )
 
 
+class ExportConfig(Section):
+    """The ``export`` section: who publishes the exported NetCDF (ACDD 1.3 discovery attributes); a key
+    left out leaves its attribute out."""
+
+    institution: Text | None = key(None, "ACDD institution: the organisation that runs the monitor.")
+    creator_name: Text | None = key(None, "ACDD creator_name: the team or person who made the data.")
+    creator_email: Text | None = key(None, "ACDD creator_email: where users write about the data.")
+    creator_url: Url | None = key(None, "ACDD creator_url: the team's page.")
+    license: Text | None = key(None, "ACDD license: the terms of use (e.g. an SPDX identifier, CC0-1.0).")
+    naming_authority: Text | None = key(
+        None, "ACDD naming_authority, reverse DNS (gov.noaa.star); a file's id is unique within it."
+    )
+    project: Text | None = key(None, "ACDD project: the programme the data serve (e.g. JPSS).")
+
+
 class HttpConfig(Section):
     """The ``http`` section."""
 
@@ -667,6 +682,7 @@ class Config(Section):
     )
     fingerprint: FingerprintConfig = key(FingerprintConfig, "The LOS fingerprint (the keys below).")
     http: HttpConfig = key(HttpConfig, "The daemon's HTTP endpoint (the key below).")
+    export: ExportConfig = key(ExportConfig, "Publisher attributes of exported NetCDF (the keys below).")
     store: StoreConfig = key(StoreConfig, "Where results are kept and published (the keys below).")
     alerts: AlertSettings = key(AlertSettings, "Alert rules and channels (the keys below).")
     report_dir: FilePath | None = key(

@@ -1,6 +1,8 @@
 """Results as data: NetCDF (CF, read back with xarray) and CSV exports, and the public API."""
 
 import datetime as dt
+import json
+import re
 
 import numpy as np
 import pytest
@@ -118,3 +120,86 @@ def test_the_netcdf_is_cf_1_8_and_acdd(store_with_days, tmp_path):
         assert ds.attrs[key], key
     assert "doi:10.1002/2016JD025812" in ds.attrs["references"] and "ACDD-1.3" in ds.attrs["Conventions"]
     assert ds.attrs["time_coverage_start"] == "2025-03-01T00:00:00Z"
+
+
+def _publisher_config(tmp_path):
+    cfg = tmp_path / "p.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+        "export:\n  institution: NOAA STAR\n  creator_name: CrIS SDR team\n"
+        "  creator_email: cris@example.org\n  creator_url: https://example.org/cris\n  license: CC0-1.0\n"
+        "  naming_authority: gov.noaa.star\n  project: JPSS\n"
+    )
+    return cfg
+
+
+def test_acdd_1_3_leaves_only_what_does_not_apply(store_with_days, tmp_path):
+    """The compliance checker's ACDD-1.3 check, run for real: every highly recommended and recommended
+    attribute is there but the CF standard names (none exists for these quantities) and the geospatial
+    extent (the file is per scan position, not per place); the time coverage matches the time axis."""
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    from monitor.cli import main
+
+    _, store = store_with_days
+    out = tmp_path / "j01.nc"
+    assert main(["export", "--config", str(_publisher_config(tmp_path)), "--out", str(out)]) == 0
+    CheckSuite.load_all_available_checkers()
+    report = tmp_path / "acdd.json"
+    ComplianceChecker.run_checker(
+        str(out),
+        ["acdd:1.3"],
+        verbose=0,
+        criteria="lenient",
+        output_filename=str(report),
+        output_format="json",
+    )
+    doc = json.loads(report.read_text())["acdd:1.3"]
+    problems = [
+        m
+        for group in ("high_priorities", "medium_priorities")
+        for check in doc[group]
+        for m in check["msgs"]
+        if not re.search(r"standard_name|geospatial", m)
+    ]
+    assert problems == [], problems
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert all(ds[v].attrs["coverage_content_type"] for v in ds.data_vars if v != "time_bnds")
+    assert ds.attrs["institution"] == "NOAA STAR" and ds.attrs["license"] == "CC0-1.0"
+    assert ds.attrs["id"] == "crisgeo_j01_20250301_20250312" and ds.attrs["time_coverage_duration"] == "P12D"
+
+
+def test_time_is_first_and_unlimited_and_the_sign_is_stated_once(store_with_days, tmp_path):
+    import h5netcdf
+
+    from monitor.export import SIGN_CONVENTION, export
+
+    _, store = store_with_days
+    out = export(store, "j01", tmp_path / "j01.nc")
+    with h5netcdf.File(out, "r") as f:
+        assert f.dimensions["time"].isunlimited() and not f.dimensions["scan_position"].isunlimited()
+        assert f.variables["d_alpha_urad"].dimensions == ("time", "scan_position")
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert ds.attrs["sign_convention"] == SIGN_CONVENTION
+    named = [v for v in ds.data_vars if "sign_convention" in ds[v].attrs.get("long_name", "")]
+    assert set(named) == {"d_alpha_urad", "d_beta_urad", "in_track_km", "cross_track_km"}
+
+
+@pytest.mark.parametrize(
+    "name,fmt,message",
+    [
+        ("y.csv", "netcdf", "--out {out}: a .csv file cannot hold --format netcdf"),
+        ("y.dat", None, "--out {out}: name it .nc or .csv, or give --format"),
+    ],
+)
+def test_the_format_follows_the_name_of_the_file(store_with_days, tmp_path, capsys, name, fmt, message):
+    from monitor.cli import main
+
+    cfg, _ = store_with_days
+    out = tmp_path / name
+    argv = ["export", "--config", str(cfg), "--satellite", "j01", "--out", str(out)]
+    assert main(argv + (["--format", fmt] if fmt else [])) == 2
+    assert message.format(out=out) in capsys.readouterr().err and not out.exists()
+    csv_out = tmp_path / "z.csv"
+    assert main(["export", "--config", str(cfg), "--satellite", "j01", "--out", str(csv_out)]) == 0
+    assert csv_out.read_text().startswith("time,scan_position,")  # CSV, not NetCDF
