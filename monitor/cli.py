@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import os
+import re
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -50,6 +51,18 @@ def _iso(text: str) -> dt.datetime:
     except ValueError:
         raise argparse.ArgumentTypeError(f"not an ISO 8601 time: {text!r}") from None
     return when if when.tzinfo else when.replace(tzinfo=dt.timezone.utc)
+
+
+def _until(text: str) -> dt.datetime:
+    """An end: ISO 8601 (UTC unless it says), or a duration from now, ``12h`` or ``7d``."""
+    m = re.fullmatch(r"(\d{1,4})([hd])", text.strip())
+    if m:
+        hours = int(m[1]) * (24 if m[2] == "d" else 1)
+        return dt.datetime.now(dt.timezone.utc).replace(microsecond=0) + dt.timedelta(hours=hours)
+    try:
+        return _iso(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"not an ISO 8601 time nor a duration (12h, 7d): {text!r}") from None
 
 
 def _day(text: str) -> dt.date:
@@ -660,7 +673,7 @@ def cmd_status(args) -> int:
     CONFIG,
     arg("--rule", choices=RULES, help="silence: the rule (default: every rule)"),
     arg("--satellite", choices=tuple(SATELLITES), help="silence: the satellite (default: every one)"),
-    arg("--until", type=_iso, help="silence: its end (ISO 8601, UTC)"),
+    arg("--until", type=_until, help="silence: its end (ISO 8601, UTC) or how long from now (12h, 7d)"),
     arg("--reason", default="", help="silence: why (shown with the silence)"),
     arg("--id", type=int, help="unsilence: the silence's number (crisgeo alerts list shows it)"),
     arg("--json", action="store_true", help="list: as JSON"),

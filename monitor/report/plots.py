@@ -90,6 +90,20 @@ def latest_urad(path, d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_ur
     return _save(fig, Path(path))
 
 
+MIN_SPAN_DAYS = 7  # a short history is drawn on a week: one day is a column, not a day stretched over hours
+
+
+def _days_axis(ax, days) -> None:
+    """Limit the date axis to the days shown (each its whole day, at least :data:`MIN_SPAN_DAYS` ending
+    at the last): matplotlib would widen a lone day to years, and an image's to hours."""
+    x1 = mdates.date2num(days[-1] + dt.timedelta(hours=12))
+    x0 = min(mdates.date2num(days[0] - dt.timedelta(hours=12)), x1 - MIN_SPAN_DAYS)
+    ax.set_xlim(x0, x1)
+    locator = mdates.AutoDateLocator(minticks=3, maxticks=8, interval_multiples=True)
+    ax.xaxis.set_major_locator(locator)
+    ax.xaxis.set_major_formatter(mdates.ConciseDateFormatter(locator))
+
+
 def _mark_changes(ax, changes, label=True):
     seen = set()
     for when, instrument, _description in changes:
@@ -129,7 +143,7 @@ def heatmaps(path, days, in_track_km, cross_track_km, spec_km, changes, title):
         fig.colorbar(im, ax=ax, label="km", pad=0.01)
         _mark_changes(ax, changes, label=False)
     axes[1].xaxis_date()
-    axes[1].xaxis.set_major_formatter(mdates.ConciseDateFormatter(axes[1].xaxis.get_major_locator()))
+    _days_axis(axes[1], days)
     fig.suptitle(title, fontsize=10)
     return _save(fig, Path(path))
 
@@ -158,7 +172,7 @@ def trend_lines(path, days, fors, in_track_km, cross_track_km, spec_km, changes,
         ax.set_title(f"{name} error (km)", fontsize=10)
         ax.grid(alpha=0.3)
     axes[0].legend(loc="upper left", fontsize=8, ncol=4)
-    axes[1].xaxis.set_major_formatter(mdates.ConciseDateFormatter(axes[1].xaxis.get_major_locator()))
+    _days_axis(axes[1], days)
     fig.suptitle(title, fontsize=10)
     return _save(fig, Path(path))
 
@@ -221,6 +235,6 @@ def calibration_trend(path, days, bias_k, gain_pct, changes, title):
         ax.grid(alpha=0.3)
     if changes:
         axes[0].legend(loc="upper left", fontsize=8)
-    axes[1].xaxis.set_major_formatter(mdates.ConciseDateFormatter(axes[1].xaxis.get_major_locator()))
+    _days_axis(axes[1], days)
     fig.suptitle(title, fontsize=10)
     return _save(fig, Path(path))

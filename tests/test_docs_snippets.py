@@ -1,0 +1,57 @@
+"""The notebook examples of docs/results.md, run as a scientist would paste them, on a store of one day
+(the first morning) and of several."""
+
+import datetime as dt
+import re
+
+import matplotlib
+import pytest
+
+from monitor import open_store
+from monitor.simulate.history import fill_store
+from tests.cli import ROOT
+
+matplotlib.use("Agg")
+pytest.importorskip("xarray")
+
+
+def _snippets() -> list[str]:
+    """The indented code blocks of docs/results.md that read a store."""
+    text = (ROOT / "docs" / "results.md").read_text()
+    blocks = re.findall(r"((?:^    .*\n)+)", text, re.M)
+    return ["\n".join(line[4:] for line in b.splitlines()) for b in blocks if "open_store(" in b]
+
+
+@pytest.mark.parametrize("days", [1, 3])
+def test_the_notebook_examples_run_on_a_store_of_any_length(tmp_path, days):
+    import matplotlib.pyplot as plt
+
+    db = tmp_path / "crisgeo.sqlite"
+    with open_store(db, create=True) as store:
+        fill_store(store, ["j01"], dt.date(2026, 11, 22), days, step_day=None, seed=3)
+    snippets = _snippets()
+    assert snippets, "docs/results.md lost its notebook examples"
+    for code in snippets:
+        exec(compile(code.replace("demo-state/crisgeo.sqlite", str(db)), "docs/results.md", "exec"), {})
+        assert plt.get_fignums(), code  # each example drew something
+        plt.close("all")
+
+
+def test_the_documented_silence_is_in_the_future_and_parses():
+    """docs/operations.md's silence example, parsed by the command line: it ends after now."""
+    import shlex
+
+    from monitor.cli import build_parser
+
+    text = (ROOT / "docs" / "operations.md").read_text()
+    (example,) = re.findall(r"`(crisgeo alerts silence [^`]+)`", text)
+    args = build_parser().parse_args(shlex.split(example)[1:])
+    assert args.until > dt.datetime.now(dt.timezone.utc) + dt.timedelta(days=6)
+
+
+def test_the_docs_link_only_to_files_that_exist():
+    """Every relative link and image of README.md and docs/*.md resolves from the file's own folder."""
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text()):
+            if "://" not in target and not target.startswith("mailto:"):
+                assert (page.parent / target).exists(), f"{page.name}: {target}"
