@@ -55,3 +55,13 @@ def test_the_docs_link_only_to_files_that_exist():
         for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text()):
             if "://" not in target and not target.startswith("mailto:"):
                 assert (page.parent / target).exists(), f"{page.name}: {target}"
+
+
+def test_the_readme_shows_the_table_the_demo_prints():
+    """The README's sample of the demo's output has the FOR table's header and units lines as printed."""
+    from monitor.render import for_table
+
+    readme = [line[4:].rstrip() for line in (ROOT / "README.md").read_text().splitlines()]
+    header, units = for_table([])[:2]
+    i = readme.index(header.rstrip())
+    assert readme[i + 1] == units.rstrip()
