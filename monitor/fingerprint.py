@@ -335,6 +335,33 @@ class DayVerdict:
     change: ProcessingChange | None
 
 
+@dataclass(frozen=True)
+class DayFingerprint:
+    """What a day's GEO files say by themselves: their granule *prints* in time order, the day's print, and
+    the library EPs ranked against it (best first). Only the comparison with the previous day's print
+    (:meth:`verdict`) needs the store, so the daily run computes this before it records anything."""
+
+    prints: tuple[GranulePrint, ...]
+    day: DayPrint
+    matches: tuple[EpMatch, ...]
+
+    def verdict(
+        self, threshold_urad: float, reference: DayPrint | None = None, day: dt.date | None = None
+    ) -> DayVerdict:
+        """The day's :class:`DayVerdict`: its print, its EP matches and the change found within the files
+        or against *reference*, the previous day's print (:func:`detect_change`)."""
+        change = detect_change(list(self.prints), threshold_urad, reference, day)
+        return DayVerdict(self.day, list(self.matches), change)
+
+
+def fingerprint_day(prints: list[GranulePrint], library: dict, platform: str | None) -> DayFingerprint:
+    """The :class:`DayFingerprint` of granule *prints*: the EPs of *library* matched against their day print
+    (those of *platform* only, when known)."""
+    prints = sorted(prints, key=lambda p: p.start)
+    today = day_print(prints)
+    return DayFingerprint(tuple(prints), today, tuple(identify_ep(today, library, platform)))
+
+
 def day_verdict(
     prints: list[GranulePrint],
     library: dict,
@@ -346,11 +373,7 @@ def day_verdict(
     """The fingerprint of a day from its granule *prints*: the day print, the EPs of *library* matched
     against it (those of *platform* only, when known), and the change (:func:`detect_change`). The daily
     run and ``crisgeo fingerprint`` both come here."""
-    prints = sorted(prints, key=lambda p: p.start)
-    today = day_print(prints)
-    return DayVerdict(
-        today, identify_ep(today, library, platform), detect_change(prints, threshold_urad, reference, day)
-    )
+    return fingerprint_day(prints, library, platform).verdict(threshold_urad, reference, day)
 
 
 @dataclass

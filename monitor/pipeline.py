@@ -111,15 +111,16 @@ def days_to_run(store: Store, satellite: str, schedule: ScheduleConfig, today: d
     return schedule.days_to_run(store.done_days(satellite, schedule.no_data_horizon(today)), today)
 
 
-def day_prints(cfg: Config, source, day: dt.date, listing) -> list:
-    """LOS fingerprints (:func:`monitor.fingerprint.granule_print`) of a sample of the day's GEO granules;
-    a granule that cannot be fetched or read is logged and left out."""
+def day_fingerprint(cfg: Config, source, satellite: str, day: dt.date, listing) -> fpr.DayFingerprint | None:
+    """The LOS fingerprint (:func:`monitor.fingerprint.granule_print`) of a sample of the day's GEO granules,
+    with the EPs of the library identified (:func:`monitor.fingerprint.fingerprint_day`); a granule that
+    cannot be fetched or read is logged and left out; None without any."""
     geos = sorted(
         (f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
         key=lambda f: f.parsed.start,
     )
     if not geos:
-        return []
+        return None
     picks = np.unique(
         np.round(np.linspace(0, len(geos) - 1, min(cfg.fingerprint.granules, len(geos)))).astype(int)
     )
@@ -130,22 +131,24 @@ def day_prints(cfg: Config, source, day: dt.date, listing) -> list:
             prints.append(fpr.granule_print(g))
         except (SourceError, DataError) as exc:
             LOG.warning("fingerprint: skipping %s: %s", geos[i].name, exc)
-    return prints
-
-
-def record_fingerprint(cfg: Config, store: Store, satellite: str, day: dt.date, prints: list) -> dict | None:
-    """Store the day's fingerprint and compare it with the previous day's and within the day.
-
-    A step becomes a ``change:cris`` event (used for jump attribution and notified by the alerts).
-    """
     if not prints:
         return None
-    prev = store.fingerprint(satellite, day)
-    reference = fpr.DayPrint.from_dict(prev[1]) if prev else None
     library, problems = load_library(cfg.fingerprint.ep_library)
     for problem in problems:
         LOG.warning("fingerprint: EP library: %s", problem)
-    verdict = fpr.day_verdict(prints, library, satellite, cfg.fingerprint.threshold_urad, reference, day)
+    return fpr.fingerprint_day(prints, library, satellite)
+
+
+def record_fingerprint(
+    cfg: Config, store: Store, satellite: str, day: dt.date, fingerprint: fpr.DayFingerprint
+) -> dict:
+    """Compare the day's *fingerprint* with the previous day's print in the store, and store it.
+
+    A step becomes a ``change:cris`` event (used for jump attribution and notified by the alerts).
+    """
+    prev = store.fingerprint(satellite, day)
+    reference = fpr.DayPrint.from_dict(prev[1]) if prev else None
+    verdict = fingerprint.verdict(cfg.fingerprint.threshold_urad, reference, day)
     body = verdict.day.to_dict()
     if verdict.matches:
         body["ep_match"] = [m.to_dict() for m in verdict.matches[:3]]
@@ -210,7 +213,7 @@ class DayWork:
     reason: str | None = None
     result: AssessmentResult | None = None
     decisions: list[SceneDecision] = field(default_factory=list)
-    prints: list = field(default_factory=list)
+    fingerprint: fpr.DayFingerprint | None = None  # the GEO files' LOS fingerprint, EPs identified
     timings: dict = field(default_factory=dict)
     counts: dict = field(default_factory=dict)
 
@@ -247,7 +250,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
             raise StopRequested
         t1 = time.perf_counter()
         logs.stage("fingerprint")
-        w.prints = day_prints(cfg, source, day, listing)
+        w.fingerprint = day_fingerprint(cfg, source, satellite, day, listing)
         w.timings["fingerprint"] = time.perf_counter() - t1
         t1 = time.perf_counter()
         logs.stage("select")
@@ -305,9 +308,9 @@ def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.dat
     run with its reason; then drain the outbox."""
     t1 = time.perf_counter()
     try:
-        if w.prints:
+        if w.fingerprint is not None:
             try:
-                record_fingerprint(cfg, store, w.satellite, w.day, w.prints)
+                record_fingerprint(cfg, store, w.satellite, w.day, w.fingerprint)
             except (DataError, OSError, ValueError) as exc:
                 LOG.warning("fingerprint of %s %s not recorded: %s", w.satellite, w.day, exc)
         out = RunOutcome(w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts)

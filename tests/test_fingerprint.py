@@ -8,7 +8,7 @@ import pytest
 from alerts.changes import all_changes, preceding_change
 from monitor import fingerprint as fpr
 from monitor.config import load_config
-from monitor.pipeline import day_prints, record_fingerprint
+from monitor.pipeline import day_fingerprint, record_fingerprint
 from monitor.sdr import read_file
 from monitor.simulate.case import SimulationSpec, simulate_case
 from monitor.sources.local import LocalSource
@@ -106,8 +106,9 @@ def test_simulated_change_found_on_the_right_day_granule_and_fors(name, tmp_path
     bodies = []
     for k in range(4):
         day = D0 + dt.timedelta(days=k)
-        prints = day_prints(cfg, src, day, src.list_day("j01", day, ("GCRSO",)))
-        bodies.append(record_fingerprint(cfg, store, "j01", day, prints))
+        fingerprint = day_fingerprint(cfg, src, "j01", day, src.list_day("j01", day, ("GCRSO",)))
+        assert fingerprint is not None and fingerprint.matches  # the EP identified before anything is stored
+        bodies.append(record_fingerprint(cfg, store, "j01", day, fingerprint))
     changed_days = [k for k, b in enumerate(bodies) if "change" in b]
     if new is None:
         assert changed_days == []
