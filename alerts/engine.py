@@ -10,6 +10,7 @@ from __future__ import annotations
 import datetime as dt
 import html
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -26,7 +27,8 @@ from alerts.rules import (
     stale_finding,
 )
 from monitor.config import AlertSettings
-from monitor.records import History
+from monitor.records import Alert, History, Silence
+from monitor.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
@@ -70,16 +72,16 @@ def build_message(store: History, satellite: str, items: list, settings: AlertSe
         counts[kind] = counts.get(kind, 0) + 1
     head = ", ".join(f"{n} {k}" for k, n in counts.items())
     worst = (
-        "critical"
-        if any(f.severity == "critical" and k != "resolved" for k, f in items)
-        else ("resolved" if all(k == "resolved" for k, _ in items) else "warning")
+        Severity.CRITICAL
+        if any(f.severity == Severity.CRITICAL and k != Notice.RESOLVED for k, f in items)
+        else (Notice.RESOLVED if all(k == Notice.RESOLVED for k, _ in items) else Severity.WARNING)
     )
     subject = f"{settings.subject_prefix} {satellite} {worst.upper()}: {head} - " + "; ".join(
         f.rule for _, f in items
     )
     blocks, text = [], []
     for kind, f in items:
-        title = f"{kind.upper()} {f.rule} ({f.severity if kind != 'resolved' else 'resolved'}): {f.summary}"
+        title = f"{kind.upper()} {f.rule} ({f.severity if kind != Notice.RESOLVED else kind}): {f.summary}"
         text += [title] + [f"  {line}" for line in f.lines] + [""]
         blocks.append("*" + _slack_escape(title) + "*\n" + "\n".join(_slack_escape(x) for x in f.lines[:25]))
     day = store.latest_day(satellite)
@@ -136,17 +138,18 @@ def evaluate(store: History, settings: AlertSettings, satellites, now: dt.dateti
             for f in found:
                 prev = state.get(f.fingerprint)
                 quiet = state.silenced(f.rule, sat, now) is not None
-                if prev is None or prev.status != "firing":
-                    kind = "firing"
+                kind: Notice | None
+                if prev is None or prev.status != AlertStatus.FIRING:
+                    kind = Notice.FIRING
                 elif (
                     prev.last_notified is None
                     or now - dt.datetime.fromisoformat(prev.last_notified) >= repeat
                 ):
-                    kind = "repeat"
+                    kind = Notice.REPEAT
                 else:
                     kind = None
                 notify = kind is not None and not quiet
-                state.upsert(f, "firing", now, notified=notify)
+                state.upsert(f, now, notified=notify)
                 if notify:
                     items.append((kind, f))
             current = {f.fingerprint for f in found}
@@ -156,7 +159,7 @@ def evaluate(store: History, settings: AlertSettings, satellites, now: dt.dateti
                     if state.silenced(prev.rule, sat, now) is None:
                         items.append(
                             (
-                                "resolved",
+                                Notice.RESOLVED,
                                 Finding(
                                     prev.rule,
                                     sat,
@@ -175,99 +178,134 @@ def evaluate(store: History, settings: AlertSettings, satellites, now: dt.dateti
     return queued
 
 
-def deliver(store: History, settings: AlertSettings, now: dt.datetime | None = None, channels=None) -> dict:
-    """Try every due delivery once; returns counts by outcome. Never raises for a channel."""
+@dataclass
+class DeliveryCounts:
+    """What one evaluation and delivery did: messages queued; deliveries sent, postponed to a retry, and
+    failed for good."""
+
+    queued: int = 0
+    sent: int = 0
+    retry: int = 0
+    failed: int = 0
+
+    def text(self) -> str:
+        """``queued 1, sent 3, to retry 0, failed 0``."""
+        return f"queued {self.queued}, sent {self.sent}, to retry {self.retry}, failed {self.failed}"
+
+
+def deliver(
+    store: History, settings: AlertSettings, now: dt.datetime | None = None, channels=None
+) -> DeliveryCounts:
+    """Try every due delivery once; the counts by outcome. Never raises for a channel."""
     now = now or dt.datetime.now(UTC)
     state = store.alert_state()
     channels = channels if channels is not None else make_channels(settings)
-    counts = {"sent": 0, "retry": 0, "failed": 0}
+    counts = DeliveryCounts()
     for d in state.due(now):
         if not state.claim(d.id, now):
             continue  # another process is sending it
         ch = channels.get(d.channel)
         if ch is None:
-            state.mark(d.id, "failed", now, f"channel {d.channel} is no longer configured")
-            counts["failed"] += 1
+            state.mark(d.id, DeliveryStatus.FAILED, now, f"channel {d.channel} is no longer configured")
+            counts.failed += 1
             continue
         try:
             ch.send(d.body)
         except Transient as exc:
             wait = max(exc.retry_after_s, 60.0 * min(2**d.attempts, 60))
-            state.mark(d.id, "pending", now, str(exc), retry_after_s=wait)
+            state.mark(d.id, DeliveryStatus.PENDING, now, str(exc), retry_after_s=wait)
             LOG.warning("alert delivery via %s postponed: %s", d.channel, exc)
-            counts["retry"] += 1
+            counts.retry += 1
         except Permanent as exc:
-            state.mark(d.id, "failed", now, str(exc))
+            state.mark(d.id, DeliveryStatus.FAILED, now, str(exc))
             LOG.error("alert delivery via %s failed (configuration error): %s", d.channel, exc)
-            counts["failed"] += 1
+            counts.failed += 1
         else:
-            state.mark(d.id, "sent", now)
-            counts["sent"] += 1
+            state.mark(d.id, DeliveryStatus.SENT, now)
+            counts.sent += 1
     return counts
 
 
-def evaluate_and_deliver(store: History, settings: AlertSettings, satellites, now=None) -> dict:
-    """Evaluate the rules, queue, deliver; the counts (queued, sent, failed)."""
+def evaluate_and_deliver(store: History, settings: AlertSettings, satellites, now=None) -> DeliveryCounts:
+    """Evaluate the rules, queue, deliver; the counts (queued, sent, to retry, failed)."""
     queued = evaluate(store, settings, satellites, now)
     counts = deliver(store, settings, now)
-    counts["queued"] = len(queued)
+    counts.queued = len(queued)
     post_state(store, settings, now)
     return counts
 
 
-def alerts_view(store: History, now: dt.datetime) -> dict:
-    """What ``crisgeo alerts list`` shows, as data: the alerts (firing, silenced, resolved in the last 7
-    days), the silences in force and the number of messages waiting for delivery."""
+@dataclass(frozen=True)
+class AlertView:
+    """One alert as ``crisgeo alerts list`` shows it: *shown* is its status, or ``silenced`` while a silence
+    quiets it."""
+
+    shown: str
+    alert: Alert
+
+    def to_dict(self) -> dict:
+        a = self.alert
+        return {
+            "status": self.shown,
+            "severity": a.severity,
+            "rule": a.rule,
+            "satellite": a.satellite,
+            "fingerprint": a.fingerprint,
+            "started": a.started,
+            "resolved": a.resolved,
+            "summary": a.summary,
+            "lines": a.lines,
+        }
+
+
+@dataclass(frozen=True)
+class AlertsView:
+    """What ``crisgeo alerts list`` shows: the alerts (firing, silenced, resolved in the last 7 days), the
+    silences in force and the number of messages waiting for delivery."""
+
+    alerts: tuple[AlertView, ...]
+    silences: tuple[Silence, ...]
+    pending_deliveries: int
+
+    def to_dict(self) -> dict:
+        """The JSON of ``crisgeo alerts list --json``."""
+        return {
+            "alerts": [a.to_dict() for a in self.alerts],
+            "silences": [
+                {"id": s.id, "rule": s.rule, "satellite": s.satellite, "until": s.until, "reason": s.reason}
+                for s in self.silences
+            ],
+            "pending_deliveries": self.pending_deliveries,
+        }
+
+    def text(self) -> str:
+        """The text of ``crisgeo alerts list``."""
+        lines = [
+            f"{v.shown:<9} {v.alert.severity or '':<8} {v.alert.fingerprint:<28} since {v.alert.started}"
+            + (f" resolved {v.alert.resolved}" if v.alert.status == AlertStatus.RESOLVED else "")
+            + f"  {v.alert.summary}"
+            for v in self.alerts
+        ]
+        lines += [
+            f"silence {s.id:<3} rule={s.rule or '*'} satellite={s.satellite or '*'} until {s.until}: "
+            f"{s.reason}"
+            for s in self.silences
+        ]
+        lines.append(f"{self.pending_deliveries} message(s) waiting for delivery")
+        return "\n".join(lines) if self.alerts or self.pending_deliveries or self.silences else "no alerts"
+
+
+def alerts_view(store: History, now: dt.datetime) -> AlertsView:
+    """The :class:`AlertsView` of the store at *now*."""
     state = store.alert_state()
-    alerts = []
+    shown = []
     for r in state.all():
         if (
-            r.status == "resolved"
+            r.status == AlertStatus.RESOLVED
             and r.resolved
             and now - dt.datetime.fromisoformat(r.resolved) > dt.timedelta(days=7)
         ):
             continue
         quiet = state.silenced(r.rule, r.satellite, now)
-        alerts.append(
-            {
-                "status": "silenced" if quiet and r.status == "firing" else r.status,
-                "severity": r.severity,
-                "rule": r.rule,
-                "satellite": r.satellite,
-                "fingerprint": r.fingerprint,
-                "started": r.started,
-                "resolved": r.resolved,
-                "summary": r.summary,
-                "lines": r.lines,
-            }
-        )
-    silences = [
-        {"id": s.id, "rule": s.rule, "satellite": s.satellite, "until": s.until, "reason": s.reason}
-        for s in state.silences(now)
-    ]
-    return {"alerts": alerts, "silences": silences, "pending_deliveries": len(state.deliveries("pending"))}
-
-
-def fmt_alerts(view: dict) -> str:
-    """The text of ``crisgeo alerts list`` from :func:`alerts_view`."""
-    lines = [
-        f"{a['status']:<9} {a['severity'] or '':<8} {a['fingerprint']:<28} since {a['started']}"
-        + (f" resolved {a['resolved']}" if a["status"] == "resolved" else "")
-        + f"  {a['summary']}"
-        for a in view["alerts"]
-    ]
-    lines += [
-        f"silence {s['id']:<3} rule={s['rule'] or '*'} satellite={s['satellite'] or '*'} until {s['until']}: "
-        f"{s['reason']}"
-        for s in view["silences"]
-    ]
-    lines.append(f"{view['pending_deliveries']} message(s) waiting for delivery")
-    return (
-        "\n".join(lines) if view["alerts"] or view["pending_deliveries"] or view["silences"] else "no alerts"
-    )
-
-
-def fmt_counts(counts: dict) -> str:
-    """Delivery counts as words: ``queued 1, sent 3, to retry 0, failed 0``."""
-    names = {"queued": "queued", "sent": "sent", "retry": "to retry", "failed": "failed"}
-    return ", ".join(f"{names[k]} {counts[k]}" for k in names if k in counts)
+        shown.append(AlertView("silenced" if quiet and r.status == AlertStatus.FIRING else r.status, r))
+    return AlertsView(tuple(shown), tuple(state.silences(now)), len(state.deliveries(DeliveryStatus.PENDING)))

@@ -136,12 +136,12 @@ def main(argv=None) -> int:
                 ("ranges", first, first_s),
                 ("ranges again", again, again_s),
             ):
-                n, req = w.counts["bytes"], w.counts["requests"]
+                n, req = w.counts.bytes, w.counts.requests
                 projected = n / PROJECTED_B_S + req * PROJECTED_REQUEST_S
                 compute = sum(v for k, v in w.timings.items() if k not in ("fetch",))
                 row = {
                     "layout": layout, "granules": granules, "run": label, "status": str(w.status),
-                    "assessed": w.counts["assessed"], "bytes": n, "files_bytes": total,
+                    "assessed": w.counts.assessed, "bytes": n, "files_bytes": total,
                     "share": n / total, "requests": req, "wall_s": round(secs, 1),
                     "projected_transfer_s": round(projected, 1),
                     "timings_s": {k: round(v, 1) for k, v in w.timings.items()},
@@ -149,7 +149,7 @@ def main(argv=None) -> int:
                 if label == "ranges":
                     row |= {"held_by_product": held, "same_bits_as_whole": same}
                 rows.append(row)
-                print(f"  {label:13s} {w.status:8s} {w.counts['assessed']:2d} assessed  {n / 1e6:8.1f} MB "
+                print(f"  {label:13s} {w.status:8s} {w.counts.assessed:2d} assessed  {n / 1e6:8.1f} MB "
                       f"({100 * n / total:5.1f} % of the files)  {req:5d} requests  {secs:6.1f} s  "
                       f"(transfer at 100 MB/s + 30 ms/request: {projected:5.1f} s; other stages "
                       f"{compute:.1f} s)")  # fmt: skip

@@ -680,7 +680,7 @@ def cmd_status(args) -> int:
 )
 def cmd_alerts(args) -> int:
     """crisgeo alerts: list, silence, unsilence, evaluate."""
-    from alerts.engine import alerts_view, evaluate_and_deliver, fmt_alerts, fmt_counts
+    from alerts.engine import alerts_view, evaluate_and_deliver
     from monitor.store.alerts import AlertState
     from monitor.store.sqlite import Store
 
@@ -692,9 +692,9 @@ def cmd_alerts(args) -> int:
         if args.json:
             import json
 
-            print(json.dumps(view, indent=1))
+            print(json.dumps(view.to_dict(), indent=1))
         else:
-            print(fmt_alerts(view))
+            print(view.text())
         return EXIT_OK
     cfg = _load(args, writes=True)
     with Store(cfg.store.sqlite) as store:
@@ -715,7 +715,7 @@ def cmd_alerts(args) -> int:
                 raise BadInput(f"--id {args.id}: no silence in force has that number")
             print(f"silence {args.id} lifted")
         else:
-            print(fmt_counts(evaluate_and_deliver(store, cfg.alerts, cfg.satellites, now)))
+            print(evaluate_and_deliver(store, cfg.alerts, cfg.satellites, now).text())
     return EXIT_OK
 
 

@@ -232,6 +232,6 @@ class ServiceMetrics:
         """Take in a :class:`monitor.pipeline.RunOutcome`."""
         for stage, secs in outcome.timings.items():
             self.duration.labels(outcome.satellite, stage).set(secs)
-        self.granules.labels(outcome.satellite).inc(outcome.counts.get("downloaded", 0))
-        self.bytes.labels(outcome.satellite).inc(outcome.counts.get("bytes", 0))
-        self.requests.labels(outcome.satellite).inc(outcome.counts.get("requests", 0))
+        self.granules.labels(outcome.satellite).inc(outcome.counts.downloaded)
+        self.bytes.labels(outcome.satellite).inc(outcome.counts.bytes)
+        self.requests.labels(outcome.satellite).inc(outcome.counts.requests)

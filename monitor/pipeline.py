@@ -71,6 +71,19 @@ class ProgressLines:
 
 
 @dataclass
+class RunCounts:
+    """What a satellite-day run handled: CrIS granules listed, selected and assessed; files downloaded
+    whole, bytes read (files and ranges) and HTTP requests made."""
+
+    listed: int = 0
+    selected: int = 0
+    assessed: int = 0
+    downloaded: int = 0
+    bytes: int = 0
+    requests: int = 0
+
+
+@dataclass
 class RunOutcome:
     """What one satellite-day run did: status and reason, the result, seconds per stage, counts."""
 
@@ -81,7 +94,7 @@ class RunOutcome:
     run_id: int | None = None
     result: AssessmentResult | None = None
     timings: dict = field(default_factory=dict)
-    counts: dict = field(default_factory=dict)  # granules listed, selected, assessed; files, bytes, requests
+    counts: RunCounts = field(default_factory=RunCounts)
 
     def summary(self) -> str:
         """The one line a run leaves in the log."""
@@ -89,12 +102,10 @@ class RunOutcome:
         parts = [
             f"run {self.satellite} {self.day}: {self.status}" + (f" ({self.reason})" if self.reason else "")
         ]
-        if c:
-            parts.append(
-                f"granules listed {c.get('listed', 0)}, selected {c.get('selected', 0)}, "
-                f"assessed {c.get('assessed', 0)}; {c.get('downloaded', 0)} files whole, "
-                f"{c.get('bytes', 0) / 1e6:.0f} MB downloaded in {c.get('requests', 0)} requests"
-            )
+        parts.append(
+            f"granules listed {c.listed}, selected {c.selected}, assessed {c.assessed}; {c.downloaded} files "
+            f"whole, {c.bytes / 1e6:.0f} MB downloaded in {c.requests} requests"
+        )
         if self.result is not None:
             ok = [f for f in self.result.fors if f.reliable]
             worst = max((f.total_km for f in ok), default=float("nan"))
@@ -215,7 +226,7 @@ class DayWork:
     decisions: list[SceneDecision] = field(default_factory=list)
     fingerprint: fpr.DayFingerprint | None = None  # the GEO files' LOS fingerprint, EPs identified
     timings: dict = field(default_factory=dict)
-    counts: dict = field(default_factory=dict)
+    counts: RunCounts = field(default_factory=RunCounts)
 
 
 def compute_day(
@@ -231,7 +242,6 @@ def compute_day(
 def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, should_stop, progress) -> DayWork:
     stop = should_stop or (lambda: False)
     w = DayWork(satellite, day, RunStatus.OK)
-    w.counts = {"listed": 0, "selected": 0, "assessed": 0, "downloaded": 0, "bytes": 0, "requests": 0}
     t0 = time.perf_counter()
     try:
         logs.stage("list")
@@ -239,7 +249,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
         source.start_day(stop)
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
         w.timings["list"] = time.perf_counter() - t0
-        w.counts["listed"] = len(listing)
+        w.counts.listed = len(listing)
         if not any(f.product in CRIS_GEO for f in listing):
             w.status, w.reason = (
                 RunStatus.NO_DATA,
@@ -258,7 +268,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
             listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep, cfg.scenes.min_inhomogeneity_k
         )
         w.timings["select"] = time.perf_counter() - t1
-        w.counts["selected"] = len(chosen)
+        w.counts.selected = len(chosen)
         if not chosen:
             w.status = RunStatus.NO_DATA
             w.reason = "no usable scene: " + "; ".join(sorted({d.reason for d in w.decisions}))[:500]
@@ -283,7 +293,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
             workers=a.workers,
         )
         w.timings["assess"] = time.perf_counter() - t1
-        w.counts["assessed"] = len(w.result.granules)
+        w.counts.assessed = len(w.result.granules)
         if stop():
             raise StopRequested
     except StopRequested:
@@ -297,8 +307,8 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
         w.status, w.reason = RunStatus.FAILED, f"unexpected {type(exc).__name__}: {exc}"[:1000]
         w.result = None
     # read in place, the bytes travel while the day is assessed: counted once it ends, however it ends
-    w.counts["downloaded"], w.counts["bytes"] = source.downloaded_files, source.spent_bytes
-    w.counts["requests"] = source.requests
+    w.counts.downloaded, w.counts.bytes = source.downloaded_files, source.spent_bytes
+    w.counts.requests = source.requests
     return w
 
 

@@ -17,7 +17,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from monitor.result import RELIABILITY_FLAGS, ForOffset
-from monitor.vocabulary import Decision, EventKind, RunStatus
+from monitor.vocabulary import AlertStatus, Decision, DeliveryStatus, EventKind, RunStatus, Severity
 
 
 def iso(t: dt.datetime) -> str:
@@ -34,8 +34,8 @@ class Alert:
     rule: str
     satellite: str
     grp: str | None
-    severity: str | None
-    status: str
+    severity: Severity | None
+    status: AlertStatus
     started: str | None
     last_notified: str | None
     resolved: str | None
@@ -47,6 +47,8 @@ class Alert:
         """The Alert of a row of the store."""
         d = {k: r[k] for k in cls.__dataclass_fields__}
         d["lines"] = json.loads(r["lines"] or "[]")
+        d["status"] = AlertStatus(d["status"])
+        d["severity"] = Severity(d["severity"]) if d["severity"] else None
         return cls(**d)
 
 
@@ -78,7 +80,7 @@ class Delivery:
     subject: str
     body: dict
     created: str
-    status: str
+    status: DeliveryStatus
     attempts: int
     next_attempt: str | None
     last_error: str | None
@@ -88,7 +90,14 @@ class Delivery:
     def from_row(cls, r) -> "Delivery":
         """The Delivery of a row of the store."""
         d = {k: r[k] for k in cls.__dataclass_fields__}
-        return cls(**{**d, "body": json.loads(d["body"]), "attempts": int(d["attempts"] or 0)})
+        return cls(
+            **{
+                **d,
+                "body": json.loads(d["body"]),
+                "attempts": int(d["attempts"] or 0),
+                "status": DeliveryStatus(d["status"]),
+            }
+        )
 
 
 @dataclass(frozen=True)
@@ -222,18 +231,18 @@ class AlertLedger(Protocol):
     def get(self, fingerprint: str) -> Alert | None: ...
     def firing(self, satellite: str | None = None) -> list[Alert]: ...
     def all(self) -> list[Alert]: ...
-    def upsert(self, finding: Any, status: str, now: dt.datetime, notified: bool) -> None: ...
+    def upsert(self, finding: Any, now: dt.datetime, notified: bool) -> None: ...
     def resolve(self, fingerprint: str, now: dt.datetime) -> None: ...
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None: ...
     def silences(self, now: dt.datetime) -> list[Silence]: ...
     def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime) -> None: ...
     def due(self, now: dt.datetime) -> list[Delivery]: ...
     def claim(self, delivery_id: int, now: dt.datetime, lease_s: float = 600.0) -> bool: ...
-    def deliveries(self, status: str | None = None) -> list[Delivery]: ...
+    def deliveries(self, status: DeliveryStatus | None = None) -> list[Delivery]: ...
     def mark(
         self,
         delivery_id: int,
-        status: str,
+        status: DeliveryStatus,
         now: dt.datetime,
         error: str | None = ...,
         retry_after_s: float = ...,

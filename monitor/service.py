@@ -27,7 +27,7 @@ from apscheduler.schedulers.blocking import BlockingScheduler
 from apscheduler.triggers.cron import CronTrigger
 
 from alerts.alertmanager import post_state
-from alerts.engine import deliver, evaluate, fmt_counts
+from alerts.engine import deliver, evaluate
 from monitor import allocator, logs
 from monitor.config import Config, parse_listen
 from monitor.endpoint import Endpoint
@@ -142,9 +142,10 @@ class Service:
             if report:
                 self.regenerate_report(store)
             counts = deliver(store, settings)
+            counts.queued = len(queued)
             post_state(store, settings)
-            if queued or counts["sent"] or counts["failed"]:
-                LOG.info("alerts: %s", fmt_counts({"queued": len(queued), **counts}))
+            if counts.queued or counts.sent or counts.failed:
+                LOG.info("alerts: %s", counts.text())
         finally:
             if own:  # the hourly timer: hand back what the evaluation freed
                 store.close()

@@ -61,6 +61,30 @@ class Severity(StrEnum):
     CRITICAL = "critical"
 
 
+class AlertStatus(StrEnum):
+    """The state of an alert in the store (a silence is kept apart: it quiets, it does not change this)."""
+
+    FIRING = "firing"
+    RESOLVED = "resolved"
+
+
+class Notice(StrEnum):
+    """Why an alert is in a message: it started, it still fires after ``repeat_hours``, or it ended."""
+
+    FIRING = "firing"
+    REPEAT = "repeat"
+    RESOLVED = "resolved"
+
+
+class DeliveryStatus(StrEnum):
+    """The state of a queued message on one channel."""
+
+    PENDING = "pending"  # waiting for its (next) attempt
+    SENDING = "sending"  # claimed by a sender (a lease: a sender that died leaves it to be tried again)
+    SENT = "sent"
+    FAILED = "failed"  # for good: a configuration error, or the channel is gone
+
+
 class Kernel(StrEnum):
     """The CrIS footprint weighting of the collocation (``assessment.kernel``)."""
 

@@ -131,7 +131,7 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     doc = json.loads(capsys.readouterr().out)
     assert doc["state"] == "OK" and doc["satellites"]["j01"]["last_run"] is None and doc["outbox"] == 0
     now = dt.datetime.now(dt.timezone.utc)
-    AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), "firing", now, True)
+    AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), now, True)
     assert main(["status", "--json"]) == 1 and json.loads(capsys.readouterr().out)["state"] == "WARNING"
     assert main(["alerts", "list", "--json"]) == 0
     (alert,) = json.loads(capsys.readouterr().out)["alerts"]

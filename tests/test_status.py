@@ -70,7 +70,7 @@ def test_the_first_line_carries_the_reason_and_the_perfdata(state):
     fors[28] = dataclasses.replace(_for(1.2, 1.2), for_index=29)  # 1.7 km total: within, per direction
     _save(store, fors)
     spec = Finding("spec", "j01", "critical", "j01: 1 FOR(s) beyond the 1.5 km specification: FOR 30")
-    AlertState(store).upsert(spec, "firing", NOW, True)
+    AlertState(store).upsert(spec, NOW, True)
     status = status_report(cfg, store, now=NOW)
     assert status.state == NagiosState.CRITICAL
     assert status.nagios_line() == (
@@ -82,7 +82,7 @@ def test_the_first_line_carries_the_reason_and_the_perfdata(state):
 
 def test_a_silence_is_shown_and_leaves_the_state(state):
     cfg, store = state
-    AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), "firing", NOW, True)
+    AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), NOW, True)
     until = NOW + dt.timedelta(days=3)
     AlertState(store).silence("jump", "j01", until, "known EP change", NOW)
     status = status_report(cfg, store, now=NOW)

@@ -7,6 +7,7 @@ import json
 from typing import TYPE_CHECKING
 
 from monitor.records import Alert, Delivery, Silence, iso
+from monitor.vocabulary import AlertStatus, DeliveryStatus
 
 if TYPE_CHECKING:
     from monitor.store.sqlite import Store
@@ -26,19 +27,20 @@ class AlertState:
 
     def firing(self, satellite: str | None = None) -> list[Alert]:
         """The alerts firing now (of *satellite*)."""
-        q = "SELECT * FROM alert_state WHERE status='firing'" + (" AND satellite=?" if satellite else "")
-        return [Alert.from_row(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
+        q = "SELECT * FROM alert_state WHERE status=?" + (" AND satellite=?" if satellite else "")
+        args = (AlertStatus.FIRING, satellite) if satellite else (AlertStatus.FIRING,)
+        return [Alert.from_row(r) for r in self.db.execute(q, args)]
 
     def all(self) -> list[Alert]:
         """Every alert, firing or resolved."""
         q = "SELECT * FROM alert_state ORDER BY satellite, rule, grp"
         return [Alert.from_row(r) for r in self.db.execute(q)]
 
-    def upsert(self, finding, status: str, now: dt.datetime, notified: bool):
+    def upsert(self, finding, now: dt.datetime, notified: bool):
         """Record *finding* as firing (keeping its start while it fires); *notified* stamps the notification
         time."""
         prev = self.get(finding.fingerprint)
-        started = prev.started if prev and prev.status == "firing" else iso(now)
+        started = prev.started if prev and prev.status == AlertStatus.FIRING else iso(now)
         last = iso(now) if notified else (prev.last_notified if prev else None)
         self.db.execute(
             "INSERT OR REPLACE INTO alert_state VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
@@ -48,7 +50,7 @@ class AlertState:
                 finding.satellite,
                 finding.group,
                 finding.severity,
-                status,
+                AlertStatus.FIRING,
                 started,
                 last,
                 None,
@@ -60,8 +62,8 @@ class AlertState:
     def resolve(self, fingerprint: str, now: dt.datetime):
         """Mark an alert resolved at *now*."""
         self.db.execute(
-            "UPDATE alert_state SET status='resolved', resolved=? WHERE fingerprint=?",
-            (iso(now), fingerprint),
+            "UPDATE alert_state SET status=?, resolved=? WHERE fingerprint=?",
+            (AlertStatus.RESOLVED, iso(now), fingerprint),
         )
 
     # -- silences
@@ -104,8 +106,16 @@ class AlertState:
         """Queue *message* (subject, text, ...) for delivery on *channel*."""
         self.db.execute(
             "INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
-            "VALUES (?, ?, ?, ?, ?, 'pending', ?)",
-            (channel, satellite, message["subject"], json.dumps(message), iso(now), iso(now)),
+            "VALUES (?, ?, ?, ?, ?, ?, ?)",
+            (
+                channel,
+                satellite,
+                message["subject"],
+                json.dumps(message),
+                iso(now),
+                DeliveryStatus.PENDING,
+                iso(now),
+            ),
         )
 
     def due(self, now: dt.datetime) -> list[Delivery]:
@@ -114,9 +124,8 @@ class AlertState:
         return [
             Delivery.from_row(r)
             for r in self.db.execute(
-                "SELECT * FROM deliveries WHERE status IN ('pending', 'sending') AND next_attempt <= ? "
-                "ORDER BY id",
-                (iso(now),),
+                "SELECT * FROM deliveries WHERE status IN (?, ?) AND next_attempt <= ? ORDER BY id",
+                (DeliveryStatus.PENDING, DeliveryStatus.SENDING, iso(now)),
             )
         ]
 
@@ -127,13 +136,20 @@ class AlertState:
         """
         with self.store.transaction():
             cur = self.db.execute(
-                "UPDATE deliveries SET status='sending', next_attempt=? "
-                "WHERE id=? AND status IN ('pending', 'sending') AND next_attempt <= ?",
-                (iso(now + dt.timedelta(seconds=lease_s)), delivery_id, iso(now)),
+                "UPDATE deliveries SET status=?, next_attempt=? "
+                "WHERE id=? AND status IN (?, ?) AND next_attempt <= ?",
+                (
+                    DeliveryStatus.SENDING,
+                    iso(now + dt.timedelta(seconds=lease_s)),
+                    delivery_id,
+                    DeliveryStatus.PENDING,
+                    DeliveryStatus.SENDING,
+                    iso(now),
+                ),
             )
             return cur.rowcount == 1
 
-    def deliveries(self, status: str | None = None) -> list[Delivery]:
+    def deliveries(self, status: DeliveryStatus | None = None) -> list[Delivery]:
         """The queued deliveries (with *status*: pending, sending, sent, failed), oldest first."""
         q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"
         return [Delivery.from_row(r) for r in self.db.execute(q, (status,) if status else ())]
@@ -141,7 +157,7 @@ class AlertState:
     def mark(
         self,
         delivery_id: int,
-        status: str,
+        status: DeliveryStatus,
         now: dt.datetime,
         error: str | None = None,
         retry_after_s: float = 0.0,
@@ -155,7 +171,7 @@ class AlertState:
                     status,
                     error,
                     iso(now + dt.timedelta(seconds=retry_after_s)),
-                    iso(now) if status == "sent" else None,
+                    iso(now) if status == DeliveryStatus.SENT else None,
                     delivery_id,
                 ),
             )

@@ -36,7 +36,7 @@ def test_alerts_are_posted_routed_and_resolved(tmp_path, receiver):
         )
         state = AlertState(store)
         finding = Finding("spec", "j01", "critical", "FOR 1 error 1.9 km > 1.5 km", ["FOR 1: 1.9 km"])
-        state.upsert(finding, "firing", now, True)
+        state.upsert(finding, now, True)
         assert post_state(store, settings, now) == 1
         (alert,) = requests.get(am + "/api/v2/alerts", timeout=10).json()
         assert alert["labels"] == {
@@ -68,7 +68,6 @@ def test_an_unreachable_alertmanager_costs_nothing_but_a_warning(tmp_path, caplo
         )
         AlertState(store).upsert(
             Finding("stale", "j01", "warning", "no run for 30 h"),
-            "firing",
             dt.datetime.now(dt.timezone.utc),
             True,
         )

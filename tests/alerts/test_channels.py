@@ -151,7 +151,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
         t.start()
     for t in threads:
         t.join()
-    assert len(webhook.received) == 1 and sorted(c["sent"] for c in counts) == [0, 1]
+    assert len(webhook.received) == 1 and sorted(c.sent for c in counts) == [0, 1]
     s = Store(path)
     assert [d.status for d in AlertState(s).deliveries()] == ["sent"]
 

@@ -101,6 +101,6 @@ def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp
     (pending,) = AlertState(store).deliveries("pending")
     assert "503" in pending.last_error
     later = dt.datetime.now(dt.timezone.utc) + dt.timedelta(hours=2)
-    assert deliver(store, service.cfg.alerts, later)["sent"] == 1
-    assert deliver(store, service.cfg.alerts, later)["sent"] == 0  # not twice
+    assert deliver(store, service.cfg.alerts, later).sent == 1
+    assert deliver(store, service.cfg.alerts, later).sent == 0  # not twice
     assert len(webhook.received) == 2 and webhook.received[0] == webhook.received[1]

@@ -153,7 +153,7 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
     store.finish_run(store.begin_run("j01", dt.date.today()), "failed", "HTTP 503")
     store.queue_lines("influx2:db.example", "j01", ["m x=1 1"] * 3)
     AlertState(store).upsert(
-        Finding("spec", "j01", "critical", "FOR 30 beyond spec"), "firing", dt.datetime.now(UTC), True
+        Finding("spec", "j01", "critical", "FOR 30 beyond spec"), dt.datetime.now(UTC), True
     )
     store.close()
     metrics = ServiceMetrics(lambda: Store(db), ["j01"], Health(300), "test", 1.5)

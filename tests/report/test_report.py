@@ -99,7 +99,6 @@ def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
         Finding(
             Rule.SPEC, "j01", Severity.CRITICAL, "FOR 30 cross-track 2.5 km over the 1.5 km spec", group="x"
         ),
-        "firing",
         dt.datetime(2025, 10, 28, tzinfo=dt.timezone.utc),
         False,
     )

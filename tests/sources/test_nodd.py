@@ -348,4 +348,4 @@ def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_
         cfg = load_config(config)
         work = compute_day(cfg, make_source(cfg), "j01", DAY)
     assert work.status == RunStatus.OK, work.reason
-    assert work.counts["assessed"] == 2 and len(work.result.fors) == 30
+    assert work.counts.assessed == 2 and len(work.result.fors) == 30

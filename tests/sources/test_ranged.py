@@ -68,14 +68,14 @@ def test_a_day_read_in_place_is_the_whole_file_day_to_the_bit_and_its_rerun_read
     assert whole.status == first.status == RunStatus.OK, (whole.reason, first.reason)
     assert [f.to_dict() for f in first.result.fors] == [f.to_dict() for f in whole.result.fors]
     assert np.array_equal(first.result.cost_cube_k, whole.result.cost_cube_k)
-    assert first.counts["downloaded"] == 0 and whole.counts["downloaded"] == whole.counts["listed"]
+    assert first.counts.downloaded == 0 and whole.counts.downloaded == whole.counts.listed
     # two CrIS granules reach every scan of the VIIRS granule: what stays home is the datasets not read
-    assert first.counts["bytes"] < 0.85 * whole.counts["bytes"]  # not Radiance, QF2 or the MW, SW bands
+    assert first.counts.bytes < 0.85 * whole.counts.bytes  # not Radiance, QF2 or the MW, SW bands
     again = compute_day(cfg, make_source(cfg), "j01", DAY)
     assert again.status == RunStatus.OK and [f.to_dict() for f in again.result.fors] == [
         f.to_dict() for f in first.result.fors
     ]
-    assert again.counts["bytes"] < 0.01 * first.counts["bytes"]
+    assert again.counts.bytes < 0.01 * first.counts.bytes
 
 
 def test_blocks_are_fetched_once_and_recorded_after_a_clean_read(moto, tmp_path):
@@ -171,5 +171,5 @@ def test_reprocessing_workers_read_their_own_ranges(moto, tmp_path, monkeypatch)
     summary = reprocess(cfg, DAY, DAY, ["j01"], workers=1, progress=outcomes.append)
     assert summary.statuses == {"ok": 1}, [o.reason for o in outcomes]
     (out,) = outcomes
-    assert out.counts["bytes"] > 0 and out.counts["requests"] > 0 and out.counts["downloaded"] == 0
+    assert out.counts.bytes > 0 and out.counts.requests > 0 and out.counts.downloaded == 0
     assert list((cfg.cache_dir / "ranges").rglob(f"*{BLOCK_LIST}"))  # the worker's block cache

@@ -15,8 +15,8 @@ def test_alert_lifecycle_keeps_its_start(tmp_path):
     with Store(tmp_path / "s.sqlite") as store:
         state = AlertState(store)
         f = Finding("spec", "j01", "critical", "FOR 30 beyond spec", ["FOR 30: 1.8 km"])
-        state.upsert(f, "firing", T0, notified=True)
-        state.upsert(f, "firing", T0 + dt.timedelta(hours=3), notified=False)
+        state.upsert(f, T0, notified=True)
+        state.upsert(f, T0 + dt.timedelta(hours=3), notified=False)
         (row,) = state.firing("j01")
         assert row.started == T0.isoformat() and row.last_notified == T0.isoformat()
         assert state.firing("npp") == []
