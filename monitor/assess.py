@@ -28,7 +28,7 @@ from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
-from monitor.result import AssessmentResult, GranuleInfo
+from monitor.result import AssessmentResult, GranuleInfo, Skipped
 from monitor.sdr import CrisGeoGranule, CrisSdrGranule, GranuleError, read_file
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_scan_start_us, read_viirs_geo_scan
@@ -462,7 +462,7 @@ def cost_and_offsets(
         end=max(ends) if ends else "",
         fors=day.fors,
         granules=[s.info for s in samples],
-        skipped=[{"item": a, "reason": b} for a, b in (skipped or [])],
+        skipped=[Skipped(str(a), str(b)) for a, b in (skipped or [])],
         half_steps=cfg.half_steps,
         step_urad=cfg.step_rad / URAD,
         cost_cube_k=day.cost_cube_k,

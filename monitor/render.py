@@ -59,5 +59,5 @@ def result_text(result: AssessmentResult) -> str:
     """What ``crisgeo assess`` and ``crisgeo run`` print of an assessment."""
     lines = [f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules"]
     lines += for_table(result.fors)
-    lines += [f"skipped {s['item']}: {s['reason']}" for s in result.skipped]
+    lines += [f"skipped {s.item}: {s.reason}" for s in result.skipped]
     return "\n".join(lines)

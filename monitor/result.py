@@ -157,6 +157,14 @@ class GranuleInfo:
         return cls(**{k: d[k] for k in cls.__dataclass_fields__ if k in d})
 
 
+@dataclass(frozen=True)
+class Skipped:
+    """An input left out of an assessment: the *item* (a granule's key or a file) and why."""
+
+    item: str
+    reason: str
+
+
 @dataclass
 class AssessmentResult:
     """One assessment of one satellite over a set of granules; all 30 FORs, in FOR order."""
@@ -164,9 +172,9 @@ class AssessmentResult:
     satellite: str
     start: str
     end: str
-    fors: list
+    fors: list[ForOffset]
     granules: list[GranuleInfo] = field(default_factory=list)
-    skipped: list = field(default_factory=list)
+    skipped: list[Skipped] = field(default_factory=list)
     half_steps: int = DEFAULT_HALF_STEPS
     step_urad: float = DEFAULT_STEP_URAD
     cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
@@ -181,7 +189,7 @@ class AssessmentResult:
             "half_steps": self.half_steps,
             "step_urad": self.step_urad,
             "granules": [asdict(g) for g in self.granules],
-            "skipped": self.skipped,
+            "skipped": [asdict(s) for s in self.skipped],
             "fors": [f.to_dict() for f in self.fors],
             "difference_bins": [asdict(b) for b in self.difference_bins],
             "notes": self.notes,
@@ -202,7 +210,7 @@ class AssessmentResult:
             end=d["end"],
             fors=[ForOffset.from_dict(f) for f in d["fors"]],
             granules=[GranuleInfo.from_dict(g) for g in d.get("granules", [])],
-            skipped=d.get("skipped", []),
+            skipped=[Skipped(**s) for s in d.get("skipped", [])],
             half_steps=int(d.get("half_steps", DEFAULT_HALF_STEPS)),
             step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),
             cost_cube_k=None if cube is None else np.asarray(cube, float),

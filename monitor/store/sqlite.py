@@ -390,7 +390,7 @@ class Store:
             for s in result.skipped:
                 self.db.execute(
                     "INSERT INTO skipped VALUES (?, ?, ?, ?, ?)",
-                    (satellite, d, run_id, s["item"], s["reason"]),
+                    (satellite, d, run_id, s.item, s.reason),
                 )
             if result.cost_cube_k is not None:
                 self.db.execute(

@@ -423,7 +423,7 @@ def test_assessment_names_the_mutant_or_keeps_its_numbers(cases, tmp_path, prefi
     except (GranuleError, ValueError) as exc:
         assert victim.name in str(exc), what
         return
-    if any(victim.name in s["item"] + s["reason"] for s in result.skipped):
+    if any(victim.name in s.item + s.reason for s in result.skipped):
         return
     for a, b in zip(result.fors, intact.fors, strict=True):
         if a.reliable and b.reliable:
