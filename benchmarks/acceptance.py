@@ -11,7 +11,7 @@ smooth response within the specification's table; ``--kernel`` the assessment's 
 fits the response; ``top-hat`` is the paper's cone).
 
 Calibration of the reported sigma (the delete-one-granule jackknife plus the floor
-``AssessConfig.floor_urad``, by kernel, in quadrature): over all cases, the share of FOR-directions whose
+``estimate.floor_urad``, by kernel, in quadrature): over all cases, the share of FOR-directions whose
 |error| <= 2 sigma (target >= 90 %) and, per case, the median sigma over the RMS error (target <= 1.5).
 It also prints the floor that would give 90 % coverage with the jackknife part as measured.
 CrIS-VIIRS calibration differences (``--mismatch``, issue 27): the CrIS BT departs from VIIRS's by a gain
@@ -42,7 +42,9 @@ from pathlib import Path
 import numpy as np
 
 from monitor import footprint
-from monitor.assess import AssessConfig, assess_paths
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
+from monitor.estimate import floor_urad
 from monitor.simulate.case import simulate_case
 from monitor.simulate.orbit import PASSES
 from monitor.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
@@ -97,7 +99,7 @@ def run_case(
             cris_response=None if shape == "top-hat" else footprint.shape(shape),
         )
     t0 = time.perf_counter()
-    cfg = AssessConfig(cost=Cost(cost), kernel=Kernel(kernel))
+    cfg = AssessmentConfig(cost=Cost(cost), kernel=Kernel(kernel))
     result = assess_paths([case], cfg, workers=workers)
     secs = time.perf_counter() - t0
     (case / "result.json").write_text(result.to_json(with_cube=False))
@@ -112,7 +114,7 @@ def run_case(
         "pass": pass_name,
         "seed": seed,
         "assess_s": secs,
-        "floor_urad": cfg.floor_urad,
+        "floor_urad": floor_urad(cfg),
         "err_alpha_urad": (np.array([f.d_alpha_urad for f in result.fors]) - ta).tolist(),
         "err_beta_urad": (np.array([f.d_beta_urad for f in result.fors]) - tb).tolist(),
         "sigma_alpha_urad": [f.sigma_alpha_urad for f in result.fors],

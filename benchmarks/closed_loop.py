@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.assess import AssessConfig, assess_paths
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
 from monitor.constants import URAD
 from monitor.geometry.instrument import EngineeringPacket
 from monitor.mapping.optimize import Optimization, optimize
@@ -89,12 +90,12 @@ def run_closed_loop(
     granules: int = 14,
     seed: int = 1,
     workers: int = 2,
-    config: AssessConfig | None = None,
+    config: AssessmentConfig | None = None,
 ) -> LoopReport:
     """Simulate with (*true_ep*, *ground_ep*), then assess, optimize, regeolocate and assess again."""
     work = Path(work_dir)
     case, regeo = work / "case", work / "regeolocated"
-    config = config or AssessConfig()
+    config = config or AssessmentConfig()
     seconds = {}
     t = time.perf_counter()
     spec = SimulationSpec(

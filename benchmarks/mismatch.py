@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.assess import AssessConfig, assess_paths
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
 from monitor.simulate.case import simulate_case
 from monitor.vocabulary import Cost, Kernel
 from tests.conftest import truth_arrays
@@ -49,8 +49,10 @@ def main(argv=None) -> None:
                 out, granules=args.granules, profile="paper", seed=seed,
                 cris_gain=gain, cris_bias_k=bias_k, cris_nonlinear_k=curve_k,
             )  # fmt: skip
-            grid = (DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, Kernel.TOP_HAT)
-            cells = [errors(assess_paths([out], AssessConfig.of(*grid, cost)), truth) for cost in Cost]
+            cells = [
+                errors(assess_paths([out], AssessmentConfig(kernel=Kernel.TOP_HAT, cost=cost)), truth)
+                for cost in Cost
+            ]
             print(f"| {seed} | {gain:+.2f} | {bias_k} | {curve_k} | {' | '.join(cells)} |", flush=True)
 
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor import refine
-from monitor.assess import AssessConfig
+from monitor.config import AssessmentConfig
 from monitor.constants import N_FOR
 from monitor.estimate import estimate
 from monitor.intercal import fit_difference
@@ -79,7 +79,7 @@ def main() -> int:
     p.add_argument("--seed", type=int, default=42)
     args = p.parse_args()
     files = sorted(DATA.glob("*.npz"))
-    cfg = AssessConfig(kernel=Kernel.TOP_HAT)  # the files hold cone means
+    cfg = AssessmentConfig(kernel=Kernel.TOP_HAT)  # the files hold cone means
     day = assess_collocations(files, cfg, "j01")
     print("\n".join(day.notes))
     print(f"{'FOR':>3} {'d_alpha':>8} {'+-':>5} {'d_beta':>8} {'+-':>5} {'G_min K':>8}  flags")

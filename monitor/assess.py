@@ -6,7 +6,7 @@ and the CrIS I5-equivalent BT (:mod:`monitor.spectral`). Then per scan position 
 estimator (:mod:`monitor.estimate`): the minimum of the cost (equation 8, G(i, j, k) = STDEV(BT_VIIRS_ij -
 BT_CrIS), or its regression form), the response fitted with the ``footprint`` kernel, the jackknife
 uncertainty with a floor calibrated on simulated cases in quadrature (what the estimator itself leaves,
-``SIGMA_FLOOR_URAD``; ``benchmarks/acceptance.py`` measures it), the intercalibration; and
+``estimate.SIGMA_FLOOR_URAD``; ``benchmarks/acceptance.py`` measures it), the intercalibration; and
 here, the offsets in km on the ground.
 """
 
@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor import collocate, swath
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, URAD
+from monitor.config import AssessmentConfig
+from monitor.constants import FOV_DIAMETER_RAD, N_FOR
 from monitor.errors import AssessmentError, StopRequested
 from monitor.estimate import ForSamples, day_offsets
 from monitor.geometry.ground import offset_km
@@ -34,57 +35,17 @@ from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_scan_start_us, read_viirs_geo_scan
 from monitor.spectral import i5_band
 from monitor.threads import parallel_threads
-from monitor.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
+from monitor.vocabulary import Kernel
 
 LOG = logging.getLogger(__name__)
 # the discs each kernel collocates; the top-hat cone is one of them either way
 KERNELS = {Kernel.TOP_HAT: collocate.TOP_HAT, Kernel.FOOTPRINT: collocate.ANNULI}
 CONE_RADIUS_RAD = FOV_DIAMETER_RAD / 2
-# The floor of the sigmas by kernel (urad): what the estimator itself leaves beside the jackknife's scatter,
-# calibrated on simulated cases (benchmarks/acceptance.py prints the floor that gives 90 % coverage). The
-# top-hat cone's is the error a plain cone leaves on a top-hat truth; the footprint's was calibrated on the
-# 6-granule smooth-response cases of seeds 1-3 and checked on the others (docs/science.md).
-SIGMA_FLOOR_URAD = {Kernel.TOP_HAT: 5.0, Kernel.FOOTPRINT: 2.0}
 
 
-@dataclass
-class AssessConfig:
-    """Settings of one assessment. The defaults are the paper's but the cost's (``DEFAULT_COST``: the
-    regression form of equation 8, chosen by measurement)."""
-
-    half_steps: int = DEFAULT_HALF_STEPS
-    step_rad: float = DEFAULT_STEP_RAD
-    kernel: Kernel = DEFAULT_KERNEL
-    cost: Cost = DEFAULT_COST
-    min_coverage: float = collocate.MIN_COVERAGE
-    min_samples: int = 30
-    flat_contrast: float = 0.03
-    max_sigma_urad: float = 250.0  # ~0.55 perturbation step, 1.5 % of the FOV
-    uncertainty: bool = True  # the jackknife (monitor.jackknife); off only where a test needs no sigma
-    # in quadrature with the jackknife: the estimator's own error, calibrated on simulated cases (None: the
-    # kernel's, SIGMA_FLOOR_URAD)
-    sigma_floor_urad: float | None = None
-
-    @classmethod
-    def of(cls, half_steps: int, step_urad: float, kernel: str, cost: Cost = DEFAULT_COST) -> AssessConfig:
-        """The assessment of a configuration's (or the command line's) grid, kernel and cost, the rest
-        the paper's."""
-        return cls(half_steps=half_steps, step_rad=step_urad * URAD, kernel=Kernel(kernel), cost=Cost(cost))
-
-    @property
-    def floor_urad(self) -> float:
-        """The floor of the sigmas (urad): ``sigma_floor_urad``, or the kernel's."""
-        return SIGMA_FLOOR_URAD[self.kernel] if self.sigma_floor_urad is None else self.sigma_floor_urad
-
-    @property
-    def radii_rad(self) -> tuple[float, ...]:
-        """The radii of the discs collocated (:data:`KERNELS`)."""
-        return KERNELS[self.kernel]
-
-    @property
-    def offsets_rad(self) -> np.ndarray:
-        """The perturbation angles (rad) of one axis of the grid, -half_steps..+half_steps steps."""
-        return perturbation_grid(self.half_steps, self.step_rad)
+def offsets_rad(cfg: AssessmentConfig) -> np.ndarray:
+    """The perturbation angles (rad) of one axis of the grid, -half_steps..+half_steps steps."""
+    return perturbation_grid(cfg.half_steps, cfg.step_rad)
 
 
 @dataclass
@@ -199,7 +160,7 @@ def read_inputs(
     viirs: list,
     viirs_all: list,
     band,
-    cfg: AssessConfig,
+    cfg: AssessmentConfig,
     prepared=(),
     timings=None,
     spans=None,
@@ -240,8 +201,8 @@ def read_inputs(
             fg.sbf_to_ecef[valid],
             fg.alpha_rad[valid],
             fg.beta_rad[valid],
-            cfg.offsets_rad,
-            cfg.radii_rad,
+            offsets_rad(cfg),
+            KERNELS[cfg.kernel],
         )
     return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, span_us, bt_cris, raw)
 
@@ -301,7 +262,7 @@ def _load_swath(
 def collocate_granule(
     cris: GranuleFiles,
     viirs: list[GranuleFiles],
-    cfg: AssessConfig,
+    cfg: AssessmentConfig,
     band,
     cache: _SwathCache,
     timings=None,
@@ -369,13 +330,13 @@ def _cris_geometry(geo):
     return granule_geometry(geo), valid, fill
 
 
-def _collocate_fors(pieces, geo, fg, valid, fill, cfg: AssessConfig, band, should_stop=None):
+def _collocate_fors(pieces, geo, fg, valid, fill, cfg: AssessmentConfig, band, should_stop=None):
     """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone, the worst coverage per FOV (of the outermost
     disc), and with the footprint kernel the radiance per annulus (nscan, 30, 9, K, m, m), else None (all
     FOVs of the granule in one call of the parallel kernel)."""
     if should_stop is not None and should_stop():
         raise StopRequested
-    m = len(cfg.offsets_rad)
+    m = len(offsets_rad(cfg))
     shape = fg.alpha_rad.shape
     cones = collocate.cone_sums(
         pieces,
@@ -383,17 +344,17 @@ def _collocate_fors(pieces, geo, fg, valid, fill, cfg: AssessConfig, band, shoul
         fg.sbf_to_ecef.reshape(-1, 3, 3),
         fg.alpha_rad.ravel(),
         fg.beta_rad.ravel(),
-        cfg.offsets_rad,
-        cfg.radii_rad,
+        offsets_rad(cfg),
+        KERNELS[cfg.kernel],
         fov_range_m=np.where(valid, geo.range_m, 1e6).ravel(),
         fov_cos_zen=np.cos(fill["zenith_rad"]).ravel(),
     )
-    cone = cfg.radii_rad.index(CONE_RADIUS_RAD)
+    cone = KERNELS[cfg.kernel].index(CONE_RADIUS_RAD)
     bt_viirs = band.bt_from_radiance(cones.mean(cone)).astype(np.float32).reshape(shape + (m, m))
     coverage = np.min(cones.coverage(), axis=(-2, -1)).reshape(shape)
     annuli = None
-    if len(cfg.radii_rad) > 1:
-        annuli = cones.annulus_means().reshape(shape + (len(cfg.radii_rad), m, m))
+    if len(KERNELS[cfg.kernel]) > 1:
+        annuli = cones.annulus_means().reshape(shape + (len(KERNELS[cfg.kernel]), m, m))
     return bt_viirs, coverage, annuli
 
 
@@ -417,10 +378,10 @@ def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
     return float(np.mean(it)), float(np.mean(ct)), jac
 
 
-def for_samples(samples: list[GranuleSamples], k: int, cfg: AssessConfig, band=None) -> ForSamples:
+def for_samples(samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, band=None) -> ForSamples:
     """The estimator's input for FOR k (0-based): every usable FOV of it over the granules (*band*, the
     satellite's I5 band, for the footprint kernel)."""
-    m = len(cfg.offsets_rad)
+    m = len(offsets_rad(cfg))
     d, cris, granule, scan, annuli = [], [], [], [], []
     for g_i, s in enumerate(samples):
         use = s.usable[:, k]  # (nscan, 9)
@@ -431,27 +392,27 @@ def for_samples(samples: list[GranuleSamples], k: int, cfg: AssessConfig, band=N
         scan.append(scans)
         if s.annuli_rad is not None:
             annuli.append(s.annuli_rad[:, k][use])
-    footprint = len(cfg.radii_rad) > 1
+    footprint = len(KERNELS[cfg.kernel]) > 1
     return ForSamples(
         np.concatenate(d) if d else np.empty((0, m, m)),
         np.concatenate(cris) if cris else np.empty(0),
         np.concatenate(granule) if granule else np.empty(0, int),
         np.concatenate(scan) if scan else np.empty(0, int),
         np.concatenate(annuli) if footprint and annuli else None,
-        cfg.radii_rad if footprint else (),
+        KERNELS[cfg.kernel] if footprint else (),
         band,
     )
 
 
 def cost_and_offsets(
-    samples: list[GranuleSamples], cfg: AssessConfig, skipped=None, satellite=""
+    samples: list[GranuleSamples], cfg: AssessmentConfig, skipped=None, satellite=""
 ) -> AssessmentResult:
     """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*."""
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
     day = day_offsets(
         [for_samples(samples, k, cfg, band) for k in range(N_FOR)],
         cfg,
-        cfg.step_rad / URAD,
+        cfg.step_urad,
         lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
     )
     starts = [s.info.start for s in samples]
@@ -464,7 +425,7 @@ def cost_and_offsets(
         granules=[s.info for s in samples],
         skipped=[Skipped(str(a), str(b)) for a, b in (skipped or [])],
         half_steps=cfg.half_steps,
-        step_urad=cfg.step_rad / URAD,
+        step_urad=cfg.step_urad,
         cost_cube_k=day.cost_cube_k,
         difference_bins=day.difference_bins,
     )
@@ -475,7 +436,7 @@ def _collocate_run(
     viirs: dict,
     viirs_all: list,
     satellite: str,
-    cfg: AssessConfig,
+    cfg: AssessmentConfig,
     progress=None,
     should_stop=None,
     timings=None,
@@ -537,7 +498,7 @@ def _collocate_run(
 
 def assess_plan(
     case: CasePlan,
-    cfg: AssessConfig | None = None,
+    cfg: AssessmentConfig | None = None,
     progress=None,
     should_stop=None,
     timings=None,
@@ -551,7 +512,7 @@ def assess_plan(
     seconds per stage. *workers* is the number of threads of the compiled VIIRS preparation and
     collocation (granules go one after the other, each VIIRS granule prepared once).
     """
-    cfg = cfg or AssessConfig()
+    cfg = cfg or AssessmentConfig()
     skipped = list(case.skipped)
     with parallel_threads(workers):
         samples, k = _collocate_run(
@@ -572,6 +533,8 @@ def assess_plan(
         return cost_and_offsets(samples, cfg, skipped, case.satellite)
 
 
-def assess_paths(paths, cfg: AssessConfig | None = None, progress=None, workers: int = 1) -> AssessmentResult:
+def assess_paths(
+    paths, cfg: AssessmentConfig | None = None, progress=None, workers: int = 1
+) -> AssessmentResult:
     """Find, pair and assess the granules under *paths* (files or directories)."""
     return assess_plan(plan(paths), cfg, progress, workers=workers)

@@ -10,8 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.assess import AssessConfig, assess_plan
+from monitor.assess import assess_plan, offsets_rad
 from monitor.collocate import warm_up
+from monitor.config import AssessmentConfig
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbed_los_sbf
@@ -35,7 +36,7 @@ def reset_peak_rss() -> bool:
         return False
 
 
-def _pyresample_reference(case, cfg: AssessConfig, max_granules=1):
+def _pyresample_reference(case, cfg: AssessmentConfig, max_granules=1):
     """Time the zero-offset and all-perturbation collocation with pyresample's radius neighbour search.
 
     For each perturbed LOS the ground point is computed and pyresample finds the VIIRS pixels within
@@ -58,7 +59,7 @@ def _pyresample_reference(case, cfg: AssessConfig, max_granules=1):
     source = prgeo.SwathDefinition(lons=lon[ok], lats=lat[ok])
     t0 = time.perf_counter()
     fg, valid = granule_geometry(geo), geo.valid
-    los = perturbed_los_sbf(fg.alpha_rad, fg.beta_rad, cfg.offsets_rad)  # (4,30,9,m,m,3)
+    los = perturbed_los_sbf(fg.alpha_rad, fg.beta_rad, offsets_rad(cfg))  # (4,30,9,m,m,3)
     los_e = np.einsum("skfij,skfabj->skfabi", fg.sbf_to_ecef, los)
     sat = np.broadcast_to(fg.sat_ecef_m[..., None, None, :], los_e.shape)
     ground = sat + wgs84.intersect_ellipsoid(sat, los_e)[..., None] * los_e
@@ -73,7 +74,7 @@ def _pyresample_reference(case, cfg: AssessConfig, max_granules=1):
 
 def run_bench(args) -> int:
     """``crisgeo bench``: simulate (or take --data), warm the kernels, time each stage, print; exit status."""
-    cfg = AssessConfig(cost=Cost(args.cost))
+    cfg = AssessmentConfig(cost=Cost(args.cost))
     with tempfile.TemporaryDirectory() as tmp:
         data = Path(args.data) if args.data else Path(tmp)
         t0 = time.perf_counter()
@@ -91,7 +92,7 @@ def run_bench(args) -> int:
         wall = time.perf_counter() - t0
         n_fov = sum(gr.n_fovs for gr in result.granules)
         print(
-            f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(cfg.offsets_rad) ** 2} "
+            f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(offsets_rad(cfg)) ** 2} "
             f"perturbations, cost {cfg.cost} (simulation {t_sim:.1f} s and kernel compile/load "
             f"{t_jit:.1f} s, not counted)"
         )

@@ -354,7 +354,7 @@ def cmd_geolocate(args) -> int:
 )
 def cmd_assess(args) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
-    from monitor.assess import AssessConfig, assess_paths
+    from monitor.assess import assess_paths
     from monitor.config import ConfigError, section_of
 
     try:  # the options are the assessment section's keys, checked by the configuration model
@@ -369,7 +369,7 @@ def cmd_assess(args) -> int:
     except ConfigError as exc:
         raise BadInput(f"--steps/--step-urad/--workers: {exc}") from None
     assert isinstance(a, AssessmentConfig)
-    cfg = AssessConfig.of(a.half_steps, a.step_urad, a.kernel, a.cost)
+    cfg = a
     collocations = [p for p in args.paths if p.endswith(".npz")]
     if collocations and len(collocations) != len(args.paths):
         raise BadInput("give either granules or collocation files (.npz), not both")

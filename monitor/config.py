@@ -394,6 +394,40 @@ class AssessmentConfig(Section):
         "gain or bias does not move it).",
     )
     workers: int = key(2, "Threads of the compiled VIIRS preparation and collocation kernels.", 1, 64)
+    min_coverage: float = key(
+        0.97,
+        "Share of a turned cone that VIIRS pixels must cover for the FOV to count (the swath's edges and "
+        "gaps leave cones part empty).",
+        0.5,
+        1.0,
+    )
+    min_samples: int = key(
+        30, "Fewest usable FOVs for a FOR's estimate (fewer: flagged few_samples), and for a day.", 3, 10**6
+    )
+    flat_contrast: float = key(
+        0.03,
+        "Least relative depth of a FOR's cost minimum; a shallower one is flagged flat (uniform scenes).",
+        0.0,
+        1.0,
+    )
+    max_sigma_urad: float = key(
+        250.0, "Largest sigma of a trusted offset (urad, ~0.55 step); larger is flagged uncertain.", 1.0, 1e5
+    )
+    sigma_floor_urad: float | None = key(
+        None,
+        "Added in quadrature to the jackknife's sigma: the estimator's own error (urad). None: the kernel's "
+        "calibrated floor (2 with footprint, 5 with top-hat).",
+        0.0,
+        1000.0,
+    )
+    uncertainty: bool = key(
+        True, "Compute the jackknife's sigmas (off: offsets without sigmas, flags from the cost alone)."
+    )
+
+    @property
+    def step_rad(self) -> float:
+        """The perturbation step in radians."""
+        return self.step_urad * URAD
 
     @model_validator(mode="after")
     def _consistent(self) -> AssessmentConfig:

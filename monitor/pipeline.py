@@ -18,7 +18,7 @@ import numpy as np
 from alerts.changes import all_changes
 from monitor import fingerprint as fpr
 from monitor import logs
-from monitor.assess import AssessConfig, assess_plan
+from monitor.assess import assess_plan
 from monitor.config import Config, ScheduleConfig
 from monitor.errors import DataError, StopRequested
 from monitor.records import SceneDecision
@@ -287,7 +287,7 @@ def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, shou
         )
         w.result = assess_plan(
             case,
-            AssessConfig.of(a.half_steps, a.step_urad, a.kernel, a.cost),
+            a,
             progress=progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris)),
             should_stop=stop,
             workers=a.workers,

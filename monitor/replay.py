@@ -15,12 +15,12 @@ that too. The cone means are plain means over the top-hat cone, so no footprint 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from monitor.assess import AssessConfig
+from monitor.config import AssessmentConfig
 from monitor.constants import N_FOR, N_FOV, URAD
 from monitor.errors import DataError
 from monitor.estimate import ForSamples, day_offsets
@@ -173,7 +173,7 @@ def notes(granules: list[Collocation]) -> list[str]:
     ]
 
 
-def assess_collocations(paths, cfg: AssessConfig, satellite: str = "") -> AssessmentResult:
+def assess_collocations(paths, cfg: AssessmentConfig, satellite: str = "") -> AssessmentResult:
     """The estimator's result for the collocation files *paths* (one granule each; all on one grid): per-FOR
     offsets in urad with jackknife sigmas, flags and the intercalibration; the km fields NaN. The files hold
     top-hat cone means: the top-hat kernel's floor of the sigmas applies."""
@@ -187,7 +187,7 @@ def assess_collocations(paths, cfg: AssessConfig, satellite: str = "") -> Assess
             or abs(g.step_rad - first.step_rad) > STEP_TOLERANCE * first.step_rad
         ):
             raise ReplayError(g.path, "alpha", f"grid differs from {first.path.name}'s")
-    cones = replace(cfg, kernel=Kernel.TOP_HAT)
+    cones = cfg.model_copy(update={"kernel": Kernel.TOP_HAT})
     day = day_offsets([for_samples(granules, k) for k in range(N_FOR)], cones, first.step_rad / URAD)
     return AssessmentResult(
         satellite=satellite,

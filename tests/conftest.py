@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from monitor.assess import AssessConfig, assess_paths
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
 from monitor.sdr.engpkt import load_ep
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
@@ -70,7 +71,7 @@ class CaseCache:
                     truth = simulate_case(
                         out, satellite=satellite, granules=granules, profile=profile, seed=seed
                     )
-                    result = assess_paths([out], AssessConfig())
+                    result = assess_paths([out], AssessmentConfig())
                     made.with_suffix(".part").write_bytes(pickle.dumps((truth, result)))
                     made.with_suffix(".part").rename(made)
             self.cases[key] = (out, *pickle.loads(made.read_bytes()))

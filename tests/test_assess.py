@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from monitor.assess import AssessConfig
+from monitor.config import AssessmentConfig
 from monitor.estimate import find_minimum
 from monitor.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult
 from tests.cli import run_crisgeo
@@ -70,9 +70,9 @@ def test_too_few_samples_are_flagged(cases):
 
     out, _, _ = cases.get("paper", 1)
     case = plan([out])
-    samples, _ = _collocate_run(case.cris[:1], case.viirs, case.viirs_all, "j01", AssessConfig())
+    samples, _ = _collocate_run(case.cris[:1], case.viirs, case.viirs_all, "j01", AssessmentConfig())
     samples[0].usable[:, :, 1:] = False  # keep FOV 1 only: 4 samples per FOR
-    result = cost_and_offsets(samples, AssessConfig(uncertainty=False), satellite="j01")
+    result = cost_and_offsets(samples, AssessmentConfig(uncertainty=False), satellite="j01")
     assert all(FLAG_FEW_SAMPLES in f.flags and not f.reliable for f in result.fors)
 
 
@@ -113,7 +113,7 @@ def test_reading_only_the_reachable_viirs_scans_changes_no_bit(cases, monkeypatc
         return whole_read(v, viirs_all, None)
 
     monkeypatch.setattr(assess, "_read_viirs", every_scan)
-    whole = assess.assess_paths([out], AssessConfig())  # as the case was assessed
+    whole = assess.assess_paths([out], AssessmentConfig())  # as the case was assessed
     assert read_scans and all(s is not None for s in read_scans)  # the partial run had spans to read by
     assert [f.to_dict() for f in whole.fors] == [f.to_dict() for f in partial.fors]
     assert np.array_equal(whole.cost_cube_k, partial.cost_cube_k)

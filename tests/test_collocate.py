@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from monitor import collocate, swath
-from monitor.assess import AssessConfig, _piece, _SwathCache
+from monitor.assess import KERNELS, _piece, _SwathCache
+from monitor.config import AssessmentConfig
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbation_grid
@@ -114,7 +115,7 @@ def test_annuli_are_nested_discs_whose_cone_is_the_top_hat(scene):
     np.testing.assert_allclose(outer, rings.mean(-1), rtol=1e-6)
     with pytest.raises(ValueError, match="increase"):
         collocate.cone_sums(*args, collocate.ANNULI[::-1])
-    assert AssessConfig(kernel="footprint").radii_rad == collocate.ANNULI
+    assert KERNELS[AssessmentConfig(kernel="footprint").kernel] == collocate.ANNULI
 
 
 def test_search_blocks_at_a_ragged_swath_edge(scene, case_plan):

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from monitor.assess import AssessConfig, assess_paths
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
 from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
 from tests.conftest import truth_arrays
@@ -25,7 +26,7 @@ def case(request, tmp_path_factory):
         request.param,
         out,
         truth,
-        assess_paths([out], AssessConfig()),
+        assess_paths([out], AssessmentConfig()),
     )  # low-contrast FORs: uncertain
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from monitor.assess import AssessConfig
+from monitor.config import AssessmentConfig
 from monitor.replay import ReplayError, assess_collocations, read_collocation
 from tests.cli import run_crisgeo
 
@@ -26,7 +26,7 @@ def test_a_collocation_is_read_on_its_centred_square_grid():
 
 
 def test_the_ten_real_granules_give_offsets_and_say_what_they_lack():
-    r = assess_collocations(REAL, AssessConfig(), "j01")
+    r = assess_collocations(REAL, AssessmentConfig(), "j01")
     assert len(r.fors) == 30 and r.half_steps == 7
     offsets = np.array([[f.d_alpha_urad, f.d_beta_urad] for f in r.fors])
     sigmas = np.array([[f.sigma_alpha_urad, f.sigma_beta_urad] for f in r.fors])
@@ -41,7 +41,7 @@ def test_split_halves_agree_within_their_jackknife_sigmas():
     """Honest sigmas on real radiances: 5 granules against the other 5, twenty random splits; the halves'
     offsets differ by more than 2 combined sigmas for at most 12 % of FOR-directions, and the rms of the
     normalised difference lies between 0.75 and 1.3 (the scan bootstrap it replaces: 13-15 %, 1.36-1.41)."""
-    cfg = AssessConfig()
+    cfg = AssessmentConfig()
     rng = np.random.default_rng(42)
     z = []
     for _ in range(20):

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from monitor import collocate, swath
-from monitor.assess import AssessConfig, _piece, _reach_us, _SwathCache
+from monitor.assess import _piece, _reach_us, _SwathCache, offsets_rad
+from monitor.config import AssessmentConfig
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.sdr import read_file
@@ -72,9 +73,9 @@ def test_columns_no_cone_reaches_change_no_cone_sum(case_plan):
     g = case_plan.cris[0]
     (geo,) = read_file(g.geo, kinds=("cris_geo",))
     fg, valid = granule_geometry(geo), geo.valid
-    cfg, band = AssessConfig(), i5_band(case_plan.satellite)
+    cfg, band = AssessmentConfig(), i5_band(case_plan.satellite)
     sel = (fg.sat_ecef_m[valid], fg.sbf_to_ecef[valid], fg.alpha_rad[valid], fg.beta_rad[valid])
-    view = collocate.view_reach_rad(*sel, cfg.offsets_rad)
+    view = collocate.view_reach_rad(*sel, offsets_rad(cfg))
     assert math.radians(45) < view < math.radians(55)
     full, cut = (
         swath.ViirsSwath(
@@ -86,7 +87,7 @@ def test_columns_no_cone_reaches_change_no_cone_sum(case_plan):
         c.radiance.shape[1] < f.radiance.shape[1] for f, c in zip(full.pieces, cut.pieces, strict=True)
     )
     assert all(c.first_column > 0 and c.view_rad < math.pi for c in cut.pieces)
-    a, b = (collocate.cone_sums(sw, *sel, cfg.offsets_rad) for sw in (full, cut))
+    a, b = (collocate.cone_sums(sw, *sel, offsets_rad(cfg)) for sw in (full, cut))
     np.testing.assert_array_equal(a.sums, b.sums)
     np.testing.assert_array_equal(a.weights, b.weights)
     assert np.isfinite(a.mean()).mean() > 0.9
@@ -110,7 +111,7 @@ def test_scans_no_cone_reaches_change_no_cone_sum(case_plan):
     g = case_plan.cris[-1]
     (geo,) = read_file(g.geo, kinds=("cris_geo",))
     fg, valid = granule_geometry(geo), geo.valid
-    cfg, band = AssessConfig(), i5_band(case_plan.satellite)
+    cfg, band = AssessmentConfig(), i5_band(case_plan.satellite)
     sel = (fg.sat_ecef_m[valid], fg.sbf_to_ecef[valid], fg.alpha_rad[valid], fg.beta_rad[valid])
     seen = geo.for_time_us[geo.for_time_us > 0]
     span = _reach_us(int(seen.min()), int(seen.max()))
@@ -131,7 +132,7 @@ def test_scans_no_cone_reaches_change_no_cone_sum(case_plan):
         cols = slice(c.first_column - f.first_column, c.first_column - f.first_column + c.shape[1])
         np.testing.assert_array_equal(c.area_vec_m2, f.area_vec_m2[rows, cols])
         np.testing.assert_array_equal(c.radiance, f.radiance[rows, cols])
-    a, b = (collocate.cone_sums(sw, *sel, cfg.offsets_rad) for sw in (full, cut))
+    a, b = (collocate.cone_sums(sw, *sel, offsets_rad(cfg)) for sw in (full, cut))
     np.testing.assert_array_equal(a.sums, b.sums)
     np.testing.assert_array_equal(a.weights, b.weights)
     assert np.isfinite(a.mean()).mean() > 0.9

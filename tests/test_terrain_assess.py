@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from monitor import swath
-from monitor.assess import AssessConfig, assess_paths
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
 from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
 from tests.conftest import truth_arrays
@@ -38,7 +39,7 @@ def test_simulated_terrain_in_the_files(mountains):
 
 def test_assessment_needs_the_height(mountains, monkeypatch):
     out, truth = mountains
-    cfg = AssessConfig(uncertainty=False)
+    cfg = AssessmentConfig(uncertainty=False)
     ea, eb = _errors(assess_paths([out], cfg), truth)
     assert len(ea) >= 25 and max(np.abs(ea).max(), np.abs(eb).max()) < 100
     assert np.sqrt(np.mean(np.r_[ea, eb] ** 2)) < 40

@@ -26,7 +26,8 @@ import h5py
 import numpy as np
 import pytest
 
-from monitor.assess import AssessConfig, assess_paths
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
 from monitor.sdr import CrisSdrGranule, GranuleError, ViirsSdrGranule, read_file
 from monitor.sdr.products import PRODUCTS
 from monitor.sdr.readers import read_metadata
@@ -419,7 +420,7 @@ def test_assessment_names_the_mutant_or_keeps_its_numbers(cases, tmp_path, prefi
     shutil.copyfile(victim, work / victim.name)
     what, _ = mutate(work / victim.name, prefix, family, np.random.default_rng(1000 * k + len(prefix)))
     try:
-        result = assess_paths([work], AssessConfig())
+        result = assess_paths([work], AssessmentConfig())
     except (GranuleError, ValueError) as exc:
         assert victim.name in str(exc), what
         return

@@ -4,7 +4,8 @@ instruments' by the bias and gain injected (what the intercalibration of issue 2
 import numpy as np
 import pytest
 
-from monitor.assess import AssessConfig, assess_paths
+from monitor.assess import assess_paths
+from monitor.config import AssessmentConfig
 from monitor.constants import CALIBRATION_REFERENCE_K
 from monitor.sdr import read_file
 from monitor.simulate.case import SimulationSpec, simulate_case
@@ -59,7 +60,7 @@ def differing(tmp_path_factory):
 
 
 def _assess(root, name, cost):
-    return assess_paths([root / name], AssessConfig(cost=cost))
+    return assess_paths([root / name], AssessmentConfig(cost=cost))
 
 
 def test_a_calibration_bias_leaves_the_paper_cost_as_it_was(differing):
