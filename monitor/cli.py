@@ -153,31 +153,28 @@ def cmd_simulate(args) -> int:
     )
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")
-    try:
-        spec = None
-        if args.true_ep:
-            spec = SimulationSpec(
-                satellite=args.satellite,
-                granules=args.granules,
-                seed=args.seed,
-                start=args.start or DEFAULT_START,
-                profile="ep",
-                true_ep=_ep(args.true_ep),
-                ground_ep=_ep(args.ground_ep),
-                **where,
-            )
-        truth = simulate_case(
-            args.out,
+    spec = None
+    if args.true_ep:
+        spec = SimulationSpec(
             satellite=args.satellite,
             granules=args.granules,
-            profile=args.profile,
             seed=args.seed,
-            start=args.start,
-            spec=spec,
+            start=args.start or DEFAULT_START,
+            profile="ep",
+            true_ep=_ep(args.true_ep),
+            ground_ep=_ep(args.ground_ep),
             **where,
         )
-    except DataError as exc:
-        raise BadInput(str(exc)) from None
+    truth = simulate_case(
+        args.out,
+        satellite=args.satellite,
+        granules=args.granules,
+        profile=args.profile,
+        seed=args.seed,
+        start=args.start,
+        spec=spec,
+        **where,
+    )
     error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {args.profile}"
     print(
         f"wrote {len(truth['files'])} files and truth.json to {args.out} "
@@ -200,10 +197,7 @@ def _footprint(names):
 def _ep(path, satellite=None):
     from monitor.sdr.engpkt import load_ep
 
-    try:
-        return load_ep(path, satellite)
-    except DataError as exc:
-        raise BadInput(str(exc)) from None
+    return load_ep(path, satellite)
 
 
 def _residuals(args):
@@ -243,10 +237,7 @@ def cmd_optimize(args) -> int:
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise BadInput(f"{args.result}: not an assessment result ({exc})") from None
     ep = _ep(args.ep)
-    try:
-        opt = optimize(result, ep, source=str(args.result))
-    except DataError as exc:
-        raise BadInput(str(exc)) from None
+    opt = optimize(result, ep, source=str(args.result))
     print(
         f"EP {ep.version} ({ep.satellite}) corrected by {args.result} ({result.start} .. {result.end}, "
         f"{len(result.granules)} granules)"
@@ -301,10 +292,7 @@ def cmd_geolocate(args) -> int:
     from monitor.mapping.regeolocate import compare_with_files
 
     ep = _ep(args.ep)
-    try:
-        rows = compare_with_files(ep, args.files, _residuals(args))
-    except DataError as exc:
-        raise BadInput(str(exc)) from None
+    rows = compare_with_files(ep, args.files, _residuals(args))
     if args.json:
         print(
             json.dumps(
@@ -373,15 +361,12 @@ def cmd_assess(args) -> int:
     collocations = [p for p in args.paths if p.endswith(".npz")]
     if collocations and len(collocations) != len(args.paths):
         raise BadInput("give either granules or collocation files (.npz), not both")
-    try:
-        if collocations:
-            from monitor.replay import assess_collocations
+    if collocations:
+        from monitor.replay import assess_collocations
 
-            result = assess_collocations(collocations, cfg)
-        else:
-            result = assess_paths(args.paths, cfg, workers=a.workers)
-    except DataError as exc:
-        raise BadInput(str(exc)) from None
+        result = assess_collocations(collocations, cfg)
+    else:
+        result = assess_paths(args.paths, cfg, workers=a.workers)
     print(result_text(result))
     if args.out:
         Path(args.out).write_text(result.to_json())
@@ -473,8 +458,7 @@ def cmd_export(args) -> int:
     sats = _satellites(cfg, args.satellite)
     if len(sats) > 1:
         raise BadInput(f"--satellite: one of {', '.join(sats)} (a file holds one satellite)")
-    if args.since and args.until and args.since > args.until:
-        raise BadInput(f"--since {args.since} is after --until {args.until}")
+    _period(args.since, args.until)
     with _open_store(cfg) as store:
         try:
             path = export(store, sats[0], args.out, args.format, args.since, args.until, cfg.export)
@@ -495,6 +479,12 @@ def _open_store(cfg: Config) -> Store:
     from monitor.store.sqlite import Store
 
     return Store(cfg.store.sqlite, create=False)
+
+
+def _period(since: dt.date | None, until: dt.date | None) -> None:
+    """Refuse (bad input) a period that ends before it starts."""
+    if since and until and since > until:
+        raise BadInput(f"--since {since} is after --until {until}")
 
 
 def _satellites(cfg: Config, satellite: str | None) -> list[str]:
@@ -524,7 +514,6 @@ def _in_mission(sats: list[str], days: dict[str, dt.date | None]) -> None:
 )
 def cmd_run(args) -> int:
     """crisgeo run: one run of the daily job, then exit."""
-    from monitor.lock import AlreadyRunning
     from monitor.service import Service
     from monitor.vocabulary import RunStatus
 
@@ -540,9 +529,6 @@ def cmd_run(args) -> int:
     service.handle_signals()
     try:
         outcomes = service.run_once(sats, args.date)
-    except AlreadyRunning as exc:
-        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
-        return EXIT_ALREADY_RUNNING
     finally:
         if bar is not None:
             bar.close()
@@ -572,22 +558,16 @@ def cmd_run(args) -> int:
 )
 def cmd_reprocess(args) -> int:
     """crisgeo reprocess: a period on Dask; this process alone writes the store."""
-    from monitor.lock import AlreadyRunning
     from monitor.reprocess import run_reprocess
     from monitor.vocabulary import RunStatus
 
     cfg = _load(args, writes=True)
     sats = _satellites(cfg, args.satellite)
-    if args.until < args.since:
-        raise BadInput(f"--until {args.until} is before --since {args.since}")
+    _period(args.since, args.until)
     _in_mission(sats, {"--since": args.since, "--until": args.until})
     if args.workers < 1:
         raise BadInput(f"--workers: {args.workers}, at least 1")
-    try:
-        summary = run_reprocess(cfg, args.since, args.until, sats, args.scheduler, args.workers, args.force)
-    except AlreadyRunning as exc:
-        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
-        return EXIT_ALREADY_RUNNING
+    summary = run_reprocess(cfg, args.since, args.until, sats, args.scheduler, args.workers, args.force)
     for line in summary.lines():
         print(line)
     return EXIT_FAIL if summary.unfinished or summary.statuses.get(RunStatus.FAILED) else EXIT_OK
@@ -605,7 +585,6 @@ def cmd_reprocess(args) -> int:
 )
 def cmd_daemon(args) -> int:
     """crisgeo daemon: the long-running service."""
-    from monitor.lock import AlreadyRunning
     from monitor.service import Service
 
     cfg = _load(args, writes=True)
@@ -616,14 +595,7 @@ def cmd_daemon(args) -> int:
             check_listen(args.listen)
         except ValueError as exc:
             raise BadInput(f"--listen: {exc}") from None
-    try:
-        Service(cfg).daemon(args.listen)
-    except AlreadyRunning as exc:
-        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
-        return EXIT_ALREADY_RUNNING
-    except OSError as exc:  # the endpoint's port is taken or not allowed
-        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
-        return EXIT_FAIL
+    Service(cfg).daemon(args.listen)  # a port taken or not allowed is an OSError: main says it
     return EXIT_OK
 
 
@@ -809,12 +781,8 @@ def cmd_fingerprint(args) -> int:
     import json
 
     from monitor import fingerprint as fpr
-    from monitor.errors import DataError
 
-    try:
-        fp = fpr.fingerprint_files(args.paths, args.ep_library or [], args.threshold_urad)
-    except DataError as exc:
-        raise BadInput(str(exc)) from None
+    fp = fpr.fingerprint_files(args.paths, args.ep_library or [], args.threshold_urad)
     if args.json:
         print(json.dumps(fp.to_dict(), indent=1))
     else:
@@ -872,8 +840,7 @@ def cmd_report(args) -> int:
 
     cfg = _load(args)
     _satellites(cfg, args.satellite)
-    if args.since and args.until and args.since > args.until:
-        raise BadInput(f"--since {args.since} is after --until {args.until}")
+    _period(args.since, args.until)
     opts = options_from_config(cfg, [args.satellite] if args.satellite else None, args.since, args.until)
     t0 = time.perf_counter()
     with _open_store(cfg) as store:
@@ -1010,7 +977,10 @@ class _PipedOutput:
 
 
 def main(argv=None) -> int:
-    """The crisgeo command: parse, set up logging, run the subcommand; its exit status."""
+    """The crisgeo command: parse, set up logging, run the subcommand; its exit status. Every error a
+    command lets through is mapped to its exit status here, in one line: bad input (2), another instance
+    (75), an unusable store or the machine's (1), an interruption (130)."""
+    from monitor.lock import AlreadyRunning
     from monitor.store.sqlite import StoreError
 
     parser = build_parser()
@@ -1023,9 +993,12 @@ def main(argv=None) -> int:
         code = args.func(args)
         sys.stdout.flush()
         return code
-    except BadInput as exc:
+    except (BadInput, DataError) as exc:  # the input's fault, named in one line
         print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except AlreadyRunning as exc:
+        print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
+        return EXIT_ALREADY_RUNNING
     except StoreError as exc:
         print(f"crisgeo {args.command}: {exc}", file=sys.stderr)
         return EXIT_FAIL

@@ -209,7 +209,7 @@ def test_status_command(cases, tmp_path):
     cfg = _config(tmp_path, tmp_path / "none")
     (tmp_path / "none").mkdir()
     r = run_crisgeo("status", "--config", cfg)  # before the daemon's first start: no store, none made
-    assert r.returncode == 3 and "no crisgeo store here yet" in r.stderr
+    assert r.returncode == 3 and r.stdout.startswith("UNKNOWN - ") and "no crisgeo store here yet" in r.stdout
     assert not (tmp_path / "state" / "crisgeo.sqlite").exists()
     Store(tmp_path / "state" / "crisgeo.sqlite").close()  # as the daemon does when it starts
     r = run_crisgeo("status", "--config", cfg)
