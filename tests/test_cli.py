@@ -241,7 +241,10 @@ def test_under_systemd_lines_carry_their_priority_and_no_second_timestamp(tmp_pa
 @pytest.mark.parametrize(
     "extra,message",
     [
-        (["--since", "2024-03-05", "--until", "2024-03-01"], "--since 2024-03-05 is after --until 2024-03-01"),
+        (
+            ["--since", "2024-03-05", "--until", "2024-03-01"],
+            "--since 2024-03-05 is after --until 2024-03-01",
+        ),
         (["--since", "2024-03-01", "--until", "2024-03-02", "--satellite", "npp"], "'npp' is not in"),
         (["--since", "2024-03-01", "--until", "2024-03-02", "--workers", "0"], "--workers: 0"),
     ],
