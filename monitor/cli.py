@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from monitor import allocator, logs
-from monitor.config import AssessmentConfig
+from monitor.config import AssessmentConfig, FingerprintConfig
 from monitor.constants import N_FOV
 from monitor.errors import DataError
 from monitor.footprint import SHAPES as FOOTPRINTS
@@ -34,7 +34,8 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     from monitor.store.sqlite import Store
 
 # the defaults of the assessment keys, for the commands that take them as flags
-ASSESSMENT = AssessmentConfig()
+ASSESSMENT = AssessmentConfig()  # the defaults of the options that mirror configuration keys
+FINGERPRINT = FingerprintConfig()
 
 EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
@@ -762,7 +763,13 @@ def _calendar(path):
     "per-FOR LOS fingerprint (SBF angles) of CrIS GEO files",
     arg("paths", nargs="+"),
     arg("--json", action="store_true"),
-    arg("--threshold-urad", type=float, default=10.0),
+    arg(
+        "--threshold-urad",
+        type=float,
+        default=FINGERPRINT.threshold_urad,
+        help=f"a processing change: a FOR moving more (default {FINGERPRINT.threshold_urad:g}, fingerprint."
+        "threshold_urad)",
+    ),
     arg(
         "--ep-library",
         action="append",
@@ -855,7 +862,12 @@ def cmd_report(args) -> int:
     arg("--granules", type=int, default=14),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
-    arg("--workers", type=int, default=2, help="threads of the compiled kernels (default 2)"),
+    arg(
+        "--workers",
+        type=int,
+        default=ASSESSMENT.workers,
+        help=f"threads of the compiled kernels (default {ASSESSMENT.workers}, assessment.workers)",
+    ),
     arg(
         "--cost",
         choices=tuple(c.value for c in Cost),
