@@ -28,6 +28,7 @@ from alerts.rules import (
 )
 from monitor.config import AlertSettings
 from monitor.records import Alert, History, Silence
+from monitor.tables import Column, text_table
 from monitor.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
 
 LOG = logging.getLogger(__name__)
@@ -279,20 +280,27 @@ class AlertsView:
         }
 
     def text(self) -> str:
-        """The text of ``crisgeo alerts list``."""
-        lines = [
-            f"{v.shown:<9} {v.alert.severity or '':<8} {v.alert.fingerprint:<28} since {v.alert.started}"
-            + (f" resolved {v.alert.resolved}" if v.alert.status == AlertStatus.RESOLVED else "")
-            + f"  {v.alert.summary}"
-            for v in self.alerts
-        ]
+        """The text of ``crisgeo alerts list``: the alerts' table, the silences, the deliveries waiting."""
+        if not (self.alerts or self.pending_deliveries or self.silences):
+            return "no alerts"
+        lines = text_table(self.alerts, ALERT_COLUMNS) if self.alerts else []
         lines += [
             f"silence {s.id:<3} rule={s.rule or '*'} satellite={s.satellite or '*'} until {s.until}: "
             f"{s.reason}"
             for s in self.silences
         ]
         lines.append(f"{self.pending_deliveries} message(s) waiting for delivery")
-        return "\n".join(lines) if self.alerts or self.pending_deliveries or self.silences else "no alerts"
+        return "\n".join(lines)
+
+
+ALERT_COLUMNS = (
+    Column("status", "shown", "", 9, align="<"),
+    Column("severity", lambda v: v.alert.severity or "", "", 8, align="<"),
+    Column("alert", "alert.fingerprint", "", 28, align="<"),
+    Column("since", lambda v: v.alert.started or "", "", 25, align="<"),
+    Column("resolved", lambda v: v.alert.resolved or "", "", 25, align="<"),
+    Column("summary", lambda v: v.alert.summary or "", "", 0, align="<"),
+)
 
 
 def alerts_view(store: History, now: dt.datetime) -> AlertsView:

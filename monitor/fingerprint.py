@@ -29,6 +29,7 @@ from monitor.sdr import GranuleError, read_file
 from monitor.sdr.engpkt import load_library
 from monitor.sdr.names import parse_name
 from monitor.sdr.pairing import find_files
+from monitor.tables import Column, text_table
 
 
 @dataclass
@@ -295,33 +296,64 @@ def identify_ep(day: DayPrint, library: dict, satellite: str | None = None) -> l
     return sorted(matches, key=lambda m: m.rms_urad)
 
 
+MATCH_COLUMNS = (
+    Column("EP", "name", "", 40, align="<"),
+    Column("sat", "satellite", "", 4, align="<"),
+    Column("version", "version", "", 20, align="<"),
+    Column("rms", "rms_urad", ".1f", 9, "urad"),
+)
+
+
+@dataclass(frozen=True)
+class _ForRow:
+    """One FOR's pair of values, for the per-FOR tables below."""
+
+    for_index: int
+    alpha_urad: float
+    beta_urad: float
+    sd_alpha_urad: float = float("nan")
+    sd_beta_urad: float = float("nan")
+
+
+RESIDUAL_COLUMNS = (
+    Column("FOR", "for_index", "d", 3),
+    Column("in-track", "alpha_urad", ".1f", 9, "urad"),
+    Column("x-track", "beta_urad", ".1f", 9, "urad"),
+)
+PRINT_COLUMNS = (
+    Column("FOR", "for_index", "d", 3),
+    Column("alpha5", "alpha_urad", ".1f", 10, "urad"),
+    Column("sd", "sd_alpha_urad", ".1f", 5, "urad"),
+    Column("beta5", "beta_urad", ".1f", 10, "urad"),
+    Column("sd", "sd_beta_urad", ".1f", 5, "urad"),
+)
+
+
 def format_matches(matches: list[EpMatch]) -> str:
     """Ranked EP matches, with the best one's per-FOR residual."""
     if not matches:
         return "no EP in the library to compare with"
     lines = ["EP identification (fingerprint - EP model, FOV 5):"]
-    lines += [f"  {m.name:<40} {m.satellite:<4} {m.version:<20} rms {m.rms_urad:9.1f} urad" for m in matches]
+    lines += text_table(matches, MATCH_COLUMNS, indent="  ")
     best = matches[0]
-    lines.append(f"best: {best.name}; residual per FOR (urad), in-track / cross-track:")
-    lines += [
-        f"  FOR {k + 1:>2} {best.d_alpha_urad[k]:8.1f} {best.d_beta_urad[k]:8.1f}"
-        for k in range(len(best.d_alpha_urad))
+    lines.append(f"best: {best.name}; residual per FOR (fingerprint - EP model):")
+    rows = [
+        _ForRow(k + 1, a, b) for k, (a, b) in enumerate(zip(best.d_alpha_urad, best.d_beta_urad, strict=True))
     ]
+    lines += text_table(rows, RESIDUAL_COLUMNS, indent="  ")
     return "\n".join(lines)
 
 
 def format_print(day: DayPrint) -> str:
-    """The per-FOR table printed by ``crisgeo fingerprint``."""
-    lines = [
-        f"{len(day.granules)} granule(s)",
-        f"{'FOR':>3} {'alpha5':>10} {'sd':>5} {'beta5':>10} {'sd':>5}   (urad, SBF, FOV 5; sd: scan to scan)",
+    """The per-FOR table printed by ``crisgeo fingerprint`` (SBF angles of FOV 5; sd: scan to scan)."""
+    rows = [
+        _ForRow(k + 1, day.alpha_urad[k], day.beta_urad[k], day.sd_alpha_urad[k], day.sd_beta_urad[k])
+        for k in range(len(day.alpha_urad))
     ]
-    for k in range(len(day.alpha_urad)):
-        lines.append(
-            f"{k + 1:>3} {day.alpha_urad[k]:10.1f} {day.sd_alpha_urad[k]:5.1f} {day.beta_urad[k]:10.1f} "
-            f"{day.sd_beta_urad[k]:5.1f}"
-        )
-    return "\n".join(lines)
+    return "\n".join(
+        [f"{len(day.granules)} granule(s); SBF angles of FOV 5, sd scan to scan"]
+        + text_table(rows, PRINT_COLUMNS)
+    )
 
 
 @dataclass

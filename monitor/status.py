@@ -16,10 +16,10 @@ from enum import IntEnum
 from monitor.config import Config
 from monitor.lock import holder
 from monitor.records import Run, Silence
-from monitor.render import BRIEF, for_table
 from monitor.result import ForOffset
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
+from monitor.tables import BRIEF, for_table
 from monitor.vocabulary import Rule, RunStatus, Severity
 
 

@@ -17,6 +17,7 @@ from monitor.constants import N_FOR, URAD
 from monitor.errors import DataError
 from monitor.geometry.instrument import EngineeringPacket, corrected_ssm_angles
 from monitor.result import AssessmentResult
+from monitor.tables import Column, text_table
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,20 @@ class AngleRow:
         }
 
 
+ANGLE_COLUMNS = (
+    Column("FOR", "for_index", "d", 3),
+    Column("roll_old", "old_roll_urad", ".1f", 10, "urad"),
+    Column("roll_new", "new_roll_urad", ".1f", 10, "urad"),
+    Column("d_roll", "d_roll_urad", ".1f", 8, "urad"),
+    Column("pitch_old", "old_pitch_urad", ".1f", 10, "urad"),
+    Column("pitch_new", "new_pitch_urad", ".1f", 10, "urad"),
+    Column("d_pitch", "d_pitch_urad", ".1f", 8, "urad"),
+    Column("d_alpha", "d_alpha_urad", ".1f", 8, "urad"),
+    Column("d_beta", "d_beta_urad", ".1f", 8, "urad"),
+    Column("note", "kept", "", 0, align="<"),
+)
+
+
 @dataclass(frozen=True)
 class Optimization:
     """The proposed EP and the per-FOR table behind it."""
@@ -70,17 +85,11 @@ class Optimization:
         return [r for r in self.rows if r.kept]
 
     def table(self) -> str:
-        """The old/new angle table as fixed-width text (urad)."""
+        """The old/new angle table as fixed-width text (urad; :data:`ANGLE_COLUMNS`)."""
         lines = [
-            "FOR  ActualCrosstrackAngleRoll (urad)       ActualIntrackAnglePitch (urad)   assessed (urad)",
-            "        old        new       diff          old      new     diff     d_alpha  d_beta  note",
+            "roll: ActualCrosstrackAngleRoll, pitch: ActualIntrackAnglePitch of the EP; d_alpha, d_beta assessed"
         ]
-        for r in self.rows:
-            lines.append(
-                f"{r.for_index:3d} {r.old_roll_urad:10.1f} {r.new_roll_urad:10.1f} {r.d_roll_urad:9.1f}"
-                f"    {r.old_pitch_urad:9.1f} {r.new_pitch_urad:8.1f} {r.d_pitch_urad:8.1f}"
-                f"    {r.d_alpha_urad:8.1f} {r.d_beta_urad:7.1f}  {r.kept}"
-            )
+        lines += text_table(self.rows, ANGLE_COLUMNS)
         if self.kept:
             lines.append(
                 f"{len(self.kept)} FOR(s) kept their angles: "

@@ -34,6 +34,7 @@ from monitor.result import RELIABILITY_FLAGS
 from monitor.satellites import SATELLITES
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
+from monitor.tables import FOR_COLUMNS, REPORT
 from monitor.vocabulary import RunStatus
 
 UTC = dt.timezone.utc
@@ -89,30 +90,25 @@ def _page(title: str, body: str) -> str:
     )
 
 
-def _f(v, fmt):
-    return "" if v is None or (isinstance(v, float) and not np.isfinite(v)) else format(v, fmt)
-
-
 def _latest_table(fors, spec_km) -> str:
-    head = (
-        "<tr><th>FOR</th><th>d_alpha urad</th><th>+-</th><th>d_beta urad</th><th>+-</th><th>% FOV a</th>"
-        "<th>% FOV b</th><th>in-track km</th><th>cross-track km</th><th>total km</th><th>N</th>"
-        "<th>G_min K</th><th>G_0 K</th><th>response FWHM urad</th><th class=l>flags</th></tr>"
+    """The latest day's FOR table (the columns of :data:`monitor.tables.REPORT`); unreliable FORs greyed,
+    FORs beyond the specification marked."""
+    cols = [FOR_COLUMNS[c] for c in REPORT]
+    head = "".join(
+        f"<th{' class=l' if c.align == '<' else ''}>{_e(f'{c.header} {c.unit}'.strip())}</th>" for c in cols
     )
     rows = []
     for f in fors:
         cls = "flag" if not f.reliable else "out" if f.spec_breaches(spec_km) else ""
-        rows.append(
-            f"<tr class='{cls}'><td>{f.for_index}</td><td>{_f(f.d_alpha_urad, '.0f')}</td>"
-            f"<td>{_f(f.sigma_alpha_urad, '.0f')}</td><td>{_f(f.d_beta_urad, '.0f')}</td>"
-            f"<td>{_f(f.sigma_beta_urad, '.0f')}</td><td>{_f(f.d_alpha_pct_fov, '.1f')}</td>"
-            f"<td>{_f(f.d_beta_pct_fov, '.1f')}</td><td>{_f(f.in_track_km, '.3f')}</td>"
-            f"<td>{_f(f.cross_track_km, '.3f')}</td>"
-            f"<td>{_f(f.total_km, '.3f')}</td><td>{f.n_samples}</td><td>{_f(f.cost_min_k, '.3f')}</td>"
-            f"<td>{_f(f.cost_zero_k, '.3f')}</td><td>{_f(f.response_width_50_urad, '.0f')}</td>"
-            f"<td class=l>{_e(', '.join(f.flags))}</td></tr>"
+        cells = "".join(
+            f"<td{' class=l' if c.align == '<' else ''}>{_e(_blank_nan(c.text(f)))}</td>" for c in cols
         )
-    return f"<table>{head}{''.join(rows)}</table>"
+        rows.append(f"<tr class='{cls}'>{cells}</tr>")
+    return f"<table><tr>{head}</tr>{''.join(rows)}</table>"
+
+
+def _blank_nan(text: str) -> str:
+    return "" if text in ("nan", "-nan") else text
 
 
 def _alerts_table(rows) -> str:
