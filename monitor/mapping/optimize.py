@@ -86,9 +86,7 @@ class Optimization:
 
     def table(self) -> str:
         """The old/new angle table as fixed-width text (urad; :data:`ANGLE_COLUMNS`)."""
-        lines = [
-            "roll: ActualCrosstrackAngleRoll, pitch: ActualIntrackAnglePitch of the EP; d_alpha, d_beta assessed"
-        ]
+        lines = ["roll: ActualCrosstrackAngleRoll, pitch: ActualIntrackAnglePitch; d_alpha, d_beta: assessed"]
         lines += text_table(self.rows, ANGLE_COLUMNS)
         if self.kept:
             lines.append(
