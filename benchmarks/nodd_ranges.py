@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.collocate import warm_up
-from monitor.config import load_config
+from monitor.config_file import load_config
 from monitor.pipeline import run_day
 from monitor.satellites import SATELLITES
 from monitor.simulate import LAYOUTS

@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from monitor.collocate import warm_up
-from monitor.config import load_config
+from monitor.config_file import load_config
 from monitor.reprocess import period_days, reprocess
 from monitor.sources.local import SimulatedSource
 

@@ -344,7 +344,8 @@ def cmd_geolocate(args) -> int:
 def cmd_assess(args) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assess import assess_paths
-    from monitor.config import ConfigError, section_of
+    from monitor.config import ConfigError
+    from monitor.config_file import section_of
 
     try:  # the options are the assessment section's keys, checked by the configuration model
         a = section_of(
@@ -378,7 +379,8 @@ def cmd_assess(args) -> int:
 def _load(args, writes: bool = False):
     """The configuration of *args*; with *writes*, its state directory made (the commands that write)."""
 
-    from monitor.config import ConfigError, load_config, make_state_dir
+    from monitor.config import ConfigError
+    from monitor.config_file import load_config, make_state_dir
 
     args.config = args.config or os.environ.get("CRISGEO_CONFIG") or DEFAULT_CONFIG
     try:
@@ -421,7 +423,7 @@ def cmd_check_config(args) -> int:
     """crisgeo check-config: validate and print the effective configuration, or the reference."""
     import yaml
 
-    from monitor.config import effective, json_schema, secret_status
+    from monitor.config_file import effective, json_schema, secret_status
 
     if args.schema:
         print(json_schema(), end="")

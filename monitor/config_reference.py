@@ -17,7 +17,8 @@ from typing import Any
 from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 
-from monitor.config import Config, key_range
+from monitor.config import Config
+from monitor.config_file import key_range
 
 UNITS = (
     ("_kb_s", "kB/s"),

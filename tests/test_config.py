@@ -2,7 +2,8 @@ from pathlib import Path
 
 import pytest
 
-from monitor.config import ConfigError, load_config
+from monitor.config import ConfigError
+from monitor.config_file import load_config
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
@@ -256,7 +257,7 @@ def test_what_check_config_prints_loads_back_as_the_same_configuration(tmp_path,
     import yaml
 
     from monitor.cli import main
-    from monitor.config import effective
+    from monitor.config_file import effective
 
     doc = {
         **GOOD,

@@ -6,7 +6,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from monitor.config import ConfigError, json_schema, load_config
+from monitor.config import ConfigError
+from monitor.config_file import json_schema, load_config
 from monitor.config_reference import model_keys, reference
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"

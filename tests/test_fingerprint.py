@@ -7,7 +7,7 @@ import pytest
 
 from alerts.changes import all_changes, preceding_change
 from monitor import fingerprint as fpr
-from monitor.config import load_config
+from monitor.config_file import load_config
 from monitor.pipeline import day_fingerprint, record_fingerprint
 from monitor.sdr import read_file
 from monitor.simulate.case import SimulationSpec, simulate_case

@@ -123,7 +123,7 @@ def test_the_daemon_under_systemd_marks_a_failed_run_as_an_error_and_does_not_fl
 
 def test_a_day_computed_alone_leaves_no_context_behind(tmp_path, captured):
     """compute_day (as the reprocessing workers call it) names its stages in its own context only."""
-    from monitor.config import load_config
+    from monitor.config_file import load_config
     from monitor.pipeline import compute_day
     from monitor.sources.local import LocalSource
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from monitor.config import load_config
+from monitor.config_file import load_config
 from monitor.pipeline import days_to_run, run_day
 from monitor.sources.local import LocalSource
 from monitor.store.sqlite import Store

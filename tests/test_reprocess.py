@@ -7,7 +7,7 @@ import threading
 import pytest
 
 from monitor import allocator
-from monitor.config import load_config
+from monitor.config_file import load_config
 from monitor.pipeline import run_day
 from monitor.reprocess import _client, day_task, period_days, reprocess
 from monitor.sources.local import LocalSource

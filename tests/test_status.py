@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from alerts.rules import Finding
-from monitor.config import load_config
+from monitor.config_file import load_config
 from monitor.lock import InstanceLock
 from monitor.result import ForOffset
 from monitor.simulate.history import day_result

@@ -7,7 +7,7 @@ from email import policy
 
 import pytest
 
-from monitor.config import load_config
+from monitor.config_file import load_config
 from monitor.service import Service
 from monitor.simulate.case import simulate_case
 from tests.alerts.conftest import PASSWORD, USER

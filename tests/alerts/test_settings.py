@@ -3,7 +3,8 @@
 import pytest
 import yaml
 
-from monitor.config import AlertSettings, ConfigError, EmailSettings, RuleSettings, SlackSettings, load_config
+from monitor.config import AlertSettings, ConfigError, EmailSettings, RuleSettings, SlackSettings
+from monitor.config_file import load_config
 
 
 def _load(tmp_path, alerts):

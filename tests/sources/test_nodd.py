@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from monitor.config import SourceConfig, load_config
+from monitor.config import SourceConfig
+from monitor.config_file import load_config
 from monitor.pipeline import compute_day
 from monitor.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
 from monitor.sources.configured import make_source

@@ -9,7 +9,8 @@ import h5py
 import numpy as np
 import pytest
 
-from monitor.config import SourceConfig, load_config
+from monitor.config import SourceConfig
+from monitor.config_file import load_config
 from monitor.pipeline import compute_day
 from monitor.satellites import SATELLITES
 from monitor.sdr import GranuleError, read_file

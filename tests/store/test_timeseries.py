@@ -87,7 +87,7 @@ def test_server_down_then_up_nothing_lost_nothing_twice(cases, tmp_path):
 
 
 def test_known_changes_reach_influxdb_for_annotations(tmp_path):
-    from monitor.config import load_config
+    from monitor.config_file import load_config
     from monitor.pipeline import publish_changes
 
     (tmp_path / "events.yaml").write_text(
@@ -117,7 +117,7 @@ def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
 
     from apscheduler.schedulers.background import BackgroundScheduler
 
-    from monitor.config import load_config
+    from monitor.config_file import load_config
     from monitor.service import Service
 
     _, _, result = cases.get()
