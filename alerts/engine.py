@@ -15,7 +15,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from alerts.alertmanager import post_state
-from alerts.changes import all_changes
 from alerts.channels import Permanent, Transient, make_channels
 from alerts.rules import (
     CALIBRATION,
@@ -26,6 +25,7 @@ from alerts.rules import (
     spec_finding,
     stale_finding,
 )
+from monitor.changes import all_changes
 from monitor.config import AlertSettings
 from monitor.records import Alert, History, Silence
 from monitor.tables import Column, text_table

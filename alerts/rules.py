@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alerts.changes import preceding_change
+from monitor.changes import preceding_change
 from monitor.config import RuleSettings
 from monitor.constants import N_FOR
 from monitor.records import History

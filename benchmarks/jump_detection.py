@@ -22,8 +22,8 @@ import sys
 
 import numpy as np
 
-from alerts.changes import Change, preceding_change
 from alerts.rules import COMPONENTS, detect_jumps
+from monitor.changes import Change, preceding_change
 from monitor.config import RuleSettings
 from monitor.simulate.profiles import paper_profile
 

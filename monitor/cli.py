@@ -5,6 +5,10 @@ arguments, configuration, data); 75 another instance holds the state directory (
 status`` follows the Nagios plugin convention instead: 0 OK, 1 WARNING (a warning alert fires), 2 CRITICAL
 (a critical alert fires or the last run of a satellite failed), 3 UNKNOWN (no usable configuration or store).
 The configuration is ``--config``, else ``$CRISGEO_CONFIG``, else ``/etc/crisgeo/monitor.yaml``.
+
+Why one module of ~1000 lines: each command is its arguments beside the short function that parses, calls
+and prints (the work is in the modules it calls); one parser gives ``crisgeo --help``, ``docs/cli.md`` and
+the one place errors become exit statuses (:func:`main`).
 """
 
 from __future__ import annotations
@@ -714,7 +718,7 @@ def cmd_alerts(args) -> int:
 )
 def cmd_events(args) -> int:
     """crisgeo events: list the known changes, or add one to the calendar."""
-    from alerts.changes import Change, add_to_calendar, all_changes
+    from monitor.changes import Change, add_to_calendar, all_changes
 
     cfg = _load(args)
     if cfg.events_file is None:
@@ -750,7 +754,7 @@ def cmd_events(args) -> int:
 
 def _calendar(path):
     """The events calendar at *path*; a calendar that does not load is bad input, named."""
-    from alerts.changes import load_calendar
+    from monitor.changes import load_calendar
 
     try:
         return load_calendar(path)

@@ -15,10 +15,10 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from alerts.changes import all_changes
 from monitor import fingerprint as fpr
 from monitor import logs
 from monitor.assess import assess_plan
+from monitor.changes import all_changes
 from monitor.config import Config, ScheduleConfig
 from monitor.errors import DataError, StopRequested
 from monitor.records import SceneDecision

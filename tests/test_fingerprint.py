@@ -5,8 +5,8 @@ import datetime as dt
 import numpy as np
 import pytest
 
-from alerts.changes import all_changes, preceding_change
 from monitor import fingerprint as fpr
+from monitor.changes import all_changes, preceding_change
 from monitor.config_file import load_config
 from monitor.pipeline import day_fingerprint, record_fingerprint
 from monitor.sdr import read_file

@@ -26,8 +26,8 @@ from monitor.geometry.instrument import EngineeringPacket
 from monitor.mapping.residuals import OwnResiduals, ResidualTable
 from monitor.sdr import read_file
 from monitor.sdr.errors import GranuleError
+from monitor.sdr.granules import CrisGeoGranule
 from monitor.sdr.products import PRODUCTS
-from monitor.sdr.readers import CrisGeoGranule
 
 GEO = PRODUCTS["GCRSO"]
 FILL_F32 = -999.3  # IDPS float32 "missing" fill

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from alerts.changes import all_changes
+from monitor.changes import all_changes
 from monitor.config import Config
 from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
 from monitor.report import plots

@@ -1,14 +1,14 @@
 """Readers for JPSS IDPS HDF5 products (CrIS SDR/GEO, VIIRS I5 SDR and I-band GEO). Files, not frames."""
 
 from monitor.sdr.errors import GranuleError
-from monitor.sdr.readers import (
+from monitor.sdr.granules import (
     CrisGeoGranule,
     CrisSdrGranule,
     GranuleMeta,
     ViirsGeoGranule,
     ViirsSdrGranule,
-    read_file,
 )
+from monitor.sdr.readers import read_file
 
 __all__ = [
     "GranuleError",

@@ -13,9 +13,10 @@ from pathlib import Path
 
 from monitor.errors import DataError
 from monitor.sdr.errors import GranuleError
+from monitor.sdr.granules import GranuleMeta, GranuleRef, as_ref
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
-from monitor.sdr.readers import GranuleMeta, GranuleRef, as_ref, read_metadata
+from monitor.sdr.readers import read_metadata
 
 COVER_MARGIN = dt.timedelta(seconds=10)
 CONTIGUOUS = dt.timedelta(seconds=5)  # VIIRS granules this close in time form one continuous swath

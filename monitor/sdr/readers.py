@@ -8,13 +8,9 @@ always reserves 48 scans). Every problem is raised as :class:`GranuleError` nami
 from __future__ import annotations
 
 import datetime as dt
-import io
-import os
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
 
 import h5py
 import numpy as np
@@ -22,6 +18,12 @@ import numpy as np
 from monitor.satellites import SATELLITES
 from monitor.sdr import consistency
 from monitor.sdr.errors import GranuleError
+from monitor.sdr.granules import (
+    _GRANULE_TYPES,
+    GranuleMeta,
+    GranuleRef,
+    as_ref,
+)
 from monitor.sdr.iet import iet_to_datetime
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import (
@@ -33,155 +35,6 @@ from monitor.sdr.products import (
     cris_lw_wavenumbers_cm1,
     is_float_fill,
 )
-
-
-class RemoteGranule(Protocol):
-    """A granule file read where it lies, a range at a time (``monitor.sources.ranged``): its base name (a
-    JPSS file name), ``str()`` naming it in errors (its key), and a binary file object to read it through.
-    When a read of that object fails, its ``failure`` says why (the transport's reason, naming the key)."""
-
-    @property
-    def name(self) -> str:
-        """The granule's file name."""
-        ...
-
-    def open(self) -> io.RawIOBase:
-        """A seekable binary file object over the granule's bytes."""
-        ...
-
-
-GranuleRef = Path | RemoteGranule  # a granule file: on local disk, or read in place
-
-
-def as_ref(path) -> GranuleRef:
-    """A local path (str or PathLike) as a Path; a :class:`RemoteGranule` as it is."""
-    return Path(path) if isinstance(path, (str, os.PathLike)) else path
-
-
-@dataclass(frozen=True)
-class GranuleMeta:
-    """What identifies a granule and what produced it (from the ``_Gran_k`` attributes)."""
-
-    path: str
-    product: str
-    collection: str
-    platform: str  # npp, j01, j02
-    granule_id: str
-    orbit: int
-    start: dt.datetime
-    end: dt.datetime
-    start_iet_us: int
-    end_iet_us: int
-    n_scans: int
-    ascending: bool | None
-    software_version: str
-    algorithm_version: str
-    aux_files: tuple[str, ...]
-    anc_files: tuple[str, ...]
-
-    def to_dict(self) -> dict:
-        d = dict(self.__dict__)
-        d["start"] = self.start.isoformat()
-        d["end"] = self.end.isoformat()
-        d["aux_files"] = list(self.aux_files)
-        d["anc_files"] = list(self.anc_files)
-        return d
-
-
-@dataclass
-class CrisGeoGranule:
-    """CrIS GEO arrays of one granule; FOV fields (nscan, 30, 9), per-FOR times (nscan, 30)."""
-
-    meta: GranuleMeta
-    for_time_us: np.ndarray
-    start_time_us: np.ndarray
-    mid_time_us: np.ndarray
-    lat_rad: np.ndarray
-    lon_rad: np.ndarray
-    height_m: np.ndarray
-    range_m: np.ndarray
-    zenith_rad: np.ndarray
-    azimuth_rad: np.ndarray
-    sc_position_m: np.ndarray
-    sc_velocity_m_s: np.ndarray
-    sc_attitude_rad: np.ndarray
-
-    @property
-    def valid(self) -> np.ndarray:
-        """FOVs whose every geometry field is present."""
-        ok = np.ones(self.lat_rad.shape, bool)
-        for a in (self.lat_rad, self.lon_rad, self.range_m, self.zenith_rad, self.azimuth_rad):
-            ok &= np.isfinite(a)
-        scan_ok = np.all(
-            np.isfinite(self.sc_position_m)
-            & np.isfinite(self.sc_velocity_m_s)
-            & np.isfinite(self.sc_attitude_rad),
-            axis=1,
-        )
-        return ok & scan_ok[:, None, None] & (self.for_time_us > 0)[:, :, None]
-
-
-@dataclass
-class CrisSdrGranule:
-    """CrIS long-wave radiances (nscan, 30, 9, nchan) in mW/(m2 sr cm-1) and their quality."""
-
-    meta: GranuleMeta
-    wavenumber_cm1: np.ndarray
-    radiance_lw: np.ndarray
-    qf3: np.ndarray
-    qf1_scan: np.ndarray | None
-
-    @property
-    def good(self) -> np.ndarray:
-        """FOVs with good LW SDR quality (``QF3 & 0b11 == 0``, Wang's rule) and finite spectra."""
-        ok = (self.qf3[..., 0] & 0b11) == 0
-        return ok & np.all(np.isfinite(self.radiance_lw), axis=-1)
-
-
-@dataclass
-class ViirsSdrGranule:
-    """VIIRS I5 brightness temperature (rows, 6400) in K, NaN where filled (bow-tie deletion included)."""
-
-    meta: GranuleMeta
-    bt_k: np.ndarray
-    qf1: np.ndarray
-
-    @property
-    def good(self) -> np.ndarray:
-        """Pixels with a value and QF1 == 0 (Wang's rule)."""
-        return np.isfinite(self.bt_k) & (self.qf1 == 0)
-
-
-@dataclass
-class ViirsGeoGranule:
-    """VIIRS I-band geolocation (rows, 6400) and per-scan spacecraft state.
-
-    Each pixel is the 3-D point (lat_rad, lon_rad, height_m): GITCO gives the terrain height where the
-    pixel's line of sight meets the terrain, GIMGO (ellipsoid geolocation) has no Height and its pixels
-    are at h = 0 (``height_m`` zeros).
-    """
-
-    meta: GranuleMeta
-    lat_rad: np.ndarray
-    lon_rad: np.ndarray
-    start_time_us: np.ndarray
-    mid_time_us: np.ndarray
-    sc_position_m: np.ndarray
-    sc_velocity_m_s: np.ndarray
-    sc_attitude_rad: np.ndarray
-    height_m: np.ndarray | None = None
-
-    def __post_init__(self):
-        if self.height_m is None:
-            self.height_m = np.zeros_like(self.lat_rad)
-
-
-_GRANULE_TYPES = {
-    "cris_geo": CrisGeoGranule,
-    "cris_sdr": CrisSdrGranule,
-    "viirs_sdr": ViirsSdrGranule,
-    "viirs_geo": ViirsGeoGranule,
-}
 
 
 def _text(value) -> str:

@@ -11,9 +11,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
+from monitor.sdr.granules import GranuleRef
 from monitor.sdr.names import JpssName, parse_name
 from monitor.sdr.products import PRODUCTS
-from monitor.sdr.readers import GranuleRef
 
 ALL_PRODUCTS = tuple(PRODUCTS)
 

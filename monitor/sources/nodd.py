@@ -43,8 +43,8 @@ import urllib3
 
 from monitor.config import SourceConfig
 from monitor.errors import StopRequested
+from monitor.sdr.granules import GranuleRef
 from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
-from monitor.sdr.readers import GranuleRef
 from monitor.sources import BudgetExceeded, ListedFile, SourceError, listed, ranged
 from monitor.sources.bounded import BoundedSession, DeadlinePassed, StallWatch
 from monitor.sources.ranged import BLOCK_LIST, RANGES_FOLDER

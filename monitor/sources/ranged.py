@@ -58,7 +58,7 @@ def forget(path: Path) -> None:
 
 @dataclass(frozen=True)
 class RangedGranule:
-    """A listed NODD granule to read in place (a :class:`monitor.sdr.readers.RemoteGranule`): *fetch*
+    """A listed NODD granule to read in place (a :class:`monitor.sdr.granules.RemoteGranule`): *fetch*
     brings one byte range (the NODD source's bounded range request), *root* holds the block cache."""
 
     listed: ListedFile

@@ -4,19 +4,27 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-from typing import TYPE_CHECKING
+import sqlite3
+from contextlib import AbstractContextManager
+from typing import Any, Protocol
 
 from monitor.records import Alert, Delivery, Silence, iso
 from monitor.vocabulary import AlertStatus, DeliveryStatus
 
-if TYPE_CHECKING:
-    from monitor.store.sqlite import Store
+
+class Database(Protocol):
+    """What the alert tables need of the store (:class:`monitor.store.sqlite.Store`): its connection and
+    its transactions. Typed so, this module and the store's do not import each other."""
+
+    db: sqlite3.Connection
+
+    def transaction(self) -> AbstractContextManager[Any]: ...
 
 
 class AlertState:
     """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries."""
 
-    def __init__(self, store: Store):
+    def __init__(self, store: Database):
         self.store = store
         self.db = store.db
 

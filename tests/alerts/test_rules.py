@@ -4,10 +4,10 @@ import datetime as dt
 import numpy as np
 import pytest
 
-from alerts.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
 from alerts.engine import findings_for
 from alerts.rules import CALIBRATION, GEOLOCATION, failure_finding, jump_findings, spec_finding, stale_finding
 from benchmarks.jump_detection import false_alarms, jump_trial
+from monitor.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
 from monitor.config import AlertSettings, RuleSettings
 from monitor.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.store.sqlite import Store

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 import requests
 
-from alerts.changes import Change
+from monitor.changes import Change
 from monitor.simulate.history import fill_store
 from monitor.store.sqlite import Store
 from monitor.store.timeseries import change_lines, result_lines
