@@ -350,3 +350,15 @@ def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_
         work = compute_day(cfg, make_source(cfg), "j01", DAY)
     assert work.status == RunStatus.OK, work.reason
     assert work.counts.assessed == 2 and len(work.result.fors) == 30
+
+
+def test_a_stop_requested_during_listing_ends_it_within_a_page(bucket, tmp_path):
+    """SIGTERM while the day's listings page through the archive: the next page is not asked for."""
+    from monitor.errors import StopRequested
+
+    with S3Server(bucket, page_size=1) as s3:
+        src = _source(s3.url, tmp_path)
+        src.start_day(lambda: len(s3.requests) >= 2)  # the stop comes after two pages
+        with pytest.raises(StopRequested):
+            src.list_day("j01", DAY, ("GCRSO",))
+        assert len(s3.requests) == 2  # a listing of one-key pages would have asked for more
