@@ -50,7 +50,6 @@ from monitor.threads import KERNEL_LOCK
 # from 0.42 to 0.48 deg (6-granule smooth cases: 11-12 urad RMS against 3-4 with four; six gave 3-3.5).
 TOP_HAT = (FOV_DIAMETER_RAD / 2,)
 ANNULI = (math.radians(0.42), FOV_DIAMETER_RAD / 2, math.radians(0.56), math.radians(0.64))
-MIN_COVERAGE = 0.97
 # The kernel's threads take FOVs in chunks of this many as they come free (FOVs differ in pixel count, and
 # the read-ahead thread takes turns on the cores), not in equal shares fixed in advance
 FOVS_PER_TASK = 8

@@ -94,7 +94,7 @@ def test_fov_off_the_swath_has_no_coverage(scene):
         fg.beta_rad[idx][None],
         perturbation_grid(2, 450e-6),
     )
-    assert np.all(np.nan_to_num(cones.coverage()) < collocate.MIN_COVERAGE)
+    assert np.all(np.nan_to_num(cones.coverage()) < AssessmentConfig().min_coverage)
 
 
 def test_annuli_are_nested_discs_whose_cone_is_the_top_hat(scene):
