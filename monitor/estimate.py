@@ -34,6 +34,7 @@ part of the error enters by construction.
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -292,17 +293,18 @@ def _with_footprint(s: ForSamples, weights) -> np.ndarray:
     return (s.band.bt_from_radiance(v) - s.cris_k[:, None, None]).astype(np.float64)
 
 
-def _estimate(s: ForSamples, cost: Cost, contrast: float, counts=None, start=None):
+def _estimate(s: ForSamples, cost: Cost, contrast: float, counts=None, start=None, start_d=None):
     """The minimum of the samples (weighted by *counts*, a replicate: the left-out granule's rows dropped)
     and the annulus weights found there (None without annuli or a refined minimum); *start*, weights to
-    begin the alternation from (a replicate starts from the day's)."""
+    begin the alternation from (a replicate starts from the day's), and *start_d* the day's surface through
+    them (N, m, m): a replicate's first surface is its rows of it, not computed again."""
     keep = slice(None) if counts is None else counts > 0
     d, c = s.d_k[keep], s.cris_k[keep]
     annuli = s.annuli_rad[keep] if s.annuli_rad is not None and len(c) >= MIN_FOOTPRINT_SAMPLES else None
     fit = annuli is not None
     sub = ForSamples(d, c, s.granule[keep], s.scan[keep], annuli, s.radii_rad, s.band)
     if fit and start is not None:  # the day's weights: the minimum through them (not the top-hat cone's)
-        d = _with_footprint(sub, start)
+        d = start_d[keep] if start_d is not None else _with_footprint(sub, start)
     best = _minimum(d, c, cost, contrast)
     if not fit or not best.refined:
         return best, None, d
@@ -350,7 +352,7 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
     if jack is not None:
         reps, vs, width_reps = [], [], []
         for counts in jack.counts:
-            b, w_b, d_b = _estimate(s, cost, contrast, counts, weights)
+            b, w_b, d_b = _estimate(s, cost, contrast, counts, weights, d if weights is not None else None)
             reps.append((b.x, b.y))
             # the intercalibration at the replicate's own optimum, over the samples it kept (the others weigh
             # nothing: any finite value serves)
@@ -412,6 +414,15 @@ def day_offsets(
     cross-track km of a turn and its Jacobian (km/rad), NaN without."""
     m = per_for[0].d_k.shape[1]
     cube = np.full((len(per_for), m, m), np.nan)
+    # the FORs are independent: estimated on the assessment's threads (numpy and the compiled BT inversion
+    # leave the interpreter's lock), each the same numbers as alone
+    with ThreadPoolExecutor(max_workers=max(1, cfg.workers), thread_name_prefix="estimate") as pool:
+        estimates = list(
+            pool.map(
+                lambda s: estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty) if len(s) >= 3 else None,
+                per_for,
+            )
+        )
     fors = []
     pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
     for k, s in enumerate(per_for):
@@ -421,8 +432,8 @@ def day_offsets(
         g = np.full((m, m), np.nan)
         cal = NO_FIT
         widths = [np.nan] * 4
-        if n >= 3:
-            best = estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty)
+        best = estimates[k]
+        if best is not None:
             if best.footprint is not None:
                 fp = best.footprint
                 widths = [

@@ -21,6 +21,8 @@ collocation is needed, and the same S, weighted by bootstrap counts, gives the b
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 HALF = 3  # window half-width (grid steps): the search range +-1.5 needs cubic support +-3
@@ -45,9 +47,19 @@ def keys_weights(x):
     )
     w = np.zeros(x.shape + (2 * HALF + 1,))
     first = (base - 1 + HALF).astype(int)
-    for k in range(4):
-        np.put_along_axis(w, (first + k)[..., None], taps[..., k : k + 1], axis=-1)
+    np.put_along_axis(w, first[..., None] + np.arange(4), taps, axis=-1)  # the four taps at once
     return w
+
+
+def _path(subscripts: str, *operands: np.ndarray) -> list:
+    """The contraction order numpy's greedy search chooses for *operands* of these shapes, found once per
+    shapes (the search costs more than the contraction of these small arrays)."""
+    return _path_of_shapes(subscripts, tuple(o.shape for o in operands))
+
+
+@functools.lru_cache(maxsize=256)
+def _path_of_shapes(subscripts: str, shapes: tuple) -> list:
+    return np.einsum_path(subscripts, *(np.empty(s) for s in shapes), optimize="greedy")[0]
 
 
 def refinable(i0: int, j0: int, m: int) -> bool:
@@ -114,8 +126,8 @@ def refined_minimum(cov):
         xs = np.clip(centre[:, :1] + offs, -REACH, REACH)  # (B, P)
         ys = np.clip(centre[:, 1:] + offs, -REACH, REACH)
         wx, wy = keys_weights(xs), keys_weights(ys)  # (B, P, 7)
-        t = np.einsum("bpa,bajcl,bpc->bpjl", wx, s, wx, optimize=True)
-        var = np.einsum("bqj,bpjl,bql->bpq", wy, t, wy, optimize=True)
+        t = np.einsum("bpa,bajcl,bpc->bpjl", wx, s, wx, optimize=_path("bpa,bajcl,bpc->bpjl", wx, s, wx))
+        var = np.einsum("bqj,bpjl,bql->bpq", wy, t, wy, optimize=_path("bqj,bpjl,bql->bpq", wy, t, wy))
         best = np.argmin(var.reshape(nb, -1), axis=1)
         p, q = np.divmod(best, len(offs))
         centre = np.stack([xs[np.arange(nb), p], ys[np.arange(nb), q]], -1)
