@@ -10,6 +10,7 @@ from __future__ import annotations
 import datetime as dt
 import html
 import logging
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -126,7 +127,9 @@ def _slack_escape(s: str) -> str:
     return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def evaluate(store: History, settings: AlertSettings, satellites, now: dt.datetime | None = None) -> list:
+def evaluate(
+    store: History, settings: AlertSettings, satellites: Iterable[str], now: dt.datetime | None = None
+) -> list:
     """Update alert state from the rules and queue the messages; returns [(satellite, message)] queued."""
     now = now or dt.datetime.now(UTC)
     state = store.alert_state()
@@ -195,7 +198,7 @@ class DeliveryCounts:
 
 
 def deliver(
-    store: History, settings: AlertSettings, now: dt.datetime | None = None, channels=None
+    store: History, settings: AlertSettings, now: dt.datetime | None = None, channels: dict | None = None
 ) -> DeliveryCounts:
     """Try every due delivery once; the counts by outcome. Never raises for a channel."""
     now = now or dt.datetime.now(UTC)
@@ -227,7 +230,9 @@ def deliver(
     return counts
 
 
-def evaluate_and_deliver(store: History, settings: AlertSettings, satellites, now=None) -> DeliveryCounts:
+def evaluate_and_deliver(
+    store: History, settings: AlertSettings, satellites: Iterable[str], now: dt.datetime | None = None
+) -> DeliveryCounts:
     """Evaluate the rules, queue, deliver; the counts (queued, sent, to retry, failed)."""
     queued = evaluate(store, settings, satellites, now)
     counts = deliver(store, settings, now)

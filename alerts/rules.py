@@ -112,13 +112,15 @@ def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | N
     )
 
 
-def _series(store: History, satellite: str, watched: Watched):
+def _series(store: History, satellite: str, watched: Watched) -> tuple[list, dict[str, np.ndarray]]:
     series = store.series(satellite)
     reliable = series.reliable()
     return series.days, {c: np.where(reliable, series.values[c], np.nan) for c, _ in watched.components}
 
 
-def step_test(y: np.ndarray, days: list, split: dt.date, s: RuleSettings, floor: float = GEOLOCATION.floor):
+def step_test(
+    y: np.ndarray, days: list, split: dt.date, s: RuleSettings, floor: float = GEOLOCATION.floor
+) -> tuple[float, float] | None:
     """(delta, z) of a step at *split* in the daily series *y*, or None when the windows are too short.
 
     Robust two-sample comparison: difference of medians after/before the split, scaled by the MAD of

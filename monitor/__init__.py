@@ -5,12 +5,20 @@ The science lives in ``monitor.sdr`` (files), ``monitor.geometry`` (frames), ``m
 object, :class:`monitor.result.AssessmentResult`.
 """
 
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING, Any
+
 from monitor.version import __version__
+
+if TYPE_CHECKING:
+    from monitor.store.sqlite import Store
 
 __all__ = ["AssessmentResult", "assess_paths", "open_store", "__version__"]
 
 
-def __getattr__(name):  # the public API, imported when first used (keeps ``import monitor`` light)
+def __getattr__(name: str) -> Any:  # the public API, imported when first used (a light import)
     if name == "assess_paths":
         from monitor.assess import assess_paths
 
@@ -24,7 +32,7 @@ def __getattr__(name):  # the public API, imported when first used (keeps ``impo
     raise AttributeError(f"module 'monitor' has no attribute {name!r}")
 
 
-def open_store(path, create: bool = False):
+def open_store(path: str | os.PathLike, create: bool = False) -> Store:
     """The service's SQLite store at *path*, e.g. ``open_store(p).to_xarray("j01")`` in a notebook. A
     missing store is an error (a typo must not start an empty history) unless *create*."""
     from monitor.store.sqlite import Store

@@ -26,7 +26,7 @@ _NEVER_TRIM = 2**31 - 1
 
 
 @lru_cache(maxsize=1)
-def _glibc():
+def _glibc() -> ctypes.CDLL | None:
     """glibc's handle, or None where the C library is another (musl, macOS)."""
     try:
         libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")

@@ -217,7 +217,7 @@ MAX_CONFIG_BYTES = 1 << 20
 class _Loader(yaml.SafeLoader):
     """Safe YAML without anchors and aliases: a configuration needs none, and aliases nest into bombs."""
 
-    def compose_node(self, parent, index):
+    def compose_node(self, parent: Any, index: Any) -> Any:
         if self.check_event(yaml.events.AliasEvent):
             mark = self.peek_event().start_mark
             raise ConfigError(
@@ -230,7 +230,7 @@ class _Loader(yaml.SafeLoader):
             )
         return super().compose_node(parent, index)
 
-    def construct_mapping(self, node, deep=False):
+    def construct_mapping(self, node: Any, deep: bool = False) -> Any:
         seen = set()
         for key_node, _ in node.value:
             key = self.construct_object(key_node, deep=True)
@@ -245,7 +245,7 @@ class _Loader(yaml.SafeLoader):
         return super().construct_mapping(node, deep)
 
 
-def read_yaml(path: Path):
+def read_yaml(path: Path) -> Any:
     """The YAML document at *path*: at most 1 MiB, safe types only, no anchors or aliases."""
     try:
         with open(path, "rb") as fh:

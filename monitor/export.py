@@ -16,6 +16,11 @@ per scan position, not per place (no geospatial bounds). xarray and h5netcdf are
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import xarray as xr
+
 import datetime as dt
 from pathlib import Path
 
@@ -87,7 +92,7 @@ def to_xarray(
     since: dt.date | None = None,
     until: dt.date | None = None,
     publisher: ExportConfig | None = None,
-):
+) -> xr.Dataset:
     """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset;
     *publisher*, the ``export`` section of the configuration, fills the ACDD publisher attributes."""
     import xarray as xr
@@ -218,10 +223,10 @@ class ExportFormatError(ValueError):
 def export(
     store: History,
     satellite: str,
-    out,
+    out: str | Path,
     fmt: str | None = None,
-    since=None,
-    until=None,
+    since: dt.date | None = None,
+    until: dt.date | None = None,
     publisher: ExportConfig | None = None,
 ) -> Path:
     """Write the results of *satellite* to *out* as ``netcdf`` or ``csv`` (*fmt*; None: from the suffix of

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 
@@ -17,7 +18,7 @@ class Health:
     *stall_s*: the scheduler counts as stalled when its heartbeat job has not run for this long.
     """
 
-    def __init__(self, stall_s: float, clock=time.monotonic):
+    def __init__(self, stall_s: float, clock: Callable[[], float] = time.monotonic) -> None:
         self.stall_s = stall_s
         self.clock = clock
         self._lock = threading.Lock()
@@ -31,7 +32,7 @@ class Health:
             self._beat = self.clock()
 
     @contextmanager
-    def job(self, name: str, budget_s: float):
+    def job(self, name: str, budget_s: float) -> Iterator[None]:
         """Track the block as job *name*, unhealthy once it runs longer than *budget_s*."""
         with self._lock:
             key = self._next

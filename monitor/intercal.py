@@ -58,7 +58,7 @@ class Intercalibration:
 NO_FIT = Intercalibration(*[np.nan] * 6)
 
 
-def fit_difference(cris_k, viirs_k, weights=None) -> np.ndarray:
+def fit_difference(cris_k: np.ndarray, viirs_k: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
     """Least-squares (b_k, g, c_k) of C - V = b + g x + c (x / S)^2, x = V - T_ref, over the samples
     *cris_k* (N,) and *viirs_k* (N,); with *weights* (B, N), e.g. bootstrap counts, one fit per row (B, 3),
     and then *viirs_k* may also be (B, N): one V per row. NaN where the samples do not span enough BT."""
@@ -78,7 +78,10 @@ def fit_difference(cris_k, viirs_k, weights=None) -> np.ndarray:
 
 
 def intercalibrate(
-    cris_k, viirs_k, jackknife: Jackknife | None = None, viirs_boot_k=None
+    cris_k: np.ndarray,
+    viirs_k: np.ndarray,
+    jackknife: Jackknife | None = None,
+    viirs_boot_k: np.ndarray | None = None,
 ) -> Intercalibration:
     """The bias, gain and curvature of one FOR's samples at its optimum; sigmas from the *jackknife*'s
     replicates, each fitted at its own optimum where *viirs_boot_k* (G, N) gives the V there. No fit (NaN)
@@ -98,7 +101,7 @@ def intercalibrate(
     )
 
 
-def difference_bins(cris_k, viirs_k) -> list[DifferenceBin]:
+def difference_bins(cris_k: np.ndarray, viirs_k: np.ndarray) -> list[DifferenceBin]:
     """C - V against C in bins ``CALIBRATION_BIN_K`` wide on multiples of it (the paper's Figure 15); bins
     without samples are left out."""
     c = np.asarray(cris_k, float)

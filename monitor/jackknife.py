@@ -39,7 +39,7 @@ class Jackknife:
     counts: np.ndarray
 
     @classmethod
-    def of(cls, granule, scan) -> Jackknife | None:
+    def of(cls, granule: np.ndarray, scan: np.ndarray) -> Jackknife | None:
         """The replicates of samples from granules *granule* (N,) and scans *scan* (N,) within them: one per
         granule from :data:`MIN_GRANULES` granules, else one per scan; None from fewer groups than that."""
         granule, scan = np.asarray(granule), np.asarray(scan)
@@ -57,7 +57,7 @@ class Jackknife:
         """G, the number of replicates."""
         return len(self.counts)
 
-    def sigma(self, replicates) -> np.ndarray:
+    def sigma(self, replicates: np.ndarray) -> np.ndarray:
         """The uncertainty of the statistic whose G *replicates* are along axis 0: the jackknife variance
         times nu / (nu - 2), nu = G - 1 (module docstring); NaN replicates are left out, G counting those
         that remain (NaN below MIN_GRANULES)."""

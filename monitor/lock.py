@@ -26,7 +26,7 @@ class InstanceLock:
         self.role = role
         self.fh: IO[str] | None = None
 
-    def __enter__(self):
+    def __enter__(self) -> InstanceLock:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.fh = open(self.path, "a+")
         try:
@@ -56,7 +56,8 @@ class InstanceLock:
             raise OSError(exc.errno, exc.strerror, str(self.path)) from None
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: object) -> None:
+        assert self.fh is not None, "entered"
         fcntl.flock(self.fh, fcntl.LOCK_UN)
         self.fh.close()
 

@@ -15,8 +15,10 @@ that too. The cone means are plain means over the top-hat cone, so no footprint 
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -64,7 +66,7 @@ class Collocation:
         return (self.v_bt_k.shape[-1] - 1) // 2
 
 
-def _array(path: Path, z, key: str) -> np.ndarray:
+def _array(path: Path, z: Any, key: str) -> np.ndarray:
     axes, _ = LAYOUT[key]
     if key not in z.files:
         raise ReplayError(path, key, "missing")
@@ -90,7 +92,7 @@ def _turns(path: Path, key: str, a: np.ndarray) -> float:
     return step
 
 
-def read_collocation(path) -> Collocation:
+def read_collocation(path: str | Path) -> Collocation:
     """One reference-implementation ``.npz``, checked against :data:`LAYOUT`; :class:`ReplayError` names
     the file, the field and what is wrong."""
     path = Path(path)
@@ -173,7 +175,9 @@ def notes(granules: list[Collocation]) -> list[str]:
     ]
 
 
-def assess_collocations(paths, cfg: AssessmentConfig, satellite: str = "") -> AssessmentResult:
+def assess_collocations(
+    paths: Iterable[str | Path], cfg: AssessmentConfig, satellite: str = ""
+) -> AssessmentResult:
     """The estimator's result for the collocation files *paths* (one granule each; all on one grid): per-FOR
     offsets in urad with jackknife sigmas, flags and the intercalibration; the km fields NaN. The files hold
     top-hat cone means: the top-hat kernel's floor of the sigmas applies."""

@@ -15,15 +15,20 @@ import logging
 import signal
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from monitor.allocator import reuse_freed_memory
 from monitor.config import Config
 from monitor.lock import InstanceLock
-from monitor.pipeline import DayWork, ProgressLines, compute_day, record_day
+from monitor.pipeline import DayWork, ProgressLines, RunOutcome, compute_day, record_day
 from monitor.sources.configured import make_source
 from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
+
+if TYPE_CHECKING:
+    from distributed import Client, LocalCluster
 
 LOG = logging.getLogger(__name__)
 
@@ -73,7 +78,7 @@ def period_days(since: dt.date, until: dt.date) -> list[dt.date]:
     return [since + dt.timedelta(days=k) for k in range((until - since).days + 1)]
 
 
-def _client(scheduler: str | None, workers: int):
+def _client(scheduler: str | None, workers: int) -> tuple[Client, LocalCluster | None]:
     """A Dask client: of the scheduler at *scheduler*, or of a local cluster of *workers* processes with
     one thread each (the assessment's own threads are set per task)."""
     from distributed import Client, LocalCluster
@@ -92,14 +97,14 @@ def _client(scheduler: str | None, workers: int):
 
 
 def reprocess(
-    cfg,
+    cfg: Config,
     since: dt.date,
     until: dt.date,
     satellites: list[str],
     scheduler: str | None = None,
     workers: int = 2,
     force: bool = False,
-    progress=None,
+    progress: Callable[[RunOutcome], None] | None = None,
     stop: threading.Event | None = None,
 ) -> ReprocessSummary:
     """Assess every satellite-day of the period not yet done (all with *force*) on Dask and record each.
@@ -166,7 +171,13 @@ def reprocess(
 
 
 def run_reprocess(
-    cfg: Config, since, until, satellites, scheduler=None, workers=2, force=False
+    cfg: Config,
+    since: dt.date,
+    until: dt.date,
+    satellites: list[str],
+    scheduler: str | None = None,
+    workers: int = 2,
+    force: bool = False,
 ) -> ReprocessSummary:
     """``crisgeo reprocess``: :func:`reprocess` with SIGINT/SIGTERM as a clean stop and a progress bar on a
     terminal (log lines otherwise)."""

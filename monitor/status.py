@@ -185,7 +185,9 @@ class Status:
         }
 
 
-def status_report(cfg: Config, store: Store, satellites=None, now: dt.datetime | None = None) -> Status:
+def status_report(
+    cfg: Config, store: Store, satellites: list[str] | None = None, now: dt.datetime | None = None
+) -> Status:
     """The :class:`Status` of *satellites* (default: the configured ones) at *now*."""
     now = now or dt.datetime.now(dt.timezone.utc)
     runs = {r.satellite: r for r in store.last_runs()}

@@ -9,6 +9,7 @@ OpenMP or TBB layers it costs nothing).
 from __future__ import annotations
 
 import threading
+from collections.abc import Iterator
 from contextlib import contextmanager
 
 import numba
@@ -17,7 +18,7 @@ KERNEL_LOCK = threading.Lock()
 
 
 @contextmanager
-def parallel_threads(workers: int):
+def parallel_threads(workers: int) -> Iterator[None]:
     """Run the compiled kernels on *workers* threads (at most numba's pool) in this block."""
     previous = numba.get_num_threads()
     numba.set_num_threads(max(1, min(workers, numba.config.NUMBA_NUM_THREADS)))

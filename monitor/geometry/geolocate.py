@@ -34,7 +34,13 @@ class GroundView:
 
 
 def geolocate_fovs(
-    los_spacecraft, for_time_us, mid_time_us, sc_position_m, sc_velocity_m_s, sc_attitude_rad, h_m=0.0
+    los_spacecraft: np.ndarray,
+    for_time_us: np.ndarray,
+    mid_time_us: np.ndarray,
+    sc_position_m: np.ndarray,
+    sc_velocity_m_s: np.ndarray,
+    sc_attitude_rad: np.ndarray,
+    h_m: float | np.ndarray = 0.0,
 ) -> GroundView:
     """Geolocate the LOS (30, 9, 3) (spacecraft body frame) of every scan.
 

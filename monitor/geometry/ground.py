@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.geometry import frames, wgs84
 from monitor.geometry.inverse import forward_geolocation
 
 
-def track_axes(ground_ecef_m, velocity_ecef_m_s):
+def track_axes(ground_ecef_m: np.ndarray, velocity_ecef_m_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit (along_track, cross_track) horizontal vectors at ground points.
 
     Along-track is the spacecraft ECEF velocity projected on the local horizontal; cross-track is
@@ -21,7 +22,15 @@ def track_axes(ground_ecef_m, velocity_ecef_m_s):
     return along, cross
 
 
-def offset_km(sat_ecef_m, sbf_to_ecef, alpha_rad, beta_rad, velocity_ecef_m_s, d_alpha_rad, d_beta_rad):
+def offset_km(
+    sat_ecef_m: np.ndarray,
+    sbf_to_ecef: np.ndarray,
+    alpha_rad: ArrayLike,
+    beta_rad: ArrayLike,
+    velocity_ecef_m_s: np.ndarray,
+    d_alpha_rad: ArrayLike,
+    d_beta_rad: ArrayLike,
+) -> tuple[np.ndarray, np.ndarray]:
     """Ground displacement (in_track_km, cross_track_km) of turning a LOS by (d_alpha, d_beta) in the SBF.
 
     Both the original and the turned LOS are intersected with the WGS84 ellipsoid; the difference is

@@ -16,7 +16,7 @@ import numpy as np
 from monitor.constants import N_FOR, URAD
 from monitor.errors import DataError
 from monitor.geometry.instrument import EngineeringPacket, corrected_ssm_angles
-from monitor.result import AssessmentResult
+from monitor.result import AssessmentResult, ForOffset
 from monitor.tables import Column, text_table
 
 
@@ -96,7 +96,7 @@ class Optimization:
         return "\n".join(lines)
 
 
-def _why_kept(f) -> str:
+def _why_kept(f: ForOffset) -> str:
     if not (np.isfinite(f.d_alpha_urad) and np.isfinite(f.d_beta_urad)):
         return "no offset (NaN)"
     if not f.reliable:

@@ -6,7 +6,7 @@ from monitor.errors import DataError
 class GranuleError(DataError):
     """A granule that cannot be used. ``str()`` reads ``FILE: FIELD: REASON``."""
 
-    def __init__(self, path, field, reason):
+    def __init__(self, path: object, field: str, reason: str) -> None:
         self.path = str(path)
         self.field = field
         self.reason = reason

@@ -32,7 +32,7 @@ class RemoteGranule(Protocol):
 GranuleRef = Path | RemoteGranule  # a granule file: on local disk, or read in place
 
 
-def as_ref(path) -> GranuleRef:
+def as_ref(path: str | os.PathLike | RemoteGranule) -> GranuleRef:
     """A local path (str or PathLike) as a Path; a :class:`RemoteGranule` as it is."""
     return Path(path) if isinstance(path, (str, os.PathLike)) else path
 
@@ -150,7 +150,7 @@ class ViirsGeoGranule:
     sc_attitude_rad: np.ndarray
     height_m: np.ndarray | None = None
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.height_m is None:
             self.height_m = np.zeros_like(self.lat_rad)
 

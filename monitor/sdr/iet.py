@@ -9,6 +9,7 @@ from __future__ import annotations
 import datetime as dt
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.errors import DataError
 
@@ -54,7 +55,7 @@ _OFFSET_US = np.array([s * 1_000_000 for _, s in LEAP_SECONDS], dtype=np.int64)
 _CHANGE_IET_US = _CHANGE_UNIX_US + _UNIX_MINUS_IET_EPOCH_US + _OFFSET_US
 
 
-def iet_to_unix_us(iet_us):
+def iet_to_unix_us(iet_us: ArrayLike) -> np.ndarray:
     """UTC microseconds since 1970 (int64) of IET microseconds."""
     iet = np.asarray(iet_us, np.int64)
     k = np.searchsorted(_CHANGE_IET_US, iet, side="right") - 1
@@ -63,7 +64,7 @@ def iet_to_unix_us(iet_us):
     return iet - _UNIX_MINUS_IET_EPOCH_US - _OFFSET_US[k]
 
 
-def unix_us_to_iet(unix_us):
+def unix_us_to_iet(unix_us: ArrayLike) -> np.ndarray:
     """IET microseconds (int64) of UTC microseconds since 1970."""
     u = np.asarray(unix_us, np.int64)
     k = np.searchsorted(_CHANGE_UNIX_US, u, side="right") - 1
@@ -72,7 +73,7 @@ def unix_us_to_iet(unix_us):
     return u + _UNIX_MINUS_IET_EPOCH_US + _OFFSET_US[k]
 
 
-def iet_to_datetime(iet_us) -> dt.datetime:
+def iet_to_datetime(iet_us: ArrayLike) -> dt.datetime:
     """Timezone-aware UTC datetime of one IET value."""
     return dt.datetime(1970, 1, 1, tzinfo=UTC) + dt.timedelta(microseconds=int(iet_to_unix_us(iet_us)))
 

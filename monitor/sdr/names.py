@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import datetime as dt
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 _PATTERN = re.compile(
@@ -82,7 +83,7 @@ def parse_name(name: str) -> JpssName | None:
 
 
 def format_name(
-    products,
+    products: Sequence[str],
     platform: str,
     start: dt.datetime,
     end: dt.datetime,
@@ -93,7 +94,7 @@ def format_name(
 ) -> str:
     """A JPSS file name for the given fields (used by the simulator)."""
 
-    def clock(t):
+    def clock(t: dt.datetime) -> str:
         return f"{t:%H%M%S}{t.microsecond // 100000}"
 
     return (

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.constants import N_FOR, N_FOV
 
@@ -38,7 +39,7 @@ FLOAT_FILLS = (
 UINT16_FILL_MIN = 65528  # IDPS uint16 fills are 65528 ... 65535
 
 
-def is_float_fill(values) -> np.ndarray:
+def is_float_fill(values: ArrayLike) -> np.ndarray:
     """True where *values* hold one of the IDPS float fill codes (not merely a large negative number)."""
     v = np.asarray(values)
     with np.errstate(invalid="ignore", over="ignore"):

@@ -7,6 +7,7 @@ step at a given day), written through the store's own ``save_day`` like real run
 from __future__ import annotations
 
 import datetime as dt
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +21,7 @@ BIAS_K, GAIN_PCT, CURVATURE_K = 0.15, -0.3, 0.1
 
 
 def day_result(
-    satellite: str, day: dt.date, rng, step_urad: float = 0.0, with_cube: bool = True
+    satellite: str, day: dt.date, rng: np.random.Generator, step_urad: float = 0.0, with_cube: bool = True
 ) -> AssessmentResult:
     """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR
     21-30."""
@@ -82,8 +83,8 @@ def day_result(
 
 
 def fill_store(
-    store,
-    satellites,
+    store: Any,  # a monitor.store.sqlite.Store: the simulator stands below the store's floor
+    satellites: list[str],
     first: dt.date,
     days: int,
     step_day: int | None = None,

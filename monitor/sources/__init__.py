@@ -7,7 +7,7 @@ It knows file names and transport, nothing of the science.
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -43,7 +43,7 @@ class ListedFile:
         return self.parsed.products[0]
 
 
-def listed(name: str, size, location: str, md5: str | None = None) -> ListedFile | None:
+def listed(name: str, size: int | None, location: str, md5: str | None = None) -> ListedFile | None:
     """A :class:`ListedFile` for a safe JPSS file name (a base name, so no dot segment can slip in), or
     None for anything else (path parts, non-ASCII, odd names)."""
     if not name.isascii() or "/" in name or "\\" in name or name.startswith("."):
@@ -68,7 +68,7 @@ class Source(Protocol):
         """Start a run: reset the run's budget and deadline, apply the cache retention; *should_stop*, the
         run's stop request, is polled between the long steps of listing (a :class:`StopRequested`)."""
 
-    def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
+    def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
         """The granule files of *satellite* for *day* whose product is in *products*."""
 
     def fetch(self, f: ListedFile) -> GranuleRef:

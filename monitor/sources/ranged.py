@@ -38,6 +38,7 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from fsspec.caching import MMapCache
 
@@ -171,7 +172,7 @@ class RangedReader(io.RawIOBase):
         self.pos = max(0, base + offset)
         return self.pos
 
-    def readinto(self, buffer) -> int:
+    def readinto(self, buffer: Any) -> int:  # a writable buffer (typeshed: Buffer)
         if self.failure is not None:
             raise OSError(self.failure)
         end = min(self.pos + len(buffer), self.size)
