@@ -13,12 +13,13 @@ import logging
 import smtplib
 import ssl
 import time
+from collections.abc import Callable
 from email.message import EmailMessage
 from pathlib import Path
 
 import requests
 
-from monitor.config import AlertSettings, env_secret
+from monitor.config import AlertSettings, EmailSettings, SlackSettings, env_secret
 
 LOG = logging.getLogger(__name__)
 
@@ -26,7 +27,7 @@ LOG = logging.getLogger(__name__)
 class Transient(Exception):
     """Try again later (server down, rate limited, 5xx)."""
 
-    def __init__(self, message, retry_after_s: float = 300.0):
+    def __init__(self, message: str, retry_after_s: float = 300.0) -> None:
         super().__init__(message)
         self.retry_after_s = retry_after_s
 
@@ -43,7 +44,7 @@ class LogChannel:
     def __init__(self, path: Path):
         self.path = Path(path)
 
-    def send(self, msg):
+    def send(self, msg: dict) -> None:
         """Append *message* to the log file."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with open(self.path, "a") as fh:
@@ -58,10 +59,10 @@ class EmailChannel:
 
     name = "email"
 
-    def __init__(self, settings):
+    def __init__(self, settings: EmailSettings) -> None:
         self.s = settings
 
-    def send(self, msg):
+    def send(self, msg: dict) -> None:
         """Send *message* as a multipart e-mail; raises on failure (the queue retries)."""
         s = self.s
         m = EmailMessage()
@@ -102,11 +103,11 @@ class SlackChannel:
 
     name = "slack"
 
-    def __init__(self, settings, sleep=time.sleep):
+    def __init__(self, settings: SlackSettings, sleep: Callable[[float], None] = time.sleep) -> None:
         self.s = settings
         self.sleep = sleep
 
-    def send(self, msg):
+    def send(self, msg: dict) -> None:
         """Post *message* to the webhook; raises on failure (the queue retries)."""
         url = env_secret(self.s.webhook_env)
         if not url:

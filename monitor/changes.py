@@ -15,6 +15,7 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,7 +47,7 @@ class Change:
         return f"{who} {self.kind} on {self.time:%Y-%m-%d %H:%M} UTC: {self.description} [{self.origin}]"
 
 
-def _when(value) -> dt.datetime:
+def _when(value: object) -> dt.datetime:
     if isinstance(value, dt.datetime):
         return value if value.tzinfo else value.replace(tzinfo=UTC)
     if isinstance(value, dt.date):
@@ -54,7 +55,7 @@ def _when(value) -> dt.datetime:
     return dt.datetime.fromisoformat(str(value).replace("Z", "+00:00")).astimezone(UTC)
 
 
-def load_calendar(path) -> list[Change]:
+def load_calendar(path: str | Path) -> list[Change]:
     """Events of the calendar YAML at *path* (missing file: none). Errors name the entry and key."""
     path = Path(path)
     if not path.exists():
@@ -82,7 +83,7 @@ def load_calendar(path) -> list[Change]:
     return out
 
 
-def add_to_calendar(path, change: Change) -> None:
+def add_to_calendar(path: str | Path, change: Change) -> None:
     """Append *change* to the calendar YAML at *path* (created if missing). The file is edited as a
     round trip (ruamel.yaml): its comments, order and quoting stay as the team wrote them. A change the
     calendar already holds (same satellite, time, instrument and kind) is a ValueError naming it."""
@@ -118,7 +119,7 @@ def add_to_calendar(path, change: Change) -> None:
     tmp.replace(path)
 
 
-def _lut_kinds(names) -> dict:
+def _lut_kinds(names: Iterable[str]) -> dict[str, set[str]]:
     out: dict[str, set[str]] = {}
     for n in names:
         m = KIND_RE.match(n)
@@ -189,7 +190,7 @@ def stored_changes(store: History, satellite: str) -> list[Change]:
     return out
 
 
-def all_changes(store: History, satellite: str, calendar_path=None) -> list[Change]:
+def all_changes(store: History, satellite: str, calendar_path: str | Path | None = None) -> list[Change]:
     """Every known change of *satellite*, in time order: the calendar, the metadata, the recorded events."""
     cal = [c for c in load_calendar(calendar_path) if c.satellite == satellite] if calendar_path else []
     return sorted(

@@ -10,16 +10,18 @@ place in an installation; ``crisgeo install-files DEST`` copies them out.
 from __future__ import annotations
 
 import shutil
+from collections.abc import Iterator
+from importlib.abc import Traversable
 from importlib.resources import as_file, files
 from pathlib import Path
 
 
-def shipped_root():
+def shipped_root() -> Traversable:
     """The shipped files (an importlib.resources Traversable)."""
     return files("monitor") / "shipped"
 
 
-def _walk(node, rel=()):
+def _walk(node: Traversable, rel: tuple[str, ...] = ()) -> Iterator[tuple[tuple[str, ...], Traversable]]:
     for child in sorted(node.iterdir(), key=lambda c: c.name):
         if child.name.startswith(".") or child.name == "__pycache__":
             continue
@@ -29,7 +31,7 @@ def _walk(node, rel=()):
             yield rel + (child.name,), child
 
 
-def install_files(dest, force: bool = False) -> list[Path]:
+def install_files(dest: str | Path, force: bool = False) -> list[Path]:
     """Copy every shipped file under *dest* (same tree: configs/, systemd/, docs/, README.md). An existing
     file is left alone unless *force* (it may be an operator's edited configuration); returns the files
     written."""
@@ -46,7 +48,7 @@ def install_files(dest, force: bool = False) -> list[Path]:
     return written
 
 
-def kept_files(dest) -> list[Path]:
+def kept_files(dest: str | Path) -> list[Path]:
     """The shipped files that already exist under *dest* (what :func:`install_files` leaves alone)."""
     dest = Path(dest)
     return [dest.joinpath(*rel) for rel, _ in _walk(shipped_root()) if dest.joinpath(*rel).exists()]

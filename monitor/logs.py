@@ -36,7 +36,7 @@ def _fields() -> dict:
 
 
 @contextmanager
-def context(**fields) -> Iterator[None]:
+def context(**fields: object) -> Iterator[None]:
     """Add *fields* (satellite, day, stage, run_id) to every line logged inside the block."""
     token = _context.set({**_fields(), **{k: v for k, v in fields.items() if v is not None}})
     try:
@@ -61,10 +61,10 @@ def priority(levelno: int) -> int:
 class JournalFormatter(logging.Formatter):
     """``<N>LEVEL logger: message``: the journal reads the priority N and adds the time."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         super().__init__("%(levelname)s %(name)s: %(message)s")
 
-    def format(self, record):
+    def format(self, record: logging.LogRecord) -> str:
         """One line, its priority first; a traceback's lines follow on it, joined by `` | ``."""
         lines = [line for line in super().format(record).splitlines() if line.strip()]
         return f"<{priority(record.levelno)}>" + " | ".join(line.strip() for line in lines)
@@ -75,7 +75,7 @@ class UtcFormatter(logging.Formatter):
 
     converter = staticmethod(time.gmtime)
 
-    def __init__(self):
+    def __init__(self) -> None:
         super().__init__("%(asctime)s %(levelname)s %(name)s: %(message)s", "%Y-%m-%dT%H:%M:%SZ")
 
 
@@ -83,7 +83,7 @@ class JsonFormatter(logging.Formatter):
     """One JSON object per line: time (UTC, ISO 8601), level, priority, logger, message, the satellite-day
     context (satellite, day, stage, run_id) where there is one, and the exception."""
 
-    def format(self, record):
+    def format(self, record: logging.LogRecord) -> str:
         """One JSON object per record."""
         doc = {
             "time": dt.datetime.fromtimestamp(record.created, dt.timezone.utc).isoformat(

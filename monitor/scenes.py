@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,7 +22,7 @@ from monitor.records import SceneDecision
 from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import GranuleFiles, granule_files
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
-from monitor.sources import BudgetExceeded, ListedFile, SourceError
+from monitor.sources import BudgetExceeded, ListedFile, Source, SourceError
 from monitor.spectral import i5_band
 from monitor.vocabulary import Decision
 
@@ -42,7 +43,9 @@ class Candidate:
     files: GranuleFiles | None = None
 
 
-def _pairs(files, sdr_prefixes, geo_prefixes):
+def _pairs(
+    files: list[ListedFile], sdr_prefixes: Iterable[str], geo_prefixes: Iterable[str]
+) -> tuple[list[tuple[str, ListedFile, ListedFile]], list[str]]:
     sdr = {f.parsed.granule_key: f for f in files if f.product in sdr_prefixes}
     geo = {f.parsed.granule_key: f for f in files if f.product in geo_prefixes}
     both = sorted(set(sdr) & set(geo), key=lambda k: geo[k].parsed.start)
@@ -50,14 +53,16 @@ def _pairs(files, sdr_prefixes, geo_prefixes):
     return [(k, sdr[k], geo[k]) for k in both], single
 
 
-def inhomogeneity_k(radiance_lw, satellite: str) -> float:
+def inhomogeneity_k(radiance_lw: np.ndarray, satellite: str) -> float:
     """Mean over FORs of the standard deviation of the 9 FOV I5-equivalent BTs (K)."""
     band = i5_band(satellite)
     bt = band.bt_from_radiance(band.cris_band_radiance(radiance_lw))
     return float(np.nanmean(np.nanstd(bt, axis=-1)))
 
 
-def select_scenes(listing, source, satellite: str, candidates: int, keep: int, min_score_k: float):
+def select_scenes(
+    listing: list[ListedFile], source: Source, satellite: str, candidates: int, keep: int, min_score_k: float
+) -> tuple[list[Candidate], list[SceneDecision]]:
     """(chosen candidates, decisions) for one satellite-day: every granule of the listing is chosen,
     rejected or not considered, with the reason."""
     decisions: list[SceneDecision] = []
