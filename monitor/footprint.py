@@ -19,9 +19,11 @@ half peak) and ``top-hat`` (the paper's 0.963 deg cone, which the table does not
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.constants import FOV_DIAMETER_RAD
 
@@ -44,7 +46,7 @@ class RadialResponse:
     radius_rad: tuple[float, ...]
     response: tuple[float, ...]
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         r, v = np.asarray(self.radius_rad, float), np.asarray(self.response, float)
         if r.ndim != 1 or r.shape != v.shape or len(r) < 2:
             raise ValueError("a radial response needs as many responses as radii, at least two")
@@ -60,7 +62,7 @@ class RadialResponse:
         last = int(np.flatnonzero(v > 0).max())
         return float(self.radius_rad[min(last + 1, len(v) - 1)])
 
-    def __call__(self, r_rad) -> np.ndarray:
+    def __call__(self, r_rad: ArrayLike) -> np.ndarray:
         """The response at angles *r_rad* (rad) from the LOS."""
         return np.interp(np.abs(r_rad), self.radius_rad, self.response, right=0.0)
 
@@ -87,7 +89,7 @@ class RadialResponse:
         return out
 
 
-def _tabulated(profile, reach_rad: float) -> RadialResponse:
+def _tabulated(profile: Callable[[np.ndarray], np.ndarray], reach_rad: float) -> RadialResponse:
     r = np.linspace(0.0, reach_rad, KNOTS)
     v = np.clip(profile(r), 0.0, 1.0)
     v[0] = 1.0
@@ -145,7 +147,9 @@ def shape(name: str) -> RadialResponse:
         raise ValueError(f"footprint {name!r} is not one of {', '.join(SHAPES)}") from None
 
 
-def widths_of_weights(radii_rad, weights, levels=(0.5, 0.1)) -> dict[float, float]:
+def widths_of_weights(
+    radii_rad: tuple[float, ...], weights: np.ndarray, levels: tuple[float, ...] = (0.5, 0.1)
+) -> dict[float, float]:
     """Full widths (rad) at *levels* of the profile that fitted annulus weights describe.
 
     *radii_rad* (K,) are the annuli's outer radii (the first annulus a disc), *weights* (K,) the share of the

@@ -11,6 +11,7 @@ import datetime as dt
 import logging
 import shutil
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -28,7 +29,7 @@ from monitor.sdr import read_file
 from monitor.sdr.engpkt import load_library
 from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
-from monitor.sources import ALL_PRODUCTS, Source, SourceError
+from monitor.sources import ALL_PRODUCTS, ListedFile, Source, SourceError
 from monitor.store.sqlite import Store
 from monitor.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 from monitor.vocabulary import EventKind, RunStatus
@@ -62,7 +63,7 @@ class ProgressLines:
         self.done = 0
         self.t0 = self.last = time.monotonic()
 
-    def __call__(self, _item=None):
+    def __call__(self, _item: object = None) -> None:
         self.done += 1
         now = time.monotonic()
         if self.done >= self.total or now - self.last >= self.every_s:
@@ -122,7 +123,9 @@ def days_to_run(store: Store, satellite: str, schedule: ScheduleConfig, today: d
     return schedule.days_to_run(store.done_days(satellite, schedule.no_data_horizon(today)), today)
 
 
-def day_fingerprint(cfg: Config, source, satellite: str, day: dt.date, listing) -> fpr.DayFingerprint | None:
+def day_fingerprint(
+    cfg: Config, source: Source, satellite: str, day: dt.date, listing: list[ListedFile]
+) -> fpr.DayFingerprint | None:
     """The LOS fingerprint (:func:`monitor.fingerprint.granule_print`) of a sample of the day's GEO granules,
     with the EPs of the library identified (:func:`monitor.fingerprint.fingerprint_day`); a granule that
     cannot be fetched or read is logged and left out; None without any."""
@@ -191,7 +194,13 @@ def publish_changes(cfg: Config, store: Store, satellite: str) -> None:
         store.queue_lines(target_name(p), satellite, change_lines(p.measurement, changes))
 
 
-def fetch_plan(source, satellite: str, chosen: list, stop=lambda: False, progress=None) -> CasePlan:
+def fetch_plan(
+    source: Source,
+    satellite: str,
+    chosen: list,
+    stop: Callable[[], bool] = lambda: False,
+    progress: Callable[[], None] | None = None,
+) -> CasePlan:
     """The assessment plan of the chosen scenes: their CrIS files as selection read them (no second
     reading, no second pairing) with the VIIRS granules covering them, each fetched and its metadata read
     once; a VIIRS granule that cannot be fetched or read is skipped with its reason."""
@@ -230,7 +239,12 @@ class DayWork:
 
 
 def compute_day(
-    cfg, source: Source, satellite: str, day: dt.date, should_stop=None, progress=None
+    cfg: Config,
+    source: Source,
+    satellite: str,
+    day: dt.date,
+    should_stop: Callable[[], bool] | None = None,
+    progress: Callable[[object], None] | None = None,
 ) -> DayWork:
     """List, fingerprint, select, fetch and assess one satellite-day, touching no store. Never raises for
     a problem of the day's data or source: it becomes the work's status and reason. Its log lines carry
@@ -239,7 +253,14 @@ def compute_day(
         return _compute_day(cfg, source, satellite, day, should_stop, progress)
 
 
-def _compute_day(cfg: Config, source: Source, satellite: str, day: dt.date, should_stop, progress) -> DayWork:
+def _compute_day(
+    cfg: Config,
+    source: Source,
+    satellite: str,
+    day: dt.date,
+    should_stop: Callable[[], bool] | None,
+    progress: Callable[[object], None] | None,
+) -> DayWork:
     stop = should_stop or (lambda: False)
     w = DayWork(satellite, day, RunStatus.OK)
     t0 = time.perf_counter()
@@ -358,8 +379,8 @@ def run_day(
     satellite: str,
     day: dt.date,
     today: dt.date,
-    should_stop=None,
-    progress=None,
+    should_stop: Callable[[], bool] | None = None,
+    progress: Callable[[object], None] | None = None,
 ) -> RunOutcome:
     """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`) as of *today*
     (the no-data horizon); every outcome is recorded in the ledger, an unexpected exception too

@@ -14,6 +14,7 @@ def make_source(cfg: Config) -> Source:
     """The source named by the configuration's ``source.kind``."""
     kind = cfg.source.kind
     if kind == "local":
+        assert cfg.source.path is not None, "the configuration requires a path for a local source"
         return LocalSource(cfg.source.path)
     if kind == "simulated":
         return SimulatedSource(cfg.state_dir / "simulated", cfg.source)

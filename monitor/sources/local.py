@@ -7,10 +7,10 @@ import logging
 import os
 import shutil
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from monitor.config import CalibrationDifference
+from monitor.config import CalibrationDifference, SourceConfig
 from monitor.sdr.products import CRIS_PRODUCTS
 from monitor.sources import ListedFile, listed, on_day
 
@@ -25,11 +25,11 @@ class LocalSource:
     downloaded_files = 0
     requests = 0
 
-    def __init__(self, root):
+    def __init__(self, root: str | Path) -> None:
         self.root = Path(root)
         self.should_stop: Callable[[], bool] | None = None
 
-    def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
+    def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
         """The granule files of *satellite* on *day* (and VIIRS of the days around it) whose product is in
         *products*."""
         if not self.root.is_dir():
@@ -50,7 +50,7 @@ class LocalSource:
         """The file itself: a local tree needs no download."""
         return Path(f.location)
 
-    def start_day(self, should_stop=None):
+    def start_day(self, should_stop: Callable[[], bool] | None = None) -> None:
         """Nothing to reset for a local tree; the run's *should_stop* is kept for a simulation."""
         self.should_stop = should_stop
 
@@ -61,11 +61,11 @@ class SimulatedSource(LocalSource):
     :data:`IN_USE_S` (a run elsewhere, e.g. another reprocessing worker, may still read it): a catch-up of
     months would otherwise fill the disk, ~0.2 GB a day."""
 
-    def __init__(self, root, source_cfg):
+    def __init__(self, root: str | Path, source_cfg: SourceConfig) -> None:
         super().__init__(root)
         self.cfg = source_cfg
 
-    def list_day(self, satellite, day, products):
+    def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
         """Simulate the satellite-day once (into ``root/<satellite>/<day>``), then list it. A stop requested
         during the simulation ends it within a granule's step; a stop or a failure (a full disk) leaves no
         half-simulated day."""
