@@ -41,15 +41,50 @@ from __future__ import annotations
 
 import datetime as dt
 import math
+from collections.abc import Callable, Iterable, Iterator
+from typing import Protocol
 
 from prometheus_client import CollectorRegistry, Counter, Gauge, disable_created_metrics
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
+from prometheus_client.metrics_core import Metric
 
 from monitor.constants import URAD
+from monitor.result import ForOffset
 from monitor.store.alerts import AlertState
+from monitor.store.sqlite import Store
 from monitor.vocabulary import RunStatus
 
 disable_created_metrics()  # a counter's start time is not a series anyone graphs
+
+
+class Counts(Protocol):
+    """What the metrics read of a run's counts (:class:`monitor.pipeline.RunCounts`)."""
+
+    @property
+    def downloaded(self) -> int: ...
+    @property
+    def bytes(self) -> int: ...
+    @property
+    def requests(self) -> int: ...
+
+
+class Outcome(Protocol):
+    """What the metrics read of a run (:class:`monitor.pipeline.RunOutcome`): its satellite, the seconds of
+    its stages, its counts. Typed so, the metrics and the pipeline (one floor) do not import each other."""
+
+    @property
+    def satellite(self) -> str: ...
+    @property
+    def timings(self) -> dict: ...
+    @property
+    def counts(self) -> Counts: ...
+
+
+class Health(Protocol):
+    """What the metrics read of the daemon's health (:class:`monitor.health.Health`)."""
+
+    def problems(self) -> list[str]: ...
+
 
 OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run row changes to one once
 
@@ -57,14 +92,21 @@ OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run
 class _StoreCollector:
     """Reads the store at each scrape (a new connection each time: scrapes come on the server's thread)."""
 
-    def __init__(self, open_store, satellites, health, started: dt.datetime, spec_km: float):
+    def __init__(
+        self,
+        open_store: Callable[[], Store],
+        satellites: Iterable[str],
+        health: Health,
+        started: dt.datetime,
+        spec_km: float,
+    ) -> None:
         self.open_store = open_store
         self.satellites = list(satellites)
         self.spec_km = spec_km
         self.health = health
         self.started = started
 
-    def collect(self):
+    def collect(self) -> Iterator[Metric]:
         with self.open_store() as store:
             success = store.last_success()
             first = store.first_runs()
@@ -107,7 +149,7 @@ class _StoreCollector:
         g = GaugeMetricFamily(
             "crisgeo_alerts_firing", "Alerts firing now", labels=["satellite", "rule", "severity"]
         )
-        per = {}
+        per: dict[tuple[str, str, str], int] = {}
         for a in firing:
             key = (a.satellite, a.rule, a.severity or "")
             per[key] = per.get(key, 0) + 1
@@ -120,7 +162,9 @@ class _StoreCollector:
         )
 
     @staticmethod
-    def _offsets(latest, fors, spec_km: float):
+    def _offsets(
+        latest: dict[str, dt.date | None], fors: dict[str, list[ForOffset]], spec_km: float
+    ) -> Iterator[Metric]:
         day = GaugeMetricFamily(
             "crisgeo_latest_day_timestamp_seconds",
             "00:00 UTC of the latest assessed day",
@@ -191,7 +235,14 @@ class _StoreCollector:
 class ServiceMetrics:
     """The daemon's registry: the store's view at each scrape plus this process's run figures."""
 
-    def __init__(self, open_store, satellites, health, version: str, spec_km: float):
+    def __init__(
+        self,
+        open_store: Callable[[], Store],
+        satellites: Iterable[str],
+        health: Health,
+        version: str,
+        spec_km: float,
+    ) -> None:
         self.registry = CollectorRegistry()
         self.registry.register(
             _StoreCollector(open_store, satellites, health, dt.datetime.now(dt.timezone.utc), spec_km)
@@ -228,7 +279,7 @@ class ServiceMetrics:
             self.bytes.labels(sat)
             self.requests.labels(sat)
 
-    def record(self, outcome) -> None:
+    def record(self, outcome: Outcome) -> None:
         """Take in a :class:`monitor.pipeline.RunOutcome`."""
         for stage, secs in outcome.timings.items():
             self.duration.labels(outcome.satellite, stage).set(secs)

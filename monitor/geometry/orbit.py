@@ -7,13 +7,14 @@ r + v dt is ~30 m off at the scan ends (docs/jpss-formats.md 2.3), so the state 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.geometry.wgs84 import A_M, GM_M3_S2, J2, OMEGA_EARTH_RAD_S
 
 _OMEGA = np.array([0.0, 0.0, OMEGA_EARTH_RAD_S])
 
 
-def acceleration_ecef(r_m, v_m_s):
+def acceleration_ecef(r_m: ArrayLike, v_m_s: ArrayLike) -> np.ndarray:
     """Acceleration (m/s^2) in the rotating frame: gravity with J2, Coriolis and centrifugal terms."""
     r = np.asarray(r_m, float)
     rn = np.linalg.norm(r, axis=-1, keepdims=True)
@@ -21,12 +22,14 @@ def acceleration_ecef(r_m, v_m_s):
     k = 1.5 * J2 * (A_M / rn) ** 2
     g = -GM_M3_S2 * r / rn**3
     g = g * np.concatenate([1 + k * (1 - 5 * z2), 1 + k * (1 - 5 * z2), 1 + k * (3 - 5 * z2)], axis=-1)
-    coriolis = -2.0 * np.cross(_OMEGA, v_m_s)
+    coriolis = -2.0 * np.cross(_OMEGA, np.asarray(v_m_s, float))
     centrifugal = -np.cross(_OMEGA, np.cross(_OMEGA, r))
     return g + coriolis + centrifugal
 
 
-def propagate(r_m, v_m_s, dt_s, steps=8):
+def propagate(
+    r_m: ArrayLike, v_m_s: ArrayLike, dt_s: ArrayLike, steps: int = 8
+) -> tuple[np.ndarray, np.ndarray]:
     """ECEF state after *dt_s* seconds (broadcast per row), by *steps* RK4 steps of dt_s/steps each."""
     r = np.array(r_m, float)
     v = np.array(v_m_s, float)
@@ -44,7 +47,9 @@ def propagate(r_m, v_m_s, dt_s, steps=8):
     return r, v
 
 
-def state_at(times_us, mid_times_us, positions_m, velocities_m_s):
+def state_at(
+    times_us: ArrayLike, mid_times_us: ArrayLike, positions_m: ArrayLike, velocities_m_s: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """Spacecraft ECEF state at each of *times_us* (IET microseconds), from the nearest scan's MidTime state.
 
     *mid_times_us* (n,) with *positions_m*/*velocities_m_s* (n, 3); returns (r, v) shaped times + (3,).
@@ -56,7 +61,7 @@ def state_at(times_us, mid_times_us, positions_m, velocities_m_s):
     return propagate(np.asarray(positions_m, float)[nearest], np.asarray(velocities_m_s, float)[nearest], dt)
 
 
-def interpolate_per_scan(times_us, mid_times_us, values):
+def interpolate_per_scan(times_us: ArrayLike, mid_times_us: ArrayLike, values: ArrayLike) -> np.ndarray:
     """Linear interpolation (extrapolation at the ends) of per-scan *values* (n, k) to *times_us*."""
     t = np.asarray(times_us, np.int64).astype(float)
     mid = np.asarray(mid_times_us, np.int64).astype(float)
