@@ -15,8 +15,10 @@ from __future__ import annotations
 import concurrent.futures as cf
 import logging
 import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -30,14 +32,30 @@ from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
 from monitor.result import AssessmentResult, GranuleInfo, Skipped
-from monitor.sdr import CrisGeoGranule, CrisSdrGranule, GranuleError, read_file
+from monitor.sdr import (
+    CrisGeoGranule,
+    CrisSdrGranule,
+    GranuleError,
+    ViirsGeoGranule,
+    ViirsSdrGranule,
+    read_file,
+)
 from monitor.sdr.pairing import CasePlan, GranuleFiles, neighbours, plan
 from monitor.sdr.readers import read_scan_start_us, read_viirs_geo_scan
-from monitor.spectral import i5_band
+from monitor.spectral import I5Band, i5_band
 from monitor.threads import parallel_threads
 from monitor.vocabulary import Kernel
 
 LOG = logging.getLogger(__name__)
+
+Timings = dict[str, float] | None  # seconds per stage, added to when a dict
+Span = tuple[int, int]  # IET (us) from, to
+StopCheck = Callable[[], bool] | None  # polled; True: stop
+Progress = Callable[["GranuleFiles"], object] | None  # called after each granule
+# a VIIRS granule read: GEO, SDR, and the neighbours' adjacent scans (lat_rad, lon_rad, height_m) or None
+RawViirs = tuple[
+    ViirsGeoGranule, ViirsSdrGranule, tuple[np.ndarray, ...] | None, tuple[np.ndarray, ...] | None
+]
 # the discs each kernel collocates; the top-hat cone is one of them either way
 KERNELS = {Kernel.TOP_HAT: collocate.TOP_HAT, Kernel.FOOTPRINT: collocate.ANNULI}
 CONE_RADIUS_RAD = FOV_DIAMETER_RAD / 2
@@ -66,7 +84,7 @@ class GranuleSamples:
 
 
 @contextmanager
-def _stage(timings, name):
+def _stage(timings: Timings, name: str) -> Iterator[None]:
     """Add the wall time of the block to timings[name] (seconds) when *timings* is a dict."""
     t0 = time.perf_counter()
     try:
@@ -86,26 +104,26 @@ class _SwathCache:
     spans: dict = field(default_factory=dict)
 
 
-def _widen(span, other):
+def _widen(span: Span | None, other: Span | None) -> Span | None:
     """The IET span covering both *span* and *other* (either may be None)."""
     if span is None or other is None:
         return other if span is None else span
     return (min(span[0], other[0]), max(span[1], other[1]))
 
 
-def _reach_us(first_us: int, last_us: int) -> tuple:
+def _reach_us(first_us: int, last_us: int) -> Span:
     """The IET span (us) of the VIIRS scans that CrIS observations from first_us to last_us may reach."""
     return (first_us - collocate.SCAN_TIME_MARGIN_US, last_us + collocate.SCAN_TIME_MARGIN_US)
 
 
-def _scan_spans(cris: list, viirs: dict) -> dict:
+def _scan_spans(cris: list[GranuleFiles], viirs: dict[str, list[GranuleFiles]]) -> dict[str, Span]:
     """Per VIIRS granule key, the IET span (us) of the scans the CrIS granules *cris* using it need (by
     their nominal bounds, :func:`_reach_us`): so that each is prepared once per run."""
     spans: dict[str, tuple[int, int]] = {}
     for g in cris:
         need = _reach_us(g.geo_meta.start_iet_us, g.geo_meta.end_iet_us)
         for v in viirs[g.key]:
-            spans[v.key] = _widen(spans.get(v.key), need)
+            spans[v.key] = _widen(spans.get(v.key), need) or need  # (never None: need is a span)
     return spans
 
 
@@ -128,7 +146,7 @@ class GranuleInputs:
     viirs: dict = field(default_factory=dict)
 
 
-def _read_viirs(v: GranuleFiles, viirs_all: list, span_us=None):
+def _read_viirs(v: GranuleFiles, viirs_all: list[GranuleFiles], span_us: Span | None = None) -> RawViirs:
     """A VIIRS granule's GEO and SDR, with the adjacent scans of its neighbours (for the scan overlap).
 
     Given *span_us* (IET us), only what :func:`swath.swath_piece` uses of that span is read: the scans
@@ -157,13 +175,13 @@ def _read_viirs(v: GranuleFiles, viirs_all: list, span_us=None):
 
 def read_inputs(
     cris: GranuleFiles,
-    viirs: list,
-    viirs_all: list,
-    band,
+    viirs: list[GranuleFiles],
+    viirs_all: list[GranuleFiles],
+    band: I5Band,
     cfg: AssessmentConfig,
-    prepared=(),
-    timings=None,
-    spans=None,
+    prepared: Iterable[str] = (),
+    timings: Timings = None,
+    spans: dict[str, Span] | None = None,
 ) -> GranuleInputs:
     """Read what :func:`collocate_granule` needs of *cris*, except the VIIRS granules in *prepared*, and
     compute what depends on the CrIS granule alone (its geometry and band BT). A VIIRS granule is read
@@ -207,15 +225,22 @@ def read_inputs(
     return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, span_us, bt_cris, raw)
 
 
-def _run_span(spans: dict, key: str, span_us):
+def _run_span(spans: dict[str, Span], key: str, span_us: Span | None) -> Span | None:
     """The IET span of VIIRS granule *key* prepared for a CrIS granule reaching *span_us*: the run's span
     of that granule widened to it (None, every scan, when the CrIS granule has no observation time)."""
     return _widen(spans.get(key), span_us) if span_us is not None else None
 
 
 def _piece(
-    v: GranuleFiles, viirs_all: list, band, cache: _SwathCache, view_rad, timings=None, raw=None, span_us=None
-):
+    v: GranuleFiles,
+    viirs_all: list[GranuleFiles],
+    band: I5Band,
+    cache: _SwathCache,
+    view_rad: float,
+    timings: Timings = None,
+    raw: RawViirs | None = None,
+    span_us: Span | None = None,
+) -> swath.SwathPiece:
     """The granule prepared out to at least *view_rad* from nadir, with its scans of the IET span
     *span_us* (None: all): from the cache, or prepared out to view_rad + VIEW_MARGIN_RAD (so that the next
     CrIS granule's slightly wider reach finds it ready) with the scans the whole run needs."""
@@ -228,6 +253,7 @@ def _piece(
         with _stage(timings, "read"):
             raw = _read_viirs(v, viirs_all, run_span)
     geo, sdr, halo_before, halo_after = raw
+    assert geo.height_m is not None  # zeros for the ellipsoid product (ViirsGeoGranule)
     with _stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
@@ -242,13 +268,13 @@ def _piece(
 
 def _load_swath(
     viirs: list[GranuleFiles],
-    viirs_all: list,
-    band,
+    viirs_all: list[GranuleFiles],
+    band: I5Band,
     cache: _SwathCache,
-    view_rad,
-    timings=None,
-    raw=None,
-    span_us=None,
+    view_rad: float,
+    timings: Timings = None,
+    raw: dict[str, RawViirs] | None = None,
+    span_us: Span | None = None,
 ) -> swath.ViirsSwath:
     """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*) out
     to *view_rad* from nadir and over the IET span *span_us*, from the raw granules in *raw* (key ->
@@ -263,11 +289,11 @@ def collocate_granule(
     cris: GranuleFiles,
     viirs: list[GranuleFiles],
     cfg: AssessmentConfig,
-    band,
+    band: I5Band,
     cache: _SwathCache,
-    timings=None,
-    viirs_all=None,
-    should_stop=None,
+    timings: Timings = None,
+    viirs_all: list[GranuleFiles] | None = None,
+    should_stop: StopCheck = None,
     inputs: GranuleInputs | None = None,
 ) -> GranuleSamples:
     """Collocate every FOV of one CrIS granule for every perturbation with its VIIRS cover.
@@ -321,7 +347,7 @@ def collocate_granule(
     )
 
 
-def _cris_geometry(geo):
+def _cris_geometry(geo: CrisGeoGranule) -> tuple[FovGeometry, np.ndarray, dict]:
     """Inverse geolocation of a CrIS GEO granule, with fill FOVs given harmless values and masked."""
     valid = geo.valid
     fill = {
@@ -330,7 +356,16 @@ def _cris_geometry(geo):
     return granule_geometry(geo), valid, fill
 
 
-def _collocate_fors(pieces, geo, fg, valid, fill, cfg: AssessmentConfig, band, should_stop=None):
+def _collocate_fors(
+    pieces: swath.ViirsSwath,
+    geo: CrisGeoGranule,
+    fg: FovGeometry,
+    valid: np.ndarray,
+    fill: dict,
+    cfg: AssessmentConfig,
+    band: I5Band,
+    should_stop: StopCheck = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone, the worst coverage per FOV (of the outermost
     disc), and with the footprint kernel the radiance per annulus (nscan, 30, 9, K, m, m), else None (all
     FOVs of the granule in one call of the parallel kernel)."""
@@ -358,7 +393,9 @@ def _collocate_fors(pieces, geo, fg, valid, fill, cfg: AssessmentConfig, band, s
     return bt_viirs, coverage, annuli
 
 
-def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
+def _ground_km(
+    samples: list[GranuleSamples], k: int, d_alpha: float, d_beta: float
+) -> tuple[float, float, np.ndarray]:
     """Mean in-track/cross-track km of a turn (rad) at FOR k over the FOV-5 views used, and the Jacobian."""
     sel = [
         (s.sat_m[:, k], s.sbf_to_ecef[:, k], s.alpha_rad[:, k], s.beta_rad[:, k], s.velocity_m_s[:, k])
@@ -378,7 +415,9 @@ def _ground_km(samples: list[GranuleSamples], k: int, d_alpha, d_beta):
     return float(np.mean(it)), float(np.mean(ct)), jac
 
 
-def for_samples(samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, band=None) -> ForSamples:
+def for_samples(
+    samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, band: I5Band | None = None
+) -> ForSamples:
     """The estimator's input for FOR k (0-based): every usable FOV of it over the granules (*band*, the
     satellite's I5 band, for the footprint kernel)."""
     m = len(offsets_rad(cfg))
@@ -405,7 +444,10 @@ def for_samples(samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, ba
 
 
 def cost_and_offsets(
-    samples: list[GranuleSamples], cfg: AssessmentConfig, skipped=None, satellite=""
+    samples: list[GranuleSamples],
+    cfg: AssessmentConfig,
+    skipped: Sequence[tuple[str, str]] | None = None,
+    satellite: str = "",
 ) -> AssessmentResult:
     """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*."""
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
@@ -432,22 +474,22 @@ def cost_and_offsets(
 
 
 def _collocate_run(
-    cris: list,
-    viirs: dict,
-    viirs_all: list,
+    cris: list[GranuleFiles],
+    viirs: dict[str, list[GranuleFiles]],
+    viirs_all: list[GranuleFiles],
     satellite: str,
     cfg: AssessmentConfig,
-    progress=None,
-    should_stop=None,
-    timings=None,
-):
+    progress: Progress = None,
+    should_stop: StopCheck = None,
+    timings: Timings = None,
+) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
     """Collocate a time-ordered run of CrIS granules; returns (samples, skipped)."""
     band = i5_band(satellite)
     cache = _SwathCache(spans=_scan_spans(cris, viirs))
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
-    def read_ahead(i):
+    def read_ahead(i: int) -> cf.Future[GranuleInputs]:
         """Read granule i's inputs (and compute its CrIS geometry) in the background while granule i - 1
         is computed (h5py, numpy and the compiled kernels release the interpreter to each other)."""
         prepared = set(cache.pieces) | ({v.key for v in viirs[cris[i - 1].key]} if i else set())
@@ -499,9 +541,9 @@ def _collocate_run(
 def assess_plan(
     case: CasePlan,
     cfg: AssessmentConfig | None = None,
-    progress=None,
-    should_stop=None,
-    timings=None,
+    progress: Progress = None,
+    should_stop: StopCheck = None,
+    timings: Timings = None,
     workers: int = 1,
 ) -> AssessmentResult:
     """Assess every CrIS granule of *case*; granules that fail are skipped with their reason. Fewer usable
@@ -534,7 +576,10 @@ def assess_plan(
 
 
 def assess_paths(
-    paths, cfg: AssessmentConfig | None = None, progress=None, workers: int = 1
+    paths: Iterable[str | Path],
+    cfg: AssessmentConfig | None = None,
+    progress: Progress = None,
+    workers: int = 1,
 ) -> AssessmentResult:
     """Find, pair and assess the granules under *paths* (files or directories)."""
     return assess_plan(plan(paths), cfg, progress, workers=workers)

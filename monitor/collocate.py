@@ -62,20 +62,27 @@ VIEW_MARGIN_RAD = math.radians(0.5)
 SCAN_TIME_MARGIN_US = 16_000_000
 
 
-def reach_rad(offsets_rad, radii_rad=TOP_HAT) -> float:
+def reach_rad(offsets_rad: np.ndarray, radii_rad: tuple[float, ...] = TOP_HAT) -> float:
     """The angle (rad) from a FOV's LOS within which one of its perturbed discs (*offsets_rad*, the
     perturbation grid; *radii_rad*, the discs' half-angles) can hold a pixel."""
     return max(radii_rad) + float(np.abs(offsets_rad).max()) * math.sqrt(2.0) * 1.02
 
 
-def los_ecef(sbf_to_ecef, alpha_rad, beta_rad) -> np.ndarray:
+def los_ecef(sbf_to_ecef: np.ndarray, alpha_rad: np.ndarray, beta_rad: np.ndarray) -> np.ndarray:
     """Unit LOS (F, 3) in ECEF of FOVs at SBF angles alpha_rad, beta_rad (F,) (equations 1-2)."""
     t = np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(np.shape(alpha_rad))], -1)
     los = np.einsum("fij,fj->fi", sbf_to_ecef, t)
     return los / np.linalg.norm(los, axis=-1, keepdims=True)
 
 
-def view_reach_rad(sat_m, sbf_to_ecef, alpha_rad, beta_rad, offsets_rad, radii_rad=TOP_HAT) -> float:
+def view_reach_rad(
+    sat_m: np.ndarray,
+    sbf_to_ecef: np.ndarray,
+    alpha_rad: np.ndarray,
+    beta_rad: np.ndarray,
+    offsets_rad: np.ndarray,
+    radii_rad: tuple[float, ...] = TOP_HAT,
+) -> float:
     """The farthest angle from the geocentric nadir (rad) that a perturbed cone of these FOVs reaches,
     plus VIEW_MARGIN_RAD: the VIIRS columns beyond it need no preparation (:func:`swath.view_columns`).
     NaN FOVs are ignored; pi when there is none."""
@@ -87,7 +94,9 @@ def view_reach_rad(sat_m, sbf_to_ecef, alpha_rad, beta_rad, offsets_rad, radii_r
     return float(np.nanmax(off)) + reach_rad(offsets_rad, radii_rad) + VIEW_MARGIN_RAD
 
 
-def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
+def _window_half_sizes(
+    piece: SwathPiece, col0: np.ndarray, range_m: np.ndarray, cos_zen: np.ndarray, rho: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Row and column half-widths (pixels) of the search window around each FOV centre pixel.
 
     The centre is the pixel nearest the LOS's ellipsoid point; pixels on terrain of height h meet the
@@ -106,7 +115,7 @@ def _window_half_sizes(piece: SwathPiece, col0, range_m, cos_zen, rho):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _nearest_index(t, guess0, guess_scale, m):
+def _nearest_index(t: float, guess0: float, guess_scale: float, m: int) -> int:
     """The j nearest t on the chord through (tan B_0, 0) and (tan B_{m-1}, m - 1), clipped to 0..m
     (0 for NaN)."""
     g = (t - guess0) * guess_scale + 0.5
@@ -115,7 +124,15 @@ def _nearest_index(t, guess0, guess_scale, m):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after):
+def _run_ends(
+    tan_b_inf: np.ndarray,
+    t_lo: np.ndarray,
+    t_hi: np.ndarray,
+    guess0: float,
+    guess_scale: float,
+    j_first: np.ndarray,
+    j_after: np.ndarray,
+) -> None:
     """The run of j with t_lo <= tan B_j <= t_hi in each row: its first j and the j after its last
     (j_first >= j_after: empty, as for a NaN interval). *tan_b_inf* is tan B_0 .. tan B_{m-1}, +inf.
 
@@ -135,9 +152,26 @@ def _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after):
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _accumulate(
-    ecef, radiance, area, block_centre, block_radius, sat, mat, los0, reach0, tan_a, tan_b, box,
-    block_row, block_col, half_brows, half_bcols, ring_g2, order, acc,
-):  # fmt: skip
+    ecef: np.ndarray,
+    radiance: np.ndarray,
+    area: np.ndarray,
+    block_centre: np.ndarray,
+    block_radius: np.ndarray,
+    sat: np.ndarray,
+    mat: np.ndarray,
+    los0: np.ndarray,
+    reach0: float,
+    tan_a: np.ndarray,
+    tan_b: np.ndarray,
+    box: np.ndarray,
+    block_row: np.ndarray,
+    block_col: np.ndarray,
+    half_brows: np.ndarray,
+    half_bcols: np.ndarray,
+    ring_g2: np.ndarray,
+    order: np.ndarray,
+    acc: np.ndarray,
+) -> None:
     """Add the pixels of one prepared granule to each FOV's cone sums (difference arrays along j).
 
     Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*; *reach0* the angle (rad)
@@ -235,7 +269,7 @@ def _accumulate(
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _finish(acc, solid, sums, weights):
+def _finish(acc: np.ndarray, solid: np.ndarray, sums: np.ndarray, weights: np.ndarray) -> None:
     """Each FOV's disc sums from its difference arrays acc (F, discs, m, m + 1) complex: the running sums
     along j give weight x radiance (real, into *sums*) and weight (imaginary, into *weights*); a weight
     below 1e-9 of the disc's *solid* angle (discs,) is what rounding leaves of the runs that passed an empty
@@ -287,14 +321,14 @@ class ConeSums:
 
 def cone_sums(
     swath: ViirsSwath,
-    sat_m,
-    sbf_to_ecef,
-    alpha_rad,
-    beta_rad,
-    offsets_rad,
-    radii_rad=TOP_HAT,
-    fov_range_m=None,
-    fov_cos_zen=None,
+    sat_m: np.ndarray,
+    sbf_to_ecef: np.ndarray,
+    alpha_rad: np.ndarray,
+    beta_rad: np.ndarray,
+    offsets_rad: np.ndarray,
+    radii_rad: tuple[float, ...] = TOP_HAT,
+    fov_range_m: np.ndarray | None = None,
+    fov_cos_zen: np.ndarray | None = None,
 ) -> ConeSums:
     """Weighted VIIRS radiance sums in nested discs about every perturbed LOS of a batch of FOVs.
 

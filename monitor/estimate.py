@@ -123,7 +123,7 @@ class ForEstimate:
     footprint: Footprint | None = None
 
 
-def _stdev(d, weights=None):
+def _stdev(d: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
     """STDEV over samples (axis 0 of d, (N, m, m)); with *weights* (B, N) one surface per row (B, m, m)."""
     n, m = d.shape[0], d.shape[1]
     flat = d.reshape(n, -1)
@@ -136,14 +136,14 @@ def _stdev(d, weights=None):
     return np.sqrt(np.maximum(var, 0.0)).reshape(-1, m, m)
 
 
-def calibration_regressors(cris):
+def calibration_regressors(cris: np.ndarray) -> np.ndarray:
     """The regressors of the regression cost (N, 2): the CrIS BT and its square about its mean, so that a
     CrIS-VIIRS difference bias + gain T + curvature T^2 is explained away."""
     c = np.asarray(cris, float) - np.mean(cris)
     return np.stack([c, c * c], axis=1)
 
 
-def _regression_stdev(d, cris, weights=None):
+def _regression_stdev(d: np.ndarray, cris: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
     """The residual STDEV of d (N, m, m) regressed on the CrIS BT *cris* (N,) and its square, per
     perturbation: sqrt(Var d - s_dX S_XX^-1 s_Xd). With d = V - C this is the residual of V - f(C) for the
     best quadratic f at each perturbation, so a CrIS-VIIRS calibration difference up to second order
@@ -167,12 +167,14 @@ def _regression_stdev(d, cris, weights=None):
     return g[0] if weights is None else g
 
 
-def cost_surface(d, cris, cost: Cost, weights=None):
+def cost_surface(
+    d: np.ndarray, cris: np.ndarray, cost: Cost, weights: np.ndarray | None = None
+) -> np.ndarray:
     """The cost over the perturbation grid of one FOR's samples (:class:`~monitor.vocabulary.Cost`)."""
     return _stdev(d, weights) if cost == Cost.STDEV else _regression_stdev(d, cris, weights)
 
 
-def find_minimum(cost, contrast=0.03):
+def find_minimum(cost: np.ndarray, contrast: float = 0.03) -> tuple[float, float, list[str]]:
     """Sub-step minimum (x_i, y_j in grid steps from the centre) of a cost surface, and its flags.
 
     A quadratic surface through the 3x3 neighbourhood of the grid minimum gives the sub-step position
@@ -218,7 +220,7 @@ class _Minimum:
     flags: list[str]
 
 
-def _minimum(d, cris, cost: Cost, contrast: float) -> _Minimum:
+def _minimum(d: np.ndarray, cris: np.ndarray, cost: Cost, contrast: float) -> _Minimum:
     """The minimum of the cost of the differences *d* (N, m, m): on the grid, then refined between grid
     points where the window fits and the surface is neither flat nor edged (:mod:`monitor.refine`)."""
     m = d.shape[1]
@@ -235,7 +237,13 @@ def _minimum(d, cris, cost: Cost, contrast: float) -> _Minimum:
 
 
 def response_weights(
-    annuli_rad, cris_k, at: _Minimum, cost: Cost, radii_rad, band: I5Band, weights=None
+    annuli_rad: np.ndarray,
+    cris_k: np.ndarray,
+    at: _Minimum,
+    cost: Cost,
+    radii_rad: tuple[float, ...],
+    band: I5Band,
+    weights: np.ndarray | None = None,
 ) -> np.ndarray:
     """The annulus weights w (K,), sum 1, that minimise the residual variance w^T M w of the cost's
     difference, BT(sum_k w_k A_k) - C, at the refined optimum *at* (module docstring), for a response that
@@ -286,14 +294,21 @@ def response_weights(
     return w / w.sum()
 
 
-def _with_footprint(s: ForSamples, weights) -> np.ndarray:
+def _with_footprint(s: ForSamples, weights: np.ndarray) -> np.ndarray:
     """The samples' VIIRS - CrIS BT (N, m, m) with V the BT of the annuli weighted by *weights*."""
     assert s.annuli_rad is not None and s.band is not None
     v = np.einsum("nkij,k->nij", s.annuli_rad, weights)
     return (s.band.bt_from_radiance(v) - s.cris_k[:, None, None]).astype(np.float64)
 
 
-def _estimate(s: ForSamples, cost: Cost, contrast: float, counts=None, start=None, start_d=None):
+def _estimate(
+    s: ForSamples,
+    cost: Cost,
+    contrast: float,
+    counts: np.ndarray | None = None,
+    start: np.ndarray | None = None,
+    start_d: np.ndarray | None = None,
+) -> tuple[_Minimum, np.ndarray | None, np.ndarray]:
     """The minimum of the samples (weighted by *counts*, a replicate: the left-out granule's rows dropped)
     and the annulus weights found there (None without annuli or a refined minimum); *start*, weights to
     begin the alternation from (a replicate starts from the day's), and *start_d* the day's surface through
@@ -325,6 +340,7 @@ def _estimate(s: ForSamples, cost: Cost, contrast: float, counts=None, start=Non
             if moved < CONVERGED_STEPS:
                 break
         # the whole surface with the weights found: the grid minimum where it was, or the window moves
+        assert weights is not None  # the alternation ran at least once
         d = _with_footprint(sub, weights)
         moved_to = _minimum(d, c, cost, contrast)
         if not moved_to.refined or (moved_to.i0, moved_to.j0) == (i0, j0):

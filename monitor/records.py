@@ -20,6 +20,31 @@ from monitor.result import RELIABILITY_FLAGS, ForOffset
 from monitor.vocabulary import AlertStatus, Decision, DeliveryStatus, EventKind, RunStatus, Severity
 
 
+class FindingRecord(Protocol):
+    """What the alert ledger records of a rule's finding (:class:`alerts.rules.Finding`, a floor above)."""
+
+    @property
+    def fingerprint(self) -> str: ...
+    @property
+    def rule(self) -> str: ...
+    @property
+    def satellite(self) -> str: ...
+    @property
+    def group(self) -> str: ...
+    @property
+    def severity(self) -> str: ...
+    @property
+    def summary(self) -> str: ...
+    @property
+    def lines(self) -> list: ...
+
+
+class Row(Protocol):
+    """A row of the store (:class:`sqlite3.Row`): its columns by name."""
+
+    def __getitem__(self, key: str, /) -> Any: ...
+
+
 def iso(t: dt.datetime) -> str:
     """*t* as an ISO 8601 UTC string, to the second."""
     return t.astimezone(dt.timezone.utc).isoformat(timespec="seconds")
@@ -43,7 +68,7 @@ class Alert:
     lines: list
 
     @classmethod
-    def from_row(cls, r) -> "Alert":
+    def from_row(cls, r: Row) -> "Alert":
         """The Alert of a row of the store."""
         d = {k: r[k] for k in cls.__dataclass_fields__}
         d["lines"] = json.loads(r["lines"] or "[]")
@@ -64,7 +89,7 @@ class Silence:
     created: str | None
 
     @classmethod
-    def from_row(cls, r) -> "Silence":
+    def from_row(cls, r: Row) -> "Silence":
         """The Silence of a row of the store."""
         return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
@@ -87,7 +112,7 @@ class Delivery:
     sent: str | None
 
     @classmethod
-    def from_row(cls, r) -> "Delivery":
+    def from_row(cls, r: Row) -> "Delivery":
         """The Delivery of a row of the store."""
         d = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(
@@ -112,7 +137,7 @@ class Event:
     detail: dict
 
     @classmethod
-    def from_row(cls, r) -> "Event":
+    def from_row(cls, r: Row) -> "Event":
         """The event of an ``events`` row."""
         try:
             detail = json.loads(r["detail"])
@@ -138,7 +163,7 @@ class Run:
     summary: str | None
 
     @classmethod
-    def from_row(cls, r) -> "Run":
+    def from_row(cls, r: Row) -> "Run":
         """The Run of a row of the store."""
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, "status": RunStatus(row["status"])})
@@ -164,7 +189,7 @@ class ForSeries:
         return self.stored & ~flagged if self.flags.size else self.stored
 
 
-def _json_list(text) -> tuple:
+def _json_list(text: str | None) -> tuple:
     return tuple(json.loads(text)) if text else ()
 
 
@@ -190,7 +215,7 @@ class GranuleRow:
     viirs_software: str | None
 
     @classmethod
-    def from_row(cls, r) -> "GranuleRow":
+    def from_row(cls, r: Row) -> "GranuleRow":
         """The GranuleRow of a row of the store."""
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
@@ -220,7 +245,7 @@ class SelectionRow:
     reason: str | None
 
     @classmethod
-    def from_row(cls, r) -> "SelectionRow":
+    def from_row(cls, r: Row) -> "SelectionRow":
         """The SelectionRow of a row of the store."""
         return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
@@ -231,7 +256,7 @@ class AlertLedger(Protocol):
     def get(self, fingerprint: str) -> Alert | None: ...
     def firing(self, satellite: str | None = None) -> list[Alert]: ...
     def all(self) -> list[Alert]: ...
-    def upsert(self, finding: Any, now: dt.datetime, notified: bool) -> None: ...
+    def upsert(self, finding: FindingRecord, now: dt.datetime, notified: bool) -> None: ...
     def resolve(self, fingerprint: str, now: dt.datetime) -> None: ...
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None: ...
     def silences(self, now: dt.datetime) -> list[Silence]: ...

@@ -24,13 +24,14 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 HALF = 3  # window half-width (grid steps): the search range +-1.5 needs cubic support +-3
 REACH = 1.5  # how far (grid steps) from the grid minimum the refined minimum may lie
 ZOOMS = (0.25, 1.0 / 16.0, 1.0 / 64.0, 1.0 / 256.0, 1.0 / 1024.0)
 
 
-def keys_weights(x):
+def keys_weights(x: ArrayLike) -> np.ndarray:
     """Cubic convolution weights (..., 2 * HALF + 1) on window nodes -HALF..HALF for positions *x*
     (grid steps from the window centre, |x| <= REACH)."""
     x = np.asarray(x, float)
@@ -67,7 +68,9 @@ def refinable(i0: int, j0: int, m: int) -> bool:
     return HALF <= i0 < m - HALF and HALF <= j0 < m - HALF
 
 
-def window_covariance(d, i0: int, j0: int, counts=None, cris=None):
+def window_covariance(
+    d: np.ndarray, i0: int, j0: int, counts: np.ndarray | None = None, cris: np.ndarray | None = None
+) -> np.ndarray:
     """Covariance (49 x 49) over samples of d (N, m, m) in the window around (i0, j0); with bootstrap
     *counts* (B, N) one covariance per replicate (B, 49, 49).
 
@@ -86,7 +89,7 @@ def window_covariance(d, i0: int, j0: int, counts=None, cris=None):
     return joint[..., :nx, :nx] - s_dx @ np.linalg.inv(joint[..., nx:, nx:]) @ np.swapaxes(s_dx, -1, -2)
 
 
-def window_values(d, i0: int, j0: int, x, y):
+def window_values(d: np.ndarray, i0: int, j0: int, x: ArrayLike, y: ArrayLike) -> np.ndarray:
     """The samples' d (N, m, m) interpolated at (x, y) grid steps from the window centre (i0, j0), with the
     weights the minimum was found with: d_n(x, y) = w(x, y)^T d_n, (N,); with *x*, *y* (B,), one row per
     position (B, N)."""
@@ -94,7 +97,7 @@ def window_values(d, i0: int, j0: int, x, y):
     return np.einsum("nab,...a,...b->...n", win, keys_weights(x), keys_weights(y))
 
 
-def _covariance(x, counts=None):
+def _covariance(x: np.ndarray, counts: np.ndarray | None = None) -> np.ndarray:
     """Covariance over samples (rows) of *x* (N, K); with *counts* (B, N) one per replicate (B, K, K)."""
     x = x - x.mean(axis=0)  # centred once: the covariance does not depend on it, rounding does
     if counts is None:
@@ -107,8 +110,8 @@ def _covariance(x, counts=None):
     return (s2 - s1[:, :, None] * s1[:, None, :] / s0[:, None, None]) / np.maximum(s0 - 1, 1)[:, None, None]
 
 
-def refined_minimum(cov):
-    """Position (x, y) in grid steps from the window centre where w^T S w is least, for one covariance
+def refined_minimum(cov: np.ndarray) -> np.ndarray:
+    """Position (x, y) (2,) in grid steps from the window centre where w^T S w is least, for one covariance
     (49, 49) or a stack (B, 49, 49); |x|, |y| <= REACH.
 
     The weights are separable, w = wx (x) wy, so on a grid of positions the quadratic form is contracted

@@ -15,6 +15,7 @@ from importlib import resources
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.errors import DataError
 from monitor.satellites import SATELLITES
@@ -30,7 +31,7 @@ PARALLEL_FROM = 1 << 16  # values converted at once from which the parallel kern
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _interp_one(v, xp, fp, guess):
+def _interp_one(v: float, xp: np.ndarray, fp: np.ndarray, guess: np.ndarray) -> float:
     """``np.interp(v, xp, fp, left=NaN, right=NaN)`` bit for bit (the same slope and fall-backs). *xp*
     ascends; guess[k] is at most the index of the last xp <= v for every v in the k-th of the uniform bins
     between xp[0] and xp[-1], so a few steps find it."""
@@ -53,26 +54,28 @@ def _interp_one(v, xp, fp, guess):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _interp_parallel(x, xp, fp, guess, out):
+def _interp_parallel(
+    x: np.ndarray, xp: np.ndarray, fp: np.ndarray, guess: np.ndarray, out: np.ndarray
+) -> None:
     """:func:`_interp_one` of every value of flat *x* into *out*, in parallel."""
     for i in numba.prange(x.shape[0]):
         out[i] = _interp_one(x[i], xp, fp, guess)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _interp_serial(x, xp, fp, guess, out):
+def _interp_serial(x: np.ndarray, xp: np.ndarray, fp: np.ndarray, guess: np.ndarray, out: np.ndarray) -> None:
     """:func:`_interp_one` of every value of flat *x* into *out*, on the calling thread."""
     for i in range(x.shape[0]):
         out[i] = _interp_one(x[i], xp, fp, guess)
 
 
-def planck_radiance(wavenumber_cm1, t_k):
+def planck_radiance(wavenumber_cm1: ArrayLike, t_k: ArrayLike) -> np.ndarray:
     """Planck radiance mW/(m2 sr cm-1) at *wavenumber_cm1* for temperature *t_k* (broadcast)."""
     nu = np.asarray(wavenumber_cm1, float)
     return C1 * nu**3 / np.expm1(C2 * nu / np.asarray(t_k, float))
 
 
-def load_srf(satellite: str):
+def load_srf(satellite: str) -> tuple[np.ndarray, np.ndarray]:
     """(wavenumber_cm1, response) of the VIIRS I5 band of *satellite* (npp, j01, j02), ascending."""
     name = SRF_FILES.get(satellite)
     if name is None:
@@ -90,7 +93,7 @@ def _read_csv(text: str) -> np.ndarray:
     return np.array([[float(a), float(b)] for a, b in rows[1:]])
 
 
-def apodize_hamming(radiance):
+def apodize_hamming(radiance: ArrayLike) -> np.ndarray:
     """Hamming apodization along the last (channel) axis; the end channels keep their value."""
     r = np.asarray(radiance)
     out = r.copy()
@@ -103,7 +106,7 @@ class I5Band:
 
     T_MIN_K, T_MAX_K, T_STEP_K = 150.0, 350.0, 0.02
 
-    def __init__(self, satellite: str, wavenumber_cm1=None):
+    def __init__(self, satellite: str, wavenumber_cm1: ArrayLike | None = None) -> None:
         self.satellite = satellite
         self.wavenumber_cm1 = (
             cris_lw_wavenumbers_cm1() if wavenumber_cm1 is None else np.asarray(wavenumber_cm1)
@@ -116,20 +119,20 @@ class I5Band:
         edges = np.linspace(self._l[0], self._l[-1], GUESS_BINS + 1)  # one below, for the edge's rounding
         self._guess = np.maximum(np.searchsorted(self._l, edges, "right") - 2, 0)
 
-    def band_radiance(self, spectra):
+    def band_radiance(self, spectra: ArrayLike) -> np.ndarray:
         """Band radiance mW/(m2 sr cm-1) of spectra on the CrIS LW grid (last axis channels)."""
         return np.asarray(spectra) @ self.weights
 
-    def cris_band_radiance(self, radiance_lw):
+    def cris_band_radiance(self, radiance_lw: ArrayLike) -> np.ndarray:
         """Band radiance of unapodized CrIS LW spectra: Hamming apodization, then the SRF convolution."""
         return self.band_radiance(apodize_hamming(radiance_lw))
 
     @property
-    def radiance_table(self):
+    def radiance_table(self) -> tuple[float, float, np.ndarray]:
         """(first BT K, BT step K, band radiance per BT): the uniform table radiance_from_bt interpolates."""
         return self.T_MIN_K, self.T_STEP_K, self._l
 
-    def radiance_from_bt(self, bt_k):
+    def radiance_from_bt(self, bt_k: ArrayLike) -> np.ndarray:
         """Band radiance of a band brightness temperature (K); NaN outside 150-350 K.
 
         The table is uniform in temperature, so the interpolation is index arithmetic.
@@ -141,7 +144,7 @@ class I5Band:
         w = x - i
         return np.where(ok, self._l[i] * (1 - w) + self._l[i + 1] * w, np.nan)
 
-    def bt_from_radiance(self, radiance):
+    def bt_from_radiance(self, radiance: ArrayLike) -> np.ndarray:
         """Band brightness temperature (K) of a band radiance (float64, the shape of *radiance*); NaN outside
         the table. The table is inverted by linear interpolation (np.interp's numbers, compiled and in
         parallel: an assessment converts ten million cone means)."""

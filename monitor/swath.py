@@ -33,9 +33,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.ndimage import minimum_filter1d
 from scipy.spatial import cKDTree
 
@@ -44,6 +46,17 @@ from monitor.threads import KERNEL_LOCK
 
 DETECTORS = 32  # VIIRS I-band detectors per scan
 BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
+
+
+class BandTable(Protocol):
+    """The I5 band's Planck table (:class:`monitor.spectral.I5Band`, a neighbour on this floor)."""
+
+    @property
+    def radiance_table(self) -> tuple[float, float, np.ndarray]:
+        """(first BT K, BT step K, band radiance per BT)."""
+        ...
+
+
 # the passes' threads take scans one at a time as they come free, not in equal shares fixed in advance:
 # the read-ahead thread takes turns on the cores, and a share fixed in advance waits for the slowest
 SCANS_PER_TASK = 1
@@ -83,15 +96,15 @@ class SwathPiece:
     span_us: tuple = (-math.inf, math.inf)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, int]:
         """(rows, columns) of the prepared piece."""
         return self.radiance.shape
 
-    def covers(self, t0_us, t1_us) -> bool:
+    def covers(self, t0_us: float, t1_us: float) -> bool:
         """Whether the piece holds every scan observed between IET t0_us and t1_us."""
         return self.span_us[0] <= t0_us and t1_us < self.span_us[1]
 
-    def nearest(self, points_m):
+    def nearest(self, points_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point,
         and that distance (m)."""
         dist, idx = self.tree.query(points_m)
@@ -109,7 +122,7 @@ class ViirsSwath:
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _ecef(lat, lon, h, out):
+def _ecef(lat: np.ndarray, lon: np.ndarray, h: np.ndarray, out: np.ndarray) -> None:
     """WGS84 geodetic (rad, rad, m; float32 arrays) to ECEF float32 *out* (..., 3): wgs84.geodetic_to_ecef."""
     rows, cols = lat.shape
     for r in range(rows):
@@ -126,7 +139,7 @@ def _ecef(lat, lon, h, out):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _scan_ends(scan, first, last, step):
+def _scan_ends(scan: np.ndarray, first: np.ndarray, last: np.ndarray, step: np.ndarray) -> None:
     """First and last valid detector positions (float64 (cols, 3), NaN where the column has none) of one
     scan (32, cols, 3) and the detector step between them (m)."""
     for c in range(scan.shape[1]):
@@ -151,7 +164,22 @@ def _scan_ends(scan, first, last, step):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _locate_scan(k, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step):
+def _locate_scan(
+    k: int,
+    lat: np.ndarray,
+    lon: np.ndarray,
+    h: np.ndarray,
+    bt: np.ndarray,
+    good: np.ndarray,
+    table: np.ndarray,
+    t_min_k: float,
+    t_step_k: float,
+    pos: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+) -> None:
     """Pass 1 for scan k: pixel points, band radiance from BT (linear in the uniform BT table, NaN outside
     it or where not *good*), and the scan's ends (slot k + 1; 0 and nscan + 1 are the halos)."""
     cols = lat.shape[1]
@@ -171,14 +199,28 @@ def _locate_scan(k, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radian
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _locate(lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step):
+def _locate(
+    lat: np.ndarray,
+    lon: np.ndarray,
+    h: np.ndarray,
+    bt: np.ndarray,
+    good: np.ndarray,
+    table: np.ndarray,
+    t_min_k: float,
+    t_step_k: float,
+    pos: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+) -> None:
     """Pass 1 (:func:`_locate_scan`), scans in parallel."""
     for k in numba.prange(lat.shape[0] // DETECTORS):
         _locate_scan(k, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _centred(here, nxt, prv):
+def _centred(here: float, nxt: float, prv: float) -> float:
     """Half the difference of a pixel's two neighbours *nxt* and *prv* (one coordinate, m), one-sided
     where one is missing (NaN)."""
     fwd = nxt - here
@@ -188,7 +230,9 @@ def _centred(here, nxt, prv):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _scan_frame(first, last, step, have, k, c, out):
+def _scan_frame(
+    first: np.ndarray, last: np.ndarray, step: np.ndarray, have: np.ndarray, k: int, c: int, out: np.ndarray
+) -> None:
     """The along-track frame of column c of scan slot k, for :func:`_share`: the unit vector u from its
     first to its last valid detector, u . first, half a detector step, and the spans along u (plus half
     a step each side) of the neighbouring scans' columns, (+inf, -inf) where there is none."""
@@ -210,7 +254,7 @@ def _scan_frame(first, last, step, have, k, c, out):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _share(p0, p1, p2, frames, c):
+def _share(p0: float, p1: float, p2: float, frames: np.ndarray, c: int) -> float:
     """The share (0.5..1) of the footprint of the pixel at (p0, p1, p2) (ECEF m) in column c that is its
     own, in its column's frame (frames[:, c], :func:`_scan_frame`).
 
@@ -228,7 +272,7 @@ def _share(p0, p1, p2, frames, c):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _load_row(pos, r, inside, out):
+def _load_row(pos: np.ndarray, r: int, inside: bool, out: np.ndarray) -> None:
     """Row r of *pos* (cols, 3) into out (3, cols + 2) as float64, one coordinate per line, with a NaN
     column at each end; all NaN when the row is not *inside* the scan."""
     if not inside:
@@ -242,7 +286,20 @@ def _load_row(pos, r, inside, out):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top):
+def _weigh_scan(
+    k: int,
+    pos: np.ndarray,
+    h: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+    have: np.ndarray,
+    area: np.ndarray,
+    centre: np.ndarray,
+    radius: np.ndarray,
+    top: np.ndarray,
+) -> None:
     """Pass 2 for scan k: vector footprints with the scan overlap removed, radiance NaN where either is
     unusable, the bounding sphere (centre, radius + 1 m for the float32 rounding) of each block's usable
     pixels (NaN where it has none), and the height of the scan's highest usable pixel (top[k], m).
@@ -307,13 +364,25 @@ def _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radi
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _weigh(pos, h, radiance, first, last, step, have, area, centre, radius, top):
+def _weigh(
+    pos: np.ndarray,
+    h: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+    have: np.ndarray,
+    area: np.ndarray,
+    centre: np.ndarray,
+    radius: np.ndarray,
+    top: np.ndarray,
+) -> None:
     """Pass 2 (:func:`_weigh_scan`), scans in parallel."""
     for k in numba.prange(radiance.shape[0] // DETECTORS):
         _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
 
-def _np_half_diff(p, axis):
+def _np_half_diff(p: np.ndarray, axis: int) -> np.ndarray:
     """Half the difference of the two neighbours along *axis* (numpy), one-sided where one is missing."""
     fwd = np.full_like(p, np.nan)
     bwd = np.full_like(p, np.nan)
@@ -326,13 +395,15 @@ def _np_half_diff(p, axis):
     return np.where(np.isfinite(both), both, np.where(np.isfinite(fwd), fwd, bwd))
 
 
-def _fill_nan(a):
+def _fill_nan(a: ArrayLike) -> np.ndarray:
     a = np.asarray(a, float)
     ok = np.isfinite(a)
     return np.interp(np.arange(len(a)), np.nonzero(ok)[0], a[ok]) if not ok.all() else a
 
 
-def view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad) -> slice:
+def view_columns(
+    lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray, sat_m: np.ndarray, view_rad: float
+) -> slice:
     """The columns holding every pixel seen within *view_rad* of nadir, judged on the middle detector row
     of every fourth scan and the last from that scan's spacecraft position *sat_m* (nscan, 3; ECEF m; NaN
     ignored): a column's view angle changes little from scan to scan.
@@ -352,7 +423,7 @@ def view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad) -> slice:
     return slice(int(cols[0]) // BLOCK_PX * BLOCK_PX, int(cols[-1]) + 1) if cols.size else slice(None)
 
 
-def scans_between(scan_start_us, t0_us, t1_us) -> slice:
+def scans_between(scan_start_us: ArrayLike, t0_us: float, t1_us: float) -> slice:
     """The scans observed between IET t0_us and t1_us, from the scans' start times *scan_start_us* (IET
     us; a scan lasts until the next starts, the last to the granule's end): all scans when those times are
     not all set and increasing (nothing to judge by)."""
@@ -365,18 +436,18 @@ def scans_between(scan_start_us, t0_us, t1_us) -> slice:
 
 
 def swath_piece(
-    lat_rad,
-    lon_rad,
-    height_m,
-    bt_k,
-    good,
-    band,
-    before=None,
-    after=None,
-    sat_m=None,
-    view_rad=math.inf,
-    scan_start_us=None,
-    span_us=None,
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    bt_k: np.ndarray,
+    good: np.ndarray,
+    band: BandTable,
+    before: tuple[np.ndarray, ...] | None = None,
+    after: tuple[np.ndarray, ...] | None = None,
+    sat_m: np.ndarray | None = None,
+    view_rad: float = math.inf,
+    scan_start_us: np.ndarray | None = None,
+    span_us: tuple[float, float] | None = None,
 ) -> SwathPiece:
     """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
 
@@ -393,7 +464,7 @@ def swath_piece(
     scans = slice(None)
     if scan_start_us is not None and span_us is not None:
         scans = scans_between(scan_start_us, *span_us)
-    if scans != slice(None):
+    if scans != slice(None) and scan_start_us is not None:
         first, stop, _ = scans.indices(len(scan_start_us))
         r0, r1 = first * DETECTORS, stop * DETECTORS
         geo = (lat_rad, lon_rad, height_m)

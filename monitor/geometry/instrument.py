@@ -24,6 +24,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.constants import N_FOR, N_FOV
 from monitor.errors import DataError
@@ -59,7 +60,7 @@ class EngineeringPacket:
     time_stamp_bias_ms: float = 0.0
     provenance: dict = field(default_factory=dict)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name, n in (
             ("fov_crosstrack_offset_rad", N_FOV),
             ("fov_intrack_offset_rad", N_FOV),
@@ -82,7 +83,13 @@ class EngineeringPacket:
             if not np.isfinite(float(getattr(self, name))):
                 raise DataError(f"EP {self.version}: {name} is not finite")
 
-    def with_ssm_angles(self, crosstrack_roll_rad, intrack_pitch_rad, version=None, provenance=None):
+    def with_ssm_angles(
+        self,
+        crosstrack_roll_rad: ArrayLike,
+        intrack_pitch_rad: ArrayLike,
+        version: str | None = None,
+        provenance: dict | None = None,
+    ) -> EngineeringPacket:
         """A copy with the 2 x 30 scene-mirror angles replaced (the only angles the optimiser changes)."""
         return dataclasses.replace(
             self,
@@ -93,7 +100,7 @@ class EngineeringPacket:
         )
 
 
-def attitude_matrix(roll_rad, pitch_rad, yaw_rad):
+def attitude_matrix(roll_rad: ArrayLike, pitch_rad: ArrayLike, yaw_rad: ArrayLike) -> np.ndarray:
     """T = R_x(roll) P_y(pitch) Y_z(yaw), equation (10): the mapping-angle transformation."""
     return rot_x(roll_rad) @ rot_y(pitch_rad) @ rot_z(yaw_rad)
 
@@ -116,7 +123,7 @@ def fov_los_ssmf(ep: EngineeringPacket) -> np.ndarray:
     return fov_los_ioar(ep) @ ioar_to_ssmf(ep).T
 
 
-def mirror_normal(crosstrack_roll_rad, intrack_pitch_rad) -> np.ndarray:
+def mirror_normal(crosstrack_roll_rad: ArrayLike, intrack_pitch_rad: ArrayLike) -> np.ndarray:
     """Unit scene-mirror normal (..., 3) in the SSMF, equation (15): P(pitch) R(roll) [-1, 0, 1]/sqrt(2)."""
     return np.einsum(
         "...ij,...jk,k->...i",
@@ -126,7 +133,7 @@ def mirror_normal(crosstrack_roll_rad, intrack_pitch_rad) -> np.ndarray:
     )
 
 
-def ssm_angles_from_normal(normal):
+def ssm_angles_from_normal(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(crosstrack_roll_rad, intrack_pitch_rad) of a mirror normal: the exact inverse of equation (15).
 
     With v = R(roll) n0 = (-1, -sin roll, cos roll)/sqrt(2), n_y = -sin(roll)/sqrt(2) gives the roll,
@@ -138,7 +145,7 @@ def ssm_angles_from_normal(normal):
     return roll, (pitch + np.pi) % (2 * np.pi) - np.pi
 
 
-def reflect(los, normal) -> np.ndarray:
+def reflect(los: np.ndarray, normal: np.ndarray) -> np.ndarray:
     """LOS reflected on a mirror of unit *normal*, equation (16): l - 2 (l . n) n."""
     return los - 2.0 * np.sum(los * normal, axis=-1, keepdims=True) * normal
 
@@ -172,7 +179,9 @@ def los_spacecraft(ep: EngineeringPacket) -> np.ndarray:
     return los_ep_sbf(ep) @ ep_sbf_to_spacecraft(ep).T
 
 
-def ssm_angles_for_los(ep: EngineeringPacket, target_los_spacecraft) -> tuple[np.ndarray, np.ndarray]:
+def ssm_angles_for_los(
+    ep: EngineeringPacket, target_los_spacecraft: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Scene-mirror angles (roll, pitch) (30,) that point FOV 5 of each FOR along *target_los_spacecraft*.
 
     Equations (22)-(23): the target goes back to the SSMF, the mirror normal is the unit difference of
@@ -189,7 +198,9 @@ def ssm_angles_for_los(ep: EngineeringPacket, target_los_spacecraft) -> tuple[np
     return ssm_angles_from_normal(normal)
 
 
-def corrected_ssm_angles(ep: EngineeringPacket, d_alpha_rad, d_beta_rad):
+def corrected_ssm_angles(
+    ep: EngineeringPacket, d_alpha_rad: ArrayLike, d_beta_rad: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """New scene-mirror angles from assessed LOS offsets, equations (19)-(23).
 
     alpha'_k = alpha_k + d_alpha_k and beta'_k = beta_k + d_beta_k for the FOV-5 LOS of *ep* in the
@@ -201,6 +212,6 @@ def corrected_ssm_angles(ep: EngineeringPacket, d_alpha_rad, d_beta_rad):
     return ssm_angles_for_los(ep, target)
 
 
-def fov5_angles(ep: EngineeringPacket):
+def fov5_angles(ep: EngineeringPacket) -> tuple[np.ndarray, np.ndarray]:
     """(alpha_rad, beta_rad) (30,) of the FOV-5 LOS of each FOR in the spacecraft frame."""
     return los_angles(los_spacecraft(ep)[:, FOV5])

@@ -7,8 +7,10 @@ Wang et al. 2017, section 2.2, steps 1-6 (with the ECI detour replaced by the in
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.geometry import frames, orbit, wgs84
 
@@ -36,7 +38,9 @@ class FovGeometry:
     beta_rad: np.ndarray
 
 
-def satellite_from_fov(lat_rad, lon_rad, zenith_rad, azimuth_rad, range_m):
+def satellite_from_fov(
+    lat_rad: ArrayLike, lon_rad: ArrayLike, zenith_rad: ArrayLike, azimuth_rad: ArrayLike, range_m: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """Ground point (h = 0) and satellite position implied by a FOV's geometry, both ECEF metres.
 
     Steps 1-2 of section 2.2: the ENU unit vector toward the satellite from zenith/azimuth, rotated to
@@ -48,16 +52,16 @@ def satellite_from_fov(lat_rad, lon_rad, zenith_rad, azimuth_rad, range_m):
 
 
 def inverse_geolocation(
-    lat_rad,
-    lon_rad,
-    zenith_rad,
-    azimuth_rad,
-    range_m,
-    for_time_us,
-    mid_time_us,
-    sc_position_m,
-    sc_velocity_m_s,
-    sc_attitude_rad,
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    zenith_rad: np.ndarray,
+    azimuth_rad: np.ndarray,
+    range_m: np.ndarray,
+    for_time_us: np.ndarray,
+    mid_time_us: np.ndarray,
+    sc_position_m: np.ndarray,
+    sc_velocity_m_s: np.ndarray,
+    sc_attitude_rad: np.ndarray,
 ) -> FovGeometry:
     """LOS of each FOV in the SBF from the GEO fields (section 2.2).
 
@@ -78,7 +82,9 @@ def inverse_geolocation(
     return FovGeometry(ground, sat, los_ecef, vel, to_ecef, los_sbf, alpha, beta)
 
 
-def forward_geolocation(sat_ecef_m, sbf_to_ecef, los_sbf, h_m=0.0):
+def forward_geolocation(
+    sat_ecef_m: np.ndarray, sbf_to_ecef: np.ndarray, los_sbf: np.ndarray, h_m: ArrayLike = 0.0
+) -> np.ndarray:
     """Ground point (ECEF metres) where an SBF line of sight from *sat_ecef_m* meets the ellipsoid.
 
     The SBF -> OCS -> ECEF path of section 2.4; NaN where the LOS misses the Earth.
@@ -88,13 +94,44 @@ def forward_geolocation(sat_ecef_m, sbf_to_ecef, los_sbf, h_m=0.0):
     return np.asarray(sat_ecef_m) + t[..., None] * los_ecef
 
 
-def granule_geometry(geo):
+class CrisGeoFields(Protocol):
+    """What :func:`granule_geometry` reads of a CrIS GEO granule (:class:`monitor.sdr.CrisGeoGranule`,
+    a floor above): per FOV (scan, FOR, FOV) unless said."""
+
+    @property
+    def valid(self) -> np.ndarray: ...
+    @property
+    def lat_rad(self) -> np.ndarray: ...
+    @property
+    def lon_rad(self) -> np.ndarray: ...
+    @property
+    def zenith_rad(self) -> np.ndarray: ...
+    @property
+    def azimuth_rad(self) -> np.ndarray: ...
+    @property
+    def range_m(self) -> np.ndarray: ...
+    @property
+    def for_time_us(self) -> np.ndarray: ...
+    @property
+    def mid_time_us(self) -> np.ndarray: ...
+    @property
+    def sc_position_m(self) -> np.ndarray: ...
+    @property
+    def sc_velocity_m_s(self) -> np.ndarray: ...
+    @property
+    def sc_attitude_rad(self) -> np.ndarray: ...
+
+
+def granule_geometry(geo: CrisGeoFields) -> FovGeometry:
     """The inverse geolocation of a CrIS GEO granule (:class:`monitor.sdr.CrisGeoGranule`): its fields in,
     fill FOVs given harmless values (a ground point at 0, 0 and a range of 1000 km) so that the arrays stay
     finite; mask the result with ``geo.valid``."""
     valid = geo.valid
     return inverse_geolocation(
-        *(np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")),
+        np.where(valid, geo.lat_rad, 0.0),
+        np.where(valid, geo.lon_rad, 0.0),
+        np.where(valid, geo.zenith_rad, 0.0),
+        np.where(valid, geo.azimuth_rad, 0.0),
         np.where(valid, geo.range_m, 1e6),
         geo.for_time_us,
         geo.mid_time_us,

@@ -7,6 +7,7 @@ in radians.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 A_M = 6378137.0  # WGS84 equatorial radius
 F = 1.0 / 298.257223563  # WGS84 flattening
@@ -17,7 +18,7 @@ GM_M3_S2 = 3.986004418e14  # WGS84 gravitational parameter
 J2 = 1.08262668e-3  # EGM96 second zonal harmonic
 
 
-def geodetic_to_ecef(lat_rad, lon_rad, h_m=0.0):
+def geodetic_to_ecef(lat_rad: ArrayLike, lon_rad: ArrayLike, h_m: ArrayLike = 0.0) -> np.ndarray:
     """ECEF position (..., 3) in metres of geodetic *lat_rad*, *lon_rad* and ellipsoidal height *h_m*."""
     lat, lon, h = np.broadcast_arrays(
         np.asarray(lat_rad, float), np.asarray(lon_rad, float), np.asarray(h_m, float)
@@ -32,7 +33,7 @@ def geodetic_to_ecef(lat_rad, lon_rad, h_m=0.0):
     return out
 
 
-def ecef_to_geodetic(xyz_m, iterations=5):
+def ecef_to_geodetic(xyz_m: ArrayLike, iterations: int = 5) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Geodetic (lat_rad, lon_rad, h_m) of ECEF points (..., 3); Bowring's iteration, converged to < 1 mm
     (5 iterations hold from the ground to orbit; 2 are enough within ~10 km of the ellipsoid)."""
     xyz = np.asarray(xyz_m, float)
@@ -51,7 +52,7 @@ def ecef_to_geodetic(xyz_m, iterations=5):
     return lat, lon, h
 
 
-def surface_to_geodetic(xyz_m):
+def surface_to_geodetic(xyz_m: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Geodetic (lat_rad, lon_rad) of ECEF points on the ellipsoid (h = 0), where the normal's slope is
     closed-form: tan(lat) = z / ((1 - e^2) p), p = sqrt(x^2 + y^2); no iteration."""
     xyz = np.asarray(xyz_m, float)
@@ -59,7 +60,7 @@ def surface_to_geodetic(xyz_m):
     return np.arctan2(z, np.hypot(x, y) * (1.0 - E2)), np.arctan2(y, x)
 
 
-def enu_basis(lat_rad, lon_rad):
+def enu_basis(lat_rad: ArrayLike, lon_rad: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unit vectors east, north, up (each (..., 3), ECEF) at geodetic *lat_rad*, *lon_rad*."""
     lat = np.asarray(lat_rad, float)
     lon = np.asarray(lon_rad, float)
@@ -70,7 +71,9 @@ def enu_basis(lat_rad, lon_rad):
     return east, north, up
 
 
-def look_vector_ecef(lat_rad, lon_rad, zenith_rad, azimuth_rad):
+def look_vector_ecef(
+    lat_rad: ArrayLike, lon_rad: ArrayLike, zenith_rad: ArrayLike, azimuth_rad: ArrayLike
+) -> np.ndarray:
     """Unit vector (..., 3, ECEF) from a ground point toward the satellite.
 
     *zenith_rad* is the satellite zenith angle at the ground point and *azimuth_rad* its azimuth,
@@ -85,7 +88,9 @@ def look_vector_ecef(lat_rad, lon_rad, zenith_rad, azimuth_rad):
     )
 
 
-def zenith_azimuth(ground_ecef_m, sat_ecef_m):
+def zenith_azimuth(
+    ground_ecef_m: ArrayLike, sat_ecef_m: ArrayLike
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Satellite (zenith_rad, azimuth_rad, range_m) seen from ECEF ground points on the ellipsoid."""
     lat, lon, _ = ecef_to_geodetic(ground_ecef_m)
     east, north, up = enu_basis(lat, lon)
@@ -97,7 +102,7 @@ def zenith_azimuth(ground_ecef_m, sat_ecef_m):
     return zen, az, rng
 
 
-def intersect_ellipsoid(origin_m, direction, h_m=0.0):
+def intersect_ellipsoid(origin_m: ArrayLike, direction: ArrayLike, h_m: ArrayLike = 0.0) -> np.ndarray:
     """Distance along unit *direction* from ECEF *origin_m* to the first crossing of the ellipsoid.
 
     The ellipsoid is WGS84 grown by *h_m* on both axes (exact for h_m = 0, the IDPS convention).
@@ -117,7 +122,7 @@ def intersect_ellipsoid(origin_m, direction, h_m=0.0):
     return np.where((disc >= 0) & (t > 0), t, np.nan)
 
 
-def geodetic_up(xyz_m):
+def geodetic_up(xyz_m: ArrayLike) -> np.ndarray:
     """Unit normal to the ellipsoid (..., 3) at (or below) ECEF points, i.e. geodetic up."""
     lat, lon, _ = ecef_to_geodetic(xyz_m)
     return enu_basis(lat, lon)[2]

@@ -16,10 +16,13 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import os
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.constants import (
     CALIBRATION_CURVATURE_SPAN_K,
@@ -124,7 +127,7 @@ class SimulationSpec:
             + self.cris_nonlinear_k * (x / CALIBRATION_CURVATURE_SPAN_K) ** 2
         )
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         if self.orbit_pass is not None and self.orbit_pass not in PASSES:
             raise DataError(f"orbit pass {self.orbit_pass!r} is not one of {', '.join(PASSES)}")
         if isinstance(self.cris_response, tuple) and len(self.cris_response) != N_FOV:
@@ -133,7 +136,7 @@ class SimulationSpec:
             raise DataError("a pass longitude needs an orbit pass")
         if (self.true_ep is None) != (self.ground_ep is None):
             raise DataError("a simulation in EP terms needs both the true EP and the ground-processing EP")
-        if self.true_ep is not None:
+        if self.true_ep is not None and self.ground_ep is not None:
             for ep in (self.true_ep, self.ground_ep):
                 if ep.satellite != self.satellite:
                     raise DataError(
@@ -142,7 +145,9 @@ class SimulationSpec:
             self.d_alpha_urad, self.d_beta_urad = ep_offsets_urad(self.true_ep, self.ground_ep)
 
 
-def ep_offsets_urad(true_ep: EngineeringPacket, ground_ep: EngineeringPacket):
+def ep_offsets_urad(
+    true_ep: EngineeringPacket, ground_ep: EngineeringPacket
+) -> tuple[np.ndarray, np.ndarray]:
     """Per-FOR (d_alpha, d_beta) (urad) of FOV 5 from the ground-processing LOS to the true one."""
     a_true, b_true = fov5_angles(true_ep)
     a_geo, b_geo = fov5_angles(ground_ep)
@@ -153,7 +158,7 @@ def _unix_s(when: dt.datetime) -> float:
     return when.timestamp()
 
 
-def _iet_us(unix_s) -> np.ndarray:
+def _iet_us(unix_s: ArrayLike) -> np.ndarray:
     return iet.unix_us_to_iet(np.round(np.asarray(unix_s) * 1e6).astype(np.int64))
 
 
@@ -169,7 +174,7 @@ def _utc(unix_s: float) -> dt.datetime:
 TOP_HAT_CONE = RadialResponse((0.0, ins.CRIS_FOV_HALF_ANGLE_RAD), (1.0, 1.0))
 
 
-def _sunflower_disk(n: int, radius: float):
+def _sunflower_disk(n: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
     """*n* (even) points evenly spread over a disk: a sunflower of n/2 points and its point reflection.
 
     A sunflower alone is off-centre by ~2e-3 of its radius (17 urad for the CrIS cone with 256 points),
@@ -222,14 +227,14 @@ class Simulator:
             self.los_true = ins.cris_los_sbf()
             self.los_geo = ins.cris_los_sbf(-spec.d_alpha_urad * URAD, -spec.d_beta_urad * URAD)
 
-    def attitude_rad(self, unix_s):
+    def attitude_rad(self, unix_s: ArrayLike) -> np.ndarray:
         """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift."""
         t = np.asarray(unix_s, float) - self.t0
         base = np.asarray(self.spec.attitude_arcsec, float)
         drift = 0.1 * np.stack([np.sin(t / 600.0), np.cos(t / 900.0), np.sin(t / 700.0)], -1)
         return (base + drift) * frames.ARCSEC_RAD
 
-    def state(self, unix_s):
+    def state(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Satellite position (m) and velocity (m/s) in ECEF and the SBF-to-ECEF matrix at unix times."""
         r, v = self.orbit.state_ecef(unix_s)
         return r, v, frames.sbf_to_ecef(r, v, self.attitude_rad(unix_s))
@@ -334,14 +339,14 @@ class Simulator:
         return names
 
     @staticmethod
-    def _cris_solar(lat_rad, lon_rad, for_unix) -> dict:
+    def _cris_solar(lat_rad: np.ndarray, lon_rad: np.ndarray, for_unix: np.ndarray) -> dict:
         """GCRSO's solar angles (deg) at each FOV (fill in the reduced files: the monitor never reads
         them)."""
         sun = complete.sun_direction_ecef(for_unix)[..., None, :]
         zen, az, _ = complete.view_angles(lat_rad, lon_rad, 0.0, sun, direction=True)
         return {"SolarZenithAngle": zen.astype(np.float32), "SolarAzimuthAngle": az.astype(np.float32)}
 
-    def _surface(self, origin, los):
+    def _surface(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is
         one."""
         if not self.spec.terrain:
@@ -351,7 +356,7 @@ class Simulator:
         return intersect_terrain(origin, los, self.scene.height_m, MAX_HEIGHT_M)[1:]
 
     @property
-    def _fov_disk(self):
+    def _fov_disk(self) -> tuple[np.ndarray, np.ndarray]:
         """The FOV's sample points (x, y), tangents of the angle from the LOS: CONE_SAMPLES points over the
         top-hat cone, as densely out to the reach of a spatial response."""
         reach = max(self._responses, key=lambda r: r.reach_rad).reach_rad
@@ -375,7 +380,7 @@ class Simulator:
         angle = np.arctan(np.hypot(*self._fov_disk))
         return np.stack([resp(angle) for resp in self._responses])
 
-    def _cris_spectra(self, sat, los_ecef):
+    def _cris_spectra(self, sat: np.ndarray, los_ecef: np.ndarray) -> np.ndarray:
         """LW spectra (nscan, 30, 9, 717) averaged over each true FOV on the scene (the top-hat cone, or
         weighted by the spatial response out to its reach), not the VIIRS grid."""
         weights = self._fov_weights()  # (9, samples)
@@ -405,7 +410,9 @@ class Simulator:
         return radiance.reshape(sat.shape[:-1] + (len(self.nu),))
 
     # ------------------------------------------------------------------ VIIRS
-    def viirs_granule(self, g0: float, out: Path, scans_per_chunk: int = 6, should_stop=None) -> list[str]:
+    def viirs_granule(
+        self, g0: float, out: Path, scans_per_chunk: int = 6, should_stop: Callable[[], bool] | None = None
+    ) -> list[str]:
         """Write the VIIRS I5 granule starting at unix time *g0* (SDR and GEO files) into *out*, a few
         scans at a time (*should_stop* polled between them); the names of the files written."""
         spec = self.spec
@@ -523,7 +530,20 @@ class Simulator:
             names.append(name)
         return names
 
-    def _granule_attrs(self, begin, end, begin_iet, end_iet, gid, nscan, v0, lat, lon, aux, coll):
+    def _granule_attrs(
+        self,
+        begin: float,
+        end: float,
+        begin_iet: int,
+        end_iet: int,
+        gid: str,
+        nscan: int,
+        v0: np.ndarray,
+        lat: np.ndarray,
+        lon: np.ndarray,
+        aux: Sequence[str],
+        coll: str,
+    ) -> dict:
         p = self.spec.satellite
         lat_d, lon_d = np.degrees(lat), np.degrees(lon)
         return {
@@ -562,12 +582,12 @@ class Simulator:
 
 
 def simulate_case(
-    out_dir,
-    satellite="j01",
-    granules=14,
-    profile="paper",
-    seed=0,
-    start=None,
+    out_dir: str | os.PathLike[str],
+    satellite: str = "j01",
+    granules: int = 14,
+    profile: str = "paper",
+    seed: int = 0,
+    start: dt.datetime | None = None,
     spec: SimulationSpec | None = None,
     viirs: bool = True,
     terrain: bool = False,
@@ -579,7 +599,7 @@ def simulate_case(
     complete: bool = False,
     layout: str | None = None,
     cris_response: RadialResponse | tuple[RadialResponse, ...] | None = None,
-    should_stop=None,
+    should_stop: Callable[[], bool] | None = None,
 ) -> dict:
     """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The ``cris_``
     parameters: the CrIS-VIIRS calibration difference; *complete* and *layout*: every dataset of the real
@@ -647,7 +667,7 @@ def simulate_case(
     return truth
 
 
-def _response_doc(response) -> list | None:
+def _response_doc(response: RadialResponse | tuple[RadialResponse, ...] | None) -> list | None:
     """The truth's record of the CrIS spatial response: per FOV its full widths (deg) at 70, 50, 10 and
     3 % and its knots; None for the top-hat cone."""
     if response is None:

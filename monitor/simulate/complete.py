@@ -12,6 +12,7 @@ GITCO view and solar angles and range from the pixels' geolocation, the CrIS ima
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.geometry import wgs84
 
@@ -19,7 +20,7 @@ F32_FILL = -999.3  # VDNE: where a pixel has no geolocation (bow-tie deleted)
 SCAN_CHUNK = 6  # scans whose pixel angles are computed together (bounded memory)
 
 
-def _enu(lat_rad, lon_rad):
+def _enu(lat_rad: np.ndarray, lon_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """East, north and up unit vectors (ECEF) at geodetic (lat_rad, lon_rad)."""
     sl, cl, so, co = np.sin(lat_rad), np.cos(lat_rad), np.sin(lon_rad), np.cos(lon_rad)
     zero = np.zeros_like(lat_rad)
@@ -30,7 +31,7 @@ def _enu(lat_rad, lon_rad):
     )
 
 
-def sun_direction_ecef(unix_s) -> np.ndarray:
+def sun_direction_ecef(unix_s: ArrayLike) -> np.ndarray:
     """Unit vector (ECEF) toward the Sun at unix time(s) *unix_s*: declination from the day of the year,
     subsolar longitude from UTC (no equation of time; ~1 deg, enough for a dataset nobody reads here)."""
     t = np.asarray(unix_s, float)
@@ -40,7 +41,13 @@ def sun_direction_ecef(unix_s) -> np.ndarray:
     return np.stack([np.cos(decl) * np.cos(lon), np.cos(decl) * np.sin(lon), np.sin(decl)], -1)
 
 
-def view_angles(lat_rad, lon_rad, h_m, toward_ecef_m, direction=False):
+def view_angles(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    h_m: ArrayLike,
+    toward_ecef_m: np.ndarray,
+    direction: bool = False,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Zenith and azimuth (deg, azimuth from north, -180..180) at each pixel toward a point (a position,
     m, ECEF; with *direction*, a unit direction), and the distance (m) to a position."""
     p = wgs84.geodetic_to_ecef(lat_rad, lon_rad, h_m)
@@ -52,7 +59,14 @@ def view_angles(lat_rad, lon_rad, h_m, toward_ecef_m, direction=False):
     return zen, az, dist
 
 
-def viirs_geo_extra(lat_deg, lon_deg, h_m, sc_position_m, scan_unix_s, rows_per_scan: int) -> dict:
+def viirs_geo_extra(
+    lat_deg: np.ndarray,
+    lon_deg: np.ndarray,
+    h_m: np.ndarray,
+    sc_position_m: np.ndarray,
+    scan_unix_s: np.ndarray,
+    rows_per_scan: int,
+) -> dict:
     """GITCO's pixel angles, range and per-scan solar angles and modes (1536 x 6400 float32 each)."""
     shape = lat_deg.shape
     out = {

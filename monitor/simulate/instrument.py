@@ -7,6 +7,7 @@ boresight about x so that the cross-track angle beta = atan(y/z) equals theta (F
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.constants import DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, N_FOV, VIIRS_SCAN_US
 from monitor.geometry.frames import rot_x, unit
@@ -33,13 +34,13 @@ def cris_scan_angles_rad() -> np.ndarray:
     return (np.arange(N_FOR) - (N_FOR - 1) / 2) * CRIS_FOR_STEP_RAD
 
 
-def cris_fov_offsets_rad():
+def cris_fov_offsets_rad() -> tuple[np.ndarray, np.ndarray]:
     """(in_track, cross_track) offsets (rad) of FOV 1..9 at nadir: FOV 7-9 ahead, FOV 1, 4, 7 on the left."""
     f = np.arange(N_FOV)
     return (f // 3 - 1) * CRIS_FOV_SPACING_RAD, (f % 3 - 1) * CRIS_FOV_SPACING_RAD
 
 
-def cris_los_sbf(d_alpha_rad=None, d_beta_rad=None) -> np.ndarray:
+def cris_los_sbf(d_alpha_rad: ArrayLike | None = None, d_beta_rad: ArrayLike | None = None) -> np.ndarray:
     """Nominal CrIS LOS (30, 9, 3) in the SBF, optionally turned per FOR by (d_alpha, d_beta) (30,) rad.
 
     The 3x3 pattern turns with the scan angle (the scene mirror rotates about the optical axis).
@@ -64,7 +65,7 @@ def cris_los_sbf(d_alpha_rad=None, d_beta_rad=None) -> np.ndarray:
     return unit(np.stack([np.tan(alpha), np.tan(beta), np.ones_like(alpha)], axis=-1))
 
 
-def viirs_column_geometry():
+def viirs_column_geometry() -> tuple[np.ndarray, np.ndarray]:
     """Scan angle (rad) and time within the Earth view (s) of each of the 6400 I-band columns."""
     agg = np.repeat(VIIRS_ZONE_AGGREGATION, VIIRS_ZONE_COLUMNS)
     native_end = np.cumsum(agg)

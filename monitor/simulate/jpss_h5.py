@@ -5,10 +5,13 @@
 from __future__ import annotations
 
 import datetime as dt
+import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import h5py
 import numpy as np
+from numpy.typing import DTypeLike
 
 from monitor.satellites import SATELLITES
 from monitor.sdr.products import Product
@@ -24,18 +27,18 @@ def text_attr(value: str) -> np.ndarray:
     return np.array([[b]], dtype=f"S{len(b) + 1}")
 
 
-def texts_attr(values) -> np.ndarray:
+def texts_attr(values: Sequence[str]) -> np.ndarray:
     """An IDPS list-of-strings attribute: (n, 1) fixed-length bytes."""
     bs = [v.encode("ascii") for v in values] or [b""]
     return np.array([[b] for b in bs], dtype=f"S{max(len(b) for b in bs) + 1}")
 
 
-def number_attr(value, dtype) -> np.ndarray:
+def number_attr(value: float, dtype: DTypeLike) -> np.ndarray:
     """A numeric HDF5 attribute shaped (1, 1), as IDPS writes them."""
     return np.array([[value]], dtype=dtype)
 
 
-def _attr(value):
+def _attr(value: object) -> np.ndarray:
     if isinstance(value, str):
         return text_attr(value)
     if isinstance(value, (list, tuple)) and value and isinstance(value[0], str):
@@ -62,7 +65,9 @@ class ProductData:
     compress: bool = True
 
 
-def write_file(path, platform: str, created: dt.datetime, products: list[ProductData]) -> None:
+def write_file(
+    path: str | os.PathLike[str], platform: str, created: dt.datetime, products: list[ProductData]
+) -> None:
     """Write *products* (one or more, for combined files) into the IDPS HDF5 file *path*."""
     with h5py.File(path, "w", userblock_size=USERBLOCK) as f:
         f.attrs["Distributor"] = text_attr("noa-")
@@ -149,7 +154,7 @@ def _write_product(f: h5py.File, pd: ProductData) -> None:
                 gran.attrs[key] = _attr(value)
 
 
-def _default_fill(dtype):
+def _default_fill(dtype: np.dtype) -> float | int:
     if dtype.kind == "f":
         return -999.3
     if dtype == np.uint8:

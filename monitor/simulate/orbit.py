@@ -9,6 +9,7 @@ tropics by day or night, high latitudes, across the 180 deg meridian.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.errors import DataError
 from monitor.geometry.wgs84 import A_M, GM_M3_S2, OMEGA_EARTH_RAD_S
@@ -21,13 +22,13 @@ J2000_UNIX_S = 946728000.0  # 2000-01-01T12:00:00 UTC
 DAY_S = 86400.0
 
 
-def earth_rotation_angle(unix_s):
+def earth_rotation_angle(unix_s: ArrayLike) -> np.ndarray:
     """Earth rotation angle (rad) at UTC seconds since 1970 (UT1 taken as UTC; IERS 2010 eq. 5.15)."""
     d = (np.asarray(unix_s, float) - J2000_UNIX_S) / DAY_S
     return 2 * np.pi * ((0.7790572732640 + 0.00273781191135448 * d + d) % 1.0)
 
 
-def mean_sun_right_ascension(unix_s):
+def mean_sun_right_ascension(unix_s: ArrayLike) -> np.ndarray:
     """Right ascension (rad) of the mean Sun: its mean longitude 280.460 + 0.9856474 deg/day from J2000
     (the equation of time, < 4.5 deg, is left out: a sun-synchronous node follows the mean Sun)."""
     d = (np.asarray(unix_s, float) - J2000_UNIX_S) / DAY_S
@@ -38,7 +39,14 @@ class CircularOrbit:
     """Circular orbit of *altitude_m* and *inclination_deg*: argument of latitude *u0_rad* (default -14 deg)
     and right ascension of the ascending node *raan_rad* at *t0_unix_s* (UTC seconds since 1970)."""
 
-    def __init__(self, t0_unix_s, altitude_m=828e3, inclination_deg=98.74, u0_rad=-0.2443461, raan_rad=0.0):
+    def __init__(
+        self,
+        t0_unix_s: float,
+        altitude_m: float = 828e3,
+        inclination_deg: float = 98.74,
+        u0_rad: float = -0.2443461,
+        raan_rad: float = 0.0,
+    ) -> None:
         self.t0 = float(t0_unix_s)
         self.a = A_M + altitude_m
         self.n = np.sqrt(GM_M3_S2 / self.a**3)
@@ -47,7 +55,14 @@ class CircularOrbit:
         self.raan = float(raan_rad)
 
     @classmethod
-    def through(cls, t0_unix_s, lon0_deg=-160.0, u0_deg=-14.0, altitude_m=828e3, inclination_deg=98.74):
+    def through(
+        cls,
+        t0_unix_s: float,
+        lon0_deg: float = -160.0,
+        u0_deg: float = -14.0,
+        altitude_m: float = 828e3,
+        inclination_deg: float = 98.74,
+    ) -> CircularOrbit:
         """The orbit whose sub-satellite point at *t0_unix_s* is at longitude *lon0_deg*, argument of
         latitude *u0_deg*."""
         orbit = cls(t0_unix_s, altitude_m, inclination_deg, np.radians(u0_deg), 0.0)
@@ -56,7 +71,7 @@ class CircularOrbit:
         return orbit
 
     @classmethod
-    def of(cls, sat: Satellite, t0_unix_s):
+    def of(cls, sat: Satellite, t0_unix_s: float) -> CircularOrbit:
         """The satellite's own orbit at *t0_unix_s*: node from the local time of the ascending node,
         argument of latitude from the phase."""
         orbit = cls(t0_unix_s, sat.altitude_m, sat.inclination_deg)
@@ -64,26 +79,26 @@ class CircularOrbit:
         orbit.raan = float(_node_right_ascension(sat, t0_unix_s))
         return orbit
 
-    def _orbit_plane(self, u, raan):
+    def _orbit_plane(self, u: ArrayLike, raan: ArrayLike) -> np.ndarray:
         ci, si = np.cos(self.i), np.sin(self.i)
         cu, su = np.cos(u), np.sin(u)
         co, so = np.cos(raan), np.sin(raan)
         return np.stack([co * cu - so * su * ci, so * cu + co * su * ci, su * si])
 
-    def state_eci(self, unix_s):
+    def state_eci(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """ECI position (m) and velocity (m/s), shapes t + (3,)."""
         u = self.u0 + self.n * (np.asarray(unix_s, float) - self.t0)
         r = self.a * np.moveaxis(self._orbit_plane(u, self.raan), 0, -1)
         du = np.moveaxis(self._orbit_plane(u + np.pi / 2, self.raan), 0, -1)
         return r, self.a * self.n * du
 
-    def state_ecef(self, unix_s):
+    def state_ecef(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """ECEF position (m) and velocity (m/s) at UTC seconds since 1970."""
         r, v = self.state_eci(unix_s)
         theta = earth_rotation_angle(unix_s)
         c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
 
-        def rot(w):
+        def rot(w: np.ndarray) -> np.ndarray:
             return np.stack(
                 [
                     c[..., 0] * w[..., 0] + s[..., 0] * w[..., 1],
@@ -98,11 +113,11 @@ class CircularOrbit:
         return r_e, v_e
 
 
-def _node_right_ascension(sat: Satellite, unix_s):
+def _node_right_ascension(sat: Satellite, unix_s: ArrayLike) -> np.ndarray:
     return mean_sun_right_ascension(unix_s) + np.radians((sat.ltan_h - 12.0) * 15.0)
 
 
-def _argument_of_latitude(sat: Satellite, unix_s):
+def _argument_of_latitude(sat: Satellite, unix_s: ArrayLike) -> np.ndarray:
     """Mean argument of latitude (rad): the satellite's phase advancing with the shared orbit's period."""
     return (
         np.radians(sat.phase_deg)

@@ -12,7 +12,7 @@ from monitor.constants import FOV_DIAMETER_URAD, N_FOR
 from monitor.errors import DataError
 
 
-def paper_profile():
+def paper_profile() -> tuple[np.ndarray, np.ndarray]:
     """The pattern of Wang et al. 2017 figure 7 (S-NPP IDPS before the EP update).
 
     Cross-track ~0 for FOR 1-10, growing to +1750 urad at FOR 30; in-track a yaw-like ramp from
@@ -24,7 +24,7 @@ def paper_profile():
     return d_alpha, d_beta
 
 
-def paper_ssm_error_urad():
+def paper_ssm_error_urad() -> tuple[np.ndarray, np.ndarray]:
     """A paper-like error as scene-mirror angle changes (urad): (d_crosstrack_roll, d_intrack_pitch) (30,).
 
     The cross-track roll grows to 1000 urad at FOR 30 (the ~1000 urad end-of-scan changes of section 4),
@@ -34,7 +34,7 @@ def paper_ssm_error_urad():
     return -1000.0 * np.clip((k - 10) / 20.0, 0.0, None) ** 2, 250.0 * (15.5 - k) / 14.5
 
 
-def random_profile(seed: int):
+def random_profile(seed: int) -> tuple[np.ndarray, np.ndarray]:
     """A smooth random profile within about +-1500 urad (low-order polynomials in scan position)."""
     rng = np.random.default_rng(seed + 7919)
     x = np.linspace(-1.0, 1.0, N_FOR)
@@ -44,7 +44,7 @@ def random_profile(seed: int):
     return d_alpha, d_beta
 
 
-def load_profile(name: str, seed: int = 0):
+def load_profile(name: str, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(d_alpha_urad, d_beta_urad), each (30,), for *name*: paper, random, zero, or a JSON/YAML file.
 
     A file holds ``fors: [{for: 1, d_alpha_urad: .., d_beta_urad: ..}, ...]`` (the truth.json and

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 
 from monitor.spectral import planck_radiance
 
@@ -36,7 +37,7 @@ MAX_HEIGHT_M = 4000.0
 CLOUD_PER_M = 0.15e-3  # more cloud over high ground: the cloud field's threshold drops 0.15 per km
 
 
-def _random_field(rng, n, slope, low_cut):
+def _random_field(rng: np.random.Generator, n: int, slope: float, low_cut: float) -> np.ndarray:
     """Zero-mean unit-variance periodic field with power spectrum ~ k^-slope above *low_cut* cycles."""
     kx = np.fft.fftfreq(n) * n
     ky = np.fft.rfftfreq(n) * n
@@ -47,7 +48,7 @@ def _random_field(rng, n, slope, low_cut):
     return ((f - f.mean()) / f.std()).astype(np.float32)
 
 
-def _unit_vectors(lat_rad, lon_rad):
+def _unit_vectors(lat_rad: ArrayLike, lon_rad: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     lat = np.asarray(lat_rad, np.float64)
     lon = np.asarray(lon_rad, np.float64)
     c = np.cos(lat)
@@ -55,7 +56,9 @@ def _unit_vectors(lat_rad, lon_rad):
 
 
 @numba.njit(cache=True, nogil=True)
-def _triplanar_samples(x, y, z, flat, n, scale, out):
+def _triplanar_samples(
+    x: np.ndarray, y: np.ndarray, z: np.ndarray, flat: np.ndarray, n: int, scale: float, out: np.ndarray
+) -> None:
     """out (P, C) = the triplanar blend at unit vectors (x, y, z) (P,) of the fields *flat* (3, n * n, C):
     for each plane the bilinear sample at the point's two in-plane coordinates (times *scale*), weighted
     by the fourth power of the direction cosine normal to the plane over their root sum of squares.
@@ -94,12 +97,12 @@ class _Triplanar:
     """Bilinear samples of stacked periodic fields (3 planes, n, n, channels) blended over the three
     planes (:func:`_triplanar_samples`)."""
 
-    def __init__(self, fields, cell_km):
+    def __init__(self, fields: np.ndarray, cell_km: float) -> None:
         self.n = fields.shape[1]
         self.flat = np.ascontiguousarray(fields.reshape(3, self.n * self.n, -1), np.float32)
         self.scale = np.float32(EARTH_RADIUS_KM / cell_km)
 
-    def __call__(self, xyz):
+    def __call__(self, xyz: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
         x, y, z = (np.ascontiguousarray(c, np.float32) for c in xyz)
         shape = x.shape
         out = np.empty((x.size, self.flat.shape[2]), np.float32)
@@ -141,7 +144,7 @@ class Scene:
         if terrain:
             self.relief_gain = min(1.0, MAX_SLOPE / self._max_slope())
 
-    def _height(self, land, relief, ridges):
+    def _height(self, land: np.ndarray, relief: np.ndarray, ridges: np.ndarray) -> np.ndarray:
         """Terrain height (m): a coastal ramp times ranges (ridged noise) on plateaus (a squashed field)."""
         coast = np.clip((land - self.land_threshold) / 1.0, 0.0, 1.0)
         coast = coast * coast * (3 - 2 * coast)  # smoothstep: no cliff at the shore
@@ -149,7 +152,7 @@ class Scene:
         ridge = 700.0 * (1.0 - np.abs(np.tanh(ridges)))
         return (coast * np.minimum(plateau + ridge, MAX_HEIGHT_M) * self.relief_gain).astype(np.float32)
 
-    def _max_slope(self):
+    def _max_slope(self) -> float:
         """Largest terrain slope on a 1 km probe grid over a few thousand km (the field is stationary)."""
         step_rad = 1.0 / EARTH_RADIUS_KM
         lat = np.arange(-0.15, 0.15, step_rad)
@@ -158,13 +161,15 @@ class Scene:
         gy, gx = np.gradient(h, 1000.0)
         return float(np.max(np.hypot(gx, gy)))
 
-    def height_m(self, lat_rad, lon_rad):
+    def height_m(self, lat_rad: ArrayLike, lon_rad: ArrayLike) -> np.ndarray:
         """Terrain height (m) above the ellipsoid at geodetic *lat_rad*, *lon_rad*; float32."""
         if not self.terrain:
             return np.zeros(np.shape(lat_rad), np.float32)
         return self._height(*np.moveaxis(self.shape(_unit_vectors(lat_rad, lon_rad)), -1, 0))
 
-    def temperature_k(self, lat_rad, lon_rad, height_m=None):
+    def temperature_k(
+        self, lat_rad: ArrayLike, lon_rad: ArrayLike, height_m: ArrayLike | None = None
+    ) -> np.ndarray:
         """Emitting temperature (K) at geodetic *lat_rad*, *lon_rad* and terrain height *height_m*."""
         xyz = _unit_vectors(lat_rad, lon_rad)
         land = self.shape(xyz)[..., 0]
@@ -179,7 +184,7 @@ class Scene:
         return (surface * (1 - cover) + np.minimum(top, surface) * cover).astype(np.float32)
 
 
-def transmittance(wavenumber_cm1):
+def transmittance(wavenumber_cm1: ArrayLike) -> np.ndarray:
     """A simple clear-sky transmittance: a moist window with CO2 below 760 cm-1 and ozone near 1040 cm-1."""
     nu = np.asarray(wavenumber_cm1, float)
     k = 0.12 + 0.25 * ((nu - 900.0) / 150.0) ** 2
@@ -189,7 +194,7 @@ def transmittance(wavenumber_cm1):
     return np.exp(-k)
 
 
-def spectra(wavenumber_cm1, mean_planck):
+def spectra(wavenumber_cm1: ArrayLike, mean_planck: ArrayLike) -> np.ndarray:
     """Top-of-atmosphere spectra from the cone-mean surface Planck radiance (..., nchan)."""
     tau = transmittance(wavenumber_cm1)
     return tau * mean_planck + (1.0 - tau) * planck_radiance(wavenumber_cm1, T_ATM_K)

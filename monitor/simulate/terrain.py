@@ -11,15 +11,20 @@ costs one terrain look-up; the final point is converted exactly.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from monitor.geometry import wgs84
 
+HeightFn = Callable[[np.ndarray, np.ndarray], np.ndarray]  # terrain height (m) at (lat_rad, lon_rad)
 TOLERANCE_M = 0.05
 NEAR_SURFACE_ITERATIONS = 2  # Bowring iterations for points within a few km of the ellipsoid (< 1 mm)
 
 
-def intersect_terrain(origin_m, los, height_fn, top_m, iterations=12):
+def intersect_terrain(
+    origin_m: np.ndarray, los: np.ndarray, height_fn: HeightFn, top_m: float, iterations: int = 12
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Distance (m) along unit *los* (..., 3) from ECEF *origin_m* to the terrain, and the point's
     geodetic (lat_rad, lon_rad, h_m). *height_fn(lat_rad, lon_rad)* gives the terrain height (m), at
     most *top_m*. NaN where the ray misses the Earth."""
@@ -39,7 +44,15 @@ def intersect_terrain(origin_m, los, height_fn, top_m, iterations=12):
     return t.reshape(shape), lat.reshape(shape), lon.reshape(shape), h.reshape(shape)
 
 
-def _root(o, d, t_floor, g_floor, height_fn, top_m, iterations):
+def _root(
+    o: np.ndarray,
+    d: np.ndarray,
+    t_floor: np.ndarray,
+    g_floor: np.ndarray,
+    height_fn: HeightFn,
+    top_m: float,
+    iterations: int,
+) -> np.ndarray:
     t_top = wgs84.intersect_ellipsoid(o, d, top_m)
     ts = (t_top, 0.5 * (t_top + t_floor), t_floor)
     geo = [wgs84.ecef_to_geodetic(o + t[:, None] * d, NEAR_SURFACE_ITERATIONS) for t in ts]
@@ -52,7 +65,7 @@ def _root(o, d, t_floor, g_floor, height_fn, top_m, iterations):
     c1 = 4 * hm - 3 * h0 - h1
     c2 = 2 * (h0 + h1) - 4 * hm
 
-    def g(tt):
+    def g(tt: np.ndarray) -> np.ndarray:
         x = (tt - t_top) / span
         return h0 + x * (c1 + x * c2) - height_fn(lat0 + x * (lat1 - lat0), lon0 + x * dlon)
 

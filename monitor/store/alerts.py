@@ -8,7 +8,7 @@ import sqlite3
 from contextlib import AbstractContextManager
 from typing import Any, Protocol
 
-from monitor.records import Alert, Delivery, Silence, iso
+from monitor.records import Alert, Delivery, FindingRecord, Silence, iso
 from monitor.vocabulary import AlertStatus, DeliveryStatus
 
 
@@ -28,7 +28,7 @@ class AlertState:
         self.store = store
         self.db = store.db
 
-    def get(self, fingerprint: str):
+    def get(self, fingerprint: str) -> Alert | None:
         """The alert row of *fingerprint* (rule:satellite:group), or None."""
         r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
         return Alert.from_row(r) if r else None
@@ -44,7 +44,7 @@ class AlertState:
         q = "SELECT * FROM alert_state ORDER BY satellite, rule, grp"
         return [Alert.from_row(r) for r in self.db.execute(q)]
 
-    def upsert(self, finding, now: dt.datetime, notified: bool):
+    def upsert(self, finding: FindingRecord, now: dt.datetime, notified: bool) -> None:
         """Record *finding* as firing (keeping its start while it fires); *notified* stamps the notification
         time."""
         prev = self.get(finding.fingerprint)
@@ -67,7 +67,7 @@ class AlertState:
             ),
         )
 
-    def resolve(self, fingerprint: str, now: dt.datetime):
+    def resolve(self, fingerprint: str, now: dt.datetime) -> None:
         """Mark an alert resolved at *now*."""
         self.db.execute(
             "UPDATE alert_state SET status=?, resolved=? WHERE fingerprint=?",
@@ -77,7 +77,7 @@ class AlertState:
     # -- silences
     def silence(
         self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime
-    ):
+    ) -> None:
         """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason."""
         with self.store.transaction():
             self.db.execute(
@@ -110,7 +110,7 @@ class AlertState:
         ]
 
     # -- delivery queue
-    def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime):
+    def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime) -> None:
         """Queue *message* (subject, text, ...) for delivery on *channel*."""
         self.db.execute(
             "INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
@@ -169,7 +169,7 @@ class AlertState:
         now: dt.datetime,
         error: str | None = None,
         retry_after_s: float = 0.0,
-    ):
+    ) -> None:
         """Record a delivery attempt's *status*; a retry waits *retry_after_s*."""
         with self.store.transaction():
             self.db.execute(

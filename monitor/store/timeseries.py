@@ -26,14 +26,16 @@ from __future__ import annotations
 import datetime as dt
 import logging
 import math
+from collections.abc import Iterable
 
 import requests
 from influxdb_client import InfluxDBClient, Point, WritePrecision
 from influxdb_client.client.exceptions import InfluxDBError
 from influxdb_client.client.write_api import SYNCHRONOUS
 
+from monitor.changes import Change
 from monitor.config import PublishConfig
-from monitor.result import MEASURED_FIELDS
+from monitor.result import MEASURED_FIELDS, ForOffset
 from monitor.store.sqlite import Store
 
 LOG = logging.getLogger(__name__)
@@ -47,7 +49,7 @@ class PublishError(RuntimeError):
     """The time-series server did not accept a batch; the points stay in the outbox."""
 
 
-def result_lines(measurement: str, satellite: str, day: dt.date, fors) -> list[str]:
+def result_lines(measurement: str, satellite: str, day: dt.date, fors: Iterable[ForOffset]) -> list[str]:
     """Line-protocol points of one day's per-FOR results."""
     when = dt.datetime(day.year, day.month, day.day, tzinfo=dt.timezone.utc)
     lines = []
@@ -62,7 +64,7 @@ def result_lines(measurement: str, satellite: str, day: dt.date, fors) -> list[s
     return lines
 
 
-def change_lines(measurement: str, changes) -> list[str]:
+def change_lines(measurement: str, changes: Iterable[Change]) -> list[str]:
     """Line-protocol points of known changes (measurement ``<measurement>_change``, for dashboard
     annotations).
 
@@ -98,7 +100,7 @@ class Influx2Writer:
         )
         self.api = self.client.write_api(write_options=SYNCHRONOUS)
 
-    def write(self, lines: list[str]):
+    def write(self, lines: list[str]) -> None:
         """Write line-protocol *lines*; raises on any failure (the outbox keeps them)."""
         try:
             self.api.write(
@@ -114,7 +116,7 @@ class Influx2Writer:
         except Exception as exc:  # urllib3 raises its own errors when the server is unreachable
             raise PublishError(f"{self.cfg.url}: {type(exc).__name__}: {exc}") from None
 
-    def close(self):
+    def close(self) -> None:
         """Close the client."""
         self.client.close()
 
@@ -127,7 +129,7 @@ class Influx1Writer:
         user, password = cfg.secret("username_env"), cfg.secret("password_env")
         self.auth = (user, password or "") if user else None
 
-    def _post(self, lines):
+    def _post(self, lines: list[str]) -> requests.Response:
         return requests.post(
             f"{self.cfg.url}/write",
             params={"db": self.cfg.database, "precision": "s"},
@@ -136,7 +138,7 @@ class Influx1Writer:
             timeout=self.cfg.timeout_s,
         )
 
-    def write(self, lines: list[str]):
+    def write(self, lines: list[str]) -> None:
         """POST line-protocol *lines* to /write; raises on any failure (the outbox keeps them)."""
         try:
             r = self._post(lines)
@@ -153,7 +155,7 @@ class Influx1Writer:
         if r.status_code != 204:
             raise PublishError(f"{self.cfg.url}: HTTP {r.status_code} {r.text[:200]}")
 
-    def close(self):
+    def close(self) -> None:
         """Close the session."""
         pass
 
