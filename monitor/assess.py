@@ -576,7 +576,7 @@ def assess_plan(
 
 
 def assess_paths(
-    paths: Iterable[str | Path],
+    paths: Sequence[str | Path],
     cfg: AssessmentConfig | None = None,
     progress: Progress = None,
     workers: int = 1,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import resource
 import tempfile
 import time
@@ -17,12 +18,12 @@ from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbed_los_sbf
 from monitor.sdr import read_file
-from monitor.sdr.pairing import plan
+from monitor.sdr.pairing import CasePlan, plan
 from monitor.simulate.case import simulate_case
 from monitor.vocabulary import Cost
 
 
-def peak_rss_mb(who=resource.RUSAGE_SELF) -> float:
+def peak_rss_mb(who: int = resource.RUSAGE_SELF) -> float:
     """Peak resident memory so far, MB (Linux ru_maxrss is in KB); RUSAGE_CHILDREN gives the largest child."""
     return resource.getrusage(who).ru_maxrss / 1024.0
 
@@ -36,7 +37,9 @@ def reset_peak_rss() -> bool:
         return False
 
 
-def _pyresample_reference(case, cfg: AssessmentConfig, max_granules=1):
+def _pyresample_reference(
+    case: CasePlan, cfg: AssessmentConfig, max_granules: int = 1
+) -> tuple[float, int] | None:
     """Time the zero-offset and all-perturbation collocation with pyresample's radius neighbour search.
 
     For each perturbed LOS the ground point is computed and pyresample finds the VIIRS pixels within
@@ -72,7 +75,7 @@ def _pyresample_reference(case, cfg: AssessmentConfig, max_granules=1):
     return time.perf_counter() - t0, int(valid.sum())
 
 
-def run_bench(args) -> int:
+def run_bench(args: argparse.Namespace) -> int:
     """``crisgeo bench``: simulate (or take --data), warm the kernels, time each stage, print; exit status."""
     cfg = AssessmentConfig(cost=Cost(args.cost))
     with tempfile.TemporaryDirectory() as tmp:

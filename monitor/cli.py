@@ -18,8 +18,9 @@ import datetime as dt
 import os
 import re
 import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TextIO
 
 from monitor import allocator, logs
 from monitor.config import AssessmentConfig, FingerprintConfig
@@ -34,8 +35,15 @@ from monitor.version import __version__
 from monitor.vocabulary import Cost, Kernel, Rule
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
+    from monitor.changes import Change
     from monitor.config import Config
+    from monitor.fingerprint import DayPrint, EpMatch
+    from monitor.footprint import RadialResponse
+    from monitor.geometry.instrument import EngineeringPacket
+    from monitor.mapping.residuals import OwnResiduals, ResidualTable
     from monitor.store.sqlite import Store
+
+Handler = Callable[[argparse.Namespace], int]  # a subcommand: its parsed arguments in, its exit status out
 
 # the defaults of the assessment keys, for the commands that take them as flags
 ASSESSMENT = AssessmentConfig()  # the defaults of the options that mirror configuration keys
@@ -77,7 +85,7 @@ def _day(text: str) -> dt.date:
         raise argparse.ArgumentTypeError(f"not a date (YYYY-MM-DD): {text!r}") from None
 
 
-def arg(*names, **options) -> tuple:
+def arg(*names: str, **options: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
     """One argument of a subcommand: the add_argument call, as data."""
     return names, options
 
@@ -92,13 +100,15 @@ RESIDUAL_ARGS = (
     ),
 )
 RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices' repr
-COMMANDS: dict = {}  # name -> (handler, help, arguments), in the order of ``crisgeo --help``
+COMMANDS: dict[str, tuple[Handler, str, tuple]] = {}  # name -> (handler, help, arguments), in the order of ``crisgeo --help``
 
 
-def command(name: str, help: str, *arguments):
+def command(
+    name: str, help: str, *arguments: tuple[tuple[str, ...], dict[str, Any]]
+) -> Callable[[Handler], Handler]:
     """Register the decorated handler as subcommand *name* with its *arguments* (:func:`arg`)."""
 
-    def register(handler):
+    def register(handler: Handler) -> Handler:
         COMMANDS[name] = (handler, help, arguments)
         return handler
 
@@ -144,7 +154,7 @@ def command(name: str, help: str, *arguments):
         "or nine (FOV 1..9); default the paper's top-hat cone",
     ),
 )
-def cmd_simulate(args) -> int:
+def cmd_simulate(args: argparse.Namespace) -> int:
     """crisgeo simulate: write a simulated case."""
     from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
 
@@ -188,7 +198,7 @@ def cmd_simulate(args) -> int:
     return EXIT_OK
 
 
-def _footprint(names):
+def _footprint(names: Sequence[str] | None) -> RadialResponse | tuple[RadialResponse, ...] | None:
     """The spatial response of --footprint: None (the top-hat cone), one shape, or one per FOV."""
     from monitor.footprint import shape
 
@@ -199,13 +209,13 @@ def _footprint(names):
     return shape(names[0]) if len(names) == 1 else tuple(shape(n) for n in names)
 
 
-def _ep(path, satellite=None):
+def _ep(path: str | os.PathLike[str], satellite: str | None = None) -> EngineeringPacket:
     from monitor.sdr.engpkt import load_ep
 
     return load_ep(path, satellite)
 
 
-def _residuals(args):
+def _residuals(args: argparse.Namespace) -> ResidualTable | OwnResiduals | None:
     """The residual table of --residuals FILE, or each granule's own against --own-residuals EP."""
     from monitor.mapping.residuals import OwnResiduals, ResidualError, load
 
@@ -229,7 +239,7 @@ def _residuals(args):
     arg("--out", required=True, help="the proposed EP, in the format of --ep"),
     arg("--table-json", help="also write the old/new angle table as JSON here"),
 )
-def cmd_optimize(args) -> int:
+def cmd_optimize(args: argparse.Namespace) -> int:
     """crisgeo optimize: new scene-mirror angles from an assessment."""
     import json
 
@@ -263,7 +273,7 @@ def cmd_optimize(args) -> int:
     arg("--out", required=True, help="output directory (never the input's)"),
     *RESIDUAL_ARGS,
 )
-def cmd_regeolocate(args) -> int:
+def cmd_regeolocate(args: argparse.Namespace) -> int:
     """crisgeo regeolocate: GEO copies geolocated with another EP."""
     from monitor.mapping.regeolocate import regeolocate_file
 
@@ -290,7 +300,7 @@ def cmd_regeolocate(args) -> int:
     arg("--json", action="store_true"),
     *RESIDUAL_ARGS,
 )
-def cmd_geolocate(args) -> int:
+def cmd_geolocate(args: argparse.Namespace) -> int:
     """crisgeo geolocate: an EP's geolocation against the files' own, per FOR."""
     import json
 
@@ -345,7 +355,7 @@ def cmd_geolocate(args) -> int:
     ),
     arg("--workers", type=int, default=ASSESSMENT.workers, help="threads of the compiled kernels"),
 )
-def cmd_assess(args) -> int:
+def cmd_assess(args: argparse.Namespace) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assess import assess_paths
     from monitor.config import ConfigError
@@ -380,7 +390,7 @@ def cmd_assess(args) -> int:
     return EXIT_OK
 
 
-def _load(args, writes: bool = False):
+def _load(args: argparse.Namespace, writes: bool = False) -> Config:
     """The configuration of *args*; with *writes*, its state directory made (the commands that write)."""
 
     from monitor.config import ConfigError
@@ -404,7 +414,7 @@ def _load(args, writes: bool = False):
     arg("dest", type=Path, help="target directory, e.g. /opt/crisgeo/share"),
     arg("--force", action="store_true", help="replace files that exist"),
 )
-def cmd_install_files(args) -> int:
+def cmd_install_files(args: argparse.Namespace) -> int:
     """crisgeo install-files: copy the shipped files out."""
     from monitor.install import install_files, kept_files
 
@@ -423,7 +433,7 @@ def cmd_install_files(args) -> int:
     arg("--reference", action="store_true", help="print the reference of every key (Markdown) instead"),
     arg("--schema", action="store_true", help="print the JSON Schema of the file instead (for editors)"),
 )
-def cmd_check_config(args) -> int:
+def cmd_check_config(args: argparse.Namespace) -> int:
     """crisgeo check-config: validate and print the effective configuration, or the reference."""
     import yaml
 
@@ -457,7 +467,7 @@ def cmd_check_config(args) -> int:
     arg("--since", type=_day, help="first day, YYYY-MM-DD"),
     arg("--until", type=_day, help="last day, YYYY-MM-DD"),
 )
-def cmd_export(args) -> int:
+def cmd_export(args: argparse.Namespace) -> int:
     """crisgeo export: the results as NetCDF or CSV."""
     from monitor.export import ExportFormatError, NothingToExport, export
 
@@ -485,7 +495,7 @@ def _open_store(cfg: Config) -> Store:
     """The configured store for a command that only reads: never created (a missing one is an error)."""
     from monitor.store.sqlite import Store
 
-    return Store(cfg.store.sqlite, create=False)
+    return Store(cfg.store.path, create=False)
 
 
 def _period(since: dt.date | None, until: dt.date | None) -> None:
@@ -519,7 +529,7 @@ def _in_mission(sats: list[str], days: dict[str, dt.date | None]) -> None:
     arg("--satellite", choices=tuple(SATELLITES)),
     arg("--date", type=_day, help="the UTC day to (re)assess, YYYY-MM-DD"),
 )
-def cmd_run(args) -> int:
+def cmd_run(args: argparse.Namespace) -> int:
     """crisgeo run: one run of the daily job, then exit."""
     from monitor.service import Service
     from monitor.vocabulary import RunStatus
@@ -563,7 +573,7 @@ def cmd_run(args) -> int:
     arg("--workers", type=int, default=2, help="processes of the local cluster (default 2)"),
     arg("--force", action="store_true", help="redo the days already done"),
 )
-def cmd_reprocess(args) -> int:
+def cmd_reprocess(args: argparse.Namespace) -> int:
     """crisgeo reprocess: a period on Dask; this process alone writes the store."""
     from monitor.reprocess import run_reprocess
     from monitor.vocabulary import RunStatus
@@ -590,7 +600,7 @@ def cmd_reprocess(args) -> int:
         help="serve /metrics, /healthz, /report/ here (overrides http.listen; off: no endpoint)",
     ),
 )
-def cmd_daemon(args) -> int:
+def cmd_daemon(args: argparse.Namespace) -> int:
     """crisgeo daemon: the long-running service."""
     from monitor.service import Service
 
@@ -613,7 +623,7 @@ def cmd_daemon(args) -> int:
     arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--json", action="store_true", help="machine-readable status"),
 )
-def cmd_status(args) -> int:
+def cmd_status(args: argparse.Namespace) -> int:
     """crisgeo status: the state of every satellite, as text or JSON, with Nagios exit codes."""
     import json
 
@@ -624,7 +634,7 @@ def cmd_status(args) -> int:
     try:
         cfg = _load(args)
         sats = _satellites(cfg, args.satellite)
-        store = Store(cfg.store.sqlite, create=False)
+        store = Store(cfg.store.path, create=False)
     except (BadInput, ConfigError, StoreError) as exc:
         if args.json:
             print(json.dumps({"state": "UNKNOWN", "exit": NagiosState.UNKNOWN, "error": str(exc)}))
@@ -657,7 +667,7 @@ def cmd_status(args) -> int:
     arg("--id", type=int, help="unsilence: the silence's number (crisgeo alerts list shows it)"),
     arg("--json", action="store_true", help="list: as JSON"),
 )
-def cmd_alerts(args) -> int:
+def cmd_alerts(args: argparse.Namespace) -> int:
     """crisgeo alerts: list, silence, unsilence, evaluate."""
     from alerts.engine import alerts_view, evaluate_and_deliver
     from monitor.store.alerts import AlertState
@@ -676,7 +686,7 @@ def cmd_alerts(args) -> int:
             print(view.text())
         return EXIT_OK
     cfg = _load(args, writes=True)
-    with Store(cfg.store.sqlite) as store:
+    with Store(cfg.store.path) as store:
         if args.action == "silence":
             if args.until is None or not args.reason:
                 raise BadInput("alerts silence needs --until and --reason")
@@ -716,7 +726,7 @@ def cmd_alerts(args) -> int:
     arg("--kind", default="change", help="add: ep_upload, lut_change, software, ..."),
     arg("--description", help="add: what changed"),
 )
-def cmd_events(args) -> int:
+def cmd_events(args: argparse.Namespace) -> int:
     """crisgeo events: list the known changes, or add one to the calendar."""
     from monitor.changes import Change, add_to_calendar, all_changes
 
@@ -740,7 +750,7 @@ def cmd_events(args) -> int:
     calendar = _calendar(cfg.events_file)
     known = {c.satellite for c in calendar} | set(cfg.satellites)
     chosen = [args.satellite] if args.satellite else [s for s in SATELLITES if s in known]
-    if not cfg.store.sqlite.exists():  # before the first run: the calendar alone
+    if not cfg.store.path.exists():  # before the first run: the calendar alone
         for c in sorted(calendar, key=lambda c: c.time):
             if c.satellite in chosen:
                 print(f"{c.satellite} {c.label()}")
@@ -752,7 +762,7 @@ def cmd_events(args) -> int:
     return EXIT_OK
 
 
-def _calendar(path):
+def _calendar(path: str | Path) -> list[Change]:
     """The events calendar at *path*; a calendar that does not load is bad input, named."""
     from monitor.changes import load_calendar
 
@@ -789,7 +799,7 @@ def _calendar(path):
     ),
     arg("--ep", help="the EP the residual table is learned against (XML or YAML)"),
 )
-def cmd_fingerprint(args) -> int:
+def cmd_fingerprint(args: argparse.Namespace) -> int:
     """crisgeo fingerprint: the per-FOR LOS fingerprint of GEO files."""
     import json
 
@@ -816,7 +826,9 @@ def cmd_fingerprint(args) -> int:
     return EXIT_OK
 
 
-def _write_residuals(args, day, matches, library):
+def _write_residuals(
+    args: argparse.Namespace, day: DayPrint, matches: Sequence[EpMatch], library: dict[str, EngineeringPacket]
+) -> None:
     from monitor.mapping.residuals import learn
 
     if args.ep:
@@ -845,7 +857,7 @@ def _write_residuals(args, day, matches, library):
     arg("--since", type=_day, help="first day shown, YYYY-MM-DD"),
     arg("--until", type=_day, help="last day shown, YYYY-MM-DD"),
 )
-def cmd_report(args) -> int:
+def cmd_report(args: argparse.Namespace) -> int:
     """crisgeo report: write the HTML report."""
     import time
 
@@ -881,7 +893,7 @@ def cmd_report(args) -> int:
         help="the cost to time (assessment.cost)",
     ),
 )
-def cmd_bench(args) -> int:
+def cmd_bench(args: argparse.Namespace) -> int:
     """crisgeo bench: time each stage on a simulated case."""
     from monitor.bench import run_bench
 
@@ -889,10 +901,16 @@ def cmd_bench(args) -> int:
 
 
 class _PrintReference(argparse.Action):
-    def __init__(self, option_strings, dest, **kwargs):
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs: Any) -> None:
         super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
 
-    def __call__(self, parser, namespace, values, option_string=None):
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: object,
+        option_string: str | None = None,
+    ) -> None:
         print(cli_reference(parser), end="")
         parser.exit()
 
@@ -963,7 +981,7 @@ class _PipedOutput:
     """Standard output that a reader closing the pipe (``| head -1``) silences instead of ending the
     command: the exit status stays the one computed (a Nagios check piped into head still says 2)."""
 
-    def __init__(self, stream):
+    def __init__(self, stream: TextIO) -> None:
         self._stream = stream
         self.gone = False
 
@@ -990,11 +1008,11 @@ class _PipedOutput:
         os.dup2(null, self._stream.fileno())
         os.close(null)
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         return getattr(self._stream, name)
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """The crisgeo command: parse, set up logging, run the subcommand; its exit status. Every error a
     command lets through is mapped to its exit status here, in one line: bad input (2), another instance
     (75), an unusable store or the machine's (1), an interruption (130)."""
@@ -1005,8 +1023,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     logs.setup(args.verbose, args.log_format)
     allocator.reuse_freed_memory()
-    if not isinstance(sys.stdout, _PipedOutput) and sys.stdout is sys.__stdout__:
-        sys.stdout = _PipedOutput(sys.stdout)
+    stdout = sys.__stdout__
+    if stdout is not None and sys.stdout is stdout:
+        sys.stdout = _PipedOutput(stdout)
     try:
         code = args.func(args)
         sys.stdout.flush()

@@ -15,13 +15,15 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import socket
 import threading
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
+from typing import Any, Protocol
 
-from prometheus_client import CONTENT_TYPE_LATEST, generate_latest
+from prometheus_client import CONTENT_TYPE_LATEST, CollectorRegistry, generate_latest
 
 LOG = logging.getLogger(__name__)
 INDEX = (
@@ -32,21 +34,34 @@ INDEX = (
 )
 
 
+class Registered(Protocol):
+    """What the endpoint serves of the metrics (:class:`monitor.metrics.ServiceMetrics`, a neighbour)."""
+
+    registry: CollectorRegistry
+
+
+class HealthView(Protocol):
+    """What the endpoint serves of the health (:class:`monitor.health.Health`, a neighbour)."""
+
+    def problems(self) -> list[str]: ...
+    def running(self) -> list[dict]: ...
+
+
 class _Handler(SimpleHTTPRequestHandler):
     server_version = "crisgeo"
     sys_version = ""
 
-    def __init__(self, *args, endpoint=None, **kwargs):
+    def __init__(self, *args: Any, endpoint: Endpoint, **kwargs: Any) -> None:
         self.endpoint = endpoint
         super().__init__(*args, **kwargs)
 
-    def do_GET(self):  # noqa: N802 - http.server's naming
+    def do_GET(self) -> None:
         self._route(head=False)
 
-    def do_HEAD(self):  # noqa: N802
+    def do_HEAD(self) -> None:
         self._route(head=True)
 
-    def _not_allowed(self):
+    def _not_allowed(self) -> None:
         self.send_response(405)
         self.send_header("Allow", "GET, HEAD")
         self.send_header("Content-Length", "0")
@@ -54,7 +69,7 @@ class _Handler(SimpleHTTPRequestHandler):
 
     do_POST = do_PUT = do_DELETE = do_PATCH = do_OPTIONS = _not_allowed  # noqa: N815
 
-    def _route(self, head: bool):
+    def _route(self, head: bool) -> None:
         path = self.path.split("?", 1)[0]
         if path == "/":
             self._send(200, INDEX, "text/plain; charset=utf-8", head)
@@ -79,11 +94,11 @@ class _Handler(SimpleHTTPRequestHandler):
         else:
             self._send(404, b"not found\n", "text/plain", head)
 
-    def list_directory(self, path):
+    def list_directory(self, path: str | os.PathLike[str]) -> None:
         self.send_error(404, "no listing")
         return None
 
-    def _send(self, code: int, body: bytes, ctype: str, head: bool):
+    def _send(self, code: int, body: bytes, ctype: str, head: bool) -> None:
         self.send_response(code)
         self.send_header("Content-Type", ctype)
         self.send_header("Content-Length", str(len(body)))
@@ -92,7 +107,7 @@ class _Handler(SimpleHTTPRequestHandler):
         if not head:
             self.wfile.write(body)
 
-    def log_message(self, fmt, *args):
+    def log_message(self, fmt: str, *args: Any) -> None:
         LOG.debug("%s %s", self.address_string(), fmt % args)
 
 
@@ -104,7 +119,9 @@ class Endpoint:
     """Serves *metrics* (:class:`monitor.metrics.ServiceMetrics`), *health* (:class:`monitor.health.Health`)
     and the files under *report_dir* on (host, port); port 0 takes a free one (see :attr:`address`)."""
 
-    def __init__(self, host: str, port: int, metrics, health, report_dir: Path | None):
+    def __init__(
+        self, host: str, port: int, metrics: Registered, health: HealthView, report_dir: Path | None
+    ) -> None:
         self.metrics = metrics
         self.health = health
         directory = str(report_dir) if report_dir else None

@@ -17,6 +17,8 @@ max(10 urad, 4 x the scan-to-scan standard deviation).
 from __future__ import annotations
 
 import datetime as dt
+import os
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -25,7 +27,7 @@ from monitor.constants import PROCESSING_CHANGE_URAD, URAD
 from monitor.errors import DataError
 from monitor.geometry.instrument import FOV5, fov5_angles
 from monitor.geometry.inverse import granule_geometry
-from monitor.sdr import GranuleError, read_file
+from monitor.sdr import CrisGeoGranule, GranuleError, read_file
 from monitor.sdr.engpkt import load_library
 from monitor.sdr.names import parse_name
 from monitor.sdr.pairing import find_files
@@ -90,7 +92,7 @@ class DayPrint:
         }
 
 
-def granule_print(geo) -> GranulePrint:
+def granule_print(geo: CrisGeoGranule) -> GranulePrint:
     """The fingerprint of one CrIS GEO granule (a :class:`monitor.sdr.CrisGeoGranule`)."""
     valid = geo.valid
     fg = granule_geometry(geo)
@@ -128,7 +130,9 @@ def day_print(prints: list[GranulePrint]) -> DayPrint:
 K_SIGMA = 4.0
 
 
-def thresholds(sd_alpha_urad, sd_beta_urad, threshold_urad: float = PROCESSING_CHANGE_URAD):
+def thresholds(
+    sd_alpha_urad: np.ndarray, sd_beta_urad: np.ndarray, threshold_urad: float = PROCESSING_CHANGE_URAD
+) -> tuple[np.ndarray, np.ndarray]:
     """Per-FOR step thresholds (urad): max(threshold, 4 x scan-to-scan scatter), per direction."""
     return (
         np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_alpha_urad)),
@@ -136,13 +140,22 @@ def thresholds(sd_alpha_urad, sd_beta_urad, threshold_urad: float = PROCESSING_C
     )
 
 
-def _changed_fors(before_a, before_b, after_a, after_b, thr_a, thr_b):
+def _changed_fors(
+    before_a: np.ndarray,
+    before_b: np.ndarray,
+    after_a: np.ndarray,
+    after_b: np.ndarray,
+    thr_a: np.ndarray,
+    thr_b: np.ndarray,
+) -> tuple[list[int], np.ndarray, np.ndarray]:
     da, db = after_a - before_a, after_b - before_b
     fors = [k + 1 for k in range(len(da)) if abs(da[k]) > thr_a[k] or abs(db[k]) > thr_b[k]]
     return fors, da, db
 
 
-def compare_days(previous: DayPrint, current: DayPrint, threshold_urad: float = PROCESSING_CHANGE_URAD):
+def compare_days(
+    previous: DayPrint, current: DayPrint, threshold_urad: float = PROCESSING_CHANGE_URAD
+) -> tuple[list[int], np.ndarray, np.ndarray]:
     """(FORs changed, d_alpha_urad, d_beta_urad) between two daily fingerprints.
 
     Thresholds use the larger scatter of the two days: a step between days does not widen either.
@@ -165,7 +178,7 @@ def change_within(
     threshold_urad: float = PROCESSING_CHANGE_URAD,
     min_side: int = 2,
     reference: DayPrint | None = None,
-):
+) -> tuple[int, list[int], np.ndarray, np.ndarray] | None:
     """The first granule after a step within a time-ordered day, or None.
 
     For every split with at least *min_side* granules on each side, the granule-median fingerprints
@@ -209,7 +222,7 @@ class ProcessingChange:
         """The largest change of any FOR in either direction."""
         return float(np.nanmax(np.abs(np.concatenate([self.d_alpha_urad, self.d_beta_urad]))))
 
-    def describe(self, matches=()) -> str:
+    def describe(self, matches: Sequence[EpMatch] = ()) -> str:
         """One sentence for logs, events and messages; with the best-matching EP of *matches* if any."""
         text = (
             f"CrIS geolocation processing changed (LOS fingerprint): FOR {', '.join(map(str, self.fors))}, "
@@ -232,7 +245,10 @@ class ProcessingChange:
 
 
 def detect_change(
-    prints: list[GranulePrint], threshold_urad: float, reference: DayPrint | None = None, day=None
+    prints: list[GranulePrint],
+    threshold_urad: float,
+    reference: DayPrint | None = None,
+    day: dt.date | None = None,
 ) -> ProcessingChange | None:
     """The processing change of a day: a step within its time-ordered *prints* (from 4 granules), else a
     step against *reference* (the previous day's print; dated 00:00 UTC of *day*), else None."""
@@ -429,7 +445,11 @@ class FilesPrint:
         return doc
 
 
-def fingerprint_files(paths, ep_library=(), threshold_urad: float = PROCESSING_CHANGE_URAD) -> FilesPrint:
+def fingerprint_files(
+    paths: Sequence[str | os.PathLike[str]],
+    ep_library: Iterable[str | os.PathLike[str]] = (),
+    threshold_urad: float = PROCESSING_CHANGE_URAD,
+) -> FilesPrint:
     """Fingerprint the CrIS GEO files under *paths*, rank the EPs of *ep_library* (files or directories;
     empty: the packaged real EPs) against it and look for a step within the files. A
     :class:`~monitor.errors.DataError` when no file can be read."""

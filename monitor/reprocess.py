@@ -118,7 +118,7 @@ def reprocess(
     summary = ReprocessSummary()
     t0 = time.monotonic()
     task_cfg = cfg.model_copy(update={"assessment": cfg.assessment.model_copy(update={"workers": 1})})
-    with InstanceLock(cfg.state_dir, "reprocess"), Store(cfg.store.sqlite) as store:
+    with InstanceLock(cfg.state_dir, "reprocess"), Store(cfg.store.path) as store:
         store.interrupt_stale_runs()
         todo = []
         s = cfg.schedule

@@ -20,9 +20,10 @@ import os
 import signal
 import socket
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
+from types import FrameType
 
-from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED
+from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED, JobEvent
 from apscheduler.schedulers.blocking import BlockingScheduler
 from apscheduler.triggers.cron import CronTrigger
 
@@ -70,7 +71,7 @@ def sd_notify(message: str) -> bool:
 class Service:
     """Runs satellite-days for a configuration; the daemon adds the scheduler and signals."""
 
-    def __init__(self, cfg: Config, progress=None):
+    def __init__(self, cfg: Config, progress: Callable[[object], None] | None = None) -> None:
         self.cfg = cfg
         self.stop_event = threading.Event()
         self.stopped_by: int | None = None  # the signal that asked for the stop (the exit status is 128 + it)
@@ -82,7 +83,7 @@ class Service:
 
     def store(self) -> Store:
         """A new connection to the configured store (close it, or use it in ``with``)."""
-        return Store(self.cfg.store.sqlite)
+        return Store(self.cfg.store.path)
 
     def run(self, satellite: str, day: dt.date, today: dt.date | None = None) -> RunOutcome:
         """Run one satellite-day (health-tracked) as of *today* (default: the date now, UTC), then evaluate
@@ -161,14 +162,14 @@ class Service:
                 LOG.info("outbox: %s", report)
             return report
 
-    def recover(self):
+    def recover(self) -> None:
         """Mark runs left 'running' by a killed process as interrupted (call with the instance lock held)."""
         with self.store() as store:
             n = store.interrupt_stale_runs()
             if n:
                 LOG.warning("%d run(s) were cut short by a previous process; their days will be redone", n)
 
-    def handle_signals(self):
+    def handle_signals(self) -> None:
         """SIGTERM and SIGINT request a clean stop between steps."""
         for sig in (signal.SIGTERM, signal.SIGINT):
             signal.signal(sig, self._on_signal)
@@ -184,12 +185,12 @@ class Service:
                 break
             yield self.run(satellite, day, today)
 
-    def daily_job(self, satellite: str):
+    def daily_job(self, satellite: str) -> None:
         """The scheduled job of *satellite*: the days of its catch-up window."""
         for _ in self.catch_up(satellite):
             pass
 
-    def run_once(self, satellites, day: dt.date | None = None) -> list[RunOutcome]:
+    def run_once(self, satellites: Iterable[str], day: dt.date | None = None) -> list[RunOutcome]:
         """``crisgeo run``: under the instance lock, recover what a killed process left, then per satellite
         the given *day* or the days of the catch-up window; the outcomes. :class:`AlreadyRunning` when the
         daemon (or another run) holds the state directory."""
@@ -203,7 +204,7 @@ class Service:
             return outcomes
 
     # -- daemon
-    def add_jobs(self, scheduler):
+    def add_jobs(self, scheduler: BlockingScheduler) -> None:
         """The daemon's jobs: per satellite the daily run (catching up at start), the hourly alert
         evaluation, and (with publishing) the outbox timer."""
 
@@ -233,7 +234,7 @@ class Service:
             )
         scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
 
-    def start_endpoint(self, listen: str):
+    def start_endpoint(self, listen: str) -> Endpoint | None:
         """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
         if listen == "off":
             return None
@@ -244,7 +245,7 @@ class Service:
         report = self.cfg.report_dir if self.cfg.report_dir else None
         return Endpoint(*parse_listen(listen), self.metrics, self.health, report).start()
 
-    def daemon(self, listen: str | None = None):
+    def daemon(self, listen: str | None = None) -> None:
         """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``."""
         sch = self.cfg.schedule
         with InstanceLock(self.cfg.state_dir, "daemon"):
@@ -278,7 +279,7 @@ class Service:
                     endpoint.stop()
                 LOG.info("crisgeo daemon stopped")
 
-    def _on_signal(self, signum, frame):
+    def _on_signal(self, signum: int, frame: FrameType | None) -> None:
         LOG.info("signal %d: stopping after the current step", signum)
         sd_notify("STOPPING=1")
         self.stopped_by = signum
@@ -286,29 +287,33 @@ class Service:
         if self.scheduler is not None and self.scheduler.running:  # a second signal finds it stopped
             self.scheduler.shutdown(wait=False)
 
-    def _job_event(self, event):
-
+    def _job_event(self, event: JobEvent) -> None:
         kind = {EVENT_JOB_ERROR: EventKind.JOB_ERROR, EVENT_JOB_MISSED: EventKind.JOB_MISSED}.get(
             event.code, EventKind.JOB_SKIPPED
         )
+        # an error or a miss is a JobExecutionEvent (one run time); a skip (max instances) a
+        # JobSubmissionEvent (its run times)
+        when = getattr(event, "scheduled_run_times", None) or [getattr(event, "scheduled_run_time", None)]
         detail = {
             "job": event.job_id,
             "error": str(getattr(event, "exception", None) or kind.value),
-            "scheduled": str(event.scheduled_run_time),
+            "scheduled": ", ".join(map(str, when)),
         }
         LOG.error("scheduler: %s: %s (scheduled %s)", detail["job"], detail["error"], detail["scheduled"])
         with self.store() as store:
             store.add_event(kind, event.job_id.split("-", 1)[-1], detail)
             self.check_alerts(store)
 
-    def _start_watchdog(self):
+    def _start_watchdog(self) -> threading.Thread | None:
         usec = os.environ.get("WATCHDOG_USEC")
         if not usec:
             return None
         interval = int(usec) / 1e6 / 2
 
-        def ping():
-            reported = set()  # what is wrong, by source (a job, the scheduler): said once, not every ping
+        def ping() -> None:
+            reported: set[str] = (
+                set()
+            )  # what is wrong, by source (a job, the scheduler): said once, not every ping
             while not self.stop_event.wait(interval):
                 sched = self.scheduler
                 problems = (

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -57,7 +58,7 @@ def geolocate_granule(
     )
 
 
-def _geo_granules(path) -> list:
+def _geo_granules(path: str | Path) -> list[CrisGeoGranule]:
     granules = read_file(path, kinds=("cris_geo",))
     if not granules:
         raise GranuleError(path, GEO.data_group, "no CrIS GEO granule in the file")
@@ -85,7 +86,7 @@ class ForDistance:
 
 
 def compare_with_files(
-    ep: EngineeringPacket, paths, residuals: ResidualTable | OwnResiduals | None = None
+    ep: EngineeringPacket, paths: Iterable[str | Path], residuals: ResidualTable | OwnResiduals | None = None
 ) -> list[ForDistance]:
     """Per-FOR statistics of the distance between *ep*'s geolocation (with *residuals*, if given) and the
     files' latitude/longitude."""
@@ -113,7 +114,10 @@ def compare_with_files(
 
 
 def regeolocate_file(
-    ep: EngineeringPacket, path, out_dir, residuals: ResidualTable | OwnResiduals | None = None
+    ep: EngineeringPacket,
+    path: str | Path,
+    out_dir: str | Path,
+    residuals: ResidualTable | OwnResiduals | None = None,
 ) -> Path:
     """Write a copy of the GEO file *path* into *out_dir* with its geolocation computed from *ep* (and the
     per-FOR *residuals*, if given)."""
@@ -161,7 +165,7 @@ def regeolocate_file(
     return dst
 
 
-def _update_bounds(h5, k: int, view: GroundView) -> None:
+def _update_bounds(h5: h5py.File, k: int, view: GroundView) -> None:
     name = f"Data_Products/{GEO.collection}/{GEO.collection}_Gran_{k}"
     if name not in h5 or not np.any(np.isfinite(view.lat_rad)):
         return

@@ -27,6 +27,7 @@ from __future__ import annotations
 import datetime as dt
 import json
 import logging
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,9 +35,10 @@ import numpy as np
 
 from monitor.constants import N_FOR, PROCESSING_CHANGE_URAD, URAD
 from monitor.errors import DataError
-from monitor.fingerprint import day_print, granule_print
+from monitor.fingerprint import DayPrint, day_print, granule_print
 from monitor.geometry.frames import los_angles, los_from_angles
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles
+from monitor.sdr import CrisGeoGranule
 
 log = logging.getLogger(__name__)
 
@@ -65,14 +67,14 @@ class ResidualTable:
     fov5_alpha_urad: np.ndarray | None = None  # FOV-5 angles the learning granules showed (spacecraft frame)
     fov5_beta_urad: np.ndarray | None = None
 
-    def apply(self, los_spacecraft) -> np.ndarray:
+    def apply(self, los_spacecraft: np.ndarray) -> np.ndarray:
         """The LOS (30, 9, 3) (spacecraft frame) with every FOV of FOR k turned by the FOR's residual."""
         alpha, beta = los_angles(los_spacecraft)
         return los_from_angles(
             alpha + self.d_alpha_urad[:, None] * URAD, beta + self.d_beta_urad[:, None] * URAD
         )
 
-    def departure_urad(self, granule) -> tuple[np.ndarray, np.ndarray] | None:
+    def departure_urad(self, granule: CrisGeoGranule) -> tuple[np.ndarray, np.ndarray] | None:
         """Per FOR, the FOV-5 angles (in-track, cross-track; urad) *granule* shows minus those of the learning
         granules (NaN where either was not measured); None for a table written without them."""
         if self.fov5_alpha_urad is None:
@@ -81,7 +83,7 @@ class ResidualTable:
         p = granule_print(granule)
         return p.alpha_urad - self.fov5_alpha_urad, p.beta_urad - self.fov5_beta_urad
 
-    def table_for(self, granule) -> "ResidualTable":
+    def table_for(self, granule: CrisGeoGranule) -> "ResidualTable":
         """The table to apply to *granule*: this one. Warns when the granule departs from the learning
         granules by more than :data:`STALE_URAD` at some FOR, naming the FORs and the departures."""
         departure = self.departure_urad(granule)
@@ -121,7 +123,7 @@ class ResidualTable:
             "fors": rows,
         }
 
-    def write(self, path) -> Path:
+    def write(self, path: str | os.PathLike[str]) -> Path:
         """Write the table as JSON to *path* (through a temporary name)."""
         path = Path(path)
         tmp = path.with_name(path.name + ".part")
@@ -130,7 +132,7 @@ class ResidualTable:
         return path
 
 
-def learn(day, ep: EngineeringPacket) -> ResidualTable:
+def learn(day: DayPrint, ep: EngineeringPacket) -> ResidualTable:
     """The residual table of a fingerprint *day* (:class:`monitor.fingerprint.DayPrint`) against *ep*:
     measured minus modelled FOV-5 angles per FOR. FORs the fingerprint could not measure get 0."""
     alpha, beta = fov5_angles(ep)
@@ -157,15 +159,14 @@ class OwnResiduals:
     ep_in_force: EngineeringPacket
     satellite: str = ""
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "satellite", self.ep_in_force.satellite)
 
-    def table_for(self, granule) -> ResidualTable:
-
+    def table_for(self, granule: CrisGeoGranule) -> ResidualTable:
         return learn(day_print([granule_print(granule)]), self.ep_in_force)
 
 
-def load(path) -> ResidualTable:
+def load(path: str | os.PathLike[str]) -> ResidualTable:
     """Read a residual table; :class:`ResidualError` naming file, field and value when it is unusable."""
     path = Path(path)
     try:
@@ -213,7 +214,7 @@ def load(path) -> ResidualTable:
     )
 
 
-def _number(path, i: int, key: str, v, limit_urad: float) -> float:
+def _number(path: object, i: int, key: str, v: object, limit_urad: float) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or abs(v) > limit_urad:
         raise ResidualError(f"{path}: fors[{i}].{key}: {v!r} is not a number within +-{limit_urad:g} urad")
     return float(v)

@@ -20,17 +20,19 @@ import datetime as dt
 import html
 import json
 import os
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from monitor.changes import all_changes
+from monitor.changes import Change, all_changes
 from monitor.config import Config
 from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
+from monitor.records import Alert, ForSeries
 from monitor.report import plots
-from monitor.result import RELIABILITY_FLAGS
+from monitor.result import RELIABILITY_FLAGS, ForOffset
 from monitor.satellites import SATELLITES
 from monitor.store.alerts import AlertState
 from monitor.store.sqlite import Store
@@ -61,7 +63,12 @@ class ReportOptions:
     satellites: list = field(default_factory=list)
 
 
-def options_from_config(cfg: Config, satellites=None, since=None, until=None) -> ReportOptions:
+def options_from_config(
+    cfg: Config,
+    satellites: Iterable[str] | None = None,
+    since: dt.date | None = None,
+    until: dt.date | None = None,
+) -> ReportOptions:
     """Report options of a service configuration: the spec of its alert rules, its events calendar."""
     return ReportOptions(
         spec_km=cfg.alerts.spec_km,
@@ -72,7 +79,7 @@ def options_from_config(cfg: Config, satellites=None, since=None, until=None) ->
     )
 
 
-def _e(x) -> str:
+def _e(x: object) -> str:
     return html.escape(str(x))
 
 
@@ -90,7 +97,7 @@ def _page(title: str, body: str) -> str:
     )
 
 
-def _latest_table(fors, spec_km) -> str:
+def _latest_table(fors: Iterable[ForOffset], spec_km: float) -> str:
     """The latest day's FOR table (the columns of :data:`monitor.tables.REPORT`); unreliable FORs greyed,
     FORs beyond the specification marked."""
     cols = [FOR_COLUMNS[c] for c in REPORT]
@@ -111,7 +118,7 @@ def _blank_nan(text: str) -> str:
     return "" if text in ("nan", "-nan") else text
 
 
-def _alerts_table(rows) -> str:
+def _alerts_table(rows: Sequence[Alert]) -> str:
     if not rows:
         return "<p class=ok>No alert is firing.</p>"
     body = "".join(
@@ -123,7 +130,7 @@ def _alerts_table(rows) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def _changes_table(changes) -> str:
+def _changes_table(changes: Sequence[Change]) -> str:
     if not changes:
         return "<p class=note>No change known (calendar, granule metadata, LOS fingerprint).</p>"
     body = "".join(
@@ -138,7 +145,7 @@ def _changes_table(changes) -> str:
     )
 
 
-def _img(name, alt) -> str:
+def _img(name: str, alt: str) -> str:
     return f'<img src="{name}" alt="{_e(alt)}">'
 
 
@@ -301,7 +308,15 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
     return summary
 
 
-def _calibration(store: Store, satellite: str, name: str, series, marks, span: str, sat_dir: Path) -> str:
+def _calibration(
+    store: Store,
+    satellite: str,
+    name: str,
+    series: ForSeries,
+    marks: list[tuple[dt.datetime, str, str]],
+    span: str,
+    sat_dir: Path,
+) -> str:
     """The intercalibration section: the latest day's CrIS - VIIRS against the CrIS BT (the paper's
     Figure 15) and the bias and gain over time; what is shown, as HTML."""
     out = []
@@ -347,7 +362,7 @@ def _drop_figures_except(sat_dir: Path, keep: set) -> None:
             old.unlink(missing_ok=True)
 
 
-def build_report(store: Store, out_dir, opts: ReportOptions) -> Path:
+def build_report(store: Store, out_dir: str | os.PathLike[str], opts: ReportOptions) -> Path:
     """Write the report for *opts.satellites* into *out_dir*; returns the index path.
 
     Pages are written under temporary names and moved into place, so a reader never sees half a page.

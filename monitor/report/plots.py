@@ -8,7 +8,9 @@ from __future__ import annotations
 import datetime as dt
 import os
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -16,15 +18,23 @@ matplotlib.use("Agg")
 import matplotlib.dates as mdates  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from numpy.typing import ArrayLike  # noqa: E402
 
 from monitor.constants import FOV_DIAMETER_URAD, N_FOR  # noqa: E402
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+PathLike = str | os.PathLike[str]
+Marks = Sequence[tuple[dt.datetime, str, str]]  # known changes: (time, instrument, description)
 
 FORS = np.arange(1, N_FOR + 1)
 DPI = 90
 CHANGE_COLOURS = {"cris": "tab:purple", "viirs": "tab:green", "common": "tab:brown"}
 
 
-def _save(fig, path: Path) -> Path:
+def _save(fig: Figure, path: Path) -> Path:
     """Write the figure as PNG through a temporary name: the served report never shows half an image."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.part")
@@ -34,7 +44,16 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def latest_km(path, in_track_km, cross_track_km, sigma_in_km, sigma_cross_km, reliable, spec_km, title):
+def latest_km(
+    path: PathLike,
+    in_track_km: ArrayLike,
+    cross_track_km: ArrayLike,
+    sigma_in_km: ArrayLike,
+    sigma_cross_km: ArrayLike,
+    reliable: ArrayLike,
+    spec_km: float,
+    title: str,
+) -> Path:
     """Per-FOR offsets on the ground with 1-sigma bars and the +-spec band (Wang et al. 2017 figure 8)."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.6), sharey=True, constrained_layout=True)
     for ax, v, s, name in (
@@ -69,7 +88,14 @@ def latest_km(path, in_track_km, cross_track_km, sigma_in_km, sigma_cross_km, re
     return _save(fig, Path(path))
 
 
-def latest_urad(path, d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_urad, title):
+def latest_urad(
+    path: PathLike,
+    d_alpha_urad: np.ndarray,
+    d_beta_urad: np.ndarray,
+    sigma_alpha_urad: np.ndarray,
+    sigma_beta_urad: np.ndarray,
+    title: str,
+) -> Path:
     """Per-FOR LOS offset angles in urad with a % of FOV axis (Wang et al. 2017 figure 7)."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.4), constrained_layout=True)
     for ax, v, s, name in (
@@ -93,7 +119,7 @@ def latest_urad(path, d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_ur
 MIN_SPAN_DAYS = 7  # a short history is drawn on a week: one day is a column, not a day stretched over hours
 
 
-def _days_axis(ax, days) -> None:
+def _days_axis(ax: Axes, days: Sequence[dt.date]) -> None:
     """Limit the date axis to the days shown (each its whole day, at least :data:`MIN_SPAN_DAYS` ending
     at the last): matplotlib would widen a lone day to years, and an image's to hours."""
     x1 = mdates.date2num(days[-1] + dt.timedelta(hours=12))
@@ -104,16 +130,24 @@ def _days_axis(ax, days) -> None:
     ax.xaxis.set_major_formatter(mdates.ConciseDateFormatter(locator))
 
 
-def _mark_changes(ax, changes, label=True):
+def _mark_changes(ax: Axes, changes: Marks, label: bool = True) -> None:
     seen = set()
     for when, instrument, _description in changes:
         colour = CHANGE_COLOURS.get(instrument, "0.3")
         lab = f"{instrument} change" if label and instrument not in seen else None
         seen.add(instrument)
-        ax.axvline(when, color=colour, lw=1.2, ls=":", label=lab)
+        ax.axvline(mdates.date2num(when), color=colour, lw=1.2, ls=":", label=lab)
 
 
-def heatmaps(path, days, in_track_km, cross_track_km, spec_km, changes, title):
+def heatmaps(
+    path: PathLike,
+    days: Sequence[dt.date],
+    in_track_km: np.ndarray,
+    cross_track_km: np.ndarray,
+    spec_km: float,
+    changes: Marks,
+    title: str,
+) -> Path:
     """FOR x day heat maps of in-track and cross-track km; *days* (n,) dates, arrays (n, 30), NaN gaps."""
     days = [dt.datetime(d.year, d.month, d.day) for d in days]
     x0, x1 = (
@@ -148,7 +182,17 @@ def heatmaps(path, days, in_track_km, cross_track_km, spec_km, changes, title):
     return _save(fig, Path(path))
 
 
-def trend_lines(path, days, fors, in_track_km, cross_track_km, spec_km, changes, alerts, title):
+def trend_lines(
+    path: PathLike,
+    days: Sequence[dt.date],
+    fors: Sequence[int],
+    in_track_km: np.ndarray,
+    cross_track_km: np.ndarray,
+    spec_km: float,
+    changes: Marks,
+    alerts: Sequence[dt.datetime],
+    title: str,
+) -> Path:
     """Chosen FORs over time with the spec band; change lines and alert markers (triangles)."""
     days = [dt.datetime(d.year, d.month, d.day) for d in days]
     fig, axes = plt.subplots(2, 1, figsize=(11, 5.6), sharex=True, constrained_layout=True)
@@ -177,7 +221,15 @@ def trend_lines(path, days, fors, in_track_km, cross_track_km, spec_km, changes,
     return _save(fig, Path(path))
 
 
-def cost_contour(path, cube_k, for_index, step_urad, d_alpha_urad, d_beta_urad, title):
+def cost_contour(
+    path: PathLike,
+    cube_k: np.ndarray,
+    for_index: int,
+    step_urad: float,
+    d_alpha_urad: float,
+    d_beta_urad: float,
+    title: str,
+) -> Path:
     """Cost surface G of one FOR over the 21 x 21 offsets with its minimum marked (figure 5c).
 
     *cube_k* (2n+1, 2n+1): index i in-track, j cross-track; axes in urad.
@@ -201,7 +253,15 @@ def cost_contour(path, cube_k, for_index, step_urad, d_alpha_urad, d_beta_urad, 
     return _save(fig, Path(path))
 
 
-def calibration_bins(path, low_k, n, mean_k, std_k, width_k, title):
+def calibration_bins(
+    path: PathLike,
+    low_k: ArrayLike,
+    n: ArrayLike,
+    mean_k: ArrayLike,
+    std_k: ArrayLike,
+    width_k: float,
+    title: str,
+) -> Path:
     """CrIS minus VIIRS I5 BT against the CrIS BT in bins *width_k* wide at the optimum, with the bins'
     standard deviation and sample count (Wang et al. 2017 figure 15)."""
     low_k, n, mean_k, std_k = (np.asarray(a, float) for a in (low_k, n, mean_k, std_k))
@@ -218,7 +278,14 @@ def calibration_bins(path, low_k, n, mean_k, std_k, width_k, title):
     return _save(fig, Path(path))
 
 
-def calibration_trend(path, days, bias_k, gain_pct, changes, title):
+def calibration_trend(
+    path: PathLike,
+    days: Sequence[dt.date],
+    bias_k: np.ndarray,
+    gain_pct: np.ndarray,
+    changes: Marks,
+    title: str,
+) -> Path:
     """The daily CrIS-VIIRS bias at the reference temperature and the gain difference (median over the
     reliable FORs, the band between their quartiles), with the known changes."""
     days = [dt.datetime(d.year, d.month, d.day) for d in days]

@@ -35,6 +35,7 @@ real NOAA-20 GCRSO granules of tests/data/real and on the simulator (docs/jpss-f
 
 from __future__ import annotations
 
+import datetime as dt
 import math
 
 import numba
@@ -45,8 +46,9 @@ from monitor.geometry import orbit, wgs84
 from monitor.geometry.inverse import satellite_from_fov
 from monitor.satellites import SATELLITES
 from monitor.sdr.errors import GranuleError
+from monitor.sdr.granules import CrisGeoGranule, GeoGranule, Granule, GranuleMeta, GranuleRef, ViirsGeoGranule
 from monitor.sdr.iet import iet_to_datetime
-from monitor.sdr.products import UINT16_FILL_MIN
+from monitor.sdr.products import UINT16_FILL_MIN, Product
 
 GRANULE_ID_EPOCH_IET_US = 1_698_019_238_000_000  # docs/jpss-formats.md 1.2
 SCAN_US = {
@@ -78,7 +80,13 @@ def granule_id_time_us(granule_id: str) -> int | None:
     return GRANULE_ID_EPOCH_IET_US + int(digits) * 100_000
 
 
-def check_identity(path, name: str, meta, text_times, file_orbit: int | None) -> None:
+def check_identity(
+    path: GranuleRef,
+    name: str,
+    meta: GranuleMeta,
+    text_times: tuple[dt.datetime, dt.datetime] | None,
+    file_orbit: int | None,
+) -> None:
     """Granule ID, orbit number, text dates and scan count against the IET times (*name* is the
     ``_Gran_k`` group; *text_times* the (start, end) parsed from the text attributes, or None)."""
     sat = SATELLITES[meta.platform]
@@ -118,7 +126,7 @@ def check_identity(path, name: str, meta, text_times, file_orbit: int | None) ->
                 )
 
 
-def check_cris_span(path, name: str, meta) -> None:
+def check_cris_span(path: GranuleRef, name: str, meta: GranuleMeta) -> None:
     """A CrIS granule of n scans spans more than n - 1 and at most n scan periods."""
     span = meta.end_iet_us - meta.start_iet_us
     if not (meta.n_scans - 1) * CRIS_SCAN_US < span <= meta.n_scans * CRIS_SCAN_US:
@@ -129,13 +137,13 @@ def check_cris_span(path, name: str, meta) -> None:
         )
 
 
-def _scans_with_data(granule, key: str, rows_per_scan: int) -> np.ndarray:
+def _scans_with_data(granule: Granule, key: str, rows_per_scan: int) -> np.ndarray:
     data = getattr(granule, key)
     finite = np.isfinite(data).reshape(data.shape[0] // rows_per_scan, -1)
     return finite.any(axis=1)
 
 
-def check_viirs_scan_count(path, product, granule, key: str) -> None:
+def check_viirs_scan_count(path: GranuleRef, product: Product, granule: Granule, key: str) -> None:
     """VIIRS arrays hold 48 scans: those past N_Number_Of_Scans are fill, the last counted one is not."""
     has = _scans_with_data(granule, key, product.rows_per_scan)
     n = granule.meta.n_scans
@@ -145,7 +153,7 @@ def check_viirs_scan_count(path, product, granule, key: str) -> None:
         raise GranuleError(path, name, f"scan {first + 1} holds data, but N_Number_Of_Scans is {n}")
 
 
-def check_scan_times(path, product, granule, has_data: np.ndarray) -> None:
+def check_scan_times(path: GranuleRef, product: Product, granule: GeoGranule, has_data: np.ndarray) -> None:
     """StartTime and MidTime of every scan with data: present, increasing by whole scan periods, MidTime
     within a period after StartTime, inside the granule."""
     period = SCAN_US[product.kind]
@@ -182,7 +190,7 @@ def check_scan_times(path, product, granule, has_data: np.ndarray) -> None:
         )
 
 
-def check_ephemeris(path, product, granule, has_data: np.ndarray) -> None:
+def check_ephemeris(path: GranuleRef, product: Product, granule: GeoGranule, has_data: np.ndarray) -> None:
     """Orbit radius and speed of the named satellite; attitude small, smooth and measured."""
     sat = SATELLITES[granule.meta.platform]
     g = product.data_group
@@ -228,7 +236,7 @@ def check_ephemeris(path, product, granule, has_data: np.ndarray) -> None:
             raise GranuleError(path, name, "exactly zero in every scan: not a measured attitude")
 
 
-def check_line_of_sight(path, product, granule) -> None:
+def check_line_of_sight(path: GranuleRef, product: Product, granule: CrisGeoGranule) -> None:
     """CrIS GEO: ground point + range along zenith/azimuth = the spacecraft at the FOR time."""
     valid = granule.valid
     if not valid.any():
@@ -265,7 +273,7 @@ def check_line_of_sight(path, product, granule) -> None:
         )
 
 
-def check_nadir(path, product, granule, has_data: np.ndarray) -> None:
+def check_nadir(path: GranuleRef, product: Product, granule: ViirsGeoGranule, has_data: np.ndarray) -> None:
     """VIIRS GEO: the middle pixel of each scan lies below the spacecraft at the scan's MidTime."""
     rows = product.rows_per_scan
     centre = granule.lat_rad.shape[1] // 2
@@ -274,7 +282,7 @@ def check_nadir(path, product, granule, has_data: np.ndarray) -> None:
         return
     row = scans * rows + rows // 2
     lat, lon = granule.lat_rad[row, centre], granule.lon_rad[row, centre]
-    h = granule.height_m[row, centre]
+    h = granule.height_m[row, centre] if granule.height_m is not None else np.zeros(len(row))
     ok = np.isfinite(lat) & np.isfinite(lon)
     if not ok.any():
         return
@@ -293,7 +301,7 @@ def check_nadir(path, product, granule, has_data: np.ndarray) -> None:
 
 
 @numba.njit(cache=True, nogil=True)
-def _first_leap(lat_rad, lon_rad, limit_rad):  # pragma: no cover - compiled
+def _first_leap(lat_rad: np.ndarray, lon_rad: np.ndarray, limit_rad: float) -> tuple[int, int, float]:
     """(row, column, step_rad) of the first pair of neighbours in a row farther apart than *limit_rad*
     on the sphere, (-1, -1, 0) if none. The step is hypot(d_lat, d_lon cos(lat)), d_lon across the
     antimeridian; the cosine only where d_lon alone could exceed the limit (near a pole)."""
@@ -310,7 +318,7 @@ def _first_leap(lat_rad, lon_rad, limit_rad):  # pragma: no cover - compiled
     return -1, -1, 0.0
 
 
-def check_pixel_steps(path, product, granule) -> None:
+def check_pixel_steps(path: GranuleRef, product: Product, granule: GeoGranule) -> None:
     """VIIRS GEO: neighbouring pixels of a row lie within PIXEL_STEP_KM of each other on the ground.
 
     A corrupt latitude or longitude (a flipped byte of a float) moves its pixel hundreds of km or more; no
@@ -325,7 +333,7 @@ def check_pixel_steps(path, product, granule) -> None:
         )
 
 
-def check_raw_counts(path, name: str, raw: np.ndarray) -> None:
+def check_raw_counts(path: GranuleRef, name: str, raw: np.ndarray) -> None:
     """Scaled VIIRS BT (uint16): raw count 0 is the scaled minimum, which no scene fills, and no real scene
     piles up on one count."""
     counts = np.bincount(raw.ravel(), minlength=UINT16_FILL_MIN)[:UINT16_FILL_MIN]  # fills left out
@@ -346,7 +354,7 @@ def check_raw_counts(path, name: str, raw: np.ndarray) -> None:
         )
 
 
-def check_spectra(path, name: str, radiance: np.ndarray) -> None:
+def check_spectra(path: GranuleRef, name: str, radiance: np.ndarray) -> None:
     """CrIS: no FOV spectrum exactly zero in every channel."""
     dead = np.all(radiance == 0, axis=-1)
     if dead.any():

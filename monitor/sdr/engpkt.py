@@ -11,13 +11,17 @@ text with the two scene-mirror angle lists replaced and a provenance comment add
 from __future__ import annotations
 
 import json
+import os
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Iterable
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import yaml
+from numpy.typing import ArrayLike
 
 from monitor.constants import N_FOR, N_FOV, URAD
 from monitor.errors import DataError
@@ -51,11 +55,11 @@ PACKAGED = {s.short: s.ep_file for s in SATELLITES.values() if s.ep_file}
 class EngPktError(DataError):
     """A malformed EP file; the message names the file, the field and the value."""
 
-    def __init__(self, path, field, problem):
+    def __init__(self, path: object, field: str, problem: str) -> None:
         super().__init__(f"{path}: {field}: {problem}")
 
 
-def _numbers(path, name, text, n):
+def _numbers(path: object, name: str, text: object, n: int | None) -> float | list[float]:
     try:
         values = [float(v) for v in str(text).replace(",", " ").split()]
     except ValueError:
@@ -72,7 +76,7 @@ def _numbers(path, name, text, n):
 
 
 class _XmlSource:
-    def __init__(self, path, text):
+    def __init__(self, path: Path, text: str) -> None:
         self.path = path
         try:
             self.root = ET.fromstring(text)
@@ -81,7 +85,7 @@ class _XmlSource:
         if self.root.tag != "EngPkt":
             raise EngPktError(path, "root element", f"{self.root.tag!r}, expected 'EngPkt'")
 
-    def get(self, name):
+    def get(self, name: str) -> str:
         node = self.root.find(name)
         if node is None or node.text is None:
             raise EngPktError(self.path, name, "missing")
@@ -89,11 +93,11 @@ class _XmlSource:
 
 
 class _YamlSource:
-    def __init__(self, path, doc):
+    def __init__(self, path: Path, doc: object) -> None:
         self.path = path
         self.doc = doc
 
-    def get(self, name):
+    def get(self, name: str) -> str:
         node = self.doc
         for part in name.split("/"):
             if not isinstance(node, dict) or part not in node:
@@ -102,9 +106,10 @@ class _YamlSource:
         return " ".join(str(v) for v in node) if isinstance(node, list) else str(node)
 
 
-def _read_angles(src, path) -> dict:
-    kw = {}
+def _read_angles(src: _XmlSource | _YamlSource, path: Path) -> dict[str, Any]:
+    kw: dict[str, Any] = {}
     for field, where, n in _ANGLES:
+        values: float | list[float] | list[float | list[float]]
         if isinstance(where, tuple):
             group, parts = where
             values = [_numbers(path, f"{group}/{p}", src.get(f"{group}/{p}"), None) for p in parts]
@@ -115,14 +120,16 @@ def _read_angles(src, path) -> dict:
     return kw
 
 
-def _build(path, kw, satellite, version, provenance) -> EngineeringPacket:
+def _build(
+    path: Path, kw: dict[str, Any], satellite: str, version: str, provenance: dict
+) -> EngineeringPacket:
     try:
         return EngineeringPacket(satellite=satellite, version=version, provenance=provenance, **kw)
     except ValueError as exc:
         raise EngPktError(path, "angles", str(exc)) from None
 
 
-def load_ep(path, satellite: str | None = None) -> EngineeringPacket:
+def load_ep(path: str | os.PathLike[str], satellite: str | None = None) -> EngineeringPacket:
     """Read an EP from a decoded EP XML file or a YAML file of the same content.
 
     *satellite* (npp, j01, j02) overrides the satellite found in the file (XML: by InstrumentId).
@@ -178,7 +185,7 @@ def packaged_path(satellite: str) -> Path:
     return Path(str(resources.files("monitor.data.ep") / PACKAGED[satellite]))
 
 
-def _urad(values):
+def _urad(values: ArrayLike) -> list[float | int]:
     out = np.round(np.asarray(values, float) / URAD, 6)
     return [float(v) if v != int(v) else int(v) for v in np.atleast_1d(out)]
 
@@ -206,7 +213,7 @@ def ep_to_yaml_doc(ep: EngineeringPacket) -> dict:
     return doc
 
 
-def _subtree(doc, path):
+def _subtree(doc: dict, path: str) -> dict:
     node = doc
     for part in path.split("/"):
         node = node.setdefault(part, {})
@@ -217,7 +224,9 @@ def _provenance_comment(ep: EngineeringPacket) -> str:
     return json.dumps(ep.provenance, indent=1, sort_keys=True).replace("--", "- -")
 
 
-def save_ep(ep: EngineeringPacket, out_path, like=None) -> Path:
+def save_ep(
+    ep: EngineeringPacket, out_path: str | os.PathLike[str], like: str | os.PathLike[str] | None = None
+) -> Path:
     """Write *ep* in the format of the file *like* (XML or YAML; YAML when *like* is None).
 
     XML: the text of *like* with ActualCrosstrackAngleRoll and ActualIntrackAnglePitch replaced (whole
@@ -247,7 +256,7 @@ def save_ep(ep: EngineeringPacket, out_path, like=None) -> Path:
     return out
 
 
-def load_library(paths) -> tuple[dict, list]:
+def load_library(paths: Iterable[str | os.PathLike[str]]) -> tuple[dict[str, EngineeringPacket], list[str]]:
     """EPs from files and directories (``*.xml``, ``*.yaml``, ``*.yml``): ({name: EP}, [problems]).
 
     With no paths the library is the real EPs shipped in the package; unreadable files are reported,

@@ -155,7 +155,10 @@ class ViirsGeoGranule:
             self.height_m = np.zeros_like(self.lat_rad)
 
 
-_GRANULE_TYPES = {
+Granule = CrisGeoGranule | CrisSdrGranule | ViirsSdrGranule | ViirsGeoGranule
+GeoGranule = CrisGeoGranule | ViirsGeoGranule
+
+_GRANULE_TYPES: dict[str, type[Granule]] = {
     "cris_geo": CrisGeoGranule,
     "cris_sdr": CrisSdrGranule,
     "viirs_sdr": ViirsSdrGranule,

@@ -7,7 +7,9 @@ by time. Files that cannot be used are returned with their reason, never dropped
 from __future__ import annotations
 
 import datetime as dt
+import os
 from collections import defaultdict
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,9 +22,12 @@ from monitor.sdr.readers import read_metadata
 
 COVER_MARGIN = dt.timedelta(seconds=10)
 CONTIGUOUS = dt.timedelta(seconds=5)  # VIIRS granules this close in time form one continuous swath
+ByPrefix = defaultdict[str, dict[str, tuple[Path, GranuleMeta]]]  # product prefix -> key -> (path, meta)
 
 
-def neighbours(viirs_all: list, granule) -> tuple:
+def neighbours(
+    viirs_all: list[GranuleFiles], granule: GranuleFiles
+) -> tuple[GranuleFiles | None, GranuleFiles | None]:
     """The VIIRS granules just before and just after *granule* in a continuous swath (None if absent)."""
     before = next(
         (v for v in viirs_all if abs(v.end - granule.start) < CONTIGUOUS and v.key != granule.key), None
@@ -60,17 +65,17 @@ class CasePlan:
     """CrIS granules with the VIIRS granules covering each, and every file or granule left out with why."""
 
     satellite: str
-    cris: list = field(default_factory=list)  # GranuleFiles
-    viirs: dict = field(default_factory=dict)  # cris key -> list[GranuleFiles], time-ordered
-    viirs_all: list = field(default_factory=list)  # every paired VIIRS granule, time-ordered
-    skipped: list = field(default_factory=list)  # (path or key, reason)
+    cris: list[GranuleFiles] = field(default_factory=list)
+    viirs: dict[str, list[GranuleFiles]] = field(default_factory=dict)  # by cris key, time-ordered
+    viirs_all: list[GranuleFiles] = field(default_factory=list)  # every paired VIIRS granule, time-ordered
+    skipped: list[tuple[str, str]] = field(default_factory=list)  # (path or key, reason)
 
 
 class PlanError(DataError):
     """Inputs that cannot form an assessment at all (no files, mixed satellites)."""
 
 
-def find_files(paths) -> list[Path]:
+def find_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
     """Every ``*.h5`` file under *paths* (files or directories), sorted; missing paths raise PlanError."""
     out = []
     for p in map(Path, paths):
@@ -83,13 +88,13 @@ def find_files(paths) -> list[Path]:
     return sorted(set(out))
 
 
-def plan(paths) -> CasePlan:
+def plan(paths: Sequence[str | os.PathLike[str]]) -> CasePlan:
     """Pair the granule files found under *paths* into a :class:`CasePlan`."""
     files = find_files(paths)
     if not files:
         raise PlanError(f"no .h5 files in {', '.join(map(str, paths))}")
-    skipped = []
-    by_prefix: defaultdict[str, dict] = defaultdict(dict)  # prefix -> key -> (path, meta)
+    skipped: list[tuple[str, str]] = []
+    by_prefix: ByPrefix = defaultdict(dict)
     platforms: defaultdict[str, int] = defaultdict(int)
     for path in files:
         name = parse_name(path.name)
@@ -140,7 +145,9 @@ def assemble(satellite: str, cris: list, viirs: list, skipped: list) -> CasePlan
     return result
 
 
-def granule_files(key: str, sdr: GranuleRef, geo: GranuleRef, sdr_meta=None) -> GranuleFiles:
+def granule_files(
+    key: str, sdr: GranuleRef, geo: GranuleRef, sdr_meta: GranuleMeta | None = None
+) -> GranuleFiles:
     """The :class:`GranuleFiles` of one single-granule SDR file and its GEO file, reading the metadata not
     given (*sdr_meta*, e.g. from a granule already read). :class:`GranuleError` for a file holding other
     than one granule of its product."""
@@ -159,7 +166,7 @@ def granule_files(key: str, sdr: GranuleRef, geo: GranuleRef, sdr_meta=None) -> 
     return GranuleFiles(key, sdr, geo, metas[0], metas[1])
 
 
-def partners_differ(sdr_meta, geo_meta) -> str | None:
+def partners_differ(sdr_meta: GranuleMeta, geo_meta: GranuleMeta) -> str | None:
     """Why an SDR granule and the GEO granule paired with it by name are not the same granule, or None:
     IDPS gives both the same granule ID and the same beginning and end (docs/jpss-formats.md 1.1)."""
     if sdr_meta.granule_id != geo_meta.granule_id:
@@ -175,12 +182,18 @@ def partners_differ(sdr_meta, geo_meta) -> str | None:
     return None
 
 
-def _pair(by_prefix, sdr_prefixes, geo_prefixes, skipped) -> list[GranuleFiles]:
-    sdrs: dict[str, tuple] = {}
+def _pair(
+    by_prefix: ByPrefix,
+    sdr_prefixes: tuple[str, ...],
+    geo_prefixes: tuple[str, ...],
+    skipped: list[tuple[str, str]],
+) -> list[GranuleFiles]:
+    """The SDR granules of *by_prefix* paired with their GEO granules; the unpaired go to *skipped*."""
+    sdrs: dict[str, tuple[Path, GranuleMeta]] = {}
     for p in sdr_prefixes:
         for key, v in by_prefix.get(p, {}).items():
             sdrs.setdefault(key, v)
-    geos: dict[str, tuple] = {}
+    geos: dict[str, tuple[Path, GranuleMeta]] = {}
     for p in geo_prefixes:
         for key, v in by_prefix.get(p, {}).items():
             geos.setdefault(key, v)

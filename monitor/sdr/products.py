@@ -173,7 +173,7 @@ PRODUCTS = {
 }
 
 
-def prefixes(kind: str) -> tuple:
+def prefixes(kind: str) -> tuple[str, ...]:
     """The prefixes of the products of *kind* (cris_sdr, cris_geo, viirs_sdr, viirs_geo), preferred first."""
     return tuple(p.prefix for p in PRODUCTS.values() if p.kind == kind)
 

@@ -8,9 +8,11 @@ always reserves 48 scans). Every problem is raised as :class:`GranuleError` nami
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Iterator
+import os
+from collections.abc import Collection, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import h5py
 import numpy as np
@@ -20,8 +22,12 @@ from monitor.sdr import consistency
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.granules import (
     _GRANULE_TYPES,
+    CrisGeoGranule,
+    CrisSdrGranule,
+    Granule,
     GranuleMeta,
     GranuleRef,
+    ViirsGeoGranule,
     as_ref,
 )
 from monitor.sdr.iet import iet_to_datetime
@@ -31,19 +37,20 @@ from monitor.sdr.products import (
     IET_LIMITS_US,
     PRODUCTS,
     UINT16_FILL_MIN,
+    Field,
     Product,
     cris_lw_wavenumbers_cm1,
     is_float_fill,
 )
 
 
-def _text(value) -> str:
+def _text(value: object) -> str:
     a = np.asarray(value).ravel()
     v = a[0] if a.size else b""
     return v.decode("ascii", "replace").strip() if isinstance(v, bytes) else str(v)
 
 
-def _texts(value) -> tuple[str, ...]:
+def _texts(value: object) -> tuple[str, ...]:
     if value is None:
         return ()
     return tuple(
@@ -57,18 +64,15 @@ def _when(date: str, time: str) -> dt.datetime:
     return dt.datetime.strptime(f"{date} {t}", "%Y%m%d %H%M%S.%f").replace(tzinfo=dt.timezone.utc)
 
 
-def _number(path, name, value, kind=int):
-    """One numeric attribute value, or GranuleError naming it (non-numeric, empty, non-finite)."""
+def _number(path: GranuleRef, name: str, value: object) -> int:
+    """One integer attribute value, or GranuleError naming it (non-numeric, empty)."""
     try:
         v = np.asarray(value).ravel()[0]
         if isinstance(v, bytes):
             v = v.decode("ascii")
-        out = kind(v)
+        return int(v)
     except (IndexError, ValueError, TypeError, UnicodeDecodeError, OverflowError):
         raise GranuleError(path, name, f"not a number: {_text(value)[:40]!r}") from None
-    if kind is float and not np.isfinite(out):
-        raise GranuleError(path, name, f"not finite: {out}")
-    return out
 
 
 def _granule_meta(path: GranuleRef, h5: h5py.File, product: Product, k: int, platform: str) -> GranuleMeta:
@@ -136,7 +140,7 @@ def _granule_meta(path: GranuleRef, h5: h5py.File, product: Product, k: int, pla
     return meta
 
 
-def _check_raw(path, name: str, raw, f, rows: int) -> None:
+def _check_raw(path: GranuleRef, name: str, raw: np.ndarray | h5py.Dataset, f: Field, rows: int) -> None:
     """Dtype family and full shape of a dataset (an array, or an HDF5 dataset not yet read) against the
     product table."""
     kinds = {"float": "f", "scaled": "uf", "time": "i", "flags": "u"}[f.kind]
@@ -150,7 +154,7 @@ def _check_raw(path, name: str, raw, f, rows: int) -> None:
         raise GranuleError(path, name, f"shape {raw.shape}, expected {expected}")
 
 
-def _check_values(path, name: str, data: np.ndarray, f) -> None:
+def _check_values(path: GranuleRef, name: str, data: np.ndarray, f: Field) -> None:
     """Physical limits of every value that is not a fill (file units, after scaling)."""
     if f.limits is not None:
         if data.dtype.kind == "f":  # fmin/fmax skip NaN (fill) without a copy; all NaN gives NaN
@@ -170,7 +174,7 @@ def _check_values(path, name: str, data: np.ndarray, f) -> None:
             raise GranuleError(path, name, f"vector length {bad:.6g} outside {f.norm[0]:g}..{f.norm[1]:g}")
 
 
-def _clean(path, dataset: str, raw: np.ndarray, f) -> np.ndarray:
+def _clean(path: GranuleRef, dataset: str, raw: np.ndarray, f: Field) -> np.ndarray:
     if f.kind == "float":
         # Per-scan and per-FOV fields become float64; VIIRS pixel arrays and spectra stay float32 (memory).
         wide = raw.dtype == np.float64 or (raw.ndim < 4 and f.per != "row")
@@ -186,7 +190,7 @@ def _clean(path, dataset: str, raw: np.ndarray, f) -> np.ndarray:
     return raw
 
 
-def _factors(path, h5, group: str, f, n_gran: int) -> np.ndarray:
+def _factors(path: GranuleRef, h5: h5py.File, group: str, f: Field, n_gran: int) -> np.ndarray:
     """(scale, offset) per granule: present, finite, scale > 0."""
     name = f"{group}/{f.factors}"
     if name not in h5:
@@ -205,7 +209,7 @@ def _factors(path, h5, group: str, f, n_gran: int) -> np.ndarray:
     return fac
 
 
-def _fill_of(f, dtype) -> float | int:
+def _fill_of(f: Field, dtype: np.dtype) -> float | int:
     """The value standing for "not read" in a per-row array: a fill the field's cleaning turns to NaN
     (floats, scaled counts) or the largest flag (never the good value 0)."""
     if dtype.kind == "f":
@@ -213,7 +217,9 @@ def _fill_of(f, dtype) -> float | int:
     return UINT16_FILL_MIN if f.kind == "scaled" else np.iinfo(dtype).max
 
 
-def _read_array(path, h5: h5py.File, name: str, f, rows: int, kept: slice | None) -> np.ndarray:
+def _read_array(
+    path: GranuleRef, h5: h5py.File, name: str, f: Field, rows: int, kept: slice | None
+) -> np.ndarray:
     """A dataset checked against the product table (dtype, shape) before any of its data is read; with
     *kept* (a row slice), only those rows are read and the others hold a fill value."""
     try:
@@ -278,7 +284,8 @@ def _product_granules(
         arrays[key] = parts
     out = []
     for k, meta in enumerate(metas):
-        kwargs = {key: (v[k] if v is not None else None) for key, v in arrays.items()}
+        # the product table names the fields: each granule type takes its own as keywords
+        kwargs: dict[str, Any] = {key: (v[k] if v is not None else None) for key, v in arrays.items()}
         radiance = kwargs.get("radiance_lw")
         if product.kind == "cris_sdr" and radiance is not None:  # a required field: never None here
             kwargs["wavenumber_cm1"] = cris_lw_wavenumbers_cm1(radiance.shape[-1])
@@ -290,28 +297,28 @@ def _product_granules(
     return out
 
 
-def _check_physics(path, product: Product, granule) -> None:
+def _check_physics(path: GranuleRef, product: Product, granule: Granule) -> None:
     """The relations between fields a genuine granule obeys (:mod:`monitor.sdr.consistency`)."""
     key = _MAIN_FIELD[product.kind]
-    if product.kind == "cris_sdr":
+    if isinstance(granule, CrisSdrGranule):
         consistency.check_spectra(
             path, f"{product.data_group}/{product.fields[key].dataset}", granule.radiance_lw
         )
     if product.scans_reserved:
         consistency.check_viirs_scan_count(path, product, granule, key)
-    if product.kind not in ("cris_geo", "viirs_geo"):
+    if not isinstance(granule, (CrisGeoGranule, ViirsGeoGranule)):
         return
     has_data = np.isfinite(granule.lat_rad).reshape(len(granule.start_time_us), -1).any(axis=1)  # per scan
     consistency.check_scan_times(path, product, granule, has_data)
     consistency.check_ephemeris(path, product, granule, has_data)
-    if product.kind == "cris_geo":
+    if isinstance(granule, CrisGeoGranule):
         consistency.check_line_of_sight(path, product, granule)
     else:
         consistency.check_nadir(path, product, granule, has_data)
         consistency.check_pixel_steps(path, product, granule)
 
 
-def _check_times(path, product: Product, granule) -> None:
+def _check_times(path: GranuleRef, product: Product, granule: Granule) -> None:
     """CrIS FOR times increase and lie within the granule (10 s of margin: the IDPS granule bounds are
     nominal); the per-scan times of both GEO products are checked with the physics
     (:func:`monitor.sdr.consistency.check_scan_times`)."""
@@ -337,7 +344,7 @@ def _check_times(path, product: Product, granule) -> None:
 _MAIN_FIELD = {"cris_geo": "lat_rad", "cris_sdr": "radiance_lw", "viirs_sdr": "bt_k", "viirs_geo": "lat_rad"}
 
 
-def _check_not_all_fill(path, product: Product, granule) -> None:
+def _check_not_all_fill(path: GranuleRef, product: Product, granule: Granule) -> None:
     key = _MAIN_FIELD[product.kind]
     if not np.any(np.isfinite(getattr(granule, key))):
         raise GranuleError(
@@ -345,7 +352,7 @@ def _check_not_all_fill(path, product: Product, granule) -> None:
             f"{product.data_group}/{product.fields[key].dataset}",
             f"granule {granule.meta.granule_id or '?'} holds only fill values",
         )
-    if product.kind in ("viirs_geo", "cris_geo"):
+    if isinstance(granule, (ViirsGeoGranule, CrisGeoGranule)):
         lat_ok, lon_ok = np.isfinite(granule.lat_rad), np.isfinite(granule.lon_rad)
         if np.any(lat_ok != lon_ok):
             n = int(np.sum(lat_ok != lon_ok))
@@ -354,7 +361,7 @@ def _check_not_all_fill(path, product: Product, granule) -> None:
                 f"{product.data_group}/Longitude",
                 f"fill at {n} pixel(s) where Latitude is set, or set where it is fill",
             )
-    if product.kind == "viirs_geo" and "height_m" in product.fields:
+    if isinstance(granule, ViirsGeoGranule) and granule.height_m is not None and "height_m" in product.fields:
         _check_height(
             path,
             f"{product.data_group}/{product.fields['height_m'].dataset}",
@@ -364,7 +371,9 @@ def _check_not_all_fill(path, product: Product, granule) -> None:
         )
 
 
-def _check_height(path, name, lat_rad, lon_rad, height_m) -> None:
+def _check_height(
+    path: GranuleRef, name: str, lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray
+) -> None:
     """A terrain-corrected pixel needs its height: fill only where the pixel itself is fill."""
     located = np.isfinite(lat_rad) & np.isfinite(lon_rad)
     missing = located & ~np.isfinite(height_m)
@@ -385,7 +394,7 @@ def _check_height(path, name, lat_rad, lon_rad, height_m) -> None:
         )
 
 
-def _failed(path: GranuleRef, fh) -> GranuleError | None:
+def _failed(path: GranuleRef, fh: object) -> GranuleError | None:
     """The error for a read in place whose transport failed (its reason names the key), else None."""
     why = getattr(fh, "failure", None)
     return GranuleError(path, "(range read)", why) if why else None
@@ -411,7 +420,7 @@ def _opened(path: GranuleRef) -> Iterator[h5py.File]:
 
 
 @contextmanager
-def _reading(path, fh=None):
+def _reading(path: GranuleRef, fh: object = None) -> Iterator[None]:
     """Errors h5py raises on corrupt metadata once a file is open become a GranuleError naming the file."""
     try:
         yield
@@ -454,7 +463,7 @@ def _platform(path: GranuleRef, h5: h5py.File) -> str:
     return platform
 
 
-def _check_name_time(path: GranuleRef, metas) -> None:
+def _check_name_time(path: GranuleRef, metas: Sequence[GranuleMeta]) -> None:
     """The file name's start time is its first granule's (to the tenth of a second; 60 s allowed)."""
     parsed = parse_name(path.name)
     if parsed is None or not metas:
@@ -483,7 +492,11 @@ def products_in(path: GranuleRef, h5: h5py.File) -> list[Product]:
     return found
 
 
-def read_file(path, kinds=None, scans: slice | None = None) -> list:
+def read_file(
+    path: str | os.PathLike[str] | GranuleRef,
+    kinds: Collection[str] | None = None,
+    scans: slice | None = None,
+) -> list:  # of Granule: the caller knows which *kinds* it asked for
     """All granules of the supported products in *path* (optionally only those of *kinds*), every field
     checked against the product table; any problem is a :class:`GranuleError` naming file and field.
 
@@ -500,7 +513,7 @@ def read_file(path, kinds=None, scans: slice | None = None) -> list:
         return out
 
 
-def read_metadata(path) -> list[GranuleMeta]:
+def read_metadata(path: str | os.PathLike[str] | GranuleRef) -> list[GranuleMeta]:
     """Granule metadata of every product in *path*, without reading the arrays."""
     path = as_ref(path)
     with _opened(path) as h5:
@@ -520,7 +533,7 @@ def read_metadata(path) -> list[GranuleMeta]:
         return metas
 
 
-def read_viirs_geo_scan(path, scan: int):
+def read_viirs_geo_scan(path: str | os.PathLike[str] | GranuleRef, scan: int) -> tuple[np.ndarray, ...]:
     """(lat_rad, lon_rad, height_m) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the
     end); height_m is zero for the ellipsoid product."""
     path = as_ref(path)
@@ -551,7 +564,7 @@ def read_viirs_geo_scan(path, scan: int):
         return tuple(out)
 
 
-def read_scan_start_us(path) -> np.ndarray:
+def read_scan_start_us(path: str | os.PathLike[str] | GranuleRef) -> np.ndarray:
     """The start time (IET us) of every scan of a VIIRS GEO file, read alone (a few hundred bytes):
     enough to choose the scans a CrIS granule can reach before any pixel is read."""
     path = as_ref(path)

@@ -18,8 +18,9 @@ import socket
 import threading
 import time
 import weakref
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import Any
 
 import requests
 import urllib3
@@ -30,23 +31,24 @@ class DeadlinePassed(Exception):
     """The watchdog cut the request: its deadline passed."""
 
 
-def _tracked(connection_cls, sockets: weakref.WeakSet):
+def _tracked(
+    connection_cls: type[urllib3.connection.HTTPConnection], sockets: weakref.WeakSet
+) -> type[urllib3.connection.HTTPConnection]:
     """A urllib3 connection class that records every socket it opens in *sockets*."""
 
-    class Tracked(connection_cls):
-        def connect(self):
-            super().connect()
-            sockets.add(self.sock)
+    def connect(self: urllib3.connection.HTTPConnection) -> None:
+        connection_cls.connect(self)
+        sockets.add(self.sock)
 
-    return Tracked
+    return type("Tracked", (connection_cls,), {"connect": connect})
 
 
 class _TrackingAdapter(HTTPAdapter):
-    def __init__(self, sockets: weakref.WeakSet):
+    def __init__(self, sockets: weakref.WeakSet) -> None:
         self._sockets = sockets
         super().__init__(max_retries=0)  # the one retry layer is the caller's
 
-    def init_poolmanager(self, *args, **kwargs):
+    def init_poolmanager(self, *args: Any, **kwargs: Any) -> None:
         super().init_poolmanager(*args, **kwargs)
         http = _tracked(urllib3.connection.HTTPConnection, self._sockets)
         https = _tracked(urllib3.connection.HTTPSConnection, self._sockets)
@@ -60,7 +62,7 @@ class BoundedSession:
     """A :class:`requests.Session` (identity encoding, no redirects followed by itself, no retries)
     whose requests a watchdog can cut at a deadline."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self._sockets: weakref.WeakSet = weakref.WeakSet()
         self.session = requests.Session()
         adapter = _TrackingAdapter(self._sockets)
@@ -95,7 +97,7 @@ class BoundedSession:
         if fired.is_set():
             raise DeadlinePassed
 
-    def get(self, url: str, **kwargs) -> requests.Response:
+    def get(self, url: str, **kwargs: Any) -> requests.Response:
         """A plain GET on the session (call it under :meth:`guard`)."""
         return self.session.get(url, allow_redirects=False, **kwargs)
 
@@ -107,7 +109,9 @@ class StallWatch:
     last *window_s* seconds are fewer than ``min_rate_b_s * window_s``.
     """
 
-    def __init__(self, min_rate_b_s: float, window_s: float, clock=time.monotonic):
+    def __init__(
+        self, min_rate_b_s: float, window_s: float, clock: Callable[[], float] = time.monotonic
+    ) -> None:
         self.min_bytes = min_rate_b_s * window_s
         self.window_s = window_s
         self.clock = clock

@@ -34,7 +34,7 @@ import re
 import threading
 import time
 import xml.etree.ElementTree as ET
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from urllib.parse import urljoin, urlsplit
 
@@ -79,7 +79,9 @@ def _retry_after_s(value: str | None) -> float | None:
 class NoddSource:
     """Granules of the NODD bucket of each satellite, cached under *cache_dir*."""
 
-    def __init__(self, cfg: SourceConfig, cache_dir: Path, sleep=time.sleep):
+    def __init__(
+        self, cfg: SourceConfig, cache_dir: Path, sleep: Callable[[float], object] = time.sleep
+    ) -> None:
         self.cfg = cfg
         self.cache_dir = Path(cache_dir)
         self._local = threading.local()
@@ -113,7 +115,7 @@ class NoddSource:
             raise SourceError(f"no NODD bucket configured for {satellite}")
         return self.cfg.endpoint.format(bucket=bucket).rstrip("/")
 
-    def start_day(self, should_stop=None):
+    def start_day(self, should_stop: Callable[[], bool] | None = None) -> None:
         """Start a run: reset the day's budget and the run deadline, apply the cache retention (age, then
         size: the least recently used files go until the cache holds at most ``cache_max_mb``); the run's
         *should_stop* is polled between listing pages."""
@@ -161,7 +163,13 @@ class NoddSource:
         return SourceError(f"{what}: no complete answer within {self.cfg.timeout_s:g} s (timeout_s)")
 
     def _get(
-        self, url: str, what: str, params=None, read_timeout_s=None, headers=None, expect: int = 200
+        self,
+        url: str,
+        what: str,
+        params: dict[str, str] | None = None,
+        read_timeout_s: float | None = None,
+        headers: dict[str, str] | None = None,
+        expect: int = 200,
     ) -> requests.Response:
         """GET *url* with the one retry layer; the response has status *expect* (200, or 206 for a range)
         with its headers read within ``timeout_s`` (and the run deadline), its body still to read (the
@@ -277,7 +285,7 @@ class NoddSource:
         raise SourceError(f"{what}: more than {self.cfg.max_list_pages} pages")
 
     @staticmethod
-    def _listed(c, folder: str, prefix: str) -> ListedFile | None:
+    def _listed(c: ET.Element, folder: str, prefix: str) -> ListedFile | None:
         key = c.findtext(f"{S3_NS}Key") or ""
         size = (c.findtext(f"{S3_NS}Size") or "").strip()
         etag = _MD5.fullmatch((c.findtext(f"{S3_NS}ETag") or "").strip())
@@ -293,7 +301,7 @@ class NoddSource:
             )
         return f
 
-    def list_day(self, satellite: str, day: dt.date, products) -> list[ListedFile]:
+    def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
         """The day's files of *products* in the satellite's bucket (the newest creation per granule)."""
         out = []
         for product in products:
@@ -378,7 +386,14 @@ class NoddSource:
             raise SourceError(f"{f.name}: MD5 {md5.hexdigest()} differs from the listing's ETag {f.md5}")
         return n
 
-    def _body(self, r, what: str, limit: int | None, sink, md5=None) -> StallWatch:
+    def _body(
+        self,
+        r: requests.Response,
+        what: str,
+        limit: int | None,
+        sink: Callable[[bytes], object],
+        md5: hashlib._Hash | None = None,
+    ) -> StallWatch:
         """Read the body of *r* into *sink*, at most *limit* bytes, cut by a stall (``min_rate_kb_s`` over
         ``stall_window_s``) and by the run deadline; returns the transfer's watch (its total)."""
         watch = StallWatch(self.cfg.min_rate_kb_s * 1e3, self.cfg.stall_window_s)

@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import os
 import sqlite3
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from types import TracebackType
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
@@ -25,6 +27,9 @@ from monitor.records import Event, ForSeries, GranuleRow, Run, SelectionRow
 from monitor.result import MEASURED_FIELDS, AssessmentResult, DifferenceBin, ForOffset
 from monitor.store.alerts import AlertState
 from monitor.vocabulary import DONE, EventKind, RunStatus
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 UTC = dt.timezone.utc
 
@@ -114,7 +119,7 @@ def utc_now() -> dt.datetime:
     return dt.datetime.now(UTC)
 
 
-def _num(v):
+def _num(v: object) -> object:
     return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
 
 
@@ -130,7 +135,9 @@ class Store:
     never re-initialised: it holds the history and the alert state.
     """
 
-    def __init__(self, path, create: bool = True, clock: Callable[[], dt.datetime] = utc_now):
+    def __init__(
+        self, path: str | os.PathLike[str], create: bool = True, clock: Callable[[], dt.datetime] = utc_now
+    ) -> None:
         self.path = Path(path)
         self.clock = clock  # the time stamped on what is written (runs, events, the outbox)
         if not self.path.exists():
@@ -163,7 +170,7 @@ class Store:
             raise StoreError(f"{self.path}: not a usable crisgeo store ({exc})") from None
 
     @staticmethod
-    def _connect(path):
+    def _connect(path: str | os.PathLike[str]) -> sqlite3.Connection:
         db = sqlite3.connect(path, timeout=30, isolation_level=None)
         db.row_factory = sqlite3.Row
         db.execute("PRAGMA journal_mode=WAL")
@@ -171,7 +178,7 @@ class Store:
         db.execute("PRAGMA foreign_keys=ON")
         return db
 
-    def _create(self):
+    def _create(self) -> None:
         tmp = self.path.with_name(self.path.name + ".new")
         tmp.unlink(missing_ok=True)
         self.db = self._connect(tmp)
@@ -180,14 +187,14 @@ class Store:
         self.db.close()
         tmp.replace(self.path)
 
-    def close(self):
+    def close(self) -> None:
         """Close the connection."""
         self.db.close()
 
     def __enter__(self) -> "Store":
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     # -- schema
@@ -196,7 +203,7 @@ class Store:
         """The schema version of the file (SQLite user_version)."""
         return self.db.execute("PRAGMA user_version").fetchone()[0]
 
-    def _migrate(self):
+    def _migrate(self) -> None:
         version = self.schema_version
         if version > len(MIGRATIONS):
             raise StoreError(
@@ -229,7 +236,7 @@ class Store:
                 "INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, ?)",
                 (satellite, day.isoformat(), self._now(), RunStatus.RUNNING),
             )
-            return cur.lastrowid
+            return int(cur.lastrowid or 0)  # (set by an INSERT)
 
     def finish_run(
         self,
@@ -238,12 +245,14 @@ class Store:
         reason: str | None = None,
         n_granules: int = 0,
         summary: dict | None = None,
-    ):
+    ) -> None:
         """Close run *run_id* with *status* and *reason*."""
         with self.transaction():
             self._finish(run_id, status, reason, n_granules, summary)
 
-    def _finish(self, run_id, status, reason, n_granules, summary):
+    def _finish(
+        self, run_id: int, status: RunStatus, reason: str | None, n_granules: int, summary: dict | None
+    ) -> None:
         self.db.execute(
             "UPDATE runs SET finished=?, status=?, reason=?, n_granules=?, summary=? WHERE id=?",
             (self._now(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id),
@@ -327,7 +336,7 @@ class Store:
         result: AssessmentResult,
         selection: list,
         outbox_lines: dict,
-    ):
+    ) -> None:
         """Replace the day's results, granules, selection and cube, queue its points, close the run, in one
         transaction."""
         d = day.isoformat()
@@ -455,7 +464,9 @@ class Store:
         r = self.db.execute("SELECT MAX(day) FROM results WHERE satellite=?", (satellite,)).fetchone()[0]
         return dt.date.fromisoformat(r) if r else None
 
-    def to_xarray(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None):
+    def to_xarray(
+        self, satellite: str, since: dt.date | None = None, until: dt.date | None = None
+    ) -> xr.Dataset:
         """The per-FOR results of *satellite* as a CF-style xarray Dataset (:mod:`monitor.export`)."""
 
         return to_xarray(self, satellite, since, until)
@@ -507,7 +518,7 @@ class Store:
             )
         ]
 
-    def cost_cube(self, satellite: str, day: dt.date):
+    def cost_cube(self, satellite: str, day: dt.date) -> tuple[np.ndarray, float] | None:
         """(cube_k (30, 2n+1, 2n+1), step_urad) of the day's assessment, or None."""
         r = self.db.execute(
             "SELECT half_steps, step_urad, cube FROM cost_cubes WHERE satellite=? AND day=?",
@@ -519,7 +530,7 @@ class Store:
         return np.frombuffer(r["cube"], np.float32).reshape(-1, m, m), r["step_urad"]
 
     # -- fingerprints
-    def save_fingerprint(self, satellite: str, day: dt.date, body: dict):
+    def save_fingerprint(self, satellite: str, day: dt.date, body: dict) -> None:
         """Store the LOS fingerprint of *satellite* on *day* (replacing one computed before)."""
         with self.transaction():
             self.db.execute(
@@ -527,7 +538,7 @@ class Store:
                 (satellite, day.isoformat(), self._now(), json.dumps(body)),
             )
 
-    def fingerprint(self, satellite: str, before: dt.date):
+    def fingerprint(self, satellite: str, before: dt.date) -> tuple[dt.date, dict] | None:
         """(day, body) of the latest fingerprint strictly before *before*, or None."""
         r = self.db.execute(
             "SELECT day, body FROM fingerprints WHERE satellite=? AND day < ? ORDER BY day DESC LIMIT 1",
@@ -536,7 +547,7 @@ class Store:
         return None if r is None else (dt.date.fromisoformat(r["day"]), json.loads(r["body"]))
 
     # -- events (failures, misses: the alerting layer reads them)
-    def add_event(self, kind: "EventKind", satellite: str | None, detail: dict):
+    def add_event(self, kind: "EventKind", satellite: str | None, detail: dict) -> None:
         """Record an event; *detail* is stored as JSON."""
         with self.transaction():
             self.db.execute(
@@ -550,7 +561,7 @@ class Store:
         return [Event.from_row(r) for r in self.db.execute(q, (EventKind(kind).value,) if kind else ())]
 
     # -- outbox
-    def queue_lines(self, target: str, satellite: str | None, lines: list):
+    def queue_lines(self, target: str, satellite: str | None, lines: list) -> None:
         """Queue points not tied to a day's results (e.g. change annotations)."""
         with self.transaction():
             for line in lines:
@@ -573,12 +584,12 @@ class Store:
         q = "SELECT COUNT(*) FROM outbox" + (" WHERE target=?" if target else "")
         return self.db.execute(q, (target,) if target else ()).fetchone()[0]
 
-    def outbox_delivered(self, ids: list):
+    def outbox_delivered(self, ids: list) -> None:
         """Remove delivered points."""
         with self.transaction():
             self.db.executemany("DELETE FROM outbox WHERE id=?", [(i,) for i in ids])
 
-    def outbox_failed(self, ids: list, error: str):
+    def outbox_failed(self, ids: list, error: str) -> None:
         """Count a failed attempt and its error on the points."""
         with self.transaction():
             self.db.executemany(
@@ -588,18 +599,20 @@ class Store:
 
 
 class _Transaction:
-    def __init__(self, db, path: Path):
+    def __init__(self, db: sqlite3.Connection, path: Path) -> None:
         self.db = db
         self.path = path
         self.depth_outer = False
 
-    def __enter__(self):
+    def __enter__(self) -> sqlite3.Connection:
         self.depth_outer = not self.db.in_transaction
         if self.depth_outer:
             self.db.execute("BEGIN IMMEDIATE")
         return self.db
 
-    def __exit__(self, exc_type, exc, tb):
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> Literal[False]:
         if not self.depth_outer:
             return False
         try:
@@ -612,6 +625,6 @@ class _Transaction:
             self.db.execute("ROLLBACK")
         if isinstance(exc, sqlite3.OperationalError) and exc.sqlite_errorcode == sqlite3.SQLITE_FULL:
             raise StoreError(f"{self.path}: no room left on its file system ({exc}); nothing was written")
-        if exc_type is None:  # a COMMIT that failed otherwise
+        if exc_type is None and exc is not None:  # a COMMIT that failed otherwise
             raise exc
         return False
