@@ -100,7 +100,8 @@ RESIDUAL_ARGS = (
     ),
 )
 RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices' repr
-COMMANDS: dict[str, tuple[Handler, str, tuple]] = {}  # name -> (handler, help, arguments), in the order of ``crisgeo --help``
+# name -> (handler, help, arguments), in the order of ``crisgeo --help``
+COMMANDS: dict[str, tuple[Handler, str, tuple]] = {}
 
 
 def command(
