@@ -20,7 +20,7 @@ from monitor.geometry.perturb import perturbed_los_sbf
 from monitor.sdr import read_file
 from monitor.sdr.pairing import CasePlan, plan
 from monitor.simulate.case import simulate_case
-from monitor.vocabulary import Cost
+from monitor.vocabulary import Cost, Kernel
 
 
 def peak_rss_mb(who: int = resource.RUSAGE_SELF) -> float:
@@ -77,7 +77,7 @@ def _pyresample_reference(
 
 def run_bench(args: argparse.Namespace) -> int:
     """``crisgeo bench``: simulate (or take --data), warm the kernels, time each stage, print; exit status."""
-    cfg = AssessmentConfig(cost=Cost(args.cost))
+    cfg = AssessmentConfig(cost=Cost(args.cost), kernel=Kernel(args.kernel))
     with tempfile.TemporaryDirectory() as tmp:
         data = Path(args.data) if args.data else Path(tmp)
         t0 = time.perf_counter()
@@ -96,8 +96,8 @@ def run_bench(args: argparse.Namespace) -> int:
         n_fov = sum(gr.n_fovs for gr in result.granules)
         print(
             f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(offsets_rad(cfg)) ** 2} "
-            f"perturbations, cost {cfg.cost} (simulation {t_sim:.1f} s and kernel compile/load "
-            f"{t_jit:.1f} s, not counted)"
+            f"perturbations, cost {cfg.cost}, kernel {cfg.kernel} (simulation {t_sim:.1f} s and kernel "
+            f"compile/load {t_jit:.1f} s, not counted)"
         )
         for stage in ("read", "geometry", "spectral", "collocation", "cost"):
             t = timings.get(stage, 0.0)

@@ -893,6 +893,12 @@ def cmd_report(args: argparse.Namespace) -> int:
         default=ASSESSMENT.cost.value,
         help="the cost to time (assessment.cost)",
     ),
+    arg(
+        "--kernel",
+        choices=tuple(k.value for k in Kernel),
+        default=ASSESSMENT.kernel.value,
+        help="the FOV weighting to time (assessment.kernel)",
+    ),
 )
 def cmd_bench(args: argparse.Namespace) -> int:
     """crisgeo bench: time each stage on a simulated case."""

@@ -82,10 +82,10 @@ def test_bench_prints_every_stage_and_the_assessment_memory():
     """`crisgeo bench` on a one-granule simulated case, in its own process so its memory is its own."""
     import re
 
-    run = run_crisgeo("bench", "--granules", "1", "--workers", "1")
+    run = run_crisgeo("bench", "--granules", "1", "--workers", "1", "--kernel", "top-hat")
     assert run.returncode == 0, run.stderr
     out = run.stdout
-    assert "case: 1 CrIS granules, 1080 FOVs x 441 perturbations" in out
+    assert "case: 1 CrIS granules, 1080 FOVs x 441 perturbations, cost regression, kernel top-hat" in out
     for stage in ("read", "geometry", "spectral", "collocation", "cost", "total"):
         secs, rate = re.search(rf"^  {stage} +([0-9.]+) s +([0-9.]+|inf) FOVs/s", out, re.M).groups()
         assert float(secs) > 0 or stage in ("spectral", "cost")
