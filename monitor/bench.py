@@ -20,7 +20,6 @@ from monitor.geometry.perturb import perturbed_los_sbf
 from monitor.sdr import read_file
 from monitor.sdr.pairing import CasePlan, plan
 from monitor.simulate.case import simulate_case
-from monitor.vocabulary import Cost, Kernel
 
 
 def peak_rss_mb(who: int = resource.RUSAGE_SELF) -> float:
@@ -75,9 +74,9 @@ def _pyresample_reference(
     return time.perf_counter() - t0, int(valid.sum())
 
 
-def run_bench(args: argparse.Namespace) -> int:
-    """``crisgeo bench``: simulate (or take --data), warm the kernels, time each stage, print; exit status."""
-    cfg = AssessmentConfig(cost=Cost(args.cost), kernel=Kernel(args.kernel))
+def run_bench(args: argparse.Namespace, cfg: AssessmentConfig) -> int:
+    """``crisgeo bench``: simulate (or take --data), warm the kernels, assess with *cfg* (on
+    ``cfg.workers`` threads), time each stage, print; exit status."""
     with tempfile.TemporaryDirectory() as tmp:
         data = Path(args.data) if args.data else Path(tmp)
         t0 = time.perf_counter()
@@ -91,7 +90,7 @@ def run_bench(args: argparse.Namespace) -> int:
         t0 = time.perf_counter()
         case = plan([data])
         timings["read"] = time.perf_counter() - t0
-        result = assess_plan(case, cfg, timings=timings, workers=args.workers)
+        result = assess_plan(case, cfg, timings=timings, workers=cfg.workers)
         wall = time.perf_counter() - t0
         n_fov = sum(gr.n_fovs for gr in result.granules)
         print(
@@ -104,7 +103,7 @@ def run_bench(args: argparse.Namespace) -> int:
             print(f"  {stage:<12} {t:8.2f} s  {n_fov / t if t else float('inf'):10.0f} FOVs/s")
         print(f"  {'total':<12} {wall:8.2f} s  {n_fov / wall:10.0f} FOVs/s")
         print("(the next granule is read in a thread while one is computed: the stages add up to more)")
-        print(f"peak memory: {peak_rss_mb():.0f} MB ({args.workers} threads in one process)")
+        print(f"peak memory: {peak_rss_mb():.0f} MB ({cfg.workers} threads in one process)")
         if sim_counted:
             print("(the main process's peak includes the simulation: this system cannot reset the count)")
         if args.pyresample:

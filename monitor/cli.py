@@ -85,6 +85,17 @@ def _day(text: str) -> dt.date:
         raise argparse.ArgumentTypeError(f"not a date (YYYY-MM-DD): {text!r}") from None
 
 
+def _count(text: str) -> int:
+    """A whole number of at least 1 (granules, processes)."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"{n}: at least 1")
+    return n
+
+
 def arg(*names: str, **options: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
     """One argument of a subcommand: the add_argument call, as data."""
     return names, options
@@ -121,7 +132,7 @@ def command(
     "write simulated CrIS/VIIRS granules with an injected LOS error",
     arg("--out", required=True, help="output directory"),
     arg("--satellite", choices=tuple(SATELLITES), default="j01"),
-    arg("--granules", type=int, default=14, help="consecutive CrIS granules (default 14, as the paper)"),
+    arg("--granules", type=_count, default=14, help="consecutive CrIS granules (default 14, as the paper)"),
     arg("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file"),
     arg("--seed", type=int, default=0),
     arg("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)"),
@@ -571,7 +582,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     arg("--until", type=_day, required=True, help="last day, YYYY-MM-DD"),
     arg("--satellite", choices=tuple(SATELLITES)),
     arg("--scheduler", help="address of a running Dask scheduler (tcp://HOST:8786); default a local cluster"),
-    arg("--workers", type=int, default=2, help="processes of the local cluster (default 2)"),
+    arg("--workers", type=_count, default=2, help="processes of the local cluster (default 2)"),
     arg("--force", action="store_true", help="redo the days already done"),
 )
 def cmd_reprocess(args: argparse.Namespace) -> int:
@@ -583,8 +594,6 @@ def cmd_reprocess(args: argparse.Namespace) -> int:
     sats = _satellites(cfg, args.satellite)
     _period(args.since, args.until)
     _in_mission(sats, {"--since": args.since, "--until": args.until})
-    if args.workers < 1:
-        raise BadInput(f"--workers: {args.workers}, at least 1")
     summary = run_reprocess(cfg, args.since, args.until, sats, args.scheduler, args.workers, args.force)
     for line in summary.lines():
         print(line)
@@ -878,7 +887,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 @command(
     "bench",
     "time each stage on a simulated case; print FOVs/s and peak memory",
-    arg("--granules", type=int, default=14),
+    arg("--granules", type=_count, default=14),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
     arg(
@@ -903,8 +912,15 @@ def cmd_report(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     """crisgeo bench: time each stage on a simulated case."""
     from monitor.bench import run_bench
+    from monitor.config import ConfigError
+    from monitor.config_file import section_of
 
-    return run_bench(args)
+    try:  # the options are the assessment section's keys, checked by the configuration model
+        cfg = section_of("assessment", cost=args.cost, kernel=args.kernel, workers=args.workers)
+    except ConfigError as exc:
+        raise BadInput(f"--cost/--kernel/--workers: {exc}") from None
+    assert isinstance(cfg, AssessmentConfig)
+    return run_bench(args, cfg)
 
 
 class _PrintReference(argparse.Action):

@@ -246,7 +246,6 @@ def test_under_systemd_lines_carry_their_priority_and_no_second_timestamp(tmp_pa
             "--since 2024-03-05 is after --until 2024-03-01",
         ),
         (["--since", "2024-03-01", "--until", "2024-03-02", "--satellite", "npp"], "'npp' is not in"),
-        (["--since", "2024-03-01", "--until", "2024-03-02", "--workers", "0"], "--workers: 0"),
     ],
 )
 def test_reprocess_refuses_bad_input_in_one_line(tmp_path, capsys, extra, message):

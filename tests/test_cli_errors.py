@@ -145,6 +145,31 @@ def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys,
 @pytest.mark.parametrize(
     "argv,message",
     [
+        (
+            ["bench", "--workers", "0"],
+            "crisgeo bench: --cost/--kernel/--workers: assessment.workers: 0 is not",
+        ),
+        (["bench", "--granules", "0"], "argument --granules: 0: at least 1"),
+        (["simulate", "--out", "{tmp}/x", "--granules", "-3"], "argument --granules: -3: at least 1"),
+        (["reprocess", "--since", "2024-06-01", "--workers", "0"], "argument --workers: 0: at least 1"),
+        (
+            ["reprocess", "--since", "2024-06-01", "--workers", "two"],
+            "argument --workers: not a whole number",
+        ),
+    ],
+)
+def test_counts_and_threads_below_one_are_bad_input(tmp_path, argv, message):
+    """A count of granules, processes or threads below one is refused before anything runs: exit 2, one
+    line naming the option (they were taken before: zero granules simulated, a bench on "0 threads")."""
+    run = run_crisgeo(*(a.format(tmp=tmp_path) for a in argv))
+    assert run.returncode == 2
+    assert message in run.stderr.strip().splitlines()[-1]
+    assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize(
+    "argv,message",
+    [
         (["run", "--date", "2010-01-01"], "--date 2010-01-01: before NOAA-20's launch on 2017-11-18"),
         (["run", "--date", "2030-01-01"], "--date 2030-01-01: after today"),
         (
