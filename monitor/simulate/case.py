@@ -10,6 +10,11 @@ the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 
 The CrIS FOV sees the scene through the paper's top-hat cone, or through a smooth radially symmetric
 spatial response (``SimulationSpec.cris_response``, :mod:`monitor.footprint`), one for all FOVs or one per
 FOV: the CrIS radiance is then the response-weighted mean of the scene out to where the response ends.
+
+Why one module of ~690 lines: it is one instrument pair in flight; the CrIS and the VIIRS granules share
+the spacecraft's state, attitude and scene at every instant. The file layouts are data
+(:mod:`monitor.simulate.jpss_h5`, :mod:`monitor.simulate.complete`), the scene and terrain their own
+modules.
 """
 
 from __future__ import annotations

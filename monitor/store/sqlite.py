@@ -4,8 +4,11 @@ It holds the runs (the ledger of processed days), the per-FOR results with their
 used with their metadata (aux file lists, software versions), the scene-selection decisions, the cost
 cubes, service events, the alert state, silences and delivery queue (:mod:`monitor.store.alerts`), and the
 outbox of time-series points still to publish. All of the service's SQL lives in this package. A day's
-results are
-replaced in one transaction, so a re-run never duplicates and a crash never leaves half a day.
+results are replaced in one transaction, so a re-run never duplicates and a crash never leaves half a day.
+
+Why one module of ~630 lines: the schema, its migrations and the reads and writes of its tables are one
+idea, the file's format; split, two modules would each know the other's columns (the alert tables, which
+the alerts use alone, are in :mod:`monitor.store.alerts`).
 """
 
 from __future__ import annotations
