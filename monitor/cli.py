@@ -814,8 +814,15 @@ def cmd_fingerprint(args: argparse.Namespace) -> int:
     import json
 
     from monitor import fingerprint as fpr
+    from monitor.config import ConfigError
+    from monitor.config_file import section_of
 
-    fp = fpr.fingerprint_files(args.paths, args.ep_library or [], args.threshold_urad)
+    try:  # the options are the fingerprint section's keys, checked by the configuration model
+        f = section_of("fingerprint", threshold_urad=args.threshold_urad, ep_library=args.ep_library or [])
+    except ConfigError as exc:
+        raise BadInput(f"--threshold-urad/--ep-library: {exc}") from None
+    assert isinstance(f, FingerprintConfig)
+    fp = fpr.fingerprint_files(args.paths, f.ep_library, f.threshold_urad)
     if args.json:
         print(json.dumps(fp.to_dict(), indent=1))
     else:

@@ -156,11 +156,16 @@ def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys,
             ["reprocess", "--since", "2024-06-01", "--workers", "two"],
             "argument --workers: not a whole number",
         ),
+        (
+            ["fingerprint", "{tmp}", "--threshold-urad", "-5"],
+            "fingerprint.threshold_urad: -5.0 is not within 0.1..10000",
+        ),
     ],
 )
-def test_counts_and_threads_below_one_are_bad_input(tmp_path, argv, message):
-    """A count of granules, processes or threads below one is refused before anything runs: exit 2, one
-    line naming the option (they were taken before: zero granules simulated, a bench on "0 threads")."""
+def test_options_out_of_range_are_bad_input(tmp_path, argv, message):
+    """A count of granules, processes or threads below one, a negative threshold: refused before anything
+    runs, exit 2, the last line naming the option (they were taken before: zero granules simulated, a bench
+    on "0 threads", a fingerprint flagging every FOR)."""
     run = run_crisgeo(*(a.format(tmp=tmp_path) for a in argv))
     assert run.returncode == 2
     assert message in run.stderr.strip().splitlines()[-1]
