@@ -85,15 +85,30 @@ def _day(text: str) -> dt.date:
         raise argparse.ArgumentTypeError(f"not a date (YYYY-MM-DD): {text!r}") from None
 
 
-def _count(text: str) -> int:
-    """A whole number of at least 1 (granules, processes)."""
+def _whole(least: int) -> Callable[[str], int]:
+    """The argparse type of a whole number of at least *least* (a count of granules or processes, a seed)."""
+
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+        if n < least:
+            raise argparse.ArgumentTypeError(f"{n}: at least {least}")
+        return n
+
+    return parse
+
+
+def _longitude(text: str) -> float:
+    """A longitude in degrees, -180..180."""
     try:
-        n = int(text)
+        lon = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"{n}: at least 1")
-    return n
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not -180.0 <= lon <= 180.0:  # NaN fails too
+        raise argparse.ArgumentTypeError(f"{text}: not a longitude within -180..180 deg")
+    return lon
 
 
 def arg(*names: str, **options: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
@@ -132,9 +147,11 @@ def command(
     "write simulated CrIS/VIIRS granules with an injected LOS error",
     arg("--out", required=True, help="output directory"),
     arg("--satellite", choices=tuple(SATELLITES), default="j01"),
-    arg("--granules", type=_count, default=14, help="consecutive CrIS granules (default 14, as the paper)"),
+    arg(
+        "--granules", type=_whole(1), default=14, help="consecutive CrIS granules (default 14, as the paper)"
+    ),
     arg("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file"),
-    arg("--seed", type=int, default=0),
+    arg("--seed", type=_whole(0), default=0),
     arg("--start", type=_iso, default=None, help="UTC start of the first granule (ISO 8601)"),
     arg("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)"),
     arg("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)"),
@@ -146,7 +163,7 @@ def command(
         help="start at this pass of the satellite's orbit after --start (day: ascending tropics, "
         "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass",
     ),
-    arg("--pass-lon", type=float, help="with --pass: the pass nearest this longitude, deg (e.g. 180)"),
+    arg("--pass-lon", type=_longitude, help="with --pass: the pass nearest this longitude, deg (e.g. 180)"),
     arg(
         "--complete",
         action="store_true",
@@ -582,7 +599,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     arg("--until", type=_day, required=True, help="last day, YYYY-MM-DD"),
     arg("--satellite", choices=tuple(SATELLITES)),
     arg("--scheduler", help="address of a running Dask scheduler (tcp://HOST:8786); default a local cluster"),
-    arg("--workers", type=_count, default=2, help="processes of the local cluster (default 2)"),
+    arg("--workers", type=_whole(1), default=2, help="processes of the local cluster (default 2)"),
     arg("--force", action="store_true", help="redo the days already done"),
 )
 def cmd_reprocess(args: argparse.Namespace) -> int:
@@ -894,7 +911,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 @command(
     "bench",
     "time each stage on a simulated case; print FOVs/s and peak memory",
-    arg("--granules", type=_count, default=14),
+    arg("--granules", type=_whole(1), default=14),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
     arg(

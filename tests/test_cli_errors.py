@@ -156,6 +156,11 @@ def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys,
             ["reprocess", "--since", "2024-06-01", "--workers", "two"],
             "argument --workers: not a whole number",
         ),
+        (["simulate", "--out", "{tmp}/x", "--seed", "-1"], "argument --seed: -1: at least 0"),
+        (
+            ["simulate", "--out", "{tmp}/x", "--pass", "day", "--pass-lon", "nan"],
+            "argument --pass-lon: nan: not a longitude within -180..180 deg",
+        ),
         (
             ["fingerprint", "{tmp}", "--threshold-urad", "-5"],
             "fingerprint.threshold_urad: -5.0 is not within 0.1..10000",
