@@ -20,10 +20,10 @@ import re
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO, TypeVar
 
 from monitor import allocator, logs
-from monitor.config import AssessmentConfig, FingerprintConfig
+from monitor.config import AssessmentConfig, Config, FingerprintConfig
 from monitor.constants import N_FOV
 from monitor.errors import DataError
 from monitor.footprint import SHAPES as FOOTPRINTS
@@ -36,7 +36,6 @@ from monitor.vocabulary import Cost, Kernel, Rule
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
     from monitor.changes import Change
-    from monitor.config import Config
     from monitor.fingerprint import DayPrint, EpMatch
     from monitor.footprint import RadialResponse
     from monitor.geometry.instrument import EngineeringPacket
@@ -44,6 +43,7 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     from monitor.store.sqlite import Store
 
 Handler = Callable[[argparse.Namespace], int]  # a subcommand: its parsed arguments in, its exit status out
+SectionT = TypeVar("SectionT", AssessmentConfig, FingerprintConfig)  # a section that commands take as options
 
 # the defaults of the assessment keys, for the commands that take them as flags
 ASSESSMENT = AssessmentConfig()  # the defaults of the options that mirror configuration keys
@@ -111,12 +111,46 @@ def _longitude(text: str) -> float:
     return lon
 
 
+def _options(model: type[SectionT], flags: str, **values: Any) -> SectionT:
+    """The options of a command that are keys of a configuration section (*model*), checked by the same
+    model as the file: a problem is bad input naming the *flags* and the key."""
+    from monitor.config import ConfigError
+    from monitor.config_file import section_of
+
+    name = next(k for k, f in Config.model_fields.items() if f.annotation is model)
+    try:
+        section = section_of(name, **values)
+    except ConfigError as exc:
+        raise BadInput(f"{flags}: {exc}") from None
+    assert isinstance(section, model)
+    return section
+
+
 def arg(*names: str, **options: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
     """One argument of a subcommand: the add_argument call, as data."""
     return names, options
 
 
 CONFIG = arg("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+# the options that are keys of the assessment section (checked by its model, :func:`_options`)
+KERNEL = arg(
+    "--kernel",
+    choices=tuple(k.value for k in Kernel),
+    default=ASSESSMENT.kernel.value,
+    help="FOV weighting: the top-hat cone or the CrIS spatial response (assessment.kernel)",
+)
+COST = arg(
+    "--cost",
+    choices=tuple(c.value for c in Cost),
+    default=ASSESSMENT.cost.value,
+    help="stdev (the paper's) or regression (unmoved by a CrIS-VIIRS gain or bias) (assessment.cost)",
+)
+WORKERS = arg(
+    "--workers",
+    type=int,
+    default=ASSESSMENT.workers,
+    help=f"threads of the compiled kernels (default {ASSESSMENT.workers}, assessment.workers)",
+)
 RESIDUAL_ARGS = (
     arg("--residuals", help="per-FOR LOS residual table (crisgeo fingerprint --write-residuals)"),
     arg(
@@ -370,39 +404,23 @@ def cmd_geolocate(args: argparse.Namespace) -> int:
         help="perturbation steps each side of zero (grid 2n+1; collocation files carry their own grid)",
     ),
     arg("--step-urad", type=float, default=ASSESSMENT.step_urad, help="perturbation step, urad"),
-    arg(
-        "--kernel",
-        choices=tuple(k.value for k in Kernel),
-        default=ASSESSMENT.kernel.value,
-        help="FOV weighting: top-hat cone or the CrIS spatial response",
-    ),
-    arg(
-        "--cost",
-        choices=tuple(c.value for c in Cost),
-        default=ASSESSMENT.cost.value,
-        help="stdev (the paper's) or regression (unmoved by a CrIS-VIIRS gain or bias)",
-    ),
-    arg("--workers", type=int, default=ASSESSMENT.workers, help="threads of the compiled kernels"),
+    KERNEL,
+    COST,
+    WORKERS,
 )
 def cmd_assess(args: argparse.Namespace) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assess import assess_paths
-    from monitor.config import ConfigError
-    from monitor.config_file import section_of
 
-    try:  # the options are the assessment section's keys, checked by the configuration model
-        a = section_of(
-            "assessment",
-            half_steps=args.steps,
-            step_urad=args.step_urad,
-            kernel=args.kernel,
-            cost=args.cost,
-            workers=args.workers,
-        )
-    except ConfigError as exc:
-        raise BadInput(f"--steps/--step-urad/--workers: {exc}") from None
-    assert isinstance(a, AssessmentConfig)
-    cfg = a
+    cfg = _options(
+        AssessmentConfig,
+        "--steps/--step-urad/--workers",
+        half_steps=args.steps,
+        step_urad=args.step_urad,
+        kernel=args.kernel,
+        cost=args.cost,
+        workers=args.workers,
+    )
     collocations = [p for p in args.paths if p.endswith(".npz")]
     if collocations and len(collocations) != len(args.paths):
         raise BadInput("give either granules or collocation files (.npz), not both")
@@ -411,7 +429,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
 
         result = assess_collocations(collocations, cfg)
     else:
-        result = assess_paths(args.paths, cfg, workers=a.workers)
+        result = assess_paths(args.paths, cfg, workers=cfg.workers)
     print(result_text(result))
     if args.out:
         Path(args.out).write_text(result.to_json())
@@ -831,14 +849,13 @@ def cmd_fingerprint(args: argparse.Namespace) -> int:
     import json
 
     from monitor import fingerprint as fpr
-    from monitor.config import ConfigError
-    from monitor.config_file import section_of
 
-    try:  # the options are the fingerprint section's keys, checked by the configuration model
-        f = section_of("fingerprint", threshold_urad=args.threshold_urad, ep_library=args.ep_library or [])
-    except ConfigError as exc:
-        raise BadInput(f"--threshold-urad/--ep-library: {exc}") from None
-    assert isinstance(f, FingerprintConfig)
+    f = _options(
+        FingerprintConfig,
+        "--threshold-urad/--ep-library",
+        threshold_urad=args.threshold_urad,
+        ep_library=args.ep_library or [],
+    )
     fp = fpr.fingerprint_files(args.paths, f.ep_library, f.threshold_urad)
     if args.json:
         print(json.dumps(fp.to_dict(), indent=1))
@@ -914,36 +931,15 @@ def cmd_report(args: argparse.Namespace) -> int:
     arg("--granules", type=_whole(1), default=14),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
-    arg(
-        "--workers",
-        type=int,
-        default=ASSESSMENT.workers,
-        help=f"threads of the compiled kernels (default {ASSESSMENT.workers}, assessment.workers)",
-    ),
-    arg(
-        "--cost",
-        choices=tuple(c.value for c in Cost),
-        default=ASSESSMENT.cost.value,
-        help="the cost to time (assessment.cost)",
-    ),
-    arg(
-        "--kernel",
-        choices=tuple(k.value for k in Kernel),
-        default=ASSESSMENT.kernel.value,
-        help="the FOV weighting to time (assessment.kernel)",
-    ),
+    WORKERS,
+    COST,
+    KERNEL,
 )
 def cmd_bench(args: argparse.Namespace) -> int:
     """crisgeo bench: time each stage on a simulated case."""
     from monitor.bench import run_bench
-    from monitor.config import ConfigError
-    from monitor.config_file import section_of
 
-    try:  # the options are the assessment section's keys, checked by the configuration model
-        cfg = section_of("assessment", cost=args.cost, kernel=args.kernel, workers=args.workers)
-    except ConfigError as exc:
-        raise BadInput(f"--cost/--kernel/--workers: {exc}") from None
-    assert isinstance(cfg, AssessmentConfig)
+    cfg = _options(AssessmentConfig, "--workers", cost=args.cost, kernel=args.kernel, workers=args.workers)
     return run_bench(args, cfg)
 
 

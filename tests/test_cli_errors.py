@@ -147,7 +147,7 @@ def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys,
     [
         (
             ["bench", "--workers", "0"],
-            "crisgeo bench: --cost/--kernel/--workers: assessment.workers: 0 is not",
+            "crisgeo bench: --workers: assessment.workers: 0 is not",
         ),
         (["bench", "--granules", "0"], "argument --granules: 0: at least 1"),
         (["simulate", "--out", "{tmp}/x", "--granules", "-3"], "argument --granules: -3: at least 1"),
