@@ -21,8 +21,8 @@ import logging
 
 import requests
 
-from monitor.config import AlertSettings
-from monitor.records import History
+from monitor.config.model import AlertSettings
+from monitor.core.records import History
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc

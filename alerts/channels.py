@@ -19,7 +19,7 @@ from pathlib import Path
 
 import requests
 
-from monitor.config import AlertSettings, EmailSettings, SlackSettings, env_secret
+from monitor.config.model import AlertSettings, EmailSettings, SlackSettings, env_secret
 
 LOG = logging.getLogger(__name__)
 

@@ -26,11 +26,11 @@ from alerts.rules import (
     spec_finding,
     stale_finding,
 )
-from monitor.changes import all_changes
-from monitor.config import AlertSettings
-from monitor.records import Alert, History, Silence
-from monitor.tables import Column, text_table
-from monitor.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
+from monitor.config.model import AlertSettings
+from monitor.core.changes import all_changes
+from monitor.core.records import Alert, History, Silence
+from monitor.core.tables import Column, text_table
+from monitor.core.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc

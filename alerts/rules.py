@@ -13,11 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.changes import preceding_change
-from monitor.config import RuleSettings
-from monitor.constants import N_FOR
-from monitor.records import History
-from monitor.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
+from monitor.config.model import RuleSettings
+from monitor.core.changes import preceding_change
+from monitor.core.constants import N_FOR
+from monitor.core.records import History
+from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 
 UTC = dt.timezone.utc
 
@@ -47,7 +47,8 @@ GEOLOCATION = Watched(
     "min_jump_km",
     0.02,
 )
-# the CrIS-VIIRS BT bias at 280 K (monitor/intercal.py): a VIIRS LUT or a CrIS calibration change moves it
+# the CrIS-VIIRS BT bias at 280 K (monitor/estimation/intercal.py): a VIIRS LUT or a CrIS calibration change
+# moves it
 CALIBRATION = Watched(
     Rule.CALIBRATION_JUMP, "CrIS-VIIRS calibration", (("bias_k", "bias"),), "K", "min_bias_jump_k", 0.01
 )
@@ -79,7 +80,7 @@ class Finding:
 
 
 def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | None:
-    """FORs of the latest day beyond the specification (:meth:`monitor.result.ForOffset.spec_breaches`:
+    """FORs of the latest day beyond the specification (:meth:`monitor.core.result.ForOffset.spec_breaches`:
     in-track or cross-track, each on its own; FORs flagged unreliable never alert).
 
     Critical when every breach of a FOR holds beyond the uncertainty (|error| - 2 sigma > spec), warning

@@ -6,7 +6,8 @@ For each case size, profile (paper, random, zero), ground (flat, or 1-4 km terra
 and seed: simulate, assess, and print per direction the RMS and the largest error over the 30 FORs against
 the bounds (14 granules: RMS <= 10 urad, every FOR within 25; 6 granules and fewer: RMS <= 12, within 30).
 
-The CrIS footprint of the truth (``--footprints``, :mod:`monitor.footprint`): the paper's top-hat cone, or a
+The CrIS footprint of the truth (``--footprints``, :mod:`monitor.instrument.footprint`): the paper's top-hat
+cone, or a
 smooth response within the specification's table; ``--kernel`` the assessment's (``footprint``, the default,
 fits the response; ``top-hat`` is the paper's cone).
 
@@ -41,13 +42,13 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor import footprint
-from monitor.assess import assess_paths
-from monitor.config import AssessmentConfig
-from monitor.estimate import floor_urad
+from monitor.assessment.assess import assess_paths
+from monitor.config.model import AssessmentConfig
+from monitor.core.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
+from monitor.estimation.estimate import floor_urad
+from monitor.instrument import footprint
 from monitor.simulate.case import simulate_case
 from monitor.simulate.orbit import PASSES
-from monitor.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
 
 # name: (gain, bias K, curvature K at 250/310 K) of CrIS against VIIRS (SimulationSpec.cris_*): the issue's
 # range, gains -3..+3 %, biases up to 2 K, curvatures up to 0.5 K over 250-310 K
@@ -223,7 +224,7 @@ def main() -> int:
     p.add_argument("--cost", choices=[c.value for c in Cost], default=DEFAULT_COST.value)
     p.add_argument(
         "--footprints", nargs="+", choices=tuple(footprint.SHAPES), default=["top-hat"],
-        help="the CrIS spatial response of the truth (monitor.footprint)",
+        help="the CrIS spatial response of the truth (monitor.instrument.footprint)",
     )  # fmt: skip
     p.add_argument("--kernel", choices=[k.value for k in Kernel], default=DEFAULT_KERNEL.value)
     p.add_argument("--workers", type=int, default=2)

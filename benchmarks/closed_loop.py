@@ -25,13 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.assess import assess_paths
-from monitor.config import AssessmentConfig
-from monitor.constants import URAD
+from monitor.assessment.assess import assess_paths
+from monitor.config.model import AssessmentConfig
+from monitor.core.constants import URAD
+from monitor.core.result import AssessmentResult
 from monitor.geometry.instrument import EngineeringPacket
 from monitor.mapping.optimize import Optimization, optimize
 from monitor.mapping.regeolocate import regeolocate_file
-from monitor.result import AssessmentResult
 from monitor.sdr.engpkt import load_ep
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import CRIS_GEO

@@ -23,8 +23,8 @@ import sys
 import numpy as np
 
 from alerts.rules import COMPONENTS, detect_jumps
-from monitor.changes import Change, preceding_change
-from monitor.config import RuleSettings
+from monitor.config.model import RuleSettings
+from monitor.core.changes import Change, preceding_change
 from monitor.simulate.profiles import paper_profile
 
 START = dt.date(2023, 1, 1)

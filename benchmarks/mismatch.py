@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.assess import assess_paths
-from monitor.config import AssessmentConfig
+from monitor.assessment.assess import assess_paths
+from monitor.config.model import AssessmentConfig
+from monitor.core.vocabulary import Cost, Kernel
 from monitor.simulate.case import simulate_case
-from monitor.vocabulary import Cost, Kernel
 from tests.conftest import truth_arrays
 
 # (gain, bias K, curvature K): none, the gains, the paper's profile, curvatures of 0.5 K

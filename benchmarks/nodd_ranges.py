@@ -4,7 +4,8 @@ Real-size simulated granules with every dataset of the real products (``Simulati
 ~325 MB, SVI05 ~49 MB, SCRIF ~19 MB, GCRSO ~0.1 MB uncompressed), in either HDF5 layout (contiguous, as
 uncompressed IDPS files; gzip with one chunk per dataset, as the real GCRSO), are put under their NODD
 keys on moto's S3 server on loopback. Each case then runs the daily job
-(:func:`monitor.pipeline.run_day`: list, fingerprint, select, assess, record) three times, each into an
+(:func:`monitor.service.pipeline.run_day`: list, fingerprint, select, assess, record) three times, each into
+an
 empty store: whole files into an empty cache, ranges into an empty cache, and ranges again on that
 cache. It prints, per run: bytes read, their share of the bytes of the files the day used, HTTP
 requests (listings included) and wall time; per product, the bytes read in place (from the block
@@ -31,15 +32,15 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.collocate import warm_up
-from monitor.config_file import load_config
-from monitor.pipeline import run_day
-from monitor.satellites import SATELLITES
+from monitor.collocation.collocate import warm_up
+from monitor.config.file import load_config
+from monitor.core.satellites import SATELLITES
+from monitor.service.pipeline import run_day
+from monitor.service.sources.configured import make_source
+from monitor.service.sources.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
+from monitor.service.store.sqlite import Store
 from monitor.simulate import LAYOUTS
 from monitor.simulate.case import DEFAULT_START, simulate_case
-from monitor.sources.configured import make_source
-from monitor.sources.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
-from monitor.store.sqlite import Store
 from tests.servers import MotoS3
 
 SATELLITE = "j01"

@@ -20,13 +20,13 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor import refine
-from monitor.config import AssessmentConfig
-from monitor.constants import N_FOR
-from monitor.estimate import estimate
-from monitor.intercal import fit_difference
-from monitor.replay import assess_collocations, for_samples, read_collocation
-from monitor.vocabulary import Kernel
+from monitor.assessment.replay import assess_collocations, for_samples, read_collocation
+from monitor.config.model import AssessmentConfig
+from monitor.core.constants import N_FOR
+from monitor.core.vocabulary import Kernel
+from monitor.estimation import refine
+from monitor.estimation.estimate import estimate
+from monitor.estimation.intercal import fit_difference
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data" / "real" / "collocations_j01_20181022"
 UNIFORM_K = (1.0, 0.5, 0.3)  # spread of the cone mean over +-3 turn steps (K) below which a scene is uniform

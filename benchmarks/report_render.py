@@ -19,9 +19,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from monitor.report.html import ReportOptions, build_report
+from monitor.service.report.html import ReportOptions, build_report
+from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
-from monitor.store.sqlite import Store
 
 
 def screenshot(page: Path, out: Path, width: int = 1200) -> None:

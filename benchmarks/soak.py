@@ -42,10 +42,10 @@ from pathlib import Path
 
 from aiosmtpd.controller import Controller
 
+from monitor.core.vocabulary import RunStatus
 from monitor.sdr.products import PRODUCTS
-from monitor.store.alerts import AlertState
-from monitor.store.sqlite import Store
-from monitor.vocabulary import RunStatus
+from monitor.service.store.alerts import AlertState
+from monitor.service.store.sqlite import Store
 from tests.servers import S3Server, Webhook, free_port, victoria_metrics, vm_export
 
 ROOT = Path(__file__).resolve().parent.parent

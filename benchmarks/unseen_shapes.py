@@ -1,5 +1,6 @@
 """Acceptance on CrIS spatial responses the code was never given: four radially symmetric shapes within
-the specification's table that are not among :data:`monitor.footprint.SHAPES` (a sharper and a softer
+the specification's table that are not among :data:`monitor.instrument.footprint.SHAPES` (a sharper and a
+softer
 super-Gaussian, a steep trapezoid, a narrower blur), on seeds 4-7 that no other acceptance run uses; 6
 granules each, the default assessment. Prints one JSON row per case: RMS per direction and the worst FOR
 (urad), the share of errors within two sigmas, the median intercalibration (gain per cent, bias K) where
@@ -20,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor import footprint
-from monitor.assess import assess_paths
-from monitor.config import AssessmentConfig
+from monitor.assessment.assess import assess_paths
+from monitor.config.model import AssessmentConfig
+from monitor.instrument import footprint
 from monitor.simulate.case import simulate_case
 
 CASES = (  # (name, response, seed, profile, ground)

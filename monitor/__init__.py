@@ -1,8 +1,9 @@
 """crisgeo-monitor: CrIS geolocation assessment against VIIRS I5 (Wang et al. 2017), run as a service.
 
-The science lives in ``monitor.sdr`` (files), ``monitor.geometry`` (frames), ``monitor.spectral``,
-``monitor.collocate``, ``monitor.assess`` and ``monitor.simulate``; it hands the service one typed
-object, :class:`monitor.result.AssessmentResult`.
+The folders are the floors, each importing only those below it (docs/layout.md): ``cli``, ``service``, the
+science (``assessment``, ``mapping`` and ``simulate``, ``collocation`` and ``estimation``, ``instrument``,
+``sdr``, ``geometry``), ``config`` and the ground floor ``core``. The science hands the service one typed
+object, :class:`monitor.core.result.AssessmentResult`.
 """
 
 from __future__ import annotations
@@ -13,18 +14,18 @@ from typing import TYPE_CHECKING, Any
 from monitor.version import __version__
 
 if TYPE_CHECKING:
-    from monitor.store.sqlite import Store
+    from monitor.service.export import ResultStore
 
 __all__ = ["AssessmentResult", "assess_paths", "open_store", "__version__"]
 
 
 def __getattr__(name: str) -> Any:  # the public API, imported when first used (a light import)
     if name == "assess_paths":
-        from monitor.assess import assess_paths
+        from monitor.assessment.assess import assess_paths
 
         return assess_paths
     if name == "AssessmentResult":
-        from monitor.result import AssessmentResult
+        from monitor.core.result import AssessmentResult
 
         return AssessmentResult
     if name == "open_store":
@@ -32,9 +33,9 @@ def __getattr__(name: str) -> Any:  # the public API, imported when first used (
     raise AttributeError(f"module 'monitor' has no attribute {name!r}")
 
 
-def open_store(path: str | os.PathLike, create: bool = False) -> Store:
+def open_store(path: str | os.PathLike, create: bool = False) -> ResultStore:
     """The service's SQLite store at *path*, e.g. ``open_store(p).to_xarray("j01")`` in a notebook. A
     missing store is an error (a typo must not start an empty history) unless *create*."""
-    from monitor.store.sqlite import Store
+    from monitor.service.export import ResultStore
 
-    return Store(path, create=create)
+    return ResultStore(path, create=create)

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from monitor.assess import assess_paths
-from monitor.config import AssessmentConfig
+from monitor.assessment.assess import assess_paths
+from monitor.config.model import AssessmentConfig
 from monitor.sdr.engpkt import load_ep
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case

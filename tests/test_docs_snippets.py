@@ -9,7 +9,7 @@ import pytest
 
 from monitor import open_store
 from monitor.simulate.history import fill_store
-from tests.cli import ROOT
+from tests.invoke import ROOT
 
 matplotlib.use("Agg")
 pytest.importorskip("xarray")
@@ -59,7 +59,7 @@ def test_the_docs_link_only_to_files_that_exist():
 
 def test_the_readme_shows_the_table_the_demo_prints():
     """The README's sample of the demo's output has the FOR table's header and units lines as printed."""
-    from monitor.tables import for_table
+    from monitor.core.tables import for_table
 
     readme = [line[4:].rstrip() for line in (ROOT / "README.md").read_text().splitlines()]
     header, units = for_table([])[:2]

@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.constants import N_FOR, N_FOV
-from monitor.errors import DataError
+from monitor.core.constants import N_FOR, N_FOV
+from monitor.core.errors import DataError
 from monitor.geometry.frames import los_angles, los_from_angles, rot_x, rot_y, rot_z, unit
 
 FOV5 = 4  # index of the central FOV, whose LOS defines the FOR's pointing (section 4.1)

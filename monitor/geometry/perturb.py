@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD
+from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_RAD
 from monitor.geometry.frames import los_from_angles
 
 

@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from monitor.constants import N_FOR, URAD
-from monitor.errors import DataError
+from monitor.core.constants import N_FOR, URAD
+from monitor.core.errors import DataError
+from monitor.core.result import AssessmentResult, ForOffset
+from monitor.core.tables import Column, text_table
 from monitor.geometry.instrument import EngineeringPacket, corrected_ssm_angles
-from monitor.result import AssessmentResult, ForOffset
-from monitor.tables import Column, text_table
 
 
 @dataclass(frozen=True)

@@ -19,8 +19,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from monitor.constants import N_FOR
-from monitor.errors import DataError
+from monitor.core.constants import N_FOR
+from monitor.core.errors import DataError
 from monitor.geometry import instrument, wgs84
 from monitor.geometry.geolocate import GroundView, geolocate_fovs
 from monitor.geometry.instrument import EngineeringPacket

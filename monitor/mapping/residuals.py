@@ -3,7 +3,8 @@
 The EP model (:mod:`monitor.geometry.instrument`) reproduces the operational CrIS geolocation to tens of
 metres, but not the scene-mirror servo corrections IDPS computes from telemetry carried only in the raw
 data records (docs/jpss-formats.md 2.3: per-FOR cross-track residuals of -30..+64 urad, a constant ~+28 urad
-in-track on NOAA-20). Those show in the GEO files themselves: the fingerprint (:mod:`monitor.fingerprint`)
+in-track on NOAA-20). Those show in the GEO files themselves: the fingerprint
+(:mod:`monitor.mapping.fingerprint`)
 measures each FOR's FOV-5 angles (alpha in-track, beta cross-track, spacecraft frame), and their difference
 from the EP model's is the residual of that FOR.
 
@@ -33,11 +34,11 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.constants import N_FOR, PROCESSING_CHANGE_URAD, URAD
-from monitor.errors import DataError
-from monitor.fingerprint import DayPrint, day_print, granule_print
+from monitor.core.constants import N_FOR, PROCESSING_CHANGE_URAD, URAD
+from monitor.core.errors import DataError
 from monitor.geometry.frames import los_angles, los_from_angles
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles
+from monitor.mapping.fingerprint import DayPrint, day_print, granule_print
 from monitor.sdr import CrisGeoGranule
 
 log = logging.getLogger(__name__)
@@ -133,7 +134,7 @@ class ResidualTable:
 
 
 def learn(day: DayPrint, ep: EngineeringPacket) -> ResidualTable:
-    """The residual table of a fingerprint *day* (:class:`monitor.fingerprint.DayPrint`) against *ep*:
+    """The residual table of a fingerprint *day* (:class:`monitor.mapping.fingerprint.DayPrint`) against *ep*:
     measured minus modelled FOV-5 angles per FOR. FORs the fingerprint could not measure get 0."""
     alpha, beta = fov5_angles(ep)
     return ResidualTable(

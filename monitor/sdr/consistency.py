@@ -9,7 +9,8 @@ real NOAA-20 GCRSO granules of tests/data/real and on the simulator (docs/jpss-f
 * **Identity.** The granule ID is the platform and the tenths of a second since the IDPS granule epoch
   (IET 1.698019238e15 us), so ``N_Beginning_Time_IET - ID x 1e5 us`` is that epoch to within a granule
   (real: the same to 1 us; allowed 10 s, a CrIS granule is 32 s). The orbit number (file name and
-  attribute) counts orbits since the satellite's launch (:meth:`monitor.satellites.Satellite.orbit_number`;
+  attribute) counts orbits since the satellite's launch
+  (:meth:`monitor.core.satellites.Satellite.orbit_number`;
   real: 4790 for 4790.0, allowed 0.5 % + 20); S-NPP and NOAA-20 differ by ~31 000 orbits. The text dates
   agree with the IET times (1 s).
 * **Scans.** CrIS scans are 8 s apart and a granule spans ``(n-1) x 8 < span <= n x 8`` s (real: 29.8 s for
@@ -41,10 +42,10 @@ import math
 import numba
 import numpy as np
 
-from monitor.constants import CRIS_SCAN_US, VIIRS_SCAN_US
+from monitor.core.constants import CRIS_SCAN_US, VIIRS_SCAN_US
+from monitor.core.satellites import SATELLITES
 from monitor.geometry import orbit, wgs84
 from monitor.geometry.inverse import satellite_from_fov
-from monitor.satellites import SATELLITES
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.granules import CrisGeoGranule, GeoGranule, Granule, GranuleMeta, GranuleRef, ViirsGeoGranule
 from monitor.sdr.iet import iet_to_datetime

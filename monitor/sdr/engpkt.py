@@ -23,10 +23,10 @@ import numpy as np
 import yaml
 from numpy.typing import ArrayLike
 
-from monitor.constants import N_FOR, N_FOV, URAD
-from monitor.errors import DataError
+from monitor.core.constants import N_FOR, N_FOV, URAD
+from monitor.core.errors import DataError
+from monitor.core.satellites import SATELLITES
 from monitor.geometry.instrument import EngineeringPacket
-from monitor.satellites import SATELLITES
 
 # (model field, path in the EP, number of values); a triple/pair path lists its components.
 _ANGLES = (

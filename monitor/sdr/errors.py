@@ -1,6 +1,6 @@
 """The one error type of the readers: it names the file, the field and what is wrong with it."""
 
-from monitor.errors import DataError
+from monitor.core.errors import DataError
 
 
 class GranuleError(DataError):

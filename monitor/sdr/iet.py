@@ -11,7 +11,7 @@ import datetime as dt
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.errors import DataError
+from monitor.core.errors import DataError
 
 UTC = dt.timezone.utc
 IET_EPOCH = dt.datetime(1958, 1, 1, tzinfo=UTC)

@@ -13,7 +13,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from monitor.errors import DataError
+from monitor.core.errors import DataError
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.granules import GranuleMeta, GranuleRef, as_ref
 from monitor.sdr.names import parse_name

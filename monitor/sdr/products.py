@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.constants import N_FOR, N_FOV
+from monitor.core.constants import N_FOR, N_FOV
 
 DEG = np.pi / 180.0
 ARCSEC = np.pi / (180.0 * 3600.0)

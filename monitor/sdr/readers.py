@@ -17,7 +17,7 @@ from typing import Any
 import h5py
 import numpy as np
 
-from monitor.satellites import SATELLITES
+from monitor.core.satellites import SATELLITES
 from monitor.sdr import consistency
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.granules import (

@@ -8,7 +8,8 @@ IDPS writes them), CrIS radiances are averaged over the true FOV on the terrain,
 the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 2.3 item 8).
 
 The CrIS FOV sees the scene through the paper's top-hat cone, or through a smooth radially symmetric
-spatial response (``SimulationSpec.cris_response``, :mod:`monitor.footprint`), one for all FOVs or one per
+spatial response (``SimulationSpec.cris_response``, :mod:`monitor.instrument.footprint`), one for all FOVs or
+one per
 FOV: the CrIS radiance is then the response-weighted mean of the scene out to where the response ends.
 
 Why one module of ~690 lines: it is one instrument pair in flight; the CrIS and the VIIRS granules share
@@ -29,18 +30,19 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.constants import (
+from monitor.core.constants import (
     CALIBRATION_CURVATURE_SPAN_K,
     CALIBRATION_REFERENCE_K,
     CRIS_SCAN_US,
     N_FOV,
     URAD,
 )
-from monitor.errors import DataError, StopRequested
-from monitor.footprint import RadialResponse
+from monitor.core.errors import DataError, StopRequested
+from monitor.core.satellites import satellite as satellite_info
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
-from monitor.satellites import satellite as satellite_info
+from monitor.instrument.footprint import RadialResponse
+from monitor.instrument.spectral import C1, C2, i5_band, planck_radiance
 from monitor.sdr import iet
 from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
 from monitor.sdr.names import format_name
@@ -52,7 +54,6 @@ from monitor.simulate.orbit import PASSES, CircularOrbit, find_pass
 from monitor.simulate.profiles import load_profile
 from monitor.simulate.scene import MAX_HEIGHT_M, Scene, spectra, transmittance
 from monitor.simulate.terrain import intersect_terrain
-from monitor.spectral import C1, C2, i5_band, planck_radiance
 
 UTC = dt.timezone.utc
 DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)

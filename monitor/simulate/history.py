@@ -11,8 +11,13 @@ from typing import Any
 
 import numpy as np
 
-from monitor.constants import CALIBRATION_BIN_K, CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K, N_FOR
-from monitor.result import FLAG_FLAT, AssessmentResult, DifferenceBin, ForOffset
+from monitor.core.constants import (
+    CALIBRATION_BIN_K,
+    CALIBRATION_CURVATURE_SPAN_K,
+    CALIBRATION_REFERENCE_K,
+    N_FOR,
+)
+from monitor.core.result import FLAG_FLAT, AssessmentResult, DifferenceBin, ForOffset
 from monitor.simulate.profiles import paper_profile
 
 KM_PER_URAD = 0.00083  # at nadir; enough for a picture
@@ -83,7 +88,7 @@ def day_result(
 
 
 def fill_store(
-    store: Any,  # a monitor.store.sqlite.Store: the simulator stands below the store's floor
+    store: Any,  # a monitor.service.store.sqlite.Store: the simulator stands below the store's floor
     satellites: list[str],
     first: dt.date,
     days: int,

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.constants import DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, N_FOV, VIIRS_SCAN_US
+from monitor.core.constants import DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, N_FOV, VIIRS_SCAN_US
 from monitor.geometry.frames import rot_x, unit
 
 CRIS_FOR_STEP_RAD = np.radians(3.3333)

@@ -13,7 +13,7 @@ import h5py
 import numpy as np
 from numpy.typing import DTypeLike
 
-from monitor.satellites import SATELLITES
+from monitor.core.satellites import SATELLITES
 from monitor.sdr.products import Product
 
 USERBLOCK = 1024

@@ -1,6 +1,6 @@
 """Circular sun-synchronous orbits: analytic ECI motion turned into ECEF by the Earth rotation angle.
 
-Each satellite's orbit comes from :mod:`monitor.satellites` (altitude, inclination, local time of the
+Each satellite's orbit comes from :mod:`monitor.core.satellites` (altitude, inclination, local time of the
 ascending node, phase). :func:`find_pass` picks the start of a pass (ascending or descending through
 a latitude, optionally nearest a longitude) so that a simulated case can be put anywhere on the Earth:
 tropics by day or night, high latitudes, across the 180 deg meridian.
@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.errors import DataError
+from monitor.core.errors import DataError
+from monitor.core.satellites import NODAL_PERIOD_S, PHASE_EPOCH_UNIX_S, Satellite
 from monitor.geometry.wgs84 import A_M, GM_M3_S2, OMEGA_EARTH_RAD_S
-from monitor.satellites import NODAL_PERIOD_S, PHASE_EPOCH_UNIX_S, Satellite
 
 # Named passes: (geocentric latitude of the first CrIS granule, ascending). A 14-granule case covers
 # ~27 deg of orbit: "arctic" runs from 60 deg N to the orbit's turning point at 81 deg N.

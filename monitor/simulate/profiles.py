@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from monitor.constants import FOV_DIAMETER_URAD, N_FOR
-from monitor.errors import DataError
+from monitor.core.constants import FOV_DIAMETER_URAD, N_FOR
+from monitor.core.errors import DataError
 
 
 def paper_profile() -> tuple[np.ndarray, np.ndarray]:

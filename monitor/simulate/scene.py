@@ -24,7 +24,7 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.spectral import planck_radiance
+from monitor.instrument.spectral import planck_radiance
 
 EARTH_RADIUS_KM = 6371.0
 FINE_KM, FINE_N = 1.1, 2048

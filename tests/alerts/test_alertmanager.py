@@ -8,9 +8,9 @@ import requests
 
 from alerts.alertmanager import post_state
 from alerts.rules import Finding
-from monitor.config import AlertSettings, Links
-from monitor.store.alerts import AlertState
-from monitor.store.sqlite import Store
+from monitor.config.model import AlertSettings, Links
+from monitor.service.store.alerts import AlertState
+from monitor.service.store.sqlite import Store
 from tests.servers import Webhook, alertmanager, wait_for
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)

@@ -3,9 +3,9 @@ import email
 import pytest
 
 from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
-from monitor.config import EmailSettings, SlackSettings
+from monitor.config.model import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
-from tests.cli import run_crisgeo
+from tests.invoke import run_crisgeo
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
@@ -118,9 +118,9 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     import threading
 
     from alerts.engine import deliver
-    from monitor.config import AlertSettings
-    from monitor.store.alerts import AlertState
-    from monitor.store.sqlite import Store
+    from monitor.config.model import AlertSettings
+    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.sqlite import Store
 
     monkeypatch.setenv("T_SLACK", webhook.url)
     settings = AlertSettings(slack=SlackSettings(webhook_env="T_SLACK", timeout_s=5))
@@ -162,8 +162,8 @@ def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
     import datetime as dt
     import os
 
-    from monitor.store.alerts import AlertState
-    from monitor.store.sqlite import Store
+    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.sqlite import Store
 
     cfg = tmp_path / "c.yaml"
     cfg.write_text(

@@ -7,8 +7,8 @@ from email import policy
 
 import pytest
 
-from monitor.config_file import load_config
-from monitor.service import Service
+from monitor.config.file import load_config
+from monitor.service.daemon import Service
 from monitor.simulate.case import simulate_case
 from tests.alerts.conftest import PASSWORD, USER
 
@@ -83,8 +83,8 @@ alerts:
 
 def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp_path):
     from alerts.engine import deliver
-    from monitor.store.alerts import AlertState
-    from monitor.store.sqlite import Store
+    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.sqlite import Store
 
     monkeypatch.setenv("T_HOOK", webhook.url)
     cfg_path = tmp_path / "c.yaml"

@@ -3,8 +3,8 @@
 import pytest
 import yaml
 
-from monitor.config import AlertSettings, ConfigError, EmailSettings, RuleSettings, SlackSettings
-from monitor.config_file import load_config
+from monitor.config.file import load_config
+from monitor.config.model import AlertSettings, ConfigError, EmailSettings, RuleSettings, SlackSettings
 
 
 def _load(tmp_path, alerts):
@@ -80,8 +80,8 @@ def test_the_subject_prefix_marks_every_message(tmp_path):
     messages say so in their subject."""
     from alerts.engine import build_message
     from alerts.rules import Finding
-    from monitor.config_reference import reference
-    from monitor.store.sqlite import Store
+    from monitor.config.reference import reference
+    from monitor.service.store.sqlite import Store
 
     assert "| `alerts.subject_prefix` | [crisgeo] |" in reference()
     settings = _load(tmp_path, {"subject_prefix": "[crisgeo test]"}).alerts

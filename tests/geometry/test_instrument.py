@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from monitor.errors import DataError
+from monitor.core.errors import DataError
 from monitor.geometry import instrument as ins
 from monitor.geometry import wgs84
 from monitor.geometry.frames import los_angles, los_from_angles

@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 import requests
 
-from monitor.changes import Change
+from monitor.core.changes import Change
+from monitor.service.store.sqlite import Store
+from monitor.service.store.timeseries import change_lines, result_lines
 from monitor.simulate.history import fill_store
-from monitor.store.sqlite import Store
-from monitor.store.timeseries import change_lines, result_lines
 from tests.servers import influxdb1, influxql
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
@@ -140,9 +140,9 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
     from prometheus_client import generate_latest
 
     from alerts.rules import Finding
-    from monitor.health import Health
-    from monitor.metrics import ServiceMetrics
-    from monitor.store.alerts import AlertState
+    from monitor.service.health import Health
+    from monitor.service.metrics import ServiceMetrics
+    from monitor.service.store.alerts import AlertState
     from tests.servers import victoria_metrics, wait_for
 
     db = tmp_path / "s.sqlite"

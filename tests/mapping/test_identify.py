@@ -4,8 +4,8 @@ import json
 
 import numpy as np
 
-from monitor import fingerprint as fpr
 from monitor.cli import main
+from monitor.mapping import fingerprint as fpr
 from monitor.mapping.regeolocate import regeolocate_file
 from monitor.sdr import read_file
 from monitor.sdr.engpkt import load_library, packaged_ep

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from monitor.cli import main
-from monitor.errors import DataError
+from monitor.core.errors import DataError
+from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.mapping.optimize import optimize
-from monitor.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.sdr.engpkt import load_ep
 from monitor.simulate.case import ep_offsets_urad
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from monitor.cli import main
-from monitor.errors import DataError
+from monitor.core.errors import DataError
 from monitor.mapping.regeolocate import compare_with_files, regeolocate_file
 from monitor.sdr import read_file
 

@@ -8,15 +8,15 @@ import h5py
 import numpy as np
 import pytest
 
-from monitor import fingerprint as fpr
-from monitor.constants import URAD
+from monitor.core.constants import URAD
 from monitor.geometry.instrument import fov5_angles
+from monitor.mapping import fingerprint as fpr
 from monitor.mapping import residuals
 from monitor.mapping.regeolocate import compare_with_files
 from monitor.sdr import read_file
 from monitor.sdr.engpkt import load_ep
-from tests.cli import run_crisgeo
 from tests.conftest import EP_CONFIGS
+from tests.invoke import run_crisgeo
 
 V115 = EP_CONFIGS.parents[1] / "monitor" / "data" / "ep" / "JPSS1_side1_V115_EngPkt.xml"
 

@@ -26,8 +26,8 @@ import h5py
 import numpy as np
 import pytest
 
-from monitor.assess import assess_paths
-from monitor.config import AssessmentConfig
+from monitor.assessment.assess import assess_paths
+from monitor.config.model import AssessmentConfig
 from monitor.sdr import CrisSdrGranule, GranuleError, ViirsSdrGranule, read_file
 from monitor.sdr.products import PRODUCTS
 from monitor.sdr.readers import read_metadata

@@ -4,13 +4,13 @@ instruments' by the bias and gain injected (what the intercalibration of issue 2
 import numpy as np
 import pytest
 
-from monitor.assess import assess_paths
-from monitor.config import AssessmentConfig
-from monitor.constants import CALIBRATION_REFERENCE_K
+from monitor.assessment.assess import assess_paths
+from monitor.config.model import AssessmentConfig
+from monitor.core.constants import CALIBRATION_REFERENCE_K
+from monitor.core.vocabulary import Cost
+from monitor.instrument.spectral import i5_band
 from monitor.sdr import read_file
 from monitor.simulate.case import SimulationSpec, simulate_case
-from monitor.spectral import i5_band
-from monitor.vocabulary import Cost
 
 
 def _cris_i5_bt_k(out):

@@ -3,7 +3,7 @@ import json
 import numpy as np
 import pytest
 
-from monitor.errors import DataError
+from monitor.core.errors import DataError
 from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
 from monitor.simulate.instrument import cris_los_sbf, viirs_bowtie_deleted, viirs_column_geometry

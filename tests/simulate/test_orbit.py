@@ -5,9 +5,9 @@ import datetime as dt
 import numpy as np
 import pytest
 
-from monitor.errors import DataError
+from monitor.core.errors import DataError
+from monitor.core.satellites import SATELLITES, satellite
 from monitor.geometry import wgs84
-from monitor.satellites import SATELLITES, satellite
 from monitor.simulate.orbit import CircularOrbit, find_pass
 
 T0 = dt.datetime(2025, 3, 1, tzinfo=dt.timezone.utc).timestamp()

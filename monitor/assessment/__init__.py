@@ -1,0 +1,1 @@
+"""The assessment of a day: granules or reference collocations in, the typed result out."""

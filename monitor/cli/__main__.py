@@ -1,0 +1,5 @@
+"""``python -m monitor.cli``: the crisgeo command."""
+
+from monitor.cli import main
+
+raise SystemExit(main())

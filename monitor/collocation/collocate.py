@@ -1,0 +1,416 @@
+"""CrIS-VIIRS collocation by the line-of-sight angle test (Wang et al. 2016), for all perturbed LOS at once.
+
+A VIIRS pixel at ECEF point P belongs to a CrIS FOV seen from S along L when the angle between
+unit(P - S) and L is within the FOV half-angle h. For the (2n+1)^2 perturbed LOS of section 2.3,
+
+    L_ij = unit(tan A_i, tan B_j, 1),  A_i = alpha + (i - n) s,  B_j = beta + (j - n) s   (SBF),
+
+the test d . L_ij >= cos h for a pixel direction d is, for fixed i, a quadratic inequality in
+t = tan B_j whose solution is one interval. So each pixel adds its value to one run of j per row i,
+and the 441 cone sums are prefix sums of these runs: exact, and 21 operations per pixel instead of 441.
+
+The pixels (3-D points, band radiance, solid-angle weights, search blocks) come prepared by
+:mod:`monitor.collocation.swath`; the cone sums of a FOV add over pixels, so each prepared granule is searched
+on its own.
+
+Search. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans), a
+sphere holding its usable pixels. Around each FOV only the blocks whose sphere comes within the union
+of the perturbed cones are opened. A row/column window alone would take in whole stretches of the
+neighbouring scans (bow-tie overlap) that lie outside the cones; testing a block costs a sixteenth of
+testing its pixels.
+
+Compiled. The search, the interval test and the accumulation run in one numba kernel, in parallel over
+FOVs; each FOV accumulates its own (2n+1) x (2n+2) difference array, so threads never share a sum. Its
+entries are complex, weight x radiance + i weight: the two sums a pixel adds to are one 16-byte
+read-modify-write at each end of its run, not two (~5 % of the kernel's time).
+The j run of an interval [t_lo, t_hi] is found by comparing with the FOV's tan B_j (no arctangent), for
+all rows in one loop of selects, not branches (the accumulation, a scatter, is a loop of its own). The
+kernel uses numba's numpy error model (a division by zero gives inf or NaN, which it tests for).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from monitor.collocation.swath import BLOCK_PX, DETECTORS, SwathPiece, ViirsSwath, swath_piece
+from monitor.core.constants import FOV_DIAMETER_RAD, MAX_GRID_SPREAD_RAD
+from monitor.core.threads import KERNEL_LOCK
+from monitor.geometry import wgs84
+from monitor.instrument.spectral import PARALLEL_FROM, i5_band
+
+# The discs (radii, rad) whose sums the kernel returns. The top-hat cone of the paper is one disc; the
+# annuli between nested discs let the estimator fit the CrIS spatial response (monitor.estimation.estimate):
+# CrIS sees
+# a smooth, radially symmetric response, 70 % of peak at 0.437 deg from the LOS and 3 % at 0.619 deg at
+# most (Wang slides, table 3, monitor.instrument.footprint), so the annuli reach past the cone to 0.64 deg.
+# Four discs:
+# the kernel's work grows with their number, and three (no edge inside the cone) miss the response's fall
+# from 0.42 to 0.48 deg (6-granule smooth cases: 11-12 urad RMS against 3-4 with four; six gave 3-3.5).
+TOP_HAT = (FOV_DIAMETER_RAD / 2,)
+ANNULI = (math.radians(0.42), FOV_DIAMETER_RAD / 2, math.radians(0.56), math.radians(0.64))
+# The kernel's threads take FOVs in chunks of this many as they come free (FOVs differ in pixel count, and
+# the read-ahead thread takes turns on the cores), not in equal shares fixed in advance
+FOVS_PER_TASK = 8
+# VIIRS columns are prepared out to the farthest view angle a cone reaches plus this: the two instruments
+# see a ground point from spacecraft positions seconds apart (its cross-track angle differs by far less)
+VIEW_MARGIN_RAD = math.radians(0.5)
+# VIIRS scans are prepared from this long before a CrIS granule's first observation to this long after its
+# last: the instruments see a ground point within seconds of each other (a corner FOV lies ~1.1 deg, a cone
+# reaches ~0.9 deg, from the FOR's LOS: ~55 km or 9 s of flight along the track at the swath edge)
+SCAN_TIME_MARGIN_US = 16_000_000
+
+
+def reach_rad(offsets_rad: np.ndarray, radii_rad: tuple[float, ...] = TOP_HAT) -> float:
+    """The angle (rad) from a FOV's LOS within which one of its perturbed discs (*offsets_rad*, the
+    perturbation grid; *radii_rad*, the discs' half-angles) can hold a pixel."""
+    return max(radii_rad) + float(np.abs(offsets_rad).max()) * math.sqrt(2.0) * 1.02
+
+
+def los_ecef(sbf_to_ecef: np.ndarray, alpha_rad: np.ndarray, beta_rad: np.ndarray) -> np.ndarray:
+    """Unit LOS (F, 3) in ECEF of FOVs at SBF angles alpha_rad, beta_rad (F,) (equations 1-2)."""
+    t = np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(np.shape(alpha_rad))], -1)
+    los = np.einsum("fij,fj->fi", sbf_to_ecef, t)
+    return los / np.linalg.norm(los, axis=-1, keepdims=True)
+
+
+def view_reach_rad(
+    sat_m: np.ndarray,
+    sbf_to_ecef: np.ndarray,
+    alpha_rad: np.ndarray,
+    beta_rad: np.ndarray,
+    offsets_rad: np.ndarray,
+    radii_rad: tuple[float, ...] = TOP_HAT,
+) -> float:
+    """The farthest angle from the geocentric nadir (rad) that a perturbed cone of these FOVs reaches,
+    plus VIEW_MARGIN_RAD: the VIIRS columns beyond it need no preparation (:func:`swath.view_columns`).
+    NaN FOVs are ignored; pi when there is none."""
+    los = los_ecef(sbf_to_ecef, alpha_rad, beta_rad)
+    nadir = -np.asarray(sat_m, float) / np.linalg.norm(sat_m, axis=-1, keepdims=True)
+    off = np.arccos(np.clip(np.sum(los * nadir, -1), -1.0, 1.0))
+    if not np.isfinite(off).any():
+        return math.pi
+    return float(np.nanmax(off)) + reach_rad(offsets_rad, radii_rad) + VIEW_MARGIN_RAD
+
+
+def _window_half_sizes(
+    piece: SwathPiece, col0: np.ndarray, range_m: np.ndarray, cos_zen: np.ndarray, rho: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Row and column half-widths (pixels) of the search window around each FOV centre pixel.
+
+    The centre is the pixel nearest the LOS's ellipsoid point; pixels on terrain of height h meet the
+    LOS up to h tan(zenith) before it, so both widths grow by that relief displacement.
+    """
+    cz = np.maximum(cos_zen, 0.2)
+    relief = piece.max_height_m * np.sqrt(1.0 - cz * cz) / cz
+    d_track = rho * range_m + relief
+    d_scan = rho * range_m / cz + relief
+    adv = piece.advance_m[col0]
+    det = piece.det_step_m[col0]
+    overlap = np.clip(1.0 - adv / (DETECTORS * det), 0.0, 1.0)
+    half_rows = np.ceil(d_track / (adv / DETECTORS) + DETECTORS * overlap + 8).astype(np.int64)
+    half_cols = np.ceil(d_scan / piece.col_spacing_m[col0] + 4).astype(np.int64)
+    return half_rows, half_cols, np.maximum(d_track, d_scan)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _nearest_index(t: float, guess0: float, guess_scale: float, m: int) -> int:
+    """The j nearest t on the chord through (tan B_0, 0) and (tan B_{m-1}, m - 1), clipped to 0..m
+    (0 for NaN)."""
+    g = (t - guess0) * guess_scale + 0.5
+    g = g if g > 0.0 else 0.0
+    return int(g if g < m else m)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _run_ends(
+    tan_b_inf: np.ndarray,
+    t_lo: np.ndarray,
+    t_hi: np.ndarray,
+    guess0: float,
+    guess_scale: float,
+    j_first: np.ndarray,
+    j_after: np.ndarray,
+) -> None:
+    """The run of j with t_lo <= tan B_j <= t_hi in each row: its first j and the j after its last
+    (j_first >= j_after: empty, as for a NaN interval). *tan_b_inf* is tan B_0 .. tan B_{m-1}, +inf.
+
+    tan B_j departs from the chord of :func:`_nearest_index` by at most tan|beta| n^2 s (index units),
+    < 0.3 within MAX_GRID_SPREAD_RAD, so the count of tan B_j below t is the nearest index or the next:
+    one comparison settles it. Selects, not branches, so that the loop vectorises.
+    """
+    m = tan_b_inf.shape[0] - 1
+    for i in range(t_lo.shape[0]):
+        t = t_lo[i]
+        j = _nearest_index(t, guess0, guess_scale, m)
+        j_first[i] = j + (tan_b_inf[j] < t)
+        t = t_hi[i]
+        j = _nearest_index(t, guess0, guess_scale, m)
+        j_after[i] = min(j + (tan_b_inf[j] <= t), m)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _accumulate(
+    ecef: np.ndarray,
+    radiance: np.ndarray,
+    area: np.ndarray,
+    block_centre: np.ndarray,
+    block_radius: np.ndarray,
+    sat: np.ndarray,
+    mat: np.ndarray,
+    los0: np.ndarray,
+    reach0: float,
+    tan_a: np.ndarray,
+    tan_b: np.ndarray,
+    box: np.ndarray,
+    block_row: np.ndarray,
+    block_col: np.ndarray,
+    half_brows: np.ndarray,
+    half_bcols: np.ndarray,
+    ring_g2: np.ndarray,
+    order: np.ndarray,
+    acc: np.ndarray,
+) -> None:
+    """Add the pixels of one prepared granule to each FOV's cone sums (difference arrays along j).
+
+    Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*; *reach0* the angle (rad)
+    within which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones'
+    union, and the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none).
+    *ring_g2* is cos^2 h of each disc, largest first. FOVs are taken in *order*, in chunks of
+    FOVS_PER_TASK. acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (real)
+    and weight (imaginary): +w at the first j, -w after the last. The discs are nested: where a row's
+    interval of a disc is empty, so are those of the smaller discs.
+    """
+    nrow, ncol = radiance.shape
+    nbr, nbc = block_radius.shape
+    m = tan_a.shape[1]
+    nk = ring_g2.shape[0]
+    for q in numba.prange(order.shape[0]):
+        f = order[q]
+        if half_brows[f] < 0:
+            continue
+        ta = tan_a[f]
+        out = acc[f]
+        g2k = np.empty((nk, m))  # g2 K = cos^2 h (1 + tan^2 A_i)
+        for k in range(nk):
+            for i in range(m):
+                g2k[k, i] = ring_g2[k] * (1.0 + ta[i] * ta[i])
+        tan_b_inf = np.empty(m + 1)  # tan B_0 .. tan B_{m-1}, +inf
+        tan_b_inf[:m] = tan_b[f]
+        tan_b_inf[m] = np.inf
+        guess0 = tan_b[f, 0]
+        guess_scale = (m - 1) / (tan_b[f, m - 1] - tan_b[f, 0]) if m > 1 else 0.0
+        t_lo = np.empty(m)
+        t_hi = np.empty(m)
+        j_first = np.empty(m, np.int64)
+        j_after = np.empty(m, np.int64)
+        sx, sy, sz = sat[f, 0], sat[f, 1], sat[f, 2]
+        m00, m01, m02 = mat[f, 0, 0], mat[f, 0, 1], mat[f, 0, 2]
+        m10, m11, m12 = mat[f, 1, 0], mat[f, 1, 1], mat[f, 1, 2]
+        m20, m21, m22 = mat[f, 2, 0], mat[f, 2, 1], mat[f, 2, 2]
+        lx, ly, lz = los0[f, 0], los0[f, 1], los0[f, 2]
+        a_lo, a_hi, b_lo, b_hi = box[f, 0], box[f, 1], box[f, 2], box[f, 3]
+        for br in range(max(block_row[f] - half_brows[f], 0), min(block_row[f] + half_brows[f] + 1, nbr)):
+            for bc in range(max(block_col[f] - half_bcols[f], 0), min(block_col[f] + half_bcols[f] + 1, nbc)):
+                rad = block_radius[br, bc]
+                if not rad >= 0.0:  # no usable pixel (NaN)
+                    continue
+                vx = block_centre[br, bc, 0] - sx
+                vy = block_centre[br, bc, 1] - sy
+                vz = block_centre[br, bc, 2] - sz
+                dist = math.sqrt(vx * vx + vy * vy + vz * vz)
+                reach = reach0 + math.asin(min(rad / dist, 1.0))
+                if reach < math.pi and vx * lx + vy * ly + vz * lz < dist * math.cos(reach):
+                    continue
+                for r in range(br * BLOCK_PX, (br + 1) * BLOCK_PX):
+                    for c in range(bc * BLOCK_PX, min((bc + 1) * BLOCK_PX, ncol)):
+                        value = np.float64(radiance[r, c])
+                        if not math.isfinite(value):
+                            continue
+                        px = np.float64(ecef[r, c, 0]) - sx
+                        py = np.float64(ecef[r, c, 1]) - sy
+                        pz = np.float64(ecef[r, c, 2]) - sz
+                        dx = px * m00 + py * m10 + pz * m20
+                        dy = px * m01 + py * m11 + pz * m21
+                        dz = px * m02 + py * m12 + pz * m22
+                        # The union of the perturbed cones is a rounded rectangle in (alpha, beta): drop
+                        # what lies outside, comparing tangents (d_z > 0 within reach of the LOS).
+                        if dx < a_lo * dz or dx > a_hi * dz or dy < b_lo * dz or dy > b_hi * dz:
+                            continue
+                        dist2 = px * px + py * py + pz * pz
+                        dist = math.sqrt(dist2)
+                        a_dot = area[r, c, 0] * px + area[r, c, 1] * py + area[r, c, 2] * pz
+                        weight = abs(a_dot) / (dist2 * dist)  # steradians seen from CrIS
+                        dx, dy, dz = dx / dist, dy / dist, dz / dist
+                        wz = complex(weight * value, weight)
+                        for k in range(nk):
+                            a2 = dy * dy - ring_g2[k]
+                            inv_a2 = 1.0 / a2
+                            for i in range(m):  # the interval of t = tan B per row i
+                                # (c + dy t)^2 >= g2 (K + t^2), c = dx tan A_i + dz: a2 t^2 + 2 b1 t + e >= 0
+                                ci = ta[i] * dx + dz
+                                b1 = ci * dy
+                                disc = b1 * b1 - a2 * (ci * ci - g2k[k, i])
+                                sq = math.sqrt(max(disc, 0.0))
+                                t_lo[i] = (sq - b1) * inv_a2 if disc >= 0.0 else np.inf
+                                t_hi[i] = -(b1 + sq) * inv_a2 if disc >= 0.0 else -np.inf
+                            _run_ends(tan_b_inf, t_lo, t_hi, guess0, guess_scale, j_first, j_after)
+                            inside = False
+                            for i in range(m):  # its run of j: +w at the first, -w after the last
+                                j0 = j_first[i]
+                                j1 = j_after[i]
+                                if j0 < j1:
+                                    out[k, i, j0] += wz
+                                    out[k, i, j1] -= wz
+                                    inside = True
+                            if not inside:  # in no cone of this disc: in none of the smaller ones
+                                break
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _finish(acc: np.ndarray, solid: np.ndarray, sums: np.ndarray, weights: np.ndarray) -> None:
+    """Each FOV's disc sums from its difference arrays acc (F, discs, m, m + 1) complex: the running sums
+    along j give weight x radiance (real, into *sums*) and weight (imaginary, into *weights*); a weight
+    below 1e-9 of the disc's *solid* angle (discs,) is what rounding leaves of the runs that passed an empty
+    disc (~1e-16 of the row's weight; one pixel weighs ~1e-3 of a cone's solid angle) and is set to 0."""
+    nk = acc.shape[1]
+    m = sums.shape[2]
+    for f in numba.prange(acc.shape[0]):
+        for k in range(nk):
+            for i in range(m):
+                s = 0.0
+                w = 0.0
+                for j in range(m):
+                    s += acc[f, k, i, j].real
+                    w += acc[f, k, i, j].imag
+                    occupied = w > 1e-9 * solid[k]
+                    sums[f, k, i, j] = s if occupied else 0.0
+                    weights[f, k, i, j] = w if occupied else 0.0
+
+
+@dataclass(frozen=True)
+class ConeSums:
+    """Solid-angle weighted VIIRS sums in nested discs about every perturbed LOS of a batch of F FOVs:
+    *sums* (F, K, m, m) weight x radiance and *weights* (F, K, m, m) weight (sr) of disc k (radius
+    ``radii_rad[k]``, increasing), *solid_sr* (K,) each disc's solid angle."""
+
+    radii_rad: tuple[float, ...]
+    sums: np.ndarray
+    weights: np.ndarray
+    solid_sr: np.ndarray
+
+    def mean(self, k: int = 0) -> np.ndarray:
+        """The weighted mean radiance (F, m, m) in disc k; NaN where it holds no pixel."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.weights[:, k] > 0, self.sums[:, k] / self.weights[:, k], np.nan)
+
+    def coverage(self, k: int = -1) -> np.ndarray:
+        """The share (F, m, m) of disc k's solid angle that usable pixels cover (the outermost disc by
+        default)."""
+        return self.weights[:, k] / self.solid_sr[k]
+
+    def annulus_means(self) -> np.ndarray:
+        """The weighted mean radiance (F, K, m, m) in each annulus between consecutive discs (the first:
+        the innermost disc); NaN where one holds no pixel."""
+        s = np.diff(self.sums, axis=1, prepend=0.0)
+        w = np.diff(self.weights, axis=1, prepend=0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(w > 0, s / w, np.nan).astype(np.float32)
+
+
+def cone_sums(
+    swath: ViirsSwath,
+    sat_m: np.ndarray,
+    sbf_to_ecef: np.ndarray,
+    alpha_rad: np.ndarray,
+    beta_rad: np.ndarray,
+    offsets_rad: np.ndarray,
+    radii_rad: tuple[float, ...] = TOP_HAT,
+    fov_range_m: np.ndarray | None = None,
+    fov_cos_zen: np.ndarray | None = None,
+) -> ConeSums:
+    """Weighted VIIRS radiance sums in nested discs about every perturbed LOS of a batch of FOVs.
+
+    sat_m (F, 3) and sbf_to_ecef (F, 3, 3) give each FOV's satellite position and SBF; alpha_rad,
+    beta_rad (F,) its LOS angles; offsets_rad (2n+1,) the perturbation grid; *radii_rad* the discs'
+    half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`).
+    """
+    nf = len(alpha_rad)
+    m = len(offsets_rad)
+    sat_m = np.ascontiguousarray(sat_m, np.float64)
+    mat = np.ascontiguousarray(sbf_to_ecef, np.float64)
+    if list(radii_rad) != sorted(radii_rad):
+        raise ValueError(f"disc radii must increase: {radii_rad}")
+    h_max = max(radii_rad)
+    big = np.abs(offsets_rad).max()
+    if m > 1 and big * big / (offsets_rad[1] - offsets_rad[0]) > MAX_GRID_SPREAD_RAD * (1 + 1e-9):
+        raise ValueError(
+            f"perturbation grid of {m} x {m} steps of {offsets_rad[1] - offsets_rad[0]:.3g} rad: n^2 s "
+            f"exceeds {MAX_GRID_SPREAD_RAD} rad, beyond the compiled kernel's index guess"
+        )
+    rho = reach_rad(offsets_rad, radii_rad)
+    los0 = los_ecef(mat, alpha_rad, beta_rad)
+    t = wgs84.intersect_ellipsoid(sat_m, los0)
+    ok_fov = np.isfinite(t)
+    centre = sat_m + np.where(ok_fov, t, 0.0)[:, None] * los0
+    rng = np.where(ok_fov, fov_range_m if fov_range_m is not None else t, 1e6)
+    cz = fov_cos_zen if fov_cos_zen is not None else np.abs(np.sum(wgs84.geodetic_up(centre) * los0, -1))
+    cz = np.where(ok_fov, cz, 1.0)
+    half_a = big + 1.02 * h_max / np.cos(beta_rad)
+    half_b = big + 1.02 * h_max
+    box = np.tan(np.stack([alpha_rad - half_a, alpha_rad + half_a, beta_rad - half_b, beta_rad + half_b], -1))
+    tan_a = np.tan(offsets_rad[None, :] + alpha_rad[:, None])
+    tan_b = np.tan(offsets_rad[None, :] + beta_rad[:, None])
+    ring_g2 = np.cos(np.asarray(radii_rad[::-1], np.float64)) ** 2  # the kernel takes the largest first
+    acc = np.zeros((nf, len(radii_rad), m, m + 1), np.complex128)
+    # FOVs interleaved by thread count: each thread's first share is spread over the granule (the scans
+    # that a VIIRS granule reaches are a contiguous part of it)
+    threads = numba.get_num_threads()
+    order = np.concatenate([np.arange(t0, nf, threads) for t0 in range(threads)])
+    for piece in swath.pieces:
+        row0, col0, dist = piece.nearest(centre)
+        hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, rho)
+        # a FOV whose cones cannot reach this granule's nearest usable block skips it
+        far = ~ok_fov | (dist > reach_m + 2 * BLOCK_PX * piece.col_spacing_m[col0] + piece.advance_m[col0])
+        with KERNEL_LOCK, numba.parallel_chunksize(FOVS_PER_TASK):
+            _accumulate(
+                piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
+                sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
+                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, acc,
+            )  # fmt: skip
+    solid = 2 * np.pi * (1 - np.cos(np.asarray(radii_rad[::-1], np.float64)))
+    sums, weights = np.empty((nf, len(radii_rad), m, m)), np.empty((nf, len(radii_rad), m, m))
+    with KERNEL_LOCK:
+        _finish(acc, solid, sums, weights)
+    return ConeSums(tuple(radii_rad), sums[:, ::-1], weights[:, ::-1], solid[::-1])
+
+
+def warm_up() -> float:
+    """Compile the kernels (or load them from numba's cache) on a tiny synthetic granule, so that a timing
+    or the first granule does not pay for it; the seconds it took."""
+    t0 = time.perf_counter()
+    rows, cols = 2 * DETECTORS, 16
+    r, c = np.meshgrid(np.arange(rows), np.arange(cols), indexing="ij")
+    lat, lon = np.radians(0.004 * r).astype(np.float32), np.radians(0.004 * c).astype(np.float32)
+    zeros = np.zeros((rows, cols), np.float32)
+    fields = (lat, lon, zeros, zeros + 280.0, zeros == 0)
+    kept = [a[:, 2:] for a in fields]  # the kept columns of a granule: strided views
+    swath_piece(kept[0], kept[1], kept[2], kept[3], kept[4], i5_band("j01"))
+    piece = swath_piece(*fields, i5_band("j01"))
+    ground = wgs84.geodetic_to_ecef(np.radians(0.06), np.radians(0.03), 0.0)
+    sat = ground * (1 + 833e3 / np.linalg.norm(ground))
+    z = -ground / np.linalg.norm(ground)
+    x = np.cross([0.0, 0.0, 1.0], z)
+    sbf = np.stack([x, np.cross(z, x), z], axis=1)
+    offsets = np.array([-1e-3, 0.0, 1e-3])
+    cones = cone_sums(ViirsSwath([piece]), sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets)
+    for radiance in (
+        cones.mean(),
+        np.full(PARALLEL_FROM, 5.0),
+    ):  # the inversion's serial and parallel kernels
+        i5_band("j01").bt_from_radiance(radiance)
+    return time.perf_counter() - t0

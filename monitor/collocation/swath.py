@@ -1,0 +1,547 @@
+"""VIIRS I5 granules prepared for the cone test: pixel points, band radiance, solid-angle weights, blocks.
+
+Pixels where they are. A terrain-corrected (GITCO) pixel is the 3-D point where its line of sight meets
+the terrain: (lat, lon, Height). Put at h = 0 instead, a pixel on terrain of height h seen from CrIS at
+view zenith z moves by about h sin(z) / range towards nadir (~0.5 mrad for 1 km at the scan edge), so
+every position below is the 3-D point; the ellipsoid product (GIMGO) has h = 0.
+
+Weights. CrIS sees the scene averaged over the solid angle of its FOV; VIIRS pixels do not sample
+that solid angle evenly (scan overlap towards the swath edge, footprint steps at the aggregation-zone
+edges). Each pixel is weighted by the solid angle it covers seen from CrIS,
+``w = |A . u| / range^2``, where ``A`` is the pixel's vector footprint (the cross product of the steps to
+its neighbours, so that a slope is foreshortened as seen along the unit direction ``u`` from CrIS) with
+the overlap between consecutive scans removed (the part of a footprint that a neighbouring scan also
+covers counts half). The sum of the weights inside a cone over the cone's solid angle is its coverage:
+1 when VIIRS fills it.
+
+Search blocks. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans),
+a sphere holding its usable pixels, and a KD-tree of the block centres to find where a FOV lands.
+
+Columns and scans. VIIRS scans to 56 deg from nadir, CrIS's cones reach ~51 deg: the columns no cone can
+reach (~15 % of a granule) are not prepared when the caller gives the reach (:func:`view_columns`). Nor
+are the scans observed long before or after every CrIS granule that uses the VIIRS granule, when the
+caller gives that time span (:func:`scans_between`): a CrIS granule (32 s) needs a third of one VIIRS
+granule (86 s), or parts of two.
+
+A granule is prepared once per run (about 10 million pixels): the per-pixel work is compiled (numba) and
+runs scan by scan in parallel; only the one-scan statistics and the KD-tree are numpy/scipy. The kernels
+use numba's numpy error model: a division by zero gives inf or NaN, which they test for, instead of a
+Python exception check in every loop that keeps the compiler from vectorising it (~8 % of the time).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Protocol
+
+import numba
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.ndimage import minimum_filter1d
+from scipy.spatial import cKDTree
+
+from monitor.core.threads import KERNEL_LOCK
+from monitor.geometry import wgs84
+
+DETECTORS = 32  # VIIRS I-band detectors per scan
+BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
+
+
+class BandTable(Protocol):
+    """The I5 band's Planck table (:class:`monitor.instrument.spectral.I5Band`, a neighbour on this floor)."""
+
+    @property
+    def radiance_table(self) -> tuple[float, float, np.ndarray]:
+        """(first BT K, BT step K, band radiance per BT)."""
+        ...
+
+
+# the passes' threads take scans one at a time as they come free, not in equal shares fixed in advance:
+# the read-ahead thread takes turns on the cores, and a share fixed in advance waits for the slowest
+SCANS_PER_TASK = 1
+SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smallest within +-200 columns
+
+
+@dataclass
+class SwathPiece:
+    """One VIIRS granule (rows of 32-detector scans) ready for collocation.
+
+    ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (rows, cols) I5 band
+    radiance mW/(m2 sr cm-1), NaN where unusable; area_vec_m2 (rows, cols, 3) float32 the vector footprint
+    with scan overlap removed. block_centre_m (rows/4, ceil(cols/4), 3) and block_radius_m bound the usable
+    pixels of each 4 x 4 block (NaN where it has none). Per column: the smallest column spacing within
+    +-200 columns (col_spacing_m), the along-track advance of a scan (advance_m) and the detector step
+    (det_step_m), all m; max_height_m the highest usable pixel. They size the search windows.
+    The piece holds the granule's columns from *first_column* on that are seen within *view_rad* of nadir
+    (inf: all columns), and its scans from *first_scan* on that cover the IET span *span_us* (start of the
+    first scan, start of the scan after the last; -inf and inf at the granule's ends).
+    """
+
+    ecef_m: np.ndarray
+    radiance: np.ndarray
+    area_vec_m2: np.ndarray
+    block_centre_m: np.ndarray
+    block_radius_m: np.ndarray
+    col_spacing_m: np.ndarray
+    advance_m: np.ndarray
+    det_step_m: np.ndarray
+    max_height_m: float
+    tree: cKDTree
+    tree_rows: np.ndarray
+    tree_cols: np.ndarray
+    first_column: int = 0
+    view_rad: float = math.inf
+    first_scan: int = 0
+    span_us: tuple = (-math.inf, math.inf)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(rows, columns) of the prepared piece."""
+        return self.radiance.shape
+
+    def covers(self, t0_us: float, t1_us: float) -> bool:
+        """Whether the piece holds every scan observed between IET t0_us and t1_us."""
+        return self.span_us[0] <= t0_us and t1_us < self.span_us[1]
+
+    def nearest(self, points_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point,
+        and that distance (m)."""
+        dist, idx = self.tree.query(points_m)
+        return self.tree_rows[idx], self.tree_cols[idx], dist
+
+
+@dataclass
+class ViirsSwath:
+    """The prepared granules (consecutive or not) that a CrIS granule's cones may reach.
+
+    Pieces are never stacked: cone sums add over pixels, so each piece is searched on its own.
+    """
+
+    pieces: list
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _ecef(lat: np.ndarray, lon: np.ndarray, h: np.ndarray, out: np.ndarray) -> None:
+    """WGS84 geodetic (rad, rad, m; float32 arrays) to ECEF float32 *out* (..., 3): wgs84.geodetic_to_ecef."""
+    rows, cols = lat.shape
+    for r in range(rows):
+        for c in range(cols):
+            la = np.float64(lat[r, c])
+            lo = np.float64(lon[r, c])
+            hh = np.float64(h[r, c])
+            s = math.sin(la)
+            n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * s * s)
+            rr = (n + hh) * math.cos(la)
+            out[r, c, 0] = rr * math.cos(lo)
+            out[r, c, 1] = rr * math.sin(lo)
+            out[r, c, 2] = (n * (1.0 - wgs84.E2) + hh) * s
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _scan_ends(scan: np.ndarray, first: np.ndarray, last: np.ndarray, step: np.ndarray) -> None:
+    """First and last valid detector positions (float64 (cols, 3), NaN where the column has none) of one
+    scan (32, cols, 3) and the detector step between them (m)."""
+    for c in range(scan.shape[1]):
+        i0 = -1
+        i1 = -1
+        for d in range(DETECTORS):
+            if math.isfinite(scan[d, c, 0]):
+                if i0 < 0:
+                    i0 = d
+                i1 = d
+        if i0 < 0:
+            first[c, :] = np.nan
+            last[c, :] = np.nan
+            step[c] = np.nan
+            continue
+        s2 = 0.0
+        for x in range(3):
+            first[c, x] = scan[i0, c, x]
+            last[c, x] = scan[i1, c, x]
+            s2 += (last[c, x] - first[c, x]) ** 2
+        step[c] = math.sqrt(s2) / max(i1 - i0, 1)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _locate_scan(
+    k: int,
+    lat: np.ndarray,
+    lon: np.ndarray,
+    h: np.ndarray,
+    bt: np.ndarray,
+    good: np.ndarray,
+    table: np.ndarray,
+    t_min_k: float,
+    t_step_k: float,
+    pos: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+) -> None:
+    """Pass 1 for scan k: pixel points, band radiance from BT (linear in the uniform BT table, NaN outside
+    it or where not *good*), and the scan's ends (slot k + 1; 0 and nscan + 1 are the halos)."""
+    cols = lat.shape[1]
+    nt = table.shape[0]
+    sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
+    _ecef(lat[sl], lon[sl], h[sl], pos[sl])
+    for r in range(k * DETECTORS, (k + 1) * DETECTORS):
+        for c in range(cols):
+            x = (np.float64(bt[r, c]) - t_min_k) / t_step_k
+            if good[r, c] and x >= 0.0 and x <= nt - 1:
+                i = min(int(x), nt - 2)
+                w = x - i
+                radiance[r, c] = table[i] * (1.0 - w) + table[i + 1] * w
+            else:
+                radiance[r, c] = np.nan
+    _scan_ends(pos[sl], first[k + 1], last[k + 1], step[k + 1])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _locate(
+    lat: np.ndarray,
+    lon: np.ndarray,
+    h: np.ndarray,
+    bt: np.ndarray,
+    good: np.ndarray,
+    table: np.ndarray,
+    t_min_k: float,
+    t_step_k: float,
+    pos: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+) -> None:
+    """Pass 1 (:func:`_locate_scan`), scans in parallel."""
+    for k in numba.prange(lat.shape[0] // DETECTORS):
+        _locate_scan(k, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _centred(here: float, nxt: float, prv: float) -> float:
+    """Half the difference of a pixel's two neighbours *nxt* and *prv* (one coordinate, m), one-sided
+    where one is missing (NaN)."""
+    fwd = nxt - here
+    bwd = here - prv
+    both = (fwd + bwd) * 0.5
+    return both if math.isfinite(both) else (fwd if math.isfinite(fwd) else bwd)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _scan_frame(
+    first: np.ndarray, last: np.ndarray, step: np.ndarray, have: np.ndarray, k: int, c: int, out: np.ndarray
+) -> None:
+    """The along-track frame of column c of scan slot k, for :func:`_share`: the unit vector u from its
+    first to its last valid detector, u . first, half a detector step, and the spans along u (plus half
+    a step each side) of the neighbouring scans' columns, (+inf, -inf) where there is none."""
+    u0 = last[k, c, 0] - first[k, c, 0]
+    u1 = last[k, c, 1] - first[k, c, 1]
+    u2 = last[k, c, 2] - first[k, c, 2]
+    norm = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    u0, u1, u2 = u0 / norm, u1 / norm, u2 / norm
+    out[0], out[1], out[2] = u0, u1, u2
+    out[3] = first[k, c, 0] * u0 + first[k, c, 1] * u1 + first[k, c, 2] * u2
+    out[4] = step[k, c] / 2
+    for slot, n in ((5, k - 1), (7, k + 1)):
+        if have[n] and math.isfinite(step[n, c]):
+            lo = first[n, c, 0] * u0 + first[n, c, 1] * u1 + first[n, c, 2] * u2 - out[3]
+            hi = last[n, c, 0] * u0 + last[n, c, 1] * u1 + last[n, c, 2] * u2 - out[3]
+            out[slot], out[slot + 1] = lo - step[n, c] / 2, hi + step[n, c] / 2
+        else:
+            out[slot], out[slot + 1] = np.inf, -np.inf
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _share(p0: float, p1: float, p2: float, frames: np.ndarray, c: int) -> float:
+    """The share (0.5..1) of the footprint of the pixel at (p0, p1, p2) (ECEF m) in column c that is its
+    own, in its column's frame (frames[:, c], :func:`_scan_frame`).
+
+    Along the track each pixel spans one detector step centred on it, each neighbouring scan its
+    first-to-last valid detector span plus half a step each side; an overlap of a fraction f of the
+    footprint leaves the pixel 1 - f / 2. (Counting whole pixels in or out instead leaves ~1 % too much
+    weight in stripes at the scan edges near nadir, where the overlap is a fraction of a detector, and
+    biases the in-track minimum there.) A neighbour with no valid pixel in the column overlaps nothing.
+    """
+    s_pix = p0 * frames[0, c] + p1 * frames[1, c] + p2 * frames[2, c] - frames[3, c]
+    half = frames[4, c]
+    before = min(s_pix + half, frames[6, c]) - max(s_pix - half, frames[5, c])
+    after = min(s_pix + half, frames[8, c]) - max(s_pix - half, frames[7, c])
+    return 1.0 - min(max(before / (2 * half), 0.0), 1.0) / 2 - min(max(after / (2 * half), 0.0), 1.0) / 2
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _load_row(pos: np.ndarray, r: int, inside: bool, out: np.ndarray) -> None:
+    """Row r of *pos* (cols, 3) into out (3, cols + 2) as float64, one coordinate per line, with a NaN
+    column at each end; all NaN when the row is not *inside* the scan."""
+    if not inside:
+        out[:] = np.nan
+        return
+    out[:, 0] = np.nan
+    out[:, -1] = np.nan
+    for c in range(pos.shape[1]):
+        for x in range(3):
+            out[x, c + 1] = pos[r, c, x]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _weigh_scan(
+    k: int,
+    pos: np.ndarray,
+    h: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+    have: np.ndarray,
+    area: np.ndarray,
+    centre: np.ndarray,
+    radius: np.ndarray,
+    top: np.ndarray,
+) -> None:
+    """Pass 2 for scan k: vector footprints with the scan overlap removed, radiance NaN where either is
+    unusable, the bounding sphere (centre, radius + 1 m for the float32 rounding) of each block's usable
+    pixels (NaN where it has none), and the height of the scan's highest usable pixel (top[k], m).
+
+    Each footprint is the cross product of half the differences of the pixel's neighbours along the scan
+    and across the detectors; the rows it needs are held as float64 lines of coordinates padded with NaN
+    (a missing neighbour), so that the loop over a row's pixels has no branches and vectorises.
+    """
+    cols = radiance.shape[1]
+    nbc = centre.shape[1]
+    frames = np.empty((9, cols))
+    for c in range(cols):
+        _scan_frame(first, last, step, have, k + 1, c, frames[:, c])
+    prev, here, after = np.empty((3, cols + 2)), np.empty((3, cols + 2)), np.empty((3, cols + 2))
+    foot = np.empty((3, cols))
+    lo = np.empty((nbc, 3))  # the bounding box of each block of the current band of BLOCK_PX rows
+    hi = np.empty((nbc, 3))
+    for r in range(k * DETECTORS, (k + 1) * DETECTORS):
+        d = r - k * DETECTORS
+        _load_row(pos, r - 1, d > 0, prev)
+        _load_row(pos, r, True, here)
+        _load_row(pos, r + 1, d + 1 < DETECTORS, after)
+        if d % BLOCK_PX == 0:
+            lo[:] = np.inf
+            hi[:] = -np.inf
+        for c in range(cols):
+            p0, p1, p2 = here[0, c + 1], here[1, c + 1], here[2, c + 1]
+            a0 = _centred(p0, here[0, c + 2], here[0, c])
+            a1 = _centred(p1, here[1, c + 2], here[1, c])
+            a2 = _centred(p2, here[2, c + 2], here[2, c])
+            b0 = _centred(p0, after[0, c + 1], prev[0, c + 1])
+            b1 = _centred(p1, after[1, c + 1], prev[1, c + 1])
+            b2 = _centred(p2, after[2, c + 1], prev[2, c + 1])
+            s = _share(p0, p1, p2, frames, c)
+            foot[0, c] = (a1 * b2 - a2 * b1) * s
+            foot[1, c] = (a2 * b0 - a0 * b2) * s
+            foot[2, c] = (a0 * b1 - a1 * b0) * s
+        for c in range(cols):
+            x0, x1, x2 = foot[0, c], foot[1, c], foot[2, c]
+            area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
+            if not (math.isfinite(x0) and math.isfinite(x1) and math.isfinite(x2)):
+                radiance[r, c] = np.nan
+            if math.isfinite(radiance[r, c]):
+                top[k] = max(top[k], h[r, c])
+                bc = c // BLOCK_PX
+                for x in range(3):
+                    lo[bc, x] = min(lo[bc, x], pos[r, c, x])
+                    hi[bc, x] = max(hi[bc, x], pos[r, c, x])
+        if d % BLOCK_PX == BLOCK_PX - 1:
+            br = r // BLOCK_PX
+            for bc in range(nbc):
+                if lo[bc, 0] > hi[bc, 0]:
+                    centre[br, bc, :] = np.nan
+                    radius[br, bc] = np.nan
+                    continue
+                lo0, lo1, lo2 = lo[bc, 0], lo[bc, 1], lo[bc, 2]
+                hi0, hi1, hi2 = hi[bc, 0], hi[bc, 1], hi[bc, 2]
+                centre[br, bc, 0] = (lo0 + hi0) / 2
+                centre[br, bc, 1] = (lo1 + hi1) / 2
+                centre[br, bc, 2] = (lo2 + hi2) / 2
+                radius[br, bc] = math.sqrt((hi0 - lo0) ** 2 + (hi1 - lo1) ** 2 + (hi2 - lo2) ** 2) / 2 + 1.0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _weigh(
+    pos: np.ndarray,
+    h: np.ndarray,
+    radiance: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    step: np.ndarray,
+    have: np.ndarray,
+    area: np.ndarray,
+    centre: np.ndarray,
+    radius: np.ndarray,
+    top: np.ndarray,
+) -> None:
+    """Pass 2 (:func:`_weigh_scan`), scans in parallel."""
+    for k in numba.prange(radiance.shape[0] // DETECTORS):
+        _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top)
+
+
+def _np_half_diff(p: np.ndarray, axis: int) -> np.ndarray:
+    """Half the difference of the two neighbours along *axis* (numpy), one-sided where one is missing."""
+    fwd = np.full_like(p, np.nan)
+    bwd = np.full_like(p, np.nan)
+    n = p.shape[axis]
+    a, b = [slice(None)] * p.ndim, [slice(None)] * p.ndim
+    a[axis], b[axis] = slice(0, n - 1), slice(1, n)
+    np.subtract(p[tuple(b)], p[tuple(a)], out=fwd[tuple(a)])
+    bwd[tuple(b)] = fwd[tuple(a)]
+    both = (fwd + bwd) * 0.5
+    return np.where(np.isfinite(both), both, np.where(np.isfinite(fwd), fwd, bwd))
+
+
+def _fill_nan(a: ArrayLike) -> np.ndarray:
+    a = np.asarray(a, float)
+    ok = np.isfinite(a)
+    return np.interp(np.arange(len(a)), np.nonzero(ok)[0], a[ok]) if not ok.all() else a
+
+
+def view_columns(
+    lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray, sat_m: np.ndarray, view_rad: float
+) -> slice:
+    """The columns holding every pixel seen within *view_rad* of nadir, judged on the middle detector row
+    of every fourth scan and the last from that scan's spacecraft position *sat_m* (nscan, 3; ECEF m; NaN
+    ignored): a column's view angle changes little from scan to scan.
+
+    The angle is from the geocentric nadir; all columns when no pixel qualifies (nothing to judge by). The
+    slice starts on a block boundary, so that the search blocks, and the order in which the cone sums add
+    pixels, are those of the whole granule.
+    """
+    scans = np.unique(np.r_[np.arange(0, len(sat_m), 4), len(sat_m) - 1])
+    sat = np.asarray(sat_m, float)[scans]
+    mid = scans * DETECTORS + DETECTORS // 2
+    los = wgs84.geodetic_to_ecef(lat_rad[mid], lon_rad[mid], height_m[mid]) - sat[:, None, :]
+    nadir = -sat / np.linalg.norm(sat, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore"):
+        seen = np.sum(los * nadir[:, None, :], -1) >= np.cos(view_rad) * np.linalg.norm(los, axis=-1)
+    cols = np.flatnonzero(seen.any(axis=0))
+    return slice(int(cols[0]) // BLOCK_PX * BLOCK_PX, int(cols[-1]) + 1) if cols.size else slice(None)
+
+
+def scans_between(scan_start_us: ArrayLike, t0_us: float, t1_us: float) -> slice:
+    """The scans observed between IET t0_us and t1_us, from the scans' start times *scan_start_us* (IET
+    us; a scan lasts until the next starts, the last to the granule's end): all scans when those times are
+    not all set and increasing (nothing to judge by)."""
+    t = np.asarray(scan_start_us, np.int64)
+    if t.size == 0 or t[0] <= 0 or np.any(np.diff(t) <= 0):
+        return slice(None)
+    first = max(int(np.searchsorted(t, t0_us, side="right")) - 1, 0)
+    stop = int(np.searchsorted(t, t1_us, side="right"))
+    return slice(first, max(stop, first + 1))
+
+
+def swath_piece(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    bt_k: np.ndarray,
+    good: np.ndarray,
+    band: BandTable,
+    before: tuple[np.ndarray, ...] | None = None,
+    after: tuple[np.ndarray, ...] | None = None,
+    sat_m: np.ndarray | None = None,
+    view_rad: float = math.inf,
+    scan_start_us: np.ndarray | None = None,
+    span_us: tuple[float, float] | None = None,
+) -> SwathPiece:
+    """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
+
+    Pixels are the 3-D points (lat_rad, lon_rad, height_m) (height above the ellipsoid; zeros for the
+    ellipsoid product). *band* (:class:`monitor.instrument.spectral.I5Band`) turns pixel BT into band
+    radiance.
+    *before* and *after* are optional (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent
+    scan, so that the scan overlap at the granule's first and last scan is counted as inside a continuous
+    swath. Given *sat_m*, the spacecraft position of each scan (ECEF m), only the columns seen within
+    *view_rad* of nadir are prepared (:func:`view_columns`); given *span_us* (t0, t1) and the start time
+    of each scan *scan_start_us* (IET us), only the scans observed between t0 and t1
+    (:func:`scans_between`), each with the same weights as in the whole granule (the scans next to those
+    kept are their halos).
+    """
+    scans = slice(None)
+    if scan_start_us is not None and span_us is not None:
+        scans = scans_between(scan_start_us, *span_us)
+    if scans != slice(None) and scan_start_us is not None:
+        first, stop, _ = scans.indices(len(scan_start_us))
+        r0, r1 = first * DETECTORS, stop * DETECTORS
+        geo = (lat_rad, lon_rad, height_m)
+        if first > 0:
+            before = tuple(a[r0 - DETECTORS : r0] for a in geo)
+        if r1 < np.shape(lat_rad)[0]:
+            after = tuple(a[r1 : r1 + DETECTORS] for a in geo)
+        lat_rad, lon_rad, height_m, bt_k, good = (a[r0:r1] for a in (*geo, bt_k, good))
+        sat_m = None if sat_m is None else sat_m[first:stop]
+        t = np.asarray(scan_start_us, np.int64)
+        covered_us = (t[first] if first > 0 else -math.inf, t[stop] if stop < len(t) else math.inf)
+    else:
+        covered_us = (-math.inf, math.inf)
+    kept = slice(None)
+    if sat_m is not None and view_rad < math.pi / 2:
+        kept = view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad)
+        lat_rad, lon_rad, height_m = lat_rad[:, kept], lon_rad[:, kept], height_m[:, kept]
+        bt_k, good = bt_k[:, kept], good[:, kept]
+        before, after = (None if b is None else tuple(a[..., kept] for a in b) for b in (before, after))
+    else:
+        view_rad = math.inf
+    f32 = np.float32
+    # the kernels read the kept columns in place (a copy of them costs more than the strided reads)
+    lat, lon, h = (np.asarray(a, f32) for a in (lat_rad, lon_rad, height_m))
+    rows, cols = lat.shape
+    nscan = rows // DETECTORS
+    pos = np.empty((rows, cols, 3), f32)
+    radiance = np.empty((rows, cols), f32)
+    ends_first = np.full((nscan + 2, cols, 3), np.nan)  # each scan's first and last row
+    ends_last = np.full_like(ends_first, np.nan)
+    step = np.full((nscan + 2, cols), np.nan)
+    have = np.zeros(nscan + 2, bool)
+    have[1:-1] = True
+    t_min, t_step, table = band.radiance_table
+    bt, good = np.asarray(bt_k, f32), np.asarray(good, bool)
+    with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
+        _locate(lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, ends_first, ends_last, step)
+    for slot, halo in ((0, before), (nscan + 1, after)):
+        if halo is not None:
+            hp = np.empty(np.shape(halo[0]) + (3,), f32)
+            _ecef(*(np.ascontiguousarray(a, f32) for a in halo), hp)
+            _scan_ends(hp, ends_first[slot], ends_last[slot], step[slot])
+            have[slot] = True
+    area = np.empty((rows, cols, 3), f32)
+    centre = np.empty((rows // BLOCK_PX, -(-cols // BLOCK_PX), 3))
+    radius = np.empty(centre.shape[:2])
+    top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
+    with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
+        _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
+
+    scan = pos.reshape(nscan, DETECTORS, cols, 3)
+    mid = scan[nscan // 2]
+    col_spacing = _fill_nan(np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=1), axis=-1), axis=0))
+    det_step = np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=0), axis=-1), axis=0)
+    if nscan > 1:
+        advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
+    else:
+        advance = det_step * DETECTORS
+    r_idx, c_idx = np.nonzero(np.isfinite(radius))
+    # unbalanced with large leaves: builds 2.5x faster, the same nearest blocks
+    tree = cKDTree(centre[r_idx, c_idx], leafsize=64, balanced_tree=False, compact_nodes=False)
+    return SwathPiece(
+        pos,
+        radiance,
+        area,
+        centre,
+        radius,
+        minimum_filter1d(col_spacing, SPACING_WINDOW_COLS, mode="nearest"),
+        _fill_nan(advance),
+        _fill_nan(det_step),
+        max(float(top.max()), 0.0),
+        tree,
+        r_idx * BLOCK_PX,
+        c_idx * BLOCK_PX,
+        kept.start or 0,
+        view_rad,
+        scans.start or 0,
+        covered_us,
+    )

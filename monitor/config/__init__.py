@@ -1,0 +1,1 @@
+"""The configuration: the model (every key once), the file, the generated reference."""

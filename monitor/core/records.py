@@ -1,0 +1,292 @@
+"""What the store gives back, typed: its rows as records, and the interfaces the alerts program against.
+
+The store (:mod:`monitor.service.store`) writes and reads SQLite; whoever reads history through it (the alert
+rules,
+the report, the CLI) receives these records, and the alerts see the store only as a :class:`History`
+with an :class:`AlertLedger` (so that ``alerts`` needs nothing of ``monitor`` above this floor).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from contextlib import AbstractContextManager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from monitor.core.result import RELIABILITY_FLAGS, ForOffset
+from monitor.core.vocabulary import AlertStatus, Decision, DeliveryStatus, EventKind, RunStatus, Severity
+
+
+class FindingRecord(Protocol):
+    """What the alert ledger records of a rule's finding (:class:`alerts.rules.Finding`, a floor above)."""
+
+    @property
+    def fingerprint(self) -> str: ...
+    @property
+    def rule(self) -> str: ...
+    @property
+    def satellite(self) -> str: ...
+    @property
+    def group(self) -> str: ...
+    @property
+    def severity(self) -> str: ...
+    @property
+    def summary(self) -> str: ...
+    @property
+    def lines(self) -> list: ...
+
+
+class Row(Protocol):
+    """A row of the store (:class:`sqlite3.Row`): its columns by name."""
+
+    def __getitem__(self, key: str, /) -> Any: ...
+
+
+def iso(t: dt.datetime) -> str:
+    """*t* as an ISO 8601 UTC string, to the second."""
+    return t.astimezone(dt.timezone.utc).isoformat(timespec="seconds")
+
+
+@dataclass(frozen=True)
+class Alert:
+    """One alert: identified by *fingerprint* (rule:satellite:group); *status* firing or resolved; times ISO
+    8601 UTC; *lines* the finding's detail lines."""
+
+    fingerprint: str
+    rule: str
+    satellite: str
+    grp: str | None
+    severity: Severity | None
+    status: AlertStatus
+    started: str | None
+    last_notified: str | None
+    resolved: str | None
+    summary: str | None
+    lines: list
+
+    @classmethod
+    def from_row(cls, r: Row) -> "Alert":
+        """The Alert of a row of the store."""
+        d = {k: r[k] for k in cls.__dataclass_fields__}
+        d["lines"] = json.loads(r["lines"] or "[]")
+        d["status"] = AlertStatus(d["status"])
+        d["severity"] = Severity(d["severity"]) if d["severity"] else None
+        return cls(**d)
+
+
+@dataclass(frozen=True)
+class Silence:
+    """A silence: *rule* and *satellite* (None: all) are quiet until *until* (ISO 8601 UTC), for *reason*."""
+
+    id: int
+    rule: str | None
+    satellite: str | None
+    until: str
+    reason: str
+    created: str | None
+
+    @classmethod
+    def from_row(cls, r: Row) -> "Silence":
+        """The Silence of a row of the store."""
+        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
+
+
+@dataclass(frozen=True)
+class Delivery:
+    """A queued notification: *body* the message (subject, text, ...), *status* pending, sending, sent or
+    failed, after *attempts* tries; times ISO 8601 UTC."""
+
+    id: int
+    channel: str
+    satellite: str | None
+    subject: str
+    body: dict
+    created: str
+    status: DeliveryStatus
+    attempts: int
+    next_attempt: str | None
+    last_error: str | None
+    sent: str | None
+
+    @classmethod
+    def from_row(cls, r: Row) -> "Delivery":
+        """The Delivery of a row of the store."""
+        d = {k: r[k] for k in cls.__dataclass_fields__}
+        return cls(
+            **{
+                **d,
+                "body": json.loads(d["body"]),
+                "attempts": int(d["attempts"] or 0),
+                "status": DeliveryStatus(d["status"]),
+            }
+        )
+
+
+@dataclass(frozen=True)
+class Event:
+    """One ``events`` row; *detail* is the decoded JSON (rows of older versions, plain text, become
+    ``{"text": ...}``)."""
+
+    id: int
+    time: str
+    kind: EventKind
+    satellite: str | None
+    detail: dict
+
+    @classmethod
+    def from_row(cls, r: Row) -> "Event":
+        """The event of an ``events`` row."""
+        try:
+            detail = json.loads(r["detail"])
+        except (TypeError, ValueError):
+            detail = None
+        if not isinstance(detail, dict):
+            detail = {"text": r["detail"]}
+        return cls(r["id"], r["time"], EventKind(r["kind"]), r["satellite"], detail)
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of the ledger; times ISO 8601 UTC (*finished* None while running); *day* YYYY-MM-DD."""
+
+    id: int
+    satellite: str
+    day: str
+    started: str
+    finished: str | None
+    status: RunStatus
+    reason: str | None
+    n_granules: int
+    summary: str | None
+
+    @classmethod
+    def from_row(cls, r: Row) -> "Run":
+        """The Run of a row of the store."""
+        row = {k: r[k] for k in cls.__dataclass_fields__}
+        return cls(**{**row, "status": RunStatus(row["status"])})
+
+
+@dataclass(frozen=True)
+class ForSeries:
+    """The per-FOR results of one satellite over days, as arrays: *days* ascending (dates); *values* per
+    measured field an array (days, N_FOR), NaN where nothing is stored (n_samples 0); *flags* a
+    (days, N_FOR) object array of flag-name tuples; *stored* where a result is."""
+
+    days: list
+    values: dict
+    flags: np.ndarray
+    stored: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.days)
+
+    def reliable(self) -> np.ndarray:
+        """(days, N_FOR): a stored FOR without any of the reliability flags."""
+        flagged = np.vectorize(lambda f: bool(set(f) & set(RELIABILITY_FLAGS)), otypes=[bool])(self.flags)
+        return self.stored & ~flagged if self.flags.size else self.stored
+
+
+def _json_list(text: str | None) -> tuple:
+    return tuple(json.loads(text)) if text else ()
+
+
+@dataclass(frozen=True)
+class GranuleRow:
+    """One assessed CrIS granule as stored: its files and VIIRS cover, usable FOVs, and the processing
+    metadata (SDR software and algorithm versions, auxiliary files) that change attribution compares from
+    day to day; *day* YYYY-MM-DD, *start* ISO 8601."""
+
+    satellite: str
+    day: str
+    run_id: int
+    granule_id: str
+    start: str | None
+    cris_geo: str | None
+    cris_sdr: str | None
+    viirs: tuple[str, ...]
+    n_usable: int | None
+    software_version: str | None
+    algorithm_version: str | None
+    cris_aux: tuple[str, ...]
+    viirs_aux: tuple[str, ...]
+    viirs_software: str | None
+
+    @classmethod
+    def from_row(cls, r: Row) -> "GranuleRow":
+        """The GranuleRow of a row of the store."""
+        row = {k: r[k] for k in cls.__dataclass_fields__}
+        return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
+
+
+@dataclass(frozen=True)
+class SceneDecision:
+    """What scene selection decided for one CrIS granule, why, and its inhomogeneity score (K) where it was
+    scored."""
+
+    granule: str
+    decision: Decision
+    reason: str
+    score_k: float | None = None
+
+
+@dataclass(frozen=True)
+class SelectionRow:
+    """One scene-selection decision: the granule, its inhomogeneity score (K), kept or rejected and why."""
+
+    satellite: str
+    day: str
+    run_id: int
+    granule: str
+    score_k: float | None
+    decision: str
+    reason: str | None
+
+    @classmethod
+    def from_row(cls, r: Row) -> "SelectionRow":
+        """The SelectionRow of a row of the store."""
+        return cls(**{k: r[k] for k in cls.__dataclass_fields__})
+
+
+class AlertLedger(Protocol):
+    """The alert state, silences and delivery queue (:class:`monitor.service.store.alerts.AlertState`)."""
+
+    def get(self, fingerprint: str) -> Alert | None: ...
+    def firing(self, satellite: str | None = None) -> list[Alert]: ...
+    def all(self) -> list[Alert]: ...
+    def upsert(self, finding: FindingRecord, now: dt.datetime, notified: bool) -> None: ...
+    def resolve(self, fingerprint: str, now: dt.datetime) -> None: ...
+    def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None: ...
+    def silences(self, now: dt.datetime) -> list[Silence]: ...
+    def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime) -> None: ...
+    def due(self, now: dt.datetime) -> list[Delivery]: ...
+    def claim(self, delivery_id: int, now: dt.datetime, lease_s: float = 600.0) -> bool: ...
+    def deliveries(self, status: DeliveryStatus | None = None) -> list[Delivery]: ...
+    def mark(
+        self,
+        delivery_id: int,
+        status: DeliveryStatus,
+        now: dt.datetime,
+        error: str | None = ...,
+        retry_after_s: float = ...,
+    ) -> None: ...
+
+
+class History(Protocol):
+    """What the alert rules and the export read of the store (:class:`monitor.service.store.sqlite.Store`)."""
+
+    path: Path  # the store's file
+
+    def alert_state(self) -> AlertLedger: ...
+    def transaction(self) -> AbstractContextManager[Any]: ...
+    def runs(self, satellite: str | None = None) -> list[Run]: ...
+    def events(self, kind: EventKind | None = None) -> list[Event]: ...
+    def day_result(self, satellite: str, day: dt.date) -> list[ForOffset]: ...
+    def latest_day(self, satellite: str) -> dt.date | None: ...
+    def series(
+        self, satellite: str, since: dt.date | None = None, until: dt.date | None = None
+    ) -> ForSeries: ...
+    def granules(self, satellite: str, day: dt.date | None = None) -> list[GranuleRow]: ...

@@ -1,0 +1,225 @@
+"""The typed result where the science hands over to the service: per-FOR LOS offsets of one assessment."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field, fields
+
+import numpy as np
+
+from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DIAMETER_URAD
+
+FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
+FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
+FLAG_FLAT = "flat"  # the cost surface has no clear minimum (uniform scenes carry no information)
+FLAG_UNCERTAIN = "uncertain"  # the bootstrap spread of the offset exceeds the configured limit
+RELIABILITY_FLAGS = (FLAG_FEW_SAMPLES, FLAG_EDGE, FLAG_FLAT, FLAG_UNCERTAIN)
+
+
+@dataclass(frozen=True)
+class SpecBreach:
+    """One direction of a FOR beyond the geolocation specification: *direction* ``in-track`` or
+    ``cross-track``, the error and its sigma on the ground (km), the specification (km)."""
+
+    direction: str
+    error_km: float
+    sigma_km: float
+    spec_km: float
+
+    @property
+    def beyond_doubt(self) -> bool:
+        """The breach holds beyond the uncertainty: |error| - 2 sigma is still beyond the specification."""
+        return math.isfinite(self.sigma_km) and abs(self.error_km) - 2 * self.sigma_km > self.spec_km
+
+
+@dataclass(frozen=True)
+class ForOffset:
+    """Offsets of one scan position (FOR 1..30): the turn to apply to the CrIS LOS to best match VIIRS.
+
+    Angles in microradians (in-track alpha, cross-track beta), distances in km on the ground (in-track
+    positive along the flight direction, cross-track positive to the right), cost in kelvin. At the optimum,
+    the CrIS-VIIRS intercalibration (:mod:`monitor.estimation.intercal`): the BT bias (K) at the reference
+    temperature,
+    the gain there (per cent) and the curvature (K), NaN where none was fitted; and the full widths (urad)
+    of the CrIS spatial response found there (:mod:`monitor.estimation.estimate`), NaN where none was fitted.
+    """
+
+    for_index: int
+    d_alpha_urad: float
+    d_beta_urad: float
+    sigma_alpha_urad: float
+    sigma_beta_urad: float
+    in_track_km: float
+    cross_track_km: float
+    total_km: float
+    sigma_in_track_km: float
+    sigma_cross_track_km: float
+    n_samples: int
+    cost_min_k: float
+    cost_zero_k: float
+    flags: tuple = ()
+    bias_k: float = float("nan")
+    sigma_bias_k: float = float("nan")
+    gain_pct: float = float("nan")
+    sigma_gain_pct: float = float("nan")
+    curvature_k: float = float("nan")
+    sigma_curvature_k: float = float("nan")
+    # the CrIS spatial response fitted at the optimum (kernel footprint, monitor.estimation.estimate): its
+    # full widths
+    # at 50 and 10 % of the peak, NaN where none was fitted
+    response_width_50_urad: float = float("nan")
+    sigma_response_width_50_urad: float = float("nan")
+    response_width_10_urad: float = float("nan")
+    sigma_response_width_10_urad: float = float("nan")
+
+    @property
+    def d_alpha_pct_fov(self) -> float:
+        """The in-track offset as a percentage of the FOV diameter."""
+        return 100.0 * self.d_alpha_urad / FOV_DIAMETER_URAD
+
+    @property
+    def d_beta_pct_fov(self) -> float:
+        """The cross-track offset as a percentage of the FOV diameter."""
+        return 100.0 * self.d_beta_urad / FOV_DIAMETER_URAD
+
+    @property
+    def reliable(self) -> bool:
+        """Whether no flag of RELIABILITY_FLAGS is set: the offset may be trusted and alerted on."""
+        return not any(f in RELIABILITY_FLAGS for f in self.flags)
+
+    def spec_breaches(self, spec_km: float) -> tuple[SpecBreach, ...]:
+        """The one definition of "out of spec": a reliable FOR whose in-track or cross-track error on the
+        ground exceeds *spec_km* in magnitude, each direction on its own (the specification is per
+        direction, as the paper plots it; the total is shown, never judged). Empty when within it, and
+        for an unreliable FOR (no trustworthy number to judge)."""
+        if not self.reliable:
+            return ()
+        return tuple(
+            SpecBreach(direction, error_km, sigma_km, spec_km)
+            for direction, error_km, sigma_km in (
+                ("in-track", self.in_track_km, self.sigma_in_track_km),
+                ("cross-track", self.cross_track_km, self.sigma_cross_track_km),
+            )
+            if math.isfinite(error_km) and abs(error_km) > spec_km
+        )
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["for"] = d.pop("for_index")
+        d["flags"] = list(self.flags)
+        d["d_alpha_pct_fov"] = self.d_alpha_pct_fov
+        d["d_beta_pct_fov"] = self.d_beta_pct_fov
+        return {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in d.items()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "ForOffset":
+        names = cls.__dataclass_fields__
+        kw = {k: d[k] for k in names if k in d and k != "for_index"}
+        kw = {k: (float("nan") if v is None else v) for k, v in kw.items()}
+        kw["flags"] = tuple(d.get("flags", ()))
+        return cls(for_index=int(d["for"]), **kw)
+
+
+# the measured fields of a FOR (all but its index and flags), in the order of the dataclass
+MEASURED_FIELDS = tuple(f.name for f in fields(ForOffset) if f.name not in ("for_index", "flags"))
+
+
+@dataclass(frozen=True)
+class DifferenceBin:
+    """CrIS minus VIIRS BT (K) at the optimum of the samples whose CrIS BT lies in [low_k, low_k + width);
+    the paper's Figure 15 (:func:`monitor.estimation.intercal.difference_bins`)."""
+
+    low_k: float
+    n: int
+    mean_k: float
+    std_k: float
+
+
+@dataclass(frozen=True)
+class GranuleInfo:
+    """One assessed CrIS granule: its ID and times (ISO 8601), its files and the VIIRS files that covered it,
+    the FOVs with geolocation and the FOVs used, and the processing metadata of its CrIS GEO and of the
+    first VIIRS GEO (software and algorithm versions, auxiliary files: what change attribution compares)."""
+
+    granule_id: str
+    start: str
+    end: str
+    cris_geo: str
+    cris_sdr: str
+    viirs: list[str]
+    n_fovs: int
+    n_usable: int
+    cris_meta: dict = field(default_factory=dict)
+    viirs_meta: dict = field(default_factory=dict)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GranuleInfo:
+        """A granule of a result file."""
+        return cls(**{k: d[k] for k in cls.__dataclass_fields__ if k in d})
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """An input left out of an assessment: the *item* (a granule's key or a file) and why."""
+
+    item: str
+    reason: str
+
+
+@dataclass
+class AssessmentResult:
+    """One assessment of one satellite over a set of granules; all 30 FORs, in FOR order."""
+
+    satellite: str
+    start: str
+    end: str
+    fors: list[ForOffset]
+    granules: list[GranuleInfo] = field(default_factory=list)
+    skipped: list[Skipped] = field(default_factory=list)
+    half_steps: int = DEFAULT_HALF_STEPS
+    step_urad: float = DEFAULT_STEP_URAD
+    cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
+    difference_bins: list[DifferenceBin] = field(default_factory=list)  # the FORs refined, pooled
+    notes: list[str] = field(default_factory=list)  # how the inputs were read, where that is not granules
+
+    def to_dict(self, with_cube: bool = False) -> dict:
+        d = {
+            "satellite": self.satellite,
+            "start": self.start,
+            "end": self.end,
+            "half_steps": self.half_steps,
+            "step_urad": self.step_urad,
+            "granules": [asdict(g) for g in self.granules],
+            "skipped": [asdict(s) for s in self.skipped],
+            "fors": [f.to_dict() for f in self.fors],
+            "difference_bins": [asdict(b) for b in self.difference_bins],
+            "notes": self.notes,
+        }
+        if with_cube and self.cost_cube_k is not None:
+            d["cost_cube_k"] = np.round(self.cost_cube_k, 5).tolist()
+        return d
+
+    def to_json(self, with_cube: bool = True) -> str:
+        return json.dumps(self.to_dict(with_cube), indent=1)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "AssessmentResult":
+        cube = d.get("cost_cube_k")
+        return cls(
+            satellite=d["satellite"],
+            start=d["start"],
+            end=d["end"],
+            fors=[ForOffset.from_dict(f) for f in d["fors"]],
+            granules=[GranuleInfo.from_dict(g) for g in d.get("granules", [])],
+            skipped=[Skipped(**s) for s in d.get("skipped", [])],
+            half_steps=int(d.get("half_steps", DEFAULT_HALF_STEPS)),
+            step_urad=float(d.get("step_urad", DEFAULT_STEP_URAD)),
+            cost_cube_k=None if cube is None else np.asarray(cube, float),
+            difference_bins=[DifferenceBin(**b) for b in d.get("difference_bins", [])],
+            notes=list(d.get("notes", [])),
+        )
+
+    @classmethod
+    def from_json(cls, text: str) -> "AssessmentResult":
+        return cls.from_dict(json.loads(text))

@@ -1,0 +1,83 @@
+"""Tables as data: every table the command line, the report and the messages show declares its columns
+once here or beside its rows, and :func:`text_table` (text) or :meth:`Column.text` (a cell, for HTML) writes
+them. The FOR table (:data:`FOR_COLUMNS`) is the one ``crisgeo assess``, ``run`` and ``status`` print and
+the report shows.
+
+On the ground floor, so that the science (the fingerprint, the mapping angles), the alerts and the service
+all reach it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from operator import attrgetter
+from typing import Any
+
+from monitor.core.result import ForOffset
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column: its header and unit, how a row's value is read (*value*: an attribute name or a
+    function of the row) and written (*fmt*, a format spec), its width and alignment (``>`` or ``<``)."""
+
+    header: str
+    value: str | Callable[[Any], Any]
+    fmt: str = ""
+    width: int = 0
+    unit: str = ""
+    align: str = ">"
+
+    def text(self, row: Any) -> str:
+        """The row's value as text, unpadded."""
+        get = attrgetter(self.value) if isinstance(self.value, str) else self.value
+        return format(get(row), self.fmt)
+
+    def pad(self, text: str) -> str:
+        """*text* aligned to the column's width."""
+        return f"{text:{self.align}{self.width}}"
+
+
+def text_table(rows: Iterable[Any], columns: Sequence[Column], indent: str = "") -> list[str]:
+    """A header line, a unit line when any column has a unit, and a line per row (trailing blanks cut)."""
+    lines = [indent + " ".join(c.pad(c.header) for c in columns)]
+    if any(c.unit for c in columns):
+        lines.append(indent + " ".join(c.pad(c.unit) for c in columns))
+    lines += [indent + " ".join(c.pad(c.text(r)) for c in columns) for r in rows]
+    return [line.rstrip() for line in lines]
+
+
+def _flags(f: ForOffset) -> str:
+    return ",".join(f.flags)
+
+
+FOR_COLUMNS = {
+    "for": Column("FOR", "for_index", "d", 3),
+    "d_alpha": Column("d_alpha", "d_alpha_urad", ".0f", 8, "urad"),
+    "sigma_alpha": Column("+-", "sigma_alpha_urad", ".0f", 5),
+    "d_beta": Column("d_beta", "d_beta_urad", ".0f", 8, "urad"),
+    "sigma_beta": Column("+-", "sigma_beta_urad", ".0f", 5),
+    "alpha_pct_fov": Column("d_alpha", "d_alpha_pct_fov", ".1f", 7, "% FOV"),
+    "beta_pct_fov": Column("d_beta", "d_beta_pct_fov", ".1f", 7, "% FOV"),
+    "in_track": Column("in-trk", "in_track_km", ".3f", 7, "km"),
+    "cross_track": Column("x-trk", "cross_track_km", ".3f", 7, "km"),
+    "total": Column("total", "total_km", ".3f", 6, "km"),
+    "n": Column("N", "n_samples", "d", 5),
+    "cost_min": Column("G_min", "cost_min_k", ".3f", 6, "K"),
+    "cost_zero": Column("G_0", "cost_zero_k", ".3f", 6, "K"),
+    "width_50": Column("FWHM", "response_width_50_urad", ".0f", 6, "urad"),
+    "flags": Column("flags", _flags, "", 0, "", "<"),
+}
+# the column sets: what assess and run print, what status prints, what the report shows
+FULL = (
+    "for", "d_alpha", "sigma_alpha", "d_beta", "sigma_beta", "in_track", "cross_track", "total", "n",
+    "cost_min", "cost_zero", "width_50", "flags",
+)  # fmt: skip
+BRIEF = ("for", "d_alpha", "d_beta", "in_track", "cross_track", "total", "flags")
+REPORT = FULL[:5] + ("alpha_pct_fov", "beta_pct_fov") + FULL[5:]
+
+
+def for_table(fors: Iterable[ForOffset], columns: tuple[str, ...] = FULL, indent: str = "") -> list[str]:
+    """The per-FOR table of *columns* (:data:`FOR_COLUMNS`): header, units, a line per FOR."""
+    return text_table(fors, [FOR_COLUMNS[c] for c in columns], indent)

@@ -1,0 +1,1 @@
+"""The estimation: the cost, its sub-step minimum, the jackknife, the intercalibration."""

@@ -1,0 +1,509 @@
+"""The estimator of Wang et al. 2017 (section 2.4): one FOR's day of samples in, its offsets, their
+uncertainty and the intercalibration out.
+
+Its input, :class:`ForSamples`, is what collocation leaves per FOR (:mod:`monitor.assessment.assess` from
+granules,
+:mod:`monitor.assessment.replay` from the reference implementation's files): for every sample (a FOV of a scan
+of a
+granule) the VIIRS-minus-CrIS BT at every perturbation through the top-hat cone, the CrIS BT, and where the
+collocation measured them, the VIIRS radiance means over annuli about each perturbed LOS.
+
+The cost (equation 8, or its regression form; :func:`cost_surface`) has its minimum refined between grid
+points by :mod:`monitor.estimation.refine`. Then:
+
+**The footprint.** CrIS sees the scene through a smooth, radially symmetric response that reaches past the
+0.963 deg cone (:mod:`monitor.instrument.footprint`); VIIRS averaged over the cone is then not what CrIS saw,
+and the
+cost's minimum moves by tens of urad on textured scenes. Given annuli A_k (radiance means between
+consecutive radii out to 0.66 deg), the VIIRS radiance CrIS would see is sum_k w_k A_k with w_k the share
+of the response in annulus k (sum 1). The weights are left free, as the regression cost leaves the
+calibration difference free: at the optimum they minimise the same residual variance the cost does,
+
+    min_w  w^T M w   subject to   1^T w = 1   and a response that does not grow outwards,
+
+with M the covariance over the samples of each annulus' difference from the CrIS BT (linearised about the
+current weights), less what the cost's calibration regressors explain (a Schur complement, as in
+:func:`monitor.estimation.refine.window_covariance`; :func:`response_weights` solves it). The
+minimum is then sought again with V = BT(sum_k w_k A_k), and the two steps alternate until the optimum
+stays put (:data:`FOOTPRINT_ITERATIONS`): a fixed point of both is a minimum of the residual over the
+turn and the response jointly. A radially symmetric response cannot move the joint minimum, whatever its
+shape; the weights found are the response seen on orbit
+(:func:`monitor.instrument.footprint.widths_of_weights`).
+
+**The uncertainty** is the delete-one-granule jackknife (:mod:`monitor.estimation.jackknife`): each replicate
+repeats the estimate (its own weights, its own refined minimum) without one granule, so the scene-to-scene
+part of the error enters by construction.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.optimize import nnls
+
+from monitor.config.model import AssessmentConfig
+from monitor.core.constants import URAD
+from monitor.core.result import (
+    FLAG_EDGE,
+    FLAG_FEW_SAMPLES,
+    FLAG_FLAT,
+    FLAG_UNCERTAIN,
+    DifferenceBin,
+    ForOffset,
+)
+from monitor.core.vocabulary import Cost, Kernel
+from monitor.estimation import refine
+from monitor.estimation.intercal import NO_FIT, Intercalibration, difference_bins, intercalibrate
+from monitor.estimation.jackknife import Jackknife
+from monitor.instrument.footprint import widths_of_weights
+from monitor.instrument.spectral import I5Band
+
+FOOTPRINT_ITERATIONS = 40  # alternations of the response fit and the refined minimum in a window, at most
+FOOTPRINT_WINDOWS = 3  # windows the alternation may move through as the grid minimum moves, at most
+CONVERGED_STEPS = refine.ZOOMS[-1] / 2  # the optimum did not move by one step of the refinement: it stops
+RIDGE = 1e-9  # of Q's trace added to its diagonal: neighbouring annuli can be nearly collinear
+MIN_FOOTPRINT_SAMPLES = 40  # fewer samples than this (the estimate is flagged few_samples below 30) fit none
+SLOPE_STEP = 1e-4  # relative radiance step of dBT/dL
+CONSTRAINT_WEIGHT = 1e8  # lambda^2 against Q's trace: the weights' sum held to 1 within ~1e-8
+
+
+@dataclass(frozen=True)
+class ForSamples:
+    """One FOR's N samples over a day: *d_k* (N, m, m) VIIRS - CrIS BT (K) at every perturbation through
+    the top-hat cone, *cris_k* (N,) the CrIS BT, *granule* and *scan* (N,) where each comes from; with the
+    footprint, *annuli_rad* (N, K, m, m) the VIIRS radiance means in the annuli whose outer radii are
+    *radii_rad* (K,), and *band* to turn radiances into BT."""
+
+    d_k: np.ndarray
+    cris_k: np.ndarray
+    granule: np.ndarray
+    scan: np.ndarray
+    annuli_rad: np.ndarray | None = None
+    radii_rad: tuple[float, ...] = ()
+    band: I5Band | None = field(default=None, repr=False)
+
+    def __len__(self) -> int:
+        return len(self.cris_k)
+
+    @property
+    def footprint(self) -> bool:
+        """Whether the samples carry annuli, so that the response is fitted."""
+        return self.annuli_rad is not None
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """The response fitted at a FOR's optimum: the share *weights* (K,) of each annulus (outer radii
+    *radii_rad*), and the full widths (rad) at 50 and 10 % of the peak they describe, with jackknife
+    sigmas (NaN without)."""
+
+    radii_rad: tuple[float, ...]
+    weights: np.ndarray
+    width_50_rad: float
+    width_10_rad: float
+    sigma_width_50_rad: float = float("nan")
+    sigma_width_10_rad: float = float("nan")
+
+
+@dataclass(frozen=True)
+class ForEstimate:
+    """The estimate of one FOR: offsets *x*, *y* (grid steps from the centre) and their jackknife sigmas
+    (steps; NaN without), *flags*, the *cost* surface (m, m, K) at the response found, *d_opt* (N,) the
+    samples' BT difference at the optimum, whether it is *refined* between grid points, the
+    *intercalibration* there and the *footprint* (None without annuli, or where the minimum was not
+    refined)."""
+
+    x: float
+    y: float
+    sigma: tuple[float, float]
+    flags: list[str]
+    cost: np.ndarray
+    d_opt: np.ndarray
+    refined: bool
+    intercalibration: Intercalibration = NO_FIT
+    footprint: Footprint | None = None
+
+
+def _stdev(d: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
+    """STDEV over samples (axis 0 of d, (N, m, m)); with *weights* (B, N) one surface per row (B, m, m)."""
+    n, m = d.shape[0], d.shape[1]
+    flat = d.reshape(n, -1)
+    if weights is None:
+        return flat.std(axis=0, ddof=1).reshape(m, m)
+    s0 = weights.sum(axis=1, keepdims=True)
+    s1 = weights @ flat
+    s2 = weights @ (flat * flat)
+    var = (s2 - s1 * s1 / s0) / np.maximum(s0 - 1, 1)
+    return np.sqrt(np.maximum(var, 0.0)).reshape(-1, m, m)
+
+
+def calibration_regressors(cris: np.ndarray) -> np.ndarray:
+    """The regressors of the regression cost (N, 2): the CrIS BT and its square about its mean, so that a
+    CrIS-VIIRS difference bias + gain T + curvature T^2 is explained away."""
+    c = np.asarray(cris, float) - np.mean(cris)
+    return np.stack([c, c * c], axis=1)
+
+
+def _regression_stdev(d: np.ndarray, cris: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
+    """The residual STDEV of d (N, m, m) regressed on the CrIS BT *cris* (N,) and its square, per
+    perturbation: sqrt(Var d - s_dX S_XX^-1 s_Xd). With d = V - C this is the residual of V - f(C) for the
+    best quadratic f at each perturbation, so a CrIS-VIIRS calibration difference up to second order
+    leaves it unchanged. *weights* (B, N): one surface per replicate (B, m, m)."""
+    n, m = d.shape[0], d.shape[1]
+    x = calibration_regressors(cris)
+    flat = np.concatenate([d.reshape(n, -1), x], axis=1)
+    w = np.ones((1, n)) if weights is None else np.asarray(weights, float)
+    s0 = w.sum(axis=1)[:, None]
+    mean = (w @ flat) / s0
+    res = np.empty((len(w), m * m))
+    for b in range(len(w)):  # one replicate at a time: (N, K) products stay small
+        c = flat - mean[b]
+        wc = c * w[b][:, None]
+        var_d = np.einsum("nk,nk->k", wc[:, :-2], c[:, :-2])
+        s_dx = wc[:, :-2].T @ c[:, -2:]  # (K, 2)
+        s_xx = wc[:, -2:].T @ c[:, -2:]  # (2, 2)
+        explained = np.einsum("ka,ab,kb->k", s_dx, np.linalg.inv(s_xx), s_dx)
+        res[b] = (var_d - explained) / max(s0[b, 0] - 1, 1)
+    g = np.sqrt(np.maximum(res, 0.0)).reshape(-1, m, m)
+    return g[0] if weights is None else g
+
+
+def cost_surface(
+    d: np.ndarray, cris: np.ndarray, cost: Cost, weights: np.ndarray | None = None
+) -> np.ndarray:
+    """The cost over the perturbation grid of one FOR's samples (:class:`~monitor.core.vocabulary.Cost`)."""
+    return _stdev(d, weights) if cost == Cost.STDEV else _regression_stdev(d, cris, weights)
+
+
+def find_minimum(cost: np.ndarray, contrast: float = 0.03) -> tuple[float, float, list[str]]:
+    """Sub-step minimum (x_i, y_j in grid steps from the centre) of a cost surface, and its flags.
+
+    A quadratic surface through the 3x3 neighbourhood of the grid minimum gives the sub-step position
+    (Wang 2013). A minimum on the grid border is flagged ``edge`` and not refined; a surface that
+    rises less than *contrast* (relative) from its minimum to the grid border, or whose fit is not
+    convex, is flagged ``flat``.
+    """
+    m = cost.shape[0]
+    n = (m - 1) // 2
+    flags = []
+    if not np.all(np.isfinite(cost)):
+        return np.nan, np.nan, [FLAG_FLAT]
+    i0, j0 = np.unravel_index(np.argmin(cost), cost.shape)
+    border = np.concatenate([cost[0], cost[-1], cost[1:-1, 0], cost[1:-1, -1]])
+    if (np.mean(border) - cost[i0, j0]) / cost[i0, j0] < contrast:
+        flags.append(FLAG_FLAT)
+    if i0 in (0, m - 1) or j0 in (0, m - 1):
+        return float(i0 - n), float(j0 - n), flags + [FLAG_EDGE]
+    x, y = np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.0, 1.0], indexing="ij")
+    a = np.stack([np.ones(9), x.ravel(), y.ravel(), x.ravel() ** 2, x.ravel() * y.ravel(), y.ravel() ** 2], 1)
+    c = np.linalg.lstsq(a, cost[i0 - 1 : i0 + 2, j0 - 1 : j0 + 2].ravel(), rcond=None)[0]
+    hess = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
+    if np.linalg.det(hess) <= 0 or hess[0, 0] <= 0:
+        return float(i0 - n), float(j0 - n), sorted(set(flags + [FLAG_FLAT]))
+    dx, dy = np.linalg.solve(hess, -c[1:3])
+    dx, dy = float(np.clip(dx, -1, 1)), float(np.clip(dy, -1, 1))
+    return i0 - n + dx, j0 - n + dy, flags
+
+
+@dataclass(frozen=True)
+class _Minimum:
+    """Where a cost surface *g* is least: (x, y) steps from the centre, the grid minimum (i0, j0), the
+    sub-step offset (dx, dy) from it where *refined*, and the flags."""
+
+    g: np.ndarray
+    x: float
+    y: float
+    i0: int
+    j0: int
+    dx: float
+    dy: float
+    refined: bool
+    flags: list[str]
+
+
+def _minimum(d: np.ndarray, cris: np.ndarray, cost: Cost, contrast: float) -> _Minimum:
+    """The minimum of the cost of the differences *d* (N, m, m): on the grid, then refined between grid
+    points where the window fits and the surface is neither flat nor edged
+    (:mod:`monitor.estimation.refine`)."""
+    m = d.shape[1]
+    g = cost_surface(d, cris, cost)
+    x, y, flags = find_minimum(g, contrast)
+    i0, j0 = (int(k) for k in np.unravel_index(np.argmin(g), g.shape)) if np.isfinite(g).all() else (0, 0)
+    fine = FLAG_EDGE not in flags and FLAG_FLAT not in flags and refine.refinable(i0, j0, m)
+    dx = dy = 0.0
+    if fine:
+        regress = calibration_regressors(cris) if cost == Cost.REGRESSION else None
+        dx, dy = refine.refined_minimum(refine.window_covariance(d, i0, j0, cris=regress))
+        x, y = i0 - (m - 1) // 2 + dx, j0 - (m - 1) // 2 + dy
+    return _Minimum(g, x, y, i0, j0, float(dx), float(dy), fine, flags)
+
+
+def response_weights(
+    annuli_rad: np.ndarray,
+    cris_k: np.ndarray,
+    at: _Minimum,
+    cost: Cost,
+    radii_rad: tuple[float, ...],
+    band: I5Band,
+    weights: np.ndarray | None = None,
+) -> np.ndarray:
+    """The annulus weights w (K,), sum 1, that minimise the residual variance w^T M w of the cost's
+    difference, BT(sum_k w_k A_k) - C, at the refined optimum *at* (module docstring), for a response that
+    does not grow outwards; *weights* (K,) are the current ones (None: the annuli's solid angles, a top hat
+    out to the last).
+
+    The difference is linear in w about the current V = sum_k w_k A_k: BT(V) + s (A_k - V) - C for annulus
+    k, s = dBT/dL at V, so that M is the covariance of these over the samples, less what the cost's
+    calibration regressors explain (a Schur complement). In BT, as the cost is: a CrIS-VIIRS bias, gain or
+    curvature leaves the weights as they were, as it leaves the cost.
+
+    Neighbouring annuli see nearly the same scene, so M is nearly singular along differences of their
+    weights, and free weights swing from annulus to annulus. A CrIS response is a monotone profile (the
+    specification bounds it by widths that grow as the level falls), so the fit keeps it one: the response
+    in annulus k, w_k / a_k (a_k its solid angle, ~ r_k^2 - r_(k-1)^2), is a sum of non-negative steps
+    delta_l >= 0 for l >= k, w = B delta with B_kl = a_k [l >= k]. With Q = B^T M B = L L^T, the least
+    squares ||L^T delta||^2 + lambda^2 (1^T B delta - 1)^2 with delta >= 0 (non-negative least squares, lambda
+    large against Q) holds the sum to 1."""
+    a = np.stack(
+        [
+            refine.window_values(annuli_rad[:, k], at.i0, at.j0, at.dx, at.dy)
+            for k in range(annuli_rad.shape[1])
+        ],
+        axis=1,
+    ).astype(float)
+    r_out = np.asarray(radii_rad, float)
+    area = r_out**2 - np.concatenate([[0.0], r_out[:-1]]) ** 2
+    v = a @ (area / area.sum() if weights is None else weights)
+    bt_v = band.bt_from_radiance(v)
+    slope = (band.bt_from_radiance(v * (1 + SLOPE_STEP)) - bt_v) / (v * SLOPE_STEP)
+    c = np.asarray(cris_k, float)
+    z = bt_v[:, None] + slope[:, None] * (a - v[:, None]) - c[:, None]
+    if cost == Cost.REGRESSION:
+        z = np.concatenate([z, calibration_regressors(c)], axis=1)
+    zc = z - z.mean(axis=0)
+    s = zc.T @ zc
+    k = a.shape[1]
+    m = s[:k, :k] - s[:k, k:] @ np.linalg.solve(s[k:, k:], s[k:, :k]) if s.shape[0] > k else s
+    b = area[:, None] * np.triu(np.ones((k, k)))  # w_k = a_k sum_(l >= k) delta_l
+    q = b.T @ m @ b
+    q = q + RIDGE * np.trace(q) / k * np.eye(k)
+    vals, vecs = np.linalg.eigh(q)
+    root = vecs * np.sqrt(np.clip(vals, 0.0, None))  # Q = root root^T (a square root where Q is singular)
+    total = b.sum(axis=0)  # 1^T B
+    lam = np.sqrt(CONSTRAINT_WEIGHT * np.trace(q)) / np.linalg.norm(total)
+    delta, _ = nnls(np.vstack([root.T, lam * total]), np.r_[np.zeros(k), lam])
+    w = b @ delta
+    return w / w.sum()
+
+
+def _with_footprint(s: ForSamples, weights: np.ndarray) -> np.ndarray:
+    """The samples' VIIRS - CrIS BT (N, m, m) with V the BT of the annuli weighted by *weights*."""
+    assert s.annuli_rad is not None and s.band is not None
+    v = np.einsum("nkij,k->nij", s.annuli_rad, weights)
+    return (s.band.bt_from_radiance(v) - s.cris_k[:, None, None]).astype(np.float64)
+
+
+def _estimate(
+    s: ForSamples,
+    cost: Cost,
+    contrast: float,
+    counts: np.ndarray | None = None,
+    start: np.ndarray | None = None,
+    start_d: np.ndarray | None = None,
+) -> tuple[_Minimum, np.ndarray | None, np.ndarray]:
+    """The minimum of the samples (weighted by *counts*, a replicate: the left-out granule's rows dropped)
+    and the annulus weights found there (None without annuli or a refined minimum); *start*, weights to
+    begin the alternation from (a replicate starts from the day's), and *start_d* the day's surface through
+    them (N, m, m): a replicate's first surface is its rows of it, not computed again."""
+    keep = slice(None) if counts is None else counts > 0
+    d, c = s.d_k[keep], s.cris_k[keep]
+    annuli = s.annuli_rad[keep] if s.annuli_rad is not None and len(c) >= MIN_FOOTPRINT_SAMPLES else None
+    fit = annuli is not None
+    sub = ForSamples(d, c, s.granule[keep], s.scan[keep], annuli, s.radii_rad, s.band)
+    if fit and start is not None:  # the day's weights: the minimum through them (not the top-hat cone's)
+        d = start_d[keep] if start_d is not None else _with_footprint(sub, start)
+    best = _minimum(d, c, cost, contrast)
+    if not fit or not best.refined:
+        return best, None, d
+    assert annuli is not None and s.band is not None
+    regress = calibration_regressors(c) if cost == Cost.REGRESSION else None
+    weights = start
+    for _ in range(FOOTPRINT_WINDOWS):
+        # the alternation within the refinement's window about the grid minimum: cheap (no cost surface)
+        h, i0, j0 = refine.HALF, best.i0, best.j0
+        window = annuli[:, :, i0 - h : i0 + h + 1, j0 - h : j0 + h + 1]
+        at = best
+        for _ in range(FOOTPRINT_ITERATIONS):
+            weights = response_weights(annuli, c, at, cost, s.radii_rad, s.band, weights)
+            d_win = s.band.bt_from_radiance(np.einsum("nkij,k->nij", window, weights)) - c[:, None, None]
+            dx, dy = refine.refined_minimum(refine.window_covariance(d_win, h, h, cris=regress))
+            moved = max(abs(dx - at.dx), abs(dy - at.dy))
+            at = replace(at, dx=float(dx), dy=float(dy), x=at.x + dx - at.dx, y=at.y + dy - at.dy)
+            if moved < CONVERGED_STEPS:
+                break
+        # the whole surface with the weights found: the grid minimum where it was, or the window moves
+        assert weights is not None  # the alternation ran at least once
+        d = _with_footprint(sub, weights)
+        moved_to = _minimum(d, c, cost, contrast)
+        if not moved_to.refined or (moved_to.i0, moved_to.j0) == (i0, j0):
+            return (moved_to if moved_to.refined else best), weights, d
+        best = moved_to
+    return best, weights, d
+
+
+def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: bool = True) -> ForEstimate:
+    """Offsets, jackknife sigmas, flags, the intercalibration and (with annuli) the footprint of one FOR's
+    samples (module docstring)."""
+    best, weights, d = _estimate(s, cost, contrast)
+    d_opt = (
+        refine.window_values(d, best.i0, best.j0, best.dx, best.dy)
+        if best.refined
+        else d[:, best.i0, best.j0]
+    )
+    jack = Jackknife.of(s.granule, s.scan) if uncertainty else None
+    sigma = (np.nan, np.nan)
+    cal_boot = None
+    fp = None
+    if weights is not None:
+        widths = widths_of_weights(s.radii_rad, weights)
+        fp = Footprint(s.radii_rad, weights, widths[0.5], widths[0.1])
+    if jack is not None:
+        reps, vs, width_reps = [], [], []
+        for counts in jack.counts:
+            b, w_b, d_b = _estimate(s, cost, contrast, counts, weights, d if weights is not None else None)
+            reps.append((b.x, b.y))
+            # the intercalibration at the replicate's own optimum, over the samples it kept (the others weigh
+            # nothing: any finite value serves)
+            v_b = d_opt + s.cris_k
+            keep = counts > 0
+            v_b[keep] = (
+                refine.window_values(d_b, b.i0, b.j0, b.dx, b.dy) if b.refined else d_b[:, b.i0, b.j0]
+            ) + s.cris_k[keep]
+            vs.append(v_b)
+            if w_b is not None:
+                wb = widths_of_weights(s.radii_rad, w_b)
+                width_reps.append((wb[0.5], wb[0.1]))
+            else:
+                width_reps.append((np.nan, np.nan))
+        sig = jack.sigma(np.array(reps))
+        sigma = (float(sig[0]), float(sig[1]))
+        cal_boot = np.array(vs)
+        if fp is not None:
+            ws = jack.sigma(np.array(width_reps))
+            fp = Footprint(
+                fp.radii_rad, fp.weights, fp.width_50_rad, fp.width_10_rad, float(ws[0]), float(ws[1])
+            )
+    cal = intercalibrate(s.cris_k, d_opt + s.cris_k, jack, cal_boot)
+    return ForEstimate(best.x, best.y, sigma, best.flags, best.g, d_opt, best.refined, cal, fp)
+
+
+# The floor of the sigmas by kernel (urad): what the estimator itself leaves beside the jackknife's scatter,
+# calibrated on simulated cases (benchmarks/acceptance.py prints the floor that gives 90 % coverage). The
+# top-hat cone's is the error a plain cone leaves on a top-hat truth; the footprint's was calibrated on the
+# 6-granule smooth-response cases of seeds 1-3 and checked on the others (docs/science.md).
+SIGMA_FLOOR_URAD = {Kernel.TOP_HAT: 5.0, Kernel.FOOTPRINT: 2.0}
+
+
+def floor_urad(cfg: AssessmentConfig) -> float:
+    """The floor of the sigmas (urad), in quadrature with the jackknife's: ``sigma_floor_urad``, or the
+    kernel's (:data:`SIGMA_FLOOR_URAD`)."""
+    return SIGMA_FLOOR_URAD[cfg.kernel] if cfg.sigma_floor_urad is None else cfg.sigma_floor_urad
+
+
+@dataclass(frozen=True)
+class DayEstimate:
+    """The 30 FORs' offsets of a day, their cost surfaces (30, m, m; NaN where none) and the CrIS - VIIRS
+    difference in BT bins pooled over the FORs refined (the paper's Figure 15)."""
+
+    fors: list[ForOffset]
+    cost_cube_k: np.ndarray
+    difference_bins: list[DifferenceBin]
+
+
+KmOf = Callable[[int, float, float], tuple[float, float, np.ndarray]]
+
+
+def day_offsets(
+    per_for: list[ForSamples], cfg: AssessmentConfig, step_urad: float, km: KmOf | None = None
+) -> DayEstimate:
+    """Every FOR's estimate as a :class:`~monitor.core.result.ForOffset`: angles in urad with the jackknife
+    sigma and the floor ``floor_urad(cfg)`` in quadrature (what the estimator itself leaves), flags,
+    the intercalibration; in km where *km* (FOR index 0-based, turn in rad) gives the mean in-track and
+    cross-track km of a turn and its Jacobian (km/rad), NaN without."""
+    m = per_for[0].d_k.shape[1]
+    cube = np.full((len(per_for), m, m), np.nan)
+    # the FORs are independent: estimated on the assessment's threads (numpy and the compiled BT inversion
+    # leave the interpreter's lock), each the same numbers as alone
+    with ThreadPoolExecutor(max_workers=max(1, cfg.workers), thread_name_prefix="estimate") as pool:
+        estimates = list(
+            pool.map(
+                lambda s: estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty) if len(s) >= 3 else None,
+                per_for,
+            )
+        )
+    fors = []
+    pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
+    for k, s in enumerate(per_for):
+        n = len(s)
+        flags = [FLAG_FEW_SAMPLES] if n < max(cfg.min_samples, 3) else []
+        x = y = sig_a = sig_b = np.nan
+        g = np.full((m, m), np.nan)
+        cal = NO_FIT
+        widths = [np.nan] * 4
+        best = estimates[k]
+        if best is not None:
+            if best.footprint is not None:
+                fp = best.footprint
+                widths = [
+                    w / URAD
+                    for w in (fp.width_50_rad, fp.sigma_width_50_rad, fp.width_10_rad, fp.sigma_width_10_rad)
+                ]
+            g, x, y, (sig_a, sig_b), cal = best.cost, best.x, best.y, best.sigma, best.intercalibration
+            cube[k] = g
+            flags += best.flags
+            if best.refined:
+                pooled.append((s.cris_k, best.d_opt + s.cris_k))
+            sig_a = float(np.hypot(sig_a * step_urad, floor_urad(cfg)))
+            sig_b = float(np.hypot(sig_b * step_urad, floor_urad(cfg)))
+            if max(sig_a, sig_b) > cfg.max_sigma_urad:
+                flags.append(FLAG_UNCERTAIN)
+        d_alpha, d_beta = x * step_urad, y * step_urad
+        it = ct = s_it = s_ct = np.nan
+        if km is not None:
+            it, ct, jac = km(k, d_alpha * URAD, d_beta * URAD)
+            if np.isfinite(sig_a):
+                s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * URAD)
+                s_ct = float(np.hypot(jac[1, 0] * sig_a, jac[1, 1] * sig_b) * URAD)
+        fors.append(
+            ForOffset(
+                for_index=k + 1,
+                d_alpha_urad=float(d_alpha),
+                d_beta_urad=float(d_beta),
+                sigma_alpha_urad=float(sig_a),
+                sigma_beta_urad=float(sig_b),
+                in_track_km=float(it),
+                cross_track_km=float(ct),
+                total_km=float(np.hypot(it, ct)),
+                sigma_in_track_km=float(s_it),
+                sigma_cross_track_km=float(s_ct),
+                n_samples=int(n),
+                cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
+                cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan,
+                bias_k=cal.bias_k,
+                sigma_bias_k=cal.sigma_bias_k,
+                gain_pct=cal.gain_pct,
+                sigma_gain_pct=cal.sigma_gain_pct,
+                curvature_k=cal.curvature_k,
+                sigma_curvature_k=cal.sigma_curvature_k,
+                response_width_50_urad=float(widths[0]),
+                sigma_response_width_50_urad=float(widths[1]),
+                response_width_10_urad=float(widths[2]),
+                sigma_response_width_10_urad=float(widths[3]),
+                flags=tuple(sorted(set(flags))),
+            )
+        )
+    bins = difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True))) if pooled else []
+    return DayEstimate(fors, cube, bins)

@@ -1,0 +1,165 @@
+"""Spectral matching of CrIS to VIIRS I5: SRF convolution and band-Planck brightness temperature.
+
+CrIS radiance R(nu) in mW/(m2 sr cm-1) is apodized (Hamming 0.23/0.54/0.23, as Wang's code does),
+integrated with the I5 response S(nu): L = sum R S / sum S, and turned into a brightness temperature
+with the band-integrated Planck function of the same response, inverted through a fine table. The
+same band model turns a VIIRS pixel BT into band radiance, so both sides are averaged in radiance.
+Responses: ``monitor/data/srf`` (NOAA/NG release; NOAA-21 has none public, NOAA-20's is used).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from importlib import resources
+
+import numba
+import numpy as np
+from numpy.typing import ArrayLike
+
+from monitor.core.errors import DataError
+from monitor.core.satellites import SATELLITES
+from monitor.core.threads import KERNEL_LOCK
+from monitor.sdr.products import cris_lw_wavenumbers_cm1
+
+C1 = 1.191042972e-5  # 2hc^2, mW/(m2 sr cm-4)
+C2 = 1.4387769  # hc/k, cm K
+SRF_FILES = {s.short: s.srf_file for s in SATELLITES.values()}
+HAMMING = (0.23, 0.54, 0.23)
+GUESS_BINS = 4096  # the inverse table's index is guessed from a uniform grid of radiance
+PARALLEL_FROM = 1 << 16  # values converted at once from which the parallel kernel is worth its lock
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _interp_one(v: float, xp: np.ndarray, fp: np.ndarray, guess: np.ndarray) -> float:
+    """``np.interp(v, xp, fp, left=NaN, right=NaN)`` bit for bit (the same slope and fall-backs). *xp*
+    ascends; guess[k] is at most the index of the last xp <= v for every v in the k-th of the uniform bins
+    between xp[0] and xp[-1], so a few steps find it."""
+    n = xp.shape[0]
+    if not (v >= xp[0] and v <= xp[n - 1]):  # NaN, or outside the table
+        return np.nan
+    nb = guess.shape[0] - 1
+    j = guess[min(int((v - xp[0]) * (nb / (xp[n - 1] - xp[0]))), nb)]
+    while j + 1 < n and xp[j + 1] <= v:
+        j += 1
+    if j == n - 1 or xp[j] == v:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    r = slope * (v - xp[j]) + fp[j]
+    if math.isnan(r):
+        r = slope * (v - xp[j + 1]) + fp[j + 1]
+        if math.isnan(r) and fp[j] == fp[j + 1]:
+            r = fp[j]
+    return r
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _interp_parallel(
+    x: np.ndarray, xp: np.ndarray, fp: np.ndarray, guess: np.ndarray, out: np.ndarray
+) -> None:
+    """:func:`_interp_one` of every value of flat *x* into *out*, in parallel."""
+    for i in numba.prange(x.shape[0]):
+        out[i] = _interp_one(x[i], xp, fp, guess)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _interp_serial(x: np.ndarray, xp: np.ndarray, fp: np.ndarray, guess: np.ndarray, out: np.ndarray) -> None:
+    """:func:`_interp_one` of every value of flat *x* into *out*, on the calling thread."""
+    for i in range(x.shape[0]):
+        out[i] = _interp_one(x[i], xp, fp, guess)
+
+
+def planck_radiance(wavenumber_cm1: ArrayLike, t_k: ArrayLike) -> np.ndarray:
+    """Planck radiance mW/(m2 sr cm-1) at *wavenumber_cm1* for temperature *t_k* (broadcast)."""
+    nu = np.asarray(wavenumber_cm1, float)
+    return C1 * nu**3 / np.expm1(C2 * nu / np.asarray(t_k, float))
+
+
+def load_srf(satellite: str) -> tuple[np.ndarray, np.ndarray]:
+    """(wavenumber_cm1, response) of the VIIRS I5 band of *satellite* (npp, j01, j02), ascending."""
+    name = SRF_FILES.get(satellite)
+    if name is None:
+        raise DataError(
+            f"no I5 spectral response for satellite {satellite!r} (known: {', '.join(SRF_FILES)})"
+        )
+    text = resources.files("monitor.data.srf").joinpath(name).read_text()
+    data = _read_csv(text)
+    order = np.argsort(data[:, 0])
+    return data[order, 0], data[order, 1]
+
+
+def _read_csv(text: str) -> np.ndarray:
+    rows = [line.split(",") for line in text.splitlines() if line and not line.startswith("#")]
+    return np.array([[float(a), float(b)] for a, b in rows[1:]])
+
+
+def apodize_hamming(radiance: ArrayLike) -> np.ndarray:
+    """Hamming apodization along the last (channel) axis; the end channels keep their value."""
+    r = np.asarray(radiance)
+    out = r.copy()
+    out[..., 1:-1] = HAMMING[0] * r[..., :-2] + HAMMING[1] * r[..., 1:-1] + HAMMING[2] * r[..., 2:]
+    return out
+
+
+class I5Band:
+    """The VIIRS I5 band of one satellite sampled on the CrIS LW grid, with its band-Planck table."""
+
+    T_MIN_K, T_MAX_K, T_STEP_K = 150.0, 350.0, 0.02
+
+    def __init__(self, satellite: str, wavenumber_cm1: ArrayLike | None = None) -> None:
+        self.satellite = satellite
+        self.wavenumber_cm1 = (
+            cris_lw_wavenumbers_cm1() if wavenumber_cm1 is None else np.asarray(wavenumber_cm1)
+        )
+        nu, s = load_srf(satellite)
+        self.response = np.interp(self.wavenumber_cm1, nu, s, left=0.0, right=0.0)
+        self.weights = self.response / self.response.sum()
+        self._t = np.arange(self.T_MIN_K, self.T_MAX_K + self.T_STEP_K / 2, self.T_STEP_K)
+        self._l = planck_radiance(self.wavenumber_cm1[None, :], self._t[:, None]) @ self.weights
+        edges = np.linspace(self._l[0], self._l[-1], GUESS_BINS + 1)  # one below, for the edge's rounding
+        self._guess = np.maximum(np.searchsorted(self._l, edges, "right") - 2, 0)
+
+    def band_radiance(self, spectra: ArrayLike) -> np.ndarray:
+        """Band radiance mW/(m2 sr cm-1) of spectra on the CrIS LW grid (last axis channels)."""
+        return np.asarray(spectra) @ self.weights
+
+    def cris_band_radiance(self, radiance_lw: ArrayLike) -> np.ndarray:
+        """Band radiance of unapodized CrIS LW spectra: Hamming apodization, then the SRF convolution."""
+        return self.band_radiance(apodize_hamming(radiance_lw))
+
+    @property
+    def radiance_table(self) -> tuple[float, float, np.ndarray]:
+        """(first BT K, BT step K, band radiance per BT): the uniform table radiance_from_bt interpolates."""
+        return self.T_MIN_K, self.T_STEP_K, self._l
+
+    def radiance_from_bt(self, bt_k: ArrayLike) -> np.ndarray:
+        """Band radiance of a band brightness temperature (K); NaN outside 150-350 K.
+
+        The table is uniform in temperature, so the interpolation is index arithmetic.
+        """
+        x = (np.asarray(bt_k, np.float64) - self.T_MIN_K) / self.T_STEP_K
+        with np.errstate(invalid="ignore"):
+            ok = (x >= 0) & (x <= len(self._t) - 1)
+        i = np.clip(np.where(ok, x, 0).astype(np.intp), 0, len(self._t) - 2)
+        w = x - i
+        return np.where(ok, self._l[i] * (1 - w) + self._l[i + 1] * w, np.nan)
+
+    def bt_from_radiance(self, radiance: ArrayLike) -> np.ndarray:
+        """Band brightness temperature (K) of a band radiance (float64, the shape of *radiance*); NaN outside
+        the table. The table is inverted by linear interpolation (np.interp's numbers, compiled and in
+        parallel: an assessment converts ten million cone means)."""
+        x = np.ravel(np.asarray(radiance, np.float64))
+        shape = np.shape(radiance)
+        out = np.empty(shape)
+        if x.size >= PARALLEL_FROM:
+            with KERNEL_LOCK:
+                _interp_parallel(x, self._l, self._t, self._guess, out.reshape(-1))
+        else:  # a CrIS granule's 1080 FOVs: no lock to wait for beside a running kernel
+            _interp_serial(x, self._l, self._t, self._guess, out.reshape(-1))
+        return out if shape else out[()]
+
+
+@lru_cache(maxsize=8)
+def i5_band(satellite: str) -> I5Band:
+    """The cached :class:`I5Band` of *satellite*."""
+    return I5Band(satellite)

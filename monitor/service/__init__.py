@@ -1,0 +1,1 @@
+"""The service: the daily pipeline, sources, stores, the report, HTTP, the daemon."""

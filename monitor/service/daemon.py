@@ -1,0 +1,339 @@
+"""The long-running service: one daily job per satellite under APScheduler, run by systemd.
+
+* BlockingScheduler in UTC; per-satellite cron job with coalesce, one instance at a time and a misfire
+  grace of hours; a catch-up job at start redoes the missed days (bounded window).
+* SIGTERM/SIGINT set a stop event that the run polls between steps and granules, then the scheduler
+  shuts down; a run cut short is recorded as interrupted and redone at the next start.
+* A single-instance lock (flock on the state directory) keeps a second copy from running.
+* sd_notify READY/STATUS/WATCHDOG/STOPPING over $NOTIFY_SOCKET, when systemd provides one; the watchdog
+  is fed only while :mod:`monitor.service.health` holds (every run within ``schedule.run_budget_min``, the
+  scheduler's heartbeat recent), so a wedged run or a stalled scheduler ends in a restart.
+* One HTTP endpoint (``http.listen``): /metrics, /healthz, /report/ (:mod:`monitor.service.endpoint`).
+* A job that fails or is missed becomes an event in the store, which the alerting layer reads.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+import os
+import signal
+import socket
+import threading
+from collections.abc import Callable, Iterable, Iterator
+from types import FrameType
+
+from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_JOB_MISSED, JobEvent
+from apscheduler.schedulers.blocking import BlockingScheduler
+from apscheduler.triggers.cron import CronTrigger
+
+from alerts.alertmanager import post_state
+from alerts.engine import deliver, evaluate
+from monitor.config.model import Config, parse_listen
+from monitor.core.vocabulary import EventKind, RunStatus
+from monitor.service import allocator, logs
+from monitor.service.endpoint import Endpoint
+from monitor.service.health import Health
+from monitor.service.lock import InstanceLock
+from monitor.service.metrics import ServiceMetrics
+from monitor.service.pipeline import RunOutcome, days_to_run, run_day
+from monitor.service.sources.configured import make_source
+from monitor.service.store.sqlite import Store
+from monitor.service.store.timeseries import drain_outbox
+from monitor.version import __version__
+
+LOG = logging.getLogger("monitor.service")  # the name journal filters know, kept
+UTC = dt.timezone.utc
+HEARTBEAT_S = 30.0  # the scheduler's heartbeat job runs this often
+STALL_S = 300.0  # ... and the scheduler counts as stalled when it has not run for this long
+
+
+def sd_notify(message: str) -> bool:
+    """Send *message* (e.g. ``READY=1``) to systemd's notify socket; False when not under systemd."""
+    addr = os.environ.get("NOTIFY_SOCKET")
+    if not addr:
+        return False
+    if addr.startswith("@"):
+        addr = "\0" + addr[1:]
+    try:
+        with socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as s:
+            s.connect(addr)
+            # never block: a notify socket nobody reads (a wedged systemd, a test) must not stop the
+            # daemon, even inside the SIGTERM handler; the message is dropped instead
+            s.send(message.encode(), socket.MSG_DONTWAIT)
+        return True
+    except OSError as exc:
+        log = LOG.debug if isinstance(exc, BlockingIOError) else LOG.warning
+        log("sd_notify %s not delivered: %s", message.split("=", 1)[0], exc)
+        return False
+
+
+class Service:
+    """Runs satellite-days for a configuration; the daemon adds the scheduler and signals."""
+
+    def __init__(self, cfg: Config, progress: Callable[[object], None] | None = None) -> None:
+        self.cfg = cfg
+        self.stop_event = threading.Event()
+        self.stopped_by: int | None = None  # the signal that asked for the stop (the exit status is 128 + it)
+        self.progress = progress
+        self.source = make_source(cfg)
+        self.scheduler: BlockingScheduler | None = None
+        self.health = Health(STALL_S)
+        self.metrics: ServiceMetrics | None = None  # while the daemon serves /metrics
+
+    def store(self) -> Store:
+        """A new connection to the configured store (close it, or use it in ``with``)."""
+        return Store(self.cfg.store.path)
+
+    def run(self, satellite: str, day: dt.date, today: dt.date | None = None) -> RunOutcome:
+        """Run one satellite-day (health-tracked) as of *today* (default: the date now, UTC), then evaluate
+        the alerts and regenerate the report."""
+        today = today or dt.datetime.now(UTC).date()
+        try:
+            with self.store() as store, logs.context(satellite=satellite, day=day.isoformat()):
+                LOG.info("run %s %s", satellite, day)
+                sd_notify(f"STATUS=assessing {satellite} {day}")
+                with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):
+                    out = run_day(
+                        self.cfg,
+                        store,
+                        self.source,
+                        satellite,
+                        day,
+                        today,
+                        self.stop_event.is_set,
+                        self.progress,
+                    )
+                level = {RunStatus.FAILED: logging.ERROR, RunStatus.INTERRUPTED: logging.WARNING}
+                LOG.log(level.get(out.status, logging.INFO), "%s", out.summary())
+                if self.metrics is not None:
+                    self.metrics.record(out)
+                self._after_run(store, out)
+                return out
+        finally:
+            # after the report and the alerts too: what they freed (their share grows with the history
+            # they plot) would otherwise stay with the daemon until the next day
+            allocator.release_freed_memory()
+
+    def _after_run(self, store: Store, outcome: RunOutcome) -> None:
+        """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the
+        e-mails attach its trend plot), deliver what is queued."""
+        self.check_alerts(store, report=not self.stop_event.is_set())  # stopping: the next run rewrites it
+
+    def regenerate_report(self, store: Store) -> None:
+        """Rewrite the HTML report into ``report_dir``; a report problem never stops the service."""
+        if not self.cfg.report_dir:
+            return
+        from monitor.service.report.html import (  # matplotlib: when first needed
+            build_report,
+            options_from_config,
+        )
+
+        try:
+            build_report(store, self.cfg.report_dir, options_from_config(self.cfg))
+        except Exception:  # noqa: BLE001 - matplotlib, disk or data surprises are logged, not fatal
+            LOG.exception("report: could not regenerate %s", self.cfg.report_dir)
+
+    def check_alerts(self, store: Store | None = None, report: bool = False) -> None:
+        """Evaluate the alert rules for every satellite and deliver the queue (regenerating the report in
+        between when *report*); a broken channel never stops the service."""
+
+        own = store is None
+        store = store or self.store()
+        try:
+            settings = self.cfg.alerts
+            queued = evaluate(store, settings, self.cfg.satellites)
+            if report:
+                self.regenerate_report(store)
+            counts = deliver(store, settings)
+            counts.queued = len(queued)
+            post_state(store, settings)
+            if counts.queued or counts.sent or counts.failed:
+                LOG.info("alerts: %s", counts.text())
+        finally:
+            if own:  # the hourly timer: hand back what the evaluation freed
+                store.close()
+                allocator.release_freed_memory()
+
+    def drain_outbox(self) -> dict:
+        """Send the time-series points waiting in the outbox (after an outage they need not wait for the
+        next daily run); returns {target: (sent, left)}."""
+
+        with self.store() as store:
+            report = drain_outbox(store, self.cfg.store.publish)
+            if any(sent for sent, _ in report.values()):
+                LOG.info("outbox: %s", report)
+            return report
+
+    def recover(self) -> None:
+        """Mark runs left 'running' by a killed process as interrupted (call with the instance lock held)."""
+        with self.store() as store:
+            n = store.interrupt_stale_runs()
+            if n:
+                LOG.warning("%d run(s) were cut short by a previous process; their days will be redone", n)
+
+    def handle_signals(self) -> None:
+        """SIGTERM and SIGINT request a clean stop between steps."""
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            signal.signal(sig, self._on_signal)
+
+    def catch_up(self, satellite: str, today: dt.date | None = None) -> Iterator[RunOutcome]:
+        """Run the days of the catch-up window that have no completed run, oldest first, yielding each
+        outcome as its day ends (the daemon keeps none: a 90-day catch-up holds no 90 results)."""
+        today = today or dt.datetime.now(UTC).date()
+        with self.store() as store:
+            days = days_to_run(store, satellite, self.cfg.schedule, today)
+        for day in days:
+            if self.stop_event.is_set():
+                break
+            yield self.run(satellite, day, today)
+
+    def daily_job(self, satellite: str) -> None:
+        """The scheduled job of *satellite*: the days of its catch-up window."""
+        for _ in self.catch_up(satellite):
+            pass
+
+    def run_once(self, satellites: Iterable[str], day: dt.date | None = None) -> list[RunOutcome]:
+        """``crisgeo run``: under the instance lock, recover what a killed process left, then per satellite
+        the given *day* or the days of the catch-up window; the outcomes. :class:`AlreadyRunning` when the
+        daemon (or another run) holds the state directory."""
+        with InstanceLock(self.cfg.state_dir, "run"):
+            self.recover()
+            outcomes: list[RunOutcome] = []
+            for sat in satellites:
+                if self.stop_event.is_set():
+                    break
+                outcomes += [self.run(sat, day)] if day else self.catch_up(sat)
+            return outcomes
+
+    # -- daemon
+    def add_jobs(self, scheduler: BlockingScheduler) -> None:
+        """The daemon's jobs: per satellite the daily run (catching up at start), the hourly alert
+        evaluation, and (with publishing) the outbox timer."""
+
+        sch = self.cfg.schedule
+        now = dt.datetime.now(UTC)
+        for sat in self.cfg.satellites:
+            trigger = CronTrigger(hour=sch.time_utc.hour, minute=sch.time_utc.minute, timezone=UTC)
+            scheduler.add_job(
+                self.daily_job, trigger, args=[sat], id=f"daily-{sat}", name=f"daily {sat}", next_run_time=now
+            )  # catch up at start, then daily
+        scheduler.add_job(self.check_alerts, "interval", hours=1, id="alerts", name="alert timer")
+        scheduler.add_job(
+            self.health.beat,
+            "interval",
+            seconds=HEARTBEAT_S,
+            id="heartbeat",
+            name="heartbeat",
+            next_run_time=now,
+        )
+        if self.cfg.store.publish:
+            scheduler.add_job(
+                self.drain_outbox,
+                "interval",
+                minutes=self.cfg.store.drain_minutes,
+                id="outbox",
+                name="outbox timer",
+            )
+        scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
+
+    def start_endpoint(self, listen: str) -> Endpoint | None:
+        """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
+        if listen == "off":
+            return None
+
+        self.metrics = ServiceMetrics(
+            self.store, self.cfg.satellites, self.health, __version__, self.cfg.alerts.spec_km
+        )
+        report = self.cfg.report_dir if self.cfg.report_dir else None
+        return Endpoint(*parse_listen(listen), self.metrics, self.health, report).start()
+
+    def daemon(self, listen: str | None = None) -> None:
+        """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``."""
+        sch = self.cfg.schedule
+        with InstanceLock(self.cfg.state_dir, "daemon"):
+            endpoint = self.start_endpoint(listen or self.cfg.http.listen)
+            self.recover()
+            self.scheduler = BlockingScheduler(
+                timezone=UTC,
+                job_defaults={
+                    "coalesce": True,
+                    "max_instances": 1,
+                    "misfire_grace_time": int(sch.misfire_grace_hours * 3600),
+                },
+            )
+            self.add_jobs(self.scheduler)
+            self.handle_signals()
+            watchdog = self._start_watchdog()
+            sd_notify("READY=1")
+            sd_notify("STATUS=scheduled daily at " + sch.time_utc.strftime("%H:%M UTC"))
+            LOG.info(
+                "crisgeo daemon started for %s; daily at %s UTC",
+                ", ".join(self.cfg.satellites),
+                sch.time_utc.strftime("%H:%M"),
+            )
+            try:
+                self.scheduler.start()
+            finally:
+                self.stop_event.set()
+                if watchdog is not None:
+                    watchdog.join(timeout=5)
+                if endpoint is not None:
+                    endpoint.stop()
+                LOG.info("crisgeo daemon stopped")
+
+    def _on_signal(self, signum: int, frame: FrameType | None) -> None:
+        LOG.info("signal %d: stopping after the current step", signum)
+        sd_notify("STOPPING=1")
+        self.stopped_by = signum
+        self.stop_event.set()
+        if self.scheduler is not None and self.scheduler.running:  # a second signal finds it stopped
+            self.scheduler.shutdown(wait=False)
+
+    def _job_event(self, event: JobEvent) -> None:
+        kind = {EVENT_JOB_ERROR: EventKind.JOB_ERROR, EVENT_JOB_MISSED: EventKind.JOB_MISSED}.get(
+            event.code, EventKind.JOB_SKIPPED
+        )
+        # an error or a miss is a JobExecutionEvent (one run time); a skip (max instances) a
+        # JobSubmissionEvent (its run times)
+        when = getattr(event, "scheduled_run_times", None) or [getattr(event, "scheduled_run_time", None)]
+        detail = {
+            "job": event.job_id,
+            "error": str(getattr(event, "exception", None) or kind.value),
+            "scheduled": ", ".join(map(str, when)),
+        }
+        LOG.error("scheduler: %s: %s (scheduled %s)", detail["job"], detail["error"], detail["scheduled"])
+        with self.store() as store:
+            store.add_event(kind, event.job_id.split("-", 1)[-1], detail)
+            self.check_alerts(store)
+
+    def _start_watchdog(self) -> threading.Thread | None:
+        usec = os.environ.get("WATCHDOG_USEC")
+        if not usec:
+            return None
+        interval = int(usec) / 1e6 / 2
+
+        def ping() -> None:
+            reported: set[str] = (
+                set()
+            )  # what is wrong, by source (a job, the scheduler): said once, not every ping
+            while not self.stop_event.wait(interval):
+                sched = self.scheduler
+                problems = (
+                    self.health.problems()
+                    if sched is not None and sched.running
+                    else ["scheduler: not running"]
+                )
+                sources = {p.split(":", 1)[0] for p in problems}
+                if not problems:
+                    if reported:
+                        LOG.info("healthy again; the watchdog is fed")
+                    sd_notify("WATCHDOG=1")
+                elif sources != reported:
+                    LOG.error("unhealthy, the watchdog is no longer fed: %s", "; ".join(problems))
+                    sd_notify("STATUS=unhealthy: " + "; ".join(problems)[:200])
+                reported = sources
+
+        t = threading.Thread(target=ping, name="watchdog", daemon=True)
+        t.start()
+        return t

@@ -1,0 +1,268 @@
+"""Results as data for scientists: the store's per-FOR offsets as a CF-1.8 / ACDD-1.3 xarray Dataset,
+NetCDF or CSV.
+
+Dimensions ``time`` (the assessed day: its start, with ``time_bnds`` the whole UTC day; first and unlimited,
+so that daily files append along it) x ``scan_position`` (the CrIS field of regard, 1..30; a name Python
+accepts: ``ds.sel(scan_position=1)``); one variable per stored quantity with its unit, long name and ACDD
+``coverage_content_type``, the reliability flags as a CF bit mask (``flag_masks`` and ``flag_meanings``),
+the sign convention stated once (the global attribute ``sign_convention``), and the ACDD global attributes
+(title, summary, references to the method paper, history, date_created, time coverage, platform,
+instrument, source, id; institution, creator, license and the like from the ``export`` section of the
+configuration). The compliance checker's CF-1.8 check passes, and its ACDD-1.3 check leaves only what
+does not apply (tests/service/test_export.py): no CF standard name exists for these quantities, and the file
+is
+per scan position, not per place (no geospatial bounds). xarray and h5netcdf are an optional extra:
+``pip install 'crisgeo-monitor[export]'``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+import datetime as dt
+from pathlib import Path
+
+import numpy as np
+
+from monitor.config.model import ExportConfig
+from monitor.core.constants import N_FOR
+from monitor.core.records import History
+from monitor.core.result import RELIABILITY_FLAGS
+from monitor.core.satellites import satellite as satellite_info
+from monitor.service.store.sqlite import Store
+from monitor.version import __version__
+
+SIGN_CONVENTION = (
+    "d_alpha_urad and d_beta_urad are the turn of the CrIS line of sight reported by the GEO product (in "
+    "the spacecraft body frame: alpha in-track, beta cross-track) that best aligns CrIS with VIIRS I5; "
+    "in_track_km and cross_track_km are the displacement on the ground that turn makes (positive along "
+    "the flight direction and to the right of it). Both are what this product calls the geolocation "
+    "error: the correction to add to the reported geolocation."
+)
+FORMATS = {".nc": "netcdf", ".nc4": "netcdf", ".csv": "csv"}  # the suffix of --out says the format
+# variable: (unit, long name); the store's column names
+VARIABLES = {
+    "d_alpha_urad": ("urad", "in-track LOS offset (see sign_convention)"),
+    "d_beta_urad": ("urad", "cross-track LOS offset (see sign_convention)"),
+    "sigma_alpha_urad": ("urad", "uncertainty (1 sigma) of the in-track offset"),
+    "sigma_beta_urad": ("urad", "uncertainty (1 sigma) of the cross-track offset"),
+    "in_track_km": ("km", "in-track geolocation error on the ground (see sign_convention)"),
+    "cross_track_km": ("km", "cross-track geolocation error on the ground (see sign_convention)"),
+    "total_km": ("km", "total geolocation error on the ground"),
+    "sigma_in_track_km": ("km", "uncertainty (1 sigma) of the in-track error"),
+    "sigma_cross_track_km": ("km", "uncertainty (1 sigma) of the cross-track error"),
+    "cost_min_k": (
+        "K",
+        "minimum over the perturbations of the cost (STDEV of BT_VIIRS - BT_CrIS, or its "
+        "residual after the calibration regression: assessment.cost)",
+    ),
+    "cost_zero_k": ("K", "cost of the unperturbed LOS"),
+    "bias_k": ("K", "CrIS minus VIIRS I5 brightness temperature at 280 K, at the optimum"),
+    "sigma_bias_k": ("K", "uncertainty (1 sigma) of the CrIS minus VIIRS bias"),
+    "gain_pct": (
+        "percent",
+        "CrIS minus VIIRS I5 gain difference (per cent of the BT departure from 280 K)",
+    ),
+    "sigma_gain_pct": ("percent", "uncertainty (1 sigma) of the gain difference"),
+    "curvature_k": ("K", "curvature of CrIS minus VIIRS: what it adds at 250 and 310 K"),
+    "sigma_curvature_k": ("K", "uncertainty (1 sigma) of the curvature"),
+    "response_width_50_urad": (
+        "urad",
+        "full width at 50 % of its peak of the CrIS FOV spatial response fitted at the optimum",
+    ),
+    "sigma_response_width_50_urad": ("urad", "uncertainty (1 sigma) of the response's full width at 50 %"),
+    "response_width_10_urad": (
+        "urad",
+        "full width at 10 % of its peak of the CrIS FOV spatial response fitted at the optimum",
+    ),
+    "sigma_response_width_10_urad": ("urad", "uncertainty (1 sigma) of the response's full width at 10 %"),
+}
+FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
+
+
+def _content_type(name: str) -> str:
+    """ACDD coverage_content_type: a measurement, or information on its quality."""
+    return "qualityInformation" if name.startswith(("sigma_", "cost_")) else "physicalMeasurement"
+
+
+class ResultStore(Store):
+    """The store as a notebook opens it (:func:`monitor.open_store`): the :class:`Store` and its results
+    as xarray."""
+
+    def to_xarray(
+        self, satellite: str, since: dt.date | None = None, until: dt.date | None = None
+    ) -> xr.Dataset:
+        """The per-FOR results of *satellite* as a CF-style xarray Dataset."""
+        return to_xarray(self, satellite, since, until)
+
+
+def to_xarray(
+    store: History,
+    satellite: str,
+    since: dt.date | None = None,
+    until: dt.date | None = None,
+    publisher: ExportConfig | None = None,
+) -> xr.Dataset:
+    """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset;
+    *publisher*, the ``export`` section of the configuration, fills the ACDD publisher attributes."""
+    import xarray as xr
+
+    series = store.series(satellite, since, until)
+    data = {k: series.values[k] for k in VARIABLES}
+    n_samples = series.values["n_samples"].astype(np.int32)
+    bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int8])
+    flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
+    days = np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]")
+    coords = {"time": days, "scan_position": np.arange(1, N_FOR + 1, dtype=np.int16)}
+    dims = ("time", "scan_position")  # time first and unlimited: daily files append along it
+    ds = xr.Dataset(
+        {
+            name: (
+                dims,
+                data[name],
+                {"units": unit, "long_name": long, "coverage_content_type": _content_type(name)},
+            )
+            for name, (unit, long) in VARIABLES.items()
+        },
+        coords=coords,
+    )
+    ds["time_bnds"] = (("time", "nv"), np.stack([days, days + np.timedelta64(1, "D")], axis=-1))
+    ds["n_samples"] = (
+        dims,
+        n_samples,
+        {
+            "units": "1",
+            "long_name": "CrIS FOVs in the cost function",
+            "coverage_content_type": "qualityInformation",
+        },
+    )
+    ds["flags"] = (
+        dims,
+        flags,
+        {
+            "long_name": "reliability flags (any set: not reliable)",
+            "flag_masks": np.array(list(FLAG_BITS.values()), np.int8),
+            "flag_meanings": " ".join(FLAG_BITS),
+            "coverage_content_type": "qualityInformation",
+        },
+    )
+    ds["scan_position"].attrs.update(
+        long_name="CrIS field of regard (scan position, 1 = first of the scan)",
+        coverage_content_type="coordinate",
+    )
+    ds["time"].attrs.update(
+        standard_name="time",
+        axis="T",
+        long_name="assessed UTC day (its start)",
+        bounds="time_bnds",
+        coverage_content_type="coordinate",
+    )
+    ds["time"].encoding.update(units="days since 1970-01-01 00:00:00", calendar="standard", dtype="int32")
+    ds["time_bnds"].encoding.update(
+        units="days since 1970-01-01 00:00:00", calendar="standard", dtype="int32"
+    )
+    info = satellite_info(satellite)
+    now = f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ}"
+    ds.attrs.update(
+        Conventions="CF-1.8, ACDD-1.3",
+        title=f"CrIS geolocation assessed against VIIRS I5, {info.name}",
+        summary=(
+            "Daily per-field-of-regard offsets of the CrIS line of sight (in-track alpha, cross-track beta, "
+            "urad) and the geolocation errors on the ground (km), found by perturbing the CrIS line of sight "
+            "21 x 21 times per FOV, collocating VIIRS I5 pixels in each perturbed footprint and minimising "
+            "a cost of the CrIS minus VIIRS brightness temperature differences."
+        ),
+        sign_convention=SIGN_CONVENTION,
+        comment=(
+            "One value per assessed UTC day and CrIS scan position; flags set mark values not to be trusted "
+            "(few samples, grid edge, flat cost, uncertain). The specification is 1.5 km in-track and "
+            "cross-track, each."
+        ),
+        acknowledgement=(
+            "CrIS and VIIRS SDR and GEO granules of NOAA's JPSS, from the NOAA Open Data Dissemination "
+            "archive; the method of Wang et al. (2017)."
+        ),
+        id=f"crisgeo_{satellite}",
+        standard_name_vocabulary="CF Standard Name Table v79",
+        time_coverage_resolution="P1D",
+        references=(
+            "Wang, L., B. Zhang, D. Tremblay, and Y. Han (2017), Improved scheme for Cross-track Infrared "
+            "Sounder geolocation assessment and optimization, J. Geophys. Res. Atmos., 122, 519-536, "
+            "doi:10.1002/2016JD025812"
+        ),
+        keywords="CrIS, VIIRS, geolocation, line of sight, JPSS, calibration",
+        platform=info.name,
+        instrument="CrIS, VIIRS",
+        satellite=satellite,
+        method="LOS perturbation assessment, Wang et al. 2017, JGR 122:519",
+        source=f"crisgeo-monitor {__version__}",
+        processing_level="L2 monitoring product (from CrIS SDR/GEO and VIIRS I5 SDR/GEO)",
+        date_created=now,
+        history=f"{now} exported from {store.path.name} by crisgeo-monitor {__version__}",
+        product_version=__version__,
+    )
+    if series.days:
+        first, last = series.days[0], series.days[-1]
+        ds.attrs.update(
+            id=f"crisgeo_{satellite}_{first:%Y%m%d}_{last:%Y%m%d}",
+            # ACDD: the times of the first and last data points, each stamped at its day's start (the
+            # days themselves are in time_bnds)
+            time_coverage_start=f"{first:%Y-%m-%d}T00:00:00Z",
+            time_coverage_end=f"{last:%Y-%m-%d}T00:00:00Z",
+            time_coverage_duration=f"P{(last - first).days + 1}D",
+        )
+    if publisher is not None:
+        ds.attrs.update({k: str(v) for k, v in publisher.model_dump().items() if v is not None})
+        if publisher.creator_name:  # the team that makes the data publishes it
+            ds.attrs.update(
+                publisher_name=publisher.creator_name,
+                **({"publisher_email": publisher.creator_email} if publisher.creator_email else {}),
+                **({"publisher_url": str(publisher.creator_url)} if publisher.creator_url else {}),
+            )
+    return ds
+
+
+class NothingToExport(ValueError):
+    """The store holds no results in the period asked for."""
+
+
+class ExportFormatError(ValueError):
+    """The format asked for and the name of the file disagree, or neither says one."""
+
+
+def export(
+    store: History,
+    satellite: str,
+    out: str | Path,
+    fmt: str | None = None,
+    since: dt.date | None = None,
+    until: dt.date | None = None,
+    publisher: ExportConfig | None = None,
+) -> Path:
+    """Write the results of *satellite* to *out* as ``netcdf`` or ``csv`` (*fmt*; None: from the suffix of
+    *out*, :data:`FORMATS`); returns the path. :class:`NothingToExport` (and no file) when the period holds
+    no results, :class:`ExportFormatError` when the format and the file's name disagree; :class:`OSError`
+    when *out* cannot be written."""
+    out = Path(out)
+    by_suffix = FORMATS.get(out.suffix.lower())
+    if fmt is None and by_suffix is None:
+        raise ExportFormatError(f"--out {out}: name it .nc or .csv, or give --format")
+    if fmt is not None and by_suffix is not None and fmt != by_suffix:
+        raise ExportFormatError(f"--out {out}: a {out.suffix} file cannot hold --format {fmt}")
+    fmt = fmt or by_suffix
+    if not out.parent.is_dir():
+        raise FileNotFoundError(f"the folder {out.parent} does not exist")
+    ds = to_xarray(store, satellite, since, until, publisher)
+    if ds.sizes["time"] == 0:
+        period = f"{since or 'the beginning'} .. {until or 'the end'}"
+        raise NothingToExport(f"no results of {satellite} in {period}: nothing written")
+    tmp = out.with_name(out.name + ".part")
+    if fmt == "netcdf":
+        ds.to_netcdf(tmp, engine="h5netcdf", unlimited_dims=["time"])
+    else:
+        ds.drop_vars("time_bnds").to_dataframe().reset_index().to_csv(tmp, index=False)
+    tmp.replace(out)
+    return out

@@ -1,0 +1,290 @@
+"""Prometheus metrics of the daemon (prometheus-client), served at ``/metrics``.
+
+What lives in the store (the run ledger, the latest per-FOR offsets, the alerts firing, the outbox) is read
+at each scrape, so it survives restarts and agrees with ``crisgeo status``; what only the process knows
+(stage durations of the last run, downloads since start) is kept in its own gauges and counters.
+
+    crisgeo_last_success_timestamp_seconds{satellite}     end of the latest ok run, 0 if none yet
+    crisgeo_watched_since_timestamp_seconds{satellite}    start of its first run (or of this process)
+    crisgeo_runs_total{satellite,outcome}                 finished runs in the ledger by outcome (only grows)
+    crisgeo_runs_in_progress{satellite}                   runs under way
+    crisgeo_run_duration_seconds{satellite,stage}         stages of the latest run of this process
+    crisgeo_downloaded_granules_total{satellite}          files downloaded whole by this process
+    crisgeo_downloaded_bytes_total{satellite}             bytes downloaded by this process (files and ranges)
+    crisgeo_nodd_requests_total{satellite}                HTTP requests to NODD by this process
+    crisgeo_outbox_points{target}                         time-series points waiting to be sent
+    crisgeo_alerts_firing{satellite,rule,severity}        alerts firing now
+    crisgeo_for_offset_radians{satellite,for,direction}   latest day's LOS offset (alpha, beta)
+    crisgeo_for_offset_meters{satellite,for,direction}    latest day's offset on the ground (in_track,
+                                                          cross_track, total)
+    crisgeo_for_beyond_spec{satellite,for}                1 when the FOR is beyond the specification (the
+                                                          one rule:
+                                                          monitor.core.result.ForOffset.spec_breaches)
+    crisgeo_for_calibration_bias_kelvin{satellite,for}    latest CrIS - VIIRS bias at 280 K
+    crisgeo_for_calibration_gain_ratio{satellite,for}     latest CrIS - VIIRS gain difference (0.01 = 1 %)
+    crisgeo_for_response_full_width_radians{satellite,for,level}  the CrIS FOV response's full width
+                                                          at level 0.5 / 0.1 of its peak, fitted per FOR
+    crisgeo_for_reliable{satellite,for}                   1 when the FOR carries no reliability flag
+    crisgeo_latest_day_timestamp_seconds{satellite}       00:00 UTC of the latest assessed day
+    crisgeo_healthy                                       1 when /healthz is ok
+    crisgeo_build_info{version}                           always 1
+
+Prometheus' conventions: base units in the names (seconds, meters, radians, kelvin, ratios), ``_total``
+for counters, no ``_created`` series; the ``for`` label is zero-padded (``"01"``..``"30"``) as the
+InfluxDB tag is, so that both sort. The code's own names keep their unit suffixes (``_km``, ``_urad``):
+this is the one surface where the convention of its readers wins.
+
+The dead-man's rule (configs/prometheus/crisgeo-rules.yml) takes the last success, or for a satellite that
+never succeeded the time it has been watched since: a deployment that never works fires too.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+from collections.abc import Callable, Iterable, Iterator
+from typing import Protocol
+
+from prometheus_client import CollectorRegistry, Counter, Gauge, disable_created_metrics
+from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
+from prometheus_client.metrics_core import Metric
+
+from monitor.core.constants import URAD
+from monitor.core.result import ForOffset
+from monitor.core.vocabulary import RunStatus
+from monitor.service.store.alerts import AlertState
+from monitor.service.store.sqlite import Store
+
+disable_created_metrics()  # a counter's start time is not a series anyone graphs
+
+
+class Counts(Protocol):
+    """What the metrics read of a run's counts (:class:`monitor.service.pipeline.RunCounts`)."""
+
+    @property
+    def downloaded(self) -> int: ...
+    @property
+    def bytes(self) -> int: ...
+    @property
+    def requests(self) -> int: ...
+
+
+class Outcome(Protocol):
+    """What the metrics read of a run (:class:`monitor.service.pipeline.RunOutcome`): its satellite, the
+    seconds of
+    its stages, its counts. Typed so, the metrics and the pipeline (one floor) do not import each other."""
+
+    @property
+    def satellite(self) -> str: ...
+    @property
+    def timings(self) -> dict: ...
+    @property
+    def counts(self) -> Counts: ...
+
+
+class Health(Protocol):
+    """What the metrics read of the daemon's health (:class:`monitor.service.health.Health`)."""
+
+    def problems(self) -> list[str]: ...
+
+
+OUTCOMES = tuple(s for s in RunStatus if s != RunStatus.RUNNING)  # final: a run row changes to one once
+
+
+class _StoreCollector:
+    """Reads the store at each scrape (a new connection each time: scrapes come on the server's thread)."""
+
+    def __init__(
+        self,
+        open_store: Callable[[], Store],
+        satellites: Iterable[str],
+        health: Health,
+        started: dt.datetime,
+        spec_km: float,
+    ) -> None:
+        self.open_store = open_store
+        self.satellites = list(satellites)
+        self.spec_km = spec_km
+        self.health = health
+        self.started = started
+
+    def collect(self) -> Iterator[Metric]:
+        with self.open_store() as store:
+            success = store.last_success()
+            first = store.first_runs()
+            counts = store.run_counts()
+            outbox = store.outbox_sizes()
+            firing = AlertState(store).firing()
+            latest = {s: store.latest_day(s) for s in self.satellites}
+            fors = {s: store.day_result(s, d) for s, d in latest.items() if d is not None}
+        g = GaugeMetricFamily(
+            "crisgeo_last_success_timestamp_seconds",
+            "End of the latest successful run (Unix time), 0 before the first",
+            labels=["satellite"],
+        )
+        since = GaugeMetricFamily(
+            "crisgeo_watched_since_timestamp_seconds",
+            "Start of the satellite's first run, or of this process before any run (Unix time)",
+            labels=["satellite"],
+        )
+        for sat in self.satellites:
+            g.add_metric([sat], success[sat].timestamp() if sat in success else 0.0)
+            since.add_metric([sat], first.get(sat, self.started).timestamp())
+        yield g
+        yield since
+        c = CounterMetricFamily(
+            "crisgeo_runs", "Finished runs in the ledger by outcome", labels=["satellite", "outcome"]
+        )
+        running = GaugeMetricFamily("crisgeo_runs_in_progress", "Runs under way", labels=["satellite"])
+        for sat in self.satellites:
+            for outcome in OUTCOMES:
+                c.add_metric([sat, outcome], counts.get((sat, outcome), 0))
+            running.add_metric([sat], counts.get((sat, RunStatus.RUNNING), 0))
+        yield c
+        yield running
+        g = GaugeMetricFamily(
+            "crisgeo_outbox_points", "Time-series points waiting to be sent", labels=["target"]
+        )
+        for target, n in outbox.items():
+            g.add_metric([target], n)
+        yield g
+        g = GaugeMetricFamily(
+            "crisgeo_alerts_firing", "Alerts firing now", labels=["satellite", "rule", "severity"]
+        )
+        per: dict[tuple[str, str, str], int] = {}
+        for a in firing:
+            key = (a.satellite, a.rule, a.severity or "")
+            per[key] = per.get(key, 0) + 1
+        for key, n in sorted(per.items()):
+            g.add_metric(list(key), n)
+        yield g
+        yield from self._offsets(latest, fors, self.spec_km)
+        yield GaugeMetricFamily(
+            "crisgeo_healthy", "1 when /healthz is ok", value=0 if self.health.problems() else 1
+        )
+
+    @staticmethod
+    def _offsets(
+        latest: dict[str, dt.date | None], fors: dict[str, list[ForOffset]], spec_km: float
+    ) -> Iterator[Metric]:
+        day = GaugeMetricFamily(
+            "crisgeo_latest_day_timestamp_seconds",
+            "00:00 UTC of the latest assessed day",
+            labels=["satellite"],
+        )
+        rad = GaugeMetricFamily(
+            "crisgeo_for_offset_radians",
+            "Latest LOS offset per FOR (spacecraft frame; the turn to apply to the CrIS LOS)",
+            labels=["satellite", "for", "direction"],
+        )
+        meters = GaugeMetricFamily(
+            "crisgeo_for_offset_meters",
+            "Latest offset per FOR on the ground",
+            labels=["satellite", "for", "direction"],
+        )
+        beyond = GaugeMetricFamily(
+            "crisgeo_for_beyond_spec",
+            "1 when the FOR's latest in-track or cross-track error is beyond the specification",
+            labels=["satellite", "for"],
+        )
+        bias = GaugeMetricFamily(
+            "crisgeo_for_calibration_bias_kelvin",
+            "Latest CrIS minus VIIRS I5 BT at the reference temperature (280 K) per FOR, at the optimum",
+            labels=["satellite", "for"],
+        )
+        gain = GaugeMetricFamily(
+            "crisgeo_for_calibration_gain_ratio",
+            "Latest CrIS minus VIIRS I5 gain difference per FOR (fraction of the BT's departure from 280 K)",
+            labels=["satellite", "for"],
+        )
+        width = GaugeMetricFamily(
+            "crisgeo_for_response_full_width_radians",
+            "Latest full width of the CrIS FOV spatial response fitted per FOR, at a level of its peak",
+            labels=["satellite", "for", "level"],
+        )
+        ok = GaugeMetricFamily(
+            "crisgeo_for_reliable",
+            "1 when the FOR's latest offset carries no reliability flag",
+            labels=["satellite", "for"],
+        )
+        for sat, d in latest.items():
+            if d is None:
+                continue
+            day.add_metric([sat], dt.datetime.combine(d, dt.time(), dt.timezone.utc).timestamp())
+            for f in fors[sat]:
+                k = f"{f.for_index:02d}"
+                for direction, v in (("alpha", f.d_alpha_urad), ("beta", f.d_beta_urad)):
+                    if math.isfinite(v):
+                        rad.add_metric([sat, k, direction], v * URAD)
+                for direction, v in (
+                    ("in_track", f.in_track_km),
+                    ("cross_track", f.cross_track_km),
+                    ("total", f.total_km),
+                ):
+                    if math.isfinite(v):
+                        meters.add_metric([sat, k, direction], 1000.0 * v)
+                beyond.add_metric([sat, k], 1 if f.spec_breaches(spec_km) else 0)
+                for family, v in ((bias, f.bias_k), (gain, f.gain_pct / 100.0)):
+                    if math.isfinite(v):
+                        family.add_metric([sat, k], v)
+                for level, v in (("0.5", f.response_width_50_urad), ("0.1", f.response_width_10_urad)):
+                    if math.isfinite(v):
+                        width.add_metric([sat, k, level], v * URAD)
+                ok.add_metric([sat, k], 1 if f.reliable else 0)
+        yield from (day, rad, meters, beyond, bias, gain, width, ok)
+
+
+class ServiceMetrics:
+    """The daemon's registry: the store's view at each scrape plus this process's run figures."""
+
+    def __init__(
+        self,
+        open_store: Callable[[], Store],
+        satellites: Iterable[str],
+        health: Health,
+        version: str,
+        spec_km: float,
+    ) -> None:
+        self.registry = CollectorRegistry()
+        self.registry.register(
+            _StoreCollector(open_store, satellites, health, dt.datetime.now(dt.timezone.utc), spec_km)
+        )
+        self.duration = Gauge(
+            "crisgeo_run_duration_seconds",
+            "Wall time of each stage of the latest run",
+            ["satellite", "stage"],
+            registry=self.registry,
+        )
+        self.granules = Counter(
+            "crisgeo_downloaded_granules",
+            "Files downloaded whole by this process",
+            ["satellite"],
+            registry=self.registry,
+        )
+        self.bytes = Counter(
+            "crisgeo_downloaded_bytes",
+            "Bytes downloaded by this process (whole files and ranges)",
+            ["satellite"],
+            registry=self.registry,
+        )
+        self.requests = Counter(
+            "crisgeo_nodd_requests",
+            "HTTP requests to NODD by this process (listings, downloads, ranges)",
+            ["satellite"],
+            registry=self.registry,
+        )
+        Gauge("crisgeo_build_info", "The running version", ["version"], registry=self.registry).labels(
+            version
+        ).set(1)
+        for sat in satellites:
+            self.granules.labels(sat)
+            self.bytes.labels(sat)
+            self.requests.labels(sat)
+
+    def record(self, outcome: Outcome) -> None:
+        """Take in a :class:`monitor.service.pipeline.RunOutcome`."""
+        for stage, secs in outcome.timings.items():
+            self.duration.labels(outcome.satellite, stage).set(secs)
+        self.granules.labels(outcome.satellite).inc(outcome.counts.downloaded)
+        self.bytes.labels(outcome.satellite).inc(outcome.counts.bytes)
+        self.requests.labels(outcome.satellite).inc(outcome.counts.requests)

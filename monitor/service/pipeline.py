@@ -1,0 +1,394 @@
+"""The daily run for one satellite-day: list, select scenes, fetch, assess, store, publish.
+
+Idempotent: a day's results are replaced in one transaction, never duplicated. Each run is a row in
+the ledger (``runs``): ok, no_data (recorded, with the reason), failed, interrupted. Days without an
+ok or no_data run within the catch-up window are redone, oldest first.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from monitor.assessment.assess import assess_plan
+from monitor.config.model import Config, ScheduleConfig
+from monitor.core.changes import all_changes
+from monitor.core.errors import DataError, StopRequested
+from monitor.core.records import SceneDecision
+from monitor.core.result import AssessmentResult
+from monitor.core.vocabulary import EventKind, RunStatus
+from monitor.mapping import fingerprint as fpr
+from monitor.sdr import read_file
+from monitor.sdr.engpkt import load_library
+from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
+from monitor.sdr.products import CRIS_GEO
+from monitor.service import logs
+from monitor.service.scenes import select_scenes
+from monitor.service.sources import ALL_PRODUCTS, ListedFile, Source, SourceError
+from monitor.service.store.sqlite import Store
+from monitor.service.store.timeseries import change_lines, drain_outbox, result_lines, target_name
+
+LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
+
+
+class NoRoom(OSError):
+    """The file system of the state directory has less room than a satellite-day needs."""
+
+
+def check_room(cfg: Config) -> None:
+    """:class:`NoRoom` naming the folder when the file system of ``state_dir`` (the store, the download
+    cache, simulated granules) has less than ``min_free_mb`` free: the day is not begun, and is redone
+    once there is room."""
+    probe = next(p for p in (cfg.state_dir, *cfg.state_dir.parents) if p.exists())
+    free_mb = shutil.disk_usage(probe).free / 2**20
+    if free_mb < cfg.min_free_mb:
+        raise NoRoom(
+            f"{cfg.state_dir}: {free_mb:.0f} MB free, a day needs min_free_mb {cfg.min_free_mb}; the day is "
+            "redone once there is room"
+        )
+
+
+class ProgressLines:
+    """Progress of a long stage as log lines, for logs and the journal where no bar can be drawn: one
+    line at most every *every_s* seconds, and one at the end. Call it once per item done."""
+
+    def __init__(self, what: str, total: int, every_s: float = 30.0):
+        self.what, self.total, self.every_s = what, total, every_s
+        self.done = 0
+        self.t0 = self.last = time.monotonic()
+
+    def __call__(self, _item: object = None) -> None:
+        self.done += 1
+        now = time.monotonic()
+        if self.done >= self.total or now - self.last >= self.every_s:
+            self.last = now
+            LOG.info("%s: %d/%d after %.0f s", self.what, self.done, self.total, now - self.t0)
+
+
+@dataclass
+class RunCounts:
+    """What a satellite-day run handled: CrIS granules listed, selected and assessed; files downloaded
+    whole, bytes read (files and ranges) and HTTP requests made."""
+
+    listed: int = 0
+    selected: int = 0
+    assessed: int = 0
+    downloaded: int = 0
+    bytes: int = 0
+    requests: int = 0
+
+
+@dataclass
+class RunOutcome:
+    """What one satellite-day run did: status and reason, the result, seconds per stage, counts."""
+
+    satellite: str
+    day: dt.date
+    status: RunStatus
+    reason: str | None = None
+    run_id: int | None = None
+    result: AssessmentResult | None = None
+    timings: dict = field(default_factory=dict)
+    counts: RunCounts = field(default_factory=RunCounts)
+
+    def summary(self) -> str:
+        """The one line a run leaves in the log."""
+        c, t = self.counts, self.timings
+        parts = [
+            f"run {self.satellite} {self.day}: {self.status}" + (f" ({self.reason})" if self.reason else "")
+        ]
+        parts.append(
+            f"granules listed {c.listed}, selected {c.selected}, assessed {c.assessed}; {c.downloaded} files "
+            f"whole, {c.bytes / 1e6:.0f} MB downloaded in {c.requests} requests"
+        )
+        if self.result is not None:
+            ok = [f for f in self.result.fors if f.reliable]
+            worst = max((f.total_km for f in ok), default=float("nan"))
+            parts.append(f"reliable FORs {len(ok)}/{len(self.result.fors)}, worst {worst:.2f} km")
+        if t:
+            parts.append("stages " + ", ".join(f"{k} {v:.1f} s" for k, v in t.items()))
+        return "; ".join(parts)
+
+
+def days_to_run(store: Store, satellite: str, schedule: ScheduleConfig, today: dt.date) -> list[dt.date]:
+    """The days of the catch-up window (ending ``lag_days`` before *today*) without a completed run, oldest
+    first. A day found empty (archive outage, late ingest) is tried again for ``no_data_retry_days`` after
+    it became due; then its empty listing is final."""
+    return schedule.days_to_run(store.done_days(satellite, schedule.no_data_horizon(today)), today)
+
+
+def day_fingerprint(
+    cfg: Config, source: Source, satellite: str, day: dt.date, listing: list[ListedFile]
+) -> fpr.DayFingerprint | None:
+    """The LOS fingerprint (:func:`monitor.mapping.fingerprint.granule_print`) of a sample of the day's GEO
+    granules,
+    with the EPs of the library identified (:func:`monitor.mapping.fingerprint.fingerprint_day`); a granule
+    that
+    cannot be fetched or read is logged and left out; None without any."""
+    geos = sorted(
+        (f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
+        key=lambda f: f.parsed.start,
+    )
+    if not geos:
+        return None
+    picks = np.unique(
+        np.round(np.linspace(0, len(geos) - 1, min(cfg.fingerprint.granules, len(geos)))).astype(int)
+    )
+    prints = []
+    for i in picks:
+        try:
+            (g,) = read_file(source.fetch(geos[i]), kinds=("cris_geo",))[:1]
+            prints.append(fpr.granule_print(g))
+        except (SourceError, DataError) as exc:
+            LOG.warning("fingerprint: skipping %s: %s", geos[i].name, exc)
+    if not prints:
+        return None
+    library, problems = load_library(cfg.fingerprint.ep_library)
+    for problem in problems:
+        LOG.warning("fingerprint: EP library: %s", problem)
+    return fpr.fingerprint_day(prints, library, satellite)
+
+
+def record_fingerprint(
+    cfg: Config, store: Store, satellite: str, day: dt.date, fingerprint: fpr.DayFingerprint
+) -> dict:
+    """Compare the day's *fingerprint* with the previous day's print in the store, and store it.
+
+    A step becomes a ``change:cris`` event (used for jump attribution and notified by the alerts).
+    """
+    prev = store.fingerprint(satellite, day)
+    reference = fpr.DayPrint.from_dict(prev[1]) if prev else None
+    verdict = fingerprint.verdict(cfg.fingerprint.threshold_urad, reference, day)
+    body = verdict.day.to_dict()
+    if verdict.matches:
+        body["ep_match"] = [m.to_dict() for m in verdict.matches[:3]]
+    change = verdict.change
+    if change is not None:
+        desc = change.describe(verdict.matches)
+        body["change"] = change.to_dict()
+        store.add_event(
+            EventKind.CHANGE_CRIS,
+            satellite,
+            {"time": change.time, "kind": "processing_change", "description": desc, "origin": "fingerprint"},
+        )
+        LOG.warning("%s %s: %s", satellite, day, desc)
+    store.save_fingerprint(satellite, day, body)
+    return body
+
+
+def publish_changes(cfg: Config, store: Store, satellite: str) -> None:
+    """Queue every known change of *satellite* for the time-series stores (dashboard annotations)."""
+    if not cfg.store.publish:
+        return
+
+    try:
+        changes = all_changes(store, satellite, cfg.events_file)
+    except (ValueError, OSError) as exc:
+        LOG.warning("changes not published: %s", exc)
+        return
+    for p in cfg.store.publish:
+        store.queue_lines(target_name(p), satellite, change_lines(p.measurement, changes))
+
+
+def fetch_plan(
+    source: Source,
+    satellite: str,
+    chosen: list,
+    stop: Callable[[], bool] = lambda: False,
+    progress: Callable[[], None] | None = None,
+) -> CasePlan:
+    """The assessment plan of the chosen scenes: their CrIS files as selection read them (no second
+    reading, no second pairing) with the VIIRS granules covering them, each fetched and its metadata read
+    once; a VIIRS granule that cannot be fetched or read is skipped with its reason."""
+    viirs: dict[str, GranuleFiles] = {}
+    skipped: list[tuple[str, str]] = []
+    for c in chosen:
+        if stop():
+            raise StopRequested
+        for vs, vg in c.viirs:
+            key = vg.parsed.granule_key
+            if key in viirs or any(key == k for k, _ in skipped):
+                continue
+            try:
+                viirs[key] = granule_files(key, source.fetch(vs), source.fetch(vg))
+            except (SourceError, DataError) as exc:  # BudgetExceeded is a SourceError
+                skipped.append((key, str(exc)))
+        if progress is not None:
+            progress()
+    return assemble(satellite, [c.files for c in chosen], list(viirs.values()), skipped)
+
+
+@dataclass
+class DayWork:
+    """What the computing half of a satellite-day produced, before anything is stored: picklable, so that
+    a reprocessing worker returns it to the one process that writes the store."""
+
+    satellite: str
+    day: dt.date
+    status: RunStatus  # ok, no_data, failed or interrupted
+    reason: str | None = None
+    result: AssessmentResult | None = None
+    decisions: list[SceneDecision] = field(default_factory=list)
+    fingerprint: fpr.DayFingerprint | None = None  # the GEO files' LOS fingerprint, EPs identified
+    timings: dict = field(default_factory=dict)
+    counts: RunCounts = field(default_factory=RunCounts)
+
+
+def compute_day(
+    cfg: Config,
+    source: Source,
+    satellite: str,
+    day: dt.date,
+    should_stop: Callable[[], bool] | None = None,
+    progress: Callable[[object], None] | None = None,
+) -> DayWork:
+    """List, fingerprint, select, fetch and assess one satellite-day, touching no store. Never raises for
+    a problem of the day's data or source: it becomes the work's status and reason. Its log lines carry
+    the satellite, day and stage (and only its own: the context ends with it)."""
+    with logs.context(satellite=satellite, day=day.isoformat()):
+        return _compute_day(cfg, source, satellite, day, should_stop, progress)
+
+
+def _compute_day(
+    cfg: Config,
+    source: Source,
+    satellite: str,
+    day: dt.date,
+    should_stop: Callable[[], bool] | None,
+    progress: Callable[[object], None] | None,
+) -> DayWork:
+    stop = should_stop or (lambda: False)
+    w = DayWork(satellite, day, RunStatus.OK)
+    t0 = time.perf_counter()
+    try:
+        logs.stage("list")
+        check_room(cfg)
+        source.start_day(stop)
+        listing = source.list_day(satellite, day, ALL_PRODUCTS)
+        w.timings["list"] = time.perf_counter() - t0
+        w.counts.listed = len(listing)
+        if not any(f.product in CRIS_GEO for f in listing):
+            w.status, w.reason = (
+                RunStatus.NO_DATA,
+                f"no CrIS GEO granule of {satellite} on {day} in the source",
+            )
+            return w
+        if stop():
+            raise StopRequested
+        t1 = time.perf_counter()
+        logs.stage("fingerprint")
+        w.fingerprint = day_fingerprint(cfg, source, satellite, day, listing)
+        w.timings["fingerprint"] = time.perf_counter() - t1
+        t1 = time.perf_counter()
+        logs.stage("select")
+        chosen, w.decisions = select_scenes(
+            listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep, cfg.scenes.min_inhomogeneity_k
+        )
+        w.timings["select"] = time.perf_counter() - t1
+        w.counts.selected = len(chosen)
+        if not chosen:
+            w.status = RunStatus.NO_DATA
+            w.reason = "no usable scene: " + "; ".join(sorted({d.reason for d in w.decisions}))[:500]
+            return w
+        t1 = time.perf_counter()
+        logs.stage("fetch")
+        case = fetch_plan(
+            source, satellite, chosen, stop, ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
+        )
+        w.timings["fetch"] = time.perf_counter() - t1
+        t1 = time.perf_counter()
+        a = cfg.assessment
+        logs.stage("assess")
+        LOG.info(
+            "assessing %d CrIS granule(s) against %d VIIRS granule(s)", len(case.cris), len(case.viirs_all)
+        )
+        w.result = assess_plan(
+            case,
+            a,
+            progress=progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris)),
+            should_stop=stop,
+            workers=a.workers,
+        )
+        w.timings["assess"] = time.perf_counter() - t1
+        w.counts.assessed = len(w.result.granules)
+        if stop():
+            raise StopRequested
+    except StopRequested:
+        w.status, w.reason, w.result = RunStatus.INTERRUPTED, "stop requested", None
+    except NoRoom as exc:
+        w.status, w.reason, w.result = RunStatus.FAILED, f"no room: {exc}", None
+    except (SourceError, DataError, OSError) as exc:
+        w.status, w.reason, w.result = RunStatus.FAILED, f"{type(exc).__name__}: {exc}", None
+    except Exception as exc:  # noqa: BLE001 - the satellite-day boundary: record, alert, let the next day run
+        LOG.exception("run %s %s failed unexpectedly", satellite, day)
+        w.status, w.reason = RunStatus.FAILED, f"unexpected {type(exc).__name__}: {exc}"[:1000]
+        w.result = None
+    # read in place, the bytes travel while the day is assessed: counted once it ends, however it ends
+    w.counts.downloaded, w.counts.bytes = source.downloaded_files, source.spent_bytes
+    w.counts.requests = source.requests
+    return w
+
+
+def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.date) -> RunOutcome:
+    """Write what :func:`compute_day` produced under the ledger row *run_id*: the fingerprint, then the
+    day's results and their outbox lines in one transaction (ok), or the empty, failed or interrupted
+    run with its reason; then drain the outbox."""
+    t1 = time.perf_counter()
+    try:
+        if w.fingerprint is not None:
+            try:
+                record_fingerprint(cfg, store, w.satellite, w.day, w.fingerprint)
+            except (DataError, OSError, ValueError) as exc:
+                LOG.warning("fingerprint of %s %s not recorded: %s", w.satellite, w.day, exc)
+        out = RunOutcome(w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts)
+        if w.status == RunStatus.OK and w.result is not None:  # an ok day always has its result
+            lines = {
+                target_name(p): result_lines(p.measurement, w.satellite, w.day, w.result.fors)
+                for p in cfg.store.publish
+            }
+            store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, lines)
+            publish_changes(cfg, store, w.satellite)
+        elif w.status == RunStatus.NO_DATA:
+            s = cfg.schedule
+            if w.day < s.no_data_horizon(today):
+                out.status = RunStatus.NO_DATA_FINAL
+            else:
+                out.reason = f"{out.reason} (tried again for {s.no_data_retry_days} day(s) after it is due)"
+            summary = {"selection": [asdict(d) for d in w.decisions[:50]]} if w.decisions else None
+            store.finish_run(run_id, out.status, out.reason, summary=summary)
+        elif w.status == RunStatus.FAILED:
+            store.finish_run(run_id, RunStatus.FAILED, w.reason)
+            store.add_event(EventKind.RUN_FAILED, w.satellite, {"day": w.day.isoformat(), "reason": w.reason})
+        else:
+            store.finish_run(run_id, w.status, w.reason)
+        return out
+    finally:
+        if cfg.store.publish:
+            drain_outbox(store, cfg.store.publish)
+        w.timings["publish"] = time.perf_counter() - t1
+
+
+def run_day(
+    cfg: Config,
+    store: Store,
+    source: Source,
+    satellite: str,
+    day: dt.date,
+    today: dt.date,
+    should_stop: Callable[[], bool] | None = None,
+    progress: Callable[[object], None] | None = None,
+) -> RunOutcome:
+    """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`) as of *today*
+    (the no-data horizon); every outcome is recorded in the ledger, an unexpected exception too
+    (``failed`` with its type and message)."""
+    run_id = store.begin_run(satellite, day)
+    with logs.context(satellite=satellite, day=day.isoformat(), run_id=run_id):
+        work = compute_day(cfg, source, satellite, day, should_stop, progress)
+        with logs.context(stage="record"):
+            return record_day(cfg, store, run_id, work, today)

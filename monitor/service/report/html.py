@@ -1,0 +1,389 @@
+"""The self-contained HTML trend report: one page per satellite plus an index, images beside them.
+
+Layout of the output directory (the alert messages link ``<sat>/index.html`` and attach
+``<sat>/trend.png``)::
+
+    index.html               every satellite: latest day, worst FOR, firing alerts
+    <sat>/index.html         the page: figures and tables
+    <sat>/latest_km.png      figure 8: per-FOR km with the spec band
+    <sat>/latest_urad.png    figure 7: per-FOR urad with a % of FOV axis
+    <sat>/heatmap.png        FOR x day heat maps, change markers
+    <sat>/trend.png          chosen FORs over time, spec band, changes and alerts
+    <sat>/cost.png           figure 5c: the cost surface of the latest run's worst FOR
+
+The pages use no script, font or style sheet from elsewhere: they open from disk.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import html
+import json
+import os
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from monitor.config.model import Config
+from monitor.core.changes import Change, all_changes
+from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
+from monitor.core.records import Alert, ForSeries
+from monitor.core.result import RELIABILITY_FLAGS, ForOffset
+from monitor.core.satellites import SATELLITES
+from monitor.core.tables import FOR_COLUMNS, REPORT
+from monitor.core.vocabulary import RunStatus
+from monitor.service.report import plots
+from monitor.service.store.alerts import AlertState
+from monitor.service.store.sqlite import Store
+
+UTC = dt.timezone.utc
+CSS = """
+body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:1.5em auto;max-width:1100px;color:#222}
+h1{font-size:1.5em}h2{font-size:1.15em;margin-top:1.6em;border-bottom:1px solid #ccc}
+table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0}td,th{border:1px solid #ddd;padding:2px
+7px;text-align:right}
+th{background:#f3f3f3}td.l,th.l{text-align:left}tr.out td{background:#fde2e1}tr.flag td{color:#999}
+img{max-width:100%;border:1px solid #eee;margin:0.3em 0}.note{color:#666;font-size:0.85em}
+.ok{color:#1a7f37}.bad{color:#c62828;font-weight:bold}
+"""
+
+
+@dataclass
+class ReportOptions:
+    """What the report shows: satellites, period, calendar, specification, FORs over time."""
+
+    spec_km: float = SPEC_KM
+    trend_fors: tuple = (1, 15, 30)
+    since: dt.date | None = None
+    until: dt.date | None = None
+    calendar: Path | None = None
+    satellites: list = field(default_factory=list)
+
+
+def options_from_config(
+    cfg: Config,
+    satellites: Iterable[str] | None = None,
+    since: dt.date | None = None,
+    until: dt.date | None = None,
+) -> ReportOptions:
+    """Report options of a service configuration: the spec of its alert rules, its events calendar."""
+    return ReportOptions(
+        spec_km=cfg.alerts.spec_km,
+        since=since,
+        until=until,
+        calendar=cfg.events_file,
+        satellites=list(satellites or cfg.satellites),
+    )
+
+
+def _e(x: object) -> str:
+    return html.escape(str(x))
+
+
+def _write(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.part")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _page(title: str, body: str) -> str:
+    return (
+        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{_e(title)}</title>'
+        '<link rel="icon" href="data:,">'  # no favicon request (a 404 in the browser console)
+        f"<style>{CSS}</style></head><body>\n{body}\n</body></html>\n"
+    )
+
+
+def _latest_table(fors: Iterable[ForOffset], spec_km: float) -> str:
+    """The latest day's FOR table (the columns of :data:`monitor.core.tables.REPORT`); unreliable FORs greyed,
+    FORs beyond the specification marked."""
+    cols = [FOR_COLUMNS[c] for c in REPORT]
+    head = "".join(
+        f"<th{' class=l' if c.align == '<' else ''}>{_e(f'{c.header} {c.unit}'.strip())}</th>" for c in cols
+    )
+    rows = []
+    for f in fors:
+        cls = "flag" if not f.reliable else "out" if f.spec_breaches(spec_km) else ""
+        cells = "".join(
+            f"<td{' class=l' if c.align == '<' else ''}>{_e(_blank_nan(c.text(f)))}</td>" for c in cols
+        )
+        rows.append(f"<tr class='{cls}'>{cells}</tr>")
+    return f"<table><tr>{head}</tr>{''.join(rows)}</table>"
+
+
+def _blank_nan(text: str) -> str:
+    return "" if text in ("nan", "-nan") else text
+
+
+def _alerts_table(rows: Sequence[Alert]) -> str:
+    if not rows:
+        return "<p class=ok>No alert is firing.</p>"
+    body = "".join(
+        f"<tr><td class=l>{_e(r.severity or '')}</td><td class=l>{_e(r.rule)}</td>"
+        f"<td class=l>{_e(r.started)}</td><td class=l>{_e(r.summary)}</td></tr>"
+        for r in rows
+    )
+    head = "".join(f"<th class=l>{h}</th>" for h in ("severity", "rule", "since", "summary"))
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def _changes_table(changes: Sequence[Change]) -> str:
+    if not changes:
+        return "<p class=note>No change known (calendar, granule metadata, LOS fingerprint).</p>"
+    body = "".join(
+        f"<tr><td class=l>{c.time:%Y-%m-%d %H:%M}</td><td class=l>{_e(c.instrument)}</td>"
+        f"<td class=l>{_e(c.kind)}</td><td class=l>{_e(c.description)}</td><td "
+        f"class=l>{_e(c.origin)}</td></tr>"
+        for c in reversed(changes)
+    )
+    return (
+        "<table><tr><th class=l>time (UTC)</th><th class=l>instrument</th><th class=l>kind</th>"
+        f"<th class=l>description</th><th class=l>origin</th></tr>{body}</table>"
+    )
+
+
+def _img(name: str, alt: str) -> str:
+    return f'<img src="{name}" alt="{_e(alt)}">'
+
+
+def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions) -> dict:
+    """Write ``out/<satellite>/`` and return a summary for the index."""
+    sat_dir = out / satellite
+    sat_dir.mkdir(parents=True, exist_ok=True)
+    name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
+    series = store.series(satellite, opts.since, opts.until)
+    changes = [
+        c
+        for c in all_changes(store, satellite, opts.calendar)
+        if (opts.since is None or c.time.date() >= opts.since)
+        and (opts.until is None or c.time.date() <= opts.until)
+    ]
+    state = AlertState(store)
+    firing = state.firing(satellite)
+    alert_times = sorted(
+        dt.datetime.fromisoformat(r.started).replace(tzinfo=None)
+        for r in state.all()
+        if r.satellite == satellite and r.started
+    )
+    parts = [
+        '<p><a href="../index.html">all satellites</a></p><h1>CrIS geolocation against VIIRS I5: '
+        f"{_e(name)}</h1>"
+    ]
+    summary: dict[str, Any] = {
+        "satellite": satellite,
+        "name": name,
+        "latest": None,
+        "worst_km": None,
+        "firing": len(firing),
+        "days": 0,
+    }
+    if not len(series):
+        parts.append("<p>No assessment in the store for this period yet.</p>")
+        parts.append("<h2>Active alerts</h2>" + _alerts_table(firing))
+        parts.append("<h2>Known changes</h2>" + _changes_table(changes))
+        _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))
+        _drop_figures_except(sat_dir, set())
+        return summary
+    days, arrays = series.days, series.values
+    latest = days[-1]
+    fors = store.day_result(satellite, latest)
+    reliable = [f.reliable for f in fors]
+    col = lambda k: np.array([getattr(f, k) for f in fors], float)  # noqa: E731
+    worst = max(
+        (f for f in fors if f.reliable and np.isfinite(f.total_km)), key=lambda f: f.total_km, default=None
+    )
+    summary.update(
+        latest=latest.isoformat(),
+        days=len(days),
+        worst_km=None if worst is None else worst.total_km,
+        worst_for=None if worst is None else worst.for_index,
+    )
+    title = f"{name}, {latest.isoformat()}"
+    plots.latest_km(
+        sat_dir / "latest_km.png",
+        col("in_track_km"),
+        col("cross_track_km"),
+        col("sigma_in_track_km"),
+        col("sigma_cross_track_km"),
+        reliable,
+        opts.spec_km,
+        title,
+    )
+    plots.latest_urad(
+        sat_dir / "latest_urad.png",
+        col("d_alpha_urad"),
+        col("d_beta_urad"),
+        col("sigma_alpha_urad"),
+        col("sigma_beta_urad"),
+        title,
+    )
+    marks = [(c.time.replace(tzinfo=None), c.instrument, c.description) for c in changes]
+    span = f"{name}, {days[0].isoformat()} .. {latest.isoformat()} ({len(days)} days)"
+    plots.heatmaps(
+        sat_dir / "heatmap.png",
+        days,
+        arrays["in_track_km"],
+        arrays["cross_track_km"],
+        opts.spec_km,
+        marks,
+        span,
+    )
+    # an alert fires after the run of the day it concerns: mark it on the last day plotted at that time
+    lo, hi = dt.datetime.combine(days[0], dt.time()), dt.datetime.combine(days[-1], dt.time())
+    alert_days = sorted(
+        {
+            min(max(dt.datetime.combine(t.date(), dt.time()) - dt.timedelta(days=1), lo), hi)
+            for t in alert_times
+            if t.date() >= days[0]
+        }
+    )
+    plots.trend_lines(
+        sat_dir / "trend.png",
+        days,
+        opts.trend_fors,
+        arrays["in_track_km"],
+        arrays["cross_track_km"],
+        opts.spec_km,
+        marks,
+        alert_days,
+        span,
+    )
+    calibration_html = _calibration(store, satellite, name, series, marks, span, sat_dir)
+    stored = store.cost_cube(satellite, latest)
+    cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
+    figures = {"latest_km.png", "latest_urad.png", "heatmap.png", "trend.png"}
+    figures |= {f for f in ("calibration_bins.png", "calibration_trend.png") if f in calibration_html}
+    if stored is not None and worst is not None:
+        cube, step = stored
+        runs = [r for r in store.runs(satellite) if r.day == latest.isoformat() and r.status == RunStatus.OK]
+        plots.cost_contour(
+            sat_dir / "cost.png",
+            np.asarray(cube[worst.for_index - 1], float),
+            worst.for_index,
+            step,
+            worst.d_alpha_urad,
+            worst.d_beta_urad,
+            f"{title}: worst FOR {worst.for_index}, "
+            f"{worst.total_km:.2f} km" + (f" (run {runs[-1].id})" if runs else ""),
+        )
+        figures.add("cost.png")
+        cost_html = (
+            _img("cost.png", f"cost surface of FOR {worst.for_index}")
+            + f"<p class=note>G_min {worst.cost_min_k:.3f} K against {worst.cost_zero_k:.3f} K as "
+            "geolocated; "
+            "a sharp, closed minimum is a trustworthy result, a flat or open one is flagged.</p>"
+        )
+    status = (
+        "<span class=bad>out of specification</span>"
+        if worst is not None and worst.total_km > opts.spec_km
+        else "<span class=ok>within specification</span>"
+    )
+    flagged = [f.for_index for f in fors if any(x in RELIABILITY_FLAGS for x in f.flags)]
+    parts += [
+        f"<p>Latest day {latest.isoformat()}: {status}; worst reliable FOR "
+        f"{'-' if worst is None else worst.for_index} at "
+        f"{'-' if worst is None else format(worst.total_km, '.2f')} km "
+        f"(spec {opts.spec_km:g} km). {len(days)} day(s) shown. Flagged FORs: "
+        f"{', '.join(map(str, flagged)) or 'none'}.</p>",
+        "<h2>Active alerts</h2>" + _alerts_table(firing),
+        "<h2>Latest per-FOR offsets</h2>"
+        + _img("latest_km.png", "per-FOR km")
+        + _img("latest_urad.png", "per-FOR urad"),
+        "<h2>Over time</h2>"
+        + _img("heatmap.png", "FOR x day heat maps")
+        + _img("trend.png", "chosen FORs over time"),
+        "<p class=note>Dotted vertical lines: known changes (purple CrIS, green VIIRS, brown common); "
+        "red triangles: alerts.</p>",
+        "<h2>Cost surface of the worst FOR</h2>" + cost_html,
+        "<h2>CrIS-VIIRS intercalibration</h2>" + calibration_html,
+        "<h2>Latest values</h2>" + _latest_table(fors, opts.spec_km),
+        "<h2>Known changes</h2>" + _changes_table(changes),
+        f"<p class=note>Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} UTC by crisgeo report.</p>",
+    ]
+    _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))
+    _drop_figures_except(sat_dir, figures)
+    return summary
+
+
+def _calibration(
+    store: Store,
+    satellite: str,
+    name: str,
+    series: ForSeries,
+    marks: list[tuple[dt.datetime, str, str]],
+    span: str,
+    sat_dir: Path,
+) -> str:
+    """The intercalibration section: the latest day's CrIS - VIIRS against the CrIS BT (the paper's
+    Figure 15) and the bias and gain over time; what is shown, as HTML."""
+    out = []
+    latest = series.days[-1]
+    bins = store.difference_bins(satellite, latest)
+    if bins:
+        plots.calibration_bins(
+            sat_dir / "calibration_bins.png",
+            [b.low_k for b in bins],
+            [b.n for b in bins],
+            [b.mean_k for b in bins],
+            [b.std_k for b in bins],
+            CALIBRATION_BIN_K,
+            f"{name}, {latest.isoformat()}: CrIS - VIIRS I5 at the optimum, all refined FORs",
+        )
+        out.append(_img("calibration_bins.png", "CrIS minus VIIRS against CrIS BT"))
+    reliable = series.reliable()
+    bias = np.where(reliable, series.values["bias_k"], np.nan)
+    if np.isfinite(bias).any():
+        plots.calibration_trend(
+            sat_dir / "calibration_trend.png",
+            series.days,
+            bias,
+            np.where(reliable, series.values["gain_pct"], np.nan),
+            marks,
+            span,
+        )
+        out.append(_img("calibration_trend.png", "CrIS minus VIIRS bias and gain over time"))
+    if not out:
+        return "<p class=note>No intercalibration stored for this period (assessed before it was kept).</p>"
+    return "".join(out) + (
+        f"<p class=note>At each FOR's optimum: CrIS - VIIRS = bias + gain (VIIRS BT - "
+        f"{CALIBRATION_REFERENCE_K:g} K), fitted over the FOR's samples; the trend shows the median over "
+        "the reliable FORs and their quartiles. A step fires the calibration_jump alert.</p>"
+    )
+
+
+def _drop_figures_except(sat_dir: Path, keep: set) -> None:
+    """Remove figures of an earlier report that this one no longer shows. Figures are replaced in place,
+    never removed first, so a page being read while the report is rewritten keeps its images."""
+    for old in sat_dir.glob("*.png"):
+        if old.name not in keep:
+            old.unlink(missing_ok=True)
+
+
+def build_report(store: Store, out_dir: str | os.PathLike[str], opts: ReportOptions) -> Path:
+    """Write the report for *opts.satellites* into *out_dir*; returns the index path.
+
+    Pages are written under temporary names and moved into place, so a reader never sees half a page.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    summaries = [satellite_page(store, sat, out, opts) for sat in opts.satellites]
+    rows = "".join(
+        f'<tr><td class=l><a href="{s["satellite"]}/index.html">{_e(s["name"])}</a></td>'
+        f"<td class=l>{s['latest'] or 'no data'}</td><td>{s['days']}</td>"
+        f"<td>{'' if s['worst_km'] is None else format(s['worst_km'], '.2f')}</td>"
+        f"<td class={'bad' if s['firing'] else 'ok'}>{s['firing']}</td></tr>"
+        for s in summaries
+    )
+    body = (
+        "<h1>crisgeo-monitor: CrIS geolocation against VIIRS</h1>"
+        "<table><tr><th class=l>satellite</th><th class=l>latest day</th><th>days</th>"
+        f"<th>worst FOR km</th><th>firing alerts</th></tr>{rows}</table>"
+        f"<p class=note>Specification {opts.spec_km:g} km. Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} "
+        "UTC.</p>"
+    )
+    _write(out / "index.html", _page("crisgeo-monitor report", body))
+    _write(out / "report.json", json.dumps(summaries, indent=1, default=str))
+    return out / "index.html"

@@ -1,0 +1,137 @@
+"""Scene selection: the day's CrIS granules whose scenes are inhomogeneous enough to pin the geolocation.
+
+Candidates are spread evenly over the day; only the small CrIS files are fetched to score them. The
+score is the inhomogeneity of the CrIS I5-equivalent brightness temperature at the FOV scale: the mean,
+over the granule's FORs, of the standard deviation of the 9 FOV BTs (K). Clouds over ocean and
+coastlines score high; uniform scenes carry no information and score near the noise. Granules
+without VIIRS I5 and GEO coverage in the listing are skipped before anything is fetched. Every
+candidate gets a decision and its reason.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from monitor.core.errors import DataError
+from monitor.core.records import SceneDecision
+from monitor.core.vocabulary import Decision
+from monitor.instrument.spectral import i5_band
+from monitor.sdr import GranuleError, read_file
+from monitor.sdr.pairing import GranuleFiles, granule_files
+from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
+from monitor.service.sources import BudgetExceeded, ListedFile, Source, SourceError
+
+LOG = logging.getLogger("monitor.scenes")  # the name journal filters know, kept
+COVER_MARGIN = dt.timedelta(seconds=10)
+
+
+@dataclass
+class Candidate:
+    """A CrIS granule considered: its listed SDR and GEO, the listed VIIRS pairs covering it, its score (K)
+    and, once fetched and read, its :class:`monitor.sdr.pairing.GranuleFiles` (paths and metadata)."""
+
+    key: str
+    sdr: ListedFile
+    geo: ListedFile
+    viirs: list  # [(sdr, geo)] listed VIIRS pairs covering it
+    score_k: float = float("nan")
+    files: GranuleFiles | None = None
+
+
+def _pairs(
+    files: list[ListedFile], sdr_prefixes: Iterable[str], geo_prefixes: Iterable[str]
+) -> tuple[list[tuple[str, ListedFile, ListedFile]], list[str]]:
+    sdr = {f.parsed.granule_key: f for f in files if f.product in sdr_prefixes}
+    geo = {f.parsed.granule_key: f for f in files if f.product in geo_prefixes}
+    both = sorted(set(sdr) & set(geo), key=lambda k: geo[k].parsed.start)
+    single = sorted(set(sdr) ^ set(geo))
+    return [(k, sdr[k], geo[k]) for k in both], single
+
+
+def inhomogeneity_k(radiance_lw: np.ndarray, satellite: str) -> float:
+    """Mean over FORs of the standard deviation of the 9 FOV I5-equivalent BTs (K)."""
+    band = i5_band(satellite)
+    bt = band.bt_from_radiance(band.cris_band_radiance(radiance_lw))
+    return float(np.nanmean(np.nanstd(bt, axis=-1)))
+
+
+def select_scenes(
+    listing: list[ListedFile], source: Source, satellite: str, candidates: int, keep: int, min_score_k: float
+) -> tuple[list[Candidate], list[SceneDecision]]:
+    """(chosen candidates, decisions) for one satellite-day: every granule of the listing is chosen,
+    rejected or not considered, with the reason."""
+    decisions: list[SceneDecision] = []
+    cris, unpaired = _pairs(listing, CRIS_SDR, CRIS_GEO)
+    for key in unpaired:
+        decisions.append(SceneDecision(key, Decision.REJECTED, "SDR or GEO file missing in the listing"))
+    viirs, _ = _pairs(listing, VIIRS_SDR, VIIRS_GEO)
+    if len(cris) > candidates:
+        picks = set(np.round(np.linspace(0, len(cris) - 1, candidates)).astype(int))
+        for i, (key, _, _) in enumerate(cris):
+            if i not in picks:
+                decisions.append(
+                    SceneDecision(
+                        key,
+                        Decision.NOT_CONSIDERED,
+                        f"outside the {candidates} candidates spread over the day",
+                    )
+                )
+        cris = [c for i, c in enumerate(cris) if i in picks]
+    pool = []
+    for key, sdr, geo in cris:
+        start, end = geo.parsed.start, geo.parsed.end
+        cover = [
+            (vs, vg)
+            for _, vs, vg in viirs
+            if vg.parsed.start <= end + COVER_MARGIN and vg.parsed.end >= start - COVER_MARGIN
+        ]
+        if not cover:
+            decisions.append(SceneDecision(key, Decision.REJECTED, "no VIIRS I5 + GEO granule covers it"))
+            continue
+        try:
+            sdr_path, geo_path = source.fetch(sdr), source.fetch(geo)
+            granules = read_file(sdr_path, kinds=("cris_sdr",))
+            if len(granules) != 1:
+                raise GranuleError(sdr_path, "(file)", f"holds {len(granules)} granules; one is expected")
+            (granule,) = granules
+            files = granule_files(key, sdr_path, geo_path, sdr_meta=granule.meta)
+            score = inhomogeneity_k(np.where(granule.good[..., None], granule.radiance_lw, np.nan), satellite)
+        except BudgetExceeded as exc:
+            decisions.append(SceneDecision(key, Decision.REJECTED, str(exc)))
+            break
+        except (SourceError, DataError) as exc:
+            decisions.append(SceneDecision(key, Decision.REJECTED, f"unusable CrIS granule: {exc}"))
+            continue
+        pool.append(Candidate(key, sdr, geo, cover, score, files))
+    pool.sort(key=lambda c: -c.score_k)
+    chosen: list[Candidate] = []
+    for c in pool:
+        if not np.isfinite(c.score_k) or c.score_k < min_score_k:
+            decisions.append(
+                SceneDecision(
+                    c.key,
+                    Decision.REJECTED,
+                    f"too homogeneous ({c.score_k:.2f} K < {min_score_k} K)",
+                    c.score_k,
+                )
+            )
+        elif len(chosen) >= keep:
+            decisions.append(
+                SceneDecision(
+                    c.key, Decision.REJECTED, f"the {keep} more inhomogeneous granules were kept", c.score_k
+                )
+            )
+        else:
+            chosen.append(c)
+            decisions.append(
+                SceneDecision(
+                    c.key, Decision.CHOSEN, f"inhomogeneity {c.score_k:.2f} K, rank {len(chosen)}", c.score_k
+                )
+            )
+    chosen.sort(key=lambda c: c.geo.parsed.start)
+    return chosen, decisions

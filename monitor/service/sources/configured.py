@@ -1,0 +1,21 @@
+"""The source a configuration names (``source.kind``): the one place that knows every kind."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from monitor.config.model import Config
+from monitor.service.sources import Source
+from monitor.service.sources.local import LocalSource, SimulatedSource
+from monitor.service.sources.nodd import NoddSource
+
+
+def make_source(cfg: Config) -> Source:
+    """The source named by the configuration's ``source.kind``."""
+    kind = cfg.source.kind
+    if kind == "local":
+        assert cfg.source.path is not None, "the configuration requires a path for a local source"
+        return LocalSource(cfg.source.path)
+    if kind == "simulated":
+        return SimulatedSource(cfg.state_dir / "simulated", cfg.source)
+    return NoddSource(cfg.source, Path(cfg.cache_dir))

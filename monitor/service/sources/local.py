@@ -1,0 +1,111 @@
+"""Local sources: a directory tree of granule files, and the simulator writing such a tree."""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+import os
+import shutil
+import time
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+from monitor.config.model import CalibrationDifference, SourceConfig
+from monitor.sdr.products import CRIS_PRODUCTS
+from monitor.service.sources import ListedFile, listed, on_day
+
+LOG = logging.getLogger("monitor.sources.local")  # the name journal filters know, kept
+IN_USE_S = 600.0  # a simulated day listed this recently may still be read by a run
+
+
+class LocalSource:
+    """Granule files anywhere below *root*; fetching returns the file itself (nothing is downloaded)."""
+
+    spent_bytes = 0
+    downloaded_files = 0
+    requests = 0
+
+    def __init__(self, root: str | Path) -> None:
+        self.root = Path(root)
+        self.should_stop: Callable[[], bool] | None = None
+
+    def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
+        """The granule files of *satellite* on *day* (and VIIRS of the days around it) whose product is in
+        *products*."""
+        if not self.root.is_dir():
+            raise FileNotFoundError(f"source.path {self.root}: no such directory")
+        out = []
+        for p in sorted(self.root.rglob("*.h5")):
+            f = listed(p.name, p.stat().st_size, str(p))
+            if (
+                f is not None
+                and f.parsed.platform == satellite
+                and f.product in products
+                and abs((f.parsed.start.date() - day).days) <= 1
+            ):
+                out.append(f)
+        return [f for f in out if on_day(f, day) or f.product not in CRIS_PRODUCTS]
+
+    def fetch(self, f: ListedFile) -> Path:
+        """The file itself: a local tree needs no download."""
+        return Path(f.location)
+
+    def start_day(self, should_stop: Callable[[], bool] | None = None) -> None:
+        """Nothing to reset for a local tree; the run's *should_stop* is kept for a simulation."""
+        self.should_stop = should_stop
+
+
+class SimulatedSource(LocalSource):
+    """The offline default: each satellite-day is simulated once (paper error profile) into *root*; the
+    ``source.retention_days`` most recently listed days are kept, and any listed in the last
+    :data:`IN_USE_S` (a run elsewhere, e.g. another reprocessing worker, may still read it): a catch-up of
+    months would otherwise fill the disk, ~0.2 GB a day."""
+
+    def __init__(self, root: str | Path, source_cfg: SourceConfig) -> None:
+        super().__init__(root)
+        self.cfg = source_cfg
+
+    def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
+        """Simulate the satellite-day once (into ``root/<satellite>/<day>``), then list it. A stop requested
+        during the simulation ends it within a granule's step; a stop or a failure (a full disk) leaves no
+        half-simulated day."""
+        from monitor.simulate.case import simulate_case
+
+        target = self.root / satellite / day.isoformat()
+        if (target / "truth.json").exists():
+            os.utime(target)  # listed now: in use
+        else:
+            LOG.info(
+                "simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target
+            )
+            difference = self.cfg.calibration.get(satellite) or CalibrationDifference()
+            try:
+                simulate_case(
+                    target,
+                    satellite=satellite,
+                    granules=self.cfg.granules,
+                    profile=self.cfg.profile,
+                    seed=self.cfg.seed + day.toordinal() % 1000,
+                    start=dt.datetime(day.year, day.month, day.day, 12, 0, tzinfo=dt.timezone.utc),
+                    cris_bias_k=difference.bias_k,
+                    cris_gain=difference.gain,
+                    cris_nonlinear_k=difference.nonlinear_k,
+                    should_stop=self.should_stop,
+                )
+            except (
+                BaseException
+            ):  # stopped or out of room: a day half simulated is no day (and frees the room)
+                shutil.rmtree(target, ignore_errors=True)
+                raise
+        self.root.mkdir(parents=True, exist_ok=True)
+        self._forget_old_days(keep=target)
+        return LocalSource(target).list_day(satellite, day, products)
+
+    def _forget_old_days(self, keep: Path) -> None:
+        days = sorted(
+            (d for d in self.root.glob("*/*") if d.is_dir() and d != keep), key=lambda d: d.stat().st_mtime
+        )
+        recent = time.time() - IN_USE_S
+        for d in days[: max(0, len(days) + 1 - max(self.cfg.retention_days, 1))]:
+            if d.stat().st_mtime < recent:
+                shutil.rmtree(d, ignore_errors=True)

@@ -1,0 +1,227 @@
+"""``crisgeo status`` as data: per satellite the last run, the latest per-FOR offsets and the alerts
+firing (with the silence that quiets each); whether a daemon holds the state directory, and its next run;
+the outbox; and the Nagios state of it all (0 OK, 1 WARNING, 2 CRITICAL, 3 UNKNOWN).
+
+The state is what the alerts say, silenced or not: a silence quiets the notifications, as a Nagios
+acknowledgement or an Alertmanager silence does, and is shown beside the state, never folded into it.
+The Nagios line (:meth:`Status.nagios_line`) follows the plugin convention: ``STATE - reason | perfdata``.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import asdict, dataclass
+from enum import IntEnum
+
+from monitor.config.model import Config
+from monitor.core.records import Run, Silence
+from monitor.core.result import ForOffset
+from monitor.core.tables import BRIEF, for_table
+from monitor.core.vocabulary import Rule, RunStatus, Severity
+from monitor.service.lock import holder
+from monitor.service.store.alerts import AlertState
+from monitor.service.store.sqlite import Store
+
+
+class NagiosState(IntEnum):
+    """The Nagios plugin states; the value is the exit status."""
+
+    OK = 0
+    WARNING = 1
+    CRITICAL = 2
+    UNKNOWN = 3
+
+
+@dataclass(frozen=True)
+class FiringAlert:
+    """An alert firing now, and the silence in force over it (None: it notifies)."""
+
+    rule: str
+    severity: str
+    summary: str
+    started: str
+    silence: Silence | None = None
+
+    def silenced_text(self) -> str:
+        """`` (silenced until ...: reason)``, or nothing."""
+        if self.silence is None:
+            return ""
+        why = f": {self.silence.reason}" if self.silence.reason else ""
+        return f" (silenced until {self.silence.until}{why})"
+
+
+@dataclass(frozen=True)
+class SatelliteStatus:
+    """One satellite: its last run, its latest assessed day and that day's FORs, its alerts firing."""
+
+    satellite: str
+    last_run: Run | None
+    latest_day: dt.date | None
+    fors: tuple[ForOffset, ...]
+    alerts: tuple[FiringAlert, ...]
+    spec_km: float
+
+    @property
+    def beyond_spec(self) -> tuple[ForOffset, ...]:
+        """The latest day's FORs beyond the specification (the one rule of :mod:`monitor.core.result`)."""
+        return tuple(f for f in self.fors if f.spec_breaches(self.spec_km))
+
+    @property
+    def worst_km(self) -> float | None:
+        """The largest in-track or cross-track error (km) of the latest day's reliable FORs."""
+        errors = [abs(v) for f in self.fors if f.reliable for v in (f.in_track_km, f.cross_track_km)]
+        errors = [v for v in errors if v == v]
+        return max(errors) if errors else None
+
+    def reasons(self) -> list[str]:
+        """What makes the state, one phrase each: the failed last run, each alert firing (silences
+        named), or the latest day's standing when all is well."""
+        out = []
+        if self.last_run is not None and self.last_run.status == RunStatus.FAILED:
+            out.append(f"{self.satellite}: run of {self.last_run.day} failed: {self.last_run.reason or '?'}")
+        for a in self.alerts:
+            if a.rule == Rule.SPEC and self.beyond_spec:
+                text = (
+                    f"{self.satellite}: {len(self.beyond_spec)} FOR(s) beyond {self.spec_km:g} km "
+                    f"(worst {self.worst_km:.2f} km)"
+                )
+            else:
+                text = a.summary
+            out.append(f"{text}{a.silenced_text()}")
+        return out
+
+    def perfdata(self) -> list[str]:
+        """Nagios performance data: FORs beyond the specification and the worst error (km), with the
+        specification as the warning and critical thresholds."""
+        if self.latest_day is None:
+            return []
+        out = [f"{self.satellite}_fors_beyond_spec={len(self.beyond_spec)};;1;0;{len(self.fors)}"]
+        if self.worst_km is not None:
+            out.append(f"{self.satellite}_worst_km={self.worst_km:.3f};{self.spec_km:g};{self.spec_km:g};0")
+        return out
+
+
+@dataclass(frozen=True)
+class Status:
+    """What ``crisgeo status`` shows: every chosen satellite, the daemon holding the state directory (its
+    pid, None when none runs) and its next run (UTC), the outbox size, and the Nagios state."""
+
+    state: NagiosState
+    satellites: tuple[SatelliteStatus, ...]
+    daemon_pid: int | None
+    next_run_utc: dt.datetime | None
+    outbox: int
+
+    def nagios_line(self) -> str:
+        """``STATE - reasons | perfdata``: the first line a Nagios plugin prints."""
+        reasons = [r for s in self.satellites for r in s.reasons()]
+        if not reasons:
+            reasons = [
+                f"{s.satellite}: {s.latest_day or 'no day yet'}"
+                + (f", worst {s.worst_km:.2f} km" if s.worst_km is not None else "")
+                for s in self.satellites
+            ]
+        perf = " ".join(p for s in self.satellites for p in s.perfdata())
+        return f"{self.state.name} - {'; '.join(reasons)}" + (f" | {perf}" if perf else "")
+
+    def text(self) -> str:
+        """What ``crisgeo status`` prints: the Nagios line first (state, reasons, perfdata), then per
+        satellite its last run, its alerts (silences named) and its latest FORs, the daemon, the outbox."""
+        lines = [self.nagios_line()]
+        for s in self.satellites:
+            r = s.last_run
+            lines.append(
+                f"{s.satellite}: no run yet"
+                if r is None
+                else f"{s.satellite}: last run {r.day} {r.status} (finished {r.finished or '-'})"
+                + (f": {r.reason}" if r.reason else "")
+            )
+            lines += [
+                f"  {a.severity} {a.rule}: {a.summary} (since {a.started})" + a.silenced_text()
+                for a in s.alerts
+            ]
+            if s.latest_day:
+                lines.append(f"  latest results: {s.latest_day}")
+                lines += for_table(list(s.fors), BRIEF, indent="  ")
+        if self.next_run_utc is None:
+            lines.append("daemon: not running on this state directory (no run scheduled)")
+        else:
+            lines.append(
+                f"daemon: pid {self.daemon_pid}, next scheduled run {self.next_run_utc:%Y-%m-%d %H:%M} UTC"
+            )
+        lines.append(f"outbox: {self.outbox} point(s) waiting")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The JSON of ``crisgeo status --json``."""
+        return {
+            "state": self.state.name,
+            "exit": int(self.state),
+            "summary": self.nagios_line(),
+            "satellites": {
+                s.satellite: {
+                    "last_run": None
+                    if s.last_run is None
+                    else {k: getattr(s.last_run, k) for k in ("day", "status", "finished", "reason")},
+                    "latest_day": None if s.latest_day is None else s.latest_day.isoformat(),
+                    "fors": [f.to_dict() for f in s.fors],
+                    "fors_beyond_spec": [f.for_index for f in s.beyond_spec],
+                    "alerts": [
+                        {
+                            "rule": a.rule,
+                            "severity": a.severity,
+                            "summary": a.summary,
+                            "started": a.started,
+                            "silence": None if a.silence is None else asdict(a.silence),
+                        }
+                        for a in s.alerts
+                    ],
+                }
+                for s in self.satellites
+            },
+            "daemon_pid": self.daemon_pid,
+            "next_run_utc": None if self.next_run_utc is None else f"{self.next_run_utc:%Y-%m-%dT%H:%MZ}",
+            "outbox": self.outbox,
+        }
+
+
+def status_report(
+    cfg: Config, store: Store, satellites: list[str] | None = None, now: dt.datetime | None = None
+) -> Status:
+    """The :class:`Status` of *satellites* (default: the configured ones) at *now*."""
+    now = now or dt.datetime.now(dt.timezone.utc)
+    runs = {r.satellite: r for r in store.last_runs()}
+    chosen = list(satellites or cfg.satellites)
+    state = AlertState(store)
+    firing = [a for a in state.firing() if a.satellite in chosen or a.satellite is None]
+    sats = []
+    for sat in chosen:
+        day = store.latest_day(sat)
+        alerts = tuple(
+            FiringAlert(
+                a.rule, a.severity or "", a.summary or "", a.started or "", state.silenced(a.rule, sat, now)
+            )
+            for a in firing
+            if a.satellite == sat
+        )
+        sats.append(
+            SatelliteStatus(
+                sat,
+                runs.get(sat),
+                day,
+                () if day is None else tuple(store.day_result(sat, day)),
+                alerts,
+                cfg.alerts.spec_km,
+            )
+        )
+    critical = any(a.severity == Severity.CRITICAL for a in firing) or any(
+        s.last_run is not None and s.last_run.status == RunStatus.FAILED for s in sats
+    )
+    daemon = holder(cfg.state_dir, "daemon")
+    return Status(
+        NagiosState.CRITICAL if critical else NagiosState.WARNING if firing else NagiosState.OK,
+        tuple(sats),
+        daemon,
+        None if daemon is None else cfg.schedule.next_run(now),
+        store.outbox_size(),
+    )

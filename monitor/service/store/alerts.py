@@ -1,0 +1,186 @@
+"""Alert state, silences and the delivery queue: the alert tables of the store (created by its migrations)."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import sqlite3
+from contextlib import AbstractContextManager
+from typing import Any, Protocol
+
+from monitor.core.records import Alert, Delivery, FindingRecord, Silence, iso
+from monitor.core.vocabulary import AlertStatus, DeliveryStatus
+
+
+class Database(Protocol):
+    """What the alert tables need of the store (:class:`monitor.service.store.sqlite.Store`): its connection
+    and
+    its transactions. Typed so, this module and the store's do not import each other."""
+
+    db: sqlite3.Connection
+
+    def transaction(self) -> AbstractContextManager[Any]: ...
+
+
+class AlertState:
+    """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries."""
+
+    def __init__(self, store: Database):
+        self.store = store
+        self.db = store.db
+
+    def get(self, fingerprint: str) -> Alert | None:
+        """The alert row of *fingerprint* (rule:satellite:group), or None."""
+        r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
+        return Alert.from_row(r) if r else None
+
+    def firing(self, satellite: str | None = None) -> list[Alert]:
+        """The alerts firing now (of *satellite*)."""
+        q = "SELECT * FROM alert_state WHERE status=?" + (" AND satellite=?" if satellite else "")
+        args = (AlertStatus.FIRING, satellite) if satellite else (AlertStatus.FIRING,)
+        return [Alert.from_row(r) for r in self.db.execute(q, args)]
+
+    def all(self) -> list[Alert]:
+        """Every alert, firing or resolved."""
+        q = "SELECT * FROM alert_state ORDER BY satellite, rule, grp"
+        return [Alert.from_row(r) for r in self.db.execute(q)]
+
+    def upsert(self, finding: FindingRecord, now: dt.datetime, notified: bool) -> None:
+        """Record *finding* as firing (keeping its start while it fires); *notified* stamps the notification
+        time."""
+        prev = self.get(finding.fingerprint)
+        started = prev.started if prev and prev.status == AlertStatus.FIRING else iso(now)
+        last = iso(now) if notified else (prev.last_notified if prev else None)
+        self.db.execute(
+            "INSERT OR REPLACE INTO alert_state VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (
+                finding.fingerprint,
+                finding.rule,
+                finding.satellite,
+                finding.group,
+                finding.severity,
+                AlertStatus.FIRING,
+                started,
+                last,
+                None,
+                finding.summary,
+                json.dumps(finding.lines),
+            ),
+        )
+
+    def resolve(self, fingerprint: str, now: dt.datetime) -> None:
+        """Mark an alert resolved at *now*."""
+        self.db.execute(
+            "UPDATE alert_state SET status=?, resolved=? WHERE fingerprint=?",
+            (AlertStatus.RESOLVED, iso(now), fingerprint),
+        )
+
+    # -- silences
+    def silence(
+        self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime
+    ) -> None:
+        """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason."""
+        with self.store.transaction():
+            self.db.execute(
+                "INSERT INTO silences (rule, satellite, until, reason, created) VALUES (?, ?, ?, ?, ?)",
+                (rule, satellite, iso(until), reason, iso(now)),
+            )
+
+    def lift(self, silence_id: int, now: dt.datetime) -> bool:
+        """End the silence *silence_id* now (kept, as history); False if no such silence is in force."""
+        with self.store.transaction():
+            cur = self.db.execute(
+                "UPDATE silences SET until=? WHERE id=? AND until > ?", (iso(now), silence_id, iso(now))
+            )
+        return cur.rowcount == 1
+
+    def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None:
+        """The silence in force for *rule* and *satellite* at *now*, or None."""
+        r = self.db.execute(
+            "SELECT * FROM silences WHERE until > ? AND (rule IS NULL OR rule=?) "
+            "AND (satellite IS NULL OR satellite=?) ORDER BY until DESC",
+            (iso(now), rule, satellite),
+        ).fetchone()
+        return Silence.from_row(r) if r else None
+
+    def silences(self, now: dt.datetime) -> list[Silence]:
+        """The silences in force at *now*."""
+        return [
+            Silence.from_row(r)
+            for r in self.db.execute("SELECT * FROM silences WHERE until > ? ORDER BY until", (iso(now),))
+        ]
+
+    # -- delivery queue
+    def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime) -> None:
+        """Queue *message* (subject, text, ...) for delivery on *channel*."""
+        self.db.execute(
+            "INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
+            "VALUES (?, ?, ?, ?, ?, ?, ?)",
+            (
+                channel,
+                satellite,
+                message["subject"],
+                json.dumps(message),
+                iso(now),
+                DeliveryStatus.PENDING,
+                iso(now),
+            ),
+        )
+
+    def due(self, now: dt.datetime) -> list[Delivery]:
+        """Deliveries to try now: pending ones whose time has come, and claims whose lease ran out (a
+        sender that died mid-send)."""
+        return [
+            Delivery.from_row(r)
+            for r in self.db.execute(
+                "SELECT * FROM deliveries WHERE status IN (?, ?) AND next_attempt <= ? ORDER BY id",
+                (DeliveryStatus.PENDING, DeliveryStatus.SENDING, iso(now)),
+            )
+        ]
+
+    def claim(self, delivery_id: int, now: dt.datetime, lease_s: float = 600.0) -> bool:
+        """Take a due delivery for sending, atomically: False when another sender has it (no double send).
+
+        The claim holds for *lease_s*; a sender that dies leaves it to be tried again after that.
+        """
+        with self.store.transaction():
+            cur = self.db.execute(
+                "UPDATE deliveries SET status=?, next_attempt=? "
+                "WHERE id=? AND status IN (?, ?) AND next_attempt <= ?",
+                (
+                    DeliveryStatus.SENDING,
+                    iso(now + dt.timedelta(seconds=lease_s)),
+                    delivery_id,
+                    DeliveryStatus.PENDING,
+                    DeliveryStatus.SENDING,
+                    iso(now),
+                ),
+            )
+            return cur.rowcount == 1
+
+    def deliveries(self, status: DeliveryStatus | None = None) -> list[Delivery]:
+        """The queued deliveries (with *status*: pending, sending, sent, failed), oldest first."""
+        q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"
+        return [Delivery.from_row(r) for r in self.db.execute(q, (status,) if status else ())]
+
+    def mark(
+        self,
+        delivery_id: int,
+        status: DeliveryStatus,
+        now: dt.datetime,
+        error: str | None = None,
+        retry_after_s: float = 0.0,
+    ) -> None:
+        """Record a delivery attempt's *status*; a retry waits *retry_after_s*."""
+        with self.store.transaction():
+            self.db.execute(
+                "UPDATE deliveries SET status=?, attempts=attempts+1, last_error=?, next_attempt=?, sent=? "
+                "WHERE id=?",
+                (
+                    status,
+                    error,
+                    iso(now + dt.timedelta(seconds=retry_after_s)),
+                    iso(now) if status == DeliveryStatus.SENT else None,
+                    delivery_id,
+                ),
+            )

@@ -1,0 +1,197 @@
+"""Publishing per-FOR results to a time-series database, through the SQLite outbox.
+
+Measurement ``cris_geolocation`` (configurable), one point per satellite, day and FOR, time = the day at
+00:00 UTC, precision seconds.
+
+* tags: ``satellite`` (npp, j01, j02) and ``for`` (01..30)
+* float fields: d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_urad, in_track_km,
+  cross_track_km, total_km, cost_min_k, cost_zero_k, and the CrIS-VIIRS intercalibration at the optimum:
+  bias_k, sigma_bias_k, gain_pct, sigma_gain_pct, curvature_k, sigma_curvature_k
+* integer field: n_samples; boolean field: reliable
+
+Known changes (calendar, metadata, fingerprint) go to ``cris_geolocation_change`` (see :func:`change_lines`),
+re-sent after every run, for the dashboards' annotations.
+
+A field's type never changes (InfluxDB 1.x rejects a type change), and a non-finite value is left out of
+its point rather than written (InfluxDB rejects NaN; VictoriaMetrics would store garbage). Points are
+queued in the store's outbox in the same transaction as the day's results and deleted only once the
+server has accepted them: a server that is down gets them at the next drain, none is lost or sent twice.
+
+Two writers: ``influx2`` uses influxdb-client's v2 write API (InfluxDB 2.x/3.x, 1.8+, VictoriaMetrics);
+``influx1`` posts line protocol to ``/write`` (InfluxDB 1.x before 1.8, where /api/v2/write is missing).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import logging
+import math
+from collections.abc import Iterable
+
+import requests
+from influxdb_client import InfluxDBClient, Point, WritePrecision
+from influxdb_client.client.exceptions import InfluxDBError
+from influxdb_client.client.write_api import SYNCHRONOUS
+
+from monitor.config.model import PublishConfig
+from monitor.core.changes import Change
+from monitor.core.result import MEASURED_FIELDS, ForOffset
+from monitor.service.store.sqlite import Store
+
+LOG = logging.getLogger("monitor.store.timeseries")  # the name journal filters know, kept
+# the published float fields: the measured ones but the sample count (an integer field) and the sigmas in km
+FLOAT_FIELDS = tuple(
+    f for f in MEASURED_FIELDS if f not in ("n_samples", "sigma_in_track_km", "sigma_cross_track_km")
+)
+
+
+class PublishError(RuntimeError):
+    """The time-series server did not accept a batch; the points stay in the outbox."""
+
+
+def result_lines(measurement: str, satellite: str, day: dt.date, fors: Iterable[ForOffset]) -> list[str]:
+    """Line-protocol points of one day's per-FOR results."""
+    when = dt.datetime(day.year, day.month, day.day, tzinfo=dt.timezone.utc)
+    lines = []
+    for f in fors:
+        p = Point(measurement).tag("satellite", satellite).tag("for", f"{f.for_index:02d}")
+        for name in FLOAT_FIELDS:
+            value = getattr(f, name)
+            if value is not None and math.isfinite(value):
+                p = p.field(name, float(value))
+        p = p.field("n_samples", int(f.n_samples)).field("reliable", bool(f.reliable))
+        lines.append(p.time(when, WritePrecision.S).to_line_protocol())
+    return lines
+
+
+def change_lines(measurement: str, changes: Iterable[Change]) -> list[str]:
+    """Line-protocol points of known changes (measurement ``<measurement>_change``, for dashboard
+    annotations).
+
+    Tags satellite, instrument, kind, origin; string field ``description``; time = the change time. The
+    same change written again overwrites its point (same measurement, tags and time).
+    """
+    lines = []
+    for c in changes:
+        p = (
+            Point(f"{measurement}_change")
+            .tag("satellite", c.satellite)
+            .tag("instrument", c.instrument)
+            .tag("kind", c.kind)
+            .tag("origin", c.origin)
+            .field("description", c.description)
+        )
+        lines.append(p.time(c.time, WritePrecision.S).to_line_protocol())
+    return lines
+
+
+def target_name(cfg: PublishConfig) -> str:
+    """Outbox target of a publisher (kind and URL; never a credential)."""
+    return f"{cfg.kind}:{cfg.url}"
+
+
+class Influx2Writer:
+    """v2 write API through influxdb-client, synchronous so that every failure is seen."""
+
+    def __init__(self, cfg: PublishConfig):
+        self.cfg = cfg
+        self.client = InfluxDBClient(
+            url=cfg.url, token=cfg.secret("token_env") or "", org=cfg.org, timeout=int(cfg.timeout_s * 1000)
+        )
+        self.api = self.client.write_api(write_options=SYNCHRONOUS)
+
+    def write(self, lines: list[str]) -> None:
+        """Write line-protocol *lines*; raises on any failure (the outbox keeps them)."""
+        try:
+            self.api.write(
+                bucket=self.cfg.bucket,
+                org=self.cfg.org,
+                record=lines,
+                write_precision=WritePrecision.S,  # type: ignore[arg-type]
+            )
+        except InfluxDBError as exc:
+            raise PublishError(
+                f"{self.cfg.url}: HTTP {getattr(exc, 'status', '?')} {getattr(exc, 'message', exc)}"
+            ) from None
+        except Exception as exc:  # urllib3 raises its own errors when the server is unreachable
+            raise PublishError(f"{self.cfg.url}: {type(exc).__name__}: {exc}") from None
+
+    def close(self) -> None:
+        """Close the client."""
+        self.client.close()
+
+
+class Influx1Writer:
+    """InfluxDB 1.x ``/write`` with line protocol; creates the database once if it is missing."""
+
+    def __init__(self, cfg: PublishConfig):
+        self.cfg = cfg
+        user, password = cfg.secret("username_env"), cfg.secret("password_env")
+        self.auth = (user, password or "") if user else None
+
+    def _post(self, lines: list[str]) -> requests.Response:
+        return requests.post(
+            f"{self.cfg.url}/write",
+            params={"db": self.cfg.database, "precision": "s"},
+            data="\n".join(lines).encode(),
+            auth=self.auth,
+            timeout=self.cfg.timeout_s,
+        )
+
+    def write(self, lines: list[str]) -> None:
+        """POST line-protocol *lines* to /write; raises on any failure (the outbox keeps them)."""
+        try:
+            r = self._post(lines)
+            if r.status_code == 404 and "database not found" in r.text:
+                requests.post(
+                    f"{self.cfg.url}/query",
+                    data={"q": f'CREATE DATABASE "{self.cfg.database}"'},
+                    auth=self.auth,
+                    timeout=self.cfg.timeout_s,
+                ).raise_for_status()
+                r = self._post(lines)
+        except requests.RequestException as exc:
+            raise PublishError(f"{self.cfg.url}: {type(exc).__name__}") from None
+        if r.status_code != 204:
+            raise PublishError(f"{self.cfg.url}: HTTP {r.status_code} {r.text[:200]}")
+
+    def close(self) -> None:
+        """Close the session."""
+        pass
+
+
+WRITERS: dict[str, type[Influx2Writer] | type[Influx1Writer]] = {
+    "influx2": Influx2Writer,
+    "influx1": Influx1Writer,
+}
+
+
+def drain_outbox(store: Store, publish_cfgs: list[PublishConfig], batch: int = 5000) -> dict:
+    """Send every queued point to its server; returns {target: (sent, left)}. Never raises for a server."""
+    report = {}
+    for cfg in publish_cfgs:
+        target = target_name(cfg)
+        writer: Influx2Writer | Influx1Writer = WRITERS[cfg.kind](cfg)
+        sent = 0
+        try:
+            while True:
+                rows = store.outbox(target, batch)
+                if not rows:
+                    break
+                try:
+                    writer.write([r["line"] for r in rows])
+                except PublishError as exc:
+                    store.outbox_failed([r["id"] for r in rows], str(exc))
+                    LOG.warning(
+                        "publishing to %s failed, %d points wait in the outbox: %s",
+                        target,
+                        store.outbox_size(target),
+                        exc,
+                    )
+                    break
+                store.outbox_delivered([r["id"] for r in rows])
+                sent += len(rows)
+        finally:
+            writer.close()
+        report[target] = (sent, store.outbox_size(target))
+    return report

@@ -1,0 +1,256 @@
+import json
+
+import pytest
+
+from monitor.cli import main
+from monitor.simulate.case import simulate_case
+from tests.conftest import tree_with_truncated
+from tests.invoke import run_crisgeo
+
+
+def test_assess_writes_the_contract_json(cases, tmp_path, capsys):
+    out, _, _ = cases.get()
+    res = tmp_path / "r.json"
+    assert main(["assess", str(out), "--out", str(res)]) == 0
+    table = capsys.readouterr().out
+    assert "FOR" in table and "d_beta" in table
+    doc = json.loads(res.read_text())
+    assert doc["satellite"] == "j01" and len(doc["fors"]) == 30 and len(doc["granules"]) == 2
+    keys = {
+        "for",
+        "d_alpha_urad",
+        "d_beta_urad",
+        "sigma_alpha_urad",
+        "sigma_beta_urad",
+        "in_track_km",
+        "cross_track_km",
+        "total_km",
+        "n_samples",
+        "cost_min_k",
+        "cost_zero_k",
+        "flags",
+    }
+    assert keys <= set(doc["fors"][0])
+    assert doc["start"] < doc["end"]
+
+
+def test_missing_path_is_exit_2_with_one_line(tmp_path, capsys):
+    assert main(["assess", str(tmp_path / "nope")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no such file" in err[0]
+
+
+def test_only_corrupt_files_is_exit_2(tmp_path, capsys):
+    (tmp_path / "GCRSO_j01_d20181022_t0023599_e0024297_b04790_c20181022005852745013_noac_ops.h5").write_text(
+        "x"
+    )
+    assert main(["assess", str(tmp_path)]) == 2
+    assert "not a readable HDF5 file" in capsys.readouterr().err
+
+
+def test_mixed_satellites_is_exit_2(real_geo_files, tmp_path, capsys):
+    simulate_case(tmp_path / "npp", satellite="npp", granules=1, profile="zero", viirs=False)
+    assert main(["assess", str(real_geo_files[0]), str(tmp_path / "npp")]) == 2
+    assert "mixed satellites" in capsys.readouterr().err
+
+
+def test_cris_without_viirs_in_time_is_exit_2(tmp_path, capsys):
+    simulate_case(tmp_path, granules=1, profile="zero", viirs=False)
+    assert main(["assess", str(tmp_path)]) == 2
+    assert "no VIIRS I5 granule covers" in capsys.readouterr().err
+
+
+def test_corrupt_granule_is_skipped_and_recorded(cases, tmp_path, capsys):
+    out, _, _ = cases.get()
+    geo = sorted(out.glob("GCRSO_*.h5"))[1]
+    work = tree_with_truncated(out, tmp_path / "case", geo)
+    res = tmp_path / "r.json"
+    assert main(["assess", str(work), "--out", str(res)]) == 0
+    doc = json.loads(res.read_text())
+    assert len(doc["granules"]) == 1
+    reasons = " ".join(s["reason"] for s in doc["skipped"])
+    assert geo.name in " ".join(s["item"] for s in doc["skipped"]) and "HDF5" in reasons
+    assert "skipped" in capsys.readouterr().out
+
+
+def test_simulate_cli_rejects_bad_profile(tmp_path, capsys):
+    assert main(["simulate", "--out", str(tmp_path), "--profile", "nonsense", "--granules", "1"]) == 2
+    assert "profile" in capsys.readouterr().err
+
+
+def test_bench_prints_every_stage_and_the_assessment_memory():
+    """`crisgeo bench` on a one-granule simulated case, in its own process so its memory is its own."""
+    import re
+
+    run = run_crisgeo("bench", "--granules", "1", "--workers", "1", "--kernel", "top-hat")
+    assert run.returncode == 0, run.stderr
+    out = run.stdout
+    assert "case: 1 CrIS granules, 1080 FOVs x 441 perturbations, cost regression, kernel top-hat" in out
+    for stage in ("read", "geometry", "spectral", "collocation", "cost", "total"):
+        secs, rate = re.search(rf"^  {stage} +([0-9.]+) s +([0-9.]+|inf) FOVs/s", out, re.M).groups()
+        assert float(secs) > 0 or stage in ("spectral", "cost")
+    peak = float(re.search(r"^peak memory: ([0-9]+) MB \(1 threads in one process\)$", out, re.M).group(1))
+    assert 100 < peak < 3000
+    assert "includes the simulation" not in out  # Linux resets the count after simulating
+
+
+def test_version_and_verbose_after_the_subcommand(capsys):
+
+    r = run_crisgeo("--version")
+    assert r.returncode == 0 and r.stdout.startswith("crisgeo ")
+    from monitor.cli import build_parser
+
+    args = build_parser().parse_args(["status", "-v", "--config", "x.yaml"])
+    assert args.verbose is True and args.command == "status"
+    assert build_parser().parse_args(["-v", "status"]).verbose is True
+    assert build_parser().parse_args(["status"]).verbose is False
+
+
+def _status_config(tmp_path):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+    )
+    return cfg
+
+
+def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
+    import datetime as dt
+
+    from alerts.rules import Finding
+    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.sqlite import Store
+
+    cfg = _status_config(tmp_path)
+    monkeypatch.setenv("CRISGEO_CONFIG", str(cfg))  # the default when --config is not given
+    assert main(["status", "--json"]) == 3  # no store yet (the daemon makes it): UNKNOWN, and none made
+    assert "no crisgeo store here yet" in json.loads(capsys.readouterr().out)["error"]
+    assert not (tmp_path / "state" / "crisgeo.sqlite").exists()
+    store = Store(tmp_path / "state" / "crisgeo.sqlite")
+    assert main(["status", "--json", "--satellite", "j01"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["state"] == "OK" and doc["satellites"]["j01"]["last_run"] is None and doc["outbox"] == 0
+    now = dt.datetime.now(dt.timezone.utc)
+    AlertState(store).upsert(Finding("jump", "j01", "warning", "a step at FOR 21-30"), now, True)
+    assert main(["status", "--json"]) == 1 and json.loads(capsys.readouterr().out)["state"] == "WARNING"
+    assert main(["alerts", "list", "--json"]) == 0
+    (alert,) = json.loads(capsys.readouterr().out)["alerts"]
+    assert (alert["status"], alert["rule"], alert["satellite"], alert["severity"]) == (
+        "firing",
+        "jump",
+        "j01",
+        "warning",
+    )
+    assert (
+        main(
+            [
+                "alerts",
+                "silence",
+                "--rule",
+                "jump",
+                "--until",
+                (now + dt.timedelta(hours=2)).isoformat(),
+                "--reason",
+                "known step",
+            ]
+        )
+        == 0
+    )
+    capsys.readouterr()
+    assert main(["alerts", "list", "--json"]) == 0
+    view = json.loads(capsys.readouterr().out)
+    assert view["alerts"][0]["status"] == "silenced" and view["silences"][0]["reason"] == "known step"
+    assert main(["alerts"]) == 0 and "silenced  warning" in capsys.readouterr().out
+    silence_id = view["silences"][0]["id"]
+    assert main(["alerts", "unsilence", "--id", str(silence_id)]) == 0
+    assert f"silence {silence_id} lifted" in capsys.readouterr().out
+    assert main(["alerts", "list", "--json"]) == 0
+    view = json.loads(capsys.readouterr().out)
+    assert view["silences"] == [] and view["alerts"][0]["status"] == "firing"
+    assert main(["alerts", "unsilence", "--id", str(silence_id)]) == 2  # no longer in force
+    assert "no silence in force" in capsys.readouterr().err
+    run = store.begin_run("j01", dt.date(2024, 6, 1))
+    store.finish_run(run, "failed", "HTTP 503")
+    assert main(["status"]) == 2
+    out = capsys.readouterr().out
+    first = out.splitlines()[0]
+    assert first == "CRITICAL - j01: run of 2024-06-01 failed: HTTP 503; a step at FOR 21-30", out
+    assert "warning jump" in out
+    store.close()
+    (tmp_path / "state" / "crisgeo.sqlite").write_bytes(b"garbage" * 100)
+    assert main(["status", "--json"]) == 3 and json.loads(capsys.readouterr().out)["state"] == "UNKNOWN"
+    monkeypatch.setenv("CRISGEO_CONFIG", str(tmp_path / "missing.yaml"))
+    assert main(["status"]) == 3
+    assert capsys.readouterr().out.startswith("UNKNOWN - ") and "missing.yaml: cannot read"
+
+
+def test_run_logs_one_summary_line_per_day_in_json(cases, tmp_path):
+    import os
+
+    data, _, _ = cases.get()
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {data}}}\n"
+        f"assessment: {{workers: 2}}\n"
+    )
+    r = run_crisgeo(
+        "run",
+        "--config",
+        cfg,
+        "--date",
+        "2024-06-01",
+        "--log-format",
+        "json",
+        env={k: v for k, v in os.environ.items() if k != "JOURNAL_STREAM"},
+    )
+    assert r.returncode == 0, r.stderr
+    lines = [json.loads(line) for line in r.stderr.splitlines() if line.startswith("{")]
+    assert lines and all({"time", "level", "logger", "message"} <= set(d) for d in lines)
+    (summary,) = [d for d in lines if d["message"].startswith("run j01 2024-06-01: ok")]
+    assert summary["satellite"] == "j01" and summary["day"] == "2024-06-01" and summary["priority"] == 6
+    assert {"stage": "assess", "day": "2024-06-01"}.items() <= next(
+        d for d in lines if "assessed granules" in d["message"]
+    ).items()
+    assert all("run_id" in d for d in lines if " after " in d["message"])
+    summary = summary["message"]
+    assert "granules listed 6, selected 2, assessed 2" in summary and "reliable FORs" in summary
+    assert "worst" in summary and "stages list" in summary
+    # not on a terminal: progress as log lines, the granules as they finish
+    progress = [d["message"] for d in lines if " after " in d["message"]]
+    assert any(m.startswith("j01 2024-06-01: fetched scenes: 2/2") for m in progress), progress
+    assert any(m.startswith("j01 2024-06-01: assessed granules: 2/2") for m in progress), progress
+
+
+def test_under_systemd_lines_carry_their_priority_and_no_second_timestamp(tmp_path):
+    """The journal reads the <N> prefix as the line's priority (journalctl -p) and stamps the time."""
+    import os
+
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+    )
+    r = run_crisgeo(
+        "run", "--config", cfg, "--date", "2024-06-01", env={**os.environ, "JOURNAL_STREAM": "8:1234"}
+    )
+    assert r.returncode == 0, r.stderr
+    log = [line for line in r.stderr.splitlines() if line.strip()]
+    prefixes = ("<6>INFO", "<4>WARNING", "<3>ERROR", "<7>DEBUG")
+    assert log and all(line.split()[0] in prefixes for line in log), log
+
+
+@pytest.mark.parametrize(
+    "extra,message",
+    [
+        (
+            ["--since", "2024-03-05", "--until", "2024-03-01"],
+            "--since 2024-03-05 is after --until 2024-03-01",
+        ),
+        (["--since", "2024-03-01", "--until", "2024-03-02", "--satellite", "npp"], "'npp' is not in"),
+    ],
+)
+def test_reprocess_refuses_bad_input_in_one_line(tmp_path, capsys, extra, message):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 's'}\nsource: {{kind: simulated}}\n")
+    assert main(["reprocess", "--config", str(cfg), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0]

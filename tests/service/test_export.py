@@ -1,0 +1,205 @@
+"""Results as data: NetCDF (CF, read back with xarray) and CSV exports, and the public API."""
+
+import datetime as dt
+import json
+import re
+
+import numpy as np
+import pytest
+
+xr = pytest.importorskip("xarray")
+
+
+@pytest.fixture
+def store_with_days(tmp_path):
+    from monitor import open_store
+    from monitor.simulate.history import fill_store
+
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01, npp]\nstate_dir: {tmp_path / 'state'}\n"
+        f"source: {{kind: local, path: {tmp_path}}}\n"
+    )
+    store = open_store(tmp_path / "state" / "crisgeo.sqlite", create=True)
+    fill_store(store, ["j01"], dt.date(2025, 3, 1), 12, step_day=6, seed=3)
+    return cfg, store
+
+
+def test_netcdf_export_reads_back_with_xarray(store_with_days, tmp_path):
+    from monitor.cli import main
+
+    cfg, store = store_with_days
+    out = tmp_path / "j01.nc"
+    assert (
+        main(
+            [
+                "export",
+                "--config",
+                str(cfg),
+                "--satellite",
+                "j01",
+                "--since",
+                "2025-03-03",
+                "--until",
+                "2025-03-10",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert (
+        ds.sizes == {"time": 8, "scan_position": 30, "nv": 2} and str(ds.time.values[0])[:10] == "2025-03-03"
+    )
+    day = dt.date(2025, 3, 5)
+    want = {f.for_index: f for f in store.day_result("j01", day)}
+    got = ds.sel(time=np.datetime64(day, "ns"))
+    assert got.d_beta_urad.sel(scan_position=21).item() == pytest.approx(want[21].d_beta_urad)
+    assert got.n_samples.sel(scan_position=7).item() == want[7].n_samples
+    assert ds.sel(scan_position=1).total_km.sizes == {"time": 8}
+    assert ds.d_alpha_urad.attrs["units"] == "urad" and ds.total_km.attrs["units"] == "km"
+    # the CrIS-VIIRS intercalibration at the optimum
+    assert got.bias_k.sel(scan_position=3).item() == pytest.approx(want[3].bias_k)
+    assert got.gain_pct.sel(scan_position=3).item() == pytest.approx(want[3].gain_pct)
+    assert ds.bias_k.attrs["units"] == "K" and ds.gain_pct.attrs["units"] == "percent"
+    assert np.isfinite(ds.sigma_bias_k).all() and np.isfinite(ds.sigma_gain_pct).all()
+    meanings = ds.flags.attrs["flag_meanings"].split()
+    masks = dict(zip(meanings, ds.flags.attrs["flag_masks"], strict=True))
+    bits = ds.flags.transpose("time", "scan_position").values
+    series = store.series("j01", dt.date(2025, 3, 3), dt.date(2025, 3, 10))
+    assert series.days[0] == dt.date(2025, 3, 3) and bits.shape == series.flags.shape
+    for (i, k), names in np.ndenumerate(series.flags):
+        assert bits[i, k] == sum(int(masks[f]) for f in names)
+    assert any(series.flags.ravel())  # the history has flagged FORs to check
+    assert ds.attrs["satellite"] == "j01" and "Wang et al. 2017" in ds.attrs["method"]
+    assert ds.attrs["source"].startswith("crisgeo-monitor")
+
+
+def test_csv_export_and_the_public_api(store_with_days, tmp_path):
+    import csv
+
+    import monitor
+    from monitor import AssessmentResult, assess_paths, open_store  # noqa: F401 - the public API imports
+
+    cfg, store = store_with_days
+    out = tmp_path / "j01.csv"
+    from monitor.cli import main
+
+    assert (
+        main(["export", "--config", str(cfg), "--satellite", "j01", "--format", "csv", "--out", str(out)])
+        == 0
+    )
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 12 * 30 and {"time", "scan_position", "d_alpha_urad", "flags"} <= set(rows[0])
+    ds = open_store(store.path).to_xarray("j01", since=dt.date(2025, 3, 12))
+    assert ds.sizes["time"] == 1 and callable(monitor.assess_paths)
+
+
+def test_the_netcdf_is_cf_1_8_and_acdd(store_with_days, tmp_path):
+    """The IOOS compliance checker's CF-1.8 check passes with no high- or medium-priority failure; the ACDD
+    attributes, the time axis and its bounds are there."""
+    cc = pytest.importorskip("compliance_checker.runner")
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    from monitor.service.export import export
+
+    _, store = store_with_days
+    out = export(store, "j01", tmp_path / "j01.nc", "netcdf")
+    CheckSuite.load_all_available_checkers()
+    report = tmp_path / "cf.json"
+    ok, errors = ComplianceChecker.run_checker(
+        str(out), ["cf:1.8"], verbose=0, criteria="normal", output_filename=str(report), output_format="json"
+    )
+    assert cc is not None and ok and not errors, report.read_text()[:3000]
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert ds.time.attrs["standard_name"] == "time" and ds.time.attrs["axis"] == "T"
+    assert ds.time.attrs["bounds"] == "time_bnds"
+    assert (ds.time_bnds.values[:, 1] - ds.time_bnds.values[:, 0] == np.timedelta64(1, "D")).all()
+    for key in ("title", "summary", "references", "history", "date_created", "source", "Conventions"):
+        assert ds.attrs[key], key
+    assert "doi:10.1002/2016JD025812" in ds.attrs["references"] and "ACDD-1.3" in ds.attrs["Conventions"]
+    assert ds.attrs["time_coverage_start"] == "2025-03-01T00:00:00Z"
+
+
+def _publisher_config(tmp_path):
+    cfg = tmp_path / "p.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+        "export:\n  institution: NOAA STAR\n  creator_name: CrIS SDR team\n"
+        "  creator_email: cris@example.org\n  creator_url: https://example.org/cris\n  license: CC0-1.0\n"
+        "  naming_authority: gov.noaa.star\n  project: JPSS\n"
+    )
+    return cfg
+
+
+def test_acdd_1_3_leaves_only_what_does_not_apply(store_with_days, tmp_path):
+    """The compliance checker's ACDD-1.3 check, run for real: every highly recommended and recommended
+    attribute is there but the CF standard names (none exists for these quantities) and the geospatial
+    extent (the file is per scan position, not per place); the time coverage matches the time axis."""
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    from monitor.cli import main
+
+    _, store = store_with_days
+    out = tmp_path / "j01.nc"
+    assert main(["export", "--config", str(_publisher_config(tmp_path)), "--out", str(out)]) == 0
+    CheckSuite.load_all_available_checkers()
+    report = tmp_path / "acdd.json"
+    ComplianceChecker.run_checker(
+        str(out),
+        ["acdd:1.3"],
+        verbose=0,
+        criteria="lenient",
+        output_filename=str(report),
+        output_format="json",
+    )
+    doc = json.loads(report.read_text())["acdd:1.3"]
+    problems = [
+        m
+        for group in ("high_priorities", "medium_priorities")
+        for check in doc[group]
+        for m in check["msgs"]
+        if not re.search(r"standard_name|geospatial", m)
+    ]
+    assert problems == [], problems
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert all(ds[v].attrs["coverage_content_type"] for v in ds.data_vars if v != "time_bnds")
+    assert ds.attrs["institution"] == "NOAA STAR" and ds.attrs["license"] == "CC0-1.0"
+    assert ds.attrs["id"] == "crisgeo_j01_20250301_20250312" and ds.attrs["time_coverage_duration"] == "P12D"
+
+
+def test_time_is_first_and_unlimited_and_the_sign_is_stated_once(store_with_days, tmp_path):
+    import h5netcdf
+
+    from monitor.service.export import SIGN_CONVENTION, export
+
+    _, store = store_with_days
+    out = export(store, "j01", tmp_path / "j01.nc")
+    with h5netcdf.File(out, "r") as f:
+        assert f.dimensions["time"].isunlimited() and not f.dimensions["scan_position"].isunlimited()
+        assert f.variables["d_alpha_urad"].dimensions == ("time", "scan_position")
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert ds.attrs["sign_convention"] == SIGN_CONVENTION
+    named = [v for v in ds.data_vars if "sign_convention" in ds[v].attrs.get("long_name", "")]
+    assert set(named) == {"d_alpha_urad", "d_beta_urad", "in_track_km", "cross_track_km"}
+
+
+@pytest.mark.parametrize(
+    "name,fmt,message",
+    [
+        ("y.csv", "netcdf", "--out {out}: a .csv file cannot hold --format netcdf"),
+        ("y.dat", None, "--out {out}: name it .nc or .csv, or give --format"),
+    ],
+)
+def test_the_format_follows_the_name_of_the_file(store_with_days, tmp_path, capsys, name, fmt, message):
+    from monitor.cli import main
+
+    cfg, _ = store_with_days
+    out = tmp_path / name
+    argv = ["export", "--config", str(cfg), "--satellite", "j01", "--out", str(out)]
+    assert main(argv + (["--format", fmt] if fmt else [])) == 2
+    assert message.format(out=out) in capsys.readouterr().err and not out.exists()
+    csv_out = tmp_path / "z.csv"
+    assert main(["export", "--config", str(cfg), "--satellite", "j01", "--out", str(csv_out)]) == 0
+    assert csv_out.read_text().startswith("time,scan_position,")  # CSV, not NetCDF
