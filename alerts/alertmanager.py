@@ -21,7 +21,7 @@ import logging
 
 import requests
 
-from monitor.config.model import AlertSettings
+from monitor.config.alerts import AlertSettings
 from monitor.core.records import History
 
 LOG = logging.getLogger(__name__)

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import requests
 
-from monitor.config.model import AlertSettings, EmailSettings, SlackSettings, env_secret
+from monitor.config.alerts import AlertSettings, EmailSettings, SlackSettings
+from monitor.config.keys import env_secret
 
 LOG = logging.getLogger(__name__)
 

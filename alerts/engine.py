@@ -26,7 +26,7 @@ from alerts.rules import (
     spec_finding,
     stale_finding,
 )
-from monitor.config.model import AlertSettings
+from monitor.config.alerts import AlertSettings
 from monitor.core.changes import all_changes
 from monitor.core.records import Alert, History, Silence
 from monitor.core.tables import Column, text_table

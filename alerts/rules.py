@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.config.model import RuleSettings
+from monitor.config.alerts import RuleSettings
 from monitor.core.changes import preceding_change
 from monitor.core.constants import N_FOR
 from monitor.core.records import History

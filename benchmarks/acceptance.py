@@ -7,9 +7,8 @@ and seed: simulate, assess, and print per direction the RMS and the largest erro
 the bounds (14 granules: RMS <= 10 urad, every FOR within 25; 6 granules and fewer: RMS <= 12, within 30).
 
 The CrIS footprint of the truth (``--footprints``, :mod:`monitor.instrument.footprint`): the paper's top-hat
-cone, or a
-smooth response within the specification's table; ``--kernel`` the assessment's (``footprint``, the default,
-fits the response; ``top-hat`` is the paper's cone).
+cone, or a smooth response within the specification's table; ``--kernel`` the assessment's (``footprint``, the
+default, fits the response; ``top-hat`` is the paper's cone).
 
 Calibration of the reported sigma (the delete-one-granule jackknife plus the floor
 ``estimate.floor_urad``, by kernel, in quadrature): over all cases, the share of FOR-directions whose
@@ -43,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.assessment.assess import assess_paths
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
 from monitor.estimation.estimate import floor_urad
 from monitor.instrument import footprint

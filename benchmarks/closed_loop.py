@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.assessment.assess import assess_paths
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import URAD
 from monitor.core.result import AssessmentResult
 from monitor.geometry.instrument import EngineeringPacket

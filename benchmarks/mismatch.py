@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.assessment.assess import assess_paths
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import Cost, Kernel
 from monitor.simulate.case import simulate_case
 from tests.conftest import truth_arrays

@@ -5,8 +5,7 @@ Real-size simulated granules with every dataset of the real products (``Simulati
 uncompressed IDPS files; gzip with one chunk per dataset, as the real GCRSO), are put under their NODD
 keys on moto's S3 server on loopback. Each case then runs the daily job
 (:func:`monitor.service.pipeline.run_day`: list, fingerprint, select, assess, record) three times, each into
-an
-empty store: whole files into an empty cache, ranges into an empty cache, and ranges again on that
+an empty store: whole files into an empty cache, ranges into an empty cache, and ranges again on that
 cache. It prints, per run: bytes read, their share of the bytes of the files the day used, HTTP
 requests (listings included) and wall time; per product, the bytes read in place (from the block
 lists); and whether the offsets are the whole-file run's to the bit.

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.assessment.replay import assess_collocations, for_samples, read_collocation
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
 from monitor.core.vocabulary import Kernel
 from monitor.estimation import refine

@@ -17,7 +17,7 @@ import argparse
 import numpy as np
 
 from monitor.assessment.assess import _collocate_run
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan
 
 THRESHOLDS_K = (0.2, 0.5, 1.0, 2.0)

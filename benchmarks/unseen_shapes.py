@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.assessment.assess import assess_paths
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.instrument import footprint
 from monitor.simulate.case import simulate_case
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from monitor.assessment.assess import assess_paths
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.engpkt import load_ep
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from monitor.collocation import collocate, swath
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import FOV_DIAMETER_RAD, N_FOR
 from monitor.core.errors import AssessmentError, StopRequested
 from monitor.core.result import AssessmentResult, GranuleInfo, Skipped

@@ -13,7 +13,7 @@ import numpy as np
 
 from monitor.assessment.assess import assess_plan, offsets_rad
 from monitor.collocation.collocate import warm_up
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbed_los_sbf

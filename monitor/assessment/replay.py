@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR, N_FOV, URAD
 from monitor.core.errors import DataError
 from monitor.core.result import AssessmentResult, GranuleInfo

@@ -15,7 +15,8 @@ import yaml
 import yaml.events
 from pydantic import BaseModel, ValidationError
 
-from monitor.config.model import Config, ConfigError, KeyProblem, env_secret
+from monitor.config.keys import ConfigError, KeyProblem, env_secret
+from monitor.config.model import Config
 from monitor.core.vocabulary import SourceKind
 
 # -- loading

@@ -22,6 +22,7 @@ from pathlib import Path
 import yaml
 
 from monitor.core.records import History
+from monitor.core.satellites import SATELLITES
 
 UTC = dt.timezone.utc
 INSTRUMENTS = ("cris", "viirs", "common")
@@ -196,6 +197,21 @@ def all_changes(store: History, satellite: str, calendar_path: str | Path | None
     return sorted(
         cal + metadata_changes(store, satellite) + stored_changes(store, satellite), key=lambda c: c.time
     )
+
+
+def listing(
+    calendar_path: str | Path, configured: Iterable[str], only: str | None, store: History | None
+) -> list[Change]:
+    """What ``crisgeo events list`` shows: the changes of satellite *only*, else of every satellite the
+    calendar or the configuration (*configured*) names, in the satellite table's order, each in time
+    order. Before the first run (*store* None) the calendar alone; after, the metadata and recorded events
+    too."""
+    calendar = load_calendar(calendar_path)
+    known = {c.satellite for c in calendar} | set(configured)
+    chosen = [only] if only else [s for s in SATELLITES if s in known]
+    if store is None:
+        return [c for c in sorted(calendar, key=lambda c: c.time) if c.satellite in chosen]
+    return [c for sat in chosen for c in all_changes(store, sat, calendar_path)]
 
 
 def preceding_change(changes: list[Change], split_day: dt.date, window_days: int = 10) -> Change | None:

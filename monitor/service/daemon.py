@@ -29,7 +29,8 @@ from apscheduler.triggers.cron import CronTrigger
 
 from alerts.alertmanager import post_state
 from alerts.engine import deliver, evaluate
-from monitor.config.model import Config, parse_listen
+from monitor.config.keys import parse_listen
+from monitor.config.model import Config
 from monitor.core.vocabulary import EventKind, RunStatus
 from monitor.service import allocator, logs
 from monitor.service.endpoint import Endpoint

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from monitor.config.model import ExportConfig
+from monitor.config.outputs import ExportConfig
 from monitor.core.constants import N_FOR
 from monitor.core.records import History
 from monitor.core.result import RELIABILITY_FLAGS

@@ -17,7 +17,8 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from monitor.assessment.assess import assess_plan
-from monitor.config.model import Config, ScheduleConfig
+from monitor.config.model import Config
+from monitor.config.schedule import ScheduleConfig
 from monitor.core.changes import all_changes
 from monitor.core.errors import DataError, StopRequested
 from monitor.core.records import SceneDecision
@@ -30,6 +31,7 @@ from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 from monitor.service import logs
 from monitor.service.scenes import select_scenes
+from monitor.service.schedule import catch_up, no_data_horizon
 from monitor.service.sources import ALL_PRODUCTS, ListedFile, Source, SourceError
 from monitor.service.store.sqlite import Store
 from monitor.service.store.timeseries import change_lines, drain_outbox, result_lines, target_name
@@ -120,7 +122,7 @@ def days_to_run(store: Store, satellite: str, schedule: ScheduleConfig, today: d
     """The days of the catch-up window (ending ``lag_days`` before *today*) without a completed run, oldest
     first. A day found empty (archive outage, late ingest) is tried again for ``no_data_retry_days`` after
     it became due; then its empty listing is final."""
-    return schedule.days_to_run(store.done_days(satellite, schedule.no_data_horizon(today)), today)
+    return catch_up(schedule, store.done_days(satellite, no_data_horizon(schedule, today)), today)
 
 
 def day_fingerprint(
@@ -356,7 +358,7 @@ def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.dat
             publish_changes(cfg, store, w.satellite)
         elif w.status == RunStatus.NO_DATA:
             s = cfg.schedule
-            if w.day < s.no_data_horizon(today):
+            if w.day < no_data_horizon(s, today):
                 out.status = RunStatus.NO_DATA_FINAL
             else:
                 out.reason = f"{out.reason} (tried again for {s.no_data_retry_days} day(s) after it is due)"

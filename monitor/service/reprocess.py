@@ -25,6 +25,7 @@ from monitor.core.vocabulary import RunStatus
 from monitor.service.allocator import reuse_freed_memory
 from monitor.service.lock import InstanceLock
 from monitor.service.pipeline import DayWork, ProgressLines, RunOutcome, compute_day, record_day
+from monitor.service.schedule import no_data_horizon
 from monitor.service.sources.configured import make_source
 from monitor.service.store.sqlite import Store
 
@@ -124,7 +125,7 @@ def reprocess(
         todo = []
         s = cfg.schedule
         today = dt.datetime.now(dt.timezone.utc).date()
-        horizon = s.no_data_horizon(today)
+        horizon = no_data_horizon(s, today)
         for sat in satellites:
             done = store.done_days(sat, horizon)  # as the daily run: ok, or no data for good
             for day in period_days(since, until):

@@ -19,6 +19,7 @@ from monitor.core.result import ForOffset
 from monitor.core.tables import BRIEF, for_table
 from monitor.core.vocabulary import Rule, RunStatus, Severity
 from monitor.service.lock import holder
+from monitor.service.schedule import next_run
 from monitor.service.store.alerts import AlertState
 from monitor.service.store.sqlite import Store
 
@@ -222,6 +223,6 @@ def status_report(
         NagiosState.CRITICAL if critical else NagiosState.WARNING if firing else NagiosState.OK,
         tuple(sats),
         daemon,
-        None if daemon is None else cfg.schedule.next_run(now),
+        None if daemon is None else next_run(cfg.schedule, now),
         store.outbox_size(),
     )

@@ -3,7 +3,7 @@ import email
 import pytest
 
 from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
-from monitor.config.model import EmailSettings, SlackSettings
+from monitor.config.alerts import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
 from tests.invoke import run_crisgeo
 
@@ -118,7 +118,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     import threading
 
     from alerts.engine import deliver
-    from monitor.config.model import AlertSettings
+    from monitor.config.alerts import AlertSettings
     from monitor.service.store.alerts import AlertState
     from monitor.service.store.sqlite import Store
 

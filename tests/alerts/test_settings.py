@@ -3,8 +3,9 @@
 import pytest
 import yaml
 
+from monitor.config.alerts import AlertSettings, EmailSettings, RuleSettings, SlackSettings
 from monitor.config.file import load_config
-from monitor.config.model import AlertSettings, ConfigError, EmailSettings, RuleSettings, SlackSettings
+from monitor.config.keys import ConfigError
 
 
 def _load(tmp_path, alerts):

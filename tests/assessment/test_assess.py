@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult
 from monitor.estimation.estimate import find_minimum
 from tests.conftest import truth_arrays

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from monitor.assessment.replay import ReplayError, assess_collocations, read_collocation
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from tests.invoke import ROOT, run_crisgeo
 
 REAL = sorted((ROOT / "tests" / "data" / "real" / "collocations_j01_20181022").glob("*.npz"))

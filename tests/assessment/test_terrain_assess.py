@@ -5,7 +5,7 @@ import pytest
 
 from monitor.assessment.assess import assess_paths
 from monitor.collocation import swath
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
 from tests.conftest import truth_arrays

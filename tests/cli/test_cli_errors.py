@@ -64,7 +64,7 @@ def test_export_refuses_in_one_line_and_writes_nothing(config_with_history, tmp_
 
 def test_read_only_commands_never_create_a_store(tmp_path, capsys):
     from monitor import open_store
-    from monitor.service.store.sqlite import StoreError
+    from monitor.service.store.database import StoreError
 
     (tmp_path / "events.yaml").write_text("events: []\n")
     cfg = tmp_path / "c.yaml"

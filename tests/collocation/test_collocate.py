@@ -7,7 +7,7 @@ import pytest
 
 from monitor.assessment.assess import KERNELS, _piece, _SwathCache
 from monitor.collocation import collocate, swath
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.threads import parallel_threads
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
@@ -303,7 +303,10 @@ def test_two_threads_may_assess_at_once():
     import subprocess
     import sys
 
-    code = "from tests.collocation.test_collocate import _two_threads; _two_threads(); print('both threads done')"
+    code = (
+        "from tests.collocation.test_collocate import _two_threads; "
+        "_two_threads(); print('both threads done')"
+    )
     env = dict(os.environ, NUMBA_THREADING_LAYER="workqueue")
     root = ROOT
     r = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True)

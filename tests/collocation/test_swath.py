@@ -8,7 +8,7 @@ import pytest
 
 from monitor.assessment.assess import _piece, _reach_us, _SwathCache, offsets_rad
 from monitor.collocation import collocate, swath
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.threads import parallel_threads
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry

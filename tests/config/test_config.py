@@ -1,7 +1,7 @@
 import pytest
 
 from monitor.config.file import load_config
-from monitor.config.model import ConfigError
+from monitor.config.keys import ConfigError
 from tests.invoke import ROOT
 
 CONFIGS = ROOT / "configs"

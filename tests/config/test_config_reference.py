@@ -6,7 +6,7 @@ import pytest
 import yaml
 
 from monitor.config.file import json_schema, load_config
-from monitor.config.model import ConfigError
+from monitor.config.keys import ConfigError
 from monitor.config.reference import model_keys, reference
 from tests.invoke import ROOT
 

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 from monitor.assessment.assess import assess_paths
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.sdr import CrisSdrGranule, GranuleError, ViirsSdrGranule, read_file
 from monitor.sdr.products import PRODUCTS
 from monitor.sdr.readers import read_metadata

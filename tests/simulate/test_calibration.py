@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from monitor.assessment.assess import assess_paths
-from monitor.config.model import AssessmentConfig
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import CALIBRATION_REFERENCE_K
 from monitor.core.vocabulary import Cost
 from monitor.instrument.spectral import i5_band

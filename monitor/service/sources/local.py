@@ -10,7 +10,7 @@ import time
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from monitor.config.model import CalibrationDifference, SourceConfig
+from monitor.config.source import CalibrationDifference, SourceConfig
 from monitor.sdr.products import CRIS_PRODUCTS
 from monitor.service.sources import ListedFile, listed, on_day
 

@@ -41,7 +41,7 @@ from urllib.parse import urljoin, urlsplit
 import requests
 import urllib3
 
-from monitor.config.model import SourceConfig
+from monitor.config.source import SourceConfig
 from monitor.core.errors import StopRequested
 from monitor.core.vocabulary import ReadMode
 from monitor.sdr.granules import GranuleRef

@@ -12,6 +12,10 @@ from monitor.core.records import Alert, Delivery, FindingRecord, Silence, iso
 from monitor.core.vocabulary import AlertStatus, DeliveryStatus
 
 
+class SilenceError(ValueError):
+    """A silence that cannot be set or lifted, said in one line."""
+
+
 class Database(Protocol):
     """What the alert tables need of the store (:class:`monitor.service.store.sqlite.Store`): its connection
     and
@@ -79,20 +83,27 @@ class AlertState:
     def silence(
         self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime
     ) -> None:
-        """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason."""
+        """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason; a silence
+        without a reason or ending before *now* is refused (:class:`SilenceError`)."""
+        if not reason.strip():
+            raise SilenceError("a silence needs a reason (--reason)")
+        if until <= now:
+            raise SilenceError("a silence must end in the future (--until)")
         with self.store.transaction():
             self.db.execute(
                 "INSERT INTO silences (rule, satellite, until, reason, created) VALUES (?, ?, ?, ?, ?)",
                 (rule, satellite, iso(until), reason, iso(now)),
             )
 
-    def lift(self, silence_id: int, now: dt.datetime) -> bool:
-        """End the silence *silence_id* now (kept, as history); False if no such silence is in force."""
+    def lift(self, silence_id: int, now: dt.datetime) -> None:
+        """End the silence *silence_id* now (kept, as history); no such silence in force is a
+        :class:`SilenceError`."""
         with self.store.transaction():
             cur = self.db.execute(
                 "UPDATE silences SET until=? WHERE id=? AND until > ?", (iso(now), silence_id, iso(now))
             )
-        return cur.rowcount == 1
+        if cur.rowcount != 1:
+            raise SilenceError(f"--id {silence_id}: no silence in force has that number")
 
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None:
         """The silence in force for *rule* and *satellite* at *now*, or None."""

@@ -33,7 +33,7 @@ from influxdb_client import InfluxDBClient, Point, WritePrecision
 from influxdb_client.client.exceptions import InfluxDBError
 from influxdb_client.client.write_api import SYNCHRONOUS
 
-from monitor.config.model import PublishConfig
+from monitor.config.outputs import PublishConfig
 from monitor.core.changes import Change
 from monitor.core.result import MEASURED_FIELDS, ForOffset
 from monitor.service.store.sqlite import Store

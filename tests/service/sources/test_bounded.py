@@ -38,7 +38,7 @@ def test_the_simulated_source_keeps_only_its_newest_days(tmp_path, monkeypatch):
     import time
 
     import monitor.simulate.case
-    from monitor.config.model import SourceConfig
+    from monitor.config.source import SourceConfig
     from monitor.service.sources.local import IN_USE_S, SimulatedSource
 
     def fake_case(target, **kw):
@@ -59,7 +59,7 @@ def test_the_download_cache_is_cut_to_its_size_least_recently_used_first(tmp_pat
     import os
     import time
 
-    from monitor.config.model import SourceConfig
+    from monitor.config.source import SourceConfig
     from monitor.service.sources.nodd import NoddSource
 
     src = NoddSource(SourceConfig(kind="nodd", cache_max_mb=2.5), tmp_path / "cache")

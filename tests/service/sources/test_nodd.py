@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from monitor.config.file import load_config
-from monitor.config.model import SourceConfig
+from monitor.config.source import SourceConfig
 from monitor.core.vocabulary import RunStatus
 from monitor.service.pipeline import compute_day
 from monitor.service.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from monitor.config.file import load_config
-from monitor.config.model import SourceConfig
+from monitor.config.source import SourceConfig
 from monitor.core.satellites import SATELLITES
 from monitor.core.vocabulary import RunStatus
 from monitor.sdr import GranuleError, read_file

@@ -6,7 +6,8 @@ import sqlite3
 from alerts.rules import Finding
 from monitor.core.vocabulary import EventKind
 from monitor.service.store.alerts import AlertState
-from monitor.service.store.sqlite import MIGRATIONS, Store
+from monitor.service.store.schema import MIGRATIONS
+from monitor.service.store.sqlite import Store
 
 T0 = dt.datetime(2026, 11, 22, 6, 0, tzinfo=dt.timezone.utc)
 

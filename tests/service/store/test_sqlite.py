@@ -7,7 +7,8 @@ import pytest
 
 from monitor.core.records import SceneDecision
 from monitor.core.vocabulary import Decision
-from monitor.service.store.sqlite import MIGRATIONS, Store
+from monitor.service.store.schema import MIGRATIONS
+from monitor.service.store.sqlite import Store
 from tests.invoke import run_crisgeo
 
 DAY = dt.date(2024, 6, 1)
@@ -132,7 +133,7 @@ def test_outbox_delivery_bookkeeping(tmp_path):
     ],
 )
 def test_an_unusable_store_is_refused_and_left_as_it_is(tmp_path, content, reason):
-    from monitor.service.store.sqlite import StoreError
+    from monitor.service.store.database import StoreError
 
     path = tmp_path / "store.sqlite"
     path.write_bytes(content)
@@ -142,7 +143,7 @@ def test_an_unusable_store_is_refused_and_left_as_it_is(tmp_path, content, reaso
 
 
 def test_a_foreign_sqlite_file_is_refused(tmp_path):
-    from monitor.service.store.sqlite import StoreError
+    from monitor.service.store.database import StoreError
 
     db = sqlite3.connect(tmp_path / "other.sqlite")
     db.execute("CREATE TABLE t (x)")

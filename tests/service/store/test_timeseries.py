@@ -4,7 +4,7 @@ import datetime as dt
 
 import pytest
 
-from monitor.config.model import PublishConfig
+from monitor.config.outputs import PublishConfig
 from monitor.service.store.sqlite import Store
 from monitor.service.store.timeseries import (
     Influx2Writer,

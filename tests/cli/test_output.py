@@ -2,7 +2,7 @@
 
 import datetime as dt
 
-from monitor.cli.render import result_text
+from monitor.cli.output import result_text
 from monitor.simulate.history import day_result
 
 

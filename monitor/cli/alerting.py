@@ -1,0 +1,135 @@
+"""The alerts and the known changes: list, silence, unsilence, evaluate; the events calendar."""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+from typing import TYPE_CHECKING
+
+from monitor.cli.registry import CONFIG, EXIT_OK, BadInput, arg, command, load, open_store
+from monitor.cli.types import iso_time, until
+from monitor.core.satellites import SATELLITES
+from monitor.core.vocabulary import Rule
+
+if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
+    pass
+
+RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices' repr
+
+
+@command(
+    "alerts",
+    "the alerts: list them, silence or unsilence a rule, evaluate the rules now",
+    arg(
+        "action",
+        choices=("list", "silence", "unsilence", "evaluate"),
+        nargs="?",
+        default="list",
+        help="list (default): firing, silenced and recently resolved alerts and the silences in force; "
+        "silence: quiet --rule/--satellite until --until, with --reason; unsilence: end silence --id; "
+        "evaluate: evaluate the rules and deliver now",
+    ),
+    CONFIG,
+    arg("--rule", choices=RULES, help="silence: the rule (default: every rule)"),
+    arg("--satellite", choices=tuple(SATELLITES), help="silence: the satellite (default: every one)"),
+    arg("--until", type=until, help="silence: its end (ISO 8601, UTC) or how long from now (12h, 7d)"),
+    arg("--reason", default="", help="silence: why (shown with the silence)"),
+    arg("--id", type=int, help="unsilence: the silence's number (crisgeo alerts list shows it)"),
+    arg("--json", action="store_true", help="list: as JSON"),
+)
+def cmd_alerts(args: argparse.Namespace) -> int:
+    """crisgeo alerts: list, silence, unsilence, evaluate."""
+    from alerts.engine import alerts_view, evaluate_and_deliver
+    from monitor.service.store.alerts import AlertState, SilenceError
+    from monitor.service.store.sqlite import Store
+
+    now = dt.datetime.now(dt.timezone.utc)
+    if args.action == "list":
+        cfg = load(args)
+        with open_store(cfg) as store:
+            view = alerts_view(store, now)
+        if args.json:
+            import json
+
+            print(json.dumps(view.to_dict(), indent=1))
+        else:
+            print(view.text())
+        return EXIT_OK
+    cfg = load(args, writes=True)
+    with Store(cfg.store.path) as store:
+        if args.action == "silence":
+            if args.until is None or not args.reason:
+                raise BadInput("alerts silence needs --until and --reason")
+            try:
+                AlertState(store).silence(args.rule, args.satellite, args.until, args.reason, now)
+            except SilenceError as exc:
+                raise BadInput(str(exc)) from None
+            print(
+                f"silenced rule={args.rule or '*'} satellite={args.satellite or '*'} until "
+                f"{args.until:%Y-%m-%d %H:%M} UTC"
+            )
+        elif args.action == "unsilence":
+            if args.id is None:
+                raise BadInput("alerts unsilence needs --id (crisgeo alerts list shows the silences)")
+            try:
+                AlertState(store).lift(args.id, now)
+            except SilenceError as exc:
+                raise BadInput(str(exc)) from None
+            print(f"silence {args.id} lifted")
+        else:
+            print(evaluate_and_deliver(store, cfg.alerts, cfg.satellites, now).text())
+    return EXIT_OK
+
+
+@command(
+    "events",
+    "list the known changes, or add one to the events calendar",
+    arg(
+        "action",
+        choices=("list", "add"),
+        nargs="?",
+        default="list",
+        help="list (default): the calendar's changes and those found in the data; add: a change to the "
+        "calendar (its comments are kept)",
+    ),
+    CONFIG,
+    arg("--satellite", choices=tuple(SATELLITES), help="list: only this satellite; add: the satellite"),
+    arg("--time", type=iso_time, help="add: when (ISO 8601, UTC)"),
+    arg("--instrument", choices=("cris", "viirs", "common"), help="add: the instrument changed"),
+    arg("--kind", default="change", help="add: ep_upload, lut_change, software, ..."),
+    arg("--description", help="add: what changed"),
+)
+def cmd_events(args: argparse.Namespace) -> int:
+    """crisgeo events: list the known changes, or add one to the calendar."""
+    from monitor.core.changes import Change, add_to_calendar, listing
+
+    cfg = load(args)
+    if cfg.events_file is None:
+        raise BadInput("alerts.events_file is not set in the configuration")
+    if args.action == "add":
+        if not (args.satellite and args.time and args.instrument and args.description):
+            raise BadInput("events add needs --satellite, --time, --instrument and --description")
+        try:
+            add_to_calendar(
+                cfg.events_file,
+                Change(args.time, args.satellite, args.instrument, args.kind, args.description, "calendar"),
+            )
+        except OSError as exc:
+            raise BadInput(f"{cfg.events_file}: {exc.strerror or exc}") from None
+        except ValueError as exc:  # its message names the file
+            raise BadInput(str(exc)) from None
+        print(f"added to {cfg.events_file}")
+        return EXIT_OK
+    try:
+        if not cfg.store.path.exists():  # before the first run: the calendar alone
+            changes = listing(cfg.events_file, cfg.satellites, args.satellite, None)
+        else:
+            with open_store(cfg) as store:
+                changes = listing(cfg.events_file, cfg.satellites, args.satellite, store)
+    except OSError as exc:
+        raise BadInput(f"{cfg.events_file}: {exc.strerror or exc}") from None
+    except ValueError as exc:  # its message names the file and the entry
+        raise BadInput(str(exc)) from None
+    for c in changes:
+        print(f"{c.satellite} {c.label()}")
+    return EXIT_OK

@@ -1,0 +1,56 @@
+"""What crisgeo writes on standard output: an assessment as ``assess`` and ``run`` print it, and standard
+output that a pipe closed by its reader silences."""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING, Any, TextIO
+
+from monitor.core.result import AssessmentResult
+from monitor.core.tables import for_table
+
+if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
+    pass
+
+
+class PipedOutput:
+    """Standard output that a reader closing the pipe (``| head -1``) silences instead of ending the
+    command: the exit status stays the one computed (a Nagios check piped into head still says 2)."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+        self.gone = False
+
+    def write(self, text: str) -> int:
+        if not self.gone:
+            try:
+                return self._stream.write(text)
+            except BrokenPipeError:
+                self._close()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.gone:
+            try:
+                self._stream.flush()
+            except BrokenPipeError:
+                self._close()
+
+    def _close(self) -> None:
+        self.gone = True
+        # the interpreter flushes stdout once more at exit: what is left goes to /dev/null, not to a
+        # "BrokenPipeError ignored" and exit status 120
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, self._stream.fileno())
+        os.close(null)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+def result_text(result: AssessmentResult) -> str:
+    """What ``crisgeo assess`` and ``crisgeo run`` print of an assessment."""
+    lines = [f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules"]
+    lines += for_table(result.fors)
+    lines += [f"skipped {s.item}: {s.reason}" for s in result.skipped]
+    return "\n".join(lines)

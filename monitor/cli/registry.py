@@ -1,0 +1,154 @@
+"""The registry of crisgeo's subcommands and what they share: exit statuses, the bad-input error, the
+arguments as data, the options that are configuration keys, loading the configuration and the store."""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
+
+from monitor.config.assessment import AssessmentConfig, FingerprintConfig
+from monitor.config.model import Config
+from monitor.core.vocabulary import Cost, Kernel
+
+if TYPE_CHECKING:
+    from monitor.geometry.instrument import (
+        EngineeringPacket,  # the commands import what they run when they run it: crisgeo starts fast
+    )
+    from monitor.service.store.sqlite import Store
+
+Handler = Callable[[argparse.Namespace], int]  # a subcommand: its parsed arguments in, its exit status out
+
+
+SectionT = TypeVar("SectionT", AssessmentConfig, FingerprintConfig)  # a section that commands take as options
+
+
+# the defaults of the assessment keys, for the commands that take them as flags
+ASSESSMENT = AssessmentConfig()  # the defaults of the options that mirror configuration keys
+
+
+FINGERPRINT = FingerprintConfig()
+
+
+EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
+
+
+EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
+
+
+DEFAULT_CONFIG = "/etc/crisgeo/monitor.yaml"
+
+
+class BadInput(Exception):
+    """An error in what the user gave; reported as one line, exit status 2."""
+
+
+def options(model: type[SectionT], flags: str, **values: Any) -> SectionT:
+    """The options of a command that are keys of a configuration section (*model*), checked by the same
+    model as the file: a problem is bad input naming the *flags* and the key."""
+    from monitor.config.file import section_of
+    from monitor.config.keys import ConfigError
+
+    name = next(k for k, f in Config.model_fields.items() if f.annotation is model)
+    try:
+        section = section_of(name, **values)
+    except ConfigError as exc:
+        raise BadInput(f"{flags}: {exc}") from None
+    assert isinstance(section, model)
+    return section
+
+
+def arg(*names: str, **options: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
+    """One argument of a subcommand: the add_argument call, as data."""
+    return names, options
+
+
+CONFIG = arg("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+
+
+# the options that are keys of the assessment section (checked by its model, :func:`options`)
+KERNEL = arg(
+    "--kernel",
+    choices=tuple(k.value for k in Kernel),
+    default=ASSESSMENT.kernel.value,
+    help="FOV weighting: the top-hat cone or the CrIS spatial response (assessment.kernel)",
+)
+
+
+COST = arg(
+    "--cost",
+    choices=tuple(c.value for c in Cost),
+    default=ASSESSMENT.cost.value,
+    help="stdev (the paper's) or regression (unmoved by a CrIS-VIIRS gain or bias) (assessment.cost)",
+)
+
+
+WORKERS = arg(
+    "--workers",
+    type=int,
+    default=ASSESSMENT.workers,
+    help=f"threads of the compiled kernels (default {ASSESSMENT.workers}, assessment.workers)",
+)
+
+
+# name -> (handler, help, arguments), in the order of ``crisgeo --help``
+COMMANDS: dict[str, tuple[Handler, str, tuple]] = {}
+
+
+def command(
+    name: str, help: str, *arguments: tuple[tuple[str, ...], dict[str, Any]]
+) -> Callable[[Handler], Handler]:
+    """Register the decorated handler as subcommand *name* with its *arguments* (:func:`arg`)."""
+
+    def register(handler: Handler) -> Handler:
+        COMMANDS[name] = (handler, help, arguments)
+        return handler
+
+    return register
+
+
+def load(args: argparse.Namespace, writes: bool = False) -> Config:
+    """The configuration of *args*; with *writes*, its state directory made (the commands that write)."""
+
+    from monitor.config.file import load_config, make_state_dir
+    from monitor.config.keys import ConfigError
+
+    args.config = args.config or os.environ.get("CRISGEO_CONFIG") or DEFAULT_CONFIG
+    try:
+        cfg = load_config(args.config)
+        if writes:
+            make_state_dir(cfg)
+        return cfg
+    except ConfigError as exc:
+        msg = str(exc)
+        named = msg.startswith((str(args.config), str(Path(args.config))))  # most errors name the file
+        raise BadInput(msg if named else f"{args.config}: {msg}") from None
+
+
+def open_store(cfg: Config) -> Store:
+    """The configured store for a command that only reads: never created (a missing one is an error)."""
+    from monitor.service.store.sqlite import Store
+
+    return Store(cfg.store.path, create=False)
+
+
+def period(since: dt.date | None, until: dt.date | None) -> None:
+    """Refuse (bad input) a period that ends before it starts."""
+    if since and until and since > until:
+        raise BadInput(f"--since {since} is after --until {until}")
+
+
+def satellites_of(cfg: Config, satellite: str | None) -> list[str]:
+    """The configured satellites, or the one asked for (which must be configured)."""
+    if satellite and satellite not in cfg.satellites:
+        raise BadInput(f"satellite {satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")
+    return [satellite] if satellite else list(cfg.satellites)
+
+
+def ep_file(path: str | os.PathLike[str], satellite: str | None = None) -> EngineeringPacket:
+    from monitor.sdr.engpkt import load_ep
+
+    return load_ep(path, satellite)

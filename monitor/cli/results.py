@@ -1,0 +1,84 @@
+"""The results' commands: export as NetCDF or CSV, the HTML report."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from monitor.cli.registry import (
+    CONFIG,
+    EXIT_OK,
+    BadInput,
+    arg,
+    command,
+    load,
+    open_store,
+    period,
+    satellites_of,
+)
+from monitor.cli.types import iso_day
+from monitor.core.satellites import SATELLITES
+
+if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
+    pass
+
+
+@command(
+    "export",
+    "per-FOR results as CF NetCDF (xarray) or CSV",
+    CONFIG,
+    arg("--format", choices=("netcdf", "csv"), help="netcdf or csv (default: from the suffix of --out)"),
+    arg("--out", required=True, help="the file to write: FILE.nc (NetCDF) or FILE.csv"),
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--since", type=iso_day, help="first day, YYYY-MM-DD"),
+    arg("--until", type=iso_day, help="last day, YYYY-MM-DD"),
+)
+def cmd_export(args: argparse.Namespace) -> int:
+    """crisgeo export: the results as NetCDF or CSV."""
+    from monitor.service.export import ExportFormatError, NothingToExport, export
+
+    cfg = load(args)
+    sats = satellites_of(cfg, args.satellite)
+    if len(sats) > 1:
+        raise BadInput(f"--satellite: one of {', '.join(sats)} (a file holds one satellite)")
+    period(args.since, args.until)
+    with open_store(cfg) as store:
+        try:
+            path = export(store, sats[0], args.out, args.format, args.since, args.until, cfg.export)
+        except ImportError as exc:
+            raise BadInput(
+                f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
+            ) from None
+        except (NothingToExport, ExportFormatError) as exc:
+            raise BadInput(str(exc)) from None
+        except OSError as exc:
+            raise BadInput(f"--out {args.out}: {exc.strerror or exc}") from None
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
+@command(
+    "report",
+    "the self-contained HTML trend report (one page per satellite)",
+    CONFIG,
+    arg("--out", help="output directory (default: report_dir of the configuration)"),
+    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--since", type=iso_day, help="first day shown, YYYY-MM-DD"),
+    arg("--until", type=iso_day, help="last day shown, YYYY-MM-DD"),
+)
+def cmd_report(args: argparse.Namespace) -> int:
+    """crisgeo report: write the HTML report."""
+    import time
+
+    from monitor.service.report.html import build_report, options_from_config
+
+    cfg = load(args)
+    satellites_of(cfg, args.satellite)
+    period(args.since, args.until)
+    opts = options_from_config(cfg, [args.satellite] if args.satellite else None, args.since, args.until)
+    t0 = time.perf_counter()
+    with open_store(cfg) as store:
+        index = build_report(store, args.out or cfg.report_dir or "report", opts)
+    print(f"wrote {Path(index).resolve()} ({', '.join(opts.satellites)}) in {time.perf_counter() - t0:.1f} s")
+    return EXIT_OK

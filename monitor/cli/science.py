@@ -1,0 +1,193 @@
+"""The science's commands: simulate granules, assess granules or collocations, time the assessment."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from monitor.cli.output import result_text
+from monitor.cli.registry import (
+    ASSESSMENT,
+    COST,
+    EXIT_OK,
+    KERNEL,
+    WORKERS,
+    BadInput,
+    arg,
+    command,
+    ep_file,
+    options,
+)
+from monitor.cli.types import iso_time, longitude, whole
+from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import N_FOV
+from monitor.core.satellites import SATELLITES
+from monitor.instrument.footprint import SHAPES as FOOTPRINTS
+from monitor.simulate import LAYOUTS
+from monitor.simulate.orbit import PASSES
+
+if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
+    from monitor.instrument.footprint import RadialResponse
+
+
+@command(
+    "simulate",
+    "write simulated CrIS/VIIRS granules with an injected LOS error",
+    arg("--out", required=True, help="output directory"),
+    arg("--satellite", choices=tuple(SATELLITES), default="j01"),
+    arg("--granules", type=whole(1), default=14, help="consecutive CrIS granules (default 14, as the paper)"),
+    arg("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file"),
+    arg("--seed", type=whole(0), default=0),
+    arg("--start", type=iso_time, default=None, help="UTC start of the first granule (ISO 8601)"),
+    arg("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)"),
+    arg("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)"),
+    arg("--terrain", action="store_true", help="1-4 km ranges and plateaus over 40 %% land"),
+    arg(
+        "--pass",
+        dest="orbit_pass",
+        choices=sorted(PASSES),
+        help="start at this pass of the satellite's orbit after --start (day: ascending tropics, "
+        "night: descending, arctic/antarctic: 60-81 deg); default an ascending tropical pass",
+    ),
+    arg("--pass-lon", type=longitude, help="with --pass: the pass nearest this longitude, deg (e.g. 180)"),
+    arg(
+        "--complete",
+        action="store_true",
+        help="every dataset of the real products, real size (GITCO ~325 MB uncompressed)",
+    ),
+    arg(
+        "--layout",
+        choices=LAYOUTS,
+        help="HDF5 layout of every dataset (default: CrIS gzip, VIIRS contiguous)",
+    ),
+    arg(
+        "--footprint",
+        nargs="+",
+        choices=tuple(FOOTPRINTS),
+        metavar="SHAPE",
+        help="the CrIS FOV's spatial response, one of " + ", ".join(FOOTPRINTS) + ": one shape for all FOVs, "
+        "or nine (FOV 1..9); default the paper's top-hat cone",
+    ),
+)
+def cmd_simulate(args: argparse.Namespace) -> int:
+    """crisgeo simulate: write a simulated case."""
+    from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
+
+    where = dict(
+        terrain=args.terrain,
+        orbit_pass=args.orbit_pass,
+        pass_lon_deg=args.pass_lon,
+        complete=args.complete,
+        layout=args.layout,
+        cris_response=_footprint(args.footprint),
+    )
+    if (args.true_ep is None) != (args.ground_ep is None):
+        raise BadInput("--true-ep and --ground-ep go together")
+    spec = None
+    if args.true_ep:
+        spec = SimulationSpec(
+            satellite=args.satellite,
+            granules=args.granules,
+            seed=args.seed,
+            start=args.start or DEFAULT_START,
+            profile="ep",
+            true_ep=ep_file(args.true_ep),
+            ground_ep=ep_file(args.ground_ep),
+            **where,
+        )
+    truth = simulate_case(
+        args.out,
+        satellite=args.satellite,
+        granules=args.granules,
+        profile=args.profile,
+        seed=args.seed,
+        start=args.start,
+        spec=spec,
+        **where,
+    )
+    error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {args.profile}"
+    print(
+        f"wrote {len(truth['files'])} files and truth.json to {args.out} "
+        f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {args.seed})"
+    )
+    return EXIT_OK
+
+
+def _footprint(names: Sequence[str] | None) -> RadialResponse | tuple[RadialResponse, ...] | None:
+    """The spatial response of --footprint: None (the top-hat cone), one shape, or one per FOV."""
+    from monitor.instrument.footprint import shape
+
+    if not names:
+        return None
+    if len(names) not in (1, N_FOV):
+        raise BadInput(f"--footprint takes one shape or {N_FOV} (FOV 1..{N_FOV}), not {len(names)}")
+    return shape(names[0]) if len(names) == 1 else tuple(shape(n) for n in names)
+
+
+@command(
+    "assess",
+    "assess CrIS geolocation against VIIRS I5 for the granules given",
+    arg(
+        "paths",
+        nargs="+",
+        help="granule files or directories; or the reference implementation's collocation files (.npz)",
+    ),
+    arg("--out", help="write the result JSON here"),
+    arg(
+        "--steps",
+        type=int,
+        default=ASSESSMENT.half_steps,
+        help="perturbation steps each side of zero (grid 2n+1; collocation files carry their own grid)",
+    ),
+    arg("--step-urad", type=float, default=ASSESSMENT.step_urad, help="perturbation step, urad"),
+    KERNEL,
+    COST,
+    WORKERS,
+)
+def cmd_assess(args: argparse.Namespace) -> int:
+    """crisgeo assess: assess the granules given; print the table, write the JSON."""
+    from monitor.assessment.assess import assess_paths
+
+    cfg = options(
+        AssessmentConfig,
+        "--steps/--step-urad/--workers",
+        half_steps=args.steps,
+        step_urad=args.step_urad,
+        kernel=args.kernel,
+        cost=args.cost,
+        workers=args.workers,
+    )
+    collocations = [p for p in args.paths if p.endswith(".npz")]
+    if collocations and len(collocations) != len(args.paths):
+        raise BadInput("give either granules or collocation files (.npz), not both")
+    if collocations:
+        from monitor.assessment.replay import assess_collocations
+
+        result = assess_collocations(collocations, cfg)
+    else:
+        result = assess_paths(args.paths, cfg, workers=cfg.workers)
+    print(result_text(result))
+    if args.out:
+        Path(args.out).write_text(result.to_json())
+        print(f"wrote {args.out}")
+    return EXIT_OK
+
+
+@command(
+    "bench",
+    "time each stage on a simulated case; print FOVs/s and peak memory",
+    arg("--granules", type=whole(1), default=14),
+    arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
+    arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
+    WORKERS,
+    COST,
+    KERNEL,
+)
+def cmd_bench(args: argparse.Namespace) -> int:
+    """crisgeo bench: time each stage on a simulated case."""
+    from monitor.assessment.bench import run_bench
+
+    cfg = options(AssessmentConfig, "--workers", cost=args.cost, kernel=args.kernel, workers=args.workers)
+    return run_bench(args, cfg)

@@ -1,0 +1,167 @@
+"""The ``alerts`` section: the rules' thresholds, the channels (e-mail, Slack, Alertmanager), the links in
+messages."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    model_validator,
+)
+
+from monitor.config.keys import Address, EnvName, FilePath, KeyProblem, Section, Text, Url, key
+from monitor.core.constants import (
+    SPEC_KM,
+)
+
+
+class RuleSettings(Section):
+    """The alert rules' parameters: the top-level keys of the ``alerts`` section."""
+
+    spec_km: float = key(
+        SPEC_KM,
+        "Specification of the geolocation error on the ground; a reliable FOR beyond it "
+        "fires the spec rule (critical when value - 2 sigma is beyond it).",
+        0.01,
+        100.0,
+    )
+    min_jump_km: float = key(
+        0.25, "Smallest step (median after minus median before) that counts as a jump.", 0.001, 100.0
+    )
+    min_bias_jump_k: float = key(
+        0.1,
+        "Smallest step of the daily CrIS-VIIRS BT bias at 280 K that counts as a calibration jump (the "
+        "calibration_jump rule: a VIIRS LUT or CrIS calibration change).",
+        0.001,
+        100.0,
+    )
+    jump_z: float = key(
+        5.0,
+        "Step size in units of its standard error that counts as a jump, on any day of the "
+        "recent window (blind search).",
+        1.0,
+        100.0,
+    )
+    jump_z_at_change: float = key(
+        3.5, "The same at the date of a known change (events calendar, fingerprint).", 1.0, 100.0
+    )
+    pre_days: int = key(21, "Days before a candidate step that form the reference.", 2, 365)
+    min_pre_days: int = key(7, "Fewest assessed days before a step for the test to run.", 2, 365)
+    min_post_days: int = key(2, "Fewest assessed days after a step for the test to run.", 1, 365)
+    post_days: int = key(14, "Days after a candidate step compared with the reference.", 1, 365)
+    blind_window_days: int = key(7, "Recent days tried as step dates without a known change.", 1, 365)
+    change_window_days: int = key(30, "Known changes this recent are tried as step dates.", 1, 3650)
+    attribution_days: int = key(
+        10, "A jump is attributed to a known change at most this many days before it.", 0, 365
+    )
+    active_days: int = key(14, "A jump or processing change older than this no longer fires.", 1, 3650)
+    stale_hours: float = key(36.0, "No completed run for this long fires the stale rule.", 1.0, 8760.0)
+    repeat_hours: float = key(24.0, "A firing alert is notified again after this long.", 0.1, 8760.0)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> RuleSettings:
+        if self.min_pre_days > self.pre_days:
+            raise KeyProblem(
+                "min_pre_days", f"{self.min_pre_days} is more than alerts.pre_days ({self.pre_days})"
+            )
+        return self
+
+
+class EmailSettings(Section):
+    """The ``alerts.email`` section."""
+
+    model_config = ConfigDict(populate_by_name=True, serialize_by_alias=True)
+
+    host: Text = key(..., "SMTP server.")
+    port: int = key(587, "SMTP port.", 1, 65535)
+    sender: Address = key("crisgeo@localhost", "Sender address.", alias="from")
+    to: Annotated[list[Address], Field(min_length=1)] = key(..., "Recipient addresses (list).")
+    starttls: bool = key(True, "Use STARTTLS (certificate verified against the system store, or cafile).")
+    username_env: EnvName | None = key(None, "Environment variable holding the SMTP user name.")
+    password_env: EnvName | None = key(None, "Environment variable holding the SMTP password.")
+    cafile: FilePath | None = key(None, "Extra CA bundle (e.g. a site CA) to verify the server with.")
+    timeout_s: float = key(30.0, "Timeout of one SMTP conversation.", 0.1, 600.0)
+
+
+class SlackSettings(Section):
+    """The ``alerts.slack`` section."""
+
+    webhook_env: EnvName = key(..., "Environment variable holding the incoming-webhook URL.")
+    retries: int = key(3, "Retries when Slack answers 429 or 5xx.", 0, 20)
+    max_wait_s: float = key(30.0, "Longest wait honoured from a Retry-After header.", 0.0, 3600.0)
+    timeout_s: float = key(15.0, "Timeout of one request.", 0.1, 600.0)
+
+
+class AlertmanagerSettings(Section):
+    """The ``alerts.alertmanager`` section: where the service posts its alerts (Alertmanager API v2)."""
+
+    url: Url = key(..., "Base URL of Alertmanager, e.g. http://127.0.0.1:9093.")
+    timeout_s: float = key(10.0, "Timeout of one post.", 0.1, 600.0)
+    validity_hours: float = key(
+        3.0,
+        "A firing alert is posted again at every evaluation (hourly, and after each "
+        "run) with this end; if the service stops posting, Alertmanager ends it then.",
+        1.5,
+        168.0,
+    )
+
+
+class Links(BaseModel):
+    """Where readers of a message find more: the top-level report_dir, report_url and dashboard_url."""
+
+    report_dir: Path | None = None
+    report_url: str | None = None
+    dashboard_url: str | None = None
+
+
+class AlertSettings(RuleSettings):
+    """The ``alerts`` section: the rule parameters, the channels and the events calendar."""
+
+    subject_prefix: Text = key(
+        "[crisgeo]",
+        "Start of every message's subject (e-mail subject, Slack headline): e.g. [crisgeo test] for a test "
+        "instance, so that its messages are not taken for the operational service's.",
+    )
+    log: FilePath | None = key(None, "File the alert messages are appended to (a channel that cannot fail).")
+    events_file: FilePath | None = key(
+        None, "The events calendar (EP uploads, LUT changes) used to attribute jumps and annotate plots."
+    )
+    email: EmailSettings | None = key(None, "E-mail channel (mapping below); absent: none.")
+    slack: SlackSettings | None = key(None, "Slack channel (mapping below); absent: none.")
+    alertmanager: AlertmanagerSettings | None = key(
+        None,
+        "Alertmanager (mapping below): the alerts are posted to its API v2 with labels alertname, service, "
+        "satellite, rule, severity and resolved there, so that Alertmanager routes, groups and silences "
+        "them; absent: none.",
+    )
+    _links: Links = PrivateAttr(default_factory=Links)
+
+    @model_validator(mode="after")
+    def _calendar_exists(self) -> AlertSettings:
+        if self.events_file is not None and not self.events_file.is_file():
+            # read as empty, a missing calendar would lose jump attribution without a word
+            raise KeyProblem(
+                "events_file",
+                f"{self.events_file} does not exist (copy configs/events.yaml there, or remove the key)",
+            )
+        return self
+
+    def linked(self, links: Links) -> AlertSettings:
+        """These settings, pointing their messages at *links*."""
+        self._links = links
+        return self
+
+    @property
+    def links(self) -> Links:
+        """The report and dashboard the messages point to (the top-level keys)."""
+        return self._links
+
+    @property
+    def channels(self) -> list[str]:
+        """The names of the configured channels."""
+        return [n for n in ("log", "email", "slack") if getattr(self, n)]

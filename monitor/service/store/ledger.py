@@ -1,0 +1,124 @@
+"""The run ledger: one row per satellite-day run (running, ok, no data, failed, interrupted) and the
+service's events."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+
+from monitor.core.records import Event, Run
+from monitor.core.vocabulary import DONE, EventKind, RunStatus
+from monitor.service.store.database import Database
+
+
+class RunLedger(Database):
+    """The ledger of runs and the service events of a store."""
+
+    # -- runs (the ledger)
+    def begin_run(self, satellite: str, day: dt.date) -> int:
+        """Open a run of *satellite* on *day* in the ledger (status running); its id."""
+        with self.transaction():
+            cur = self.db.execute(
+                "INSERT INTO runs (satellite, day, started, status) VALUES (?, ?, ?, ?)",
+                (satellite, day.isoformat(), self._now(), RunStatus.RUNNING),
+            )
+            return int(cur.lastrowid or 0)  # (set by an INSERT)
+
+    def finish_run(
+        self,
+        run_id: int,
+        status: RunStatus,
+        reason: str | None = None,
+        n_granules: int = 0,
+        summary: dict | None = None,
+    ) -> None:
+        """Close run *run_id* with *status* and *reason*."""
+        with self.transaction():
+            self._finish(run_id, status, reason, n_granules, summary)
+
+    def _finish(
+        self, run_id: int, status: RunStatus, reason: str | None, n_granules: int, summary: dict | None
+    ) -> None:
+        self.db.execute(
+            "UPDATE runs SET finished=?, status=?, reason=?, n_granules=?, summary=? WHERE id=?",
+            (self._now(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id),
+        )
+
+    def interrupt_stale_runs(self) -> int:
+        """Mark runs left 'running' by a killed process as 'interrupted'; returns how many."""
+        with self.transaction():
+            cur = self.db.execute(
+                "UPDATE runs SET status=?, finished=?, reason='process ended during the run' WHERE status=?",
+                (RunStatus.INTERRUPTED, self._now(), RunStatus.RUNNING),
+            )
+            return cur.rowcount
+
+    def done_days(self, satellite: str, no_data_final_before: dt.date | None = None) -> set:
+        """Days with a completed run: results stored, or no data for good. A plain ``no_data`` day counts
+        as done only before *no_data_final_before* (None: always); later ones are tried again."""
+        rows = self.db.execute(
+            "SELECT DISTINCT day, status FROM runs WHERE satellite=? AND status IN (?, ?, ?)",
+            (satellite, *DONE),
+        )
+        out = set()
+        for day, status in rows:
+            d = dt.date.fromisoformat(day)
+            if status != RunStatus.NO_DATA or no_data_final_before is None or d < no_data_final_before:
+                out.add(d)
+        return out
+
+    def last_runs(self) -> list[Run]:
+        """The latest run of each satellite."""
+        return [
+            Run.from_row(r)
+            for r in self.db.execute(
+                "SELECT r.* FROM runs r JOIN (SELECT satellite, MAX(id) AS id FROM runs GROUP BY satellite) "
+                "m ON r.id = m.id ORDER BY r.satellite"
+            )
+        ]
+
+    def run_counts(self) -> dict:
+        """{(satellite, status): number of runs} over the whole ledger."""
+        return {
+            (r[0], r[1]): r[2]
+            for r in self.db.execute(
+                "SELECT satellite, status, COUNT(*) FROM runs GROUP BY satellite, status"
+            )
+        }
+
+    def first_runs(self) -> dict:
+        """{satellite: start time (aware UTC datetime) of its first run}: since when it is monitored."""
+        return {
+            r[0]: dt.datetime.fromisoformat(r[1])
+            for r in self.db.execute("SELECT satellite, MIN(started) FROM runs GROUP BY satellite")
+        }
+
+    def last_success(self) -> dict:
+        """{satellite: finish time (aware UTC datetime) of its latest ok run}."""
+        return {
+            r[0]: dt.datetime.fromisoformat(r[1])
+            for r in self.db.execute(
+                "SELECT satellite, MAX(finished) FROM runs WHERE status=? AND finished IS NOT NULL GROUP "
+                "BY satellite",
+                (RunStatus.OK,),
+            )
+        }
+
+    def runs(self, satellite: str | None = None) -> list[Run]:
+        """The runs (of *satellite*), oldest first."""
+        q = "SELECT * FROM runs" + (" WHERE satellite=?" if satellite else "") + " ORDER BY id"
+        return [Run.from_row(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
+
+    # -- events (failures, misses: the alerting layer reads them)
+    def add_event(self, kind: "EventKind", satellite: str | None, detail: dict) -> None:
+        """Record an event; *detail* is stored as JSON."""
+        with self.transaction():
+            self.db.execute(
+                "INSERT INTO events (time, kind, satellite, detail) VALUES (?, ?, ?, ?)",
+                (self._now(), EventKind(kind).value, satellite, json.dumps(detail)),
+            )
+
+    def events(self, kind: "EventKind | None" = None) -> list["Event"]:
+        """The events (of *kind*), oldest first."""
+        q = "SELECT * FROM events" + (" WHERE kind=?" if kind else "") + " ORDER BY id"
+        return [Event.from_row(r) for r in self.db.execute(q, (EventKind(kind).value,) if kind else ())]

@@ -1,0 +1,50 @@
+"""The outbox: time-series lines still to publish, per target, delivered or retried by the publisher."""
+
+from __future__ import annotations
+
+from monitor.service.store.database import Database
+
+
+class Outbox(Database):
+    """The outbox of a store."""
+
+    # -- outbox
+    def queue_lines(self, target: str, satellite: str | None, lines: list) -> None:
+        """Queue points not tied to a day's results (e.g. change annotations)."""
+        with self.transaction():
+            for line in lines:
+                self.db.execute(
+                    "INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, NULL, ?, ?)",
+                    (target, satellite, line, self._now()),
+                )
+
+    def outbox(self, target: str, limit: int = 5000) -> list:
+        """Up to *limit* points waiting for *target*, oldest first."""
+        return [
+            dict(r)
+            for r in self.db.execute(
+                "SELECT id, line FROM outbox WHERE target=? ORDER BY id LIMIT ?", (target, limit)
+            )
+        ]
+
+    def outbox_size(self, target: str | None = None) -> int:
+        """The number of points waiting (for *target*)."""
+        q = "SELECT COUNT(*) FROM outbox" + (" WHERE target=?" if target else "")
+        return self.db.execute(q, (target,) if target else ()).fetchone()[0]
+
+    def outbox_delivered(self, ids: list) -> None:
+        """Remove delivered points."""
+        with self.transaction():
+            self.db.executemany("DELETE FROM outbox WHERE id=?", [(i,) for i in ids])
+
+    def outbox_failed(self, ids: list, error: str) -> None:
+        """Count a failed attempt and its error on the points."""
+        with self.transaction():
+            self.db.executemany(
+                "UPDATE outbox SET attempts = attempts + 1, last_error=? WHERE id=?",
+                [(error[:500], i) for i in ids],
+            )
+
+    def outbox_sizes(self) -> dict:
+        """{target: points waiting}."""
+        return dict(self.db.execute("SELECT target, COUNT(*) FROM outbox GROUP BY target").fetchall())

@@ -1,0 +1,240 @@
+"""A day's results: the per-FOR offsets and flags (a column per measured field), the calibration
+difference bins, the granules used with their metadata, the scene selection, the cost cube, the LOS
+fingerprint. A day is replaced in one transaction: a re-run never duplicates, a crash never leaves half a
+day."""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+from typing import Any
+
+import numpy as np
+
+from monitor.core.constants import N_FOR
+from monitor.core.records import ForSeries, GranuleRow, SelectionRow
+from monitor.core.result import MEASURED_FIELDS, AssessmentResult, DifferenceBin, ForOffset
+from monitor.core.vocabulary import RunStatus
+from monitor.service.store.ledger import RunLedger
+
+RESULT_FIELDS = MEASURED_FIELDS  # the results table has a column for each
+
+
+def _num(v: object) -> object:
+    return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
+
+
+class Results(RunLedger):
+    """The per-day results of a store (a day's results close its run in the ledger, in one transaction)."""
+
+    # -- results
+    def save_day(
+        self,
+        run_id: int,
+        satellite: str,
+        day: dt.date,
+        result: AssessmentResult,
+        selection: list,
+        outbox_lines: dict,
+    ) -> None:
+        """Replace the day's results, granules, selection and cube, queue its points, close the run, in one
+        transaction."""
+        d = day.isoformat()
+        with self.transaction():
+            for table in ("results", "granules", "selection", "cost_cubes", "skipped", "difference_bins"):
+                self.db.execute(f"DELETE FROM {table} WHERE satellite=? AND day=?", (satellite, d))
+            for f in result.fors:
+                self.db.execute(
+                    f"INSERT INTO results (satellite, day, for_index, run_id, {', '.join(RESULT_FIELDS)}, "
+                    "flags) "
+                    f"VALUES (?, ?, ?, ?, {', '.join('?' * len(RESULT_FIELDS))}, ?)",
+                    (
+                        satellite,
+                        d,
+                        f.for_index,
+                        run_id,
+                        *[_num(getattr(f, k)) for k in RESULT_FIELDS],
+                        json.dumps(list(f.flags)),
+                    ),
+                )
+            for g in result.granules:
+                cm, vm = g.cris_meta, g.viirs_meta
+                self.db.execute(
+                    "INSERT OR REPLACE INTO granules VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    (
+                        satellite,
+                        d,
+                        run_id,
+                        g.granule_id,
+                        g.start,
+                        g.cris_geo,
+                        g.cris_sdr,
+                        json.dumps(g.viirs),
+                        g.n_usable,
+                        cm.get("software_version"),
+                        cm.get("algorithm_version"),
+                        json.dumps(cm.get("aux_files", [])),
+                        json.dumps(vm.get("aux_files", [])),
+                        vm.get("software_version"),
+                    ),
+                )
+            for s in selection:
+                self.db.execute(
+                    "INSERT INTO selection VALUES (?, ?, ?, ?, ?, ?, ?)",
+                    (
+                        satellite,
+                        d,
+                        run_id,
+                        s.granule,
+                        _num(s.score_k),
+                        s.decision,
+                        s.reason,
+                    ),
+                )
+            for b in result.difference_bins:
+                self.db.execute(
+                    "INSERT INTO difference_bins VALUES (?, ?, ?, ?, ?, ?, ?)",
+                    (satellite, d, run_id, b.low_k, b.n, _num(b.mean_k), _num(b.std_k)),
+                )
+            for s in result.skipped:
+                self.db.execute(
+                    "INSERT INTO skipped VALUES (?, ?, ?, ?, ?)",
+                    (satellite, d, run_id, s.item, s.reason),
+                )
+            if result.cost_cube_k is not None:
+                self.db.execute(
+                    "INSERT INTO cost_cubes VALUES (?, ?, ?, ?, ?, ?)",
+                    (
+                        satellite,
+                        d,
+                        run_id,
+                        result.half_steps,
+                        result.step_urad,
+                        np.asarray(result.cost_cube_k, np.float32).tobytes(),
+                    ),
+                )
+            self.db.execute("DELETE FROM outbox WHERE satellite=? AND day=?", (satellite, d))
+            for target, lines in outbox_lines.items():
+                for line in lines:
+                    self.db.execute(
+                        "INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, ?, ?, ?)",
+                        (target, satellite, d, line, self._now()),
+                    )
+            self._finish(
+                run_id,
+                RunStatus.OK,
+                None,
+                len(result.granules),
+                {
+                    "reliable_fors": sum(f.reliable for f in result.fors),
+                    "max_total_km": max(
+                        (f.total_km for f in result.fors if np.isfinite(f.total_km)), default=None
+                    ),
+                },
+            )
+
+    def day_result(self, satellite: str, day: dt.date) -> list[ForOffset]:
+        """The per-FOR offsets stored for *satellite* on *day*."""
+        rows = self.db.execute(
+            "SELECT * FROM results WHERE satellite=? AND day=? ORDER BY for_index",
+            (satellite, day.isoformat()),
+        ).fetchall()
+        out = []
+        for r in rows:
+            kw: dict[str, Any] = {k: (float("nan") if r[k] is None else r[k]) for k in RESULT_FIELDS}
+            kw["n_samples"] = int(r["n_samples"] or 0)
+            out.append(ForOffset(for_index=r["for_index"], flags=tuple(json.loads(r["flags"])), **kw))
+        return out
+
+    def difference_bins(self, satellite: str, day: dt.date) -> list[DifferenceBin]:
+        """CrIS minus VIIRS against the CrIS BT at the optimum on *satellite*'s *day* (Figure 15)."""
+        rows = self.db.execute(
+            "SELECT low_k, n, mean_k, std_k FROM difference_bins WHERE satellite=? AND day=? ORDER BY low_k",
+            (satellite, day.isoformat()),
+        ).fetchall()
+        return [
+            DifferenceBin(
+                r["low_k"], r["n"], *(float("nan") if v is None else v for v in (r["mean_k"], r["std_k"]))
+            )
+            for r in rows
+        ]
+
+    def latest_day(self, satellite: str) -> dt.date | None:
+        """The latest day with results for *satellite*, or None."""
+        r = self.db.execute("SELECT MAX(day) FROM results WHERE satellite=?", (satellite,)).fetchone()[0]
+        return dt.date.fromisoformat(r) if r else None
+
+    def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> ForSeries:
+        """The per-FOR results of *satellite* from *since* to *until* (both included) as arrays."""
+        q = "SELECT * FROM results WHERE satellite=?"
+        args = [satellite]
+        if since:
+            q += " AND day >= ?"
+            args.append(since.isoformat())
+        if until:
+            q += " AND day <= ?"
+            args.append(until.isoformat())
+        rows = self.db.execute(q + " ORDER BY day, for_index", args).fetchall()
+        days = sorted({r["day"] for r in rows})
+        index = {d: i for i, d in enumerate(days)}
+        shape = (len(days), N_FOR)
+        values = {k: np.full(shape, np.nan) for k in RESULT_FIELDS if k != "n_samples"}
+        values["n_samples"] = np.zeros(shape, np.int64)
+        flags = np.empty(shape, object)
+        flags.fill(())
+        stored = np.zeros(shape, bool)
+        for r in rows:
+            at = (index[r["day"]], r["for_index"] - 1)
+            for k in values:
+                if r[k] is not None:
+                    values[k][at] = r[k]
+            flags[at] = tuple(json.loads(r["flags"] or "[]"))
+            stored[at] = True
+        return ForSeries([dt.date.fromisoformat(d) for d in days], values, flags, stored)
+
+    def granules(self, satellite: str, day: dt.date | None = None) -> list[GranuleRow]:
+        """The granules assessed for *satellite* (on *day*), with their metadata."""
+        q = (
+            "SELECT * FROM granules WHERE satellite=?"
+            + (" AND day=?" if day else "")
+            + " ORDER BY day, start"
+        )
+        args = (satellite, day.isoformat()) if day else (satellite,)
+        return [GranuleRow.from_row(r) for r in self.db.execute(q, args)]
+
+    def selection(self, satellite: str, day: dt.date) -> list[SelectionRow]:
+        """The scene-selection decisions of *satellite* on *day*."""
+        return [
+            SelectionRow.from_row(r)
+            for r in self.db.execute(
+                "SELECT * FROM selection WHERE satellite=? AND day=?", (satellite, day.isoformat())
+            )
+        ]
+
+    def cost_cube(self, satellite: str, day: dt.date) -> tuple[np.ndarray, float] | None:
+        """(cube_k (30, 2n+1, 2n+1), step_urad) of the day's assessment, or None."""
+        r = self.db.execute(
+            "SELECT half_steps, step_urad, cube FROM cost_cubes WHERE satellite=? AND day=?",
+            (satellite, day.isoformat()),
+        ).fetchone()
+        if r is None:
+            return None
+        m = 2 * r["half_steps"] + 1
+        return np.frombuffer(r["cube"], np.float32).reshape(-1, m, m), r["step_urad"]
+
+    # -- fingerprints
+    def save_fingerprint(self, satellite: str, day: dt.date, body: dict) -> None:
+        """Store the LOS fingerprint of *satellite* on *day* (replacing one computed before)."""
+        with self.transaction():
+            self.db.execute(
+                "INSERT OR REPLACE INTO fingerprints VALUES (?, ?, ?, ?)",
+                (satellite, day.isoformat(), self._now(), json.dumps(body)),
+            )
+
+    def fingerprint(self, satellite: str, before: dt.date) -> tuple[dt.date, dict] | None:
+        """(day, body) of the latest fingerprint strictly before *before*, or None."""
+        r = self.db.execute(
+            "SELECT day, body FROM fingerprints WHERE satellite=? AND day < ? ORDER BY day DESC LIMIT 1",
+            (satellite, before.isoformat()),
+        ).fetchone()
+        return None if r is None else (dt.date.fromisoformat(r["day"]), json.loads(r["body"]))
