@@ -1,7 +1,6 @@
 """Acceptance on CrIS spatial responses the code was never given: four radially symmetric shapes within
 the specification's table that are not among :data:`monitor.instrument.footprint.SHAPES` (a sharper and a
-softer
-super-Gaussian, a steep trapezoid, a narrower blur), on seeds 4-7 that no other acceptance run uses; 6
+softer super-Gaussian, a steep trapezoid, a narrower blur), on seeds 4-7 that no other acceptance run uses; 6
 granules each, the default assessment. Prints one JSON row per case: RMS per direction and the worst FOR
 (urad), the share of errors within two sigmas, the median intercalibration (gain per cent, bias K) where
 none was injected, and the median fitted full width at half peak against the truth's (urad).

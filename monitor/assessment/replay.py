@@ -9,8 +9,7 @@ and the GEO fields, the turns in radians.
 They hold no geometry to turn angles into ground distance (no spacecraft position or attitude), so the km
 fields of the result stay empty (NaN) and the result says so in its notes. The estimator
 (:mod:`monitor.estimation.estimate`) takes a square grid centred on zero turn: of a rectangular grid (17 alpha
-x 15
-beta in the files at hand) the centred square of the shorter side is used (15 x 15), and the result says
+x 15 beta in the files at hand) the centred square of the shorter side is used (15 x 15), and the result says
 that too. The cone means are plain means over the top-hat cone, so no footprint is fitted here.
 """
 

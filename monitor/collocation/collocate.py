@@ -45,11 +45,10 @@ from monitor.instrument.spectral import PARALLEL_FROM, i5_band
 
 # The discs (radii, rad) whose sums the kernel returns. The top-hat cone of the paper is one disc; the
 # annuli between nested discs let the estimator fit the CrIS spatial response (monitor.estimation.estimate):
-# CrIS sees
-# a smooth, radially symmetric response, 70 % of peak at 0.437 deg from the LOS and 3 % at 0.619 deg at
-# most (Wang slides, table 3, monitor.instrument.footprint), so the annuli reach past the cone to 0.64 deg.
-# Four discs:
-# the kernel's work grows with their number, and three (no edge inside the cone) miss the response's fall
+# CrIS sees a smooth, radially symmetric response, 70 % of peak at 0.437 deg from the LOS and 3 % at 0.619 deg
+# at most (Wang slides, table 3, monitor.instrument.footprint), so the annuli reach past the cone to 0.64 deg.
+# Four discs: the kernel's work grows with their number, and three (no edge inside the cone) miss the
+# response's fall
 # from 0.42 to 0.48 deg (6-granule smooth cases: 11-12 urad RMS against 3-4 with four; six gave 3-3.5).
 TOP_HAT = (FOV_DIAMETER_RAD / 2,)
 ANNULI = (math.radians(0.42), FOV_DIAMETER_RAD / 2, math.radians(0.56), math.radians(0.64))

@@ -1,7 +1,7 @@
 """The configuration file: YAML read safely (no anchors, aliases or duplicate keys, 1 MiB at most), validated
 by the model of :mod:`monitor.config.model`, and every problem said in one line naming the key
-(``store.publish[0].url: missing``); the effective configuration printed back, with its secrets' state,
-and the JSON Schema editors validate YAML with.
+(``store.publish[0].url: missing``); the effective configuration printed back, with its secrets' state, and
+the JSON Schema editors validate YAML with.
 """
 
 from __future__ import annotations

@@ -2,9 +2,9 @@
 
 Nothing is written here but the layout: keys, defaults, ranges and meanings are the fields of
 :class:`monitor.config.model.Config` and its sections; the unit is read from the key's name (``_km``,
-``_s``...).
-``crisgeo check-config --reference`` prints it and ``docs/configuration.md`` is its output; ``crisgeo
-check-config --schema`` prints the JSON Schema, ``docs/crisgeo-config.schema.json``. A test keeps both equal.
+``_s``...). ``crisgeo check-config --reference`` prints it and ``docs/configuration.md`` is its output;
+``crisgeo check-config --schema`` prints the JSON Schema, ``docs/crisgeo-config.schema.json``. A test keeps
+both equal.
 """
 
 from __future__ import annotations

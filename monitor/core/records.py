@@ -1,8 +1,7 @@
 """What the store gives back, typed: its rows as records, and the interfaces the alerts program against.
 
 The store (:mod:`monitor.service.store`) writes and reads SQLite; whoever reads history through it (the alert
-rules,
-the report, the CLI) receives these records, and the alerts see the store only as a :class:`History`
+rules, the report, the CLI) receives these records, and the alerts see the store only as a :class:`History`
 with an :class:`AlertLedger` (so that ``alerts`` needs nothing of ``monitor`` above this floor).
 """
 

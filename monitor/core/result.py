@@ -40,9 +40,9 @@ class ForOffset:
     Angles in microradians (in-track alpha, cross-track beta), distances in km on the ground (in-track
     positive along the flight direction, cross-track positive to the right), cost in kelvin. At the optimum,
     the CrIS-VIIRS intercalibration (:mod:`monitor.estimation.intercal`): the BT bias (K) at the reference
-    temperature,
-    the gain there (per cent) and the curvature (K), NaN where none was fitted; and the full widths (urad)
-    of the CrIS spatial response found there (:mod:`monitor.estimation.estimate`), NaN where none was fitted.
+    temperature, the gain there (per cent) and the curvature (K), NaN where none was fitted; and the full
+    widths (urad) of the CrIS spatial response found there (:mod:`monitor.estimation.estimate`), NaN where
+    none was fitted.
     """
 
     for_index: int
@@ -66,8 +66,7 @@ class ForOffset:
     curvature_k: float = float("nan")
     sigma_curvature_k: float = float("nan")
     # the CrIS spatial response fitted at the optimum (kernel footprint, monitor.estimation.estimate): its
-    # full widths
-    # at 50 and 10 % of the peak, NaN where none was fitted
+    # full widths at 50 and 10 % of the peak, NaN where none was fitted
     response_width_50_urad: float = float("nan")
     sigma_response_width_50_urad: float = float("nan")
     response_width_10_urad: float = float("nan")

@@ -2,9 +2,8 @@
 uncertainty and the intercalibration out.
 
 Its input, :class:`ForSamples`, is what collocation leaves per FOR (:mod:`monitor.assessment.assess` from
-granules,
-:mod:`monitor.assessment.replay` from the reference implementation's files): for every sample (a FOV of a scan
-of a
+granules, :mod:`monitor.assessment.replay` from the reference implementation's files): for every sample (a FOV
+of a scan of a
 granule) the VIIRS-minus-CrIS BT at every perturbation through the top-hat cone, the CrIS BT, and where the
 collocation measured them, the VIIRS radiance means over annuli about each perturbed LOS.
 
@@ -13,8 +12,7 @@ points by :mod:`monitor.estimation.refine`. Then:
 
 **The footprint.** CrIS sees the scene through a smooth, radially symmetric response that reaches past the
 0.963 deg cone (:mod:`monitor.instrument.footprint`); VIIRS averaged over the cone is then not what CrIS saw,
-and the
-cost's minimum moves by tens of urad on textured scenes. Given annuli A_k (radiance means between
+and the cost's minimum moves by tens of urad on textured scenes. Given annuli A_k (radiance means between
 consecutive radii out to 0.66 deg), the VIIRS radiance CrIS would see is sum_k w_k A_k with w_k the share
 of the response in annulus k (sum 1). The weights are left free, as the regression cost leaves the
 calibration difference free: at the optimum they minimise the same residual variance the cost does,
@@ -23,12 +21,11 @@ calibration difference free: at the optimum they minimise the same residual vari
 
 with M the covariance over the samples of each annulus' difference from the CrIS BT (linearised about the
 current weights), less what the cost's calibration regressors explain (a Schur complement, as in
-:func:`monitor.estimation.refine.window_covariance`; :func:`response_weights` solves it). The
-minimum is then sought again with V = BT(sum_k w_k A_k), and the two steps alternate until the optimum
-stays put (:data:`FOOTPRINT_ITERATIONS`): a fixed point of both is a minimum of the residual over the
-turn and the response jointly. A radially symmetric response cannot move the joint minimum, whatever its
-shape; the weights found are the response seen on orbit
-(:func:`monitor.instrument.footprint.widths_of_weights`).
+:func:`monitor.estimation.refine.window_covariance`; :func:`response_weights` solves it). The minimum is then
+sought again with V = BT(sum_k w_k A_k), and the two steps alternate until the optimum stays put
+(:data:`FOOTPRINT_ITERATIONS`): a fixed point of both is a minimum of the residual over the turn and the
+response jointly. A radially symmetric response cannot move the joint minimum, whatever its shape; the weights
+found are the response seen on orbit (:func:`monitor.instrument.footprint.widths_of_weights`).
 
 **The uncertainty** is the delete-one-granule jackknife (:mod:`monitor.estimation.jackknife`): each replicate
 repeats the estimate (its own weights, its own refined minimum) without one granule, so the scene-to-scene

@@ -21,8 +21,7 @@ some hundred I5 pixels against one CrIS spectrum), so least squares is not atten
 The sigmas come from the same delete-one-granule jackknife as the offsets'
 (:mod:`monitor.estimation.estimate`,
 :mod:`monitor.estimation.jackknife`): the fit on each replicate's samples at that replicate's own optimum; so
-a FOR
-whose optimum is uncertain has an uncertain intercalibration too.
+a FOR whose optimum is uncertain has an uncertain intercalibration too.
 """
 
 from __future__ import annotations

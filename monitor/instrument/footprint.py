@@ -8,8 +8,7 @@ the response by its full widths at four levels of its peak:
 A :class:`RadialResponse` is a profile R(r) of the angle r (rad) from the LOS, peak 1, linear between its
 knots and 0 beyond the last. The simulator weights the scene by it (:mod:`monitor.simulate.case`); the
 assessment does not assume one: it fits the profile over annuli (:mod:`monitor.estimation.estimate`) and
-reports the
-widths it finds (:meth:`RadialResponse.full_width_rad`, :func:`widths_of_weights`).
+reports the widths it finds (:meth:`RadialResponse.full_width_rad`, :func:`widths_of_weights`).
 
 Named shapes (:data:`SHAPES`), each within the table (``tests/instrument/test_footprint.py`` checks them):
 ``super-gaussian`` (the default: exp(-ln 2 (r / r50)^10)), ``trapezoid`` (flat to 0.391 deg, linear to 0

@@ -4,8 +4,8 @@ The EP model (:mod:`monitor.geometry.instrument`) reproduces the operational CrI
 metres, but not the scene-mirror servo corrections IDPS computes from telemetry carried only in the raw
 data records (docs/jpss-formats.md 2.3: per-FOR cross-track residuals of -30..+64 urad, a constant ~+28 urad
 in-track on NOAA-20). Those show in the GEO files themselves: the fingerprint
-(:mod:`monitor.mapping.fingerprint`)
-measures each FOR's FOV-5 angles (alpha in-track, beta cross-track, spacecraft frame), and their difference
+(:mod:`monitor.mapping.fingerprint`) measures each FOR's FOV-5 angles (alpha in-track, beta cross-track,
+spacecraft frame), and their difference
 from the EP model's is the residual of that FOR.
 
 Learned from a set of GEO granules, the table turns every FOV of FOR k by (d_alpha_k, d_beta_k) on top of

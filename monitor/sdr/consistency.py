@@ -32,6 +32,12 @@ real NOAA-20 GCRSO granules of tests/data/real and on the simulator (docs/jpss-f
   piles up there), and no other raw count holding more than 1 % of the pixels (the noise alone, 0.4 K,
   spreads a uniform scene over ~250 counts of 0.003 K; a value stamped over the array piles up).
 * **CrIS spectra.** No FOV's long-wave spectrum exactly zero in every channel (no scene radiates nothing).
+* **Fill.** A granule's main field is not all fill; Latitude and Longitude are fill together; a
+  terrain-corrected pixel has its height, -500..9000 m.
+* **CrIS FOR times.** They increase and lie within the granule (10 s of margin: the bounds are nominal).
+
+The readers (:mod:`monitor.sdr.readers`) call :func:`check_not_all_fill`, :func:`check_for_times` and
+:func:`check_relations` on every granule they give.
 """
 
 from __future__ import annotations
@@ -47,7 +53,15 @@ from monitor.core.satellites import SATELLITES
 from monitor.geometry import orbit, wgs84
 from monitor.geometry.inverse import satellite_from_fov
 from monitor.sdr.errors import GranuleError
-from monitor.sdr.granules import CrisGeoGranule, GeoGranule, Granule, GranuleMeta, GranuleRef, ViirsGeoGranule
+from monitor.sdr.granules import (
+    CrisGeoGranule,
+    CrisSdrGranule,
+    GeoGranule,
+    Granule,
+    GranuleMeta,
+    GranuleRef,
+    ViirsGeoGranule,
+)
 from monitor.sdr.iet import iet_to_datetime
 from monitor.sdr.products import UINT16_FILL_MIN, Product
 
@@ -361,4 +375,99 @@ def check_spectra(path: GranuleRef, name: str, radiance: np.ndarray) -> None:
     if dead.any():
         raise GranuleError(
             path, name, f"the spectra of {int(dead.sum())} FOV(s) are exactly zero in every channel"
+        )
+
+
+def check_relations(path: GranuleRef, product: Product, granule: Granule) -> None:
+    """The relations between fields a genuine granule obeys (:mod:`monitor.sdr.consistency`)."""
+    key = MAIN_FIELD[product.kind]
+    if isinstance(granule, CrisSdrGranule):
+        check_spectra(path, f"{product.data_group}/{product.fields[key].dataset}", granule.radiance_lw)
+    if product.scans_reserved:
+        check_viirs_scan_count(path, product, granule, key)
+    if not isinstance(granule, (CrisGeoGranule, ViirsGeoGranule)):
+        return
+    has_data = np.isfinite(granule.lat_rad).reshape(len(granule.start_time_us), -1).any(axis=1)  # per scan
+    check_scan_times(path, product, granule, has_data)
+    check_ephemeris(path, product, granule, has_data)
+    if isinstance(granule, CrisGeoGranule):
+        check_line_of_sight(path, product, granule)
+    else:
+        check_nadir(path, product, granule, has_data)
+        check_pixel_steps(path, product, granule)
+
+
+def check_for_times(path: GranuleRef, product: Product, granule: Granule) -> None:
+    """CrIS FOR times increase and lie within the granule (10 s of margin: the IDPS granule bounds are
+    nominal); the per-scan times of both GEO products are checked with the physics
+    (:func:`monitor.sdr.check_scan_times`)."""
+    t = getattr(granule, "for_time_us", None)
+    name = f"{product.data_group}/FORTime"
+    if t is None:  # VIIRS GEO: per-scan times only; SDR files: their times are their GEO's
+        return
+    t = t.ravel()
+    t = t[t > 0]
+    lo, hi = granule.meta.start_iet_us - 10_000_000, granule.meta.end_iet_us + 10_000_000
+    if t.size and (t.min() < lo or t.max() > hi):
+        bad = t.min() if t.min() < lo else t.max()
+        raise GranuleError(
+            path,
+            name,
+            f"time {bad} (IET us) outside the granule {granule.meta.start_iet_us}..{granule.meta.end_iet_us}",
+        )
+    if np.any(np.diff(t) <= 0):
+        i = int(np.argmax(np.diff(t) <= 0))
+        raise GranuleError(path, name, f"times do not increase: {t[i]} then {t[i + 1]}")
+
+
+MAIN_FIELD = {"cris_geo": "lat_rad", "cris_sdr": "radiance_lw", "viirs_sdr": "bt_k", "viirs_geo": "lat_rad"}
+
+
+def check_not_all_fill(path: GranuleRef, product: Product, granule: Granule) -> None:
+    key = MAIN_FIELD[product.kind]
+    if not np.any(np.isfinite(getattr(granule, key))):
+        raise GranuleError(
+            path,
+            f"{product.data_group}/{product.fields[key].dataset}",
+            f"granule {granule.meta.granule_id or '?'} holds only fill values",
+        )
+    if isinstance(granule, (ViirsGeoGranule, CrisGeoGranule)):
+        lat_ok, lon_ok = np.isfinite(granule.lat_rad), np.isfinite(granule.lon_rad)
+        if np.any(lat_ok != lon_ok):
+            n = int(np.sum(lat_ok != lon_ok))
+            raise GranuleError(
+                path,
+                f"{product.data_group}/Longitude",
+                f"fill at {n} pixel(s) where Latitude is set, or set where it is fill",
+            )
+    if isinstance(granule, ViirsGeoGranule) and granule.height_m is not None and "height_m" in product.fields:
+        check_height(
+            path,
+            f"{product.data_group}/{product.fields['height_m'].dataset}",
+            granule.lat_rad,
+            granule.lon_rad,
+            granule.height_m,
+        )
+
+
+def check_height(
+    path: GranuleRef, name: str, lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray
+) -> None:
+    """A terrain-corrected pixel needs its height: fill only where the pixel itself is fill."""
+    located = np.isfinite(lat_rad) & np.isfinite(lon_rad)
+    missing = located & ~np.isfinite(height_m)
+    if missing.any():
+        r, c = np.argwhere(missing)[0]
+        raise GranuleError(
+            path,
+            name,
+            f"fill or non-finite at {int(missing.sum())} geolocated pixel(s), first at row {r}, column {c}",
+        )
+    bad = located & ((height_m < -500.0) | (height_m > 9000.0))
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise GranuleError(
+            path,
+            name,
+            f"terrain height {float(height_m[r, c]):.6g} m at row {r}, column {c} is outside -500..9000 m",
         )

@@ -16,9 +16,9 @@ import numpy as np
 
 class RemoteGranule(Protocol):
     """A granule file read where it lies, a range at a time (``monitor.service.sources.ranged``): its base
-    name (a
-    JPSS file name), ``str()`` naming it in errors (its key), and a binary file object to read it through.
-    When a read of that object fails, its ``failure`` says why (the transport's reason, naming the key)."""
+    name (a JPSS file name), ``str()`` naming it in errors (its key), and a binary file object to read it
+    through. When a read of that object fails, its ``failure`` says why (the transport's reason, naming the
+    key)."""
 
     @property
     def name(self) -> str:

@@ -22,12 +22,8 @@ from monitor.sdr import consistency
 from monitor.sdr.errors import GranuleError
 from monitor.sdr.granules import (
     _GRANULE_TYPES,
-    CrisGeoGranule,
-    CrisSdrGranule,
-    Granule,
     GranuleMeta,
     GranuleRef,
-    ViirsGeoGranule,
     as_ref,
 )
 from monitor.sdr.iet import iet_to_datetime
@@ -290,108 +286,11 @@ def _product_granules(
         if product.kind == "cris_sdr" and radiance is not None:  # a required field: never None here
             kwargs["wavenumber_cm1"] = cris_lw_wavenumbers_cm1(radiance.shape[-1])
         granule = _GRANULE_TYPES[product.kind](meta=meta, **kwargs)
-        _check_not_all_fill(path, product, granule)
-        _check_times(path, product, granule)
-        _check_physics(path, product, granule)
+        consistency.check_not_all_fill(path, product, granule)
+        consistency.check_for_times(path, product, granule)
+        consistency.check_relations(path, product, granule)
         out.append(granule)
     return out
-
-
-def _check_physics(path: GranuleRef, product: Product, granule: Granule) -> None:
-    """The relations between fields a genuine granule obeys (:mod:`monitor.sdr.consistency`)."""
-    key = _MAIN_FIELD[product.kind]
-    if isinstance(granule, CrisSdrGranule):
-        consistency.check_spectra(
-            path, f"{product.data_group}/{product.fields[key].dataset}", granule.radiance_lw
-        )
-    if product.scans_reserved:
-        consistency.check_viirs_scan_count(path, product, granule, key)
-    if not isinstance(granule, (CrisGeoGranule, ViirsGeoGranule)):
-        return
-    has_data = np.isfinite(granule.lat_rad).reshape(len(granule.start_time_us), -1).any(axis=1)  # per scan
-    consistency.check_scan_times(path, product, granule, has_data)
-    consistency.check_ephemeris(path, product, granule, has_data)
-    if isinstance(granule, CrisGeoGranule):
-        consistency.check_line_of_sight(path, product, granule)
-    else:
-        consistency.check_nadir(path, product, granule, has_data)
-        consistency.check_pixel_steps(path, product, granule)
-
-
-def _check_times(path: GranuleRef, product: Product, granule: Granule) -> None:
-    """CrIS FOR times increase and lie within the granule (10 s of margin: the IDPS granule bounds are
-    nominal); the per-scan times of both GEO products are checked with the physics
-    (:func:`monitor.sdr.consistency.check_scan_times`)."""
-    t = getattr(granule, "for_time_us", None)
-    name = f"{product.data_group}/FORTime"
-    if t is None:  # VIIRS GEO: per-scan times only; SDR files: their times are their GEO's
-        return
-    t = t.ravel()
-    t = t[t > 0]
-    lo, hi = granule.meta.start_iet_us - 10_000_000, granule.meta.end_iet_us + 10_000_000
-    if t.size and (t.min() < lo or t.max() > hi):
-        bad = t.min() if t.min() < lo else t.max()
-        raise GranuleError(
-            path,
-            name,
-            f"time {bad} (IET us) outside the granule {granule.meta.start_iet_us}..{granule.meta.end_iet_us}",
-        )
-    if np.any(np.diff(t) <= 0):
-        i = int(np.argmax(np.diff(t) <= 0))
-        raise GranuleError(path, name, f"times do not increase: {t[i]} then {t[i + 1]}")
-
-
-_MAIN_FIELD = {"cris_geo": "lat_rad", "cris_sdr": "radiance_lw", "viirs_sdr": "bt_k", "viirs_geo": "lat_rad"}
-
-
-def _check_not_all_fill(path: GranuleRef, product: Product, granule: Granule) -> None:
-    key = _MAIN_FIELD[product.kind]
-    if not np.any(np.isfinite(getattr(granule, key))):
-        raise GranuleError(
-            path,
-            f"{product.data_group}/{product.fields[key].dataset}",
-            f"granule {granule.meta.granule_id or '?'} holds only fill values",
-        )
-    if isinstance(granule, (ViirsGeoGranule, CrisGeoGranule)):
-        lat_ok, lon_ok = np.isfinite(granule.lat_rad), np.isfinite(granule.lon_rad)
-        if np.any(lat_ok != lon_ok):
-            n = int(np.sum(lat_ok != lon_ok))
-            raise GranuleError(
-                path,
-                f"{product.data_group}/Longitude",
-                f"fill at {n} pixel(s) where Latitude is set, or set where it is fill",
-            )
-    if isinstance(granule, ViirsGeoGranule) and granule.height_m is not None and "height_m" in product.fields:
-        _check_height(
-            path,
-            f"{product.data_group}/{product.fields['height_m'].dataset}",
-            granule.lat_rad,
-            granule.lon_rad,
-            granule.height_m,
-        )
-
-
-def _check_height(
-    path: GranuleRef, name: str, lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray
-) -> None:
-    """A terrain-corrected pixel needs its height: fill only where the pixel itself is fill."""
-    located = np.isfinite(lat_rad) & np.isfinite(lon_rad)
-    missing = located & ~np.isfinite(height_m)
-    if missing.any():
-        r, c = np.argwhere(missing)[0]
-        raise GranuleError(
-            path,
-            name,
-            f"fill or non-finite at {int(missing.sum())} geolocated pixel(s), first at row {r}, column {c}",
-        )
-    bad = located & ((height_m < -500.0) | (height_m > 9000.0))
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise GranuleError(
-            path,
-            name,
-            f"terrain height {float(height_m[r, c]):.6g} m at row {r}, column {c} is outside -500..9000 m",
-        )
 
 
 def _failed(path: GranuleRef, fh: object) -> GranuleError | None:
@@ -560,7 +459,7 @@ def read_viirs_geo_scan(path: str | os.PathLike[str] | GranuleRef, scan: int) ->
             _check_values(path, name, data, f)
             out.append(data * f.to_si if f.to_si != 1.0 else data)
         if "height_m" in product.fields:
-            _check_height(path, f"{product.data_group}/Height", *out)
+            consistency.check_height(path, f"{product.data_group}/Height", *out)
         return tuple(out)
 
 

@@ -7,8 +7,7 @@ assessment, a quarter of a second to half a second of its wall time on two cores
 not trimmed at every free, freed memory is reused as it is; :func:`release_freed_memory` hands what is
 free back to the system after a job (the daemon then idles until the next day). Reprocessing's Dask
 workers set it at each satellite-day (:func:`monitor.service.reprocess.day_task`) and keep the memory between
-days (their peak, ~2 GB): Dask's own setting (MALLOC_TRIM_THRESHOLD_ = 64 KiB) would return it at every
-free.
+days (their peak, ~2 GB): Dask's own setting (MALLOC_TRIM_THRESHOLD_ = 64 KiB) would return it at every free.
 """
 
 from __future__ import annotations

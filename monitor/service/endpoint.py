@@ -118,8 +118,8 @@ class _V6Server(ThreadingHTTPServer):
 
 class Endpoint:
     """Serves *metrics* (:class:`monitor.service.metrics.ServiceMetrics`), *health*
-    (:class:`monitor.service.health.Health`)
-    and the files under *report_dir* on (host, port); port 0 takes a free one (see :attr:`address`)."""
+    (:class:`monitor.service.health.Health`) and the files under *report_dir* on (host, port); port 0 takes a
+    free one (see :attr:`address`)."""
 
     def __init__(
         self, host: str, port: int, metrics: Registered, health: HealthView, report_dir: Path | None

@@ -10,8 +10,7 @@ the sign convention stated once (the global attribute ``sign_convention``), and 
 instrument, source, id; institution, creator, license and the like from the ``export`` section of the
 configuration). The compliance checker's CF-1.8 check passes, and its ACDD-1.3 check leaves only what
 does not apply (tests/service/test_export.py): no CF standard name exists for these quantities, and the file
-is
-per scan position, not per place (no geospatial bounds). xarray and h5netcdf are an optional extra:
+is per scan position, not per place (no geospatial bounds). xarray and h5netcdf are an optional extra:
 ``pip install 'crisgeo-monitor[export]'``.
 """
 

@@ -71,8 +71,8 @@ class Counts(Protocol):
 
 class Outcome(Protocol):
     """What the metrics read of a run (:class:`monitor.service.pipeline.RunOutcome`): its satellite, the
-    seconds of
-    its stages, its counts. Typed so, the metrics and the pipeline (one floor) do not import each other."""
+    seconds of its stages, its counts. Typed so, the metrics and the pipeline (one floor) do not import each
+    other."""
 
     @property
     def satellite(self) -> str: ...

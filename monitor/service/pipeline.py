@@ -131,8 +131,7 @@ def day_fingerprint(
     """The LOS fingerprint (:func:`monitor.mapping.fingerprint.granule_print`) of a sample of the day's GEO
     granules,
     with the EPs of the library identified (:func:`monitor.mapping.fingerprint.fingerprint_day`); a granule
-    that
-    cannot be fetched or read is logged and left out; None without any."""
+    that cannot be fetched or read is logged and left out; None without any."""
     geos = sorted(
         (f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
         key=lambda f: f.parsed.start,

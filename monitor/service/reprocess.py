@@ -1,10 +1,9 @@
 """``crisgeo reprocess``: assess a whole period on a Dask cluster; this process alone writes the store.
 
 One task per satellite-day runs :func:`monitor.service.pipeline.compute_day` (list, fingerprint, select,
-fetch,
-assess) on a worker and returns its :class:`~monitor.service.pipeline.DayWork`; the client records each as it
-arrives with :func:`monitor.service.pipeline.record_day`, the path of the daily run (ledger row, results and
-outbox lines in one transaction). Days already done (``ok``, or found empty for good) are skipped unless
+fetch, assess) on a worker and returns its :class:`~monitor.service.pipeline.DayWork`; the client records each
+as it arrives with :func:`monitor.service.pipeline.record_day`, the path of the daily run (ledger row, results
+and outbox lines in one transaction). Days already done (``ok``, or found empty for good) are skipped unless
 forced, so a second call does nothing and an interrupted call resumes. SIGINT/SIGTERM cancel what is
 still queued or running; what finished is recorded.
 """

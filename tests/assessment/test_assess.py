@@ -102,17 +102,17 @@ def test_too_few_usable_fovs_is_an_error_naming_the_files(cases, tmp_path):
 def test_reading_only_the_reachable_viirs_scans_changes_no_bit(cases, monkeypatch):
     """The VIIRS granules are read over the scans the CrIS granules can reach (and their halos); read
     whole, every offset, sigma, cost and intercalibration value is the same to the bit."""
-    from monitor.assessment import assess
+    from monitor.assessment import assess, inputs
 
     out, _, partial = cases.get("paper", 1)
-    whole_read = assess._read_viirs
+    whole_read = inputs.read_viirs
     read_scans = []
 
     def every_scan(v, viirs_all, span_us=None):
         read_scans.append(span_us)
         return whole_read(v, viirs_all, None)
 
-    monkeypatch.setattr(assess, "_read_viirs", every_scan)
+    monkeypatch.setattr(inputs, "read_viirs", every_scan)
     whole = assess.assess_paths([out], AssessmentConfig())  # as the case was assessed
     assert read_scans and all(s is not None for s in read_scans)  # the partial run had spans to read by
     assert [f.to_dict() for f in whole.fors] == [f.to_dict() for f in partial.fors]

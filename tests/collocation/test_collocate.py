@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from monitor.assessment.assess import KERNELS, _piece, _SwathCache
+from monitor.assessment.inputs import KERNELS, SwathCache, piece
 from monitor.collocation import collocate, swath
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.threads import parallel_threads
@@ -23,7 +23,7 @@ def scene(case_plan):
     (geo,) = read_file(g.geo, kinds=("cris_geo",))
     fg = granule_geometry(geo)
     band = i5_band("j01")  # every column prepared (no reach given)
-    pieces = [_piece(v, case_plan.viirs_all, band, _SwathCache(), math.inf) for v in case_plan.viirs[g.key]]
+    pieces = [piece(v, case_plan.viirs_all, band, SwathCache(), math.inf) for v in case_plan.viirs[g.key]]
     return fg, swath.ViirsSwath(pieces)
 
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from monitor.assessment.assess import _piece, _reach_us, _SwathCache, offsets_rad
+from monitor.assessment.inputs import SwathCache, offsets_rad, piece, reach_us
 from monitor.collocation import collocate, swath
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.threads import parallel_threads
@@ -79,7 +79,7 @@ def test_columns_no_cone_reaches_change_no_cone_sum(case_plan):
     assert math.radians(45) < view < math.radians(55)
     full, cut = (
         swath.ViirsSwath(
-            [_piece(v, case_plan.viirs_all, band, _SwathCache(), reach) for v in case_plan.viirs[g.key]]
+            [piece(v, case_plan.viirs_all, band, SwathCache(), reach) for v in case_plan.viirs[g.key]]
         )
         for reach in (math.inf, view)
     )
@@ -114,11 +114,11 @@ def test_scans_no_cone_reaches_change_no_cone_sum(case_plan):
     cfg, band = AssessmentConfig(), i5_band(case_plan.satellite)
     sel = (fg.sat_ecef_m[valid], fg.sbf_to_ecef[valid], fg.alpha_rad[valid], fg.beta_rad[valid])
     seen = geo.for_time_us[geo.for_time_us > 0]
-    span = _reach_us(int(seen.min()), int(seen.max()))
+    span = reach_us(int(seen.min()), int(seen.max()))
     full, cut = (
         swath.ViirsSwath(
             [
-                _piece(v, case_plan.viirs_all, band, _SwathCache(), 1.0, span_us=s)
+                piece(v, case_plan.viirs_all, band, SwathCache(), 1.0, span_us=s)
                 for v in case_plan.viirs[g.key]
             ]
         )

@@ -10,15 +10,14 @@ one run may download, and cached files older than the retention go.
 
 Everything a server says is bounded in wall-clock time and size, so that no listing, download or range
 hangs or grows without end (:mod:`monitor.service.sources.bounded` cuts a request at its deadline, body
-included): a listing page, and the headers of any answer, come within ``timeout_s``; every request of a
-run ends by the run deadline (``source.run_deadline_min``); a download or a range must keep up
-``min_rate_kb_s`` over every sliding window of ``stall_window_s`` and may not bring more bytes than
-listed or asked for (Content-Length is checked first);
-at most ``max_list_pages`` pages and ``max_listed_keys`` keys per listing, and a continuation token seen
-twice is an error; Retry-After is honoured up to ``max_retry_after_s`` (a longer one ends the attempt); a
-compressed response is refused (granules are stored as they are, never transparently decoded).
-Redirects are followed only on the endpoint's own host. Listed keys must be plain ASCII JPSS names in
-the day folder asked for (no dot segments, no field longer than the real pattern allows): a key that is
+included): a listing page, and the headers of any answer, come within ``timeout_s``; every request of a run
+ends by the run deadline (``source.run_deadline_min``); a download or a range must keep up ``min_rate_kb_s``
+over every sliding window of ``stall_window_s`` and may not bring more bytes than listed or asked for
+(Content-Length is checked first); at most ``max_list_pages`` pages and ``max_listed_keys`` keys per listing,
+and a continuation token seen twice is an error; Retry-After is honoured up to ``max_retry_after_s`` (a longer
+one ends the attempt); a compressed response is refused (granules are stored as they are, never transparently
+decoded). Redirects are followed only on the endpoint's own host. Listed keys must be plain ASCII JPSS names
+in the day folder asked for (no dot segments, no field longer than the real pattern allows): a key that is
 not is logged and left out, and the rest of the listing is used. There is one retry layer, here:
 connection errors, 429 and 5xx, ``retries`` times with exponential backoff.
 """

@@ -18,8 +18,7 @@ class SilenceError(ValueError):
 
 class Database(Protocol):
     """What the alert tables need of the store (:class:`monitor.service.store.sqlite.Store`): its connection
-    and
-    its transactions. Typed so, this module and the store's do not import each other."""
+    and its transactions. Typed so, this module and the store's do not import each other."""
 
     db: sqlite3.Connection
 

@@ -44,8 +44,7 @@ MIGRATIONS = [
         PRIMARY KEY (satellite, day));
     """,
     # 3: the alert tables (monitor/service/store/alerts.py), until now created by the alert state itself: IF
-    # NOT
-    # EXISTS keeps the rows of stores that have them; alert_meta, their own version table, goes
+    # NOT EXISTS keeps the rows of stores that have them; alert_meta, their own version table, goes
     """
     CREATE TABLE IF NOT EXISTS alert_state (
         fingerprint TEXT PRIMARY KEY, rule TEXT NOT NULL, satellite TEXT NOT NULL, grp TEXT, severity TEXT,
@@ -73,8 +72,7 @@ MIGRATIONS = [
         n INTEGER, mean_k REAL, std_k REAL, PRIMARY KEY (satellite, day, low_k));
     """,
     # 5: the CrIS spatial response seen at each FOR's optimum (kernel footprint,
-    # monitor/estimation/estimate.py); days
-    # stored before have none (NULL)
+    # monitor/estimation/estimate.py); days stored before have none (NULL)
     """
     ALTER TABLE results ADD COLUMN response_width_50_urad REAL;
     ALTER TABLE results ADD COLUMN sigma_response_width_50_urad REAL;

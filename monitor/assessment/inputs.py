@@ -1,0 +1,260 @@
+"""The inputs of a CrIS granule's assessment, read ahead of its collocation: its GEO and SDR, their inverse
+geometry and band BT, the VIIRS granules it reaches read over the scans it needs (the scan overlap's halos
+included) and prepared once per run as swath pieces (:mod:`monitor.collocation.swath`)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from monitor.collocation import collocate, swath
+from monitor.config.assessment import AssessmentConfig
+from monitor.core.vocabulary import Kernel
+from monitor.geometry.inverse import FovGeometry, granule_geometry
+from monitor.geometry.perturb import perturbation_grid
+from monitor.instrument.spectral import I5Band
+from monitor.sdr import (
+    CrisGeoGranule,
+    CrisSdrGranule,
+    GranuleError,
+    ViirsGeoGranule,
+    ViirsSdrGranule,
+    read_file,
+)
+from monitor.sdr.pairing import GranuleFiles, neighbours
+from monitor.sdr.readers import read_scan_start_us, read_viirs_geo_scan
+
+Timings = dict[str, float] | None  # seconds per stage, added to when a dict
+
+
+Span = tuple[int, int]  # IET (us) from, to
+
+
+# a VIIRS granule read: GEO, SDR, and the neighbours' adjacent scans (lat_rad, lon_rad, height_m) or None
+RawViirs = tuple[
+    ViirsGeoGranule, ViirsSdrGranule, tuple[np.ndarray, ...] | None, tuple[np.ndarray, ...] | None
+]
+
+
+# the discs each kernel collocates; the top-hat cone is one of them either way
+KERNELS = {Kernel.TOP_HAT: collocate.TOP_HAT, Kernel.FOOTPRINT: collocate.ANNULI}
+
+
+def offsets_rad(cfg: AssessmentConfig) -> np.ndarray:
+    """The perturbation angles (rad) of one axis of the grid, -half_steps..+half_steps steps."""
+    return perturbation_grid(cfg.half_steps, cfg.step_rad)
+
+
+@contextmanager
+def stage(timings: Timings, name: str) -> Iterator[None]:
+    """Add the wall time of the block to timings[name] (seconds) when *timings* is a dict."""
+    t0 = time.perf_counter()
+    try:
+        yield
+    finally:
+        if timings is not None:
+            timings[name] = timings.get(name, 0.0) + time.perf_counter() - t0
+
+
+@dataclass
+class SwathCache:
+    """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept. *spans* holds, by key,
+    the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`)."""
+
+    pieces: dict = field(default_factory=dict)
+    keep: int = 3
+    spans: dict = field(default_factory=dict)
+
+
+def _widen(span: Span | None, other: Span | None) -> Span | None:
+    """The IET span covering both *span* and *other* (either may be None)."""
+    if span is None or other is None:
+        return other if span is None else span
+    return (min(span[0], other[0]), max(span[1], other[1]))
+
+
+def reach_us(first_us: int, last_us: int) -> Span:
+    """The IET span (us) of the VIIRS scans that CrIS observations from first_us to last_us may reach."""
+    return (first_us - collocate.SCAN_TIME_MARGIN_US, last_us + collocate.SCAN_TIME_MARGIN_US)
+
+
+def scan_spans(cris: list[GranuleFiles], viirs: dict[str, list[GranuleFiles]]) -> dict[str, Span]:
+    """Per VIIRS granule key, the IET span (us) of the scans the CrIS granules *cris* using it need (by
+    their nominal bounds, :func:`reach_us`): so that each is prepared once per run."""
+    spans: dict[str, tuple[int, int]] = {}
+    for g in cris:
+        need = reach_us(g.geo_meta.start_iet_us, g.geo_meta.end_iet_us)
+        for v in viirs[g.key]:
+            spans[v.key] = _widen(spans.get(v.key), need) or need  # (never None: need is a span)
+    return spans
+
+
+@dataclass
+class GranuleInputs:
+    """What one CrIS granule's assessment needs before its VIIRS granules are prepared: its GEO and SDR,
+    their inverse geometry (fg, valid, fill: :func:`cris_geometry`), how far from nadir its cones reach
+    (view_rad), the IET span (us) of the VIIRS scans they may reach (span_us, from its observation
+    times: :func:`reach_us`; None when it has none), its band BT (bt_cris_k), and the raw VIIRS
+    granules (key -> (GEO, SDR, scan before, scan after)) not yet prepared."""
+
+    geo: CrisGeoGranule
+    sdr: CrisSdrGranule
+    fg: FovGeometry
+    valid: np.ndarray
+    fill: dict
+    view_rad: float
+    span_us: tuple | None
+    bt_cris_k: np.ndarray
+    viirs: dict = field(default_factory=dict)
+
+
+def read_viirs(v: GranuleFiles, viirs_all: list[GranuleFiles], span_us: Span | None = None) -> RawViirs:
+    """A VIIRS granule's GEO and SDR, with the adjacent scans of its neighbours (for the scan overlap).
+
+    Given *span_us* (IET us), only what :func:`swath.swath_piece` uses of that span is read: the scans
+    observed in it and one scan either side (their halos), and a neighbour's adjacent scan only where the
+    span reaches the granule's edge. The other rows hold fill; read in place, their bytes never travel."""
+    scans = slice(None)
+    if span_us is not None:
+        start_us = read_scan_start_us(v.geo)
+        first, stop, _ = swath.scans_between(start_us, *span_us).indices(len(start_us))
+        scans = slice(max(first - 1, 0), min(stop + 1, len(start_us)))
+    before, after = neighbours(viirs_all, v)
+    geo = read_file(v.geo, kinds=("viirs_geo",), scans=scans)[0]
+    sdr = read_file(v.sdr, kinds=("viirs_sdr",), scans=scans)[0]
+    n_scans = len(geo.start_time_us)
+    edge_before, edge_after = scans.indices(n_scans)[0] == 0, scans.indices(n_scans)[1] == n_scans
+    halo_before = read_viirs_geo_scan(before.geo, -1) if before is not None and edge_before else None
+    halo_after = read_viirs_geo_scan(after.geo, 0) if after is not None and edge_after else None
+    if sdr.bt_k.shape != geo.lat_rad.shape:
+        raise GranuleError(
+            v.sdr,
+            "BrightnessTemperature",
+            f"shape {sdr.bt_k.shape} does not match the GEO {geo.lat_rad.shape}",
+        )
+    return geo, sdr, halo_before, halo_after
+
+
+def read_inputs(
+    cris: GranuleFiles,
+    viirs: list[GranuleFiles],
+    viirs_all: list[GranuleFiles],
+    band: I5Band,
+    cfg: AssessmentConfig,
+    prepared: Iterable[str] = (),
+    timings: Timings = None,
+    spans: dict[str, Span] | None = None,
+) -> GranuleInputs:
+    """Read what :func:`collocate_granule` needs of *cris*, except the VIIRS granules in *prepared*, and
+    compute what depends on the CrIS granule alone (its geometry and band BT). A VIIRS granule is read
+    over its scans of the run (*spans*, by key: :func:`scan_spans`) and of this granule's reach."""
+    with stage(timings, "read"):
+        geo = next(
+            g
+            for g in read_file(cris.geo, kinds=("cris_geo",))
+            if g.meta.granule_id == cris.geo_meta.granule_id
+        )
+        sdr = next(
+            g
+            for g in read_file(cris.sdr, kinds=("cris_sdr",))
+            if g.meta.granule_id == cris.sdr_meta.granule_id
+        )
+        if sdr.radiance_lw.shape[:3] != geo.lat_rad.shape:
+            raise GranuleError(
+                cris.sdr,
+                "ES_RealLW",
+                f"shape {sdr.radiance_lw.shape[:3]} does not match the GEO {geo.lat_rad.shape}",
+            )
+        seen = geo.for_time_us[geo.for_time_us > 0]
+        span_us = reach_us(int(seen.min()), int(seen.max())) if seen.size else None
+        raw = {
+            v.key: read_viirs(v, viirs_all, _run_span(spans or {}, v.key, span_us))
+            for v in viirs
+            if v.key not in prepared
+        }
+    with stage(timings, "spectral"):
+        bt_cris = band.bt_from_radiance(band.cris_band_radiance(np.nan_to_num(sdr.radiance_lw)))
+    with stage(timings, "geometry"):
+        fg, valid, fill = cris_geometry(geo)
+        view_rad = collocate.view_reach_rad(
+            fg.sat_ecef_m[valid],
+            fg.sbf_to_ecef[valid],
+            fg.alpha_rad[valid],
+            fg.beta_rad[valid],
+            offsets_rad(cfg),
+            KERNELS[cfg.kernel],
+        )
+    return GranuleInputs(geo, sdr, fg, valid, fill, view_rad, span_us, bt_cris, raw)
+
+
+def _run_span(spans: dict[str, Span], key: str, span_us: Span | None) -> Span | None:
+    """The IET span of VIIRS granule *key* prepared for a CrIS granule reaching *span_us*: the run's span
+    of that granule widened to it (None, every scan, when the CrIS granule has no observation time)."""
+    return _widen(spans.get(key), span_us) if span_us is not None else None
+
+
+def piece(
+    v: GranuleFiles,
+    viirs_all: list[GranuleFiles],
+    band: I5Band,
+    cache: SwathCache,
+    view_rad: float,
+    timings: Timings = None,
+    raw: RawViirs | None = None,
+    span_us: Span | None = None,
+) -> swath.SwathPiece:
+    """The granule prepared out to at least *view_rad* from nadir, with its scans of the IET span
+    *span_us* (None: all): from the cache, or prepared out to view_rad + VIEW_MARGIN_RAD (so that the next
+    CrIS granule's slightly wider reach finds it ready) with the scans the whole run needs."""
+    cached = cache.pieces.get(v.key)
+    if cached is not None and cached.view_rad >= view_rad and (span_us is None or cached.covers(*span_us)):
+        return cached
+    cache.pieces.pop(v.key, None)
+    run_span = _run_span(cache.spans, v.key, span_us)
+    if raw is None:
+        with stage(timings, "read"):
+            raw = read_viirs(v, viirs_all, run_span)
+    geo, sdr, halo_before, halo_after = raw
+    assert geo.height_m is not None  # zeros for the ellipsoid product (ViirsGeoGranule)
+    with stage(timings, "geometry"):
+        piece = swath.swath_piece(
+            geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
+            sat_m=geo.sc_position_m, view_rad=view_rad + collocate.VIEW_MARGIN_RAD,
+            scan_start_us=geo.start_time_us, span_us=run_span,
+        )  # fmt: skip
+    while len(cache.pieces) >= cache.keep:
+        cache.pieces.pop(next(iter(cache.pieces)))
+    cache.pieces[v.key] = piece
+    return piece
+
+
+def load_swath(
+    viirs: list[GranuleFiles],
+    viirs_all: list[GranuleFiles],
+    band: I5Band,
+    cache: SwathCache,
+    view_rad: float,
+    timings: Timings = None,
+    raw: dict[str, RawViirs] | None = None,
+    span_us: Span | None = None,
+) -> swath.ViirsSwath:
+    """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*) out
+    to *view_rad* from nadir and over the IET span *span_us*, from the raw granules in *raw* (key ->
+    :func:`read_viirs`) or read here."""
+    raw = raw or {}
+    return swath.ViirsSwath(
+        [piece(v, viirs_all, band, cache, view_rad, timings, raw.get(v.key), span_us) for v in viirs]
+    )
+
+
+def cris_geometry(geo: CrisGeoGranule) -> tuple[FovGeometry, np.ndarray, dict]:
+    """Inverse geolocation of a CrIS GEO granule, with fill FOVs given harmless values and masked."""
+    valid = geo.valid
+    fill = {
+        k: np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")
+    }
+    return granule_geometry(geo), valid, fill
