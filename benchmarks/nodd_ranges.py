@@ -53,7 +53,10 @@ def simulate(root: Path, granules: int, layout: str) -> list[Path]:
     out = root / f"{layout}_{granules}"
     if not (out / "truth.json").exists():
         shutil.rmtree(out, ignore_errors=True)
-        simulate_case(out, SATELLITE, granules, "paper", seed=1, complete=True, layout=layout)
+        simulate_case(
+            out, satellite=SATELLITE, granules=granules, profile="paper", seed=1, complete=True,
+            layout=layout,
+        )  # fmt: skip
     return [out / n for n in json.loads((out / "truth.json").read_text())["files"]]
 
 

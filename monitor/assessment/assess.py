@@ -31,7 +31,7 @@ from monitor.assessment.inputs import (
 )
 from monitor.collocation import collocate, swath
 from monitor.config.assessment import AssessmentConfig
-from monitor.core.constants import FOV_DIAMETER_RAD, N_FOR
+from monitor.core.constants import FOV_HALF_ANGLE_RAD, N_FOR
 from monitor.core.errors import AssessmentError, StopRequested
 from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
 from monitor.core.threads import parallel_threads
@@ -53,9 +53,6 @@ StopCheck = Callable[[], bool] | None  # polled; True: stop
 
 
 Progress = Callable[["GranuleFiles"], object] | None  # called after each granule
-
-
-CONE_RADIUS_RAD = FOV_DIAMETER_RAD / 2
 
 
 @dataclass
@@ -163,7 +160,7 @@ def _collocate_fors(
         fov_range_m=np.where(valid, geo.range_m, 1e6).ravel(),
         fov_cos_zen=np.cos(fill["zenith_rad"]).ravel(),
     )
-    cone = KERNELS[cfg.kernel].index(CONE_RADIUS_RAD)
+    cone = KERNELS[cfg.kernel].index(FOV_HALF_ANGLE_RAD)
     bt_viirs = band.bt_from_radiance(cones.mean(cone)).astype(np.float32).reshape(shape + (m, m))
     coverage = np.min(cones.coverage(), axis=(-2, -1)).reshape(shape)
     annuli = None

@@ -22,7 +22,7 @@ from monitor.cli.registry import (
 )
 from monitor.cli.types import iso_time, longitude, whole
 from monitor.config.assessment import AssessmentConfig
-from monitor.core.constants import N_FOV
+from monitor.core.constants import N_FOV, PAPER_GRANULES
 from monitor.core.satellites import SATELLITES
 from monitor.instrument.footprint import SHAPES as FOOTPRINTS
 from monitor.simulate import LAYOUTS
@@ -37,9 +37,14 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     "write simulated CrIS/VIIRS granules with an injected LOS error",
     arg("--out", required=True, help="output directory"),
     arg("--satellite", choices=tuple(SATELLITES), default="j01"),
-    arg("--granules", type=whole(1), default=14, help="consecutive CrIS granules (default 14, as the paper)"),
-    arg("--profile", default="paper", help="paper, random, zero, or a JSON/YAML profile file"),
-    arg("--seed", type=whole(0), default=0),
+    arg(
+        "--granules",
+        type=whole(1),
+        default=PAPER_GRANULES,
+        help=f"consecutive CrIS granules (default {PAPER_GRANULES}, as the paper)",
+    ),
+    arg("--profile", help="paper (default), random, zero, or a JSON/YAML profile file"),
+    arg("--seed", type=whole(0), help="the simulator's seed (default 0)"),
     arg("--start", type=iso_time, default=None, help="UTC start of the first granule (ISO 8601)"),
     arg("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)"),
     arg("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)"),
@@ -73,7 +78,7 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
 )
 def cmd_simulate(args: argparse.Namespace) -> int:
     """crisgeo simulate: write a simulated case."""
-    from monitor.simulate.case import DEFAULT_START, SimulationSpec, simulate_case
+    from monitor.simulate.case import simulate_case
 
     where = dict(
         terrain=args.terrain,
@@ -85,32 +90,20 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     )
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")
-    spec = None
+    given = {
+        "start": args.start,
+        "seed": args.seed,
+        "profile": args.profile,
+    }  # unset: the simulator's
+    case = dict(satellite=args.satellite, granules=args.granules, **where)
+    case.update({k: v for k, v in given.items() if v is not None})
     if args.true_ep:
-        spec = SimulationSpec(
-            satellite=args.satellite,
-            granules=args.granules,
-            seed=args.seed,
-            start=args.start or DEFAULT_START,
-            profile="ep",
-            true_ep=ep_file(args.true_ep),
-            ground_ep=ep_file(args.ground_ep),
-            **where,
-        )
-    truth = simulate_case(
-        args.out,
-        satellite=args.satellite,
-        granules=args.granules,
-        profile=args.profile,
-        seed=args.seed,
-        start=args.start,
-        spec=spec,
-        **where,
-    )
-    error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {args.profile}"
+        case.update(profile="ep", true_ep=ep_file(args.true_ep), ground_ep=ep_file(args.ground_ep))
+    truth = simulate_case(args.out, **case)
+    error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {truth['profile']}"
     print(
         f"wrote {len(truth['files'])} files and truth.json to {args.out} "
-        f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {args.seed})"
+        f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {truth['seed']})"
     )
     return EXIT_OK
 
@@ -178,7 +171,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
 @command(
     "bench",
     "time each stage on a simulated case; print FOVs/s and peak memory",
-    arg("--granules", type=whole(1), default=14),
+    arg("--granules", type=whole(1), default=PAPER_GRANULES),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
     WORKERS,

@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from monitor.collocation.swath import BLOCK_PX, DETECTORS, SwathPiece, ViirsSwath, swath_piece
-from monitor.core.constants import FOV_DIAMETER_RAD, MAX_GRID_SPREAD_RAD
+from monitor.collocation.swath import BLOCK_PX, SwathPiece, ViirsSwath, swath_piece
+from monitor.core.constants import FOV_HALF_ANGLE_RAD, MAX_GRID_SPREAD_RAD, VIIRS_DETECTORS
 from monitor.core.threads import KERNEL_LOCK
 from monitor.geometry import wgs84
 from monitor.instrument.spectral import PARALLEL_FROM, i5_band
@@ -50,8 +50,8 @@ from monitor.instrument.spectral import PARALLEL_FROM, i5_band
 # Four discs: the kernel's work grows with their number, and three (no edge inside the cone) miss the
 # response's fall
 # from 0.42 to 0.48 deg (6-granule smooth cases: 11-12 urad RMS against 3-4 with four; six gave 3-3.5).
-TOP_HAT = (FOV_DIAMETER_RAD / 2,)
-ANNULI = (math.radians(0.42), FOV_DIAMETER_RAD / 2, math.radians(0.56), math.radians(0.64))
+TOP_HAT = (FOV_HALF_ANGLE_RAD,)
+ANNULI = (math.radians(0.42), FOV_HALF_ANGLE_RAD, math.radians(0.56), math.radians(0.64))
 # The kernel's threads take FOVs in chunks of this many as they come free (FOVs differ in pixel count, and
 # the read-ahead thread takes turns on the cores), not in equal shares fixed in advance
 FOVS_PER_TASK = 8
@@ -110,8 +110,8 @@ def _window_half_sizes(
     d_scan = rho * range_m / cz + relief
     adv = piece.advance_m[col0]
     det = piece.det_step_m[col0]
-    overlap = np.clip(1.0 - adv / (DETECTORS * det), 0.0, 1.0)
-    half_rows = np.ceil(d_track / (adv / DETECTORS) + DETECTORS * overlap + 8).astype(np.int64)
+    overlap = np.clip(1.0 - adv / (VIIRS_DETECTORS * det), 0.0, 1.0)
+    half_rows = np.ceil(d_track / (adv / VIIRS_DETECTORS) + VIIRS_DETECTORS * overlap + 8).astype(np.int64)
     half_cols = np.ceil(d_scan / piece.col_spacing_m[col0] + 4).astype(np.int64)
     return half_rows, half_cols, np.maximum(d_track, d_scan)
 
@@ -392,7 +392,7 @@ def warm_up() -> float:
     """Compile the kernels (or load them from numba's cache) on a tiny synthetic granule, so that a timing
     or the first granule does not pay for it; the seconds it took."""
     t0 = time.perf_counter()
-    rows, cols = 2 * DETECTORS, 16
+    rows, cols = 2 * VIIRS_DETECTORS, 16
     r, c = np.meshgrid(np.arange(rows), np.arange(cols), indexing="ij")
     lat, lon = np.radians(0.004 * r).astype(np.float32), np.radians(0.004 * c).astype(np.float32)
     zeros = np.zeros((rows, cols), np.float32)

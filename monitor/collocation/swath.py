@@ -41,11 +41,11 @@ from numpy.typing import ArrayLike
 from scipy.ndimage import minimum_filter1d
 from scipy.spatial import cKDTree
 
+from monitor.core.constants import VIIRS_DETECTORS
 from monitor.core.threads import KERNEL_LOCK
 from monitor.geometry import wgs84
 
-DETECTORS = 32  # VIIRS I-band detectors per scan
-BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of DETECTORS)
+BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of VIIRS_DETECTORS)
 
 
 class BandTable(Protocol):
@@ -145,7 +145,7 @@ def _scan_ends(scan: np.ndarray, first: np.ndarray, last: np.ndarray, step: np.n
     for c in range(scan.shape[1]):
         i0 = -1
         i1 = -1
-        for d in range(DETECTORS):
+        for d in range(VIIRS_DETECTORS):
             if math.isfinite(scan[d, c, 0]):
                 if i0 < 0:
                     i0 = d
@@ -184,9 +184,9 @@ def _locate_scan(
     it or where not *good*), and the scan's ends (slot k + 1; 0 and nscan + 1 are the halos)."""
     cols = lat.shape[1]
     nt = table.shape[0]
-    sl = slice(k * DETECTORS, (k + 1) * DETECTORS)
+    sl = slice(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS)
     _ecef(lat[sl], lon[sl], h[sl], pos[sl])
-    for r in range(k * DETECTORS, (k + 1) * DETECTORS):
+    for r in range(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS):
         for c in range(cols):
             x = (np.float64(bt[r, c]) - t_min_k) / t_step_k
             if good[r, c] and x >= 0.0 and x <= nt - 1:
@@ -215,7 +215,7 @@ def _locate(
     step: np.ndarray,
 ) -> None:
     """Pass 1 (:func:`_locate_scan`), scans in parallel."""
-    for k in numba.prange(lat.shape[0] // DETECTORS):
+    for k in numba.prange(lat.shape[0] // VIIRS_DETECTORS):
         _locate_scan(k, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step)
 
 
@@ -317,11 +317,11 @@ def _weigh_scan(
     foot = np.empty((3, cols))
     lo = np.empty((nbc, 3))  # the bounding box of each block of the current band of BLOCK_PX rows
     hi = np.empty((nbc, 3))
-    for r in range(k * DETECTORS, (k + 1) * DETECTORS):
-        d = r - k * DETECTORS
+    for r in range(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS):
+        d = r - k * VIIRS_DETECTORS
         _load_row(pos, r - 1, d > 0, prev)
         _load_row(pos, r, True, here)
-        _load_row(pos, r + 1, d + 1 < DETECTORS, after)
+        _load_row(pos, r + 1, d + 1 < VIIRS_DETECTORS, after)
         if d % BLOCK_PX == 0:
             lo[:] = np.inf
             hi[:] = -np.inf
@@ -378,7 +378,7 @@ def _weigh(
     top: np.ndarray,
 ) -> None:
     """Pass 2 (:func:`_weigh_scan`), scans in parallel."""
-    for k in numba.prange(radiance.shape[0] // DETECTORS):
+    for k in numba.prange(radiance.shape[0] // VIIRS_DETECTORS):
         _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
 
@@ -414,7 +414,7 @@ def view_columns(
     """
     scans = np.unique(np.r_[np.arange(0, len(sat_m), 4), len(sat_m) - 1])
     sat = np.asarray(sat_m, float)[scans]
-    mid = scans * DETECTORS + DETECTORS // 2
+    mid = scans * VIIRS_DETECTORS + VIIRS_DETECTORS // 2
     los = wgs84.geodetic_to_ecef(lat_rad[mid], lon_rad[mid], height_m[mid]) - sat[:, None, :]
     nadir = -sat / np.linalg.norm(sat, axis=-1, keepdims=True)
     with np.errstate(invalid="ignore"):
@@ -467,12 +467,12 @@ def swath_piece(
         scans = scans_between(scan_start_us, *span_us)
     if scans != slice(None) and scan_start_us is not None:
         first, stop, _ = scans.indices(len(scan_start_us))
-        r0, r1 = first * DETECTORS, stop * DETECTORS
+        r0, r1 = first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS
         geo = (lat_rad, lon_rad, height_m)
         if first > 0:
-            before = tuple(a[r0 - DETECTORS : r0] for a in geo)
+            before = tuple(a[r0 - VIIRS_DETECTORS : r0] for a in geo)
         if r1 < np.shape(lat_rad)[0]:
-            after = tuple(a[r1 : r1 + DETECTORS] for a in geo)
+            after = tuple(a[r1 : r1 + VIIRS_DETECTORS] for a in geo)
         lat_rad, lon_rad, height_m, bt_k, good = (a[r0:r1] for a in (*geo, bt_k, good))
         sat_m = None if sat_m is None else sat_m[first:stop]
         t = np.asarray(scan_start_us, np.int64)
@@ -491,7 +491,7 @@ def swath_piece(
     # the kernels read the kept columns in place (a copy of them costs more than the strided reads)
     lat, lon, h = (np.asarray(a, f32) for a in (lat_rad, lon_rad, height_m))
     rows, cols = lat.shape
-    nscan = rows // DETECTORS
+    nscan = rows // VIIRS_DETECTORS
     pos = np.empty((rows, cols, 3), f32)
     radiance = np.empty((rows, cols), f32)
     ends_first = np.full((nscan + 2, cols, 3), np.nan)  # each scan's first and last row
@@ -516,14 +516,14 @@ def swath_piece(
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
         _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
 
-    scan = pos.reshape(nscan, DETECTORS, cols, 3)
+    scan = pos.reshape(nscan, VIIRS_DETECTORS, cols, 3)
     mid = scan[nscan // 2]
     col_spacing = _fill_nan(np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=1), axis=-1), axis=0))
     det_step = np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=0), axis=-1), axis=0)
     if nscan > 1:
         advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
     else:
-        advance = det_step * DETECTORS
+        advance = det_step * VIIRS_DETECTORS
     r_idx, c_idx = np.nonzero(np.isfinite(radius))
     # unbalanced with large leaves: builds 2.5x faster, the same nearest blocks
     tree = cKDTree(centre[r_idx, c_idx], leafsize=64, balanced_tree=False, compact_nodes=False)

@@ -7,11 +7,19 @@ URAD = 1e-6  # radians per microradian (EP files and reports hold urad)
 
 N_FOR = 30  # CrIS fields of regard (scan positions) per scan
 N_FOV = 9  # CrIS fields of view per FOR (3 x 3)
+PAPER_GRANULES = 14  # the granules of the paper's day (Wang et al. 2017: 14 granules x 4 scans x 9 FOVs)
 FOV_DIAMETER_URAD = 16807.5  # CrIS FOV size, 0.963 deg (Wang et al. 2017; the EP files carry 16808)
 FOV_DIAMETER_RAD = FOV_DIAMETER_URAD * URAD
+FOV_HALF_ANGLE_RAD = FOV_DIAMETER_RAD / 2  # the paper's cone: its radius about the LOS
+FOV_SPACING_RAD = 19.1e-3  # CrIS FOV centre spacing, ~1.1 deg (EP offsets, docs/jpss-formats.md 2.1)
 
 CRIS_SCAN_US = 8_000_000  # CrIS scan period (IET microseconds)
+CRIS_SCANS_PER_GRANULE = 4
+CRIS_GRANULE_US = CRIS_SCANS_PER_GRANULE * CRIS_SCAN_US  # a CrIS granule, 32 s
 VIIRS_SCAN_US = 1_786_400  # VIIRS scan period, 1.7864 s
+VIIRS_DETECTORS = 32  # VIIRS I-band detectors: the rows of one scan
+VIIRS_SCANS = 48  # scans a VIIRS granule's arrays always hold (those past N_Number_Of_Scans are fill)
+VIIRS_COLUMNS = 6400  # I-band samples per row
 
 SPEC_KM = 1.5  # the CrIS geolocation specification (each of in-track and cross-track), km
 

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass, field, fields
+import typing
+from dataclasses import MISSING, asdict, dataclass, field, fields
+from typing import Any
 
 import numpy as np
 
-from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DIAMETER_URAD
+from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DIAMETER_URAD, URAD
 
 FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
 FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
@@ -34,43 +36,155 @@ class SpecBreach:
 
 
 @dataclass(frozen=True)
+class Family:
+    """A gauge family of ``/metrics`` that per-FOR fields are published in: its name (in base units, by
+    Prometheus' conventions), its help, and the label that tells its fields apart (empty: one field)."""
+
+    name: str
+    help: str
+    label: str = ""
+
+
+# the /metrics families of the per-FOR fields (:mod:`monitor.service.metrics` adds the FOR's labels)
+OFFSET_RADIANS = Family(
+    "crisgeo_for_offset_radians",
+    "Latest LOS offset per FOR (spacecraft frame; the turn to apply to the CrIS LOS)",
+    "direction",
+)
+OFFSET_METERS = Family("crisgeo_for_offset_meters", "Latest offset per FOR on the ground", "direction")
+CALIBRATION_BIAS = Family(
+    "crisgeo_for_calibration_bias_kelvin",
+    "Latest CrIS minus VIIRS I5 BT at the reference temperature (280 K) per FOR, at the optimum",
+)
+CALIBRATION_GAIN = Family(
+    "crisgeo_for_calibration_gain_ratio",
+    "Latest CrIS minus VIIRS I5 gain difference per FOR (fraction of the BT's departure from 280 K)",
+)
+RESPONSE_WIDTH = Family(
+    "crisgeo_for_response_full_width_radians",
+    "Latest full width of the CrIS FOV spatial response fitted per FOR, at a level of its peak",
+    "level",
+)
+# a field's unit (as CF writes it) -> the factor to the SI unit /metrics publishes it in
+TO_BASE_UNIT = {"urad": URAD, "km": 1000.0, "K": 1.0, "percent": 0.01, "1": 1.0}
+
+
+@dataclass(frozen=True)
+class Measure:
+    """A measured per-FOR field, as :class:`ForOffset` declares it: its name (ending in its unit), its unit
+    as CF writes it, its meaning; whether it tells the quality of a measurement (an uncertainty, a cost)
+    rather than being one; whether the time series carries it; where ``/metrics`` publishes it (a family
+    and the value of its label), if it does. The export, the text tables' units, ``/metrics``, the time
+    series and the store's columns all derive from these (:func:`measures`)."""
+
+    name: str
+    kind: type
+    unit: str
+    meaning: str
+    quality: bool = False
+    series: bool = True
+    metric: tuple[Family, str] | None = None
+
+    @property
+    def to_base_unit(self) -> float:
+        """The factor from the field's unit to the SI unit of ``/metrics``."""
+        return TO_BASE_UNIT[self.unit]
+
+
+def measured(
+    unit: str,
+    meaning: str,
+    default: Any = MISSING,
+    quality: bool = False,
+    series: bool = True,
+    metric: tuple[Family, str] | None = None,
+) -> Any:
+    """Declare a measured field of :class:`ForOffset` (or of a record extending it): its unit, meaning and
+    outputs (:class:`Measure`); *default* MISSING: required."""
+    spec = {"unit": unit, "meaning": meaning, "quality": quality, "series": series, "metric": metric}
+    return field(default=default, metadata={"measure": spec})
+
+
+NAN = float("nan")
+SIGMA = "uncertainty (1 sigma) of the"
+
+
+@dataclass(frozen=True)
 class ForOffset:
     """Offsets of one scan position (FOR 1..30): the turn to apply to the CrIS LOS to best match VIIRS.
 
     Angles in microradians (in-track alpha, cross-track beta), distances in km on the ground (in-track
     positive along the flight direction, cross-track positive to the right), cost in kelvin. At the optimum,
-    the CrIS-VIIRS intercalibration (:mod:`monitor.estimation.intercal`): the BT bias (K) at the reference
-    temperature, the gain there (per cent) and the curvature (K), NaN where none was fitted; and the full
-    widths (urad) of the CrIS spatial response found there (:mod:`monitor.estimation.estimate`), NaN where
-    none was fitted.
+    the CrIS-VIIRS intercalibration (:mod:`monitor.estimation.intercal`) and the full widths of the CrIS
+    spatial response found there (:mod:`monitor.estimation.estimate`), NaN where none was fitted. Every
+    measured field is declared once, here, with its unit and meaning (:func:`measured`).
     """
 
     for_index: int
-    d_alpha_urad: float
-    d_beta_urad: float
-    sigma_alpha_urad: float
-    sigma_beta_urad: float
-    in_track_km: float
-    cross_track_km: float
-    total_km: float
-    sigma_in_track_km: float
-    sigma_cross_track_km: float
-    n_samples: int
-    cost_min_k: float
-    cost_zero_k: float
+    d_alpha_urad: float = measured(
+        "urad", "in-track LOS offset (see sign_convention)", metric=(OFFSET_RADIANS, "alpha")
+    )
+    d_beta_urad: float = measured(
+        "urad", "cross-track LOS offset (see sign_convention)", metric=(OFFSET_RADIANS, "beta")
+    )
+    sigma_alpha_urad: float = measured("urad", f"{SIGMA} in-track offset", quality=True)
+    sigma_beta_urad: float = measured("urad", f"{SIGMA} cross-track offset", quality=True)
+    in_track_km: float = measured(
+        "km",
+        "in-track geolocation error on the ground (see sign_convention)",
+        metric=(OFFSET_METERS, "in_track"),
+    )
+    cross_track_km: float = measured(
+        "km",
+        "cross-track geolocation error on the ground (see sign_convention)",
+        metric=(OFFSET_METERS, "cross_track"),
+    )
+    total_km: float = measured("km", "total geolocation error on the ground", metric=(OFFSET_METERS, "total"))
+    sigma_in_track_km: float = measured("km", f"{SIGMA} in-track error", quality=True, series=False)
+    sigma_cross_track_km: float = measured("km", f"{SIGMA} cross-track error", quality=True, series=False)
+    n_samples: int = measured("1", "CrIS FOVs in the cost function", quality=True)
+    cost_min_k: float = measured(
+        "K",
+        "minimum over the perturbations of the cost (STDEV of BT_VIIRS - BT_CrIS, or its residual after the "
+        "calibration regression: assessment.cost)",
+        quality=True,
+    )
+    cost_zero_k: float = measured("K", "cost of the unperturbed LOS", quality=True)
     flags: tuple = ()
-    bias_k: float = float("nan")
-    sigma_bias_k: float = float("nan")
-    gain_pct: float = float("nan")
-    sigma_gain_pct: float = float("nan")
-    curvature_k: float = float("nan")
-    sigma_curvature_k: float = float("nan")
-    # the CrIS spatial response fitted at the optimum (kernel footprint, monitor.estimation.estimate): its
-    # full widths at 50 and 10 % of the peak, NaN where none was fitted
-    response_width_50_urad: float = float("nan")
-    sigma_response_width_50_urad: float = float("nan")
-    response_width_10_urad: float = float("nan")
-    sigma_response_width_10_urad: float = float("nan")
+    bias_k: float = measured(
+        "K",
+        "CrIS minus VIIRS I5 brightness temperature at 280 K, at the optimum",
+        NAN,
+        metric=(CALIBRATION_BIAS, ""),
+    )
+    sigma_bias_k: float = measured("K", f"{SIGMA} CrIS minus VIIRS bias", NAN, quality=True)
+    gain_pct: float = measured(
+        "percent",
+        "CrIS minus VIIRS I5 gain difference (per cent of the BT departure from 280 K)",
+        NAN,
+        metric=(CALIBRATION_GAIN, ""),
+    )
+    sigma_gain_pct: float = measured("percent", f"{SIGMA} gain difference", NAN, quality=True)
+    curvature_k: float = measured("K", "curvature of CrIS minus VIIRS: what it adds at 250 and 310 K", NAN)
+    sigma_curvature_k: float = measured("K", f"{SIGMA} curvature", NAN, quality=True)
+    response_width_50_urad: float = measured(
+        "urad",
+        "full width at 50 % of its peak of the CrIS FOV spatial response fitted at the optimum",
+        NAN,
+        metric=(RESPONSE_WIDTH, "0.5"),
+    )
+    sigma_response_width_50_urad: float = measured(
+        "urad", f"{SIGMA} response's full width at 50 %", NAN, quality=True
+    )
+    response_width_10_urad: float = measured(
+        "urad",
+        "full width at 10 % of its peak of the CrIS FOV spatial response fitted at the optimum",
+        NAN,
+        metric=(RESPONSE_WIDTH, "0.1"),
+    )
+    sigma_response_width_10_urad: float = measured(
+        "urad", f"{SIGMA} response's full width at 10 %", NAN, quality=True
+    )
 
     @property
     def d_alpha_pct_fov(self) -> float:
@@ -120,8 +234,19 @@ class ForOffset:
         return cls(for_index=int(d["for"]), **kw)
 
 
+def measures(record: type = ForOffset) -> tuple[Measure, ...]:
+    """The measured fields of *record* (:class:`ForOffset`, or a record extending it) in declaration order:
+    what the export, the tables, ``/metrics``, the time series and the store derive from."""
+    hints = typing.get_type_hints(record)
+    return tuple(
+        Measure(f.name, hints[f.name], **f.metadata["measure"])
+        for f in fields(record)
+        if "measure" in f.metadata
+    )
+
+
 # the measured fields of a FOR (all but its index and flags), in the order of the dataclass
-MEASURED_FIELDS = tuple(f.name for f in fields(ForOffset) if f.name not in ("for_index", "flags"))
+MEASURED_FIELDS = tuple(m.name for m in measures())
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from operator import attrgetter
 from typing import Any
 
-from monitor.core.result import ForOffset
+from monitor.core.result import ForOffset, measures
 
 
 @dataclass(frozen=True)
@@ -52,21 +52,27 @@ def _flags(f: ForOffset) -> str:
     return ",".join(f.flags)
 
 
+def field_column(header: str, name: str, fmt: str, width: int, record: type = ForOffset) -> Column:
+    """The column of the measured field *name* of *record*, its unit the declaration's (a count has none)."""
+    unit = next(m.unit for m in measures(record) if m.name == name)
+    return Column(header, name, fmt, width, "" if unit == "1" else unit)
+
+
 FOR_COLUMNS = {
     "for": Column("FOR", "for_index", "d", 3),
-    "d_alpha": Column("d_alpha", "d_alpha_urad", ".0f", 8, "urad"),
-    "sigma_alpha": Column("+-", "sigma_alpha_urad", ".0f", 5),
-    "d_beta": Column("d_beta", "d_beta_urad", ".0f", 8, "urad"),
+    "d_alpha": field_column("d_alpha", "d_alpha_urad", ".0f", 8),
+    "sigma_alpha": Column("+-", "sigma_alpha_urad", ".0f", 5),  # the unit is the offset's, left of it
+    "d_beta": field_column("d_beta", "d_beta_urad", ".0f", 8),
     "sigma_beta": Column("+-", "sigma_beta_urad", ".0f", 5),
     "alpha_pct_fov": Column("d_alpha", "d_alpha_pct_fov", ".1f", 7, "% FOV"),
     "beta_pct_fov": Column("d_beta", "d_beta_pct_fov", ".1f", 7, "% FOV"),
-    "in_track": Column("in-trk", "in_track_km", ".3f", 7, "km"),
-    "cross_track": Column("x-trk", "cross_track_km", ".3f", 7, "km"),
-    "total": Column("total", "total_km", ".3f", 6, "km"),
-    "n": Column("N", "n_samples", "d", 5),
-    "cost_min": Column("G_min", "cost_min_k", ".3f", 6, "K"),
-    "cost_zero": Column("G_0", "cost_zero_k", ".3f", 6, "K"),
-    "width_50": Column("FWHM", "response_width_50_urad", ".0f", 6, "urad"),
+    "in_track": field_column("in-trk", "in_track_km", ".3f", 7),
+    "cross_track": field_column("x-trk", "cross_track_km", ".3f", 7),
+    "total": field_column("total", "total_km", ".3f", 6),
+    "n": field_column("N", "n_samples", "d", 5),
+    "cost_min": field_column("G_min", "cost_min_k", ".3f", 6),
+    "cost_zero": field_column("G_0", "cost_zero_k", ".3f", 6),
+    "width_50": field_column("FWHM", "response_width_50_urad", ".0f", 6),
     "flags": Column("flags", _flags, "", 0, "", "<"),
 }
 # the column sets: what assess and run print, what status prints, what the report shows

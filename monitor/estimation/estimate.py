@@ -36,7 +36,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import nnls
@@ -489,12 +489,7 @@ def day_offsets(
                 n_samples=int(n),
                 cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
                 cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan,
-                bias_k=cal.bias_k,
-                sigma_bias_k=cal.sigma_bias_k,
-                gain_pct=cal.gain_pct,
-                sigma_gain_pct=cal.sigma_gain_pct,
-                curvature_k=cal.curvature_k,
-                sigma_curvature_k=cal.sigma_curvature_k,
+                **asdict(cal),  # the intercalibration's fields are the FOR's (Intercalibration)
                 response_width_50_urad=float(widths[0]),
                 sigma_response_width_50_urad=float(widths[1]),
                 response_width_10_urad=float(widths[2]),

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.core.constants import FOV_DIAMETER_RAD
+from monitor.core.constants import FOV_HALF_ANGLE_RAD
 
 # The specification's full widths (rad) at these levels of the peak: (level, lower bound, upper bound)
 SPEC_WIDTHS = (
@@ -129,7 +129,7 @@ def blurred_top_hat(
     return _tabulated(lambda x: np.interp(x, r, v / v[0]), reach)
 
 
-TOP_HAT = RadialResponse((0.0, FOV_DIAMETER_RAD / 2, FOV_DIAMETER_RAD / 2), (1.0, 1.0, 0.0))
+TOP_HAT = RadialResponse((0.0, FOV_HALF_ANGLE_RAD, FOV_HALF_ANGLE_RAD), (1.0, 1.0, 0.0))
 SHAPES = {
     "super-gaussian": super_gaussian,
     "trapezoid": trapezoid,

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.core.constants import N_FOR, N_FOV
+from monitor.core.constants import N_FOR, N_FOV, VIIRS_COLUMNS, VIIRS_DETECTORS, VIIRS_SCANS
 
 DEG = np.pi / 180.0
 ARCSEC = np.pi / (180.0 * 3600.0)
@@ -92,7 +92,6 @@ CRIS_LW_FIRST_CM1 = 648.75
 CRIS_LW_STEP_CM1 = 0.625
 CRIS_LW_CHANNELS = 717
 FOV = (N_FOR, N_FOV)  # CrIS: 30 fields of regard of 9 FOVs per scan
-VIIRS_COLUMNS = 6400  # I-band samples per row
 CRIS_GEO_FIELDS = {
     "for_time_us": Field("FORTime", kind="time", dims=(N_FOR,), limits=IET_LIMITS_US),
     "start_time_us": Field("StartTime", kind="time", limits=IET_LIMITS_US),
@@ -151,22 +150,27 @@ PRODUCTS = {
         Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
         Product("GCRSO", "CrIS-SDR-GEO", "cris_geo", fields=CRIS_GEO_FIELDS),
         Product(
-            "SVI05", "VIIRS-I5-SDR", "viirs_sdr", rows_per_scan=32, scans_reserved=48, fields=VIIRS_SDR_FIELDS
+            "SVI05",
+            "VIIRS-I5-SDR",
+            "viirs_sdr",
+            rows_per_scan=VIIRS_DETECTORS,
+            scans_reserved=VIIRS_SCANS,
+            fields=VIIRS_SDR_FIELDS,
         ),
         Product(
             "GITCO",
             "VIIRS-IMG-GEO-TC",
             "viirs_geo",
-            rows_per_scan=32,
-            scans_reserved=48,
+            rows_per_scan=VIIRS_DETECTORS,
+            scans_reserved=VIIRS_SCANS,
             fields=VIIRS_TC_GEO_FIELDS,
         ),
         Product(
             "GIMGO",
             "VIIRS-IMG-GEO",
             "viirs_geo",
-            rows_per_scan=32,
-            scans_reserved=48,
+            rows_per_scan=VIIRS_DETECTORS,
+            scans_reserved=VIIRS_SCANS,
             fields=VIIRS_GEO_FIELDS,
         ),
     )

@@ -29,7 +29,7 @@ import numpy as np
 from monitor.config.outputs import ExportConfig
 from monitor.core.constants import N_FOR
 from monitor.core.records import History
-from monitor.core.result import RELIABILITY_FLAGS
+from monitor.core.result import RELIABILITY_FLAGS, ForOffset, measures
 from monitor.core.satellites import satellite as satellite_info
 from monitor.service.store.sqlite import Store
 from monitor.version import __version__
@@ -42,49 +42,7 @@ SIGN_CONVENTION = (
     "error: the correction to add to the reported geolocation."
 )
 FORMATS = {".nc": "netcdf", ".nc4": "netcdf", ".csv": "csv"}  # the suffix of --out says the format
-# variable: (unit, long name); the store's column names
-VARIABLES = {
-    "d_alpha_urad": ("urad", "in-track LOS offset (see sign_convention)"),
-    "d_beta_urad": ("urad", "cross-track LOS offset (see sign_convention)"),
-    "sigma_alpha_urad": ("urad", "uncertainty (1 sigma) of the in-track offset"),
-    "sigma_beta_urad": ("urad", "uncertainty (1 sigma) of the cross-track offset"),
-    "in_track_km": ("km", "in-track geolocation error on the ground (see sign_convention)"),
-    "cross_track_km": ("km", "cross-track geolocation error on the ground (see sign_convention)"),
-    "total_km": ("km", "total geolocation error on the ground"),
-    "sigma_in_track_km": ("km", "uncertainty (1 sigma) of the in-track error"),
-    "sigma_cross_track_km": ("km", "uncertainty (1 sigma) of the cross-track error"),
-    "cost_min_k": (
-        "K",
-        "minimum over the perturbations of the cost (STDEV of BT_VIIRS - BT_CrIS, or its "
-        "residual after the calibration regression: assessment.cost)",
-    ),
-    "cost_zero_k": ("K", "cost of the unperturbed LOS"),
-    "bias_k": ("K", "CrIS minus VIIRS I5 brightness temperature at 280 K, at the optimum"),
-    "sigma_bias_k": ("K", "uncertainty (1 sigma) of the CrIS minus VIIRS bias"),
-    "gain_pct": (
-        "percent",
-        "CrIS minus VIIRS I5 gain difference (per cent of the BT departure from 280 K)",
-    ),
-    "sigma_gain_pct": ("percent", "uncertainty (1 sigma) of the gain difference"),
-    "curvature_k": ("K", "curvature of CrIS minus VIIRS: what it adds at 250 and 310 K"),
-    "sigma_curvature_k": ("K", "uncertainty (1 sigma) of the curvature"),
-    "response_width_50_urad": (
-        "urad",
-        "full width at 50 % of its peak of the CrIS FOV spatial response fitted at the optimum",
-    ),
-    "sigma_response_width_50_urad": ("urad", "uncertainty (1 sigma) of the response's full width at 50 %"),
-    "response_width_10_urad": (
-        "urad",
-        "full width at 10 % of its peak of the CrIS FOV spatial response fitted at the optimum",
-    ),
-    "sigma_response_width_10_urad": ("urad", "uncertainty (1 sigma) of the response's full width at 10 %"),
-}
 FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
-
-
-def _content_type(name: str) -> str:
-    """ACDD coverage_content_type: a measurement, or information on its quality."""
-    return "qualityInformation" if name.startswith(("sigma_", "cost_")) else "physicalMeasurement"
 
 
 class ResultStore(Store):
@@ -104,14 +62,14 @@ def to_xarray(
     since: dt.date | None = None,
     until: dt.date | None = None,
     publisher: ExportConfig | None = None,
+    record: type = ForOffset,
 ) -> xr.Dataset:
-    """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset;
-    *publisher*, the ``export`` section of the configuration, fills the ACDD publisher attributes."""
+    """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset, a
+    variable per measured field of *record* with the unit and meaning it declares; *publisher*, the
+    ``export`` section of the configuration, fills the ACDD publisher attributes."""
     import xarray as xr
 
     series = store.series(satellite, since, until)
-    data = {k: series.values[k] for k in VARIABLES}
-    n_samples = series.values["n_samples"].astype(np.int32)
     bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int8])
     flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
     days = np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]")
@@ -119,25 +77,20 @@ def to_xarray(
     dims = ("time", "scan_position")  # time first and unlimited: daily files append along it
     ds = xr.Dataset(
         {
-            name: (
+            m.name: (
                 dims,
-                data[name],
-                {"units": unit, "long_name": long, "coverage_content_type": _content_type(name)},
+                series.values[m.name].astype(np.int32 if m.kind is int else np.float64),
+                {
+                    "units": m.unit,
+                    "long_name": m.meaning,
+                    "coverage_content_type": "qualityInformation" if m.quality else "physicalMeasurement",
+                },
             )
-            for name, (unit, long) in VARIABLES.items()
+            for m in measures(record)
         },
         coords=coords,
     )
     ds["time_bnds"] = (("time", "nv"), np.stack([days, days + np.timedelta64(1, "D")], axis=-1))
-    ds["n_samples"] = (
-        dims,
-        n_samples,
-        {
-            "units": "1",
-            "long_name": "CrIS FOVs in the cost function",
-            "coverage_content_type": "qualityInformation",
-        },
-    )
     ds["flags"] = (
         dims,
         flags,

@@ -49,8 +49,7 @@ from prometheus_client import CollectorRegistry, Counter, Gauge, disable_created
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 from prometheus_client.metrics_core import Metric
 
-from monitor.core.constants import URAD
-from monitor.core.result import ForOffset
+from monitor.core.result import Family, ForOffset, measures
 from monitor.core.vocabulary import RunStatus
 from monitor.service.store.alerts import AlertState
 from monitor.service.store.sqlite import Store
@@ -172,36 +171,13 @@ class _StoreCollector:
             "00:00 UTC of the latest assessed day",
             labels=["satellite"],
         )
-        rad = GaugeMetricFamily(
-            "crisgeo_for_offset_radians",
-            "Latest LOS offset per FOR (spacecraft frame; the turn to apply to the CrIS LOS)",
-            labels=["satellite", "for", "direction"],
-        )
-        meters = GaugeMetricFamily(
-            "crisgeo_for_offset_meters",
-            "Latest offset per FOR on the ground",
-            labels=["satellite", "for", "direction"],
-        )
         beyond = GaugeMetricFamily(
             "crisgeo_for_beyond_spec",
             "1 when the FOR's latest in-track or cross-track error is beyond the specification",
             labels=["satellite", "for"],
         )
-        bias = GaugeMetricFamily(
-            "crisgeo_for_calibration_bias_kelvin",
-            "Latest CrIS minus VIIRS I5 BT at the reference temperature (280 K) per FOR, at the optimum",
-            labels=["satellite", "for"],
-        )
-        gain = GaugeMetricFamily(
-            "crisgeo_for_calibration_gain_ratio",
-            "Latest CrIS minus VIIRS I5 gain difference per FOR (fraction of the BT's departure from 280 K)",
-            labels=["satellite", "for"],
-        )
-        width = GaugeMetricFamily(
-            "crisgeo_for_response_full_width_radians",
-            "Latest full width of the CrIS FOV spatial response fitted per FOR, at a level of its peak",
-            labels=["satellite", "for", "level"],
-        )
+        # the families the FOR's fields are published in, as their declaration says (ForOffset)
+        families = {m.metric[0]: _gauge(m.metric[0]) for m in measures() if m.metric}
         ok = GaugeMetricFamily(
             "crisgeo_for_reliable",
             "1 when the FOR's latest offset carries no reliability flag",
@@ -213,25 +189,23 @@ class _StoreCollector:
             day.add_metric([sat], dt.datetime.combine(d, dt.time(), dt.timezone.utc).timestamp())
             for f in fors[sat]:
                 k = f"{f.for_index:02d}"
-                for direction, v in (("alpha", f.d_alpha_urad), ("beta", f.d_beta_urad)):
-                    if math.isfinite(v):
-                        rad.add_metric([sat, k, direction], v * URAD)
-                for direction, v in (
-                    ("in_track", f.in_track_km),
-                    ("cross_track", f.cross_track_km),
-                    ("total", f.total_km),
-                ):
-                    if math.isfinite(v):
-                        meters.add_metric([sat, k, direction], 1000.0 * v)
+                for m in measures(type(f)):
+                    v = getattr(f, m.name)
+                    if m.metric is None or not math.isfinite(v):
+                        continue
+                    family, label = m.metric
+                    gauge = families.setdefault(family, _gauge(family))
+                    gauge.add_metric([sat, k, *([label] if family.label else [])], v * m.to_base_unit)
                 beyond.add_metric([sat, k], 1 if f.spec_breaches(spec_km) else 0)
-                for family, v in ((bias, f.bias_k), (gain, f.gain_pct / 100.0)):
-                    if math.isfinite(v):
-                        family.add_metric([sat, k], v)
-                for level, v in (("0.5", f.response_width_50_urad), ("0.1", f.response_width_10_urad)):
-                    if math.isfinite(v):
-                        width.add_metric([sat, k, level], v * URAD)
                 ok.add_metric([sat, k], 1 if f.reliable else 0)
-        yield from (day, rad, meters, beyond, bias, gain, width, ok)
+        yield from (day, *families.values(), beyond, ok)
+
+
+def _gauge(family: Family) -> GaugeMetricFamily:
+    """The gauge of a per-FOR family: labelled by satellite and FOR (and the family's own label)."""
+    return GaugeMetricFamily(
+        family.name, family.help, labels=["satellite", "for", *([family.label] if family.label else [])]
+    )
 
 
 class ServiceMetrics:

@@ -26,6 +26,7 @@ import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -33,9 +34,16 @@ from numpy.typing import ArrayLike
 from monitor.core.constants import (
     CALIBRATION_CURVATURE_SPAN_K,
     CALIBRATION_REFERENCE_K,
+    CRIS_GRANULE_US,
     CRIS_SCAN_US,
+    FOV_HALF_ANGLE_RAD,
+    N_FOR,
     N_FOV,
+    PAPER_GRANULES,
     URAD,
+    VIIRS_COLUMNS,
+    VIIRS_DETECTORS,
+    VIIRS_SCANS,
 )
 from monitor.core.errors import DataError, StopRequested
 from monitor.core.satellites import satellite as satellite_info
@@ -57,8 +65,8 @@ from monitor.simulate.terrain import intersect_terrain
 
 UTC = dt.timezone.utc
 DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)
-CRIS_GRANULE_S = 32.0
-VIIRS_GRANULE_S = ins.VIIRS_SCANS * ins.VIIRS_SCAN_S
+CRIS_GRANULE_S = CRIS_GRANULE_US * 1e-6
+VIIRS_GRANULE_S = VIIRS_SCANS * ins.VIIRS_SCAN_S
 CONE_SAMPLES = 512
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
@@ -79,15 +87,18 @@ DEFAULT_AUX = {
 
 @dataclass
 class SimulationSpec:
-    """What to simulate. Offsets are the per-FOR turn (urad) that takes the GEO LOS onto the true LOS."""
+    """What to simulate, every parameter declared once, with its default (``crisgeo simulate``, the
+    simulated source and the benchmarks take these). Offsets are the per-FOR turn (urad) that takes the
+    GEO LOS onto the true LOS: given, or the *profile*'s (:func:`load_profile`; with engineering packets,
+    none: the EPs carry the error)."""
 
     satellite: str = "j01"
-    granules: int = 14
-    d_alpha_urad: np.ndarray = field(default_factory=lambda: np.zeros(30))
-    d_beta_urad: np.ndarray = field(default_factory=lambda: np.zeros(30))
+    granules: int = PAPER_GRANULES
+    d_alpha_urad: np.ndarray = field(default_factory=lambda: np.empty(0))  # empty: the profile's
+    d_beta_urad: np.ndarray = field(default_factory=lambda: np.empty(0))
     seed: int = 0
     start: dt.datetime = DEFAULT_START
-    profile: str = "zero"
+    profile: str = "paper"  # paper, random, zero, a file, or "ep" with true_ep and ground_ep
     attitude_arcsec: tuple = (0.6, -0.3, 0.5)
     software_version: str = "I2.3.00.00"
     aux: dict = field(default_factory=lambda: {k: list(v) for k, v in DEFAULT_AUX.items()})
@@ -134,6 +145,12 @@ class SimulationSpec:
         )
 
     def __post_init__(self) -> None:
+        if self.d_alpha_urad.size == 0 or self.d_beta_urad.size == 0:
+            by_ep = self.true_ep is not None  # the EPs carry the error
+            d_alpha, d_beta = (
+                (np.zeros(N_FOR), np.zeros(N_FOR)) if by_ep else load_profile(self.profile, self.seed)
+            )
+            self.d_alpha_urad, self.d_beta_urad = np.asarray(d_alpha, float), np.asarray(d_beta, float)
         if self.orbit_pass is not None and self.orbit_pass not in PASSES:
             raise DataError(f"orbit pass {self.orbit_pass!r} is not one of {', '.join(PASSES)}")
         if isinstance(self.cris_response, tuple) and len(self.cris_response) != N_FOV:
@@ -177,7 +194,7 @@ def _utc(unix_s: float) -> dt.datetime:
     return dt.datetime.fromtimestamp(unix_s, UTC)
 
 
-TOP_HAT_CONE = RadialResponse((0.0, ins.CRIS_FOV_HALF_ANGLE_RAD), (1.0, 1.0))
+TOP_HAT_CONE = RadialResponse((0.0, FOV_HALF_ANGLE_RAD), (1.0, 1.0))
 
 
 def _sunflower_disk(n: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
@@ -366,7 +383,7 @@ class Simulator:
         """The FOV's sample points (x, y), tangents of the angle from the LOS: CONE_SAMPLES points over the
         top-hat cone, as densely out to the reach of a spatial response."""
         reach = max(self._responses, key=lambda r: r.reach_rad).reach_rad
-        n = 2 * round(CONE_SAMPLES * (reach / ins.CRIS_FOV_HALF_ANGLE_RAD) ** 2 / 2)
+        n = 2 * round(CONE_SAMPLES * (reach / FOV_HALF_ANGLE_RAD) ** 2 / 2)
         return _sunflower_disk(n, np.tan(reach))
 
     @property
@@ -427,15 +444,15 @@ class Simulator:
         local = frames.unit(np.stack([np.tan(a_det), np.zeros_like(a_det), np.ones_like(a_det)], -1))
         los_sbf = np.einsum("cij,dj->dci", frames.rot_x(-theta), local)  # (32, 6400, 3)
         deleted = ins.viirs_bowtie_deleted()
-        nrow = ins.VIIRS_SCANS * ins.VIIRS_DETECTORS
-        lat_out = np.empty((nrow, ins.VIIRS_COLUMNS), np.float32)
+        nrow = VIIRS_SCANS * VIIRS_DETECTORS
+        lat_out = np.empty((nrow, VIIRS_COLUMNS), np.float32)
         lon_out = np.empty_like(lat_out)
         h_out = np.empty_like(lat_out)
-        bt_dn = np.empty((nrow, ins.VIIRS_COLUMNS), np.uint16)
+        bt_dn = np.empty((nrow, VIIRS_COLUMNS), np.uint16)
         rad_dn = np.empty_like(bt_dn)
-        scan_start = g0 + np.arange(ins.VIIRS_SCANS) * ins.VIIRS_SCAN_S
+        scan_start = g0 + np.arange(VIIRS_SCANS) * ins.VIIRS_SCAN_S
         cwv = float(np.sum(self.band.weights * self.nu))
-        for s0 in range(0, ins.VIIRS_SCANS, scans_per_chunk):
+        for s0 in range(0, VIIRS_SCANS, scans_per_chunk):
             if should_stop is not None and should_stop():
                 raise StopRequested
             ss = slice(s0, s0 + scans_per_chunk)
@@ -447,19 +464,17 @@ class Simulator:
             temp = self.scene.temperature_k(lat, lon, h)
             lrad = np.interp(temp, T_BINS_K, self.band_table)
             bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, temp.shape)
-            rows = slice(s0 * 32, (s0 + lat.shape[0]) * 32)
-            lat_out[rows] = np.degrees(lat).reshape(-1, ins.VIIRS_COLUMNS)
-            lon_out[rows] = np.degrees(lon).reshape(-1, ins.VIIRS_COLUMNS)
-            h_out[rows] = h.reshape(-1, ins.VIIRS_COLUMNS)
-            bt_dn[rows] = np.clip(np.round((bt - BT_OFFSET) / BT_SCALE), 0, 65527).reshape(
-                -1, ins.VIIRS_COLUMNS
-            )
+            rows = slice(s0 * VIIRS_DETECTORS, (s0 + lat.shape[0]) * VIIRS_DETECTORS)
+            lat_out[rows] = np.degrees(lat).reshape(-1, VIIRS_COLUMNS)
+            lon_out[rows] = np.degrees(lon).reshape(-1, VIIRS_COLUMNS)
+            h_out[rows] = h.reshape(-1, VIIRS_COLUMNS)
+            bt_dn[rows] = np.clip(np.round((bt - BT_OFFSET) / BT_SCALE), 0, 65527).reshape(-1, VIIRS_COLUMNS)
             # W/(m2 sr um) from mW/(m2 sr cm-1): L_lambda = L_nu * nu^2 / 1e4 / 1e3
             lam = self.band.radiance_from_bt(bt) * cwv**2 * 1e-7
             rad_dn[rows] = np.clip(np.round((lam - RAD_OFFSET) / RAD_SCALE), 0, 65527).reshape(
-                -1, ins.VIIRS_COLUMNS
+                -1, VIIRS_COLUMNS
             )
-        mask = np.tile(deleted, (ins.VIIRS_SCANS, 1))
+        mask = np.tile(deleted, (VIIRS_SCANS, 1))
         bt_dn[mask] = OBPT_U16
         rad_dn[mask] = OBPT_U16
         lat_out[mask] = OBPT_F32
@@ -480,7 +495,7 @@ class Simulator:
             int(start_iet[0]),
             int(_iet_us(end)),
             gid,
-            ins.VIIRS_SCANS,
+            VIIRS_SCANS,
             v_mid[0],
             np.radians(lat_out[valid][::97]),
             np.radians(lon_out[valid][::97]),
@@ -493,8 +508,8 @@ class Simulator:
             "SCPosition": r_mid.astype(np.float32),
             "SCVelocity": v_mid.astype(np.float32),
             "SCAttitude": att_mid.astype(np.float32),
-            "QF1_SCAN_VIIRSSDRGEO": np.zeros(ins.VIIRS_SCANS, np.uint8),
-            "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32),
+            "QF1_SCAN_VIIRSSDRGEO": np.zeros(VIIRS_SCANS, np.uint8),
+            "NumberOfScans": np.array([VIIRS_SCANS], np.int32),
         }
         geo = {
             "Latitude": lat_out,
@@ -509,12 +524,12 @@ class Simulator:
             "Radiance": rad_dn,
             "RadianceFactors": np.array([RAD_SCALE, RAD_OFFSET], np.float32),
             "QF1_VIIRSIBANDSDR": np.zeros(bt_dn.shape, np.uint8),
-            "QF2_SCAN_SDR": np.zeros(ins.VIIRS_SCANS, np.uint8),
-            "NumberOfScans": np.array([ins.VIIRS_SCANS], np.int32),
+            "QF2_SCAN_SDR": np.zeros(VIIRS_SCANS, np.uint8),
+            "NumberOfScans": np.array([VIIRS_SCANS], np.int32),
         }
         if spec.complete:
-            geo |= complete.viirs_geo_extra(lat_out, lon_out, h_out, r_mid, scan_start, ins.VIIRS_DETECTORS)
-            sdr |= complete.viirs_sdr_extra(ins.VIIRS_SCANS, ins.VIIRS_DETECTORS)
+            geo |= complete.viirs_geo_extra(lat_out, lon_out, h_out, r_mid, scan_start, VIIRS_DETECTORS)
+            sdr |= complete.viirs_sdr_extra(VIIRS_SCANS, VIIRS_DETECTORS)
         names = []
         for prefix, data, tag in (("GITCO", geo, "GEO"), ("SVI05", sdr, "SDR")):
             product = PRODUCTS[prefix]
@@ -589,51 +604,19 @@ class Simulator:
 
 def simulate_case(
     out_dir: str | os.PathLike[str],
-    satellite: str = "j01",
-    granules: int = 14,
-    profile: str = "paper",
-    seed: int = 0,
-    start: dt.datetime | None = None,
     spec: SimulationSpec | None = None,
     viirs: bool = True,
-    terrain: bool = False,
-    orbit_pass: str | None = None,
-    pass_lon_deg: float | None = None,
-    cris_bias_k: float = 0.0,
-    cris_gain: float = 0.0,
-    cris_nonlinear_k: float = 0.0,
-    complete: bool = False,
-    layout: str | None = None,
-    cris_response: RadialResponse | tuple[RadialResponse, ...] | None = None,
     should_stop: Callable[[], bool] | None = None,
+    **parameters: Any,
 ) -> dict:
-    """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The ``cris_``
-    parameters: the CrIS-VIIRS calibration difference; *complete* and *layout*: every dataset of the real
-    products, and their HDF5 layout; *cris_response*, the CrIS FOV's spatial response
-    (:class:`SimulationSpec`). *should_stop*, polled between granules and between a VIIRS granule's scans,
-    ends the simulation with :class:`StopRequested` (what was written stays: the caller decides)."""
+    """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The case is
+    *spec*, or a :class:`SimulationSpec` of *parameters* (its fields: a name it does not declare is a
+    TypeError). *viirs* False: the CrIS granules alone. *should_stop*, polled between granules and between
+    a VIIRS granule's scans, ends the simulation with :class:`StopRequested` (what was written stays: the
+    caller decides)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    if spec is None:
-        d_alpha, d_beta = load_profile(profile, seed)
-        spec = SimulationSpec(
-            satellite=satellite,
-            granules=granules,
-            d_alpha_urad=np.asarray(d_alpha, float),
-            d_beta_urad=np.asarray(d_beta, float),
-            seed=seed,
-            start=start or DEFAULT_START,
-            profile=profile,
-            terrain=terrain,
-            orbit_pass=orbit_pass,
-            pass_lon_deg=pass_lon_deg,
-            cris_bias_k=cris_bias_k,
-            cris_gain=cris_gain,
-            cris_nonlinear_k=cris_nonlinear_k,
-            complete=complete,
-            layout=layout,
-            cris_response=cris_response,
-        )
+    spec = spec or SimulationSpec(**parameters)
     sim = Simulator(spec)
     stop = should_stop or (lambda: False)
     files = []

@@ -9,18 +9,21 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.core.constants import DEFAULT_STEP_RAD, FOV_DIAMETER_RAD, N_FOR, N_FOV, VIIRS_SCAN_US
+from monitor.core.constants import (
+    DEFAULT_STEP_RAD,
+    FOV_SPACING_RAD,
+    N_FOR,
+    N_FOV,
+    VIIRS_COLUMNS,
+    VIIRS_DETECTORS,
+    VIIRS_SCAN_US,
+)
 from monitor.geometry.frames import rot_x, unit
 
 CRIS_FOR_STEP_RAD = np.radians(3.3333)
-CRIS_FOV_SPACING_RAD = 19.1e-3  # FOV centre spacing, ~1.1 deg (EP offsets, docs/jpss-formats.md 2.1)
-CRIS_FOV_HALF_ANGLE_RAD = FOV_DIAMETER_RAD / 2
 CRIS_FOR_DT_US = 200_000
 CRIS_MID_OFFSET_US = 2_899_989
 
-VIIRS_DETECTORS = 32
-VIIRS_SCANS = 48
-VIIRS_COLUMNS = 6400
 VIIRS_SCAN_S = VIIRS_SCAN_US * 1e-6
 VIIRS_ZONE_COLUMNS = (1280, 736, 2368, 736, 1280)  # aggregation zones, output columns (VcstGeoParameters.h)
 VIIRS_ZONE_AGGREGATION = (1, 2, 3, 2, 1)
@@ -37,7 +40,7 @@ def cris_scan_angles_rad() -> np.ndarray:
 def cris_fov_offsets_rad() -> tuple[np.ndarray, np.ndarray]:
     """(in_track, cross_track) offsets (rad) of FOV 1..9 at nadir: FOV 7-9 ahead, FOV 1, 4, 7 on the left."""
     f = np.arange(N_FOV)
-    return (f // 3 - 1) * CRIS_FOV_SPACING_RAD, (f % 3 - 1) * CRIS_FOV_SPACING_RAD
+    return (f // 3 - 1) * FOV_SPACING_RAD, (f % 3 - 1) * FOV_SPACING_RAD
 
 
 def cris_los_sbf(d_alpha_rad: ArrayLike | None = None, d_beta_rad: ArrayLike | None = None) -> np.ndarray:

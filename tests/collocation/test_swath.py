@@ -9,6 +9,7 @@ import pytest
 from monitor.assessment.inputs import SwathCache, offsets_rad, piece, reach_us
 from monitor.collocation import collocate, swath
 from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import VIIRS_DETECTORS
 from monitor.core.threads import parallel_threads
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
@@ -31,7 +32,7 @@ def granule(case_plan):
 
 def _view_deg(geo, rows):
     """View angle from the geocentric nadir (deg) of the pixels of *rows*, from their scan's spacecraft."""
-    sat = geo.sc_position_m[rows // swath.DETECTORS]
+    sat = geo.sc_position_m[rows // VIIRS_DETECTORS]
     los = wgs84.geodetic_to_ecef(geo.lat_rad[rows], geo.lon_rad[rows], geo.height_m[rows]) - sat[:, None]
     cos = (
         -np.sum(los * sat[:, None], -1) / np.linalg.norm(los, axis=-1) / np.linalg.norm(sat, axis=-1)[:, None]
@@ -53,8 +54,8 @@ def test_one_and_two_threads_prepare_the_same_granule(granule):
 
 def test_view_columns_keep_every_pixel_seen_within_the_angle(granule):
     geo, _, _ = granule
-    nscan = geo.lat_rad.shape[0] // swath.DETECTORS
-    rows = np.arange(nscan) * swath.DETECTORS + swath.DETECTORS // 2
+    nscan = geo.lat_rad.shape[0] // VIIRS_DETECTORS
+    rows = np.arange(nscan) * VIIRS_DETECTORS + VIIRS_DETECTORS // 2
     view = _view_deg(geo, rows)
     kept = swath.view_columns(geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m, math.radians(40.0))
     inside = np.zeros(view.shape[1], bool)
@@ -128,7 +129,7 @@ def test_scans_no_cone_reaches_change_no_cone_sum(case_plan):
     assert all(c.covers(*span) for c in cut.pieces)
     assert not any(c.covers(span[0] - 10**9, span[1] + 10**9) for c in cut.pieces if c.first_scan)
     for f, c in zip(full.pieces, cut.pieces, strict=True):  # the kept scans weigh as in the whole granule
-        rows = slice(c.first_scan * swath.DETECTORS, c.first_scan * swath.DETECTORS + c.shape[0])
+        rows = slice(c.first_scan * VIIRS_DETECTORS, c.first_scan * VIIRS_DETECTORS + c.shape[0])
         cols = slice(c.first_column - f.first_column, c.first_column - f.first_column + c.shape[1])
         np.testing.assert_array_equal(c.area_vec_m2, f.area_vec_m2[rows, cols])
         np.testing.assert_array_equal(c.radiance, f.radiance[rows, cols])

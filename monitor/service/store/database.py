@@ -13,7 +13,7 @@ from types import TracebackType
 from typing import Literal, Self
 
 from monitor.service.store.alerts import AlertState
-from monitor.service.store.schema import MIGRATIONS
+from monitor.service.store.schema import MIGRATIONS, result_columns
 
 UTC = dt.timezone.utc
 
@@ -114,6 +114,11 @@ class Database:
                 for stmt in filter(str.strip, MIGRATIONS[v].split(";")):
                     self.db.execute(stmt)
                 self.db.execute(f"PRAGMA user_version={v + 1}")
+        have = {r[1] for r in self.db.execute("PRAGMA table_info(results)")}
+        if added := result_columns(have):
+            with self.transaction():
+                for stmt in added:
+                    self.db.execute(stmt)
 
     def _now(self) -> str:
         return self.clock().astimezone(UTC).isoformat(timespec="seconds")

@@ -1,7 +1,11 @@
 """The store's schema: every table as a forward migration, numbered by SQLite's user_version (a file
-is brought up to date when opened; never down)."""
+is brought up to date when opened; never down). The results table has a column for each measured field of a
+FOR, derived from its declaration (:func:`result_columns`): a new field is a new column, added when a store
+is opened."""
 
 from __future__ import annotations
+
+from monitor.core.result import ForOffset, measures
 
 MIGRATIONS = [
     # 1: the first schema
@@ -13,10 +17,7 @@ MIGRATIONS = [
     CREATE INDEX runs_day ON runs (satellite, day);
     CREATE TABLE results (
         satellite TEXT NOT NULL, day TEXT NOT NULL, for_index INTEGER NOT NULL, run_id INTEGER NOT NULL,
-        d_alpha_urad REAL, d_beta_urad REAL, sigma_alpha_urad REAL, sigma_beta_urad REAL,
-        in_track_km REAL, cross_track_km REAL, total_km REAL, sigma_in_track_km REAL,
-        sigma_cross_track_km REAL, n_samples INTEGER, cost_min_k REAL, cost_zero_k REAL, flags TEXT,
-        PRIMARY KEY (satellite, day, for_index));
+        flags TEXT, PRIMARY KEY (satellite, day, for_index));
     CREATE TABLE granules (
         satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, granule_id TEXT NOT NULL,
         start TEXT, cris_geo TEXT, cris_sdr TEXT, viirs TEXT, n_usable INTEGER,
@@ -61,22 +62,21 @@ MIGRATIONS = [
     # 4: the CrIS-VIIRS intercalibration at each FOR's optimum, and the day's difference against the CrIS BT
     # (monitor/estimation/intercal.py); days stored before have none (NULL)
     """
-    ALTER TABLE results ADD COLUMN bias_k REAL;
-    ALTER TABLE results ADD COLUMN sigma_bias_k REAL;
-    ALTER TABLE results ADD COLUMN gain_pct REAL;
-    ALTER TABLE results ADD COLUMN sigma_gain_pct REAL;
-    ALTER TABLE results ADD COLUMN curvature_k REAL;
-    ALTER TABLE results ADD COLUMN sigma_curvature_k REAL;
     CREATE TABLE difference_bins (
         satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, low_k REAL NOT NULL,
         n INTEGER, mean_k REAL, std_k REAL, PRIMARY KEY (satellite, day, low_k));
     """,
-    # 5: the CrIS spatial response seen at each FOR's optimum (kernel footprint,
-    # monitor/estimation/estimate.py); days stored before have none (NULL)
-    """
-    ALTER TABLE results ADD COLUMN response_width_50_urad REAL;
-    ALTER TABLE results ADD COLUMN sigma_response_width_50_urad REAL;
-    ALTER TABLE results ADD COLUMN response_width_10_urad REAL;
-    ALTER TABLE results ADD COLUMN sigma_response_width_10_urad REAL;
-    """,
+    # 5: the CrIS spatial response seen at each FOR's optimum: its columns, like every measured field's, are
+    # the declaration's (result_columns)
+    "",
 ]
+
+
+def result_columns(have: set[str], record: type = ForOffset) -> list[str]:
+    """The statements adding to the results table a column for each measured field of *record* it lacks
+    (*have*: its columns), in declaration order: REAL, or INTEGER for a count."""
+    return [
+        f"ALTER TABLE results ADD COLUMN {m.name} {'INTEGER' if m.kind is int else 'REAL'}"
+        for m in measures(record)
+        if m.name not in have
+    ]

@@ -4,10 +4,9 @@ Measurement ``cris_geolocation`` (configurable), one point per satellite, day an
 00:00 UTC, precision seconds.
 
 * tags: ``satellite`` (npp, j01, j02) and ``for`` (01..30)
-* float fields: d_alpha_urad, d_beta_urad, sigma_alpha_urad, sigma_beta_urad, in_track_km,
-  cross_track_km, total_km, cost_min_k, cost_zero_k, and the CrIS-VIIRS intercalibration at the optimum:
-  bias_k, sigma_bias_k, gain_pct, sigma_gain_pct, curvature_k, sigma_curvature_k
-* integer field: n_samples; boolean field: reliable
+* fields: every measured field of the FOR whose declaration publishes it (``series``,
+  :func:`monitor.core.result.measures`), named as declared (a float, or an integer: n_samples); boolean
+  field: reliable
 
 Known changes (calendar, metadata, fingerprint) go to ``cris_geolocation_change`` (see :func:`change_lines`),
 re-sent after every run, for the dashboards' annotations.
@@ -35,14 +34,10 @@ from influxdb_client.client.write_api import SYNCHRONOUS
 
 from monitor.config.outputs import PublishConfig
 from monitor.core.changes import Change
-from monitor.core.result import MEASURED_FIELDS, ForOffset
+from monitor.core.result import ForOffset, measures
 from monitor.service.store.sqlite import Store
 
 LOG = logging.getLogger("monitor.store.timeseries")  # the name journal filters know, kept
-# the published float fields: the measured ones but the sample count (an integer field) and the sigmas in km
-FLOAT_FIELDS = tuple(
-    f for f in MEASURED_FIELDS if f not in ("n_samples", "sigma_in_track_km", "sigma_cross_track_km")
-)
 
 
 class PublishError(RuntimeError):
@@ -55,11 +50,11 @@ def result_lines(measurement: str, satellite: str, day: dt.date, fors: Iterable[
     lines = []
     for f in fors:
         p = Point(measurement).tag("satellite", satellite).tag("for", f"{f.for_index:02d}")
-        for name in FLOAT_FIELDS:
-            value = getattr(f, name)
-            if value is not None and math.isfinite(value):
-                p = p.field(name, float(value))
-        p = p.field("n_samples", int(f.n_samples)).field("reliable", bool(f.reliable))
+        for m in measures(type(f)):
+            value = getattr(f, m.name)
+            if m.series and value is not None and math.isfinite(value):
+                p = p.field(m.name, m.kind(value))
+        p = p.field("reliable", bool(f.reliable))
         lines.append(p.time(when, WritePrecision.S).to_line_protocol())
     return lines
 
