@@ -80,8 +80,8 @@ def test_the_intercalibration_and_its_bins_are_stored_with_the_day(cases, tmp_pa
 # the measured columns of schema 1's results table (the columns now derive from ForOffset's declaration)
 SCHEMA_1_RESULTS = (
     "d_alpha_urad REAL", "d_beta_urad REAL", "sigma_alpha_urad REAL", "sigma_beta_urad REAL",
-    "in_track_km REAL", "cross_track_km REAL", "total_km REAL", "sigma_in_track_km REAL", "sigma_cross_track_km REAL",
-    "n_samples INTEGER", "cost_min_k REAL", "cost_zero_k REAL",
+    "in_track_km REAL", "cross_track_km REAL", "total_km REAL", "sigma_in_track_km REAL",
+    "sigma_cross_track_km REAL", "n_samples INTEGER", "cost_min_k REAL", "cost_zero_k REAL",
 )  # fmt: skip
 
 
