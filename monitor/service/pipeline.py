@@ -37,6 +37,8 @@ from monitor.service.store.sqlite import Store
 from monitor.service.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
 LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
+# what assesses a day's fetched granules: the assessment (:func:`assess_plan`), or a test's stand-in
+Assessor = Callable[..., AssessmentResult]
 
 
 class NoRoom(OSError):
@@ -248,12 +250,13 @@ def compute_day(
     day: dt.date,
     should_stop: Callable[[], bool] | None = None,
     progress: Callable[[object], None] | None = None,
+    assessor: Assessor | None = None,
 ) -> DayWork:
-    """List, fingerprint, select, fetch and assess one satellite-day, touching no store. Never raises for
-    a problem of the day's data or source: it becomes the work's status and reason. Its log lines carry
-    the satellite, day and stage (and only its own: the context ends with it)."""
+    """List, fingerprint, select, fetch and assess (*assessor*, default :func:`assess_plan`) one
+    satellite-day, touching no store. Never raises for a problem of the day's data or source: it becomes the
+    work's status and reason. Its log lines carry the satellite, day and stage (and only its own: the context ends with it)."""
     with logs.context(satellite=satellite, day=day.isoformat()):
-        return _compute_day(cfg, source, satellite, day, should_stop, progress)
+        return _compute_day(cfg, source, satellite, day, should_stop, progress, assessor)
 
 
 def _compute_day(
@@ -263,6 +266,7 @@ def _compute_day(
     day: dt.date,
     should_stop: Callable[[], bool] | None,
     progress: Callable[[object], None] | None,
+    assessor: Assessor | None,
 ) -> DayWork:
     stop = should_stop or (lambda: False)
     w = DayWork(satellite, day, RunStatus.OK)
@@ -309,7 +313,7 @@ def _compute_day(
         LOG.info(
             "assessing %d CrIS granule(s) against %d VIIRS granule(s)", len(case.cris), len(case.viirs_all)
         )
-        w.result = assess_plan(
+        w.result = (assessor or assess_plan)(
             case,
             a,
             progress=progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris)),
@@ -384,12 +388,13 @@ def run_day(
     today: dt.date,
     should_stop: Callable[[], bool] | None = None,
     progress: Callable[[object], None] | None = None,
+    assessor: Assessor | None = None,
 ) -> RunOutcome:
     """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`) as of *today*
     (the no-data horizon); every outcome is recorded in the ledger, an unexpected exception too
     (``failed`` with its type and message)."""
     run_id = store.begin_run(satellite, day)
     with logs.context(satellite=satellite, day=day.isoformat(), run_id=run_id):
-        work = compute_day(cfg, source, satellite, day, should_stop, progress)
+        work = compute_day(cfg, source, satellite, day, should_stop, progress, assessor)
         with logs.context(stage="record"):
             return record_day(cfg, store, run_id, work, today)

@@ -13,8 +13,6 @@ from monitor.service.store.alerts import AlertState
 from monitor.service.store.sqlite import Store
 from tests.servers import Webhook, alertmanager, wait_for
 
-pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
-
 
 @pytest.fixture
 def receiver():
@@ -28,6 +26,7 @@ def statuses(receiver) -> list:
     return [n["status"] for n in receiver.received]
 
 
+@pytest.mark.servers
 def test_alerts_are_posted_routed_and_resolved(tmp_path, receiver):
     now = dt.datetime.now(dt.timezone.utc)
     with alertmanager(tmp_path / "am", receiver.url) as am, Store(tmp_path / "s.sqlite") as store:

@@ -7,8 +7,6 @@ from monitor.config.alerts import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
 from tests.invoke import run_crisgeo
 
-pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
-
 MSG = {
     "subject": "[crisgeo] j01 CRITICAL: 1 firing - spec",
     "text": "FOR 30: total 4.51 km\nspec 1.5 km",
@@ -32,6 +30,7 @@ def _email(port, cafile, **kw):
     )
 
 
+@pytest.mark.servers
 def test_email_over_starttls_with_login_arrives_intact_once(smtp_server, monkeypatch, tmp_path):
     inbox, port, cafile = smtp_server
     monkeypatch.setenv("T_SMTP_USER", USER)
@@ -51,6 +50,7 @@ def test_email_over_starttls_with_login_arrives_intact_once(smtp_server, monkeyp
     assert PASSWORD.encode() not in env.content
 
 
+@pytest.mark.servers
 def test_email_wrong_password_is_permanent_and_untrusted_cert_refused(smtp_server, monkeypatch):
     inbox, port, cafile = smtp_server
     monkeypatch.setenv("T_SMTP_USER", USER)
@@ -74,6 +74,7 @@ def _slack(monkeypatch, url, **kw):
     return SlackChannel(SlackSettings(webhook_env="T_SLACK", timeout_s=5, **kw), sleep=sleeps.append), sleeps
 
 
+@pytest.mark.servers
 def test_slack_ok(webhook, monkeypatch):
     ch, _ = _slack(monkeypatch, webhook.url)
     ch.send(MSG)
@@ -81,6 +82,7 @@ def test_slack_ok(webhook, monkeypatch):
     assert payload["text"].startswith("FOR 30") and payload["blocks"][0]["text"]["type"] == "mrkdwn"
 
 
+@pytest.mark.servers
 def test_slack_429_honours_retry_after(webhook, monkeypatch):
     ch, sleeps = _slack(monkeypatch, webhook.url)
     webhook.script = [(429, "rate_limited", {"Retry-After": "2"})]
@@ -92,6 +94,7 @@ def test_slack_429_honours_retry_after(webhook, monkeypatch):
     assert e.value.retry_after_s == 120.0
 
 
+@pytest.mark.servers
 def test_slack_5xx_retried_with_backoff_then_transient(webhook, monkeypatch):
     ch, sleeps = _slack(monkeypatch, webhook.url, retries=2)
     webhook.script = [(500, "rollup_error", {}), (503, "", {})]
@@ -102,6 +105,7 @@ def test_slack_5xx_retried_with_backoff_then_transient(webhook, monkeypatch):
         ch.send(MSG)
 
 
+@pytest.mark.servers
 def test_slack_4xx_is_a_configuration_error_without_the_url(webhook, monkeypatch):
     ch, _ = _slack(monkeypatch, webhook.url)
     webhook.script = [(404, "channel_not_found", {})]
@@ -111,6 +115,7 @@ def test_slack_4xx_is_a_configuration_error_without_the_url(webhook, monkeypatch
     assert len(webhook.received) == 1
 
 
+@pytest.mark.servers
 def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatch):
     """Two processes' deliverers on one store (two connections, two threads) race for the same queued
     message; the claim lets exactly one post it, even though the webhook answers slowly."""
@@ -156,6 +161,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     assert [d.status for d in AlertState(s).deliveries()] == ["sent"]
 
 
+@pytest.mark.servers
 def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
     """`crisgeo -v` logs at debug level; urllib3's request lines (which carry the webhook's secret path)
     are kept out."""

@@ -8,10 +8,16 @@ from tests.conftest import tree_with_truncated
 from tests.invoke import run_crisgeo
 
 
-def test_assess_writes_the_contract_json(cases, tmp_path, capsys):
-    out, _, _ = cases.get()
+def test_assess_writes_the_contract_json(cases, tmp_path, capsys, monkeypatch):
+    """The command's own work (options, the table, the file) on the cached assessment of the case."""
+    from monitor.assessment import assess
+
+    out, _, result = cases.get()
+    given = []
+    monkeypatch.setattr(assess, "assess_paths", lambda paths, cfg, workers: given.append(paths) or result)
     res = tmp_path / "r.json"
-    assert main(["assess", str(out), "--out", str(res)]) == 0
+    assert main(["assess", str(out), "--out", str(res), "--workers", "1"]) == 0
+    assert given == [[str(out)]]
     table = capsys.readouterr().out
     assert "FOR" in table and "d_beta" in table
     doc = json.loads(res.read_text())

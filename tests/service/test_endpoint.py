@@ -19,8 +19,6 @@ from monitor.service.store.sqlite import Store
 from tests.invoke import CRISGEO, ROOT, run_crisgeo
 from tests.servers import chromium_driver, free_port, wait_for
 
-pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
-
 DAY = "2024-06-01"
 
 
@@ -102,6 +100,7 @@ def _samples(fam, name=None, **labels):
     ]
 
 
+@pytest.mark.servers
 def test_metrics_after_a_run(served):
     url, db = served
     # the daemon's catch-up run is recorded in the ledger before its figures reach the gauges
@@ -182,12 +181,14 @@ def test_metrics_after_a_run(served):
     assert "_created" not in text and "_km" not in text and "_urad" not in text and "percent" not in text
 
 
+@pytest.mark.servers
 def test_healthz_when_all_is_well(served):
     url, _ = served
     r = requests.get(url + "/healthz", timeout=10)
     assert r.status_code == 200 and r.json()["status"] == "ok" and r.json()["problems"] == []
 
 
+@pytest.mark.servers
 def test_report_served_read_only(served, tmp_path):
     url, _ = served
     index = requests.get(url + "/report/", timeout=10)
@@ -225,6 +226,7 @@ def test_report_served_read_only(served, tmp_path):
         driver.quit()
 
 
+@pytest.mark.servers
 def test_a_run_over_its_budget_makes_the_daemon_unhealthy_and_starves_the_watchdog(tmp_path):
     cfg = tmp_path / "c.yaml"
     cfg.write_text(
@@ -265,6 +267,7 @@ def test_a_run_over_its_budget_makes_the_daemon_unhealthy_and_starves_the_watchd
     assert proc.returncode == 0
 
 
+@pytest.mark.servers
 def test_listen_is_checked(tmp_path):
     cfg = tmp_path / "c.yaml"
     cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: simulated}}\n")

@@ -52,8 +52,14 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
     # the same numbers as assessing the files directly (crisgeo assess)
     assert [f.d_beta_urad for f in first.result.fors] == [f.d_beta_urad for f in reference.fors]
     assert first.status == "ok" and len(first.result.fors) == 30
-    second = run_day(cfg, store, src, "j01", DAY, TODAY)
-    assert second.status == "ok"
+    seen = []
+
+    def same_numbers(case, config, **kw):  # the rerun pays for no second assessment: the recording is tested
+        seen.append(len(case.cris))
+        return first.result
+
+    second = run_day(cfg, store, src, "j01", DAY, TODAY, assessor=same_numbers)
+    assert second.status == "ok" and seen == [2]
     assert len(store.day_result("j01", DAY)) == 30  # replaced, not added
     assert {g.run_id for g in store.granules("j01", DAY)} == {second.run_id}
     decisions = store.selection("j01", DAY)

@@ -17,8 +17,6 @@ from monitor.service.store.sqlite import Store
 from tests.invoke import CRISGEO, ROOT, run_crisgeo
 from tests.servers import wait_for
 
-pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
-
 DAY = "2024-06-01"
 
 
@@ -49,6 +47,7 @@ def _assessing(proc_log: Path):
     return proc_log.exists() and "assessing " in proc_log.read_text()
 
 
+@pytest.mark.servers
 def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     data, _, _ = cases.get()
     cfg = _config(tmp_path, data, slow=True)
@@ -73,6 +72,7 @@ def test_sigkill_mid_run_then_restart_redoes_the_day(cases, tmp_path):
     assert len(s.day_result("j01", dt.date.fromisoformat(DAY))) == 30
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("workers,sig", [(1, signal.SIGTERM), (2, signal.SIGINT)])
 def test_a_signal_mid_run_stops_within_seconds_with_its_exit_status(cases, tmp_path, workers, sig):
     """SIGTERM (systemd) or SIGINT (Ctrl-C) mid-assessment: the run is recorded interrupted, nothing is
@@ -96,6 +96,7 @@ def test_a_signal_mid_run_stops_within_seconds_with_its_exit_status(cases, tmp_p
     assert s.day_result("j01", dt.date.fromisoformat(DAY)) == []
 
 
+@pytest.mark.servers
 def test_sigint_while_simulating_stops_within_a_step_and_leaves_no_half_day(tmp_path):
     """The offline default simulates the day first (tens of seconds): a Ctrl-C then ends the run within a
     granule's step, exit status 130, the day recorded interrupted and no half-simulated day left behind
@@ -122,6 +123,7 @@ def test_sigint_while_simulating_stops_within_a_step_and_leaves_no_half_day(tmp_
     assert not [d for d in (tmp_path / "state").rglob(DAY) if d.is_dir()]
 
 
+@pytest.mark.servers
 def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
@@ -171,6 +173,7 @@ def test_daemon_notifies_systemd_and_stops_on_sigterm(tmp_path):
         sock.close()
 
 
+@pytest.mark.servers
 def test_daemon_stops_even_when_nobody_reads_its_notify_socket(tmp_path):
     """A notify socket whose queue is full (a wedged systemd) must not block the daemon: its keep-alives
     are dropped, and SIGTERM still stops it at once (it used to hang in the handler's STOPPING=1)."""
@@ -220,6 +223,7 @@ def _verify(unit: Path):
     return subprocess.run(["systemd-analyze", "verify", str(unit)], capture_output=True, text=True)
 
 
+@pytest.mark.servers
 @pytest.mark.skipif(shutil.which("systemd-analyze") is None, reason="systemd-analyze not installed")
 def test_systemd_unit_verifies_without_any_warning(tmp_path):
     text = (ROOT / "systemd" / "crisgeo.service").read_text()
@@ -234,6 +238,7 @@ def test_systemd_unit_verifies_without_any_warning(tmp_path):
     assert "Unknown key" in _verify(bad).stderr  # the check above can fail
 
 
+@pytest.mark.servers
 @pytest.mark.skipif(shutil.which("systemd-analyze") is None, reason="systemd-analyze not installed")
 def test_systemd_unit_exposure_is_at_most_2(tmp_path):
     """`systemd-analyze security` rates the unit's sandbox; 10 is unprotected, the shipped unit <= 2.0."""

@@ -17,8 +17,6 @@ from monitor.service.sources.configured import make_source
 from monitor.service.sources.nodd import NoddSource
 from tests.servers import S3Server, nodd_key
 
-pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
-
 DAY = dt.date(2024, 6, 1)
 
 
@@ -65,6 +63,7 @@ def _nothing_held(cache: Path) -> bool:
     return not list(cache.rglob("*.part")) + list(cache.rglob("*.blocks")) + list(cache.glob("[!r]*/*.h5"))
 
 
+@pytest.mark.servers
 def test_listing_follows_pages_and_keeps_newest(bucket, tmp_path):
     with S3Server(bucket, page_size=2) as s3:
         src = _source(s3.url, tmp_path)
@@ -76,6 +75,7 @@ def test_listing_follows_pages_and_keeps_newest(bucket, tmp_path):
     assert any("_c2025" in n for n in names)  # the reprocessed granule replaces the original
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_dropped_connection_is_retried_and_never_leaves_a_partial_granule(bucket, tmp_path, read):
     with S3Server(bucket) as s3:
@@ -87,6 +87,7 @@ def test_dropped_connection_is_retried_and_never_leaves_a_partial_granule(bucket
         assert sum(f.name in r for r in s3.requests) == 2  # the cut download, then the full one
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_size_mismatch_and_budget(bucket, tmp_path, read):
     with S3Server(bucket) as s3:
@@ -102,6 +103,7 @@ def test_size_mismatch_and_budget(bucket, tmp_path, read):
             _read(src, big)
 
 
+@pytest.mark.servers
 def test_unsafe_keys_are_ignored(bucket, tmp_path):
     assert listed("../../etc/passwd", 1, "x") is None and listed(".hidden.h5", 1, "x") is None
     with S3Server(bucket) as s3:
@@ -146,6 +148,7 @@ def _timed(fn):
     pytest.fail("no SourceError")
 
 
+@pytest.mark.servers
 def test_endless_and_repeated_continuation_tokens_end(bucket, tmp_path):
     with S3Server(bucket, page_size=1) as s3:
         s3.endless_tokens = True
@@ -160,6 +163,7 @@ def test_endless_and_repeated_continuation_tokens_end(bucket, tmp_path):
         assert "continuation token 'c2FtZQ==' came back" in why and len(s3.requests) == 2
 
 
+@pytest.mark.servers
 def test_a_huge_retry_after_is_not_waited_for(bucket, tmp_path):
     with S3Server(bucket) as s3:
         s3.retry_after = 3600
@@ -174,6 +178,7 @@ def test_a_huge_retry_after_is_not_waited_for(bucket, tmp_path):
         ({"run_deadline_min": 0.05}, "run deadline of 0.05 min has passed", 3 + 10),
     ],
 )
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s, read):
     """By the minimum rate over the stall window, or by the run deadline, whichever comes first: each
@@ -187,6 +192,7 @@ def test_a_slow_drip_download_is_cut(bucket, tmp_path, bound, reason, limit_s, r
         assert _nothing_held(tmp_path / "cache")  # no partial granule left
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_one_byte_a_second_is_a_stall_not_a_budget(bucket, tmp_path, read):
     """A drip of one byte at a time is cut after one stall window (before: a budget of 30 s + size / rate,
@@ -200,6 +206,7 @@ def test_one_byte_a_second_is_a_stall_not_a_budget(bucket, tmp_path, read):
         assert sum(f.name in r for r in s3.requests) == 2
 
 
+@pytest.mark.servers
 def test_a_slow_listing_ends_within_the_request_bound(bucket, tmp_path):
     """A listing page sent at one byte per 0.2 s (~90 s for the page) is cut at timeout_s, body included;
     before, only each read had a timeout and the page took as long as the server liked."""
@@ -210,6 +217,7 @@ def test_a_slow_listing_ends_within_the_request_bound(bucket, tmp_path):
         assert len(s3.requests) == 1
 
 
+@pytest.mark.servers
 def test_slow_headers_end_within_the_request_bound(bucket, tmp_path):
     """Headers trickled one byte at a time are cut at timeout_s, and the retries are bounded the same."""
     with S3Server(bucket) as s3:
@@ -220,6 +228,7 @@ def test_slow_headers_end_within_the_request_bound(bucket, tmp_path):
         assert "no answer within 2 s after 2 attempts" in why and secs < 2 * 2 + 10
 
 
+@pytest.mark.servers
 def test_the_run_deadline_cuts_a_listing_in_flight(bucket, tmp_path):
     with S3Server(bucket) as s3:
         s3.slow_list_s = 0.2
@@ -229,6 +238,7 @@ def test_the_run_deadline_cuts_a_listing_in_flight(bucket, tmp_path):
         assert "run deadline of 0.05 min has passed" in why and secs < 3 + 10
 
 
+@pytest.mark.servers
 def test_a_name_longer_than_the_pattern_is_left_out_and_the_day_goes_on(bucket, tmp_path):
     """A listed name with a 300-digit orbit number: before, it passed the name check, its cache write
     failed with 'File name too long' and the whole day was recorded failed."""
@@ -243,6 +253,7 @@ def test_a_name_longer_than_the_pattern_is_left_out_and_the_day_goes_on(bucket, 
     assert sorted(f.name for f in files) == sorted(f.name for f in genuine)
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_a_cache_that_cannot_hold_a_file_is_a_source_error(bucket, tmp_path, read):
     """An OSError of the cache (here: a file where the product folder should be) names the file; it is not
@@ -259,6 +270,7 @@ def test_a_cache_that_cannot_hold_a_file_is_a_source_error(bucket, tmp_path, rea
             _read(src, f)
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_a_lying_size_and_a_gzip_response_are_refused(bucket, tmp_path, read):
     with S3Server(bucket) as s3:
@@ -277,6 +289,7 @@ def test_a_lying_size_and_a_gzip_response_are_refused(bucket, tmp_path, read):
     assert _nothing_held(tmp_path / "cache")
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_md5_against_the_etag(bucket, tmp_path, read):
     """Read in place, a granule of one block (the GCRSO) is checked whole before any byte is used."""
@@ -290,6 +303,7 @@ def test_md5_against_the_etag(bucket, tmp_path, read):
         assert _read(src, f) == (bucket / "noaa-nesdis-n20-pds" / f.location).read_bytes()
 
 
+@pytest.mark.servers
 def test_odd_keys_never_shadow_the_granule(bucket, tmp_path):
     folder = "CrIS-SDR-GEO/2024/06/01/"
     with S3Server(bucket) as s3:
@@ -308,6 +322,7 @@ def test_odd_keys_never_shadow_the_granule(bucket, tmp_path):
     assert sorted(f.name for f in files) == sorted(f.name for f in genuine)
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_a_redirect_to_another_host_is_refused(bucket, tmp_path, read):
     with S3Server(bucket, host="127.0.0.2") as other, S3Server(bucket) as s3:
@@ -321,6 +336,7 @@ def test_a_redirect_to_another_host_is_refused(bucket, tmp_path, read):
         assert len(_read(src, f)) == f.size
 
 
+@pytest.mark.servers
 def test_one_retry_layer(bucket, tmp_path):
     """503s are retried `retries` times by the source alone (no urllib3 Retry nested inside: that made up
     to 36 attempts per file)."""
@@ -330,6 +346,7 @@ def test_one_retry_layer(bucket, tmp_path):
         assert "HTTP 503 after 4 attempts" in why and len(s3.requests) == 4
 
 
+@pytest.mark.servers
 @pytest.mark.parametrize("read", MODES)
 def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_path, read):
     """End to end: the listing also holds a name with a 300-digit orbit and a name that leaves the folder;
@@ -352,6 +369,7 @@ def test_a_day_with_hostile_keys_is_assessed_from_the_good_granules(bucket, tmp_
     assert work.counts.assessed == 2 and len(work.result.fors) == 30
 
 
+@pytest.mark.servers
 def test_a_stop_requested_during_listing_ends_it_within_a_page(bucket, tmp_path):
     """SIGTERM while the day's listings page through the archive: the next page is not asked for."""
     from monitor.core.errors import StopRequested

@@ -15,8 +15,6 @@ from monitor.service.store.timeseries import (
 )
 from tests.servers import free_port, influxdb1, influxql, victoria_metrics, vm_export, wait_for
 
-pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
-
 DAY = dt.date(2024, 6, 1)
 
 
@@ -41,6 +39,7 @@ def test_lines_have_fixed_types_and_skip_non_finite(cases):
     assert "n_samples=72i" in line and "reliable=true" in line and line.endswith(" 1717200000")
 
 
+@pytest.mark.servers
 def test_victoria_metrics_receives_influxdb_client_writes(cases, tmp_path):
     _, _, result = cases.get()
     with victoria_metrics(tmp_path / "vm") as url:
@@ -56,6 +55,7 @@ def test_victoria_metrics_receives_influxdb_client_writes(cases, tmp_path):
         assert series[0]["timestamps"][0] == 1717200000000
 
 
+@pytest.mark.servers
 def test_influxdb1_over_write_endpoint_read_back_with_influxql(cases, tmp_path):
     _, _, result = cases.get()
     with influxdb1(tmp_path / "influx") as url:
@@ -75,6 +75,7 @@ def test_influxdb1_over_write_endpoint_read_back_with_influxql(cases, tmp_path):
             Influx2Writer(PublishConfig(kind="influx2", url=url)).write(["m f=1 1"])
 
 
+@pytest.mark.servers
 def test_server_down_then_up_nothing_lost_nothing_twice(cases, tmp_path):
     _, _, result = cases.get()
     port = free_port()
@@ -92,6 +93,7 @@ def test_server_down_then_up_nothing_lost_nothing_twice(cases, tmp_path):
         assert len(series) == 30 and all(len(s["values"]) == 2 for s in series)
 
 
+@pytest.mark.servers
 def test_known_changes_reach_influxdb_for_annotations(tmp_path):
     from monitor.config.file import load_config
     from monitor.service.pipeline import publish_changes
@@ -117,6 +119,7 @@ def test_known_changes_reach_influxdb_for_annotations(tmp_path):
         assert series["values"] == [[1716192000, "VIIRS-SDR-GEO-IMG-PARAM-LUT update", "viirs"]]
 
 
+@pytest.mark.servers
 def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
     """Points that waited through an outage leave without a daily run: the daemon's outbox job sends them
     as soon as the server is back."""
@@ -152,6 +155,7 @@ def test_the_daemon_drains_the_outbox_on_its_own_timer(cases, tmp_path):
         assert not store.runs("j01") or all(r.status != "ok" or r.day == str(DAY) for r in store.runs("j01"))
 
 
+@pytest.mark.servers
 def test_a_rerun_day_keeps_one_value_per_series_with_dedup(cases, tmp_path):
     """Re-running a day queues the same points again (same series, same timestamps). InfluxDB overwrites
     a point with the same series and time; VictoriaMetrics keeps one only with deduplication on
