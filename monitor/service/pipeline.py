@@ -254,7 +254,8 @@ def compute_day(
 ) -> DayWork:
     """List, fingerprint, select, fetch and assess (*assessor*, default :func:`assess_plan`) one
     satellite-day, touching no store. Never raises for a problem of the day's data or source: it becomes the
-    work's status and reason. Its log lines carry the satellite, day and stage (and only its own: the context ends with it)."""
+    work's status and reason. Its log lines carry the satellite, day and stage (and only its own: the
+    context ends with it)."""
     with logs.context(satellite=satellite, day=day.isoformat()):
         return _compute_day(cfg, source, satellite, day, should_stop, progress, assessor)
 
