@@ -9,13 +9,10 @@ the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 
 
 The CrIS FOV sees the scene through the paper's top-hat cone, or through a smooth radially symmetric
 spatial response (``SimulationSpec.cris_response``, :mod:`monitor.instrument.footprint`), one for all FOVs or
-one per
-FOV: the CrIS radiance is then the response-weighted mean of the scene out to where the response ends.
-
-Why one module of ~690 lines: it is one instrument pair in flight; the CrIS and the VIIRS granules share
-the spacecraft's state, attitude and scene at every instant. The file layouts are data
-(:mod:`monitor.simulate.jpss_h5`, :mod:`monitor.simulate.complete`), the scene and terrain their own
-modules.
+one per FOV: the CrIS radiance is then the response-weighted mean of the scene out to where the response
+ends. The CrIS and the VIIRS granules share the spacecraft's state, attitude and scene at every instant; the
+file layouts are data (:mod:`monitor.simulate.jpss_h5`, :mod:`monitor.simulate.complete`), the scene and
+terrain modules of their own.
 """
 
 from __future__ import annotations

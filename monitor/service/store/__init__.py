@@ -1,1 +1,2 @@
-"""Stores: the embedded SQLite store (runs, results, granules, outbox) and time-series publishers."""
+"""Stores: the embedded SQLite store (its file, schema, ledger, results, outbox and alert state) and the
+time-series publishers."""
