@@ -15,8 +15,12 @@ from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DI
 FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
 FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
 FLAG_FLAT = "flat"  # the cost surface has no clear minimum (uniform scenes carry no information)
-FLAG_UNCERTAIN = "uncertain"  # the bootstrap spread of the offset exceeds the configured limit
+FLAG_UNCERTAIN = "uncertain"  # the jackknife spread of the offset exceeds the configured limit
 RELIABILITY_FLAGS = (FLAG_FEW_SAMPLES, FLAG_EDGE, FLAG_FLAT, FLAG_UNCERTAIN)
+# how the estimate was made, where it is not the configured way (the offset stays usable, its sigma is the
+# kernel's that was used): said in the flags, stored and shown, never silent
+FLAG_TOP_HAT = "top_hat"  # too few FOVs to fit the footprint: the top-hat cone's estimate and floor
+FLAG_UNCONVERGED = "unconverged"  # the footprint's alternation ran out of iterations or windows
 
 
 @dataclass(frozen=True)

@@ -47,7 +47,9 @@ from monitor.core.result import (
     FLAG_EDGE,
     FLAG_FEW_SAMPLES,
     FLAG_FLAT,
+    FLAG_TOP_HAT,
     FLAG_UNCERTAIN,
+    FLAG_UNCONVERGED,
     DifferenceBin,
     ForOffset,
 )
@@ -317,7 +319,10 @@ def _estimate(
     them (N, m, m): a replicate's first surface is its rows of it, not computed again."""
     keep = slice(None) if counts is None else counts > 0
     d, c = s.d_k[keep], s.cris_k[keep]
-    annuli = s.annuli_rad[keep] if s.annuli_rad is not None and len(c) >= MIN_FOOTPRINT_SAMPLES else None
+    # the day fits the footprint from MIN_FOOTPRINT_SAMPLES on; a replicate fits it whenever the day did
+    # (its few samples fewer never switch it to the cone)
+    fits = len(c) >= MIN_FOOTPRINT_SAMPLES if counts is None else start is not None
+    annuli = s.annuli_rad[keep] if s.annuli_rad is not None and fits else None
     fit = annuli is not None
     sub = ForSamples(d, c, s.granule[keep], s.scan[keep], annuli, s.radii_rad, s.band)
     if fit and start is not None:  # the day's weights: the minimum through them (not the top-hat cone's)
@@ -328,6 +333,7 @@ def _estimate(
     assert annuli is not None and s.band is not None
     regress = calibration_regressors(c) if cost == Cost.REGRESSION else None
     weights = start
+    converged = False
     for _ in range(FOOTPRINT_WINDOWS):
         # the alternation within the refinement's window about the grid minimum: cheap (no cost surface)
         h, i0, j0 = refine.HALF, best.i0, best.j0
@@ -339,16 +345,25 @@ def _estimate(
             dx, dy = refine.refined_minimum(refine.window_covariance(d_win, h, h, cris=regress))
             moved = max(abs(dx - at.dx), abs(dy - at.dy))
             at = replace(at, dx=float(dx), dy=float(dy), x=at.x + dx - at.dx, y=at.y + dy - at.dy)
-            if moved < CONVERGED_STEPS:
+            converged = moved < CONVERGED_STEPS
+            if converged:
                 break
         # the whole surface with the weights found: the grid minimum where it was, or the window moves
         assert weights is not None  # the alternation ran at least once
         d = _with_footprint(sub, weights)
         moved_to = _minimum(d, c, cost, contrast)
-        if not moved_to.refined or (moved_to.i0, moved_to.j0) == (i0, j0):
-            return (moved_to if moved_to.refined else best), weights, d
+        if not moved_to.refined:  # flat or at the edge through the response found: said, not dropped
+            return _flagged(best, moved_to.flags, converged), weights, d
+        if (moved_to.i0, moved_to.j0) == (i0, j0):
+            return _flagged(moved_to, [], converged), weights, d
         best = moved_to
-    return best, weights, d
+    return _flagged(best, [FLAG_UNCONVERGED], False), weights, d  # the windows ran out
+
+
+def _flagged(at: _Minimum, flags: list[str], converged: bool) -> _Minimum:
+    """*at* with *flags* added, and :data:`FLAG_UNCONVERGED` unless the alternation *converged*."""
+    more = flags + ([] if converged else [FLAG_UNCONVERGED])
+    return replace(at, flags=sorted(set(at.flags + more))) if more else at
 
 
 def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: bool = True) -> ForEstimate:
@@ -404,10 +419,11 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
 SIGMA_FLOOR_URAD = {Kernel.TOP_HAT: 5.0, Kernel.FOOTPRINT: 2.0}
 
 
-def floor_urad(cfg: AssessmentConfig) -> float:
-    """The floor of the sigmas (urad), in quadrature with the jackknife's: ``sigma_floor_urad``, or the
-    kernel's (:data:`SIGMA_FLOOR_URAD`)."""
-    return SIGMA_FLOOR_URAD[cfg.kernel] if cfg.sigma_floor_urad is None else cfg.sigma_floor_urad
+def floor_urad(cfg: AssessmentConfig, kernel: Kernel | None = None) -> float:
+    """The floor of the sigmas (urad), in quadrature with the jackknife's: ``sigma_floor_urad``, or that of
+    the *kernel* used (default the configured one; :data:`SIGMA_FLOOR_URAD`)."""
+    used = kernel or cfg.kernel
+    return SIGMA_FLOOR_URAD[used] if cfg.sigma_floor_urad is None else cfg.sigma_floor_urad
 
 
 @dataclass(frozen=True)
@@ -463,8 +479,14 @@ def day_offsets(
             flags += best.flags
             if best.refined:
                 pooled.append((s.cris_k, best.d_opt + s.cris_k))
-            sig_a = float(np.hypot(sig_a * step_urad, floor_urad(cfg)))
-            sig_b = float(np.hypot(sig_b * step_urad, floor_urad(cfg)))
+            # the kernel used: the footprint where a response was fitted, else the cone (too few FOVs, cone
+            # means, no refined minimum), said in the flags, its floor the cone's
+            used = Kernel.FOOTPRINT if best.footprint is not None else Kernel.TOP_HAT
+            if used != cfg.kernel:
+                flags.append(FLAG_TOP_HAT)
+            floor = floor_urad(cfg, used)
+            sig_a = float(np.hypot(sig_a * step_urad, floor))
+            sig_b = float(np.hypot(sig_b * step_urad, floor))
             if max(sig_a, sig_b) > cfg.max_sigma_urad:
                 flags.append(FLAG_UNCERTAIN)
         d_alpha, d_beta = x * step_urad, y * step_urad
