@@ -16,7 +16,7 @@ that too. The cone means are plain means over the top-hat cone, so no footprint 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +25,7 @@ import numpy as np
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR, N_FOV, URAD
 from monitor.core.errors import DataError
-from monitor.core.result import AssessmentResult, GranuleInfo
+from monitor.core.result import FLAG_TOP_HAT, AssessmentResult, GranuleInfo
 from monitor.core.vocabulary import Kernel
 from monitor.estimation.estimate import ForSamples, day_offsets
 
@@ -195,11 +195,14 @@ def assess_collocations(
             raise ReplayError(g.path, "alpha", f"grid differs from {first.path.name}'s")
     cones = cfg.model_copy(update={"kernel": Kernel.TOP_HAT})
     day = day_offsets([for_samples(granules, k) for k in range(N_FOR)], cones, first.step_rad / URAD)
+    fors = day.fors
+    if cfg.kernel != Kernel.TOP_HAT:  # the cone's estimate where the footprint is configured: said per FOR
+        fors = [replace(f, flags=tuple(sorted({*f.flags, FLAG_TOP_HAT}))) for f in fors]
     return AssessmentResult(
         satellite=satellite,
         start="",
         end="",
-        fors=day.fors,
+        fors=fors,
         granules=[granule_info(g) for g in granules],
         half_steps=first.half_steps,
         step_urad=first.step_rad / URAD,
