@@ -197,14 +197,15 @@ def for_samples(
     """The estimator's input for FOR k (0-based): every usable FOV of it over the granules (*band*, the
     satellite's I5 band, for the footprint kernel)."""
     m = len(offsets_rad(cfg))
-    d, cris, granule, scan, annuli = [], [], [], [], []
+    d, cris, granule, scan, fov, annuli = [], [], [], [], [], []
     for g_i, s in enumerate(samples):
         use = s.usable[:, k]  # (nscan, 9)
         d.append((s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]).astype(np.float64))
         cris.append(s.bt_cris_k[:, k][use].astype(np.float64))
-        scans = np.nonzero(use)[0]  # the scan of each sample
+        scans, fovs = np.nonzero(use)  # the scan and FOV of each sample
         granule.append(np.full(scans.size, g_i))
         scan.append(scans)
+        fov.append(fovs)
         if s.annuli_rad is not None:
             annuli.append(s.annuli_rad[:, k][use])
     footprint = len(KERNELS[cfg.kernel]) > 1
@@ -216,6 +217,7 @@ def for_samples(
         np.concatenate(annuli) if footprint and annuli else None,
         KERNELS[cfg.kernel] if footprint else (),
         band,
+        np.concatenate(fov) if fov else np.empty(0, int),
     )
 
 

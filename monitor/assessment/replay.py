@@ -133,15 +133,19 @@ def read_collocation(path: str | Path) -> Collocation:
 
 def for_samples(granules: list[Collocation], k: int) -> ForSamples:
     """The estimator's input for FOR k (0-based) over *granules*: every usable FOV (cone means only)."""
-    d, cris, granule, scan = [], [], [], []
+    d, cris, granule, scan, fov = [], [], [], [], []
     for g_i, g in enumerate(granules):
         use = g.usable[:, k]
         d.append(g.v_bt_k[:, k][use] - g.c_bt_k[:, k][use][:, None, None])
         cris.append(g.c_bt_k[:, k][use])
-        scans = np.nonzero(use)[0]
+        scans, fovs = np.nonzero(use)
         granule.append(np.full(scans.size, g_i))
         scan.append(scans)
-    return ForSamples(np.concatenate(d), np.concatenate(cris), np.concatenate(granule), np.concatenate(scan))
+        fov.append(fovs)
+    return ForSamples(
+        np.concatenate(d), np.concatenate(cris), np.concatenate(granule), np.concatenate(scan),
+        fov=np.concatenate(fov),
+    )  # fmt: skip
 
 
 def granule_info(g: Collocation) -> GranuleInfo:

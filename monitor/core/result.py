@@ -69,6 +69,11 @@ RESPONSE_WIDTH = Family(
     "Latest full width of the CrIS FOV spatial response fitted per FOR, at a level of its peak",
     "level",
 )
+FOV_ROWS = Family(
+    "crisgeo_for_fov_rows_offset_radians",
+    "Latest offset of the FOV rows ahead (FOVs 7-9) minus the rows behind (FOVs 1-3) per FOR",
+    "direction",
+)
 # a field's unit (as CF writes it) -> the factor to the SI unit /metrics publishes it in
 TO_BASE_UNIT = {"urad": URAD, "km": 1000.0, "K": 1.0, "percent": 0.01, "1": 1.0}
 
@@ -189,6 +194,19 @@ class ForOffset:
     sigma_response_width_10_urad: float = measured(
         "urad", f"{SIGMA} response's full width at 10 %", NAN, quality=True
     )
+    # the FOV rows: the offset of the rows ahead (FOVs 7-9) minus that of the rows behind (FOVs 1-3), each
+    # estimated alone (monitor.estimation.estimate): parallax of high clouds, or an error of the EP's FOV
+    # positions
+    fov_rows_alpha_urad: float = measured(
+        "urad", "in-track offset of the FOV rows ahead (FOVs 7-9) minus the rows behind (1-3)", NAN,
+        metric=(FOV_ROWS, "alpha"),
+    )  # fmt: skip
+    fov_rows_beta_urad: float = measured(
+        "urad", "cross-track offset of the FOV rows ahead (FOVs 7-9) minus the rows behind (1-3)", NAN,
+        metric=(FOV_ROWS, "beta"),
+    )  # fmt: skip
+    sigma_fov_rows_alpha_urad: float = measured("urad", f"{SIGMA} rows' in-track offset", NAN, quality=True)
+    sigma_fov_rows_beta_urad: float = measured("urad", f"{SIGMA} rows' cross-track offset", NAN, quality=True)
 
     @property
     def d_alpha_pct_fov(self) -> float:

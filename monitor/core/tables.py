@@ -73,6 +73,8 @@ FOR_COLUMNS = {
     "cost_min": field_column("G_min", "cost_min_k", ".3f", 6),
     "cost_zero": field_column("G_0", "cost_zero_k", ".3f", 6),
     "width_50": field_column("FWHM", "response_width_50_urad", ".0f", 6),
+    "rows_alpha": field_column("rows_a", "fov_rows_alpha_urad", ".0f", 7),
+    "rows_beta": field_column("rows_b", "fov_rows_beta_urad", ".0f", 7),
     "flags": Column("flags", _flags, "", 0, "", "<"),
 }
 # the column sets: what assess and run print, what status prints, what the report shows
@@ -81,7 +83,7 @@ FULL = (
     "cost_min", "cost_zero", "width_50", "flags",
 )  # fmt: skip
 BRIEF = ("for", "d_alpha", "d_beta", "in_track", "cross_track", "total", "flags")
-REPORT = FULL[:5] + ("alpha_pct_fov", "beta_pct_fov") + FULL[5:]
+REPORT = FULL[:5] + ("alpha_pct_fov", "beta_pct_fov") + FULL[5:-1] + ("rows_alpha", "rows_beta", "flags")
 
 
 def for_table(fors: Iterable[ForOffset], columns: tuple[str, ...] = FULL, indent: str = "") -> list[str]:

@@ -83,6 +83,7 @@ class ForSamples:
     annuli_rad: np.ndarray | None = None
     radii_rad: tuple[float, ...] = ()
     band: I5Band | None = field(default=None, repr=False)
+    fov: np.ndarray | None = None  # (N,) the FOV (0..8) of each sample, for the rows (FOV_ROWS)
 
     def __len__(self) -> int:
         return len(self.cris_k)
@@ -124,6 +125,27 @@ class ForEstimate:
     refined: bool
     intercalibration: Intercalibration = NO_FIT
     footprint: Footprint | None = None
+    rows: tuple[float, float] = (np.nan, np.nan)  # the rows ahead minus behind (steps), FOV_ROWS
+    rows_sigma: tuple[float, float] = (np.nan, np.nan)
+
+
+# the FOV rows (0-based FOV indices) whose offsets are told apart: those ahead and behind along-track
+FOV_ROWS = ((6, 7, 8), (0, 1, 2))
+
+
+def _rows(d: np.ndarray, s: ForSamples, cost: Cost, contrast: float, keep: np.ndarray | None) -> np.ndarray:
+    """The offset (x, y in steps) of the rows ahead minus that of the rows behind (:data:`FOV_ROWS`),
+    each the minimum of its own samples' surface *d* (the day's, through the response found); *keep*
+    selects the samples (a replicate's). NaN where either row has no refined minimum."""
+    assert s.fov is not None
+    rows = []
+    for fovs in FOV_ROWS:
+        use = np.isin(s.fov, fovs) if keep is None else np.isin(s.fov, fovs) & keep
+        if use.sum() < 3:
+            return np.array([np.nan, np.nan])
+        at = _minimum(d[use], s.cris_k[use], cost, contrast)
+        rows.append((at.x, at.y) if at.refined else (np.nan, np.nan))
+    return np.asarray(rows[0]) - np.asarray(rows[1])
 
 
 def _stdev(d: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
@@ -376,12 +398,18 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
         else d[:, best.i0, best.j0]
     )
     jack = Jackknife.of(s.granule, s.scan) if uncertainty else None
+    rows = _rows(d, s, cost, contrast, None) if s.fov is not None else np.array([np.nan, np.nan])
+    rows_sigma = (np.nan, np.nan)
     sigma = (np.nan, np.nan)
     cal_boot = None
     fp = None
     if weights is not None:
         widths = widths_of_weights(s.radii_rad, weights)
         fp = Footprint(s.radii_rad, weights, widths[0.5], widths[0.1])
+    if jack is not None and s.fov is not None:  # the rows' replicates, on the day's surface
+        row_reps = [_rows(d, s, cost, contrast, counts > 0) for counts in jack.counts]
+        rs = jack.sigma(np.array(row_reps))
+        rows_sigma = (float(rs[0]), float(rs[1]))
     if jack is not None:
         reps, vs, width_reps = [], [], []
         for counts in jack.counts:
@@ -409,7 +437,10 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
                 fp.radii_rad, fp.weights, fp.width_50_rad, fp.width_10_rad, float(ws[0]), float(ws[1])
             )
     cal = intercalibrate(s.cris_k, d_opt + s.cris_k, jack, cal_boot)
-    return ForEstimate(best.x, best.y, sigma, best.flags, best.g, d_opt, best.refined, cal, fp)
+    return ForEstimate(
+        best.x, best.y, sigma, best.flags, best.g, d_opt, best.refined, cal, fp,
+        (float(rows[0]), float(rows[1])), rows_sigma,
+    )  # fmt: skip
 
 
 # The floor of the sigmas by kernel (urad): what the estimator itself leaves beside the jackknife's scatter,
@@ -466,6 +497,7 @@ def day_offsets(
         g = np.full((m, m), np.nan)
         cal = NO_FIT
         widths = [np.nan] * 4
+        rows = [np.nan] * 4  # ahead minus behind: alpha, beta, and their sigmas (steps)
         best = estimates[k]
         if best is not None:
             if best.footprint is not None:
@@ -475,6 +507,7 @@ def day_offsets(
                     for w in (fp.width_50_rad, fp.sigma_width_50_rad, fp.width_10_rad, fp.sigma_width_10_rad)
                 ]
             g, x, y, (sig_a, sig_b), cal = best.cost, best.x, best.y, best.sigma, best.intercalibration
+            rows = [*best.rows, *best.rows_sigma]
             cube[k] = g
             flags += best.flags
             if best.refined:
@@ -516,6 +549,10 @@ def day_offsets(
                 sigma_response_width_50_urad=float(widths[1]),
                 response_width_10_urad=float(widths[2]),
                 sigma_response_width_10_urad=float(widths[3]),
+                fov_rows_alpha_urad=rows[0] * step_urad,
+                fov_rows_beta_urad=rows[1] * step_urad,
+                sigma_fov_rows_alpha_urad=rows[2] * step_urad,
+                sigma_fov_rows_beta_urad=rows[3] * step_urad,
                 flags=tuple(sorted(set(flags))),
             )
         )
