@@ -41,6 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.provenance import commit
 from monitor.assessment.assess import assess_paths
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
@@ -108,6 +109,7 @@ def run_case(
     ta = np.array([f["d_alpha_urad"] for f in truth["fors"]])
     tb = np.array([f["d_beta_urad"] for f in truth["fors"]])
     return {
+        "commit": commit(),
         "size": size,
         "profile": profile,
         "ground": ground,

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks.provenance import commit
 from monitor.assessment.replay import assess_collocations, read_collocation
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR, URAD
@@ -53,9 +53,8 @@ def main() -> None:
     fors = assess_collocations(args.files, AssessmentConfig()).fors
     own = np.array([[f.fov_rows_alpha_urad, f.fov_rows_beta_urad] for f in fors])
     sigma = np.array([[f.sigma_fov_rows_alpha_urad, f.sigma_fov_rows_beta_urad] for f in fors])
-    commit = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True, text=True)
     row = {
-        "commit": commit.stdout.strip(),
+        "commit": commit(),
         "granules": len(args.files),
         "stdev_in_track_mean_urad": round(float(paper[:, 0].mean()), 1),
         "stdev_in_track_sem_urad": round(float(paper[:, 0].std(ddof=1) / np.sqrt(N_FOR)), 1),

@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.provenance import commit
 from monitor.collocation.collocate import warm_up
 from monitor.config.file import load_config
 from monitor.core.satellites import SATELLITES
@@ -143,6 +144,7 @@ def main(argv=None) -> int:
                 projected = n / PROJECTED_B_S + req * PROJECTED_REQUEST_S
                 compute = sum(v for k, v in w.timings.items() if k not in ("fetch",))
                 row = {
+                    "commit": commit(),
                     "layout": layout, "granules": granules, "run": label, "status": str(w.status),
                     "assessed": w.counts.assessed, "bytes": n, "files_bytes": total,
                     "share": n / total, "requests": req, "wall_s": round(secs, 1),

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.provenance import commit
 from monitor.assessment.assess import assess_paths
 from monitor.config.assessment import AssessmentConfig
 from monitor.instrument import footprint
@@ -56,6 +57,7 @@ def main() -> None:
         sig_a = np.array([f.sigma_alpha_urad for f in result.fors])
         sig_b = np.array([f.sigma_beta_urad for f in result.fors])
         row = {
+            "commit": commit(),
             "shape": name,
             "seed": seed,
             "profile": profile,
