@@ -85,9 +85,9 @@ class AlertState:
         """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason; a silence
         without a reason or ending before *now* is refused (:class:`SilenceError`)."""
         if not reason.strip():
-            raise SilenceError("a silence needs a reason (--reason)")
+            raise SilenceError("alerts silence needs --until and --reason")
         if until <= now:
-            raise SilenceError("a silence must end in the future (--until)")
+            raise SilenceError("--until must be in the future")
         with self.store.transaction():
             self.db.execute(
                 "INSERT INTO silences (rule, satellite, until, reason, created) VALUES (?, ?, ?, ?, ?)",

@@ -3,9 +3,11 @@
 import datetime as dt
 import sqlite3
 
+import pytest
+
 from alerts.rules import Finding
 from monitor.core.vocabulary import EventKind
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alerts import AlertState, SilenceError
 from monitor.service.store.schema import MIGRATIONS
 from monitor.service.store.sqlite import Store
 
@@ -33,6 +35,22 @@ def test_silence_matches_rule_and_satellite_until_it_ends(tmp_path):
         assert state.silenced("spec", "j01", T0 + dt.timedelta(hours=1)) is None
         assert state.silenced("jump", "j01", T0 + dt.timedelta(hours=3)) is None
         assert [s.reason for s in state.silences(T0)] == ["EP upload"]
+
+
+def test_a_silence_needs_a_reason_and_a_future_end_and_lifts_only_what_is_in_force(tmp_path):
+    with Store(tmp_path / "s.sqlite") as store:
+        state = AlertState(store)
+        with pytest.raises(SilenceError, match="--reason"):
+            state.silence("jump", None, T0 + dt.timedelta(hours=1), "  ", T0)
+        with pytest.raises(SilenceError, match="in the future"):
+            state.silence("jump", None, T0, "EP upload", T0)
+        assert state.silences(T0) == []
+        state.silence("jump", None, T0 + dt.timedelta(hours=1), "EP upload", T0)
+        (s,) = state.silences(T0)
+        with pytest.raises(SilenceError, match=f"--id {s.id + 1}"):
+            state.lift(s.id + 1, T0)
+        state.lift(s.id, T0)
+        assert state.silences(T0) == []
 
 
 def test_a_delivery_is_claimed_once_and_retried_after_its_lease(tmp_path):
