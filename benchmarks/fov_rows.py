@@ -1,7 +1,9 @@
 """The FOV rows' signature on the real collocations: per FOR, the offset estimated from the rows ahead
 (FOVs 7-9) alone minus that from the rows behind (FOVs 1-3) alone, with the paper's STDEV cost on the
 reference implementation's cone means, grid minimum and quadratic refinement (the fact sheet's method), and
-with the assessment's own estimator (``fov_rows_*``, regression cost). Prints one JSON row.
+with the assessment's own estimator (``fov_rows_*``, regression cost); and how far the FOR offsets of one
+granule alone scatter from granule to granule (the median over FORs of their standard deviation). Prints
+one JSON row.
 
     .venv/bin/python -m benchmarks.fov_rows [FILES.npz ...]     (default: the ten in tests/data/real)
 """
@@ -53,6 +55,13 @@ def main() -> None:
     fors = assess_collocations(args.files, AssessmentConfig()).fors
     own = np.array([[f.fov_rows_alpha_urad, f.fov_rows_beta_urad] for f in fors])
     sigma = np.array([[f.sigma_fov_rows_alpha_urad, f.sigma_fov_rows_beta_urad] for f in fors])
+    alone = np.array(
+        [
+            [[f.d_alpha_urad, f.d_beta_urad] for f in assess_collocations([p], AssessmentConfig()).fors]
+            for p in args.files
+        ]
+    )  # (granules, N_FOR, 2)
+    scatter = np.nanmedian(np.nanstd(alone, axis=0, ddof=1), axis=0)
     row = {
         "commit": commit(),
         "granules": len(args.files),
@@ -64,6 +73,8 @@ def main() -> None:
         "own_in_track_negative_fors": int((own[:, 0] < 0).sum()),
         "own_cross_track_mean_urad": round(float(np.nanmean(own[:, 1])), 1),
         "own_median_sigma_urad": round(float(np.nanmedian(sigma)), 1),
+        "per_granule_scatter_in_track_urad": round(float(scatter[0]), 1),
+        "per_granule_scatter_cross_track_urad": round(float(scatter[1]), 1),
     }
     print(json.dumps(row))
 

@@ -133,19 +133,23 @@ class ForEstimate:
 FOV_ROWS = ((6, 7, 8), (0, 1, 2))
 
 
-def _rows(d: np.ndarray, s: ForSamples, cost: Cost, contrast: float, keep: np.ndarray | None) -> np.ndarray:
+def _rows(d: np.ndarray, s: ForSamples, cost: Cost, contrast: float, counts: np.ndarray) -> np.ndarray:
     """The offset (x, y in steps) of the rows ahead minus that of the rows behind (:data:`FOV_ROWS`),
-    each the minimum of its own samples' surface *d* (the day's, through the response found); *keep*
-    selects the samples (a replicate's). NaN where either row has no refined minimum."""
+    each the minimum of its own samples' surface *d* (the day's, through the response found), for every
+    row of *counts* (B, N): the day (ones) and its jackknife replicates at once, one weighted surface each
+    (:func:`cost_surface`), refined by the quadratic through the 3 x 3 about the grid minimum
+    (:func:`find_minimum`). (B, 2); NaN where either row has fewer than 3 samples or no clear minimum."""
     assert s.fov is not None
-    rows = []
+    xy = []
     for fovs in FOV_ROWS:
-        use = np.isin(s.fov, fovs) if keep is None else np.isin(s.fov, fovs) & keep
-        if use.sum() < 3:
-            return np.array([np.nan, np.nan])
-        at = _minimum(d[use], s.cris_k[use], cost, contrast)
-        rows.append((at.x, at.y) if at.refined else (np.nan, np.nan))
-    return np.asarray(rows[0]) - np.asarray(rows[1])
+        w = counts * np.isin(s.fov, fovs)
+        surfaces = cost_surface(d, s.cris_k, cost, w)
+        found = []
+        for g, n in zip(surfaces, (w > 0).sum(axis=1), strict=True):
+            x, y, flags = find_minimum(g, contrast) if n >= 3 else (np.nan, np.nan, [FLAG_FLAT])
+            found.append((np.nan, np.nan) if FLAG_FLAT in flags or FLAG_EDGE in flags else (x, y))
+        xy.append(np.array(found))
+    return xy[0] - xy[1]
 
 
 def _stdev(d: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
@@ -398,18 +402,20 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
         else d[:, best.i0, best.j0]
     )
     jack = Jackknife.of(s.granule, s.scan) if uncertainty else None
-    rows = _rows(d, s, cost, contrast, None) if s.fov is not None else np.array([np.nan, np.nan])
-    rows_sigma = (np.nan, np.nan)
+    rows = rows_sigma = (np.nan, np.nan)
     sigma = (np.nan, np.nan)
     cal_boot = None
     fp = None
     if weights is not None:
         widths = widths_of_weights(s.radii_rad, weights)
         fp = Footprint(s.radii_rad, weights, widths[0.5], widths[0.1])
-    if jack is not None and s.fov is not None:  # the rows' replicates, on the day's surface
-        row_reps = [_rows(d, s, cost, contrast, counts > 0) for counts in jack.counts]
-        rs = jack.sigma(np.array(row_reps))
-        rows_sigma = (float(rs[0]), float(rs[1]))
+    if s.fov is not None:  # the rows, the day's and its replicates', on the day's surface
+        counts = np.ones((1, len(s))) if jack is None else np.vstack([np.ones(len(s)), jack.counts])
+        found = _rows(d, s, cost, contrast, counts)
+        rows = (float(found[0, 0]), float(found[0, 1]))
+        if jack is not None:
+            rs = jack.sigma(found[1:])
+            rows_sigma = (float(rs[0]), float(rs[1]))
     if jack is not None:
         reps, vs, width_reps = [], [], []
         for counts in jack.counts:
@@ -439,7 +445,7 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
     cal = intercalibrate(s.cris_k, d_opt + s.cris_k, jack, cal_boot)
     return ForEstimate(
         best.x, best.y, sigma, best.flags, best.g, d_opt, best.refined, cal, fp,
-        (float(rows[0]), float(rows[1])), rows_sigma,
+        rows, rows_sigma,
     )  # fmt: skip
 
 
