@@ -79,10 +79,12 @@ def run_case(
     cost=DEFAULT_COST.value,
     shape="top-hat",
     kernel=DEFAULT_KERNEL.value,
+    clouds="ground",
+    rows_urad=0.0,
 ):
     orbit_pass, lon = EXTRA_PASSES.get(pass_name, (pass_name, None))
     gain, bias_k, curve_k = MISMATCHES[mismatch]
-    case = root / f"{profile}_{ground}_{pass_name}_{seed}_{size}_{mismatch}_{shape}"
+    case = root / f"{profile}_{ground}_{pass_name}_{seed}_{size}_{mismatch}_{shape}_{clouds}_{rows_urad:g}"
     if keep and (case / "truth.json").exists():  # a kept case is assessed again, not simulated again
         truth = json.loads((case / "truth.json").read_text())
     else:
@@ -98,6 +100,8 @@ def run_case(
             cris_bias_k=bias_k,
             cris_nonlinear_k=curve_k,
             cris_response=None if shape == "top-hat" else footprint.shape(shape),
+            cloud_heights=clouds,
+            fov_rows_alpha_urad=rows_urad,
         )
     t0 = time.perf_counter()
     cfg = AssessmentConfig(cost=Cost(cost), kernel=Kernel(kernel))
@@ -132,6 +136,12 @@ def run_case(
         "sigma_gain_pct": [f.sigma_gain_pct for f in result.fors],
         "curvature_k": [f.curvature_k for f in result.fors],
         "sigma_curvature_k": [f.sigma_curvature_k for f in result.fors],
+        "clouds": clouds,
+        "fov_rows_alpha_urad": rows_urad,
+        "rows_err_alpha_urad": [f.fov_rows_alpha_urad - rows_urad for f in result.fors],
+        "rows_err_beta_urad": [f.fov_rows_beta_urad for f in result.fors],
+        "sigma_rows_alpha_urad": [f.sigma_fov_rows_alpha_urad for f in result.fors],
+        "sigma_rows_beta_urad": [f.sigma_fov_rows_beta_urad for f in result.fors],
     }
 
 
@@ -146,6 +156,8 @@ def _key(r) -> tuple:
         r.get("cost", "stdev"),
         r.get("footprint", "top-hat"),
         r.get("kernel", "top-hat"),
+        r.get("clouds", "ground"),
+        r.get("fov_rows_alpha_urad", 0.0),
     )
 
 
@@ -182,9 +194,24 @@ def verdict(row) -> tuple[bool, str]:
         f"{row.get('mismatch', 'none'):<17} {row.get('cost', 'stdev'):<10} "
         f"{row['profile']:<7} {row['ground']:<8} {row['pass']:<9} {row['seed']:>4} {row['size']:>4} "
         f"{rms[0]:6.1f} {worst[0]:6.1f} {rms[1]:6.1f} {worst[1]:6.1f} {row['reliable'].count(False):>7} "
-        f"{row['assess_s']:8.1f}  {'pass' if ok else 'FAIL'}{recovery(row)}"
+        f"{row['assess_s']:8.1f}  {'pass' if ok else 'FAIL'}{recovery(row)}{rows_read(row)}"
     )
     return ok, line
+
+
+def rows_read(row) -> str:
+    """How the FOV rows' product reads the injected row error (ahead minus behind, in-track; none
+    cross-track): per direction the median error and the share of FORs within 2 sigma (issue 42: >= 90 %,
+    median within 40 urad, median sigma <= 60 urad)."""
+    if "rows_err_alpha_urad" not in row:
+        return ""
+    parts = []
+    for d in ("alpha", "beta"):
+        e = np.array(row[f"rows_err_{d}_urad"], float)
+        s = np.array(row[f"sigma_rows_{d}_urad"], float)
+        within = 100 * np.mean(np.abs(e) <= 2 * s)
+        parts.append(f"{d} {np.nanmedian(e):+.0f} ({within:.0f}% in 2s, s {np.nanmedian(s):.0f})")
+    return f"  rows {row['clouds']} {row['fov_rows_alpha_urad']:+g}: " + ", ".join(parts)
 
 
 def calibration(rows) -> str:
@@ -228,6 +255,14 @@ def main() -> int:
         help="the CrIS spatial response of the truth (monitor.instrument.footprint)",
     )  # fmt: skip
     p.add_argument("--kernel", choices=[k.value for k in Kernel], default=DEFAULT_KERNEL.value)
+    p.add_argument(
+        "--clouds", nargs="+", default=["ground"],
+        help="cloud-height laws of the truth (monitor.simulate.clouds): ground, lapse:G, tropical",
+    )  # fmt: skip
+    p.add_argument(
+        "--rows-error", type=float, nargs="+", default=[0.0],
+        help="FOV rows ahead minus behind turned in-track by this much in the truth, urad",
+    )  # fmt: skip
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--keep", help="directory to keep the cases and results in")
     p.add_argument("--rows", help="append one JSON line per case here (errors and sigmas per FOR)")
@@ -254,15 +289,28 @@ def main() -> int:
                 r = json.loads(line)
                 done[_key(r)] = r
     for case in itertools.product(
-        args.sizes, args.ground, args.passes, args.profiles, args.seeds, args.mismatch, args.footprints
-    ):
-        size, ground, pass_name, profile, seed, mismatch, shape = case
-        key = (size, ground, pass_name, profile, seed, mismatch, args.cost, shape, args.kernel)
+        args.sizes, args.ground, args.passes, args.profiles, args.seeds, args.mismatch, args.footprints,
+        args.clouds, args.rows_error,
+    ):  # fmt: skip
+        size, ground, pass_name, profile, seed, mismatch, shape, clouds, rows_urad = case
+        key = (
+            size,
+            ground,
+            pass_name,
+            profile,
+            seed,
+            mismatch,
+            args.cost,
+            shape,
+            args.kernel,
+            clouds,
+            rows_urad,
+        )
         row = done.get(key)
         if row is None:
             row = run_case(
                 root, size, profile, ground, pass_name, seed, args.workers, args.keep, mismatch, args.cost,
-                shape, args.kernel,
+                shape, args.kernel, clouds, rows_urad,
             )  # fmt: skip
             if args.rows:
                 with open(args.rows, "a") as fh:

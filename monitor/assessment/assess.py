@@ -316,6 +316,17 @@ def _collocate_run(
     return samples, skipped
 
 
+def collocate_plan(
+    case: CasePlan, cfg: AssessmentConfig | None = None, workers: int = 1
+) -> list[GranuleSamples]:
+    """The collocated samples of every CrIS granule of *case*, in time order (granules that fail are left
+    out, logged): what :func:`assess_plan` estimates from, for benchmarks that estimate otherwise."""
+    with parallel_threads(workers):
+        return _collocate_run(
+            case.cris, case.viirs, case.viirs_all, case.satellite, cfg or AssessmentConfig()
+        )[0]
+
+
 def assess_plan(
     case: CasePlan,
     cfg: AssessmentConfig | None = None,

@@ -50,6 +50,20 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     arg("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)"),
     arg("--terrain", action="store_true", help="1-4 km ranges and plateaus over 40 %% land"),
     arg(
+        "--clouds",
+        default="ground",
+        metavar="LAW",
+        help="cloud tops at the height their temperature implies: lapse:G (K/km, e.g. lapse:6.5) or "
+        "tropical (a profile that is not linear); default ground (flat clouds, no parallax)",
+    ),
+    arg(
+        "--fov-rows-urad",
+        type=float,
+        default=0.0,
+        help="turn the true LOS of FOVs 7-9 in-track by +half this and of FOVs 1-3 by -half, unknown to "
+        "GEO (an error of the EP's FOV positions, urad)",
+    ),
+    arg(
         "--pass",
         dest="orbit_pass",
         choices=sorted(PASSES),
@@ -87,6 +101,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         complete=args.complete,
         layout=args.layout,
         cris_response=_footprint(args.footprint),
+        cloud_heights=args.clouds,
+        fov_rows_alpha_urad=args.fov_rows_urad,
     )
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")

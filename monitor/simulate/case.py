@@ -13,6 +13,13 @@ one per FOV: the CrIS radiance is then the response-weighted mean of the scene o
 ends. The CrIS and the VIIRS granules share the spacecraft's state, attitude and scene at every instant; the
 file layouts are data (:mod:`monitor.simulate.jpss_h5`, :mod:`monitor.simulate.complete`), the scene and
 terrain modules of their own.
+
+Clouds with height (``SimulationSpec.cloud_heights``, :mod:`monitor.simulate.clouds`): both instruments'
+rays meet the first cloud they pass, its top or its side, and see its temperature there; GEO stays where
+the ray meets the terrain (or the ellipsoid), as IDPS writes it. So a high cloud seen by CrIS's rows ahead
+(FOVs 7-9, 19 mrad forward) lands forward of where VIIRS puts it, and behind for the rows behind.
+``fov_rows_alpha_urad`` turns the true LOS of the rows ahead by half of it in-track and the rows behind by
+minus half, which GEO does not know: an error of the EP's FOV positions, ahead minus behind.
 """
 
 from __future__ import annotations
@@ -54,11 +61,11 @@ from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
 from monitor.simulate import complete
 from monitor.simulate import instrument as ins
+from monitor.simulate.clouds import CloudHeights
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
 from monitor.simulate.orbit import PASSES, CircularOrbit, find_pass
 from monitor.simulate.profiles import load_profile
-from monitor.simulate.scene import MAX_HEIGHT_M, Scene, spectra, transmittance
-from monitor.simulate.terrain import intersect_terrain
+from monitor.simulate.scene import Scene, spectra, transmittance
 
 UTC = dt.timezone.utc
 DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)
@@ -121,6 +128,10 @@ class SimulationSpec:
     # the CrIS FOV's spatial response: None, the top-hat cone of FOV_DIAMETER_RAD (the paper's); one
     # response for all FOVs, or a tuple of 9 (FOV 1..9)
     cris_response: RadialResponse | tuple[RadialResponse, ...] | None = None
+    # the height of the cloud tops (monitor.simulate.clouds): ground (flat), lapse:G (K/km) or tropical
+    cloud_heights: str = "ground"
+    # the true LOS of FOVs 7-9 turned +half this in-track, of FOVs 1-3 -half, unknown to GEO (urad)
+    fov_rows_alpha_urad: float = 0.0
 
     def compressed(self, instrument: str) -> bool:
         """Whether the datasets of *instrument* (CrIS, VIIRS) are written gzip-compressed."""
@@ -152,6 +163,7 @@ class SimulationSpec:
             raise DataError(f"orbit pass {self.orbit_pass!r} is not one of {', '.join(PASSES)}")
         if isinstance(self.cris_response, tuple) and len(self.cris_response) != N_FOV:
             raise DataError(f"a response per FOV needs {N_FOV}, not {len(self.cris_response)}")
+        CloudHeights.parse(self.cloud_heights)  # a law it does not know is a DataError now, not mid-case
         if self.pass_lon_deg is not None and self.orbit_pass is None:
             raise DataError("a pass longitude needs an orbit pass")
         if (self.true_ep is None) != (self.ground_ep is None):
@@ -230,7 +242,11 @@ class Simulator:
             self.orbit = CircularOrbit.of(sat, self.t0)
             night = not ascending  # the descending node of a 13:30 orbit is at 01:30 local time
         self.scene = Scene(
-            spec.seed, land_fraction=0.4 if spec.terrain else 0.3, terrain=spec.terrain, night=night
+            spec.seed,
+            land_fraction=0.4 if spec.terrain else 0.3,
+            terrain=spec.terrain,
+            night=night,
+            clouds=CloudHeights.parse(spec.cloud_heights),
         )
         self.band = i5_band(spec.satellite)
         self.nu = cris_lw_wavenumbers_cm1()
@@ -246,6 +262,10 @@ class Simulator:
         else:
             self.los_true = ins.cris_los_sbf()
             self.los_geo = ins.cris_los_sbf(-spec.d_alpha_urad * URAD, -spec.d_beta_urad * URAD)
+        if spec.fov_rows_alpha_urad:
+            rows = np.zeros(N_FOV)
+            rows[6:9], rows[0:3] = 0.5, -0.5  # FOVs 7-9 ahead, 1-3 behind
+            self.los_true = ins.turned(self.los_true, rows * spec.fov_rows_alpha_urad * URAD, 0.0)
 
     def attitude_rad(self, unix_s: ArrayLike) -> np.ndarray:
         """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift."""
@@ -373,7 +393,15 @@ class Simulator:
             pts = origin + wgs84.intersect_ellipsoid(origin, los)[..., None] * los
             lat, lon = wgs84.surface_to_geodetic(pts)
             return lat, lon, np.zeros(lat.shape)
-        return intersect_terrain(origin, los, self.scene.height_m, MAX_HEIGHT_M)[1:]
+        return self.scene.intersect(origin, los, clouds=False)[1:]
+
+    def _seen(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What each ray sees: geodetic (lat_rad, lon_rad) of the first cloud or terrain it meets, and the
+        terrain height (m) there (the flat scene's temperature is a function of the three)."""
+        if self.scene.clouds.flat:
+            return self._surface(origin, los)
+        _, lat, lon, _ = self.scene.intersect(origin, los)
+        return lat, lon, self.scene.height_m(lat, lon)
 
     @property
     def _fov_disk(self) -> tuple[np.ndarray, np.ndarray]:
@@ -413,7 +441,7 @@ class Simulator:
             los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :]
         )
         origin = np.broadcast_to(sat[..., None, :], dirs.shape)
-        temp = self.scene.temperature_k(*self._surface(origin, dirs)).reshape(-1, n)
+        temp = self.scene.temperature_k(*self._seen(origin, dirs)).reshape(-1, n)
         w = np.broadcast_to(weights, sat.shape[:-1] + weights.shape[-1:]).reshape(-1, n)
         nfov = temp.shape[0]
         pos = (np.clip(temp, T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (T_BINS_K[1] - T_BINS_K[0])
@@ -458,7 +486,8 @@ class Simulator:
             los = np.einsum("scij,dcj->sdci", m, los_sbf)
             origin = np.broadcast_to(r[:, None], los.shape)
             lat, lon, h = self._surface(origin, los)
-            temp = self.scene.temperature_k(lat, lon, h)
+            seen = (lat, lon, h) if self.scene.clouds.flat else self._seen(origin, los)
+            temp = self.scene.temperature_k(*seen)
             lrad = np.interp(temp, T_BINS_K, self.band_table)
             bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, temp.shape)
             rows = slice(s0 * VIIRS_DETECTORS, (s0 + lat.shape[0]) * VIIRS_DETECTORS)
@@ -635,6 +664,8 @@ def simulate_case(
         "orbit_pass": spec.orbit_pass,
         "pass_lon_deg": spec.pass_lon_deg,
         "terrain": spec.terrain,
+        "cloud_heights": spec.cloud_heights,
+        "fov_rows_alpha_urad": spec.fov_rows_alpha_urad,
         "cris_calibration": {
             "bias_k": spec.cris_bias_k,
             "gain": spec.cris_gain,

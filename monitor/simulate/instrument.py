@@ -57,14 +57,19 @@ def cris_los_sbf(d_alpha_rad: ArrayLike | None = None, d_beta_rad: ArrayLike | N
     los = np.einsum("kij,kfj->kfi", rot_x(-theta), local)
     if d_alpha_rad is None and d_beta_rad is None:
         return los
-    alpha = (
-        np.arctan2(los[..., 0], los[..., 2])
-        + np.asarray(d_alpha_rad if d_alpha_rad is not None else 0.0)[..., None]
+    zero = np.zeros(N_FOR)
+    return turned(
+        los,
+        np.asarray(d_alpha_rad if d_alpha_rad is not None else zero)[..., None],
+        np.asarray(d_beta_rad if d_beta_rad is not None else zero)[..., None],
     )
-    beta = (
-        np.arctan2(los[..., 1], los[..., 2])
-        + np.asarray(d_beta_rad if d_beta_rad is not None else 0.0)[..., None]
-    )
+
+
+def turned(los_sbf: np.ndarray, d_alpha_rad: ArrayLike, d_beta_rad: ArrayLike) -> np.ndarray:
+    """Unit LOS (..., 3) in the SBF turned by (d_alpha, d_beta) rad (broadcast over ``los_sbf[..., 0]``):
+    alpha = atan(x/z) in-track and beta = atan(y/z) cross-track (equations 1-2) grow by them."""
+    alpha = np.arctan2(los_sbf[..., 0], los_sbf[..., 2]) + d_alpha_rad
+    beta = np.arctan2(los_sbf[..., 1], los_sbf[..., 2]) + d_beta_rad
     return unit(np.stack([np.tan(alpha), np.tan(beta), np.ones_like(alpha)], axis=-1))
 
 

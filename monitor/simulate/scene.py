@@ -15,16 +15,29 @@ of some tens of km. Its slopes stay below ``MAX_SLOPE`` (0.4, ~22 deg), so a lin
 satellite meets it once except on the steepest slopes seen at the very edge of the VIIRS swath (at view
 zenith z a ray can meet a slope s twice only when s > cot z; cot 68 deg = 0.4).
 
+Clouds with height (optional, :mod:`monitor.simulate.clouds`): a cloud top stands at the height its
+temperature implies under a law (a lapse rate or a profile) from the surface air temperature below it (the
+sea-surface temperature of its latitude). Where the cover is partial (the soft edges) the cloud surface
+stands at cover x that height, so the scene is one surface ``top_m(lat, lon)``, the terrain or the cloud
+above it, with steep sides at the cloud edges; the emitting temperature of a point on it is the flat
+scene's at the same (lat, lon). Clouds on the ground are the law ``ground``: the surface is the terrain.
+
 Spectra add a simple atmosphere: R(nu) = tau(nu) B(nu, T) + (1 - tau(nu)) B(nu, T_atm).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
+from monitor.core.threads import KERNEL_LOCK
 from monitor.instrument.spectral import planck_radiance
+from monitor.simulate import terrain
+from monitor.simulate.clouds import CEILING_M, FLAT, CloudHeights
 
 EARTH_RADIUS_KM = 6371.0
 FINE_KM, FINE_N = 1.1, 2048
@@ -55,42 +68,170 @@ def _unit_vectors(lat_rad: ArrayLike, lon_rad: ArrayLike) -> tuple[np.ndarray, n
     return c * np.cos(lon), c * np.sin(lon), np.sin(lat)
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _sample(x: float, y: float, z: float, flat: np.ndarray, n: int, scale: float, out: np.ndarray) -> None:
+    """out (C,) = the triplanar blend at unit vector (x, y, z) of the fields *flat* (3, n * n, C): for
+    each plane the bilinear sample at the point's two in-plane coordinates (times *scale*), weighted by the
+    fourth power of the direction cosine normal to the plane over their root sum of squares."""
+    mask = n - 1  # n is a power of two: modulo by mask
+    nc = flat.shape[2]
+    c = (x, y, z)
+    w = (x**4, y**4, z**4)
+    norm = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    for ch in range(nc):
+        out[ch] = 0.0
+    for p in range(3):
+        u = c[(p + 1) % 3] * scale
+        v = c[(p + 2) % 3] * scale
+        u0 = np.floor(u)
+        v0 = np.floor(v)
+        fu = u - u0
+        fv = v - v0
+        i0 = np.int32(u0) & mask
+        j0 = np.int32(v0) & mask
+        i1 = ((i0 + 1) & mask) * n
+        j1 = (j0 + 1) & mask
+        i0 *= n
+        wp = w[p] / norm
+        for ch in range(nc):
+            a = flat[p, i0 + j0, ch]
+            a += (flat[p, i0 + j1, ch] - a) * fv
+            b = flat[p, i1 + j0, ch]
+            b += (flat[p, i1 + j1, ch] - b) * fv
+            a += (b - a) * fu
+            out[ch] += a * wp
+
+
 @numba.njit(cache=True, nogil=True)
 def _triplanar_samples(
     x: np.ndarray, y: np.ndarray, z: np.ndarray, flat: np.ndarray, n: int, scale: float, out: np.ndarray
 ) -> None:
-    """out (P, C) = the triplanar blend at unit vectors (x, y, z) (P,) of the fields *flat* (3, n * n, C):
-    for each plane the bilinear sample at the point's two in-plane coordinates (times *scale*), weighted
-    by the fourth power of the direction cosine normal to the plane over their root sum of squares.
-    One pass per point: the arithmetic of the array form, without its (P, C) temporaries."""
-    mask = n - 1  # n is a power of two: modulo by mask
-    nc = flat.shape[2]
+    """out (P, C) = :func:`_sample` at unit vectors (x, y, z) (P,): one pass per point, the arithmetic of
+    the array form without its (P, C) temporaries."""
     for k in range(x.shape[0]):
-        c = (x[k], y[k], z[k])
-        w = (c[0] ** 4, c[1] ** 4, c[2] ** 4)
-        norm = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-        for ch in range(nc):
-            out[k, ch] = 0.0
-        for p in range(3):
-            u = c[(p + 1) % 3] * scale
-            v = c[(p + 2) % 3] * scale
-            u0 = np.floor(u)
-            v0 = np.floor(v)
-            fu = u - u0
-            fv = v - v0
-            i0 = np.int32(u0) & mask
-            j0 = np.int32(v0) & mask
-            i1 = ((i0 + 1) & mask) * n
-            j1 = (j0 + 1) & mask
-            i0 *= n
-            wp = w[p] / norm
-            for ch in range(nc):
-                a = flat[p, i0 + j0, ch]
-                a += (flat[p, i0 + j1, ch] - a) * fv
-                b = flat[p, i1 + j0, ch]
-                b += (flat[p, i1 + j1, ch] - b) * fv
-                a += (b - a) * fu
-                out[k, ch] += a * wp
+        _sample(x[k], y[k], z[k], flat, n, scale, out[k])
+
+
+# The scene's rules, each written once as a ufunc: the array methods of Scene and the compiled march
+# (_surface_m) call the same ones.
+@numba.vectorize(["float64(float64, float64, float64, float64, float64)"], cache=True)
+def _terrain_m(land: float, relief: float, ridges: float, land_threshold: float, gain: float) -> float:
+    """Terrain height (m): a coastal ramp times ranges (ridged noise) on plateaus (a squashed field)."""
+    coast = min(max(land - land_threshold, 0.0), 1.0)
+    coast = coast * coast * (3 - 2 * coast)  # smoothstep: no cliff at the shore
+    plateau = 2200.0 + 1300.0 * np.tanh(1.2 * relief)
+    ridge = 700.0 * (1.0 - abs(np.tanh(ridges)))
+    return coast * min(plateau + ridge, MAX_HEIGHT_M) * gain
+
+
+@numba.vectorize(["float64(float64, float64, float64)"], cache=True)
+def _cover(cloud: float, threshold: float, ground_m: float) -> float:
+    """Cloud cover 0..1 of the cloud field's value (more cloud over high ground), soft at the edges."""
+    return min(max((cloud - threshold + CLOUD_PER_M * ground_m) / 0.6, 0.0), 1.0)
+
+
+@numba.vectorize(["float64(float64)"], cache=True)
+def _top_k(top: float) -> float:
+    """Cloud-top temperature (K) of the cloud-top field's value."""
+    return 245.0 + 18.0 * top
+
+
+@numba.vectorize(["float64(float64)"], cache=True)
+def _air_k(sin_lat: float) -> float:
+    """Sea-surface (and surface air) temperature (K) by the sine of the latitude."""
+    return 301.0 - 12.0 * sin_lat * sin_lat
+
+
+@numba.njit(cache=True, nogil=True)
+def _surface_m(x, y, z, fields, params, law_k, law_m, clouds, buf):  # type: ignore[no-untyped-def]
+    """Height (m) of the surface a ray meets at unit normal (x, y, z): the terrain, and with *clouds* the
+    cloud standing on it (cover x its top's height above the terrain: tops and sides). *fields* the cloud,
+    surface and shape fields' (flat, n, scale); *params* (cloud threshold, land threshold, relief gain,
+    terrain 0/1); the law's knots (cooling K, height m); *buf* (3,) scratch."""
+    cloud, surf, shape = fields
+    cloud_threshold, land_threshold, gain, terrain = params
+    ground = 0.0
+    if terrain:
+        _sample(x, y, z, shape[0], shape[1], shape[2], buf)
+        ground = _terrain_m(buf[0], buf[1], buf[2], land_threshold, gain)
+    if not clouds:
+        return ground
+    _sample(x, y, z, cloud[0], cloud[1], cloud[2], buf)
+    cover = _cover(buf[0], cloud_threshold, ground)
+    if cover <= 0.0:
+        return ground
+    _sample(x, y, z, surf[0], surf[1], surf[2], buf)
+    height = _piecewise(_air_k(z) - _top_k(buf[0]), law_k, law_m)
+    return ground + cover * max(height - ground, 0.0)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _piecewise(x: float, knots_x: np.ndarray, knots_y: np.ndarray) -> float:
+    """np.interp of one value (held at the ends), without its array allocation."""
+    if x <= knots_x[0]:
+        return knots_y[0]
+    for i in range(1, knots_x.shape[0]):
+        if x < knots_x[i]:
+            f = (x - knots_x[i - 1]) / (knots_x[i] - knots_x[i - 1])
+            return knots_y[i - 1] + f * (knots_y[i] - knots_y[i - 1])
+    return knots_y[-1]
+
+
+@numba.njit(cache=True, nogil=True)
+def _surface_points(x, y, z, fields, params, law_k, law_m, clouds, out):  # type: ignore[no-untyped-def]
+    """out (P,) = :func:`_surface_m` at unit normals (x, y, z) (P,)."""
+    buf = np.empty(3, np.float32)
+    for k in range(x.shape[0]):
+        out[k] = _surface_m(x[k], y[k], z[k], fields, params, law_k, law_m, clouds, buf)
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def _march(ray, steps, fields, params, law_k, law_m, clouds, iterations, tolerance_m, out):  # type: ignore[no-untyped-def]
+    """out (R,) = the distance along each ray of :class:`monitor.simulate.terrain.RayGeometry` *ray* to
+    its first crossing of the surface (:func:`_surface_m`): march *steps* (R,) equal steps from the top
+    shell to the ellipsoid; the first that ends on or below the surface brackets the crossing, which
+    regula falsi (Illinois) finds to *tolerance_m*."""
+    t_top, span, n0, n1, n2, h0, c1, c2 = ray
+    # a parallel loop takes arrays, not tuples of them: taken apart here, put together in the loop
+    (cloud, cloud_n, cloud_s), (surf, surf_n, surf_s), (shape, shape_n, shape_s) = fields
+    for r in numba.prange(t_top.shape[0]):
+        fields = ((cloud, cloud_n, cloud_s), (surf, surf_n, surf_s), (shape, shape_n, shape_s))
+        buf = np.empty(3, np.float32)
+        a, ga = 0.0, 0.0
+        b, gb = 1.0, 0.0
+        for k in range(int(steps[r]) + 1):
+            x = min(k / steps[r], 1.0)
+            nx = n0[r, 0] + x * (n1[r, 0] + x * n2[r, 0])
+            ny = n0[r, 1] + x * (n1[r, 1] + x * n2[r, 1])
+            nz = n0[r, 2] + x * (n1[r, 2] + x * n2[r, 2])
+            norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+            g = h0[r] + x * (c1[r] + x * c2[r])
+            g -= _surface_m(nx / norm, ny / norm, nz / norm, fields, params, law_k, law_m, clouds, buf)
+            if g > 0.0 and k < steps[r]:
+                a, ga = x, g
+            else:
+                b, gb = x, min(g, 0.0)  # the ellipsoid (h = 0 to rounding) ends every ray
+                break
+        c, last = b, 0
+        for _ in range(iterations):
+            c = b if gb == 0.0 else b - gb * (b - a) / (gb - ga)
+            nx = n0[r, 0] + c * (n1[r, 0] + c * n2[r, 0])
+            ny = n0[r, 1] + c * (n1[r, 1] + c * n2[r, 1])
+            nz = n0[r, 2] + c * (n1[r, 2] + c * n2[r, 2])
+            norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+            gc = h0[r] + c * (c1[r] + c * c2[r])
+            gc -= _surface_m(nx / norm, ny / norm, nz / norm, fields, params, law_k, law_m, clouds, buf)
+            if abs(gc) < tolerance_m:
+                break
+            if gc > 0:
+                if last == 1:
+                    gb *= 0.5  # Illinois: the same end moved twice, halve the other
+                a, ga, last = c, gc, 1
+            else:
+                if last == -1:
+                    ga *= 0.5
+                b, gb, last = c, gc, -1
+        out[r] = t_top[r] + c * span[r]
 
 
 class _Triplanar:
@@ -114,7 +255,8 @@ class Scene:
     """Emitting temperature and terrain of the synthetic Earth.
 
     ``temperature_k(lat_rad, lon_rad, height_m)`` and ``height_m(lat_rad, lon_rad)`` (zero without
-    *terrain*); *night* makes land colder than the sea instead of warmer.
+    *terrain*); *night* makes land colder than the sea instead of warmer. *clouds* stands the cloud tops at
+    the height their temperature implies (``top_m``, the surface a line of sight meets first).
     """
 
     def __init__(
@@ -124,9 +266,11 @@ class Scene:
         land_fraction: float = 0.3,
         terrain: bool = False,
         night: bool = False,
+        clouds: CloudHeights = FLAT,
     ):
         rng = np.random.default_rng(seed)
         self.terrain = terrain
+        self.clouds = clouds
         self.land_offset_k = LAND_NIGHT_K if night else LAND_DAY_K
         self.cloud = _Triplanar(
             np.stack([_random_field(rng, FINE_N, 3.2, 4) for _ in range(3)])[..., None], FINE_KM
@@ -145,12 +289,8 @@ class Scene:
             self.relief_gain = min(1.0, MAX_SLOPE / self._max_slope())
 
     def _height(self, land: np.ndarray, relief: np.ndarray, ridges: np.ndarray) -> np.ndarray:
-        """Terrain height (m): a coastal ramp times ranges (ridged noise) on plateaus (a squashed field)."""
-        coast = np.clip((land - self.land_threshold) / 1.0, 0.0, 1.0)
-        coast = coast * coast * (3 - 2 * coast)  # smoothstep: no cliff at the shore
-        plateau = 2200.0 + 1300.0 * np.tanh(1.2 * relief)
-        ridge = 700.0 * (1.0 - np.abs(np.tanh(ridges)))
-        return (coast * np.minimum(plateau + ridge, MAX_HEIGHT_M) * self.relief_gain).astype(np.float32)
+        """Terrain height (m) of the shape fields' values (:func:`_terrain_m`)."""
+        return _terrain_m(land, relief, ridges, self.land_threshold, self.relief_gain).astype(np.float32)
 
     def _max_slope(self) -> float:
         """Largest terrain slope on a 1 km probe grid over a few thousand km (the field is stationary)."""
@@ -167,21 +307,63 @@ class Scene:
             return np.zeros(np.shape(lat_rad), np.float32)
         return self._height(*np.moveaxis(self.shape(_unit_vectors(lat_rad, lon_rad)), -1, 0))
 
+    @property
+    def ceiling_m(self) -> float:
+        """The highest the scene's surface (terrain or cloud) stands (m)."""
+        return MAX_HEIGHT_M if self.clouds.flat else max(MAX_HEIGHT_M, CEILING_M)
+
+    def _compiled(self, clouds: bool) -> tuple:
+        """The arguments of :func:`_surface_m` after the point: fields, parameters, law, *clouds*."""
+        fields = tuple((f.flat, f.n, f.scale) for f in (self.cloud, self.surface, self.shape))
+        params = (self.cloud_threshold, self.land_threshold, self.relief_gain, float(self.terrain))
+        law_k, law_m = self.clouds.knots()
+        return fields, params, law_k, law_m, clouds and not self.clouds.flat
+
+    def top_m(self, lat_rad: ArrayLike, lon_rad: ArrayLike) -> np.ndarray:
+        """Height (m) of the surface a line of sight meets at geodetic *lat_rad*, *lon_rad*: the terrain,
+        or a cloud's top or side standing on it (cover x the top's height above the terrain)."""
+        x, y, z = (np.ascontiguousarray(c, np.float64).ravel() for c in _unit_vectors(lat_rad, lon_rad))
+        out = np.empty(x.size)
+        _surface_points(x, y, z, *self._compiled(True), out)
+        return out.reshape(np.shape(lat_rad)).astype(np.float32)
+
+    def intersect(
+        self, origin_m: np.ndarray, los: np.ndarray, clouds: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Distance (m) along unit *los* (..., 3) from ECEF *origin_m* to the first surface it meets (the
+        terrain, and with *clouds* the clouds standing on it), and that point's geodetic (lat_rad,
+        lon_rad, h_m); NaN where the ray misses the Earth. Terrain alone is met once: one bracket; clouds
+        are bracketed by marching (:mod:`monitor.simulate.terrain`)."""
+        tall = clouds and not self.clouds.flat
+        return terrain.first_crossing(
+            origin_m,
+            los,
+            self.ceiling_m if tall else MAX_HEIGHT_M,
+            terrain.MARCH_STEP_M if tall else np.inf,
+            lambda ray, steps, out: _locked(
+                _march, ray, steps, *self._compiled(clouds), terrain.ITERATIONS, terrain.TOLERANCE_M, out
+            ),
+            None if tall else self.height_m,
+        )
+
     def temperature_k(
         self, lat_rad: ArrayLike, lon_rad: ArrayLike, height_m: ArrayLike | None = None
     ) -> np.ndarray:
         """Emitting temperature (K) at geodetic *lat_rad*, *lon_rad* and terrain height *height_m*."""
         xyz = _unit_vectors(lat_rad, lon_rad)
         land = self.shape(xyz)[..., 0]
-        top, texture = np.moveaxis(self.surface(xyz), -1, 0)
         h = np.zeros(np.shape(lat_rad), np.float32) if height_m is None else np.asarray(height_m, np.float32)
-        sst = (301.0 - 12.0 * np.sin(np.asarray(lat_rad)) ** 2).astype(np.float32)
+        top, texture = np.moveaxis(self.surface(xyz), -1, 0)
+        cover = _cover(self.cloud(xyz)[..., 0], self.cloud_threshold, h)
         land_frac = np.clip((land - self.land_threshold) / 0.05, 0.0, 1.0)
-        surface = sst + land_frac * (self.land_offset_k + 3.0 * texture) - LAPSE_K_PER_M * h
-        top = 245.0 + 18.0 * top
-        cloud = self.cloud(xyz)[..., 0]
-        cover = np.clip((cloud - self.cloud_threshold + CLOUD_PER_M * h) / 0.6, 0.0, 1.0)
-        return (surface * (1 - cover) + np.minimum(top, surface) * cover).astype(np.float32)
+        surface = _air_k(xyz[2]) + land_frac * (self.land_offset_k + 3.0 * texture) - LAPSE_K_PER_M * h
+        return (surface * (1 - cover) + np.minimum(_top_k(top), surface) * cover).astype(np.float32)
+
+
+def _locked(kernel: Callable[..., None], *args: Any) -> None:
+    """Run a parallel *kernel* holding :data:`KERNEL_LOCK` (one parallel region at a time)."""
+    with KERNEL_LOCK:
+        kernel(*args)
 
 
 def transmittance(wavenumber_cm1: ArrayLike) -> np.ndarray:

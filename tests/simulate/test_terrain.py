@@ -5,7 +5,6 @@ import pytest
 
 from monitor.geometry import wgs84
 from monitor.simulate.scene import MAX_HEIGHT_M, MAX_SLOPE, Scene
-from monitor.simulate.terrain import intersect_terrain
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +46,7 @@ def test_rays_meet_the_terrain_on_their_line(scene):
         0.6 + rng.uniform(-0.15, 0.15, 20_000), 2.0 + rng.uniform(-0.2, 0.2, 20_000)
     )
     los = (ground - sat) / np.linalg.norm(ground - sat, axis=1, keepdims=True)
-    t, lat, lon, h = intersect_terrain(sat, los, scene.height_m, MAX_HEIGHT_M)
+    t, lat, lon, h = scene.intersect(sat, los)
     point = wgs84.geodetic_to_ecef(lat, lon, h)
     assert np.allclose(point, sat + t[:, None] * los, atol=0.01)  # on the ray
     assert np.abs(h - scene.height_m(lat, lon)).max() < 1.0  # on the terrain

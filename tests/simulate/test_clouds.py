@@ -1,0 +1,90 @@
+"""Clouds with height in the simulator: the height laws, the cloud surface, and rays that meet the first
+cloud they pass."""
+
+import numpy as np
+import pytest
+
+from monitor.core.errors import DataError
+from monitor.geometry import wgs84
+from monitor.simulate import instrument as ins
+from monitor.simulate.case import SimulationSpec, Simulator
+from monitor.simulate.clouds import CEILING_M, CloudHeights
+from monitor.simulate.scene import Scene
+
+
+def test_the_laws_turn_a_top_temperature_into_a_height():
+    lapse = CloudHeights.parse("lapse:6.5")
+    assert lapse.top_height_m(235.0, 300.0) == pytest.approx(10_000.0, abs=1.0)
+    assert lapse.top_height_m(305.0, 300.0) == 0.0  # warmer than the air: on the ground
+    assert lapse.top_height_m(150.0, 300.0) == CEILING_M  # colder than the tropopause: at the ceiling
+    assert CloudHeights.parse("lapse:5").top_height_m(235.0, 300.0) == pytest.approx(13_000.0, abs=1.0)
+    tropical = CloudHeights.parse("tropical")
+    heights = tropical.top_height_m(300.0 - np.array([6.0, 12.0, 16.0, 23.0]), 300.0)
+    assert np.allclose(heights, [1000, 2000, 3000, 4000], atol=1.0)
+    assert np.ptp(np.diff(heights)) == 0.0
+    assert tropical.top_height_m(298.0, 300.0) == pytest.approx(333.3, 0.01)
+    # not linear: 4 K per km between 2 and 3 km, 7 between 3 and 4
+    assert tropical.top_height_m(286.0, 300.0) == pytest.approx(2500.0, abs=1.0)
+    assert CloudHeights.parse("ground").top_height_m(200.0, 300.0) == 0.0
+    assert str(lapse) == "lapse:6.5" and str(tropical) == "tropical"
+
+
+@pytest.mark.parametrize("text", ["lapse", "lapse:0", "lapse:-3", "lapse:x", "tropical:2", "steep", ""])
+def test_a_law_it_does_not_know_is_named(text):
+    with pytest.raises(DataError, match=repr(text).replace("(", r"\(")):
+        CloudHeights.parse(text)
+    with pytest.raises(DataError):
+        SimulationSpec(cloud_heights=text)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return Scene(4, clouds=CloudHeights.parse("lapse:6.5"))
+
+
+def test_clouds_stand_where_they_are_and_nowhere_else(scene):
+    rng = np.random.default_rng(2)
+    lat, lon = rng.uniform(-0.4, 0.4, 50_000), rng.uniform(-np.pi, np.pi, 50_000)
+    top = scene.top_m(lat, lon)
+    flat = Scene(4)
+    assert np.all(flat.top_m(lat, lon) == 0.0)
+    cloudy = flat.temperature_k(lat, lon) < 275.0  # cold: a cloud covers the point
+    clear = np.isclose(flat.temperature_k(lat, lon), 301.0 - 12.0 * np.sin(lat) ** 2, atol=3.5)
+    assert np.median(top[cloudy]) > 4000.0 and top.max() <= CEILING_M
+    assert np.mean(top[clear] == 0.0) > 0.9
+    # the temperature of the scene does not depend on the law: clouds are moved up, not changed
+    assert np.array_equal(scene.temperature_k(lat, lon), flat.temperature_k(lat, lon))
+
+
+def test_rays_meet_the_first_cloud_they_pass(scene):
+    rng = np.random.default_rng(3)
+    sat = wgs84.geodetic_to_ecef(0.1, 1.0, 833e3)
+    ground = wgs84.geodetic_to_ecef(0.1 + rng.uniform(-0.2, 0.2, 4000), 1.0 + rng.uniform(-0.2, 0.2, 4000))
+    los = (ground - sat) / np.linalg.norm(ground - sat, axis=1, keepdims=True)
+    t, lat, lon, h = scene.intersect(sat, los)
+    assert np.allclose(wgs84.geodetic_to_ecef(lat, lon, h), sat + t[:, None] * los, atol=0.05)  # on the ray
+    assert np.abs(h - scene.top_m(lat, lon)).max() < 1.0  # on the surface
+    assert (h > 3000).mean() > 0.2  # many rays end on a cloud
+    # the first: every point of the ray before it, 20 m apart, is above the surface, but for grazes of a
+    # cloud's corner shorter than the march's step (500 m of ground), a few tens of metres deep
+    before = t[:, None] - np.arange(20.0, 40_000.0, 20.0)[None, :]
+    points = sat + before[..., None] * los[:, None, :]
+    plat, plon, ph = wgs84.ecef_to_geodetic(points)
+    under = np.where(ph < CEILING_M, scene.top_m(plat, plon) - ph, 0.0)
+    grazed = (under > 1.0).any(axis=1)
+    assert grazed.mean() < 0.005 and under.max() < 100.0 and (under > 1.0).sum(axis=1).max() * 20 < 500
+    # without clouds the ray meets the ground (the ellipsoid here), as GEO reports
+    t0, _, _, h0 = scene.intersect(sat, los, clouds=False)
+    assert np.allclose(t0, wgs84.intersect_ellipsoid(sat, los), atol=0.05) and np.abs(h0).max() < 0.01
+    assert np.all(t <= t0 + 0.05)
+
+
+def test_the_rows_can_be_turned_where_geo_does_not_see():
+    plain = Simulator(SimulationSpec(granules=1, profile="zero"))
+    turned = Simulator(SimulationSpec(granules=1, profile="zero", fov_rows_alpha_urad=300.0))
+    alpha = [np.arctan2(s.los_true[..., 0], s.los_true[..., 2]) for s in (plain, turned)]
+    moved = (alpha[1] - alpha[0]) / 1e-6  # (FOR, FOV) urad
+    assert np.allclose(moved[:, 6:9], 150.0, atol=1e-3) and np.allclose(moved[:, 0:3], -150.0, atol=1e-3)
+    assert np.allclose(moved[:, 3:6], 0.0, atol=1e-6)
+    assert np.array_equal(plain.los_geo, turned.los_geo)  # GEO does not know
+    assert np.allclose(ins.cris_los_sbf(), plain.los_true)
