@@ -13,7 +13,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import logging
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -30,11 +30,13 @@ from monitor.assessment.inputs import (
     stage,
 )
 from monitor.collocation import collocate, swath
+from monitor.collocation.parallax import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, N_FOR
 from monitor.core.errors import AssessmentError, StopRequested
-from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
+from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo, Skipped
 from monitor.core.threads import parallel_threads
+from monitor.estimation import parallax
 from monitor.estimation.estimate import ForSamples, day_offsets
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
@@ -226,22 +228,49 @@ def cost_and_offsets(
     cfg: AssessmentConfig,
     skipped: Sequence[tuple[str, str]] | None = None,
     satellite: str = "",
+    probe: list[GranuleSamples] | None = None,
 ) -> AssessmentResult:
-    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*."""
+    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*. With
+    *probe*, the same granules collocated with the VIIRS pixels lifted by PROBE_M_PER_K, the day's lift is
+    chosen by the cost (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it."""
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
+    per_for = [for_samples(samples, k, cfg, band) for k in range(N_FOR)]
+    m_per_k = np.nan
+    spread = np.zeros((N_FOR, 4))  # the sigma (steps) the day's lift adds: FOR alpha, beta; rows alpha, beta
+    if probe is not None:
+        pairs = _paired(samples, probe)
+        if pairs is not None:
+            per_for = [for_samples(pairs[0], k, cfg, band) for k in range(N_FOR)]
+            lifted = [for_samples(pairs[1], k, cfg, band) for k in range(N_FOR)]
+            f, sigma_f = parallax.day_lift(per_for, lifted, cfg.cost)
+            if cfg.uncertainty and np.isfinite(sigma_f):
+                spread = np.array(
+                    [
+                        np.abs(parallax.sensitivity(a, b, f, cfg.cost)) * sigma_f
+                        if len(a) >= 3
+                        else np.zeros(4)
+                        for a, b in zip(per_for, lifted, strict=True)
+                    ]
+                )
+            per_for = [parallax.blend(a, b, f) for a, b in zip(per_for, lifted, strict=True)]
+            m_per_k = f * PROBE_M_PER_K
     day = day_offsets(
-        [for_samples(samples, k, cfg, band) for k in range(N_FOR)],
+        per_for,
         cfg,
         cfg.step_urad,
         lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
     )
+    fors = [
+        _with_lift_spread(f, np.nan_to_num(e) * cfg.step_urad, m_per_k, _cold_height_km(s, m_per_k))
+        for f, s, e in zip(day.fors, per_for, spread, strict=True)
+    ]
     starts = [s.info.start for s in samples]
     ends = [s.info.end for s in samples]
     return AssessmentResult(
         satellite=satellite,
         start=min(starts) if starts else "",
         end=max(ends) if ends else "",
-        fors=day.fors,
+        fors=fors,
         granules=[s.info for s in samples],
         skipped=[Skipped(str(a), str(b)) for a, b in (skipped or [])],
         half_steps=cfg.half_steps,
@@ -249,6 +278,44 @@ def cost_and_offsets(
         cost_cube_k=day.cost_cube_k,
         difference_bins=day.difference_bins,
     )
+
+
+def _with_lift_spread(f: ForOffset, spread_urad: np.ndarray, m_per_k: float, height_km: float) -> ForOffset:
+    """*f* with the sigma that the day's lift adds (urad: FOR alpha, beta; rows alpha, beta) in quadrature,
+    and the lift it was estimated at (:mod:`monitor.estimation.parallax`)."""
+    a, b, ra, rb = spread_urad
+    return replace(
+        f,
+        sigma_alpha_urad=float(np.hypot(f.sigma_alpha_urad, a)),
+        sigma_beta_urad=float(np.hypot(f.sigma_beta_urad, b)),
+        sigma_fov_rows_alpha_urad=float(np.hypot(f.sigma_fov_rows_alpha_urad, ra)),
+        sigma_fov_rows_beta_urad=float(np.hypot(f.sigma_fov_rows_beta_urad, rb)),
+        parallax_m_per_k=m_per_k,
+        parallax_height_km=height_km,
+    )
+
+
+def _paired(
+    samples: list[GranuleSamples], probe: list[GranuleSamples]
+) -> tuple[list[GranuleSamples], list[GranuleSamples]] | None:
+    """The granules of both collocations with the FOVs usable in both; None (no parallax correction, said
+    in the log) when the two did not collocate the same granules."""
+    if [s.key for s in samples] != [s.key for s in probe]:
+        LOG.warning("parallax: the lifted collocation lost granules; the day is assessed without it")
+        return None
+    both = [s.usable & p.usable for s, p in zip(samples, probe, strict=True)]
+    return (
+        [replace(s, usable=u) for s, u in zip(samples, both, strict=True)],
+        [replace(p, usable=u) for p, u in zip(probe, both, strict=True)],
+    )
+
+
+def _cold_height_km(s: ForSamples, m_per_k: float) -> float:
+    """The height (km) the correction puts a FOR's cold scenes at: *m_per_k* times its CrIS BT's 95th
+    minus 5th percentile (NaN without samples or correction)."""
+    if len(s) < 3 or not np.isfinite(m_per_k):
+        return np.nan
+    return float(m_per_k * np.subtract(*np.percentile(s.cris_k, [95, 5])) / 1000.0)
 
 
 def _collocate_run(
@@ -260,10 +327,12 @@ def _collocate_run(
     progress: Progress = None,
     should_stop: StopCheck = None,
     timings: Timings = None,
+    lift_m_per_k: float = 0.0,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
-    """Collocate a time-ordered run of CrIS granules; returns (samples, skipped)."""
+    """Collocate a time-ordered run of CrIS granules, the VIIRS pixels lifted by *lift_m_per_k*
+    (:mod:`monitor.collocation.parallax`); returns (samples, skipped)."""
     band = i5_band(satellite)
-    cache = SwathCache(spans=scan_spans(cris, viirs))
+    cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k)
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
@@ -317,14 +386,17 @@ def _collocate_run(
 
 
 def collocate_plan(
-    case: CasePlan, cfg: AssessmentConfig | None = None, workers: int = 1
+    case: CasePlan, cfg: AssessmentConfig | None = None, workers: int = 1, lift_m_per_k: float = 0.0
 ) -> list[GranuleSamples]:
     """The collocated samples of every CrIS granule of *case*, in time order (granules that fail are left
-    out, logged): what :func:`assess_plan` estimates from, for benchmarks that estimate otherwise."""
+    out, logged), the VIIRS pixels lifted by *lift_m_per_k*: what :func:`assess_plan` estimates from, for
+    benchmarks that estimate otherwise."""
+    cfg = cfg or AssessmentConfig()
     with parallel_threads(workers):
-        return _collocate_run(
-            case.cris, case.viirs, case.viirs_all, case.satellite, cfg or AssessmentConfig()
-        )[0]
+        run = _collocate_run(
+            case.cris, case.viirs, case.viirs_all, case.satellite, cfg, lift_m_per_k=lift_m_per_k
+        )
+    return run[0]
 
 
 def assess_plan(
@@ -345,10 +417,11 @@ def assess_plan(
     """
     cfg = cfg or AssessmentConfig()
     skipped = list(case.skipped)
+    run = (case.cris, case.viirs, case.viirs_all, case.satellite, cfg)
     with parallel_threads(workers):
-        samples, k = _collocate_run(
-            case.cris, case.viirs, case.viirs_all, case.satellite, cfg, progress, should_stop, timings
-        )
+        samples, k = _collocate_run(*run, progress, should_stop, timings)
+        # the pixels lifted by the probe's height per K (monitor.estimation.parallax chooses the day's)
+        probe = _collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else None
     skipped += k
     if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
         raise StopRequested
@@ -361,7 +434,7 @@ def assess_plan(
             f"{len(samples)} granule(s) [{files}]" + (f"; skipped: {why}" if why else "")
         )
     with stage(timings, "cost"):
-        return cost_and_offsets(samples, cfg, skipped, case.satellite)
+        return cost_and_offsets(samples, cfg, skipped, case.satellite, probe)
 
 
 def assess_paths(

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.collocation import collocate, swath
+from monitor.collocation import collocate, parallax, swath
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import Kernel
 from monitor.geometry.inverse import FovGeometry, granule_geometry
@@ -63,11 +63,14 @@ def stage(timings: Timings, name: str) -> Iterator[None]:
 @dataclass
 class SwathCache:
     """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept. *spans* holds, by key,
-    the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`)."""
+    the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`). Every
+    piece has its pixels lifted by *lift_m_per_k* (m per K colder than the clear-sky reference:
+    :mod:`monitor.collocation.parallax`; 0, at their GEO points)."""
 
     pieces: dict = field(default_factory=dict)
     keep: int = 3
     spans: dict = field(default_factory=dict)
+    lift_m_per_k: float = 0.0
 
 
 def _widen(span: Span | None, other: Span | None) -> Span | None:
@@ -220,11 +223,18 @@ def piece(
             raw = read_viirs(v, viirs_all, run_span)
     geo, sdr, halo_before, halo_after = raw
     assert geo.height_m is not None  # zeros for the ellipsoid product (ViirsGeoGranule)
+    seen = None
+    if cache.lift_m_per_k:
+        with stage(timings, "parallax"):
+            lift = parallax.lift_m(sdr.bt_k, sdr.good, cache.lift_m_per_k)
+            seen = parallax.lifted(
+                geo.lat_rad, geo.lon_rad, geo.height_m, lift, geo.sc_position_m, geo.sc_velocity_m_s
+            )
     with stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
             sat_m=geo.sc_position_m, view_rad=view_rad + collocate.VIEW_MARGIN_RAD,
-            scan_start_us=geo.start_time_us, span_us=run_span,
+            scan_start_us=geo.start_time_us, span_us=run_span, seen=seen,
         )  # fmt: skip
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))

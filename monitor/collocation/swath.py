@@ -448,6 +448,7 @@ def swath_piece(
     view_rad: float = math.inf,
     scan_start_us: np.ndarray | None = None,
     span_us: tuple[float, float] | None = None,
+    seen: tuple[np.ndarray, ...] | None = None,
 ) -> SwathPiece:
     """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
 
@@ -461,6 +462,10 @@ def swath_piece(
     of each scan *scan_start_us* (IET us), only the scans observed between t0 and t1
     (:func:`scans_between`), each with the same weights as in the whole granule (the scans next to those
     kept are their halos).
+    *seen*, (lat_rad, lon_rad, height_m) like the pixels', are the 3-D points the pixels see (a cloud above
+    the GEO point: :mod:`monitor.collocation.parallax`): the pixels are searched and tested there, and
+    weighted by their footprints at the GEO points (a pixel's solid angle does not change along its line
+    of sight, but the steps between a lifted pixel and its neighbours would tilt its footprint).
     """
     scans = slice(None)
     if scan_start_us is not None and span_us is not None:
@@ -474,6 +479,7 @@ def swath_piece(
         if r1 < np.shape(lat_rad)[0]:
             after = tuple(a[r1 : r1 + VIIRS_DETECTORS] for a in geo)
         lat_rad, lon_rad, height_m, bt_k, good = (a[r0:r1] for a in (*geo, bt_k, good))
+        seen = None if seen is None else tuple(a[r0:r1] for a in seen)
         sat_m = None if sat_m is None else sat_m[first:stop]
         t = np.asarray(scan_start_us, np.int64)
         covered_us = (t[first] if first > 0 else -math.inf, t[stop] if stop < len(t) else math.inf)
@@ -484,6 +490,7 @@ def swath_piece(
         kept = view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad)
         lat_rad, lon_rad, height_m = lat_rad[:, kept], lon_rad[:, kept], height_m[:, kept]
         bt_k, good = bt_k[:, kept], good[:, kept]
+        seen = None if seen is None else tuple(a[:, kept] for a in seen)
         before, after = (None if b is None else tuple(a[..., kept] for a in b) for b in (before, after))
     else:
         view_rad = math.inf
@@ -515,6 +522,13 @@ def swath_piece(
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
         _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
+    if seen is not None:  # searched and tested where they see, weighted by their GEO footprints
+        h = np.asarray(seen[2], f32)
+        _ecef(*(np.asarray(a, f32) for a in seen[:2]), h, pos)
+        with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
+            _weigh(
+                pos, h, radiance, ends_first, ends_last, step, have, np.empty_like(area), centre, radius, top
+            )
 
     scan = pos.reshape(nscan, VIIRS_DETECTORS, cols, 3)
     mid = scan[nscan // 2]

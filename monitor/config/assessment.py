@@ -99,6 +99,12 @@ class AssessmentConfig(Section):
     uncertainty: bool = key(
         True, "Compute the jackknife's sigmas (off: offsets without sigmas, flags from the cost alone)."
     )
+    parallax: bool = key(
+        True,
+        "Place each VIIRS pixel at the height its BT implies (colder than its clear-sky neighbourhood), "
+        "with the day's height scale chosen by the cost: clouds with height seen by CrIS's FOV rows from "
+        "another angle (a second collocation; off: pixels at their GEO points).",
+    )
 
     @property
     def step_rad(self) -> float:

@@ -75,7 +75,7 @@ FOV_ROWS = Family(
     "direction",
 )
 # a field's unit (as CF writes it) -> the factor to the SI unit /metrics publishes it in
-TO_BASE_UNIT = {"urad": URAD, "km": 1000.0, "K": 1.0, "percent": 0.01, "1": 1.0}
+TO_BASE_UNIT = {"urad": URAD, "km": 1000.0, "K": 1.0, "percent": 0.01, "1": 1.0, "m K-1": 1.0}
 
 
 @dataclass(frozen=True)
@@ -207,6 +207,15 @@ class ForOffset:
     )  # fmt: skip
     sigma_fov_rows_alpha_urad: float = measured("urad", f"{SIGMA} rows' in-track offset", NAN, quality=True)
     sigma_fov_rows_beta_urad: float = measured("urad", f"{SIGMA} rows' cross-track offset", NAN, quality=True)
+    parallax_m_per_k: float = measured(
+        "m K-1", "height the parallax correction gave a VIIRS pixel per K colder than its clear-sky "
+        "neighbourhood (the day's, chosen by the cost; 0: none; NaN: not collocated here)", NAN,
+        quality=True, series=False,
+    )  # fmt: skip
+    parallax_height_km: float = measured(
+        "km", "height the parallax correction put the FOR's cold scenes at: its lift per K times its "
+        "CrIS BT's 95th minus 5th percentile", NAN, quality=True,
+    )  # fmt: skip
 
     @property
     def d_alpha_pct_fov(self) -> float:
