@@ -60,16 +60,21 @@ class CaseCache:
         self.root.mkdir(exist_ok=True)
         self.cases = {}
 
-    def get(self, profile="paper", seed=1, granules=2, satellite="j01"):
-        key = (profile, seed, granules, satellite)
+    def get(self, profile="paper", seed=1, granules=2, satellite="j01", clouds="ground"):
+        key = (profile, seed, granules, satellite, clouds)
         if key not in self.cases:
-            name = f"case_{profile}_{seed}_{granules}_{satellite}"
+            name = f"case_{profile}_{seed}_{granules}_{satellite}_{clouds}"
             out, made = self.root / name, self.root / f"{name}.pickle"
             with open(self.root / f"{name}.lock", "w") as lock:
                 fcntl.flock(lock, fcntl.LOCK_EX)
                 if not made.exists():
                     truth = simulate_case(
-                        out, satellite=satellite, granules=granules, profile=profile, seed=seed
+                        out,
+                        satellite=satellite,
+                        granules=granules,
+                        profile=profile,
+                        seed=seed,
+                        cloud_heights=clouds,
                     )
                     result = assess_paths([out], AssessmentConfig())
                     made.with_suffix(".part").write_bytes(pickle.dumps((truth, result)))

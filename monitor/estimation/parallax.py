@@ -11,18 +11,21 @@ the probe kappa1 (V1), and for a fraction f
 
 is the collocation at kappa = f kappa1 to first order (a lift moves a pixel by a small part of a cone;
 a cone mean moves linearly with the pixels that cross its edge). The day's f is where the sum over the
-FORs of their cost minimum (the top-hat cone, the configured cost) is least: a wrong scale leaves each
-cloud edge turned by an amount that grows with its height, which no single turn of a FOR can undo. An
-error of the EP's FOV positions, the same for every scene of a row, is a turn, so it does not pull f.
+FORs, and over each FOR's three FOV rows (:data:`ROWS`), of their own cost minimum (the top-hat cone, the
+configured cost) is least: a wrong scale leaves each cloud edge turned by an amount that grows with its
+height, which no single turn of a row can undo. Each row has its own turn because an error of the EP's FOV
+positions turns the rows apart, the same for every scene, as the parallax of one cloud height does: one
+turn for the whole FOR would take a lift for it (a case whose rows were 250 urad apart chose f = 1.9 for
+a truth of ~1.3).
 f is searched on :data:`FRACTIONS` and refined by the parabola through the least three; it stays within
 them (0 where the cost prefers no lift).
 
 Its uncertainty is derived like the offsets': the delete-one-granule jackknife of f (each replicate
 searched again), sigma_f^2 = (G - 1)/G sum (f_g - mean)^2. The lift is kept only where it lowers the
-day's cost by more than twice the jackknife sigma of that gain; else the day is estimated without it (f = 0)
-and sigma_f is the f declined. A simulated day whose clouds lie on the ground prefers f ~ 0.1 by a gain
-of 0.3 % of its cost (1.5 of its sigmas), which would have moved its rows by ~25 urad; one whose tops
-stand at 6.5 K/km gains 15 % (8 sigmas). It reaches every offset through that offset's
+day's cost by more than twice the jackknife sigma of that gain; else the day is estimated without it
+(f = 0) and sigma_f is the f declined. With fewer than 3 granules nothing can be judged: no lift. A day
+whose clouds lie on the ground can prefer a small lift by a hair of its cost, which would turn its rows
+apart by tens of urad: the test keeps it at none. sigma_f reaches every offset through that offset's
 sensitivity to f, by the delta method: sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference
 over +-:data:`SENSITIVITY_STEP` of the top-hat cone's minimum (the FOR's, and each FOV row's for the rows'
 difference). The rows ahead and behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
@@ -42,6 +45,7 @@ from monitor.estimation.estimate import FOV_ROWS, ForSamples, cost_surface, find
 
 FRACTIONS = np.linspace(0.0, 2.5, 11)
 SENSITIVITY_STEP = 0.1
+ROWS = ((6, 7, 8), (3, 4, 5), (0, 1, 2))  # FOVs 7-9 ahead, 4-6, 1-3 behind
 
 
 def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
@@ -56,14 +60,17 @@ def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
 def day_cost(
     s0: list[ForSamples], s1: list[ForSamples], f: float, cost: Cost, without: int | None = None
 ) -> float:
-    """The sum over the FORs (with 3 samples or more) of their cost minimum (K) at fraction *f*; *without*
-    granule that one's samples (a jackknife replicate)."""
+    """The sum over the FORs and their FOV rows (:data:`ROWS`; the FOR where the samples do not say their
+    FOV), each with 3 samples or more, of their cost minimum (K) at fraction *f*; *without* granule that
+    one's samples (a jackknife replicate)."""
     total = 0.0
     for a, b in zip(s0, s1, strict=True):
-        keep = slice(None) if without is None else a.granule != without
-        d0, d1, cris = a.d_k[keep], b.d_k[keep], a.cris_k[keep]
-        if len(cris) >= 3:
-            total += float(np.nanmin(cost_surface(d0 + f * (d1 - d0), cris, cost)))
+        keep = np.ones(len(a), bool) if without is None else a.granule != without
+        groups = [keep] if a.fov is None else [keep & np.isin(a.fov, fovs) for fovs in ROWS]
+        for sel in groups:
+            if sel.sum() >= 3:
+                d = a.d_k[sel] + f * (b.d_k[sel] - a.d_k[sel])
+                total += float(np.nanmin(cost_surface(d, a.cris_k[sel], cost)))
     return total
 
 
@@ -80,11 +87,12 @@ def day_fraction(s0: list[ForSamples], s1: list[ForSamples], cost: Cost, without
 
 def day_lift(s0: list[ForSamples], s1: list[ForSamples], cost: Cost) -> tuple[float, float]:
     """The day's fraction of the probe's lift and its jackknife sigma (module docstring): (0, the f
-    declined) where the lift's gain in cost is not significant; sigma NaN with fewer than 3 granules."""
+    declined) where the lift's gain in cost is not significant, or cannot be judged (fewer than 3
+    granules: sigma NaN)."""
     f = day_fraction(s0, s1, cost)
     granules = [int(g) for g in np.unique(np.concatenate([a.granule for a in s0]))]
     if len(granules) < 3:
-        return f, float("nan")
+        return 0.0, float("nan")
     f_g = np.array([day_fraction(s0, s1, cost, g) for g in granules])
     gain_g = np.array([day_cost(s0, s1, 0.0, cost, g) - day_cost(s0, s1, f, cost, g) for g in granules])
     sigma_f, sigma_gain = _jackknife_sigma(f_g), _jackknife_sigma(gain_g)

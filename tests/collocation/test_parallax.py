@@ -1,0 +1,88 @@
+"""VIIRS pixels lifted to what they see: the clear-sky reference, the lift, and the line of sight."""
+
+import numpy as np
+import pytest
+
+from monitor.collocation.parallax import REFERENCE_HALF_PX, ROTATION_RAD_S, lift_m, lifted, reference_k
+from monitor.core.constants import VIIRS_DETECTORS
+from monitor.geometry import wgs84
+
+
+def cloudy_field(rows=96, cols=300):
+    """295 K with a 230 K cloud disc of radius 20 pixels at (48, 150), a soft edge, and noise."""
+    r, c = np.mgrid[:rows, :cols]
+    dist = np.hypot(r - 48, c - 150)
+    cover = np.clip((22 - dist) / 4, 0, 1)
+    bt = 295 - 65 * cover + np.random.default_rng(0).normal(0, 0.3, (rows, cols))
+    return bt.astype(np.float32), cover
+
+
+def test_the_reference_is_the_clear_sky_around_and_never_a_bad_pixel():
+    bt, cover = cloudy_field()
+    good = np.ones(bt.shape, bool)
+    good[10, 10] = False
+    bt[10, 10] = 400.0  # a hot unusable pixel never sets the reference
+    ref = reference_k(bt, good)
+    assert np.all(np.abs(ref - 295) < 1.0)  # the cloud is within reach of clear sky everywhere
+    uniform = reference_k(np.full((40, 40), 250.0, np.float32), np.ones((40, 40), bool))
+    assert np.allclose(uniform, 250.0)
+    none = reference_k(bt, np.zeros(bt.shape, bool))
+    assert np.all(np.isnan(none))
+    # beyond the reach, a wide deck's middle is its own reference: no lift there
+    wide = np.full((40, 4 * REFERENCE_HALF_PX), 230.0, np.float32)
+    wide[:, :5] = 295.0
+    assert reference_k(wide, np.ones(wide.shape, bool))[0, -1] == pytest.approx(230.0)
+
+
+def test_the_lift_grows_with_the_cooling_and_is_zero_in_clear_sky():
+    bt, cover = cloudy_field()
+    good = np.ones(bt.shape, bool)
+    lift = lift_m(bt, good, 150.0)
+    assert np.median(lift[cover == 1]) == pytest.approx(150.0 * 65, rel=0.03)
+    assert np.percentile(lift[cover == 0], 99) < 150.0 * 1.5  # noise: well under a kilometre
+    assert np.all(lift_m(bt, good, 0.0) == 0) and np.all(lift_m(bt, ~good, 150.0) == 0)
+
+
+def scan_geometry(cols=400):
+    """One VIIRS scan (32 detectors) seen from a satellite 833 km over the equator flying north: ground
+    points (lat, lon, h) and, per pixel, the spacecraft position at its time (the scan's middle plus the
+    velocity times its scan angle over the rotation rate)."""
+    sat = wgs84.geodetic_to_ecef(0.0, 0.0, 833e3)
+    v = np.array([0.0, 0.0, 7400.0])
+    angle = np.linspace(-0.9, 0.9, cols)  # columns in time order
+    det = (np.arange(VIIRS_DETECTORS) - 15.5) * 4.5e-4
+    pix_sat = sat + v * (angle / ROTATION_RAD_S)[:, None]
+    nadir = -sat / np.linalg.norm(sat)
+    east = np.array([0.0, 1.0, 0.0])
+    north = np.array([0.0, 0.0, 1.0])
+    los = (
+        np.cos(angle)[None, :, None] * nadir
+        + np.sin(angle)[None, :, None] * east
+        + np.tan(det)[:, None, None] * north
+    )
+    los /= np.linalg.norm(los, axis=-1, keepdims=True)
+    origin = np.broadcast_to(pix_sat[None], los.shape)
+    t = wgs84.intersect_ellipsoid(origin, los)
+    lat, lon = wgs84.surface_to_geodetic(origin + t[..., None] * los)
+    return lat, lon, np.zeros(lat.shape), origin, sat, v
+
+
+def test_a_lifted_pixel_stands_on_its_own_line_of_sight_at_its_height():
+    lat, lon, h, origin, sat, v = scan_geometry()
+    lift = np.full(lat.shape, 10_000.0, np.float32)
+    lift[:, :50] = 0.0
+    la, lo, hh = lifted(lat, lon, h, lift, sat[None], v[None])
+    assert np.array_equal(la[:, :50], lat[:, :50]) and np.all(hh[:, :50] == 0)
+    point = wgs84.geodetic_to_ecef(la, lo, hh)[:, 50:]
+    ground = wgs84.geodetic_to_ecef(lat, lon, h)[:, 50:]
+    line = ground - origin[:, 50:]
+    line /= np.linalg.norm(line, axis=-1, keepdims=True)
+    off = point - ground
+    sideways = off - np.sum(off * line, axis=-1, keepdims=True) * line
+    assert np.abs(np.linalg.norm(sideways, axis=-1)).max() < 1.0  # on the line from the spacecraft
+    assert np.allclose(hh[:, 50:], 10_000.0, rtol=0.005)  # at the lift (the Earth's curvature: < 0.5 %)
+    # the spacecraft position of the scan's middle alone would miss the line by tens of metres at the edge
+    mid = ground - sat
+    mid /= np.linalg.norm(mid, axis=-1, keepdims=True)
+    off_mid = off - np.sum(off * mid, axis=-1, keepdims=True) * mid
+    assert np.linalg.norm(off_mid, axis=-1).max() > 20.0
