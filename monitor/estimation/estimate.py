@@ -27,6 +27,14 @@ sought again with V = BT(sum_k w_k A_k), and the two steps alternate until the o
 response jointly. A radially symmetric response cannot move the joint minimum, whatever its shape; the weights
 found are the response seen on orbit (:func:`monitor.instrument.footprint.widths_of_weights`).
 
+**The rows apart.** CrIS's FOV rows ahead (FOVs 7-9) and behind (1-3) can disagree by hundreds of urad
+in-track: an error of the EP's FOV positions, or the parallax of high clouds that the collocation left.
+One turn for all nine FOVs would then sit on neither row and blur the minimum. So the estimate first finds
+how far apart they are (each row's own top-hat minimum, :func:`rows_apart`), moves each outer row's surfaces
+half of that towards the other (linear interpolation, sub-step), and estimates the FOR on the rows thus
+aligned: the FOR offset is the rows' common turn, and the rows' product is what the day's surface still
+finds apart plus the move.
+
 **The uncertainty** is the delete-one-granule jackknife (:mod:`monitor.estimation.jackknife`): each replicate
 repeats the estimate (its own weights, its own refined minimum) without one granule, so the scene-to-scene
 part of the error enters by construction.
@@ -39,6 +47,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
+from scipy.ndimage import shift as shift_grid
 from scipy.optimize import nnls
 
 from monitor.config.assessment import AssessmentConfig
@@ -392,9 +401,45 @@ def _flagged(at: _Minimum, flags: list[str], converged: bool) -> _Minimum:
     return replace(at, flags=sorted(set(at.flags + more))) if more else at
 
 
+def rows_apart(s: ForSamples, cost: Cost, contrast: float = 0.03) -> tuple[float, float]:
+    """(x, y) steps from the rows behind to the rows ahead (:data:`FOV_ROWS`), each row's own minimum of
+    the top-hat surface; (0, 0) where either has fewer than 3 samples or no clear minimum."""
+    if s.fov is None:
+        return 0.0, 0.0
+    found = []
+    for fovs in FOV_ROWS:
+        sel = np.isin(s.fov, fovs)
+        x, y, flags = (
+            find_minimum(cost_surface(s.d_k[sel], s.cris_k[sel], cost), contrast)
+            if sel.sum() >= 3
+            else (0, 0, [FLAG_FLAT])
+        )
+        if FLAG_FLAT in flags or FLAG_EDGE in flags:
+            return 0.0, 0.0
+        found.append((x, y))
+    return found[0][0] - found[1][0], found[0][1] - found[1][1]
+
+
+def aligned(s: ForSamples, apart: tuple[float, float]) -> ForSamples:
+    """*s* with the rows ahead's surfaces moved by -apart/2 and the rows behind's by +apart/2 (steps; linear
+    interpolation, held at the grid's edge), so that both rows meet at their common turn."""
+    if s.fov is None or apart == (0.0, 0.0):
+        return s
+    d, annuli = s.d_k.copy(), None if s.annuli_rad is None else s.annuli_rad.copy()
+    for fovs, sign in zip(FOV_ROWS, (1.0, -1.0), strict=True):
+        sel = np.isin(s.fov, fovs)
+        move = (0.0, -sign * 0.5 * apart[0], -sign * 0.5 * apart[1])  # out(t) = in(t + apart/2) ahead
+        d[sel] = shift_grid(s.d_k[sel], move, order=1, mode="nearest")
+        if annuli is not None and s.annuli_rad is not None:
+            annuli[sel] = shift_grid(s.annuli_rad[sel], (0.0, *move), order=1, mode="nearest")
+    return replace(s, d_k=d, annuli_rad=annuli)
+
+
 def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: bool = True) -> ForEstimate:
     """Offsets, jackknife sigmas, flags, the intercalibration and (with annuli) the footprint of one FOR's
-    samples (module docstring)."""
+    samples (module docstring), its rows aligned first (:func:`aligned`)."""
+    apart = rows_apart(s, cost, contrast)
+    s = aligned(s, apart)
     best, weights, d = _estimate(s, cost, contrast)
     d_opt = (
         refine.window_values(d, best.i0, best.j0, best.dx, best.dy)
@@ -411,7 +456,7 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
         fp = Footprint(s.radii_rad, weights, widths[0.5], widths[0.1])
     if s.fov is not None:  # the rows, the day's and its replicates', on the day's surface
         counts = np.ones((1, len(s))) if jack is None else np.vstack([np.ones(len(s)), jack.counts])
-        found = _rows(d, s, cost, contrast, counts)
+        found = _rows(d, s, cost, contrast, counts) + np.asarray(apart)
         rows = (float(found[0, 0]), float(found[0, 1]))
         if jack is not None:
             rs = jack.sigma(found[1:])
