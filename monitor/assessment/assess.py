@@ -238,7 +238,7 @@ def cost_and_offsets(
     m_per_k = np.nan
     spread = np.zeros((N_FOR, 4))  # the sigma (steps) the day's lift adds: FOR alpha, beta; rows alpha, beta
     if probe is not None:
-        pairs = _paired(samples, probe)
+        pairs = paired(samples, probe)
         if pairs is not None:
             per_for = [for_samples(pairs[0], k, cfg, band) for k in range(N_FOR)]
             lifted = [for_samples(pairs[1], k, cfg, band) for k in range(N_FOR)]
@@ -295,7 +295,7 @@ def _with_lift_spread(f: ForOffset, spread_urad: np.ndarray, m_per_k: float, hei
     )
 
 
-def _paired(
+def paired(
     samples: list[GranuleSamples], probe: list[GranuleSamples]
 ) -> tuple[list[GranuleSamples], list[GranuleSamples]] | None:
     """The granules of both collocations with the FOVs usable in both; None (no parallax correction, said

@@ -178,6 +178,9 @@ def notes(granules: list[Collocation]) -> list[str]:
         "no footprint fitted: the files hold cone means only; the minimum is the top-hat cone's, which a "
         "smooth CrIS response moves (simulated: 9-16 urad RMS), and its sigmas carry the cone's floor "
         "(flag top_hat)",
+        "no parallax correction: cone means cannot be collocated again with the VIIRS pixels at their "
+        "clouds' height, so the FOV rows (fov_rows_*) show the raw parallax of the day's clouds as well as "
+        "any error of the EP's FOV positions (parallax_* fields empty)",
     ]
 
 

@@ -40,6 +40,8 @@ def test_the_ten_real_granules_give_offsets_and_say_what_they_lack():
     # behind (docs/science.md; cone means cannot be re-collocated)
     rows = np.array([f.fov_rows_alpha_urad for f in r.fors])
     assert np.nanmean(rows) < -200 and np.sum(rows < 0) >= 24
+    assert any("no parallax correction" in n for n in r.notes)
+    assert all(np.isnan(f.parallax_m_per_k) and np.isnan(f.parallax_height_km) for f in r.fors)
     assert sum(g.n_usable for g in r.granules) > 0.9 * 10 * 4 * 30 * 9
 
 
