@@ -137,6 +137,7 @@ def run_case(
         "curvature_k": [f.curvature_k for f in result.fors],
         "sigma_curvature_k": [f.sigma_curvature_k for f in result.fors],
         "clouds": clouds,
+        "parallax_m_per_k": result.fors[0].parallax_m_per_k,
         "fov_rows_alpha_urad": rows_urad,
         "rows_err_alpha_urad": [f.fov_rows_alpha_urad - rows_urad for f in result.fors],
         "rows_err_beta_urad": [f.fov_rows_beta_urad for f in result.fors],

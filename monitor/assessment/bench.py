@@ -98,7 +98,7 @@ def run_bench(args: argparse.Namespace, cfg: AssessmentConfig) -> int:
             f"perturbations, cost {cfg.cost}, kernel {cfg.kernel} (simulation {t_sim:.1f} s and kernel "
             f"compile/load {t_jit:.1f} s, not counted)"
         )
-        for stage in ("read", "geometry", "spectral", "collocation", "cost"):
+        for stage in ("read", "geometry", "parallax", "spectral", "collocation", "cost"):
             t = timings.get(stage, 0.0)
             print(f"  {stage:<12} {t:8.2f} s  {n_fov / t if t else float('inf'):10.0f} FOVs/s")
         print(f"  {'total':<12} {wall:8.2f} s  {n_fov / wall:10.0f} FOVs/s")
