@@ -19,7 +19,6 @@ temperatures (real, shared ten: -429 +- 78 urad in-track).
 from __future__ import annotations
 
 import argparse
-import json
 import shutil
 import tempfile
 from collections.abc import Sequence
@@ -27,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.provenance import commit
+from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import collocate_plan, cost_and_offsets
 from monitor.assessment.replay import assess_collocations, read_collocation
 from monitor.config.assessment import AssessmentConfig
@@ -140,10 +139,7 @@ def main() -> None:
     else:
         rows = [real(args.files)]
     for row in rows:
-        print(json.dumps(row), flush=True)
-        if args.rows:
-            with open(args.rows, "a") as fh:
-                fh.write(json.dumps(row) + "\n")
+        emit(row, args.rows)
 
 
 if __name__ == "__main__":

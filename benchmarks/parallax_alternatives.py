@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.provenance import commit
+from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import collocate_plan, cost_and_offsets, paired
 from monitor.collocation.parallax import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
@@ -72,10 +72,7 @@ def main() -> None:
     args = p.parse_args()
     for case in args.cases:
         for row in alternatives(case):
-            print(json.dumps(row), flush=True)
-            if args.rows:
-                with open(args.rows, "a") as fh:
-                    fh.write(json.dumps(row) + "\n")
+            emit(row, args.rows)
 
 
 if __name__ == "__main__":

@@ -18,3 +18,13 @@ def commit() -> str:
         cwd=Path(__file__).parent,
     )
     return done.stdout.strip() or "unknown"
+
+
+def emit(row: dict, rows_path: str | None) -> None:
+    """Print one JSON result row, and append it to *rows_path* when given."""
+    import json
+
+    print(json.dumps(row), flush=True)
+    if rows_path:
+        with open(rows_path, "a") as fh:
+            fh.write(json.dumps(row) + "\n")

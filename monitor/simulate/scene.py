@@ -185,6 +185,18 @@ def _surface_points(x, y, z, fields, params, law_k, law_m, clouds, out):  # type
         out[k] = _surface_m(x[k], y[k], z[k], fields, params, law_k, law_m, clouds, buf)
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _above_m(r, x, n0, n1, n2, h0, c1, c2, fields, params, law_k, law_m, clouds, buf):  # type: ignore[no-untyped-def]
+    """Height (m) of ray *r* above the surface (:func:`_surface_m`) at fraction *x* of its span
+    (:class:`monitor.simulate.terrain.RayGeometry`: the normal below it and its height are quadratics)."""
+    nx = n0[r, 0] + x * (n1[r, 0] + x * n2[r, 0])
+    ny = n0[r, 1] + x * (n1[r, 1] + x * n2[r, 1])
+    nz = n0[r, 2] + x * (n1[r, 2] + x * n2[r, 2])
+    norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+    height = h0[r] + x * (c1[r] + x * c2[r])
+    return height - _surface_m(nx / norm, ny / norm, nz / norm, fields, params, law_k, law_m, clouds, buf)
+
+
 @numba.njit(cache=True, nogil=True, parallel=True)
 def _march(ray, steps, fields, params, law_k, law_m, clouds, iterations, tolerance_m, out):  # type: ignore[no-untyped-def]
     """out (R,) = the distance along each ray of :class:`monitor.simulate.terrain.RayGeometry` *ray* to
@@ -201,12 +213,7 @@ def _march(ray, steps, fields, params, law_k, law_m, clouds, iterations, toleran
         b, gb = 1.0, 0.0
         for k in range(int(steps[r]) + 1):
             x = min(k / steps[r], 1.0)
-            nx = n0[r, 0] + x * (n1[r, 0] + x * n2[r, 0])
-            ny = n0[r, 1] + x * (n1[r, 1] + x * n2[r, 1])
-            nz = n0[r, 2] + x * (n1[r, 2] + x * n2[r, 2])
-            norm = np.sqrt(nx * nx + ny * ny + nz * nz)
-            g = h0[r] + x * (c1[r] + x * c2[r])
-            g -= _surface_m(nx / norm, ny / norm, nz / norm, fields, params, law_k, law_m, clouds, buf)
+            g = _above_m(r, x, n0, n1, n2, h0, c1, c2, fields, params, law_k, law_m, clouds, buf)
             if g > 0.0 and k < steps[r]:
                 a, ga = x, g
             else:
@@ -215,12 +222,7 @@ def _march(ray, steps, fields, params, law_k, law_m, clouds, iterations, toleran
         c, last = b, 0
         for _ in range(iterations):
             c = b if gb == 0.0 else b - gb * (b - a) / (gb - ga)
-            nx = n0[r, 0] + c * (n1[r, 0] + c * n2[r, 0])
-            ny = n0[r, 1] + c * (n1[r, 1] + c * n2[r, 1])
-            nz = n0[r, 2] + c * (n1[r, 2] + c * n2[r, 2])
-            norm = np.sqrt(nx * nx + ny * ny + nz * nz)
-            gc = h0[r] + c * (c1[r] + c * c2[r])
-            gc -= _surface_m(nx / norm, ny / norm, nz / norm, fields, params, law_k, law_m, clouds, buf)
+            gc = _above_m(r, c, n0, n1, n2, h0, c1, c2, fields, params, law_k, law_m, clouds, buf)
             if abs(gc) < tolerance_m:
                 break
             if gc > 0:
