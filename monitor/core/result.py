@@ -21,6 +21,9 @@ RELIABILITY_FLAGS = (FLAG_FEW_SAMPLES, FLAG_EDGE, FLAG_FLAT, FLAG_UNCERTAIN)
 # kernel's that was used): said in the flags, stored and shown, never silent
 FLAG_TOP_HAT = "top_hat"  # too few FOVs to fit the footprint: the top-hat cone's estimate and floor
 FLAG_UNCONVERGED = "unconverged"  # the footprint's alternation ran out of iterations or windows
+# the day's uniform scenes span too little BT to determine a CrIS-VIIRS gain: gain and curvature empty, the
+# bias the scenes' mean difference (monitor/estimation/intercal.py)
+FLAG_GAIN_UNDETERMINED = "gain_undetermined"
 
 
 @dataclass(frozen=True)

@@ -51,11 +51,12 @@ from scipy.ndimage import shift as shift_grid
 from scipy.optimize import nnls
 
 from monitor.config.assessment import AssessmentConfig
-from monitor.core.constants import URAD
+from monitor.core.constants import DEFAULT_STEP_RAD, URAD
 from monitor.core.result import (
     FLAG_EDGE,
     FLAG_FEW_SAMPLES,
     FLAG_FLAT,
+    FLAG_GAIN_UNDETERMINED,
     FLAG_TOP_HAT,
     FLAG_UNCERTAIN,
     FLAG_UNCONVERGED,
@@ -64,7 +65,14 @@ from monitor.core.result import (
 )
 from monitor.core.vocabulary import Cost, Kernel
 from monitor.estimation import refine
-from monitor.estimation.intercal import NO_FIT, Intercalibration, difference_bins, intercalibrate
+from monitor.estimation.intercal import (
+    NO_FIT,
+    Intercalibration,
+    collocation_spread_k,
+    difference_bins,
+    intercalibrate,
+    reach_steps,
+)
 from monitor.estimation.jackknife import Jackknife
 from monitor.instrument.footprint import widths_of_weights
 from monitor.instrument.spectral import I5Band
@@ -435,9 +443,16 @@ def aligned(s: ForSamples, apart: tuple[float, float]) -> ForSamples:
     return replace(s, d_k=d, annuli_rad=annuli)
 
 
-def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: bool = True) -> ForEstimate:
+def estimate(
+    s: ForSamples,
+    cost: Cost,
+    contrast: float = 0.03,
+    uncertainty: bool = True,
+    reach: int = reach_steps(DEFAULT_STEP_RAD),
+) -> ForEstimate:
     """Offsets, jackknife sigmas, flags, the intercalibration and (with annuli) the footprint of one FOR's
-    samples (module docstring), its rows aligned first (:func:`aligned`)."""
+    samples (module docstring), its rows aligned first (:func:`aligned`); the intercalibration weighs each
+    sample by how much its cone mean changes within *reach* steps of the optimum (:mod:`intercal`)."""
     apart = rows_apart(s, cost, contrast)
     s = aligned(s, apart)
     best, weights, d = _estimate(s, cost, contrast)
@@ -487,7 +502,8 @@ def estimate(s: ForSamples, cost: Cost, contrast: float = 0.03, uncertainty: boo
             fp = Footprint(
                 fp.radii_rad, fp.weights, fp.width_50_rad, fp.width_10_rad, float(ws[0]), float(ws[1])
             )
-    cal = intercalibrate(s.cris_k, d_opt + s.cris_k, jack, cal_boot)
+    spread = collocation_spread_k(d, best.i0, best.j0, reach)
+    cal = intercalibrate(s.cris_k, d_opt + s.cris_k, spread, jack, cal_boot)
     return ForEstimate(
         best.x, best.y, sigma, best.flags, best.g, d_opt, best.refined, cal, fp,
         rows, rows_sigma,
@@ -530,12 +546,15 @@ def day_offsets(
     cross-track km of a turn and its Jacobian (km/rad), NaN without."""
     m = per_for[0].d_k.shape[1]
     cube = np.full((len(per_for), m, m), np.nan)
+    reach = reach_steps(step_urad * URAD)
     # the FORs are independent: estimated on the assessment's threads (numpy and the compiled BT inversion
     # leave the interpreter's lock), each the same numbers as alone
     with ThreadPoolExecutor(max_workers=max(1, cfg.workers), thread_name_prefix="estimate") as pool:
         estimates = list(
             pool.map(
-                lambda s: estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty) if len(s) >= 3 else None,
+                lambda s: (
+                    estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty, reach) if len(s) >= 3 else None
+                ),
                 per_for,
             )
         )
@@ -559,6 +578,8 @@ def day_offsets(
                 ]
             g, x, y, (sig_a, sig_b), cal = best.cost, best.x, best.y, best.sigma, best.intercalibration
             rows = [*best.rows, *best.rows_sigma]
+            if cal.gain_undetermined:
+                flags.append(FLAG_GAIN_UNDETERMINED)
             cube[k] = g
             flags += best.flags
             if best.refined:

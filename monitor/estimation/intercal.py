@@ -1,52 +1,90 @@
-"""CrIS-VIIRS intercalibration at the geolocation optimum: the BT bias at a reference temperature, the gain
-and the curvature there.
+"""CrIS-VIIRS intercalibration at the geolocation optimum, on the scenes the collocation cannot move: the
+BT bias at a reference temperature, the gain and the curvature there.
 
-At a FOR's optimum perturbation the VIIRS cone mean V_n (the I5 BT of the VIIRS radiance averaged over the
-perturbed CrIS FOV n) and the CrIS BT C_n convolved with the I5 response see the same scene; what separates
-them, once the geolocation is right, is the calibration difference of the two instruments and their noise.
-To second order about a reference temperature T_ref (``CALIBRATION_REFERENCE_K``, 280 K), with
-x = V_n - T_ref and S = ``CALIBRATION_CURVATURE_SPAN_K`` (30 K),
+**The law.** At a FOR's optimum perturbation the VIIRS cone mean V_n (the I5 BT of the VIIRS radiance
+averaged over the perturbed CrIS FOV n) and the CrIS BT C_n convolved with the I5 response see nearly the
+same scene. To second order about a reference temperature T_ref (``CALIBRATION_REFERENCE_K``, 280 K for
+every satellite, so that the stored series and ``calibration_jump`` keep one meaning), with x = V_n - T_ref
+and S = ``CALIBRATION_CURVATURE_SPAN_K`` (30 K),
 
     C_n - V_n = b + g x + c (x / S)^2 + e_n,
 
 b is the CrIS-VIIRS bias at T_ref (K), g the gain difference there (relative; reported in per cent) and c the
-curvature (K: what it adds at 250 and 310 K). That is the simulator's calibration law
-(:class:`monitor.simulate.case.SimulationSpec`) and the seeds' CrIS/VIIRS intercalibration plots in one line.
-The curvature is fitted so that b and g are the difference *at* T_ref whatever mix of scenes a day brings:
-a straight line through a curved difference would give the secant over the day's BT range, and a day of
-more cloud would move it. V is the regressor because it is the better measured of the two (a mean over
-some hundred I5 pixels against one CrIS spectrum), so least squares is not attenuated by its noise.
-:func:`difference_bins` (the paper's Figure 15: C - V against C in 10 K bins) shows the shape.
+curvature (K: what it adds at 250 and 310 K): the simulator's calibration law
+(:class:`monitor.simulate.case.SimulationSpec`) and the seeds' intercalibration plots in one line.
+
+**What the collocation puts in e_n** (inter-calibration practice, GSICS: compare only where the collocation
+cannot matter). The cone mean is not what CrIS saw: the optimum is uncertain, the outer FOV rows see high
+clouds from elsewhere (parallax), and the CrIS response reaches past the cone's edge. Each moves the VIIRS
+mean by at most how much the cone mean changes when the cone moves by that much. The response's skirt is
+the farthest of the three: the specification's 3 %-of-peak width (``footprint.SPEC_WIDTHS``, 1.238 deg)
+reaches ``REACH_RAD`` (~2.4 mrad) beyond the cone's radius. So each sample's *collocation spread*
+s_n = max |V(turn) - V(optimum)| over the turns within that reach (:func:`collocation_spread_k`) bounds what
+the collocation adds to V_n: a uniform scene has s_n at its noise, a cloud edge kelvins. Regressing C - V on
+V over every scene read that mismatch as calibration (a gain diluted by -var(e)/var(V): -2.8 % on the real
+collocations).
+
+**Errors in both variables.** C_n carries its noise sigma_0; V_n its own noise and what the collocation put
+in, a part kappa of its spread: sigma_0^2 + kappa^2 s_n^2. V enters both sides of the law, so the residual's
+variance is the *effective variance* (Orear 1982, errors in both variables for a model linear in its
+parameters; for a straight line, York's regression):
+
+    var_n = sigma_0^2 + (1 + g + 2 c x_n / S^2)^2 (sigma_0^2 + kappa^2 s_n^2),
+
+and the law is fitted by least squares weighted 1 / var_n, the slope factor updated once from a first fit.
+No threshold is chosen: the weights are the uniformity test in its continuous form, and sigma_0 and kappa
+are not assumed but found from the day's residuals by maximum likelihood (:func:`variance_scale`). On the
+simulated days kappa comes out near 0.01 (the optimum is good to a few urad, so the collocation moves V by a
+hundredth of what the reach would); a cloud edge of s_n = 3 K then weighs as a uniform scene at 0.03 K.
+
+**A gain only where the scenes determine it.** A day of warm ocean alone (uniform scenes within a few K)
+determines a bias but not a gain. The gain (and curvature) are stated where the sigma of the gain (the jackknife's,
+else the fit's) is at most ``GAIN_RESOLUTION_PCT`` (the 0.1 % to which the product claims to
+recover a gain); elsewhere only the bias is fitted (g = c = 0: the mean difference of the weighted scenes,
+stated at T_ref on the assumption of no gain) and the gain is NaN, flagged ``gain_undetermined`` by the
+estimator. :func:`difference_bins` (the paper's Figure 15: C - V against C in 10 K bins, every scene) shows
+the shape.
 
 The sigmas come from the same delete-one-granule jackknife as the offsets'
-(:mod:`monitor.estimation.estimate`,
-:mod:`monitor.estimation.jackknife`): the fit on each replicate's samples at that replicate's own optimum; so
-a FOR whose optimum is uncertain has an uncertain intercalibration too.
+(:mod:`monitor.estimation.jackknife`): the fit on each replicate's samples at that replicate's own optimum,
+with the day's variances.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import optimize
 
-from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_CURVATURE_SPAN_K, CALIBRATION_REFERENCE_K
+from monitor.core.constants import (
+    CALIBRATION_BIN_K,
+    CALIBRATION_CURVATURE_SPAN_K,
+    CALIBRATION_REFERENCE_K,
+    FOV_HALF_ANGLE_RAD,
+)
 from monitor.core.result import DifferenceBin
 from monitor.estimation.jackknife import Jackknife
+from monitor.instrument.footprint import SPEC_WIDTHS
 
 MAX_CONDITION = 1e10  # a fit whose normal equations are worse conditioned (no BT spread) gives NaN
-# The fit is stated at T_ref only where the samples reach it: T_ref within the 5th-95th percentile range of
-# V, and that range at least this wide. A FOR of ocean alone (a few K around 295 K) would put a quadratic's
-# value at 280 K from extrapolation, off by tenths of a K with a bootstrap sigma that cannot tell (measured
-# on one simulated granule: 0.63 K off, sigma 0.04 K, from 36 samples within 288-294 K).
-MIN_SPAN_K = 2 * CALIBRATION_BIN_K
+# how far past the cone's radius the response reaches: half the specification's widest width (3 % of peak)
+REACH_RAD = max(hi for _, _, hi in SPEC_WIDTHS if hi is not None) / 2 - FOV_HALF_ANGLE_RAD
+GAIN_RESOLUTION_PCT = 0.1  # a gain known worse than this (the fit's sigma) is not stated
+# sigma_0 is kept above this (K), so that a sample whose cone mean does not change at all does not weigh
+# without bound: below any instrument's noise (the real collocations' bias moves by < 0.01 K for floors of
+# 0.001-0.03 K)
+NOISE_FLOOR_K = 1e-3
+MIN_SAMPLES = 4
 
 
 @dataclass(frozen=True)
 class Intercalibration:
     """CrIS minus VIIRS at one FOR: the bias (K) at ``CALIBRATION_REFERENCE_K``, the gain there (per cent of
     the BT's departure from it) and the curvature (K at ``CALIBRATION_CURVATURE_SPAN_K`` from it), with
-    their jackknife sigmas (NaN without)."""
+    their jackknife sigmas (NaN without); the gain and curvature NaN where the scenes do not determine them
+    (module docstring)."""
 
     bias_k: float
     sigma_bias_k: float
@@ -55,51 +93,145 @@ class Intercalibration:
     curvature_k: float
     sigma_curvature_k: float
 
+    @property
+    def gain_undetermined(self) -> bool:
+        """A bias was fitted, but the scenes' temperatures could not determine a gain."""
+        return math.isfinite(self.bias_k) and not math.isfinite(self.gain_pct)
+
 
 NO_FIT = Intercalibration(*[np.nan] * 6)
 
 
-def fit_difference(cris_k: np.ndarray, viirs_k: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
-    """Least-squares (b_k, g, c_k) of C - V = b + g x + c (x / S)^2, x = V - T_ref, over the samples
-    *cris_k* (N,) and *viirs_k* (N,); with *weights* (B, N), e.g. bootstrap counts, one fit per row (B, 3),
-    and then *viirs_k* may also be (B, N): one V per row. NaN where the samples do not span enough BT."""
-    v = np.asarray(viirs_k, float)
-    x = v - CALIBRATION_REFERENCE_K
-    y = np.asarray(cris_k, float) - v
-    a = np.stack([np.ones_like(x), x, (x / CALIBRATION_CURVATURE_SPAN_K) ** 2], axis=-1)  # (..., N, 3)
-    w = np.ones((1, x.shape[-1])) if weights is None else np.asarray(weights, float)
-    a, y = np.broadcast_to(a, w.shape + (3,)), np.broadcast_to(y, w.shape)
+def reach_steps(step_rad: float) -> int:
+    """The turns (grid steps of *step_rad*) that cover ``REACH_RAD`` about the optimum."""
+    return max(1, math.ceil(REACH_RAD / step_rad - 1e-9))
+
+
+def collocation_spread_k(d_k: np.ndarray, i0: int, j0: int, reach: int) -> np.ndarray:
+    """Per sample, the most the cone mean changes (K) over the turns within *reach* steps (a square,
+    clipped to the grid) of the optimum (*i0*, *j0*) of the surfaces *d_k* (N, m, m) of V - C: what the
+    collocation can put into V there (module docstring); infinite where a turn has no cone mean (the
+    sample then weighs nothing)."""
+    m = d_k.shape[1]
+    window = d_k[:, max(0, i0 - reach) : min(m, i0 + reach + 1), max(0, j0 - reach) : min(m, j0 + reach + 1)]
+    spread = np.abs(window - d_k[:, i0, j0][:, None, None]).max(axis=(1, 2))
+    return np.where(np.isnan(spread), np.inf, spread)
+
+
+def _design(viirs_k: np.ndarray, terms: int) -> np.ndarray:
+    """The law's regressors (..., N, terms): 1, x, (x / S)^2, x = V - T_ref."""
+    x = viirs_k - CALIBRATION_REFERENCE_K
+    return np.stack([np.ones_like(x), x, (x / CALIBRATION_CURVATURE_SPAN_K) ** 2][:terms], axis=-1)
+
+
+def _solve(a: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Weighted least squares per row of *w* (B, N): the parameters (B, p) (NaN where the normal equations
+    are singular) and their covariances (B, p, p) for weights that are inverse variances."""
     normal = np.einsum("bn,bni,bnj->bij", w, a, a)
     rhs = np.einsum("bn,bni,bn->bi", w, a, y)
+    p = a.shape[-1]
+    out, cov = np.full((len(w), p), np.nan), np.full((len(w), p, p), np.nan)
     ok = np.linalg.cond(normal) < MAX_CONDITION
-    out = np.full((len(w), 3), np.nan)
     if ok.any():
         out[ok] = np.linalg.solve(normal[ok], rhs[ok][..., None])[..., 0]
-    return out[0] if weights is None else out
+        cov[ok] = np.linalg.inv(normal[ok])
+    return out, cov
+
+
+def _variance(
+    viirs_k: np.ndarray, spread_k: np.ndarray, scale: tuple[float, float], beta: np.ndarray
+) -> np.ndarray:
+    """The effective variance (K^2) of each residual for the noise and spread factor *scale* and the
+    parameters *beta* (B, p) (module docstring)."""
+    noise, kappa = scale
+    x = viirs_k - CALIBRATION_REFERENCE_K
+    slope = np.ones(np.broadcast_shapes(x.shape, (len(beta), 1)))
+    if beta.shape[-1] > 1:
+        slope = slope + beta[:, 1:2]
+    if beta.shape[-1] > 2:
+        slope = slope + 2 * beta[:, 2:3] * x / CALIBRATION_CURVATURE_SPAN_K**2
+    return noise**2 + np.nan_to_num(slope, nan=1.0) ** 2 * (noise**2 + (kappa * spread_k) ** 2)
+
+
+def fit_difference(
+    cris_k: np.ndarray,
+    viirs_k: np.ndarray,
+    spread_k: np.ndarray,
+    scale: tuple[float, float],
+    counts: np.ndarray | None = None,
+    terms: int = 3,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The law's first *terms* parameters (b_k, g, c_k) over the samples *cris_k*, *viirs_k* (N,) whose
+    collocation spreads are *spread_k* (N,), with the variance model's *scale* (sigma_0 in K, kappa): (p,)
+    and the covariance (p, p); with *counts* (B, N), e.g. jackknife replicates, one fit per row ((B, p),
+    (B, p, p)), and *viirs_k* may be (B, N): one V per row. The effective-variance weights, their slope
+    factor from a first fit."""
+    one = counts is None
+    w0 = np.ones((1, len(cris_k))) if one else np.asarray(counts, float)
+    v = np.broadcast_to(np.asarray(viirs_k, float), w0.shape)
+    y = np.asarray(cris_k, float) - v
+    a = _design(v, terms)
+    beta = np.zeros((len(w0), terms))
+    for _ in range(2):
+        beta, cov = _solve(a, y, w0 / _variance(v, spread_k, scale, beta))
+    return (beta[0], cov[0]) if one else (beta, cov)
+
+
+def variance_scale(
+    cris_k: np.ndarray, viirs_k: np.ndarray, spread_k: np.ndarray, terms: int = 3
+) -> tuple[float, float]:
+    """(sigma_0 in K, kappa) of the variance model sigma_0^2 + kappa^2 s_n^2, by maximum likelihood of the
+    fit's residuals (the law's parameters profiled out); None-like (NaN, NaN) without degrees of freedom."""
+    if len(cris_k) <= terms + 2:
+        return math.nan, math.nan
+    finite = np.isfinite(spread_k)
+
+    def minus_log_likelihood(p: np.ndarray) -> float:
+        scale = (math.exp(p[0]), math.exp(p[1]))
+        beta, _ = fit_difference(cris_k, viirs_k, spread_k, scale, terms=terms)
+        if not np.isfinite(beta).all():
+            return 1e300  # the simplex steps back from where the normal equations fail
+        r = (cris_k - viirs_k - _design(viirs_k, terms) @ beta)[finite]
+        var = _variance(viirs_k, spread_k, scale, beta[None])[0][finite]
+        return float(0.5 * np.sum(r * r / var + np.log(var)))
+
+    start = np.log([max(NOISE_FLOOR_K, float(np.median(spread_k[finite])) / 10), 0.3])
+    found = optimize.minimize(minus_log_likelihood, start, method="Nelder-Mead", options={"xatol": 1e-3})
+    noise, kappa = np.exp(found.x)
+    return max(float(noise), NOISE_FLOOR_K), float(kappa)
 
 
 def intercalibrate(
     cris_k: np.ndarray,
     viirs_k: np.ndarray,
+    spread_k: np.ndarray,
     jackknife: Jackknife | None = None,
     viirs_boot_k: np.ndarray | None = None,
 ) -> Intercalibration:
-    """The bias, gain and curvature of one FOR's samples at its optimum; sigmas from the *jackknife*'s
-    replicates, each fitted at its own optimum where *viirs_boot_k* (G, N) gives the V there. No fit (NaN)
-    from fewer than 4 samples, or from samples that do not reach T_ref (``MIN_SPAN_K``)."""
-    if len(cris_k) < 4:
+    """The bias, gain and curvature of one FOR's samples at its optimum, the samples' collocation spreads
+    *spread_k* (:func:`collocation_spread_k`) weighing them; sigmas from the *jackknife*'s replicates, each
+    fitted at its own optimum where *viirs_boot_k* (G, N) gives the V there. No fit (NaN) from fewer than
+    ``MIN_SAMPLES``; the gain and curvature NaN where their sigma (the jackknife's, else the fit's) exceeds
+    ``GAIN_RESOLUTION_PCT``."""
+    c, v, s = (np.asarray(a, float) for a in (cris_k, viirs_k, spread_k))
+    if len(c) < MIN_SAMPLES:
         return NO_FIT
-    lo, hi = np.percentile(viirs_k, [5, 95])
-    if not (lo <= CALIBRATION_REFERENCE_K <= hi and hi - lo >= MIN_SPAN_K):
-        return NO_FIT
-    b, g, c = fit_difference(cris_k, viirs_k)
-    sig = np.full(3, np.nan)
-    if jackknife is not None:
-        v = viirs_k if viirs_boot_k is None else viirs_boot_k
-        sig = jackknife.sigma(fit_difference(cris_k, v, jackknife.counts))
-    return Intercalibration(
-        float(b), float(sig[0]), 100.0 * float(g), 100.0 * float(sig[1]), float(c), float(sig[2])
-    )
+    for terms in (3, 1):
+        scale = variance_scale(c, v, s, terms)
+        if not math.isfinite(scale[0]):
+            return NO_FIT
+        beta, cov = fit_difference(c, v, s, scale, terms=terms)
+        sig = np.sqrt(np.diag(cov))
+        if jackknife is not None:
+            v_reps = v if viirs_boot_k is None else viirs_boot_k
+            sig = jackknife.sigma(fit_difference(c, v_reps, s, scale, jackknife.counts, terms)[0])
+        if terms == 1 or (np.isfinite(beta).all() and 100 * sig[1] <= GAIN_RESOLUTION_PCT):
+            break
+    if jackknife is None:
+        sig = np.full(terms, np.nan)
+    b, g, cv = (*beta, np.nan, np.nan)[:3] if terms == 1 else beta
+    sb, sg, sc = (*sig, np.nan, np.nan)[:3] if terms == 1 else sig
+    return Intercalibration(float(b), float(sb), 100.0 * float(g), 100.0 * float(sg), float(cv), float(sc))
 
 
 def difference_bins(cris_k: np.ndarray, viirs_k: np.ndarray) -> list[DifferenceBin]:

@@ -71,9 +71,10 @@ def _minimum(d, c):
 
 def test_a_calibration_difference_leaves_the_offsets_and_sigmas_and_is_recovered_at_the_optimum():
     """Offsets and their jackknife sigmas within 1 urad of the agreeing instruments'; the bias and gain
-    fitted at the optimum are the injected ones (the truth's V at the optimum is T + noise)."""
+    fitted at the optimum are the injected ones (the truth's V at the optimum is T + noise): 2000 samples,
+    so that the scenes determine a gain to intercal.GAIN_RESOLUTION_PCT (300 do not: it is then left out)."""
     rng = np.random.default_rng(5)
-    v, c = _samples(rng)
+    v, c = _samples(rng, n=2000)
     agree = _minimum(v - c[:, None, None], c)
     assert agree.refined
     law = c + 1.5 + 0.03 * (c - 280.0)  # a 3 % gain and a 1.5 K bias on every CrIS BT
@@ -86,4 +87,4 @@ def test_a_calibration_difference_leaves_the_offsets_and_sigmas_and_is_recovered
     assert np.allclose(viirs, agree.d_opt + c)
     cal = differ.intercalibration
     assert cal.bias_k == pytest.approx(1.5, abs=0.05) and cal.gain_pct == pytest.approx(3.0, abs=0.2)
-    assert 0 < cal.sigma_bias_k < 0.05 and 0 < cal.sigma_gain_pct < 0.2
+    assert 0 < cal.sigma_bias_k < 0.05 and 0 < cal.sigma_gain_pct < 0.1

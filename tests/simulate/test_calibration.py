@@ -86,9 +86,10 @@ def test_the_regression_cost_keeps_the_offsets_and_recovers_the_calibration_diff
     assert len(reliable) >= 20
     for a, g in reliable:
         assert abs(a.d_alpha_urad - g.d_alpha_urad) < 1.0 and abs(a.d_beta_urad - g.d_beta_urad) < 1.0, (a, g)
-    # the FORs whose samples reach 280 K (intercal.MIN_SPAN_K: the others have no intercalibration)
-    fitted = [(a, g) for a, g in reliable if np.isfinite(a.bias_k) and np.isfinite(g.bias_k)]
-    assert len(fitted) >= 15
+    # the intercalibration where the uniform scenes determine a gain (intercal.GAIN_RESOLUTION_PCT: 9 FORs
+    # of one granule's 36 samples each; a day of 6 determines it at more, benchmarks/acceptance.py)
+    fitted = [(a, g) for a, g in reliable if np.isfinite(a.gain_pct) and np.isfinite(g.gain_pct)]
+    assert len(fitted) >= 6, len(fitted)
     for a, g in fitted:
         for f, bias_k, gain_pct in ((a, 0.0, 0.0), (g, 1.5, 3.0)):
             assert abs(f.bias_k - bias_k) < 0.02 + 4 * f.sigma_bias_k, f
@@ -96,9 +97,12 @@ def test_the_regression_cost_keeps_the_offsets_and_recovers_the_calibration_diff
             # a straight law: no curvature (a FOR of one granule shows up to ~0.1 K of the scene's own)
             assert abs(f.curvature_k) < 0.1 + 4 * f.sigma_curvature_k, f
     for f, bias_k, gain_pct in (([a for a, _ in fitted], 0.0, 0.0), ([g for _, g in fitted], 1.5, 3.0)):
-        assert np.median([x.bias_k for x in f]) == pytest.approx(bias_k, abs=0.05)
-        assert np.median([x.gain_pct for x in f]) == pytest.approx(gain_pct, abs=0.2)
+        assert np.median([x.bias_k for x in f]) == pytest.approx(bias_k, abs=0.03)
+        assert np.median([x.gain_pct for x in f]) == pytest.approx(gain_pct, abs=0.1)
         assert np.median([x.curvature_k for x in f]) == pytest.approx(0.0, abs=0.05)
+    # elsewhere the bias alone, flagged: the agreeing instruments' within 0.03 K
+    alone = [a for a, _ in reliable if "gain_undetermined" in a.flags]
+    assert all(np.isnan(a.gain_pct) and abs(a.bias_k) < 0.03 + 4 * a.sigma_bias_k for a in alone)
     # Figure 15's bins: the difference grows with the CrIS BT as the gain says
     bins = [b for b in gained.difference_bins if b.n >= 30]
     slope = np.polyfit([b.low_k for b in bins], [b.mean_k for b in bins], 1)[0]
@@ -117,7 +121,7 @@ def test_a_curved_calibration_difference_keeps_the_offsets_and_shows_its_curvatu
         assert abs(a.d_alpha_urad - c.d_alpha_urad) < 0.5 * a.sigma_alpha_urad, (a, c)
         assert abs(a.d_beta_urad - c.d_beta_urad) < 0.5 * a.sigma_beta_urad, (a, c)
     fitted = [c for _, c in reliable if np.isfinite(c.curvature_k)]
-    assert len(fitted) >= 15
+    assert len(fitted) >= 6, len(fitted)
     assert np.median([c.curvature_k for c in fitted]) == pytest.approx(0.5, abs=0.1)
     assert np.median([c.gain_pct for c in fitted]) == pytest.approx(1.0, abs=0.2)
     assert np.median([c.bias_k for c in fitted]) == pytest.approx(0.0, abs=0.05)
