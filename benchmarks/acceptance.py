@@ -61,6 +61,7 @@ MISMATCHES = {
     "gain-1,bias-2": (-0.01, -2.0, 0.0),
 }
 RECOVERY = (0.05, 0.2)  # the intercalibration's bound: bias K, gain per cent (issue 27)
+NO_DIFFERENCE = (0.03, 0.1)  # where none was injected (issue 43)
 BOUNDS = {14: (10.0, 25.0)}  # granules: (RMS, worst FOR) urad; smaller cases get SMALL_BOUNDS
 SMALL_BOUNDS = (12.0, 30.0)
 EXTRA_PASSES = {"dateline": ("night", 180.0)}
@@ -163,21 +164,24 @@ def _key(r) -> tuple:
 
 
 def recovery(row) -> str:
-    """The intercalibration of a row against the injected values: median and worst reliable FOR of the bias
-    and gain (bounded by RECOVERY) and of the curvature (where the row has it)."""
+    """The intercalibration of a row against the injected values: how many reliable FORs determine a gain
+    (intercal.GAIN_RESOLUTION_PCT), and over those the median and worst bias and gain (bounded by RECOVERY,
+    NO_DIFFERENCE where none was injected) and curvature (where the row has it)."""
     if "bias_k" not in row:
         return ""
     gain, bias_k, curve_k = MISMATCHES[row["mismatch"]]
+    bounds = NO_DIFFERENCE if row["mismatch"] == "none" else RECOVERY
     ok = np.array(row["reliable"])
-    parts, within = [], True
+    determined = ok & np.isfinite(np.array(row["gain_pct"], float))
+    parts, within = [f"gain at {determined.sum()}/{ok.sum()}"], determined.any()
     for name, injected, unit, bound in (
-        ("bias_k", bias_k, "K", RECOVERY[0]),
-        ("gain_pct", 100 * gain, "%", RECOVERY[1]),
+        ("bias_k", bias_k, "K", bounds[0]),
+        ("gain_pct", 100 * gain, "%", bounds[1]),
         ("curvature_k", curve_k, "K", None),
     ):
-        if name not in row:
+        if name not in row or not determined.any():
             continue
-        e = np.array(row[name], float)[ok] - injected
+        e = np.array(row[name], float)[determined] - injected
         worst = e[np.nanargmax(np.abs(e))]
         parts.append(f"{name.split('_')[0]} {np.nanmedian(e):+.3f} (worst {worst:+.3f}) {unit}")
         within &= bound is None or abs(worst) <= bound

@@ -34,9 +34,10 @@ class RuleSettings(Section):
         0.25, "Smallest step (median after minus median before) that counts as a jump.", 0.001, 100.0
     )
     min_bias_jump_k: float = key(
-        0.1,
+        0.05,
         "Smallest step of the daily CrIS-VIIRS BT bias at 280 K that counts as a calibration jump (the "
-        "calibration_jump rule: a VIIRS LUT or CrIS calibration change).",
+        "calibration_jump rule: a VIIRS LUT or CrIS calibration change). Half the 0.1 K step it must see; "
+        "a change of scenes alone moves the bias by < 0.01 K (real halves, docs/science.md).",
         0.001,
         100.0,
     )

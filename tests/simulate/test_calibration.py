@@ -1,15 +1,21 @@
 """A simulated CrIS-VIIRS calibration difference: the CrIS BT in the I5 band departs from the agreeing
 instruments' by the bias and gain injected (what the intercalibration of issue 27 must recover)."""
 
+import dataclasses
+import datetime as dt
+
 import numpy as np
 import pytest
 
+from alerts.rules import CALIBRATION, jump_findings
 from monitor.assessment.assess import assess_paths
+from monitor.config.alerts import RuleSettings
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import CALIBRATION_REFERENCE_K
 from monitor.core.vocabulary import Cost
 from monitor.instrument.spectral import i5_band
 from monitor.sdr import read_file
+from monitor.service.store.sqlite import Store
 from monitor.simulate.case import SimulationSpec, simulate_case
 
 
@@ -43,15 +49,17 @@ def test_the_band_bt_carries_the_injected_bias_and_gain(tmp_path, bias_k, gain):
 @pytest.fixture(scope="module")
 def differing(tmp_path_factory):
     """One granule as the agreeing instruments see it, and with CrIS's calibration differing: a 2 K bias;
-    a 3 % gain and a 1.5 K bias; a 1 % gain and a 0.5 K curvature. The VIIRS files are the agreeing case's
-    (VIIRS is the reference)."""
+    a 3 % gain and a 1.5 K bias; a 1 % gain and a 0.5 K curvature; a 0.1 K bias. The VIIRS files are the
+    agreeing case's (VIIRS is the reference). And another granule's scenes, the instruments agreeing."""
     root = tmp_path_factory.mktemp("calibration")
     same = {"granules": 1, "profile": "paper", "seed": 2}
     simulate_case(root / "agree", **same)
+    simulate_case(root / "other", **{**same, "seed": 3})
     for name, kw in (
         ("biased", {"cris_bias_k": 2.0}),
         ("gained", {"cris_gain": 0.03, "cris_bias_k": 1.5}),
         ("curved", {"cris_gain": 0.01, "cris_nonlinear_k": 0.5}),
+        ("stepped", {"cris_bias_k": 0.1}),
     ):
         simulate_case(root / name, viirs=False, **kw, **same)
         for f in [*(root / "agree").glob("SVI05_*.h5"), *(root / "agree").glob("GITCO_*.h5")]:
@@ -125,3 +133,33 @@ def test_a_curved_calibration_difference_keeps_the_offsets_and_shows_its_curvatu
     assert np.median([c.curvature_k for c in fitted]) == pytest.approx(0.5, abs=0.1)
     assert np.median([c.gain_pct for c in fitted]) == pytest.approx(1.0, abs=0.2)
     assert np.median([c.bias_k for c in fitted]) == pytest.approx(0.0, abs=0.05)
+
+
+def test_calibration_jump_fires_on_a_calibration_step_and_not_on_a_change_of_scenes(differing, tmp_path):
+    """40 days whose scenes alternate between two granules; from day 34 either one granule's scenes alone
+    (a change of scene mix) or the same scenes with CrIS 0.1 K warmer. The first is no calibration jump;
+    the second is one (alerts.min_bias_jump_k 0.05 K: a 0.1 K step is not left to the rounding of a
+    threshold at 0.1)."""
+    results = {name: _assess(differing, name, Cost.REGRESSION) for name in ("agree", "other", "stepped")}
+    days = [dt.date(2024, 6, 1) + dt.timedelta(days=i) for i in range(40)]
+    split = days[34]
+    for after, fires in (("other", False), ("stepped", True)):
+        store = Store(tmp_path / f"{after}.sqlite")
+        for i, day in enumerate(days):
+            name = ("agree", "other")[i % 2] if day < split else after
+            result = dataclasses.replace(
+                results[name],
+                granules=[
+                    dataclasses.replace(g, granule_id=f"{g.granule_id}-{day}") for g in results[name].granules
+                ],
+            )
+            store.save_day(store.begin_run("j01", day), "j01", day, result, [], {})
+        found = jump_findings(store, "j01", [], RuleSettings(), days[-1], CALIBRATION)
+        if not fires:
+            assert found == [], [f.lines for f in found]
+            continue
+        # one jump, at the split or the day before it (day 33 has the other granule's scenes: either
+        # reads as the last day of the old level)
+        (f,) = found
+        assert f.rule == "calibration_jump" and "+0.10 K" in f.lines[0], f.lines
+        assert 0 <= (split - dt.date.fromisoformat(f.data["split"])).days <= 1, f.data
