@@ -10,10 +10,9 @@ The CrIS footprint of the truth (``--footprints``, :mod:`monitor.instrument.foot
 cone, or a smooth response within the specification's table; ``--kernel`` the assessment's (``footprint``, the
 default, fits the response; ``top-hat`` is the paper's cone).
 
-Calibration of the reported sigma (the delete-one-granule jackknife plus the floor
-``estimate.floor_urad``, by kernel, in quadrature): over all cases, the share of FOR-directions whose
-|error| <= 2 sigma (target >= 90 %) and, per case, the median sigma over the RMS error (target <= 1.5).
-It also prints the floor that would give 90 % coverage with the jackknife part as measured.
+The reported sigma (derived: :mod:`monitor.estimation.jackknife`, nothing fitted to these cases) against
+the errors: over all cases, the share of FOR-directions whose |error| <= 2 sigma (target >= 90 %) and, per
+case, the median sigma over the RMS error (target <= 1.5).
 CrIS-VIIRS calibration differences (``--mismatch``, issue 27): the CrIS BT departs from VIIRS's by a gain
 about 280 K, a bias and a curvature (:data:`MISMATCHES`); ``--cost`` picks the cost (assessment.cost). Each
 row also holds the intercalibration recovered per FOR (bias at 280 K, gain), printed against the injected
@@ -45,7 +44,6 @@ from benchmarks.provenance import commit
 from monitor.assessment.assess import assess_paths
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
-from monitor.estimation.estimate import floor_urad
 from monitor.instrument import footprint
 from monitor.simulate.case import simulate_case
 from monitor.simulate.orbit import PASSES
@@ -121,7 +119,7 @@ def run_case(
         "pass": pass_name,
         "seed": seed,
         "assess_s": secs,
-        "floor_urad": floor_urad(cfg),
+        "sigma_note": result.notes[-1] if result.notes else "",
         "err_alpha_urad": (np.array([f.d_alpha_urad for f in result.fors]) - ta).tolist(),
         "err_beta_urad": (np.array([f.d_beta_urad for f in result.fors]) - tb).tolist(),
         "sigma_alpha_urad": [f.sigma_alpha_urad for f in result.fors],
@@ -221,27 +219,19 @@ def rows_read(row) -> str:
 
 def calibration(rows) -> str:
     """The uncertainty table: coverage of 2 sigma and median sigma / RMS error, per case size."""
-    lines = [f"{'gran':>4} {'cases':>5} {'|e|<=2s':>8} {'med s/rms':>10} {'worst s/rms':>11} {'floor_90':>9}"]
+    lines = [f"{'gran':>4} {'cases':>5} {'|e|<=2s':>8} {'med s/rms':>10} {'worst s/rms':>11}"]
     for size in sorted({r["size"] for r in rows}, reverse=True):
         sel = [r for r in rows if r["size"] == size]
         err = np.concatenate([np.r_[r["err_alpha_urad"], r["err_beta_urad"]] for r in sel])
         sig = np.concatenate([np.r_[r["sigma_alpha_urad"], r["sigma_beta_urad"]] for r in sel])
-        boot = np.sqrt(
-            np.maximum(sig**2 - np.concatenate([np.full(60, r["floor_urad"]) for r in sel]) ** 2, 0)
-        )
         ratios = [
             np.median(np.r_[r["sigma_alpha_urad"], r["sigma_beta_urad"]])
             / np.sqrt(np.mean(np.r_[r["err_alpha_urad"], r["err_beta_urad"]] ** 2))
             for r in sel
         ]
         cover = np.mean(np.abs(err) <= 2 * sig)
-        floor = next(
-            (f for f in np.arange(0.0, 60.0, 0.5) if np.mean(np.abs(err) <= 2 * np.hypot(boot, f)) >= 0.9),
-            np.nan,
-        )
         lines.append(
-            f"{size:>4} {len(sel):>5} {100 * cover:7.1f}% {np.median(ratios):10.2f} {max(ratios):11.2f} "
-            f"{floor:9.1f}"
+            f"{size:>4} {len(sel):>5} {100 * cover:7.1f}% {np.median(ratios):10.2f} {max(ratios):11.2f}"
         )
     return "\n".join(lines)
 

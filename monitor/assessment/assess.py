@@ -11,6 +11,7 @@ jackknife uncertainty, the intercalibration; and here, the offsets in km on the 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import datetime as dt
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -38,6 +39,7 @@ from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo, Skippe
 from monitor.core.threads import parallel_threads
 from monitor.estimation import parallax
 from monitor.estimation.estimate import ForSamples, day_offsets
+from monitor.estimation.jackknife import follows_in_time, uncertainty_note
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry
@@ -259,6 +261,7 @@ def cost_and_offsets(
         cfg,
         cfg.step_urad,
         lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
+        follows_in_time([_seconds(s.info.start) for s in samples]),
     )
     fors = [
         _with_lift_spread(f, np.nan_to_num(e) * cfg.step_urad, m_per_k, _cold_height_km(s, m_per_k))
@@ -277,7 +280,16 @@ def cost_and_offsets(
         step_urad=cfg.step_urad,
         cost_cube_k=day.cost_cube_k,
         difference_bins=day.difference_bins,
+        notes=[uncertainty_note(len(samples), day.correlation)],
     )
+
+
+def _seconds(iso: str) -> float:
+    """Seconds since the epoch of an ISO time (NaN where there is none: then no granule follows another)."""
+    try:
+        return dt.datetime.fromisoformat(iso).timestamp()
+    except ValueError:
+        return np.nan
 
 
 def _with_lift_spread(f: ForOffset, spread_urad: np.ndarray, m_per_k: float, height_km: float) -> ForOffset:

@@ -15,6 +15,7 @@ that too. The cone means are plain means over the top-hat cone, so no footprint 
 
 from __future__ import annotations
 
+import datetime as dt
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -28,6 +29,8 @@ from monitor.core.errors import DataError
 from monitor.core.result import FLAG_TOP_HAT, AssessmentResult, GranuleInfo
 from monitor.core.vocabulary import Kernel
 from monitor.estimation.estimate import ForSamples, day_offsets
+from monitor.estimation.jackknife import follows_in_time, uncertainty_note
+from monitor.sdr.names import parse_name
 
 # key: (axes, what it is); axes name the dimensions in the file's order
 LAYOUT = {
@@ -184,13 +187,20 @@ def notes(granules: list[Collocation]) -> list[str]:
     ]
 
 
+def _start_s(path: Path) -> float:
+    """The start (s since the epoch) in a collocation file's name, the granule's SCRIF name with ``.npz``
+    appended; NaN for another name (then it follows no other granule)."""
+    name = parse_name(path.name.removesuffix(".npz"))
+    return name.start.replace(tzinfo=dt.timezone.utc).timestamp() if name else np.nan
+
+
 def assess_collocations(
     paths: Iterable[str | Path], cfg: AssessmentConfig, satellite: str = ""
 ) -> AssessmentResult:
     """The estimator's result for the collocation files *paths* (one granule each; all on one grid): per-FOR
     offsets in urad with jackknife sigmas, flags and the intercalibration; the km fields NaN. The files hold
     top-hat cone means: the top-hat kernel's floor of the sigmas applies."""
-    granules = [read_collocation(p) for p in paths]
+    granules = sorted((read_collocation(p) for p in paths), key=lambda g: (_start_s(g.path), g.path.name))
     if not granules:
         raise DataError("no collocation files given")
     first = granules[0]
@@ -201,7 +211,12 @@ def assess_collocations(
         ):
             raise ReplayError(g.path, "alpha", f"grid differs from {first.path.name}'s")
     cones = cfg.model_copy(update={"kernel": Kernel.TOP_HAT})
-    day = day_offsets([for_samples(granules, k) for k in range(N_FOR)], cones, first.step_rad / URAD)
+    day = day_offsets(
+        [for_samples(granules, k) for k in range(N_FOR)],
+        cones,
+        first.step_rad / URAD,
+        follows=follows_in_time([_start_s(g.path) for g in granules]),
+    )
     fors = day.fors
     if cfg.kernel != Kernel.TOP_HAT:  # the cone's estimate where the footprint is configured: said per FOR
         fors = [replace(f, flags=tuple(sorted({*f.flags, FLAG_TOP_HAT}))) for f in fors]
@@ -215,5 +230,5 @@ def assess_collocations(
         step_urad=first.step_rad / URAD,
         cost_cube_k=day.cost_cube_k,
         difference_bins=day.difference_bins,
-        notes=notes(granules),
+        notes=[*notes(granules), uncertainty_note(len(granules), day.correlation)],
     )

@@ -91,8 +91,9 @@ class AssessmentConfig(Section):
     )
     sigma_floor_urad: float | None = key(
         None,
-        "Added in quadrature to the jackknife's sigma: the estimator's own error (urad). None: the kernel's "
-        "calibrated floor (2 with footprint, 5 with top-hat).",
+        "Added in quadrature to the jackknife's sigma (urad), for an estimator error you know of. None: "
+        "nothing where the configured kernel was used; a cone's estimate where the footprint is configured "
+        "carries the day's cone-minus-footprint RMS.",
         0.0,
         1000.0,
     )

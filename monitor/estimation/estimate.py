@@ -64,7 +64,7 @@ from monitor.core.result import (
     ForOffset,
 )
 from monitor.core.vocabulary import Cost, Kernel
-from monitor.estimation import refine
+from monitor.estimation import jackknife, refine
 from monitor.estimation.intercal import (
     NO_FIT,
     Intercalibration,
@@ -144,6 +144,14 @@ class ForEstimate:
     footprint: Footprint | None = None
     rows: tuple[float, float] = (np.nan, np.nan)  # the rows ahead minus behind (steps), FOV_ROWS
     rows_sigma: tuple[float, float] = (np.nan, np.nan)
+    # the offsets' jackknife replicates (G, 2) and the granule each leaves out (G,), where the groups are
+    # granules: the day's correlation of consecutive granules is estimated from them (jackknife.py)
+    replicates: np.ndarray | None = None
+    granules: np.ndarray | None = None
+    cone: tuple[float, float] = (
+        np.nan,
+        np.nan,
+    )  # the top-hat cone's minimum (steps), where a response was fitted
 
 
 # the FOV rows (0-based FOV indices) whose offsets are told apart: those ahead and behind along-track
@@ -462,13 +470,17 @@ def estimate(
         else d[:, best.i0, best.j0]
     )
     jack = Jackknife.of(s.granule, s.scan) if uncertainty else None
+    replicates = None
     rows = rows_sigma = (np.nan, np.nan)
     sigma = (np.nan, np.nan)
     cal_boot = None
     fp = None
+    cone = (np.nan, np.nan)
     if weights is not None:
         widths = widths_of_weights(s.radii_rad, weights)
         fp = Footprint(s.radii_rad, weights, widths[0.5], widths[0.1])
+        top_hat = _minimum(s.d_k, s.cris_k, cost, contrast)
+        cone = (top_hat.x, top_hat.y)
     if s.fov is not None:  # the rows, the day's and its replicates', on the day's surface
         counts = np.ones((1, len(s))) if jack is None else np.vstack([np.ones(len(s)), jack.counts])
         found = _rows(d, s, cost, contrast, counts) + np.asarray(apart)
@@ -494,7 +506,8 @@ def estimate(
                 width_reps.append((wb[0.5], wb[0.1]))
             else:
                 width_reps.append((np.nan, np.nan))
-        sig = jack.sigma(np.array(reps))
+        replicates = np.array(reps)
+        sig = jack.sigma(replicates)
         sigma = (float(sig[0]), float(sig[1]))
         cal_boot = np.array(vs)
         if fp is not None:
@@ -506,44 +519,50 @@ def estimate(
     cal = intercalibrate(s.cris_k, d_opt + s.cris_k, spread, jack, cal_boot)
     return ForEstimate(
         best.x, best.y, sigma, best.flags, best.g, d_opt, best.refined, cal, fp,
-        rows, rows_sigma,
+        rows, rows_sigma, replicates, None if jack is None else jack.granules, cone,
     )  # fmt: skip
 
 
-# The floor of the sigmas by kernel (urad): what the estimator itself leaves beside the jackknife's scatter,
-# calibrated on simulated cases (benchmarks/acceptance.py prints the floor that gives 90 % coverage). The
-# top-hat cone's is the error a plain cone leaves on a top-hat truth; the footprint's was calibrated on the
-# 6-granule smooth-response cases of seeds 1-3 and checked on the others (docs/science.md).
-SIGMA_FLOOR_URAD = {Kernel.TOP_HAT: 5.0, Kernel.FOOTPRINT: 2.0}
-
-
-def floor_urad(cfg: AssessmentConfig, kernel: Kernel | None = None) -> float:
-    """The floor of the sigmas (urad), in quadrature with the jackknife's: ``sigma_floor_urad``, or that of
-    the *kernel* used (default the configured one; :data:`SIGMA_FLOOR_URAD`)."""
-    used = kernel or cfg.kernel
-    return SIGMA_FLOOR_URAD[used] if cfg.sigma_floor_urad is None else cfg.sigma_floor_urad
+def floor_urad(
+    cfg: AssessmentConfig, used: Kernel, cone_error_urad: tuple[float, float]
+) -> tuple[float, float]:
+    """What the estimator itself leaves beside the jackknife's scatter (urad, in-track and cross-track), added
+    in quadrature: ``sigma_floor_urad`` where configured; else nothing where the kernel *used* is the
+    configured one, and for a cone's estimate where the footprint is configured the day's own measure of
+    the cone's error, *cone_error_urad* (the RMS of cone minus footprint over the FORs that fitted a
+    response; 0 where none did)."""
+    if cfg.sigma_floor_urad is not None:
+        return cfg.sigma_floor_urad, cfg.sigma_floor_urad
+    return (0.0, 0.0) if used == cfg.kernel else cone_error_urad
 
 
 @dataclass(frozen=True)
 class DayEstimate:
-    """The 30 FORs' offsets of a day, their cost surfaces (30, m, m; NaN where none) and the CrIS - VIIRS
-    difference in BT bins pooled over the FORs refined (the paper's Figure 15)."""
+    """The 30 FORs' offsets of a day, their cost surfaces (30, m, m; NaN where none), the CrIS - VIIRS
+    difference in BT bins pooled over the FORs refined (the paper's Figure 15) and the correlation of
+    consecutive granules the sigmas count."""
 
     fors: list[ForOffset]
     cost_cube_k: np.ndarray
     difference_bins: list[DifferenceBin]
+    correlation: float = 0.0  # of consecutive granules' replicates (jackknife.adjacent_correlation)
 
 
 KmOf = Callable[[int, float, float], tuple[float, float, np.ndarray]]
 
 
 def day_offsets(
-    per_for: list[ForSamples], cfg: AssessmentConfig, step_urad: float, km: KmOf | None = None
+    per_for: list[ForSamples],
+    cfg: AssessmentConfig,
+    step_urad: float,
+    km: KmOf | None = None,
+    follows: np.ndarray | None = None,
 ) -> DayEstimate:
     """Every FOR's estimate as a :class:`~monitor.core.result.ForOffset`: angles in urad with the jackknife
-    sigma and the floor ``floor_urad(cfg)`` in quadrature (what the estimator itself leaves), flags,
-    the intercalibration; in km where *km* (FOR index 0-based, turn in rad) gives the mean in-track and
-    cross-track km of a turn and its Jacobian (km/rad), NaN without."""
+    sigma (granules that directly follow one another, *follows* (granules,) bool, counted as fewer by the
+    day's correlation of their replicates: :mod:`monitor.estimation.jackknife`) and ``floor_urad`` in
+    quadrature, flags, the intercalibration; in km where *km* (FOR index 0-based, turn in rad) gives the
+    mean in-track and cross-track km of a turn and its Jacobian (km/rad), NaN without."""
     m = per_for[0].d_k.shape[1]
     cube = np.full((len(per_for), m, m), np.nan)
     reach = reach_steps(step_urad * URAD)
@@ -558,6 +577,21 @@ def day_offsets(
                 per_for,
             )
         )
+    series = [
+        (e.granules, e.replicates)
+        for e in estimates
+        if e is not None and e.granules is not None and e.replicates is not None
+    ]
+    rho = jackknife.adjacent_correlation(series, follows) if follows is not None else 0.0
+    cone = np.array([(e.cone[0] - e.x, e.cone[1] - e.y) for e in estimates if e is not None and e.footprint])
+    cone_error_urad = (
+        (
+            float(np.sqrt(np.mean(cone[:, 0] ** 2))) * step_urad,
+            float(np.sqrt(np.mean(cone[:, 1] ** 2))) * step_urad,
+        )
+        if len(cone)
+        else (0.0, 0.0)
+    )
     fors = []
     pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
     for k, s in enumerate(per_for):
@@ -576,8 +610,18 @@ def day_offsets(
                     w / URAD
                     for w in (fp.width_50_rad, fp.sigma_width_50_rad, fp.width_10_rad, fp.sigma_width_10_rad)
                 ]
-            g, x, y, (sig_a, sig_b), cal = best.cost, best.x, best.y, best.sigma, best.intercalibration
-            rows = [*best.rows, *best.rows_sigma]
+            # every sigma of the FOR from the same replicates: the same count of independent granules
+            factor = 1.0 if best.granules is None else jackknife.correlation_factor(len(best.granules), rho)
+            g, x, y, cal = best.cost, best.x, best.y, best.intercalibration
+            sig_a, sig_b = (factor * v for v in best.sigma)
+            widths[1], widths[3] = factor * widths[1], factor * widths[3]
+            cal = replace(
+                cal,
+                sigma_bias_k=factor * cal.sigma_bias_k,
+                sigma_gain_pct=factor * cal.sigma_gain_pct,
+                sigma_curvature_k=factor * cal.sigma_curvature_k,
+            )
+            rows = [*best.rows, *(factor * v for v in best.rows_sigma)]
             if cal.gain_undetermined:
                 flags.append(FLAG_GAIN_UNDETERMINED)
             cube[k] = g
@@ -589,9 +633,9 @@ def day_offsets(
             used = Kernel.FOOTPRINT if best.footprint is not None else Kernel.TOP_HAT
             if used != cfg.kernel:
                 flags.append(FLAG_TOP_HAT)
-            floor = floor_urad(cfg, used)
-            sig_a = float(np.hypot(sig_a * step_urad, floor))
-            sig_b = float(np.hypot(sig_b * step_urad, floor))
+            floor = floor_urad(cfg, used, cone_error_urad)
+            sig_a = float(np.hypot(sig_a * step_urad, floor[0]))
+            sig_b = float(np.hypot(sig_b * step_urad, floor[1]))
             if max(sig_a, sig_b) > cfg.max_sigma_urad:
                 flags.append(FLAG_UNCERTAIN)
         d_alpha, d_beta = x * step_urad, y * step_urad
@@ -629,4 +673,4 @@ def day_offsets(
             )
         )
     bins = difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True))) if pooled else []
-    return DayEstimate(fors, cube, bins)
+    return DayEstimate(fors, cube, bins, rho)

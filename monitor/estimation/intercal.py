@@ -38,8 +38,8 @@ simulated days kappa comes out near 0.01 (the optimum is good to a few urad, so 
 hundredth of what the reach would); a cloud edge of s_n = 3 K then weighs as a uniform scene at 0.03 K.
 
 **A gain only where the scenes determine it.** A day of warm ocean alone (uniform scenes within a few K)
-determines a bias but not a gain. The gain (and curvature) are stated where the sigma of the gain (the jackknife's,
-else the fit's) is at most ``GAIN_RESOLUTION_PCT`` (the 0.1 % to which the product claims to
+determines a bias but not a gain. The gain (and curvature) are stated where the sigma of the gain (the
+jackknife's, else the fit's) is at most ``GAIN_RESOLUTION_PCT`` (the 0.1 % to which the product claims to
 recover a gain); elsewhere only the bias is fitted (g = c = 0: the mean difference of the weighted scenes,
 stated at T_ref on the assumption of no gain) and the gain is NaN, flagged ``gain_undetermined`` by the
 estimator. :func:`difference_bins` (the paper's Figure 15: C - V against C in 10 K bins, every scene) shows

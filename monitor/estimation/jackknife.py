@@ -1,56 +1,154 @@
-"""The uncertainty of a day's estimates: the delete-one-granule jackknife.
+"""The uncertainty of a day's estimates, derived: the delete-one-granule jackknife, the t's quantile for few
+granules, and the granules counted as fewer when consecutive ones share their scenes.
 
-The error of an offset varies from scene to scene: on real radiances two halves of the same day's granules
-disagree by far more than resampling scans within granules allows (``docs/science.md``, "Honest sigmas").
-So the unit of resampling is the granule: replicate g leaves granule g out, and with G granules and
-estimates t_g the variance is (Tukey; Efron and Stein 1981)
+**The unit.** The error of an offset varies from scene to scene: on real radiances two halves of a day's
+granules disagree by far more than resampling scans within granules allows (``docs/science.md``). So the unit
+of resampling is the granule: replicate g leaves granule g out, and with G granules and estimates t_g the
+standard error is (Tukey; Efron and Stein 1981)
 
-    var = (G - 1) / G * sum_g (t_g - mean t)^2 = (G - 1) * var_0(t_g),
+    se^2 = (G - 1) / G * sum_g (t_g - mean t)^2 = (G - 1) * var_0(t_g),
 
-which is unbiased for a mean and conservative (too large in expectation) for a smooth statistic: the
-scene-to-scene part enters by construction, with no factor fitted to data. A granule bootstrap would need
-hundreds of replicates to say as much with as few granules as a day brings (6-14); the jackknife needs G.
+unbiased for a mean and conservative for a smooth statistic. A granule bootstrap would need hundreds of
+replicates to say as much with the 6-14 granules a day brings; the jackknife needs G.
 
-**Few granules.** With G groups that variance is itself estimated with nu = G - 1 degrees of freedom, so an
-error divided by it is Student-t distributed, whose variance is nu / (nu - 2), not 1: with 5 granules, twice
-what a normal error would have (errors beyond two such sigmas: ~12 % instead of 5 %). The sigma reported is
-the t's standard deviation, sqrt(var nu / (nu - 2)), so that error / sigma has unit variance whatever G is:
-a factor of 1.41 with 5 granules, 1.13 with 10, 1.09 with 14, derived from G alone.
+**Few granules.** se is itself estimated with nu = G - 1 degrees of freedom, so error / se is Student-t
+distributed, not normal. The sigma reported is the one whose two-sigma interval has the normal's coverage
+(95.45 %, what a reader of "within 2 sigma" expects):
 
-With fewer than :data:`MIN_GRANULES` granules the scene-to-scene part cannot be told from so few, and the
-scans are the groups instead (what they say is then the scatter within the granule(s)); fewer than
-:data:`MIN_GRANULES` groups give no sigma.
+    sigma = se * t_nu(Phi(2)) / 2,
+
+a factor of 1.33 with 6 granules, 1.12 with 14 (the t quantile, not its standard deviation: the quantile is
+finite for every nu >= 1 and is what the 2-sigma statements of the product test).
+
+**Consecutive granules.** Granules a minute apart share cloud systems, so their estimates are not
+independent, and G overstates the information. With a lag-one correlation rho between the replicates of
+granules that follow each other, the variance of a mean of G is that of G_eff = G (1 - rho) / (1 + rho)
+independent ones (the AR(1) effective sample size), and nu = G_eff - 1. rho is a property of the day's scenes,
+not of one FOR, so it is estimated once per day, pooled over every FOR and direction
+(:func:`adjacent_correlation`), corrected for the bias of a lag-one correlation of G values about their mean
+(-1 / G where the values are independent), and counted only where it exceeds twice its standard error over
+the day's pairs of consecutive granules (the FORs share their granules' scenes, so the pairs are the
+independent units; a day of five granules has at most four, and a correlation read from them alone would
+make its sigmas noisier than the ones it corrects). Granules spread over the day (the daily
+run's) have no neighbours, so rho = 0 and G_eff = G. :func:`correlation_factor` is what rho does to a sigma.
+
+No constant is fitted to data: G, rho and the t distribution make the factor.
+
+With fewer than :data:`MIN_GRANULES` granules the scans are the groups instead (what they say is then the
+scatter within the granule(s), and rho is not applied); fewer groups than that give no sigma.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 
-MIN_GRANULES = 4  # groups from which a sigma is stated (nu = 3, nu / (nu - 2) = 3); granules from this many
+from monitor.core.constants import CRIS_GRANULE_US
+
+MIN_GRANULES = 4  # groups from which a sigma is stated; granules as groups from this many
+TWO_SIGMA = float(stats.norm.cdf(2.0))  # the normal's one-sided probability within 2 sigma
+MAX_CORRELATION = 0.95  # rho is held below this: above it a day has less than one granule's worth
+
+
+def t_factor(nu: float) -> float:
+    """The factor from a standard error with *nu* degrees of freedom to the sigma whose 2-sigma interval
+    covers as a normal's (module docstring); NaN for nu < 1."""
+    return float(stats.t.ppf(TWO_SIGMA, nu) / 2.0) if nu >= 1 else math.nan
+
+
+def effective_groups(groups: int, rho: float) -> float:
+    """G_eff of *groups* granules whose neighbours correlate by *rho* (module docstring)."""
+    return groups * (1.0 - rho) / (1.0 + rho)
+
+
+def correlation_factor(groups: int, rho: float) -> float:
+    """What a lag-one correlation *rho* of consecutive granules does to a sigma from *groups* granules:
+    sqrt(G / G_eff) t(G_eff - 1) / t(G - 1); NaN where G_eff - 1 < 1."""
+    if rho <= 0:
+        return 1.0
+    g_eff = effective_groups(groups, rho)
+    return math.sqrt(groups / g_eff) * t_factor(g_eff - 1.0) / t_factor(groups - 1.0)
+
+
+def follows_in_time(starts_s: Sequence[float]) -> np.ndarray:
+    """Per granule (in the order given, start times *starts_s* in seconds), whether it directly follows the
+    one before: it starts at most 1.5 CrIS granules after it (consecutive granules start 32 s apart)."""
+    s = np.asarray(starts_s, float)
+    gap = np.diff(s, prepend=np.nan)
+    return (gap > 0) & (gap <= 1.5 * CRIS_GRANULE_US * 1e-6)
+
+
+def adjacent_correlation(replicates: Sequence[tuple[np.ndarray, np.ndarray]], follows: np.ndarray) -> float:
+    """The day's lag-one correlation of the replicates of consecutive granules (module docstring): each
+    series in *replicates* (pairs of the granule of each replicate (G,) and the replicates (G, k), one
+    column a series) on its own scale; per pair of granules of which the second directly follows the first
+    (*follows* (granules,)), the mean product over the series; rho their mean, corrected for the -1 / G
+    bias. The series of one day share their granules' scenes, so the pairs of granules, not the products,
+    are the independent units: rho counts only where it exceeds twice its standard error over the pairs
+    (0 otherwise, and where no granule follows another)."""
+    products: dict[int, list[float]] = {}
+    lengths = []
+    for granules, reps in replicates:
+        r = np.asarray(reps, float)
+        ok = np.all(np.isfinite(r), axis=1)
+        granules, r = np.asarray(granules)[ok], r[ok]
+        if len(granules) < MIN_GRANULES:
+            continue
+        r = r - r.mean(axis=0)
+        scale = np.sqrt(np.mean(r * r, axis=0))
+        r = np.divide(r, scale, out=np.zeros_like(r), where=scale > 0)
+        adjacent = np.flatnonzero((np.diff(granules) == 1) & follows[granules[1:]])
+        for i in adjacent:
+            products.setdefault(int(granules[i + 1]), []).extend(r[i] * r[i + 1])
+        lengths.append(len(granules))
+    pairs = np.array([np.mean(v) for v in products.values()])
+    if len(pairs) < 2:
+        return 0.0
+    rho = float(pairs.mean()) + 1.0 / float(np.mean(lengths))
+    se = float(pairs.std(ddof=1)) / np.sqrt(len(pairs))
+    return float(min(rho, MAX_CORRELATION)) if rho > 2 * se else 0.0
+
+
+def uncertainty_note(granules: int, rho: float) -> str:
+    """What a result says of how its sigmas count its *granules*, consecutive ones correlated by *rho*."""
+    if granules < MIN_GRANULES:
+        return (
+            f"sigmas: {granules} granule(s), the scans within them resampled (the scene-to-scene part unseen)"
+        )
+    return (
+        f"sigmas: delete-one-granule jackknife over {granules} granules, t quantile for the 2-sigma level; "
+        f"consecutive granules correlate by {rho:.2f}: counted as {effective_groups(granules, rho):.1f}"
+    )
 
 
 @dataclass(frozen=True)
 class Jackknife:
     """Delete-one-group replicates over N samples: *counts* (G, N) weighs each sample 1 in each replicate
-    but the one leaving its group out (0)."""
+    but the one leaving its group out (0); *granules* (G,) the granule each group leaves out, where the
+    groups are granules (None where they are scans)."""
 
     counts: np.ndarray
+    granules: np.ndarray | None = None
 
     @classmethod
     def of(cls, granule: np.ndarray, scan: np.ndarray) -> Jackknife | None:
         """The replicates of samples from granules *granule* (N,) and scans *scan* (N,) within them: one per
         granule from :data:`MIN_GRANULES` granules, else one per scan; None from fewer groups than that."""
         granule, scan = np.asarray(granule), np.asarray(scan)
-        if len(np.unique(granule)) >= MIN_GRANULES:
+        by_granule = len(np.unique(granule)) >= MIN_GRANULES
+        if by_granule:
             groups = granule
         else:
             groups = np.unique(np.stack([granule, scan], 1), axis=0, return_inverse=True)[1].reshape(-1)
         ids, member = np.unique(groups, return_inverse=True)
         if len(ids) < MIN_GRANULES:
             return None
-        return cls((member[None, :] != np.arange(len(ids))[:, None]).astype(float))
+        counts = (member[None, :] != np.arange(len(ids))[:, None]).astype(float)
+        return cls(counts, ids if by_granule else None)
 
     @property
     def groups(self) -> int:
@@ -58,12 +156,12 @@ class Jackknife:
         return len(self.counts)
 
     def sigma(self, replicates: np.ndarray) -> np.ndarray:
-        """The uncertainty of the statistic whose G *replicates* are along axis 0: the jackknife variance
-        times nu / (nu - 2), nu = G - 1 (module docstring); NaN replicates are left out, G counting those
-        that remain (NaN below MIN_GRANULES)."""
+        """The sigma of the statistic whose G *replicates* are along axis 0, its groups independent: the
+        jackknife's standard error times t_factor(G - 1) (module docstring); NaN replicates are left out, G
+        counting those that remain (NaN below MIN_GRANULES)."""
         t = np.asarray(replicates, float)
         g = np.sum(np.isfinite(t), axis=0)
-        nu = g - 1.0
+        factor = np.vectorize(t_factor, otypes=[float])(g - 1.0)
         with np.errstate(invalid="ignore", divide="ignore"):
-            var = (g - 1) * np.nanvar(t, axis=0) * nu / (nu - 2)
-            return np.where(g >= MIN_GRANULES, np.sqrt(var), np.nan)
+            se = np.sqrt((g - 1) * np.nanvar(t, axis=0))
+            return np.where(g >= MIN_GRANULES, se * factor, np.nan)

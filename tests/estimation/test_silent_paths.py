@@ -1,13 +1,14 @@
 """Nothing silent: each way the estimate departs from the configured one is flagged, in the result, with
-the floor of the kernel actually used (each path forced here on synthetic samples)."""
+the error of the kernel actually used (each path forced here on synthetic samples)."""
 
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import FLAG_FLAT, FLAG_TOP_HAT, FLAG_UNCONVERGED
-from monitor.core.vocabulary import Cost, Kernel
+from monitor.core.vocabulary import Cost
 from monitor.estimation import estimate as est
 from monitor.instrument import footprint
 from tests.estimation.test_estimate import STEP_RAD, _samples
@@ -15,16 +16,25 @@ from tests.estimation.test_estimate import STEP_RAD, _samples
 STEP_URAD = STEP_RAD * 1e6
 
 
-def test_too_few_fovs_for_the_footprint_is_the_cones_estimate_flagged_with_the_cones_floor():
-    few = _samples(footprint.super_gaussian(), n=36)  # below MIN_FOOTPRINT_SAMPLES
+def test_too_few_fovs_for_the_footprint_is_the_cones_estimate_flagged_with_the_cones_error():
+    """A FOR below MIN_FOOTPRINT_SAMPLES takes the cone's estimate, flagged, its sigma carrying the day's
+    own measure of the cone's error: how far the cone's minimum lies from the footprint's at the FORs that
+    fitted a response (here one)."""
+    few = _samples(footprint.super_gaussian(), n=36)
     assert len(few) < est.MIN_FOOTPRINT_SAMPLES
-    cfg = AssessmentConfig(min_samples=10)
-    (f,) = est.day_offsets([few], cfg, STEP_URAD).fors
-    assert FLAG_TOP_HAT in f.flags and f.reliable  # said, and still usable
-    assert min(f.sigma_alpha_urad, f.sigma_beta_urad) >= est.SIGMA_FLOOR_URAD[Kernel.TOP_HAT]
     enough = _samples(footprint.super_gaussian(), n=160)
-    (g,) = est.day_offsets([enough], cfg, STEP_URAD).fors
-    assert FLAG_TOP_HAT not in g.flags and np.isfinite(g.response_width_50_urad)
+    cfg = AssessmentConfig(min_samples=10)
+    alone, fitted = est.day_offsets([few, enough], cfg, STEP_URAD).fors
+    assert FLAG_TOP_HAT in alone.flags and alone.reliable  # said, and still usable
+    assert FLAG_TOP_HAT not in fitted.flags and np.isfinite(fitted.response_width_50_urad)
+    day = est.estimate(enough, Cost.REGRESSION)
+    cone_error = np.abs(np.subtract(day.cone, (day.x, day.y))) * STEP_URAD
+    assert cone_error.max() > 1.0  # the smooth truth moves the cone's minimum
+    assert alone.sigma_alpha_urad >= cone_error[0] and alone.sigma_beta_urad >= cone_error[1]
+    # a day without a fitted response has no measure of it: the jackknife's sigma alone
+    (bare,) = est.day_offsets([few], cfg, STEP_URAD).fors
+    jack = est.estimate(few, Cost.REGRESSION).sigma
+    assert bare.sigma_alpha_urad == pytest.approx(jack[0] * STEP_URAD)
 
 
 def test_a_replicate_fits_the_footprint_whenever_the_day_does():
