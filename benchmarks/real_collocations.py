@@ -6,9 +6,9 @@ Prints
 - the honesty of the sigmas: over random splits of the granules into halves, the share of FOR-directions
   whose halves differ by more than 2 combined sigmas (honest: ~5 %, and up to ~12 % with so few granules
   per half: the sigmas themselves are estimated from 5) and the rms of the normalised difference (honest: 1);
-- the intercalibration at the optimum, pooled over all FORs: on every sample, and on the samples whose cone
-  mean varies by less than a threshold over +-3 turn steps about the optimum (uniform scenes, where the
-  collocation cannot matter; GSICS practice), with the 5-95 % range of their BT.
+- the intercalibration: the product's per FOR (on the scenes the collocation cannot move), against least
+  squares over every sample pooled (what reads the collocation as calibration);
+- what N consecutive real granules resolve: the median per-FOR sigma for N = 4..10.
 
     .venv/bin/python -m benchmarks.real_collocations [--splits 20] [--seed 42]
 """
@@ -22,14 +22,11 @@ import numpy as np
 
 from monitor.assessment.replay import assess_collocations, for_samples, read_collocation
 from monitor.config.assessment import AssessmentConfig
-from monitor.core.constants import N_FOR
+from monitor.core.constants import CALIBRATION_REFERENCE_K, N_FOR
 from monitor.core.vocabulary import Kernel
-from monitor.estimation import refine
 from monitor.estimation.estimate import estimate
-from monitor.estimation.intercal import fit_difference
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data" / "real" / "collocations_j01_20181022"
-UNIFORM_K = (1.0, 0.5, 0.3)  # spread of the cone mean over +-3 turn steps (K) below which a scene is uniform
 
 
 def splits(files, cfg, n: int, seed: int) -> np.ndarray:
@@ -49,27 +46,46 @@ def splits(files, cfg, n: int, seed: int) -> np.ndarray:
     return np.array(z)
 
 
-def uniform_intercalibration(files, cfg) -> list[str]:
-    """The pooled intercalibration on every sample and on the uniform ones."""
+def intercalibration(day, files, cfg) -> list[str]:
+    """The product's intercalibration (monitor/estimation/intercal.py) against an ordinary least-squares
+    fit of C - V on V over every sample at each FOR's optimum, pooled (what the product did until
+    2026-11-26)."""
     granules = [read_collocation(f) for f in files]
-    c, v, spread = [], [], []
+    c, v = [], []
     for k in range(N_FOR):
         s = for_samples(granules, k)
         e = estimate(s, cfg.cost, cfg.flat_contrast, uncertainty=False)
-        i0, j0 = e.cost.shape[0] // 2 + round(e.x), e.cost.shape[1] // 2 + round(e.y)
-        h = refine.HALF
-        win = s.d_k[:, max(i0 - h, 0) : i0 + h + 1, max(j0 - h, 0) : j0 + h + 1] + s.cris_k[:, None, None]
         c.append(s.cris_k)
         v.append(e.d_opt + s.cris_k)
-        spread.append(win.max(axis=(1, 2)) - win.min(axis=(1, 2)))
-    c, v, spread = (np.concatenate(x) for x in (c, v, spread))
-    out = [f"{'samples':<24} {'share':>6} {'bias K':>7} {'gain %':>7} {'curv K':>7}  BT 5-95 %"]
-    for name, sel in [("all", np.ones(c.size, bool))] + [
-        (f"cone mean spread < {t:g} K", spread < t) for t in UNIFORM_K
-    ]:
-        b, g, cv = fit_difference(c[sel], v[sel])
-        lo, hi = np.percentile(v[sel], [5, 95])
-        out.append(f"{name:<24} {sel.mean():6.2f} {b:+7.3f} {100 * g:+7.2f} {cv:+7.3f}  {lo:.1f}-{hi:.1f} K")
+    c, v = np.concatenate(c), np.concatenate(v)
+    gain, bias = np.polyfit(v - CALIBRATION_REFERENCE_K, c - v, 1)
+    bias_k = np.array([f.bias_k for f in day.fors])
+    determined = [f for f in day.fors if np.isfinite(f.gain_pct)]
+    return [
+        f"least squares on every sample, pooled: gain {100 * gain:+.2f} %, bias {bias:+.3f} K at 280 K",
+        f"the product: gain determined at {len(determined)}/{len(day.fors)} FORs"
+        + (f" (median {np.median([f.gain_pct for f in determined]):+.2f} %)" if determined else "")
+        + f", bias median {np.nanmedian(bias_k):+.3f} K"
+        + f" (FORs {np.nanmin(bias_k):+.3f}..{np.nanmax(bias_k):+.3f}),"
+        f" median sigma {np.nanmedian([f.sigma_bias_k for f in day.fors]):.3f} K",
+    ]
+
+
+def resolution(files, cfg) -> list[str]:
+    """What N consecutive real granules resolve: the median per-FOR sigma over every window of N."""
+    out = [f"{'granules':>8} {'windows':>7} {'sigma in-track':>15} {'sigma cross-track':>18}  (urad, median)"]
+    for n in range(4, len(files) + 1):
+        sig = []
+        for start in range(len(files) - n + 1):
+            fors = assess_collocations(files[start : start + n], cfg).fors
+            sig.append(
+                [
+                    np.nanmedian([f.sigma_alpha_urad for f in fors]),
+                    np.nanmedian([f.sigma_beta_urad for f in fors]),
+                ]
+            )
+        s = np.median(sig, axis=0)
+        out.append(f"{n:>8} {len(sig):>7} {s[0]:15.0f} {s[1]:18.0f}")
     return out
 
 
@@ -95,7 +111,8 @@ def main() -> int:
         f"{100 * np.mean(np.abs(ok) > 2):.1f} % beyond 2 combined sigmas, rms normalised difference "
         f"{np.sqrt(np.mean(ok**2)):.2f}"
     )
-    print("\n".join(uniform_intercalibration(files, cfg)))
+    print("\n".join(intercalibration(day, files, cfg)))
+    print("\n".join(resolution(files, cfg)))
     return 0
 
 
