@@ -110,6 +110,7 @@ class RunOutcome:
         parts.append(
             f"granules listed {c.listed}, selected {c.selected}, assessed {c.assessed}; {c.downloaded} files "
             f"whole, {c.bytes / 1e6:.0f} MB downloaded in {c.requests} requests"
+            + (f" ({c.bytes / 1e6 / c.assessed:.0f} MB per assessed granule)" if c.assessed else "")
         )
         if self.result is not None:
             ok = [f for f in self.result.fors if f.reliable]
