@@ -112,7 +112,8 @@ def main() -> int:
     print(
         f"split halves ({args.splits} splits, {ok.size} FOR-directions): "
         f"{100 * np.mean(np.abs(ok) > 2):.1f} % beyond 2 combined sigmas, rms normalised difference "
-        f"{np.sqrt(np.mean(ok**2)):.2f}; the halves' median biases at most {np.max(np.abs(apart_k)):.3f} K apart"
+        f"{np.sqrt(np.mean(ok**2)):.2f}; the halves' median biases at most "
+        f"{np.max(np.abs(apart_k)):.3f} K apart"
     )
     print("\n".join(intercalibration(day, files, cfg)))
     print("\n".join(resolution(files, cfg)))
