@@ -1,0 +1,140 @@
+"""What a perfect parallax correction would give: the clouds-with-height case assessed with each VIIRS pixel
+lifted to the true height of what it sees, against the day's learnt lift.
+
+The learnt correction (``monitor/collocation/parallax.py``) lifts a pixel by kappa times how much colder it is
+than its clear-sky neighbourhood; on clouds with height the FOR offsets still miss the accuracy bounds
+(docs/science.md). This bench asks whether better heights could close the gap, or whether something no
+height removes is left (the sides of clouds hiding what behind them one instrument sees and the other does
+not; a CrIS cone meeting a 3-D scene the collocation treats as a lifted sheet). It simulates the case once,
+recording for every VIIRS pixel row the height above the ground of the first cloud or terrain its ray meets
+(the simulator's own intersection), then assesses it twice with the same default configuration: as
+shipped, and with the probe collocation lifting every pixel by its true height and the day's fraction held
+at 1 (the oracle). Flat ground only (the true lift is then the hit's height).
+
+    .venv/bin/python -m benchmarks.parallax_oracle [--clouds lapse:6.5] [--seed 11] [--granules 6]
+
+Prints RMS and worst FOR per direction for both, with the bounds (6 granules: RMS <= 12, worst <= 30 urad).
+A test-only hook: the simulator and the collocation are patched in this process; nothing ships.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.provenance import commit, emit
+from monitor.assessment.assess import assess_paths
+from monitor.collocation import parallax
+from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import VIIRS_COLUMNS
+from monitor.estimation import parallax as day_parallax
+from monitor.simulate import case as sim
+from monitor.simulate.case import simulate_case
+
+TRUTH: dict[tuple[float, float], np.ndarray] = {}  # row key (lat, lon of column 0, float32 deg) -> lift (m)
+
+
+def _key(lat_deg: np.ndarray, lon_deg: np.ndarray) -> list[tuple[float, float]]:
+    """Row keys of (rows, cols) float32 degrees: the first column's position identifies a pixel row."""
+    return list(zip(lat_deg[:, 0].tolist(), lon_deg[:, 0].tolist(), strict=True))
+
+
+def _recording(self, origin, los):
+    """The simulator's ``_seen`` (its body, for clouds with height), also recording per pixel row the
+    geodetic height of what the rays meet: on flat ground, the lift a perfect correction would apply."""
+    lat, lon, _ = self._surface(origin, los)
+    _, s_lat, s_lon, s_h = self.scene.intersect(origin, los)
+    rows_lat = np.degrees(lat).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
+    rows_lon = np.degrees(lon).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
+    lift = np.nan_to_num(s_h, nan=0.0).reshape(-1, VIIRS_COLUMNS)
+    for key, row in zip(_key(rows_lat, rows_lon), lift, strict=True):
+        TRUTH[key] = row.astype(np.float32)
+    return s_lat, s_lon, self.scene.height_m(s_lat, s_lon)
+
+
+def _true_lift(lifted):
+    """``parallax.lifted`` with each row's lift replaced by the recorded truth (0 where none)."""
+
+    def wrapped(lat_rad, lon_rad, height_m, lift, sat_m, velocity_m_s):
+        lat = np.degrees(np.asarray(lat_rad, np.float64)).astype(np.float32)
+        lon = np.degrees(np.asarray(lon_rad, np.float64)).astype(np.float32)
+        truth = np.zeros(np.shape(lift), np.float32)
+        found = 0
+        for i, key in enumerate(_key(lat, lon)):
+            row = TRUTH.get(key)
+            if row is not None:
+                truth[i] = row
+                found += 1
+        wrapped.rows += found
+        wrapped.total += len(truth)
+        return lifted(lat_rad, lon_rad, height_m, truth, sat_m, velocity_m_s)
+
+    wrapped.rows = wrapped.total = 0
+    return wrapped
+
+
+def _scores(result, truth) -> dict:
+    ta = np.array([f["d_alpha_urad"] for f in truth["fors"]])
+    tb = np.array([f["d_beta_urad"] for f in truth["fors"]])
+    ea = np.array([f.d_alpha_urad for f in result.fors]) - ta
+    eb = np.array([f.d_beta_urad for f in result.fors]) - tb
+    sa = np.array([f.sigma_alpha_urad for f in result.fors])
+    sb = np.array([f.sigma_beta_urad for f in result.fors])
+    return {
+        "rms_urad": [float(np.sqrt(np.nanmean(ea**2))), float(np.sqrt(np.nanmean(eb**2)))],
+        "worst_urad": [float(np.nanmax(np.abs(ea))), float(np.nanmax(np.abs(eb)))],
+        "within_2_sigma": float(np.mean(np.r_[np.abs(ea) <= 2 * sa, np.abs(eb) <= 2 * sb])),
+        "err_alpha_urad": ea.tolist(),
+        "err_beta_urad": eb.tolist(),
+    }
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--clouds", default="lapse:6.5")
+    p.add_argument("--seed", type=int, default=11)
+    p.add_argument("--granules", type=int, default=6)
+    p.add_argument("--rows", help="append the JSON line here")
+    args = p.parse_args()
+    root = Path(tempfile.mkdtemp(prefix="crisgeo-oracle-"))
+    sim.Simulator._seen = _recording
+    t0 = time.perf_counter()
+    truth = simulate_case(
+        root, granules=args.granules, profile="paper", seed=args.seed, cloud_heights=args.clouds,
+        cris_response=None,
+    )  # fmt: skip
+    print(
+        f"simulated in {time.perf_counter() - t0:.0f} s; {len(TRUTH)} VIIRS pixel rows recorded", flush=True
+    )
+    cfg = AssessmentConfig()
+    shipped = _scores(assess_paths([root], cfg), truth)
+    parallax.lifted = _true_lift(parallax.lifted)
+    day_parallax.day_lift = lambda s0, s1, cost: (1.0, float("nan"))
+    oracle = _scores(assess_paths([root], cfg), truth)
+    print(f"oracle rows matched {parallax.lifted.rows}/{parallax.lifted.total}")
+    for name, s in (("shipped", shipped), ("true heights", oracle)):
+        print(
+            f"{name:<13} RMS {s['rms_urad'][0]:5.1f} / {s['rms_urad'][1]:5.1f} urad, worst "
+            f"{s['worst_urad'][0]:5.1f} / {s['worst_urad'][1]:5.1f}, "
+            f"within 2 sigma {100 * s['within_2_sigma']:.0f} %"
+        )
+    emit(
+        {
+            "commit": commit(),
+            "clouds": args.clouds,
+            "seed": args.seed,
+            "granules": args.granules,
+            "shipped": shipped,
+            "oracle": oracle,
+        },
+        args.rows,
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
