@@ -46,8 +46,10 @@ def _key(lat_deg: np.ndarray, lon_deg: np.ndarray) -> list[tuple[float, float]]:
 def _recording(self, origin, los):
     """The simulator's ``_seen`` (its body, for clouds with height), also recording per pixel row the
     geodetic height of what the rays meet: on flat ground, the lift a perfect correction would apply."""
-    lat, lon, _ = self._surface(origin, los)
     _, s_lat, s_lon, s_h = self.scene.intersect(origin, los)
+    if los.shape[-2] != VIIRS_COLUMNS:  # CrIS's rays: not recorded
+        return s_lat, s_lon, self.scene.height_m(s_lat, s_lon)
+    lat, lon, _ = self._surface(origin, los)
     rows_lat = np.degrees(lat).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     rows_lon = np.degrees(lon).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     lift = np.nan_to_num(s_h, nan=0.0).reshape(-1, VIIRS_COLUMNS)
