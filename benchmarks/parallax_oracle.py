@@ -35,12 +35,16 @@ from monitor.estimation import parallax as day_parallax
 from monitor.simulate import case as sim
 from monitor.simulate.case import simulate_case
 
-TRUTH: dict[tuple[float, float], np.ndarray] = {}  # row key (lat, lon of column 0, float32 deg) -> lift (m)
+TRUTH: dict[tuple[float, float], np.ndarray] = {}  # row key (:func:`_key`) -> lift (m) of each pixel
 
 
 def _key(lat_deg: np.ndarray, lon_deg: np.ndarray) -> list[tuple[float, float]]:
-    """Row keys of (rows, cols) float32 degrees: the first column's position identifies a pixel row."""
-    return list(zip(lat_deg[:, 0].tolist(), lon_deg[:, 0].tolist(), strict=True))
+    """Row keys of (rows, cols) degrees: the middle column's position to 1e-4 deg (~10 m; GEO's float32
+    degrees come back through radians) identifies a pixel row."""
+    mid = lat_deg.shape[1] // 2
+    lat = np.round(np.asarray(lat_deg[:, mid], np.float64), 4)
+    lon = np.round(np.asarray(lon_deg[:, mid], np.float64), 4)
+    return list(zip(lat.tolist(), lon.tolist(), strict=True))
 
 
 def _recording(self, origin, los):
