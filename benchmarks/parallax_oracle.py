@@ -75,6 +75,8 @@ def _true_lift(lifted):
             if row is not None:
                 truth[i] = row
                 found += 1
+        # only where GEO has a position (the deleted bow-tie pixels and fill rows have none)
+        truth = np.where(np.isfinite(lat) & np.isfinite(lon) & (np.abs(lat) <= 90.0), truth, 0.0)
         wrapped.rows += found
         wrapped.total += len(truth)
         return lifted(lat_rad, lon_rad, height_m, truth, sat_m, velocity_m_s)
