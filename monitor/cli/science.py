@@ -29,7 +29,7 @@ from monitor.simulate import LAYOUTS
 from monitor.simulate.orbit import PASSES
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    from monitor.instrument.footprint import RadialResponse
+    from monitor.instrument.footprint import Response
 
 
 @command(
@@ -84,9 +84,9 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     arg(
         "--footprint",
         nargs="+",
-        choices=tuple(FOOTPRINTS),
         metavar="SHAPE",
-        help="the CrIS FOV's spatial response, one of " + ", ".join(FOOTPRINTS) + ": one shape for all FOVs, "
+        help="the CrIS FOV's spatial response, one of " + ", ".join(FOOTPRINTS) + ", stretched by :S (e.g. "
+        "blurred:0.95) or unequally by :AxB@DEG (axis a DEG deg from in-track): one shape for all FOVs, "
         "or nine (FOV 1..9); default the paper's top-hat cone",
     ),
 )
@@ -124,7 +124,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _footprint(names: Sequence[str] | None) -> RadialResponse | tuple[RadialResponse, ...] | None:
+def _footprint(names: Sequence[str] | None) -> Response | tuple[Response, ...] | None:
     """The spatial response of --footprint: None (the top-hat cone), one shape, or one per FOV."""
     from monitor.instrument.footprint import shape
 
@@ -132,7 +132,10 @@ def _footprint(names: Sequence[str] | None) -> RadialResponse | tuple[RadialResp
         return None
     if len(names) not in (1, N_FOV):
         raise BadInput(f"--footprint takes one shape or {N_FOV} (FOV 1..{N_FOV}), not {len(names)}")
-    return shape(names[0]) if len(names) == 1 else tuple(shape(n) for n in names)
+    try:
+        return shape(names[0]) if len(names) == 1 else tuple(shape(n) for n in names)
+    except ValueError as exc:
+        raise BadInput(f"--footprint: {exc}") from None
 
 
 @command(

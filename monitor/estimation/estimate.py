@@ -30,10 +30,11 @@ found are the response seen on orbit (:func:`monitor.instrument.footprint.widths
 **The rows apart.** CrIS's FOV rows ahead (FOVs 7-9) and behind (1-3) can disagree by hundreds of urad
 in-track: an error of the EP's FOV positions, or the parallax of high clouds that the collocation left.
 One turn for all nine FOVs would then sit on neither row and blur the minimum. So the estimate first finds
-how far apart they are (each row's own top-hat minimum, :func:`rows_apart`), moves each outer row's surfaces
-half of that towards the other (linear interpolation, sub-step), and estimates the FOR on the rows thus
-aligned: the FOR offset is the rows' common turn, and the rows' product is what the day's surface still
-finds apart plus the move.
+how far apart they are (each row's own minimum through the response the unaligned FOR finds,
+:func:`rows_apart`; the top-hat cone's minima disagree where the response is narrower than the cone), moves
+each outer row's surfaces half of that towards the other (linear interpolation, sub-step), and estimates the
+FOR on the rows thus aligned: the FOR offset is the rows' common turn, and the rows' product is what the day's
+surface still finds apart plus the move.
 
 **The uncertainty** is the delete-one-granule jackknife (:mod:`monitor.estimation.jackknife`): each replicate
 repeats the estimate (its own weights, its own refined minimum) without one granule, so the scene-to-scene
@@ -48,7 +49,6 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 from scipy.ndimage import shift as shift_grid
-from scipy.optimize import nnls
 
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import DEFAULT_STEP_RAD, URAD
@@ -74,16 +74,14 @@ from monitor.estimation.intercal import (
     reach_steps,
 )
 from monitor.estimation.jackknife import Jackknife
-from monitor.instrument.footprint import widths_of_weights
+from monitor.instrument.footprint import monotone_weights, widths_of_weights
 from monitor.instrument.spectral import I5Band
 
 FOOTPRINT_ITERATIONS = 40  # alternations of the response fit and the refined minimum in a window, at most
 FOOTPRINT_WINDOWS = 3  # windows the alternation may move through as the grid minimum moves, at most
 CONVERGED_STEPS = refine.ZOOMS[-1] / 2  # the optimum did not move by one step of the refinement: it stops
-RIDGE = 1e-9  # of Q's trace added to its diagonal: neighbouring annuli can be nearly collinear
 MIN_FOOTPRINT_SAMPLES = 40  # fewer samples than this (the estimate is flagged few_samples below 30) fit none
 SLOPE_STEP = 1e-4  # relative radiance step of dBT/dL
-CONSTRAINT_WEIGHT = 1e8  # lambda^2 against Q's trace: the weights' sum held to 1 within ~1e-8
 
 
 @dataclass(frozen=True)
@@ -308,15 +306,8 @@ def response_weights(
     The difference is linear in w about the current V = sum_k w_k A_k: BT(V) + s (A_k - V) - C for annulus
     k, s = dBT/dL at V, so that M is the covariance of these over the samples, less what the cost's
     calibration regressors explain (a Schur complement). In BT, as the cost is: a CrIS-VIIRS bias, gain or
-    curvature leaves the weights as they were, as it leaves the cost.
-
-    Neighbouring annuli see nearly the same scene, so M is nearly singular along differences of their
-    weights, and free weights swing from annulus to annulus. A CrIS response is a monotone profile (the
-    specification bounds it by widths that grow as the level falls), so the fit keeps it one: the response
-    in annulus k, w_k / a_k (a_k its solid angle, ~ r_k^2 - r_(k-1)^2), is a sum of non-negative steps
-    delta_l >= 0 for l >= k, w = B delta with B_kl = a_k [l >= k]. With Q = B^T M B = L L^T, the least
-    squares ||L^T delta||^2 + lambda^2 (1^T B delta - 1)^2 with delta >= 0 (non-negative least squares, lambda
-    large against Q) holds the sum to 1."""
+    curvature leaves the weights as they were, as it leaves the cost. The response stays monotone
+    (:func:`monitor.instrument.footprint.monotone_weights`)."""
     a = np.stack(
         [
             refine.window_values(annuli_rad[:, k], at.i0, at.j0, at.dx, at.dy)
@@ -337,16 +328,7 @@ def response_weights(
     s = zc.T @ zc
     k = a.shape[1]
     m = s[:k, :k] - s[:k, k:] @ np.linalg.solve(s[k:, k:], s[k:, :k]) if s.shape[0] > k else s
-    b = area[:, None] * np.triu(np.ones((k, k)))  # w_k = a_k sum_(l >= k) delta_l
-    q = b.T @ m @ b
-    q = q + RIDGE * np.trace(q) / k * np.eye(k)
-    vals, vecs = np.linalg.eigh(q)
-    root = vecs * np.sqrt(np.clip(vals, 0.0, None))  # Q = root root^T (a square root where Q is singular)
-    total = b.sum(axis=0)  # 1^T B
-    lam = np.sqrt(CONSTRAINT_WEIGHT * np.trace(q)) / np.linalg.norm(total)
-    delta, _ = nnls(np.vstack([root.T, lam * total]), np.r_[np.zeros(k), lam])
-    w = b @ delta
-    return w / w.sum()
+    return monotone_weights(m, radii_rad)
 
 
 def _with_footprint(s: ForSamples, weights: np.ndarray) -> np.ndarray:
@@ -419,7 +401,7 @@ def _flagged(at: _Minimum, flags: list[str], converged: bool) -> _Minimum:
 
 def rows_apart(s: ForSamples, cost: Cost, contrast: float = 0.03) -> tuple[float, float]:
     """(x, y) steps from the rows behind to the rows ahead (:data:`FOV_ROWS`), each row's own minimum of
-    the top-hat surface; (0, 0) where either has fewer than 3 samples or no clear minimum."""
+    the surface *s* carries; (0, 0) where either has fewer than 3 samples or no clear minimum."""
     if s.fov is None:
         return 0.0, 0.0
     found = []
@@ -461,9 +443,14 @@ def estimate(
     """Offsets, jackknife sigmas, flags, the intercalibration and (with annuli) the footprint of one FOR's
     samples (module docstring), its rows aligned first (:func:`aligned`); the intercalibration weighs each
     sample by how much its cone mean changes within *reach* steps of the optimum (:mod:`intercal`)."""
-    apart = rows_apart(s, cost, contrast)
-    s = aligned(s, apart)
-    best, weights, d = _estimate(s, cost, contrast)
+    start, apart = None, (0.0, 0.0)
+    if s.fov is not None:
+        # the rows apart on the surface through the response the unaligned rows find: the top-hat cone's
+        # rows disagree where the response is narrower than the cone (5 % narrower: 15 urad RMS, not 5)
+        _, start, d0 = _estimate(s, cost, contrast)
+        apart = rows_apart(s if start is None else replace(s, d_k=d0), cost, contrast)
+        s = aligned(s, apart)
+    best, weights, d = _estimate(s, cost, contrast, start=start)
     d_opt = (
         refine.window_values(d, best.i0, best.j0, best.dx, best.dy)
         if best.refined

@@ -7,12 +7,13 @@ With terrain, VIIRS GITCO pixels are where each line of sight meets the terrain,
 IDPS writes them), CrIS radiances are averaged over the true FOV on the terrain, and GCRSO stays on
 the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 2.3 item 8).
 
-The CrIS FOV sees the scene through the paper's top-hat cone, or through a smooth radially symmetric
-spatial response (``SimulationSpec.cris_response``, :mod:`monitor.instrument.footprint`), one for all FOVs or
-one per FOV: the CrIS radiance is then the response-weighted mean of the scene out to where the response
-ends. The CrIS and the VIIRS granules share the spacecraft's state, attitude and scene at every instant; the
-file layouts are data (:mod:`monitor.simulate.jpss_h5`, :mod:`monitor.simulate.complete`), the scene and
-terrain modules of their own.
+The CrIS FOV sees the scene through the paper's top-hat cone, or through a smooth spatial response, radially
+symmetric or elliptical (``SimulationSpec.cris_response``, :mod:`monitor.instrument.footprint`), one for all
+FOVs or one per FOV: the CrIS radiance is then the response-weighted mean of the scene out to where the
+response ends. An elliptical field turns with the scene mirror, by the FOR's scan angle. The CrIS and the
+VIIRS granules share the spacecraft's state, attitude and scene at every instant; the file layouts are data
+(:mod:`monitor.simulate.jpss_h5`, :mod:`monitor.simulate.complete`), the scene and terrain modules of their
+own.
 
 Clouds with height (``SimulationSpec.cloud_heights``, :mod:`monitor.simulate.clouds`): both instruments'
 rays meet the first cloud they pass, its top or its side, and see its temperature there; GEO stays where
@@ -26,6 +27,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import math
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -53,7 +55,7 @@ from monitor.core.errors import DataError, StopRequested
 from monitor.core.satellites import satellite as satellite_info
 from monitor.geometry import frames, wgs84
 from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
-from monitor.instrument.footprint import RadialResponse
+from monitor.instrument.footprint import EllipticalResponse, RadialResponse, Response
 from monitor.instrument.spectral import C1, C2, i5_band, planck_radiance
 from monitor.sdr import iet
 from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
@@ -127,7 +129,7 @@ class SimulationSpec:
     layout: str | None = None
     # the CrIS FOV's spatial response: None, the top-hat cone of FOV_DIAMETER_RAD (the paper's); one
     # response for all FOVs, or a tuple of 9 (FOV 1..9)
-    cris_response: RadialResponse | tuple[RadialResponse, ...] | None = None
+    cris_response: Response | tuple[Response, ...] | None = None
     # the height of the cloud tops (monitor.simulate.clouds): ground (flat), lapse:G (K/km) or tropical
     cloud_heights: str = "ground"
     # the true LOS of FOVs 7-9 turned +half this in-track, of FOVs 1-3 -half, unknown to GEO (urad)
@@ -296,7 +298,7 @@ class Simulator:
         zen, az, rng_m = wgs84.zenith_azimuth(ground, sat)
         height = self.scene.height_m(lat, lon)  # reported only: GCRSO points are on the ellipsoid
         if spec.cris_sdr:
-            radiance = self._cris_spectra(sat, true_ecef)
+            radiance = self._cris_spectra(sat, true_ecef, m[..., :, 0])
             radiance += self.rng.normal(0.0, spec.cris_noise, radiance.shape)
 
         for_iet = _iet_us(for_unix)
@@ -412,7 +414,7 @@ class Simulator:
         return _sunflower_disk(n, np.tan(reach))
 
     @property
-    def _responses(self) -> tuple[RadialResponse, ...]:
+    def _responses(self) -> tuple[Response, ...]:
         """The spatial response of each FOV 1..9 (the top-hat cone's where none is given)."""
         r = self.spec.cris_response
         if r is None:
@@ -420,22 +422,29 @@ class Simulator:
         return r if isinstance(r, tuple) else (r,) * N_FOV
 
     def _fov_weights(self) -> np.ndarray:
-        """(9, samples): each FOV's response at every sample point of :attr:`_fov_disk` (the top-hat cone:
-        1 at each)."""
-        x, _ = self._fov_disk
-        if self.spec.cris_response is None:
-            return np.ones((N_FOV, len(x)))
-        angle = np.arctan(np.hypot(*self._fov_disk))
-        return np.stack([resp(angle) for resp in self._responses])
-
-    def _cris_spectra(self, sat: np.ndarray, los_ecef: np.ndarray) -> np.ndarray:
-        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV on the scene (the top-hat cone, or
-        weighted by the spatial response out to its reach), not the VIIRS grid."""
-        weights = self._fov_weights()  # (9, samples)
-        n = weights.shape[1]
+        """(30, 9, samples): each FOV's response at every sample point of :attr:`_fov_disk` (the top-hat
+        cone: 1 at each), its field turned by the FOR's scan angle as the scene mirror turns it."""
         x, y = self._fov_disk
-        helper = np.where(np.abs(los_ecef[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
-        e1 = frames.unit(np.cross(los_ecef, helper))
+        if self.spec.cris_response is None:
+            return np.ones((N_FOR, N_FOV, len(x)))
+        rho = np.hypot(x, y)
+        to_angle = np.divide(np.arctan(rho), rho, out=np.ones_like(rho), where=rho > 0)
+        return np.stack(
+            [
+                np.stack([resp.at(x * to_angle, y * to_angle, turn) for resp in self._responses])
+                for turn in ins.cris_scan_angles_rad()
+            ]
+        )
+
+    def _cris_spectra(self, sat: np.ndarray, los_ecef: np.ndarray, in_track_ecef: np.ndarray) -> np.ndarray:
+        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV on the scene (the top-hat cone, or
+        weighted by the spatial response out to its reach), not the VIIRS grid; *in_track_ecef* (nscan, 30,
+        3), the SBF x axis, orients the sample points: x in-track, y cross-track."""
+        weights = self._fov_weights()  # (30, 9, samples)
+        n = weights.shape[-1]
+        x, y = self._fov_disk
+        ahead = np.broadcast_to(in_track_ecef[:, :, None, :], los_ecef.shape)
+        e1 = frames.unit(ahead - np.sum(ahead * los_ecef, axis=-1, keepdims=True) * los_ecef)
         e2 = np.cross(los_ecef, e1)
         dirs = frames.unit(
             los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :]
@@ -684,20 +693,25 @@ def simulate_case(
     return truth
 
 
-def _response_doc(response: RadialResponse | tuple[RadialResponse, ...] | None) -> list | None:
+def _response_doc(response: Response | tuple[Response, ...] | None) -> list | None:
     """The truth's record of the CrIS spatial response: per FOV its full widths (deg) at 70, 50, 10 and
-    3 % and its knots; None for the top-hat cone."""
+    3 % (of the azimuthal mean where it is elliptical, with its axes' stretch and angle) and the knots of the
+    radial profile; None for the top-hat cone."""
     if response is None:
         return None
     each = response if isinstance(response, tuple) else (response,) * N_FOV
-    return [
-        {
+    docs = []
+    for k, r in enumerate(each):
+        radial = r.radial if isinstance(r, EllipticalResponse) else r
+        doc = {
             "fov": k + 1,
             "full_width_deg": {
                 f"{round(100 * lv)}%": float(np.degrees(r.full_width_rad(lv))) for lv in (0.7, 0.5, 0.1, 0.03)
             },
-            "radius_rad": list(r.radius_rad),
-            "response": list(r.response),
+            "radius_rad": list(radial.radius_rad),
+            "response": list(radial.response),
         }
-        for k, r in enumerate(each)
-    ]
+        if isinstance(r, EllipticalResponse):
+            doc["stretch"] = {"a": r.scale_a, "b": r.scale_b, "angle_deg": math.degrees(r.angle_rad)}
+        docs.append(doc)
+    return docs
