@@ -157,6 +157,10 @@ def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys,
         ),
         (["simulate", "--out", "{tmp}/x", "--seed", "-1"], "argument --seed: -1: at least 0"),
         (
+            ["simulate", "--out", "{tmp}/x", "--footprint", "trapezoid:wide"],
+            "--footprint: footprint 'trapezoid:wide': the stretch is S or AxB@DEG, not 'wide'",
+        ),
+        (
             ["simulate", "--out", "{tmp}/x", "--pass", "day", "--pass-lon", "nan"],
             "argument --pass-lon: nan: not a longitude within -180..180 deg",
         ),
