@@ -106,6 +106,7 @@ def main() -> None:
             "fwhm_urad": float(np.nanmedian([f.response_width_50_urad for f in result.fors])),
             "true_fwhm_urad": response.full_width_rad(0.5) / 1e-6,
             "spec_check": response.within_spec(),
+            "parallax_m_per_k": result.fors[0].parallax_m_per_k,
         }
         print(json.dumps(row), flush=True)
 

@@ -244,14 +244,15 @@ def cost_and_offsets(
         if pairs is not None:
             per_for = [for_samples(pairs[0], k, cfg, band) for k in range(N_FOR)]
             lifted = [for_samples(pairs[1], k, cfg, band) for k in range(N_FOR)]
-            f, sigma_f = parallax.day_lift(per_for, lifted, cfg.cost)
+            cones0, cones1 = parallax.matched_cones(per_for, lifted, cfg.cost)
+            f, sigma_f = parallax.day_lift(cones0, cones1, cfg.cost)
             if cfg.uncertainty and np.isfinite(sigma_f):
                 spread = np.array(
                     [
                         np.abs(parallax.sensitivity(a, b, f, cfg.cost)) * sigma_f
                         if len(a) >= 3
                         else np.zeros(4)
-                        for a, b in zip(per_for, lifted, strict=True)
+                        for a, b in zip(cones0, cones1, strict=True)
                     ]
                 )
             per_for = [parallax.blend(a, b, f) for a, b in zip(per_for, lifted, strict=True)]

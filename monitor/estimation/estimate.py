@@ -393,6 +393,17 @@ def _estimate(
     return _flagged(best, [FLAG_UNCONVERGED], False), weights, d  # the windows ran out
 
 
+def fitted_response(s: ForSamples, cost: Cost, contrast: float = 0.03) -> np.ndarray | None:
+    """The annulus weights (K,) the FOR's samples find at their minimum (None: no annuli, too few samples or
+    no refined minimum)."""
+    return _estimate(s, cost, contrast)[1]
+
+
+def through(s: ForSamples, weights: np.ndarray) -> ForSamples:
+    """*s* with its surface the VIIRS - CrIS BT through the annulus *weights*, not the top-hat cone."""
+    return replace(s, d_k=_with_footprint(s, weights))
+
+
 def _flagged(at: _Minimum, flags: list[str], converged: bool) -> _Minimum:
     """*at* with *flags* added, and :data:`FLAG_UNCONVERGED` unless the alternation *converged*."""
     more = flags + ([] if converged else [FLAG_UNCONVERGED])

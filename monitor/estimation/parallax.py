@@ -9,14 +9,14 @@ the probe kappa1 (V1), and for a fraction f
 
     V(f) = V0 + f (V1 - V0)
 
-is the collocation at kappa = f kappa1 to first order (a lift moves a pixel by a small part of a cone;
-a cone mean moves linearly with the pixels that cross its edge). The day's f is where the sum over the
-FORs, and over each FOR's three FOV rows (:data:`ROWS`), of their own cost minimum (the top-hat cone, the
-configured cost) is least: a wrong scale leaves each cloud edge turned by an amount that grows with its
-height, which no single turn of a row can undo. Each row has its own turn because an error of the EP's FOV
-positions turns the rows apart, the same for every scene, as the parallax of one cloud height does: one
-turn for the whole FOR would take a lift for it (a case whose rows were 250 urad apart chose f = 1.9 for
-a truth of ~1.3).
+is the collocation at kappa = f kappa1 to first order (a lift moves a pixel by a small part of a cone; a cone
+mean moves linearly with the pixels that cross its edge). The day's f is where the sum over the FORs, and over
+each FOR's three FOV rows (:data:`ROWS`), of their own cost minimum (the configured cost, through the paper's
+cone scaled to the width the FOR's response reads, :func:`matched_cones`) is least: a wrong scale leaves each
+cloud edge turned by an amount that grows with its height, which no single turn of a row can undo. Each row
+has its own turn because an error of the EP's FOV positions turns the rows apart, the same for every scene, as
+the parallax of one cloud height does: one turn for the whole FOR would take a lift for it (a case whose rows
+were 250 urad apart chose f = 1.9 for a truth of ~1.3).
 f is searched on :data:`FRACTIONS` and refined by the parabola through the least three; it stays within
 them (0 where the cost prefers no lift).
 
@@ -27,7 +27,7 @@ without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules not
 lift. A day whose clouds lie on the ground can prefer a small lift by a hair of its cost, which would turn
 its rows apart by tens of urad: the test keeps it at none. sigma_f reaches every offset through that offset's
 sensitivity to f, by the delta method: sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference
-over +-:data:`SENSITIVITY_STEP` of the top-hat cone's minimum (the FOR's, and each FOV row's for the rows'
+over +-:data:`SENSITIVITY_STEP` of that scaled cone's minimum (the FOR's, and each FOV row's for the rows'
 difference). The rows ahead and behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
 
 Measured (docs/science.md, "The FOV rows and clouds with height"): the lift follows the simulated laws (232
@@ -41,8 +41,17 @@ from dataclasses import replace
 
 import numpy as np
 
+from monitor.core.constants import FOV_HALF_ANGLE_RAD
 from monitor.core.vocabulary import Cost
-from monitor.estimation.estimate import FOV_ROWS, ForSamples, cost_surface, find_minimum
+from monitor.estimation.estimate import (
+    FOV_ROWS,
+    ForSamples,
+    cost_surface,
+    find_minimum,
+    fitted_response,
+    through,
+)
+from monitor.instrument.footprint import HALF_WIDTH_50_RAD, top_hat_weights, widths_of_weights
 
 FRACTIONS = np.linspace(0.0, 2.5, 11)
 SENSITIVITY_STEP = 0.1
@@ -56,6 +65,33 @@ def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
     if s0.annuli_rad is not None and s1.annuli_rad is not None:
         annuli = s0.annuli_rad + f * (s1.annuli_rad - s0.annuli_rad)
     return replace(s0, d_k=s0.d_k + f * (s1.d_k - s0.d_k), annuli_rad=annuli)
+
+
+def matched_cones(
+    s0: list[ForSamples], s1: list[ForSamples], cost: Cost
+) -> tuple[list[ForSamples], list[ForSamples]]:
+    """The FORs' samples at no lift (*s0*) and at the probe's (*s1*), their surfaces through the paper's
+    cone scaled by the half-peak width each FOR's response reads against the nominal, where it has annuli
+    (elsewhere the cone's, as they came).
+
+    The paper's cone wants a lift that is not there where the response is narrower than it: flat-cloud
+    days seen through responses 5 % narrower chose 259 and 191 m/K, which left 26 and 20 urad RMS in-track;
+    through a cone as wide as the response they decline it (5 urad). The response's own weights decline it
+    too, but read the lift of days with high clouds short (90 and 124 m/K against the cone's 151 and 175 at
+    8 and 6.5 K/km) and their rows ahead minus behind 73 and 90 urad short; the scaled cone chose 111 and
+    168 (2026-11-26, 6 granules; docs/science.md, "Responses off the table")."""
+    out0, out1 = [], []
+    for a, b in zip(s0, s1, strict=True):
+        w = fitted_response(a, cost)
+        width = np.nan if w is None else widths_of_weights(a.radii_rad, w)[0.5]
+        if not np.isfinite(width):
+            out0.append(a)
+            out1.append(b)
+            continue
+        cone = top_hat_weights(a.radii_rad, width / 2 * FOV_HALF_ANGLE_RAD / HALF_WIDTH_50_RAD)
+        out0.append(through(a, cone))
+        out1.append(through(b, cone))
+    return out0, out1
 
 
 def day_cost(

@@ -325,6 +325,16 @@ def _super_gaussians(radii_rad: tuple[float, ...]) -> tuple[np.ndarray, np.ndarr
     return table, np.log(READ_ORDERS)
 
 
+def top_hat_weights(radii_rad: tuple[float, ...], radius_rad: float) -> np.ndarray:
+    """The annulus weights (K,) of a top hat of angular radius *radius_rad*: each annulus' solid angle within
+    it, over the top hat's (the annuli's outer radii *radii_rad*, the first a disc; the last holds the rest
+    if the top hat reaches past it)."""
+    r_out = np.asarray(radii_rad, float)
+    r_in = np.concatenate([[0.0], r_out[:-1]])
+    inside = np.clip(np.minimum(radius_rad, r_out) ** 2 - r_in**2, 0.0, None)
+    return inside / inside.sum()
+
+
 def widths_of_weights(
     radii_rad: tuple[float, ...], weights: np.ndarray, levels: tuple[float, ...] = (0.5, 0.1)
 ) -> dict[float, float]:

@@ -130,3 +130,10 @@ def test_a_bad_stretch_is_refused():
     for spec in ("trapezoid:wide", "trapezoid:-1", "trapezoid:1x0@3", "oval:1.0"):
         with pytest.raises(ValueError, match="footprint"):
             footprint.shape(spec)
+
+
+def test_a_top_hat_in_annuli_holds_each_annulus_share_of_its_solid_angle():
+    radii = (0.004, 0.006, 0.008)
+    w = footprint.top_hat_weights(radii, 0.005)
+    assert w == pytest.approx([16 / 25, 9 / 25, 0.0])
+    assert footprint.top_hat_weights(radii, 0.008) == pytest.approx([16 / 64, 20 / 64, 28 / 64])
