@@ -421,37 +421,41 @@ class Simulator:
             return (TOP_HAT_CONE,) * N_FOV
         return r if isinstance(r, tuple) else (r,) * N_FOV
 
-    def _fov_weights(self) -> np.ndarray:
-        """(30, 9, samples): each FOV's response at every sample point of :attr:`_fov_disk` (the top-hat
-        cone: 1 at each), its field turned by the FOR's scan angle as the scene mirror turns it."""
+    def _fov_weights(self, psi_rad: np.ndarray) -> np.ndarray:
+        """(..., 30, 9, samples): each FOV's response at every sample point of :attr:`_fov_disk` (the top-hat
+        cone: 1 at each), *psi_rad* (..., 30, 9) the angle from the disk's x axis to the in-track direction,
+        the field turned by the FOR's scan angle as the scene mirror turns it."""
         x, y = self._fov_disk
         if self.spec.cris_response is None:
-            return np.ones((N_FOR, N_FOV, len(x)))
+            return np.ones(psi_rad.shape + x.shape)
         rho = np.hypot(x, y)
         to_angle = np.divide(np.arctan(rho), rho, out=np.ones_like(rho), where=rho > 0)
-        return np.stack(
-            [
-                np.stack([resp.at(x * to_angle, y * to_angle, turn) for resp in self._responses])
-                for turn in ins.cris_scan_angles_rad()
-            ]
-        )
+        c, s = np.cos(psi_rad)[..., None], np.sin(psi_rad)[..., None]
+        along, across = (c * x + s * y) * to_angle, (-s * x + c * y) * to_angle
+        turns = ins.cris_scan_angles_rad()
+        out = np.empty(along.shape)
+        for k, turn in enumerate(turns):
+            for f, resp in enumerate(self._responses):
+                out[..., k, f, :] = resp.at(along[..., k, f, :], across[..., k, f, :], turn)
+        return out
 
     def _cris_spectra(self, sat: np.ndarray, los_ecef: np.ndarray, in_track_ecef: np.ndarray) -> np.ndarray:
         """LW spectra (nscan, 30, 9, 717) averaged over each true FOV on the scene (the top-hat cone, or
         weighted by the spatial response out to its reach), not the VIIRS grid; *in_track_ecef* (nscan, 30,
-        3), the SBF x axis, orients the sample points: x in-track, y cross-track."""
-        weights = self._fov_weights()  # (30, 9, samples)
-        n = weights.shape[-1]
+        3), the SBF x axis, orients an elliptical response."""
         x, y = self._fov_disk
-        ahead = np.broadcast_to(in_track_ecef[:, :, None, :], los_ecef.shape)
-        e1 = frames.unit(ahead - np.sum(ahead * los_ecef, axis=-1, keepdims=True) * los_ecef)
+        n = len(x)
+        helper = np.where(np.abs(los_ecef[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+        e1 = frames.unit(np.cross(los_ecef, helper))
         e2 = np.cross(los_ecef, e1)
         dirs = frames.unit(
             los_ecef[..., None, :] + x[:, None] * e1[..., None, :] + y[:, None] * e2[..., None, :]
         )
+        ahead = np.broadcast_to(in_track_ecef[:, :, None, :], los_ecef.shape)
+        weights = self._fov_weights(np.arctan2(np.sum(ahead * e2, -1), np.sum(ahead * e1, -1)))
         origin = np.broadcast_to(sat[..., None, :], dirs.shape)
         temp = self.scene.temperature_k(*self._seen(origin, dirs)).reshape(-1, n)
-        w = np.broadcast_to(weights, sat.shape[:-1] + weights.shape[-1:]).reshape(-1, n)
+        w = weights.reshape(-1, n)
         nfov = temp.shape[0]
         pos = (np.clip(temp, T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (T_BINS_K[1] - T_BINS_K[0])
         b0 = np.floor(pos).astype(np.int64)
