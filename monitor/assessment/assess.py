@@ -412,6 +412,65 @@ def collocate_plan(
     return run[0]
 
 
+class DayAssessment:
+    """A day's assessment built batch by batch (:meth:`add`): each batch's CrIS granules collocated once
+    (and once more lifted, for the parallax), the estimate made over every granule so far whenever asked
+    (:meth:`result`), so that a day can stop at the precision it needs."""
+
+    def __init__(self, satellite: str, cfg: AssessmentConfig | None = None, workers: int = 1) -> None:
+        self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
+        self.samples: list[GranuleSamples] = []
+        self.probe: list[GranuleSamples] = []
+        self.skipped: list[tuple[str, str]] = []
+
+    @property
+    def granules(self) -> int:
+        """The granules collocated so far."""
+        return len(self.samples)
+
+    def add(
+        self,
+        case: CasePlan,
+        progress: Progress = None,
+        should_stop: StopCheck = None,
+        timings: Timings = None,
+    ) -> None:
+        """Collocate every CrIS granule of *case* (a granule that fails is skipped with its reason).
+
+        *progress* is called after each granule; *should_stop* is polled before each (a stop request
+        ends the batch with :class:`StopRequested`); *timings*, a dict, collects seconds per stage.
+        *workers* (the constructor's) is the number of threads of the compiled VIIRS preparation and
+        collocation (granules go one after the other, each VIIRS granule prepared once per batch)."""
+        cfg = self.cfg
+        run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
+        with parallel_threads(self.workers):
+            samples, skipped = _collocate_run(*run, progress, should_stop, timings)
+            # the pixels lifted by the probe's height per K (monitor.estimation.parallax chooses the day's)
+            probe = _collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else []
+        self.skipped += list(case.skipped) + skipped
+        self.samples += samples
+        self.probe += probe
+        if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
+            raise StopRequested
+
+    def result(self, timings: Timings = None) -> AssessmentResult:
+        """The estimate over every granule added, in time order. Fewer usable FOVs in all than
+        ``min_samples`` is an :class:`AssessmentError` naming the files."""
+        cfg, skipped = self.cfg, self.skipped
+        usable = sum(int(s.usable.sum()) for s in self.samples)
+        if usable < cfg.min_samples:
+            files = ", ".join(sorted({s.info.cris_geo for s in self.samples} | {str(k) for k, _ in skipped}))
+            why = "; ".join(f"{k}: {r}" for k, r in skipped[:3])
+            raise AssessmentError(
+                f"too few usable FOVs to assess: {usable} (at least {cfg.min_samples}) in "
+                f"{len(self.samples)} granule(s) [{files[:800]}]" + (f"; skipped: {why}" if why else "")
+            )
+        in_time = sorted(self.samples, key=lambda s: (s.info.start, s.key))
+        probe = sorted(self.probe, key=lambda s: (s.info.start, s.key)) if cfg.parallax else None
+        with stage(timings, "cost"):
+            return cost_and_offsets(in_time, cfg, skipped, self.satellite, probe)
+
+
 def assess_plan(
     case: CasePlan,
     cfg: AssessmentConfig | None = None,
@@ -420,34 +479,11 @@ def assess_plan(
     timings: Timings = None,
     workers: int = 1,
 ) -> AssessmentResult:
-    """Assess every CrIS granule of *case*; granules that fail are skipped with their reason. Fewer usable
-    FOVs in all than ``cfg.min_samples`` is an :class:`AssessmentError` naming the files.
-
-    *progress* is called after each granule; *should_stop* is polled before each and before the cost
-    stage (a stop request ends the assessment with :class:`StopRequested`); *timings*, a dict, collects
-    seconds per stage. *workers* is the number of threads of the compiled VIIRS preparation and
-    collocation (granules go one after the other, each VIIRS granule prepared once).
-    """
-    cfg = cfg or AssessmentConfig()
-    skipped = list(case.skipped)
-    run = (case.cris, case.viirs, case.viirs_all, case.satellite, cfg)
-    with parallel_threads(workers):
-        samples, k = _collocate_run(*run, progress, should_stop, timings)
-        # the pixels lifted by the probe's height per K (monitor.estimation.parallax chooses the day's)
-        probe = _collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else None
-    skipped += k
-    if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
-        raise StopRequested
-    usable = sum(int(s.usable.sum()) for s in samples)
-    if usable < cfg.min_samples:
-        files = ", ".join(sorted({s.info.cris_geo for s in samples} | {str(k) for k, _ in skipped}))[:800]
-        why = "; ".join(f"{k}: {r}" for k, r in skipped[:3])
-        raise AssessmentError(
-            f"too few usable FOVs to assess: {usable} (at least {cfg.min_samples}) in "
-            f"{len(samples)} granule(s) [{files}]" + (f"; skipped: {why}" if why else "")
-        )
-    with stage(timings, "cost"):
-        return cost_and_offsets(samples, cfg, skipped, case.satellite, probe)
+    """Assess every CrIS granule of *case* in one batch (:class:`DayAssessment`); granules that fail are
+    skipped with their reason, a stop request ends it with :class:`StopRequested`."""
+    day = DayAssessment(case.satellite, cfg, workers)
+    day.add(case, progress, should_stop, timings)
+    return day.result(timings)
 
 
 def assess_paths(

@@ -30,15 +30,38 @@ class SceneConfig(Section):
     """The ``scenes`` section: which CrIS granules of a day are assessed."""
 
     candidates: int = key(
-        40, "CrIS granules of the day scored for inhomogeneity (spread over the day).", 1, 1000
+        40, "CrIS granules of the day scored for inhomogeneity (spread over the day).", 1, 3000
     )
-    keep: int = key(14, "Most inhomogeneous granules assessed (the paper uses 14).", 1, 200)
+    keep: int = key(
+        14,
+        "Granules assessed per batch, the most informative per byte first; without target_sigma_urad the "
+        "day's only batch (the paper uses 14).",
+        1,
+        200,
+    )
     min_inhomogeneity_k: float = key(0.5, "A granule whose VIIRS-BT spread is below this is not used.", 0, 50)
+    target_sigma_urad: float | None = key(
+        None,
+        "The day's precision goal: the median per-FOR jackknife sigma (urad, worse direction). Batches of "
+        "keep granules are assessed until it is reached, max_granules are assessed, the candidates are "
+        "spent, or the next batch would pass source.daily_budget_mb or schedule.run_budget_min. None: one "
+        "batch.",
+        1.0,
+        10000.0,
+    )
+    max_granules: int = key(
+        200,
+        "Most granules a day with a target_sigma_urad assesses (at most candidates are scored).",
+        1,
+        3000,
+    )
 
     @model_validator(mode="after")
     def _consistent(self) -> SceneConfig:
         if self.keep > self.candidates:
             raise KeyProblem("keep", f"{self.keep} is more than scenes.candidates ({self.candidates})")
+        if self.keep > self.max_granules:
+            raise KeyProblem("keep", f"{self.keep} is more than scenes.max_granules ({self.max_granules})")
         return self
 
 

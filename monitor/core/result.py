@@ -341,6 +341,20 @@ class AssessmentResult:
     difference_bins: list[DifferenceBin] = field(default_factory=list)  # the FORs refined, pooled
     notes: list[str] = field(default_factory=list)  # how the inputs were read, where that is not granules
 
+    def day_sigma_urad(self) -> float | None:
+        """The day's precision, the one number a precision target is held to: the median over FORs of the
+        jackknife sigma, in the worse direction (urad; None where no FOR has one). The sigmas already count
+        consecutive granules as fewer independent ones (:mod:`monitor.estimation.jackknife`)."""
+        medians = [
+            float(np.median(v))
+            for v in (
+                [f.sigma_alpha_urad for f in self.fors if np.isfinite(f.sigma_alpha_urad)],
+                [f.sigma_beta_urad for f in self.fors if np.isfinite(f.sigma_beta_urad)],
+            )
+            if v
+        ]
+        return max(medians) if medians else None
+
     def to_dict(self, with_cube: bool = False) -> dict:
         d = {
             "satellite": self.satellite,

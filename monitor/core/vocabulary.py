@@ -137,3 +137,14 @@ DEFAULT_COST = Cost.REGRESSION
 # the default footprint weighting: the response fitted over annuli, which a real CrIS FOV's smooth response
 # cannot bias (docs/science.md, "The CrIS footprint")
 DEFAULT_KERNEL = Kernel.FOOTPRINT
+
+
+class DayStop(StrEnum):
+    """Why a satellite-day stopped assessing granules (``scenes.target_sigma_urad``, docs/operations.md)."""
+
+    ONE_BATCH = "one batch"  # no target: the scenes.keep most informative granules, as the paper
+    TARGET = "target reached"  # the day's sigma reached scenes.target_sigma_urad
+    MAX_GRANULES = "max_granules"  # scenes.max_granules assessed
+    CANDIDATES = "candidates spent"  # every usable candidate assessed
+    BYTES = "byte budget"  # the next batch would pass source.daily_budget_mb
+    TIME = "time budget"  # the next batch would pass schedule.run_budget_min

@@ -26,6 +26,12 @@ at each scrape, so it survives restarts and agrees with ``crisgeo status``; what
                                                           at level 0.5 / 0.1 of its peak, fitted per FOR
     crisgeo_for_reliable{satellite,for}                   1 when the FOR carries no reliability flag
     crisgeo_latest_day_timestamp_seconds{satellite}       00:00 UTC of the latest assessed day
+    crisgeo_day_granules_assessed{satellite}              granules the latest ok run assessed
+    crisgeo_day_sigma_radians{satellite}                  the median per-FOR sigma it reached (worse
+                                                          direction: AssessmentResult.day_sigma_urad)
+    crisgeo_day_target_sigma_radians{satellite}           its scenes.target_sigma_urad (absent: none)
+    crisgeo_day_stop_info{satellite,reason}               1 on why it stopped (one_batch, target,
+                                                          max_granules, candidates, bytes, time)
     crisgeo_healthy                                       1 when /healthz is ok
     crisgeo_build_info{version}                           always 1
 
@@ -49,8 +55,10 @@ from prometheus_client import CollectorRegistry, Counter, Gauge, disable_created
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 from prometheus_client.metrics_core import Metric
 
+from monitor.core.constants import URAD
+from monitor.core.records import DayPrecision
 from monitor.core.result import Family, ForOffset, measures
-from monitor.core.vocabulary import RunStatus
+from monitor.core.vocabulary import DayStop, RunStatus
 from monitor.service.store.alerts import AlertState
 from monitor.service.store.sqlite import Store
 
@@ -115,6 +123,7 @@ class _StoreCollector:
             outbox = store.outbox_sizes()
             firing = AlertState(store).firing()
             latest = {s: store.latest_day(s) for s in self.satellites}
+            precision = {s: store.latest_precision(s) for s in self.satellites}
             fors = {s: store.day_result(s, d) for s, d in latest.items() if d is not None}
         g = GaugeMetricFamily(
             "crisgeo_last_success_timestamp_seconds",
@@ -158,9 +167,42 @@ class _StoreCollector:
             g.add_metric(list(key), n)
         yield g
         yield from self._offsets(latest, fors, self.spec_km)
+        yield from self._precision(precision)
         yield GaugeMetricFamily(
             "crisgeo_healthy", "1 when /healthz is ok", value=0 if self.health.problems() else 1
         )
+
+    @staticmethod
+    def _precision(precision: dict[str, DayPrecision | None]) -> Iterator[Metric]:
+        granules = GaugeMetricFamily(
+            "crisgeo_day_granules_assessed", "CrIS granules the latest ok run assessed", labels=["satellite"]
+        )
+        sigma = GaugeMetricFamily(
+            "crisgeo_day_sigma_radians",
+            "Median per-FOR jackknife sigma (worse direction) the latest ok run reached",
+            labels=["satellite"],
+        )
+        target = GaugeMetricFamily(
+            "crisgeo_day_target_sigma_radians",
+            "scenes.target_sigma_urad of the latest ok run",
+            labels=["satellite"],
+        )
+        stop = GaugeMetricFamily(
+            "crisgeo_day_stop_info",
+            "Why the latest ok run stopped assessing (1 on its reason)",
+            labels=["satellite", "reason"],
+        )
+        for sat, p in precision.items():
+            if p is None:
+                continue
+            granules.add_metric([sat], p.granules)
+            if p.sigma_urad is not None:
+                sigma.add_metric([sat], p.sigma_urad * URAD)
+            if p.target_sigma_urad is not None:
+                target.add_metric([sat], p.target_sigma_urad * URAD)
+            for reason in DayStop:
+                stop.add_metric([sat, reason.name.lower()], 1 if p.stop == reason else 0)
+        yield from (granules, sigma, target, stop)
 
     @staticmethod
     def _offsets(

@@ -1,4 +1,5 @@
-"""The daily run for one satellite-day: list, select scenes, fetch, assess, store, publish.
+"""The daily run for one satellite-day: list, rank scenes, fetch and assess them in batches until the day's
+precision target or a budget, store, publish.
 
 Idempotent: a day's results are replaced in one transaction, never duplicated. Each run is a row in
 the ledger (``runs``): ok, no_data (recorded, with the reason), failed, interrupted. Days without an
@@ -12,33 +13,50 @@ import logging
 import shutil
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
+from typing import Protocol
 
 import numpy as np
 
-from monitor.assessment.assess import assess_plan
+from monitor.assessment.assess import DayAssessment, Progress, StopCheck, Timings
+from monitor.config.assessment import AssessmentConfig
 from monitor.config.model import Config
 from monitor.config.schedule import ScheduleConfig
 from monitor.core.changes import all_changes
 from monitor.core.errors import DataError, StopRequested
-from monitor.core.records import SceneDecision
+from monitor.core.records import DayPrecision, SceneDecision
 from monitor.core.result import AssessmentResult
-from monitor.core.vocabulary import EventKind, RunStatus
+from monitor.core.vocabulary import DayStop, EventKind, RunStatus
 from monitor.mapping import fingerprint as fpr
 from monitor.sdr import read_file
 from monitor.sdr.engpkt import load_library
 from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 from monitor.service import logs
-from monitor.service.scenes import select_scenes
+from monitor.service.scenes import Candidate, batch_decisions, rank_scenes
 from monitor.service.schedule import catch_up, no_data_horizon
 from monitor.service.sources import ALL_PRODUCTS, ListedFile, Source, SourceError
 from monitor.service.store.sqlite import Store
 from monitor.service.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
 LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
-# what assesses a day's fetched granules: the assessment (:func:`assess_plan`), or a test's stand-in
-Assessor = Callable[..., AssessmentResult]
+
+
+class DayEstimate(Protocol):
+    """What assesses a day's fetched granules batch by batch (:class:`DayAssessment`, or a test's
+    stand-in)."""
+
+    def add(
+        self,
+        case: CasePlan,
+        progress: Progress = None,
+        should_stop: StopCheck = None,
+        timings: Timings = None,
+    ) -> None: ...
+    def result(self, timings: Timings = None) -> AssessmentResult: ...
+
+
+Assessor = Callable[[str, AssessmentConfig, int], DayEstimate]  # (satellite, config, workers)
 
 
 class NoRoom(OSError):
@@ -100,6 +118,7 @@ class RunOutcome:
     result: AssessmentResult | None = None
     timings: dict = field(default_factory=dict)
     counts: RunCounts = field(default_factory=RunCounts)
+    precision: DayPrecision | None = None
 
     def summary(self) -> str:
         """The one line a run leaves in the log."""
@@ -116,6 +135,8 @@ class RunOutcome:
             ok = [f for f in self.result.fors if f.reliable]
             worst = max((f.total_km for f in ok), default=float("nan"))
             parts.append(f"reliable FORs {len(ok)}/{len(self.result.fors)}, worst {worst:.2f} km")
+        if self.precision is not None:
+            parts.append(self.precision.text())
         if t:
             parts.append("stages " + ", ".join(f"{k} {v:.1f} s" for k, v in t.items()))
         return "; ".join(parts)
@@ -242,6 +263,7 @@ class DayWork:
     fingerprint: fpr.DayFingerprint | None = None  # the GEO files' LOS fingerprint, EPs identified
     timings: dict = field(default_factory=dict)
     counts: RunCounts = field(default_factory=RunCounts)
+    precision: DayPrecision | None = None  # how far the batches went, and why they stopped
 
 
 def compute_day(
@@ -294,35 +316,19 @@ def _compute_day(
         w.timings["fingerprint"] = time.perf_counter() - t1
         t1 = time.perf_counter()
         logs.stage("select")
-        chosen, w.decisions = select_scenes(
-            listing, source, satellite, cfg.scenes.candidates, cfg.scenes.keep, cfg.scenes.min_inhomogeneity_k
+        ranked, w.decisions = rank_scenes(
+            listing, source, satellite, cfg.scenes.candidates, cfg.scenes.min_inhomogeneity_k
         )
         w.timings["select"] = time.perf_counter() - t1
-        w.counts.selected = len(chosen)
-        if not chosen:
+        if not ranked:
             w.status = RunStatus.NO_DATA
             w.reason = "no usable scene: " + "; ".join(sorted({d.reason for d in w.decisions}))[:500]
             return w
-        t1 = time.perf_counter()
-        logs.stage("fetch")
-        case = fetch_plan(
-            source, satellite, chosen, stop, ProgressLines(f"{satellite} {day}: fetched scenes", len(chosen))
+        w.result, w.precision, decided = assess_in_batches(
+            cfg, source, satellite, day, ranked, t0, w.timings, stop, progress, assessor
         )
-        w.timings["fetch"] = time.perf_counter() - t1
-        t1 = time.perf_counter()
-        a = cfg.assessment
-        logs.stage("assess")
-        LOG.info(
-            "assessing %d CrIS granule(s) against %d VIIRS granule(s)", len(case.cris), len(case.viirs_all)
-        )
-        w.result = (assessor or assess_plan)(
-            case,
-            a,
-            progress=progress or ProgressLines(f"{satellite} {day}: assessed granules", len(case.cris)),
-            should_stop=stop,
-            workers=a.workers,
-        )
-        w.timings["assess"] = time.perf_counter() - t1
+        w.decisions += decided
+        w.counts.selected = w.precision.granules
         w.counts.assessed = len(w.result.granules)
         if stop():
             raise StopRequested
@@ -339,7 +345,86 @@ def _compute_day(
     # read in place, the bytes travel while the day is assessed: counted once it ends, however it ends
     w.counts.downloaded, w.counts.bytes = source.downloaded_files, source.spent_bytes
     w.counts.requests = source.requests
+    if w.precision is not None and w.counts.assessed:
+        w.precision = replace(w.precision, mb_per_granule=w.counts.bytes / 1e6 / w.counts.assessed)
     return w
+
+
+def assess_in_batches(
+    cfg: Config,
+    source: Source,
+    satellite: str,
+    day: dt.date,
+    ranked: list[Candidate],
+    started: float,
+    timings: dict,
+    stop: Callable[[], bool],
+    progress: Callable[[object], None] | None = None,
+    assessor: Assessor | None = None,
+) -> tuple[AssessmentResult, DayPrecision, list[SceneDecision]]:
+    """Fetch and assess the *ranked* candidates in batches of ``scenes.keep`` until the day's sigma
+    (:meth:`AssessmentResult.day_sigma_urad`) reaches ``scenes.target_sigma_urad`` (without a target: one
+    batch), ``scenes.max_granules`` are assessed, the candidates are spent, or the next batch, as costly
+    in bytes and seconds as the costliest so far, would pass ``source.daily_budget_mb`` or
+    ``schedule.run_budget_min`` (counted from *started*, the run's ``perf_counter``). Returns the
+    estimate over every batch, how far it went, and the candidates' decisions. *timings* gains the
+    seconds of ``fetch`` and ``assess``."""
+    s = cfg.scenes
+    a = cfg.assessment
+    estimate = (assessor or DayAssessment)(satellite, a, a.workers)
+    budget_bytes = cfg.source.daily_budget_mb * 1e6
+    budget_s = cfg.schedule.run_budget_min * 60.0
+    taken = batches = 0
+    costliest_s = costliest_bytes = 0.0
+    label = f"{satellite} {day}"
+    while True:
+        batch = ranked[taken : taken + min(s.keep, s.max_granules - taken)]
+        t1, bytes1 = time.perf_counter(), source.spent_bytes
+        logs.stage("fetch")
+        case = fetch_plan(
+            source, satellite, batch, stop, ProgressLines(f"{label}: fetched scenes", len(batch))
+        )
+        t2 = time.perf_counter()
+        logs.stage("assess")
+        LOG.info(
+            "batch %d: assessing %d CrIS granule(s) against %d VIIRS granule(s)",
+            batches + 1, len(case.cris), len(case.viirs_all),
+        )  # fmt: skip
+        estimate.add(case, progress or ProgressLines(f"{label}: assessed granules", len(case.cris)), stop)
+        result = estimate.result()
+        t3 = time.perf_counter()
+        timings["fetch"] = timings.get("fetch", 0.0) + t2 - t1
+        timings["assess"] = timings.get("assess", 0.0) + t3 - t2
+        taken, batches = taken + len(batch), batches + 1
+        costliest_s = max(costliest_s, t3 - t1)
+        costliest_bytes = max(costliest_bytes, source.spent_bytes - bytes1)
+        sigma = result.day_sigma_urad()
+        if stop():
+            raise StopRequested
+        if s.target_sigma_urad is None:
+            why = DayStop.ONE_BATCH
+        elif sigma is not None and sigma <= s.target_sigma_urad:
+            why = DayStop.TARGET
+        elif taken >= len(ranked):
+            why = DayStop.CANDIDATES
+        elif taken >= s.max_granules:
+            why = DayStop.MAX_GRANULES
+        elif source.spent_bytes + costliest_bytes > budget_bytes:
+            why = DayStop.BYTES
+        elif t3 - started + costliest_s > budget_s:
+            why = DayStop.TIME
+        else:
+            LOG.info(
+                "after %d granule(s) the day's sigma is %s urad; target %g", taken, sigma, s.target_sigma_urad
+            )
+            continue
+        precision = DayPrecision(taken, batches, sigma, s.target_sigma_urad, why)
+        LOG.info("precision: %s", precision.text())
+        return (
+            result,
+            precision,
+            batch_decisions(ranked, taken, s.keep, f"the day stopped at {taken} ({why})"),
+        )
 
 
 def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.date) -> RunOutcome:
@@ -353,13 +438,15 @@ def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.dat
                 record_fingerprint(cfg, store, w.satellite, w.day, w.fingerprint)
             except (DataError, OSError, ValueError) as exc:
                 LOG.warning("fingerprint of %s %s not recorded: %s", w.satellite, w.day, exc)
-        out = RunOutcome(w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts)
+        out = RunOutcome(
+            w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts, w.precision
+        )
         if w.status == RunStatus.OK and w.result is not None:  # an ok day always has its result
             lines = {
                 target_name(p): result_lines(p.measurement, w.satellite, w.day, w.result.fors)
                 for p in cfg.store.publish
             }
-            store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, lines)
+            store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, lines, w.precision)
             publish_changes(cfg, store, w.satellite)
         elif w.status == RunStatus.NO_DATA:
             s = cfg.schedule

@@ -4,14 +4,16 @@ Candidates are spread evenly over the day; only the small CrIS files are fetched
 score is the inhomogeneity of the CrIS I5-equivalent brightness temperature at the FOV scale: the mean,
 over the granule's FORs, of the standard deviation of the 9 FOV BTs (K). Clouds over ocean and
 coastlines score high; uniform scenes carry no information and score near the noise. Granules
-without VIIRS I5 and GEO coverage in the listing are skipped before anything is fetched. Every
-candidate gets a decision and its reason.
+without VIIRS I5 and GEO coverage in the listing are skipped before anything is fetched. The usable ones
+are ranked by information per byte (:func:`bytes_of`), the order in which the daily run assesses them in
+batches (:func:`monitor.service.pipeline.assess_in_batches`). Every candidate gets a decision and its reason.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 import logging
+from collections import Counter
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -60,11 +62,12 @@ def inhomogeneity_k(radiance_lw: np.ndarray, satellite: str) -> float:
     return float(np.nanmean(np.nanstd(bt, axis=-1)))
 
 
-def select_scenes(
-    listing: list[ListedFile], source: Source, satellite: str, candidates: int, keep: int, min_score_k: float
+def rank_scenes(
+    listing: list[ListedFile], source: Source, satellite: str, candidates: int, min_score_k: float
 ) -> tuple[list[Candidate], list[SceneDecision]]:
-    """(chosen candidates, decisions) for one satellite-day: every granule of the listing is chosen,
-    rejected or not considered, with the reason."""
+    """(usable candidates, the most informative per byte first; the decisions of every other granule of
+    the listing, rejected or not considered, with the reason). Scoring reads each candidate's CrIS SDR and
+    GEO files (a few MB); no VIIRS byte is read before a candidate is assessed."""
     decisions: list[SceneDecision] = []
     cris, unpaired = _pairs(listing, CRIS_SDR, CRIS_GEO)
     for key in unpaired:
@@ -108,10 +111,11 @@ def select_scenes(
             decisions.append(SceneDecision(key, Decision.REJECTED, f"unusable CrIS granule: {exc}"))
             continue
         pool.append(Candidate(key, sdr, geo, cover, score, files))
-    pool.sort(key=lambda c: -c.score_k)
-    chosen: list[Candidate] = []
+    ranked = []
     for c in pool:
-        if not np.isfinite(c.score_k) or c.score_k < min_score_k:
+        if np.isfinite(c.score_k) and c.score_k >= min_score_k:
+            ranked.append(c)
+        else:
             decisions.append(
                 SceneDecision(
                     c.key,
@@ -120,18 +124,32 @@ def select_scenes(
                     c.score_k,
                 )
             )
-        elif len(chosen) >= keep:
-            decisions.append(
-                SceneDecision(
-                    c.key, Decision.REJECTED, f"the {keep} more inhomogeneous granules were kept", c.score_k
-                )
-            )
-        else:
-            chosen.append(c)
-            decisions.append(
-                SceneDecision(
-                    c.key, Decision.CHOSEN, f"inhomogeneity {c.score_k:.2f} K, rank {len(chosen)}", c.score_k
-                )
-            )
-    chosen.sort(key=lambda c: c.geo.parsed.start)
-    return chosen, decisions
+    covering = Counter(vg.parsed.granule_key for c in ranked for _, vg in c.viirs)
+    return sorted(ranked, key=lambda c: -c.score_k / max(1.0, bytes_of(c, covering))), decisions
+
+
+def bytes_of(c: Candidate, covering: Counter[str]) -> float:
+    """What assessing *c* costs in bytes, as listed: its CrIS SDR and GEO, and its share of each VIIRS pair
+    covering it, split among the *covering* candidates (per VIIRS granule key: a VIIRS granule that two
+    consecutive CrIS granules share costs each half, so at equal information per byte consecutive runs
+    come first)."""
+    own = (c.sdr.size or 0) + (c.geo.size or 0)
+    return own + sum(
+        ((vs.size or 0) + (vg.size or 0)) / covering[vg.parsed.granule_key] for vs, vg in c.viirs
+    )
+
+
+def batch_decisions(ranked: list[Candidate], assessed: int, batch: int, why_not: str) -> list[SceneDecision]:
+    """The decisions of the *ranked* candidates once a day has assessed the first *assessed* in batches of
+    *batch*: chosen with their rank and batch, the rest rejected for *why_not* (why the day stopped)."""
+    return [
+        SceneDecision(
+            c.key,
+            Decision.CHOSEN,
+            f"inhomogeneity {c.score_k:.2f} K, rank {i + 1}, batch {i // batch + 1}",
+            c.score_k,
+        )
+        if i < assessed
+        else SceneDecision(c.key, Decision.REJECTED, f"not assessed: {why_not}", c.score_k)
+        for i, c in enumerate(ranked)
+    ]

@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 from enum import IntEnum
 
 from monitor.config.model import Config
-from monitor.core.records import Run, Silence
+from monitor.core.records import DayPrecision, Run, Silence
 from monitor.core.result import ForOffset
 from monitor.core.tables import BRIEF, for_table
 from monitor.core.vocabulary import Rule, RunStatus, Severity
@@ -61,6 +61,7 @@ class SatelliteStatus:
     fors: tuple[ForOffset, ...]
     alerts: tuple[FiringAlert, ...]
     spec_km: float
+    precision: DayPrecision | None = None  # how far the latest ok run went, and why it stopped
 
     @property
     def beyond_spec(self) -> tuple[ForOffset, ...]:
@@ -141,6 +142,8 @@ class Status:
                 f"  {a.severity} {a.rule}: {a.summary} (since {a.started})" + a.silenced_text()
                 for a in s.alerts
             ]
+            if s.precision is not None:
+                lines.append(f"  precision: {s.precision.text()}")
             if s.latest_day:
                 lines.append(f"  latest results: {s.latest_day}")
                 lines += for_table(list(s.fors), BRIEF, indent="  ")
@@ -165,6 +168,7 @@ class Status:
                     if s.last_run is None
                     else {k: getattr(s.last_run, k) for k in ("day", "status", "finished", "reason")},
                     "latest_day": None if s.latest_day is None else s.latest_day.isoformat(),
+                    "precision": None if s.precision is None else s.precision.to_dict(),
                     "fors": [f.to_dict() for f in s.fors],
                     "fors_beyond_spec": [f.for_index for f in s.beyond_spec],
                     "alerts": [
@@ -213,6 +217,7 @@ def status_report(
                 () if day is None else tuple(store.day_result(sat, day)),
                 alerts,
                 cfg.alerts.spec_km,
+                store.latest_precision(sat),
             )
         )
     critical = any(a.severity == Severity.CRITICAL for a in firing) or any(

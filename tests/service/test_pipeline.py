@@ -52,13 +52,21 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
     # the same numbers as assessing the files directly (crisgeo assess)
     assert [f.d_beta_urad for f in first.result.fors] == [f.d_beta_urad for f in reference.fors]
     assert first.status == "ok" and len(first.result.fors) == 30
+    assert first.precision.granules == 2 and first.precision.stop == "one batch"
+    assert store.latest_precision("j01") == first.precision
     seen = []
 
-    def same_numbers(case, config, **kw):  # the rerun pays for no second assessment: the recording is tested
-        seen.append(len(case.cris))
-        return first.result
+    class SameNumbers:  # the rerun pays for no second assessment: the recording is tested
+        def __init__(self, satellite, config, workers):
+            pass
 
-    second = run_day(cfg, store, src, "j01", DAY, TODAY, assessor=same_numbers)
+        def add(self, case, *args, **kw):
+            seen.append(len(case.cris))
+
+        def result(self, timings=None):
+            return first.result
+
+    second = run_day(cfg, store, src, "j01", DAY, TODAY, assessor=SameNumbers)
     assert second.status == "ok" and seen == [2]
     assert len(store.day_result("j01", DAY)) == 30  # replaced, not added
     assert {g.run_id for g in store.granules("j01", DAY)} == {second.run_id}
@@ -151,14 +159,14 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
     )
     log = tmp_path / "alerts.log"
     cfg = make_config(tmp_path, tree, f"alerts: {{log: {log}}}\n")
-    real = pipeline.assess_plan
 
-    def poison(case, *args, **kw):
-        if case.cris[0].key.startswith("j01_d20240601"):
-            raise RuntimeError("poison granule")
-        return real(case, *args, **kw)
+    class Poisoned(pipeline.DayAssessment):
+        def add(self, case, *args, **kw):
+            if case.cris[0].key.startswith("j01_d20240601"):
+                raise RuntimeError("poison granule")
+            super().add(case, *args, **kw)
 
-    monkeypatch.setattr(pipeline, "assess_plan", poison)
+    monkeypatch.setattr(pipeline, "DayAssessment", Poisoned)
     outcomes = list(Service(cfg).catch_up("j01", today=DAY + dt.timedelta(days=2)))
     assert [(o.day, o.status) for o in outcomes][-2:] == [(DAY, "failed"), (DAY + dt.timedelta(days=1), "ok")]
     assert outcomes[-2].reason == "unexpected RuntimeError: poison granule"

@@ -1,8 +1,9 @@
-"""Scene selection on a listing: pairing, coverage, candidates spread over the day, scores, decisions."""
+"""Scene selection on a listing: pairing, coverage, candidates spread over the day, scores, the order of
+information per byte, decisions."""
 
 import datetime as dt
 
-from monitor.service.scenes import select_scenes
+from monitor.service.scenes import batch_decisions, bytes_of, rank_scenes
 from monitor.service.sources import ALL_PRODUCTS
 from monitor.service.sources.local import LocalSource
 
@@ -15,34 +16,44 @@ def _listing(cases):
     return source, source.list_day("j01", DAY, ALL_PRODUCTS)
 
 
-def test_every_candidate_gets_a_decision_and_the_best_are_kept(cases):
+def test_every_candidate_gets_a_decision_and_the_best_per_byte_come_first(cases):
     source, listing = _listing(cases)
-    chosen, decisions = select_scenes(listing, source, "j01", candidates=40, keep=1, min_score_k=0.0)
-    assert len(chosen) == 1 and all(
-        vs.product == "SVI05" and vg.product == "GITCO" for vs, vg in chosen[0].viirs
-    )
-    by_decision = {}
-    for d in decisions:
-        by_decision.setdefault(d.decision, []).append(d)
-    assert len(by_decision["chosen"]) == 1 and len(by_decision["rejected"]) == 1
-    assert "more inhomogeneous granules were kept" in by_decision["rejected"][0].reason
-    assert by_decision["chosen"][0].score_k >= by_decision["rejected"][0].score_k
+    ranked, decisions = rank_scenes(listing, source, "j01", candidates=40, min_score_k=0.0)
+    assert decisions == [] and len(ranked) == 2
+    assert all(vs.product == "SVI05" and vg.product == "GITCO" for c in ranked for vs, vg in c.viirs)
+    # one VIIRS granule covers both: the order is the score's
+    assert ranked[0].score_k >= ranked[1].score_k
+    kept = batch_decisions(ranked, assessed=1, batch=1, why_not="the day stopped at 1 (one batch)")
+    assert [d.decision for d in kept] == ["chosen", "rejected"]
+    assert kept[0].reason.endswith("rank 1, batch 1") and "one batch" in kept[1].reason
+
+
+def test_a_shared_viirs_granule_costs_each_candidate_its_share(cases):
+    """At equal score, the candidate whose VIIRS granule another shares costs fewer bytes and comes first."""
+    source, listing = _listing(cases)
+    ranked, _ = rank_scenes(listing, source, "j01", candidates=40, min_score_k=0.0)
+    one = ranked[0]
+    (vs, vg) = one.viirs[0]
+    alone = bytes_of(one, {vg.parsed.granule_key: 1})
+    shared = bytes_of(one, {vg.parsed.granule_key: 2})
+    assert alone - shared == (vs.size + vg.size) / 2 > 0
+    assert alone == one.sdr.size + one.geo.size + vs.size + vg.size
 
 
 def test_homogeneous_scenes_and_missing_partners_are_rejected_with_reasons(cases):
     source, listing = _listing(cases)
-    chosen, decisions = select_scenes(listing, source, "j01", candidates=40, keep=14, min_score_k=1e6)
+    chosen, decisions = rank_scenes(listing, source, "j01", candidates=40, min_score_k=1e6)
     assert chosen == [] and all("too homogeneous" in d.reason for d in decisions)
     no_geo = [f for f in listing if f.product != "GCRSO"]
-    chosen, decisions = select_scenes(no_geo, source, "j01", candidates=40, keep=14, min_score_k=0.0)
+    chosen, decisions = rank_scenes(no_geo, source, "j01", candidates=40, min_score_k=0.0)
     assert chosen == [] and {d.reason for d in decisions} == {"SDR or GEO file missing in the listing"}
     no_viirs = [f for f in listing if f.product in ("SCRIF", "GCRSO")]
-    chosen, decisions = select_scenes(no_viirs, source, "j01", candidates=40, keep=14, min_score_k=0.0)
+    chosen, decisions = rank_scenes(no_viirs, source, "j01", candidates=40, min_score_k=0.0)
     assert chosen == [] and {d.reason for d in decisions} == {"no VIIRS I5 + GEO granule covers it"}
 
 
 def test_candidates_are_spread_over_the_day(cases):
     source, listing = _listing(cases)
-    chosen, decisions = select_scenes(listing, source, "j01", candidates=1, keep=14, min_score_k=0.0)
+    chosen, decisions = rank_scenes(listing, source, "j01", candidates=1, min_score_k=0.0)
     assert len(chosen) == 1
     assert [d.decision for d in decisions].count("not considered") == 1

@@ -30,7 +30,7 @@ import numpy as np
 from monitor.config.model import Config
 from monitor.core.changes import Change, all_changes
 from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
-from monitor.core.records import Alert, ForSeries
+from monitor.core.records import Alert, DayPrecision, ForSeries
 from monitor.core.result import RELIABILITY_FLAGS, ForOffset
 from monitor.core.satellites import SATELLITES
 from monitor.core.tables import FOR_COLUMNS, REPORT
@@ -147,6 +147,14 @@ def _changes_table(changes: Sequence[Change]) -> str:
 
 def _img(name: str, alt: str) -> str:
     return f'<img src="{name}" alt="{_e(alt)}">'
+
+
+def _precision(p: DayPrecision | None) -> str:
+    """The latest run's precision: granules assessed, the sigma reached against its target, why it
+    stopped (scenes.target_sigma_urad)."""
+    if p is None:
+        return ""
+    return f"<p>Precision of the latest run: {_e(p.text())}.</p>"
 
 
 def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions) -> dict:
@@ -288,6 +296,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         f"{'-' if worst is None else format(worst.total_km, '.2f')} km "
         f"(spec {opts.spec_km:g} km). {len(days)} day(s) shown. Flagged FORs: "
         f"{', '.join(map(str, flagged)) or 'none'}.</p>",
+        _precision(store.latest_precision(satellite)),
         "<h2>Active alerts</h2>" + _alerts_table(firing),
         "<h2>Latest per-FOR offsets</h2>"
         + _img("latest_km.png", "per-FOR km")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import datetime as dt
 import json
 
-from monitor.core.records import Event, Run
+from monitor.core.records import DayPrecision, Event, Run
 from monitor.core.vocabulary import DONE, EventKind, RunStatus
 from monitor.service.store.database import Database
 
@@ -76,6 +76,15 @@ class RunLedger(Database):
                 "m ON r.id = m.id ORDER BY r.satellite"
             )
         ]
+
+    def latest_precision(self, satellite: str) -> DayPrecision | None:
+        """How far *satellite*'s latest ok run went for its precision (None: no such run, or one from
+        before the batches)."""
+        row = self.db.execute(
+            "SELECT summary FROM runs WHERE satellite=? AND status=? ORDER BY id DESC LIMIT 1",
+            (satellite, RunStatus.OK),
+        ).fetchone()
+        return None if row is None else DayPrecision.from_summary(row[0])
 
     def run_counts(self) -> dict:
         """{(satellite, status): number of runs} over the whole ledger."""

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from monitor.core.constants import N_FOR
-from monitor.core.records import ForSeries, GranuleRow, SelectionRow
+from monitor.core.records import DayPrecision, ForSeries, GranuleRow, SelectionRow
 from monitor.core.result import MEASURED_FIELDS, AssessmentResult, DifferenceBin, ForOffset
 from monitor.core.vocabulary import RunStatus
 from monitor.service.store.ledger import RunLedger
@@ -36,9 +36,10 @@ class Results(RunLedger):
         result: AssessmentResult,
         selection: list,
         outbox_lines: dict,
+        precision: DayPrecision | None = None,
     ) -> None:
-        """Replace the day's results, granules, selection and cube, queue its points, close the run, in one
-        transaction."""
+        """Replace the day's results, granules, selection and cube, queue its points, close the run (its
+        summary: reliable FORs, the worst error, the *precision* reached), in one transaction."""
         d = day.isoformat()
         with self.transaction():
             for table in ("results", "granules", "selection", "cost_cubes", "skipped", "difference_bins"):
@@ -130,6 +131,7 @@ class Results(RunLedger):
                     "max_total_km": max(
                         (f.total_km for f in result.fors if np.isfinite(f.total_km)), default=None
                     ),
+                    **({"precision": precision.to_dict()} if precision is not None else {}),
                 },
             )
 
