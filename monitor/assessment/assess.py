@@ -423,11 +423,6 @@ class DayAssessment:
         self.probe: list[GranuleSamples] = []
         self.skipped: list[tuple[str, str]] = []
 
-    @property
-    def granules(self) -> int:
-        """The granules collocated so far."""
-        return len(self.samples)
-
     def add(
         self,
         case: CasePlan,

@@ -14,11 +14,10 @@ import shutil
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
-from typing import Protocol
 
 import numpy as np
 
-from monitor.assessment.assess import DayAssessment, Progress, StopCheck, Timings
+from monitor.assessment.assess import DayAssessment
 from monitor.config.assessment import AssessmentConfig
 from monitor.config.model import Config
 from monitor.config.schedule import ScheduleConfig
@@ -42,21 +41,9 @@ from monitor.service.store.timeseries import change_lines, drain_outbox, result_
 LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
 
 
-class DayEstimate(Protocol):
-    """What assesses a day's fetched granules batch by batch (:class:`DayAssessment`, or a test's
-    stand-in)."""
-
-    def add(
-        self,
-        case: CasePlan,
-        progress: Progress = None,
-        should_stop: StopCheck = None,
-        timings: Timings = None,
-    ) -> None: ...
-    def result(self, timings: Timings = None) -> AssessmentResult: ...
-
-
-Assessor = Callable[[str, AssessmentConfig, int], DayEstimate]  # (satellite, config, workers)
+# what assesses a day's fetched granules batch by batch, from (satellite, config, workers): the assessment,
+# or a test's stand-in
+Assessor = Callable[[str, AssessmentConfig, int], DayAssessment]
 
 
 class NoRoom(OSError):
