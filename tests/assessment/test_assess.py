@@ -117,3 +117,19 @@ def test_reading_only_the_reachable_viirs_scans_changes_no_bit(cases, monkeypatc
     assert read_scans and all(s is not None for s in read_scans)  # the partial run had spans to read by
     assert [f.to_dict() for f in whole.fors] == [f.to_dict() for f in partial.fors]
     assert np.array_equal(whole.cost_cube_k, partial.cost_cube_k)
+
+
+def test_a_day_assessed_in_batches_is_the_day_assessed_at_once(cases, case_plan):
+    """Batches in any order give the one-batch estimate: the granules are put back in time order before
+    the estimate (the jackknife's consecutive granules), and each is collocated the same way alone."""
+    from dataclasses import replace
+
+    from monitor.assessment.assess import DayAssessment
+
+    _, _, at_once = cases.get()
+    day = DayAssessment(case_plan.satellite, AssessmentConfig())
+    for g in reversed(case_plan.cris):  # the later granule first
+        day.add(replace(case_plan, cris=[g], viirs={g.key: case_plan.viirs[g.key]}, skipped=[]))
+    batched = day.result()
+    assert [g.granule_id for g in batched.granules] == [g.granule_id for g in at_once.granules]
+    assert [f.to_dict() for f in batched.fors] == [f.to_dict() for f in at_once.fors]
