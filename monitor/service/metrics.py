@@ -184,7 +184,7 @@ class _StoreCollector:
         )
         target = GaugeMetricFamily(
             "crisgeo_day_target_sigma_radians",
-            "scenes.target_sigma_urad of the latest ok run",
+            "The precision target of the latest ok run (its scenes key, in radians)",
             labels=["satellite"],
         )
         stop = GaugeMetricFamily(
