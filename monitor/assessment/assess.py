@@ -16,6 +16,7 @@ import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import overload
 
 import numpy as np
 
@@ -30,6 +31,7 @@ from monitor.assessment.inputs import (
     scan_spans,
     stage,
 )
+from monitor.assessment.spool import OnDisk, Spool
 from monitor.collocation import collocate, swath
 from monitor.collocation.parallax import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
@@ -65,7 +67,7 @@ class GranuleSamples:
 
     key: str
     info: GranuleInfo
-    bt_viirs_k: np.ndarray  # (nscan, 30, 9, m, m) through the top-hat cone
+    bt_viirs_k: np.ndarray | OnDisk  # (nscan, 30, 9, m, m) through the top-hat cone
     bt_cris_k: np.ndarray  # (nscan, 30, 9)
     usable: np.ndarray  # (nscan, 30, 9)
     sat_m: np.ndarray  # FOV-5 geometry per (nscan, 30) for the km conversion
@@ -73,7 +75,15 @@ class GranuleSamples:
     alpha_rad: np.ndarray
     beta_rad: np.ndarray
     velocity_m_s: np.ndarray
-    annuli_rad: np.ndarray | None = None  # (nscan, 30, 9, K, m, m) VIIRS radiance per annulus (footprint)
+    annuli_rad: np.ndarray | OnDisk | None = None  # (nscan, 30, 9, K, m, m) radiance per annulus (footprint)
+
+    def kept_in(self, spool: Spool) -> GranuleSamples:
+        """These samples with their perturbed cones' arrays in *spool*, on disk (:mod:`spool`)."""
+        cones = self.bt_viirs_k if isinstance(self.bt_viirs_k, OnDisk) else spool.keep(self.bt_viirs_k)
+        annuli = self.annuli_rad
+        if isinstance(annuli, np.ndarray):
+            annuli = spool.keep(annuli)
+        return replace(self, bt_viirs_k=cones, annuli_rad=annuli)
 
 
 def collocate_granule(
@@ -236,27 +246,31 @@ def cost_and_offsets(
     *probe*, the same granules collocated with the VIIRS pixels lifted by PROBE_M_PER_K, the day's lift is
     chosen by the cost (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it."""
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
-    per_for = [for_samples(samples, k, cfg, band) for k in range(N_FOR)]
+    per_for: Sequence[ForSamples] = PerFor(lambda k: for_samples(samples, k, cfg, band))
     m_per_k = np.nan
     spread = np.zeros((N_FOR, 4))  # the sigma (steps) the day's lift adds: FOR alpha, beta; rows alpha, beta
-    if probe is not None:
-        pairs = paired(samples, probe)
-        if pairs is not None:
-            per_for = [for_samples(pairs[0], k, cfg, band) for k in range(N_FOR)]
-            lifted = [for_samples(pairs[1], k, cfg, band) for k in range(N_FOR)]
-            cones0, cones1 = parallax.matched_cones(per_for, lifted, cfg.cost)
-            f, sigma_f = parallax.day_lift(cones0, cones1, cfg.cost)
-            if cfg.uncertainty and np.isfinite(sigma_f):
-                spread = np.array(
-                    [
-                        np.abs(parallax.sensitivity(a, b, f, cfg.cost)) * sigma_f
-                        if len(a) >= 3
-                        else np.zeros(4)
-                        for a, b in zip(cones0, cones1, strict=True)
-                    ]
-                )
-            per_for = [parallax.blend(a, b, f) for a, b in zip(per_for, lifted, strict=True)]
-            m_per_k = f * PROBE_M_PER_K
+    pairs = paired(samples, probe) if probe is not None else None
+    if pairs is not None:
+        s0, s1 = pairs
+        cones0, cones1 = zip(
+            *(
+                parallax.matched_cone(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), cfg.cost)
+                for k in range(N_FOR)
+            ),
+            strict=True,
+        )
+        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost)
+        if cfg.uncertainty and np.isfinite(sigma_f):
+            spread = np.array(
+                [
+                    np.abs(parallax.sensitivity(a, b, f, cfg.cost)) * sigma_f if len(a) >= 3 else np.zeros(4)
+                    for a, b in zip(cones0, cones1, strict=True)
+                ]
+            )
+        per_for = PerFor(
+            lambda k: parallax.blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
+        )
+        m_per_k = f * PROBE_M_PER_K
     day = day_offsets(
         per_for,
         cfg,
@@ -264,9 +278,12 @@ def cost_and_offsets(
         lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
         follows_in_time([_seconds(s.info.start) for s in samples]),
     )
+    used = samples if pairs is None else pairs[0]
     fors = [
-        _with_lift_spread(f, np.nan_to_num(e) * cfg.step_urad, m_per_k, _cold_height_km(s, m_per_k))
-        for f, s, e in zip(day.fors, per_for, spread, strict=True)
+        _with_lift_spread(
+            f, np.nan_to_num(e) * cfg.step_urad, m_per_k, _cold_height_km(_cris_k(used, k), m_per_k)
+        )
+        for k, (f, e) in enumerate(zip(day.fors, spread, strict=True))
     ]
     starts = [s.info.start for s in samples]
     ends = [s.info.end for s in samples]
@@ -323,12 +340,43 @@ def paired(
     )
 
 
-def _cold_height_km(s: ForSamples, m_per_k: float) -> float:
+def _cris_k(samples: list[GranuleSamples], k: int) -> np.ndarray:
+    """The CrIS BT (K) of FOR k's usable FOVs over the granules (what :func:`for_samples` puts in cris_k)."""
+    return np.concatenate([s.bt_cris_k[:, k][s.usable[:, k]] for s in samples] or [np.empty(0)]).astype(
+        np.float64
+    )
+
+
+def _cold_height_km(cris_k: np.ndarray, m_per_k: float) -> float:
     """The height (km) the correction puts a FOR's cold scenes at: *m_per_k* times its CrIS BT's 95th
     minus 5th percentile (NaN without samples or correction)."""
-    if len(s) < 3 or not np.isfinite(m_per_k):
+    if len(cris_k) < 3 or not np.isfinite(m_per_k):
         return np.nan
-    return float(m_per_k * np.subtract(*np.percentile(s.cris_k, [95, 5])) / 1000.0)
+    return float(m_per_k * np.subtract(*np.percentile(cris_k, [95, 5])) / 1000.0)
+
+
+class PerFor(Sequence[ForSamples]):
+    """The 30 FORs' samples, each built when indexed (read from the day's spool, blended): one FOR of a
+    long day in memory at a time, not the day (:func:`~monitor.estimation.estimate.day_offsets`)."""
+
+    def __init__(self, build: Callable[[int], ForSamples]) -> None:
+        self._build = build
+
+    def __len__(self) -> int:
+        return N_FOR
+
+    @overload
+    def __getitem__(self, k: int) -> ForSamples: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> list[ForSamples]: ...
+
+    def __getitem__(self, k: int | slice) -> ForSamples | list[ForSamples]:
+        if isinstance(k, slice):
+            return [self._build(i) for i in range(N_FOR)[k]]
+        if not -N_FOR <= k < N_FOR:
+            raise IndexError(k)
+        return self._build(k % N_FOR)
 
 
 def _collocate_run(
@@ -415,13 +463,26 @@ def collocate_plan(
 class DayAssessment:
     """A day's assessment built batch by batch (:meth:`add`): each batch's CrIS granules collocated once
     (and once more lifted, for the parallax), the estimate made over every granule so far whenever asked
-    (:meth:`result`), so that a day can stop at the precision it needs."""
+    (:meth:`result`), so that a day can stop at the precision it needs. Each granule's perturbed cones are
+    kept on disk (:mod:`~monitor.assessment.spool`) until :meth:`close` (or the context's end): memory holds
+    one granule's collocation and one FOR's estimate, not the day."""
 
     def __init__(self, satellite: str, cfg: AssessmentConfig | None = None, workers: int = 1) -> None:
         self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
         self.samples: list[GranuleSamples] = []
         self.probe: list[GranuleSamples] = []
         self.skipped: list[tuple[str, str]] = []
+        self._spool = Spool()
+
+    def __enter__(self) -> DayAssessment:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Remove the day's spooled samples (the assessment is done with)."""
+        self._spool.close()
 
     def add(
         self,
@@ -443,8 +504,8 @@ class DayAssessment:
             # the pixels lifted by the probe's height per K (monitor.estimation.parallax chooses the day's)
             probe = _collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else []
         self.skipped += list(case.skipped) + skipped
-        self.samples += samples
-        self.probe += probe
+        self.samples += [s.kept_in(self._spool) for s in samples]
+        self.probe += [s.kept_in(self._spool) for s in probe]
         if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
             raise StopRequested
 
@@ -476,9 +537,9 @@ def assess_plan(
 ) -> AssessmentResult:
     """Assess every CrIS granule of *case* in one batch (:class:`DayAssessment`); granules that fail are
     skipped with their reason, a stop request ends it with :class:`StopRequested`."""
-    day = DayAssessment(case.satellite, cfg, workers)
-    day.add(case, progress, should_stop, timings)
-    return day.result(timings)
+    with DayAssessment(case.satellite, cfg, workers) as day:
+        day.add(case, progress, should_stop, timings)
+        return day.result(timings)
 
 
 def assess_paths(

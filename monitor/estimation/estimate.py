@@ -43,7 +43,7 @@ part of the error enters by construction.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
 
@@ -550,7 +550,7 @@ KmOf = Callable[[int, float, float], tuple[float, float, np.ndarray]]
 
 
 def day_offsets(
-    per_for: list[ForSamples],
+    per_for: Sequence[ForSamples],
     cfg: AssessmentConfig,
     step_urad: float,
     km: KmOf | None = None,
@@ -560,21 +560,24 @@ def day_offsets(
     sigma (granules that directly follow one another, *follows* (granules,) bool, counted as fewer by the
     day's correlation of their replicates: :mod:`monitor.estimation.jackknife`) and ``floor_urad`` in
     quadrature, flags, the intercalibration; in km where *km* (FOR index 0-based, turn in rad) gives the
-    mean in-track and cross-track km of a turn and its Jacobian (km/rad), NaN without."""
-    m = per_for[0].d_k.shape[1]
-    cube = np.full((len(per_for), m, m), np.nan)
+    mean in-track and cross-track km of a turn and its Jacobian (km/rad), NaN without. *per_for* may build
+    each FOR's samples when indexed (a long day's are read from disk): each is taken once, and dropped once
+    estimated."""
     reach = reach_steps(step_urad * URAD)
+
+    def one(k: int) -> tuple[ForEstimate | None, np.ndarray]:
+        """FOR k's estimate (None with fewer than 3 samples) and its samples' CrIS BT."""
+        s = per_for[k]
+        return (
+            estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty, reach) if len(s) >= 3 else None
+        ), s.cris_k
+
     # the FORs are independent: estimated on the assessment's threads (numpy and the compiled BT inversion
     # leave the interpreter's lock), each the same numbers as alone
     with ThreadPoolExecutor(max_workers=max(1, cfg.workers), thread_name_prefix="estimate") as pool:
-        estimates = list(
-            pool.map(
-                lambda s: (
-                    estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty, reach) if len(s) >= 3 else None
-                ),
-                per_for,
-            )
-        )
+        estimates, cris = (list(x) for x in zip(*pool.map(one, range(len(per_for))), strict=True))
+    m = next((e.cost.shape[0] for e in estimates if e is not None), 2 * cfg.half_steps + 1)
+    cube = np.full((len(per_for), m, m), np.nan)
     series = [
         (e.granules, e.replicates)
         for e in estimates
@@ -592,8 +595,8 @@ def day_offsets(
     )
     fors = []
     pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
-    for k, s in enumerate(per_for):
-        n = len(s)
+    for k, cris_k in enumerate(cris):
+        n = len(cris_k)
         flags = [FLAG_FEW_SAMPLES] if n < max(cfg.min_samples, 3) else []
         x = y = sig_a = sig_b = np.nan
         g = np.full((m, m), np.nan)
@@ -625,7 +628,7 @@ def day_offsets(
             cube[k] = g
             flags += best.flags
             if best.refined:
-                pooled.append((s.cris_k, best.d_opt + s.cris_k))
+                pooled.append((cris_k, best.d_opt + cris_k))
             # the kernel used: the footprint where a response was fitted, else the cone (too few FOVs, cone
             # means, no refined minimum), said in the flags, its floor the cone's
             used = Kernel.FOOTPRINT if best.footprint is not None else Kernel.TOP_HAT

@@ -12,7 +12,7 @@ the probe kappa1 (V1), and for a fraction f
 is the collocation at kappa = f kappa1 to first order (a lift moves a pixel by a small part of a cone; a cone
 mean moves linearly with the pixels that cross its edge). The day's f is where the sum over the FORs, and over
 each FOR's three FOV rows (:data:`ROWS`), of their own cost minimum (the configured cost, through the paper's
-cone scaled to the width the FOR's response reads, :func:`matched_cones`) is least: a wrong scale leaves each
+cone scaled to the width the FOR's response reads, :func:`matched_cone`) is least: a wrong scale leaves each
 cloud edge turned by an amount that grows with its height, which no single turn of a row can undo. Each row
 has its own turn because an error of the EP's FOV positions turns the rows apart, the same for every scene, as
 the parallax of one cloud height does: one turn for the whole FOR would take a lift for it (a case whose rows
@@ -67,12 +67,11 @@ def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
     return replace(s0, d_k=s0.d_k + f * (s1.d_k - s0.d_k), annuli_rad=annuli)
 
 
-def matched_cones(
-    s0: list[ForSamples], s1: list[ForSamples], cost: Cost
-) -> tuple[list[ForSamples], list[ForSamples]]:
-    """The FORs' samples at no lift (*s0*) and at the probe's (*s1*), their surfaces through the paper's
-    cone scaled by the half-peak width each FOR's response reads against the nominal, where it has annuli
-    (elsewhere the cone's, as they came).
+def matched_cone(a: ForSamples, b: ForSamples, cost: Cost) -> tuple[ForSamples, ForSamples]:
+    """A FOR's samples at no lift (*a*) and at the probe's (*b*), their surfaces through the paper's cone
+    scaled by the half-peak width the FOR's response reads against the nominal, where it has annuli
+    (elsewhere the cone's, as they came); kept compact for the day's search (float32 surfaces, no annuli:
+    a day of 100 granules holds 30 of them at once).
 
     The paper's cone wants a lift that is not there where the response is narrower than it: flat-cloud
     days seen through responses 5 % narrower chose 259 and 191 m/K, which left 26 and 20 urad RMS in-track;
@@ -80,18 +79,17 @@ def matched_cones(
     too, but read the lift of days with high clouds short (90 and 124 m/K against the cone's 151 and 175 at
     8 and 6.5 K/km) and their rows ahead minus behind 73 and 90 urad short; the scaled cone chose 111 and
     168 (2026-11-26, 6 granules; docs/science.md, "Responses off the table")."""
-    out0, out1 = [], []
-    for a, b in zip(s0, s1, strict=True):
-        w = fitted_response(a, cost)
-        width = np.nan if w is None else widths_of_weights(a.radii_rad, w)[0.5]
-        if not np.isfinite(width):
-            out0.append(a)
-            out1.append(b)
-            continue
+    w = fitted_response(a, cost)
+    width = np.nan if w is None else widths_of_weights(a.radii_rad, w)[0.5]
+    if np.isfinite(width):
         cone = top_hat_weights(a.radii_rad, width / 2 * FOV_HALF_ANGLE_RAD / HALF_WIDTH_50_RAD)
-        out0.append(through(a, cone))
-        out1.append(through(b, cone))
-    return out0, out1
+        a, b = through(a, cone), through(b, cone)
+    return _compact(a), _compact(b)
+
+
+def _compact(s: ForSamples) -> ForSamples:
+    """*s* with its surface in float32 (BT differences of a few K keep ~1e-6 K) and no annuli."""
+    return replace(s, d_k=s.d_k.astype(np.float32), annuli_rad=None)
 
 
 def day_cost(
@@ -106,7 +104,7 @@ def day_cost(
         groups = [keep] if a.fov is None else [keep & np.isin(a.fov, fovs) for fovs in ROWS]
         for sel in groups:
             if sel.sum() >= 3:
-                d = a.d_k[sel] + f * (b.d_k[sel] - a.d_k[sel])
+                d = _lifted(a.d_k[sel], b.d_k[sel], f)
                 total += float(np.nanmin(cost_surface(d, a.cris_k[sel], cost)))
     return total
 
@@ -147,6 +145,12 @@ def day_lift(s0: list[ForSamples], s1: list[ForSamples], cost: Cost) -> tuple[fl
     return f, sigma_f
 
 
+def _lifted(d0: np.ndarray, d1: np.ndarray, f: float) -> np.ndarray:
+    """The surfaces (float64) at fraction *f* of the probe's lift from those at none and at the probe's."""
+    d0 = d0.astype(np.float64)
+    return d0 + f * (d1 - d0)
+
+
 def _jackknife_sigma(replicates: np.ndarray) -> float:
     """The delete-one jackknife standard error from the replicates' estimates."""
     g = len(replicates)
@@ -158,7 +162,7 @@ def sensitivity(s0: ForSamples, s1: ForSamples, f: float, cost: Cost) -> np.ndar
     behind (alpha, beta): (4,), NaN where a minimum is missing."""
     ends = []
     for df in (-SENSITIVITY_STEP, SENSITIVITY_STEP):
-        d = s0.d_k + (f + df) * (s1.d_k - s0.d_k)
+        d = _lifted(s0.d_k, s1.d_k, f + df)
         xy = list(find_minimum(cost_surface(d, s0.cris_k, cost))[:2])
         rows = [find_minimum(cost_surface(d[sel], s0.cris_k[sel], cost))[:2] for sel in _row_masks(s0)]
         xy += list(np.subtract(rows[0], rows[1])) if len(rows) == 2 else [np.nan, np.nan]

@@ -358,60 +358,63 @@ def assess_in_batches(
     seconds of ``fetch`` and ``assess``."""
     s = cfg.scenes
     a = cfg.assessment
-    estimate = (assessor or DayAssessment)(satellite, a, a.workers)
-    budget_bytes = cfg.source.daily_budget_mb * 1e6
-    budget_s = cfg.schedule.run_budget_min * 60.0
-    taken = batches = 0
-    costliest_s = costliest_bytes = 0.0
-    label = f"{satellite} {day}"
-    while True:
-        batch = ranked[taken : taken + min(s.keep, s.max_granules - taken)]
-        t1, bytes1 = time.perf_counter(), source.spent_bytes
-        logs.stage("fetch")
-        case = fetch_plan(
-            source, satellite, batch, stop, ProgressLines(f"{label}: fetched scenes", len(batch))
-        )
-        t2 = time.perf_counter()
-        logs.stage("assess")
-        LOG.info(
-            "batch %d: assessing %d CrIS granule(s) against %d VIIRS granule(s)",
-            batches + 1, len(case.cris), len(case.viirs_all),
-        )  # fmt: skip
-        estimate.add(case, progress or ProgressLines(f"{label}: assessed granules", len(case.cris)), stop)
-        result = estimate.result()
-        t3 = time.perf_counter()
-        timings["fetch"] = timings.get("fetch", 0.0) + t2 - t1
-        timings["assess"] = timings.get("assess", 0.0) + t3 - t2
-        taken, batches = taken + len(batch), batches + 1
-        costliest_s = max(costliest_s, t3 - t1)
-        costliest_bytes = max(costliest_bytes, source.spent_bytes - bytes1)
-        sigma = result.day_sigma_urad()
-        if stop():
-            raise StopRequested
-        if s.target_sigma_urad is None:
-            why = DayStop.ONE_BATCH
-        elif sigma is not None and sigma <= s.target_sigma_urad:
-            why = DayStop.TARGET
-        elif taken >= len(ranked):
-            why = DayStop.CANDIDATES
-        elif taken >= s.max_granules:
-            why = DayStop.MAX_GRANULES
-        elif source.spent_bytes + costliest_bytes > budget_bytes:
-            why = DayStop.BYTES
-        elif t3 - started + costliest_s > budget_s:
-            why = DayStop.TIME
-        else:
-            LOG.info(
-                "after %d granule(s) the day's sigma is %s urad; target %g", taken, sigma, s.target_sigma_urad
+    with (assessor or DayAssessment)(satellite, a, a.workers) as estimate:  # its spool removed at the end
+        budget_bytes = cfg.source.daily_budget_mb * 1e6
+        budget_s = cfg.schedule.run_budget_min * 60.0
+        taken = batches = 0
+        costliest_s = costliest_bytes = 0.0
+        label = f"{satellite} {day}"
+        while True:
+            batch = ranked[taken : taken + min(s.keep, s.max_granules - taken)]
+            t1, bytes1 = time.perf_counter(), source.spent_bytes
+            logs.stage("fetch")
+            case = fetch_plan(
+                source, satellite, batch, stop, ProgressLines(f"{label}: fetched scenes", len(batch))
             )
-            continue
-        precision = DayPrecision(taken, batches, sigma, s.target_sigma_urad, why)
-        LOG.info("precision: %s", precision.text())
-        return (
-            result,
-            precision,
-            batch_decisions(ranked, taken, s.keep, f"the day stopped at {taken} ({why})"),
-        )
+            t2 = time.perf_counter()
+            logs.stage("assess")
+            LOG.info(
+                "batch %d: assessing %d CrIS granule(s) against %d VIIRS granule(s)",
+                batches + 1, len(case.cris), len(case.viirs_all),
+            )  # fmt: skip
+            estimate.add(case, progress or ProgressLines(f"{label}: assessed granules", len(case.cris)), stop)
+            result = estimate.result()
+            t3 = time.perf_counter()
+            timings["fetch"] = timings.get("fetch", 0.0) + t2 - t1
+            timings["assess"] = timings.get("assess", 0.0) + t3 - t2
+            taken, batches = taken + len(batch), batches + 1
+            costliest_s = max(costliest_s, t3 - t1)
+            costliest_bytes = max(costliest_bytes, source.spent_bytes - bytes1)
+            sigma = result.day_sigma_urad()
+            if stop():
+                raise StopRequested
+            if s.target_sigma_urad is None:
+                why = DayStop.ONE_BATCH
+            elif sigma is not None and sigma <= s.target_sigma_urad:
+                why = DayStop.TARGET
+            elif taken >= len(ranked):
+                why = DayStop.CANDIDATES
+            elif taken >= s.max_granules:
+                why = DayStop.MAX_GRANULES
+            elif source.spent_bytes + costliest_bytes > budget_bytes:
+                why = DayStop.BYTES
+            elif t3 - started + costliest_s > budget_s:
+                why = DayStop.TIME
+            else:
+                LOG.info(
+                    "after %d granule(s) the day's sigma is %s urad; target %g",
+                    taken,
+                    sigma,
+                    s.target_sigma_urad,
+                )
+                continue
+            precision = DayPrecision(taken, batches, sigma, s.target_sigma_urad, why)
+            LOG.info("precision: %s", precision.text())
+            return (
+                result,
+                precision,
+                batch_decisions(ranked, taken, s.keep, f"the day stopped at {taken} ({why})"),
+            )
 
 
 def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.date) -> RunOutcome:

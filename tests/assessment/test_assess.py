@@ -121,15 +121,32 @@ def test_reading_only_the_reachable_viirs_scans_changes_no_bit(cases, monkeypatc
 
 def test_a_day_assessed_in_batches_is_the_day_assessed_at_once(cases, case_plan):
     """Batches in any order give the one-batch estimate: the granules are put back in time order before
-    the estimate (the jackknife's consecutive granules), and each is collocated the same way alone."""
+    the estimate (the jackknife's consecutive granules), and each is collocated the same way alone. The
+    day keeps its cones on disk, reads them back exactly, and removes them when closed."""
     from dataclasses import replace
 
-    from monitor.assessment.assess import DayAssessment
+    from monitor.assessment.assess import DayAssessment, cost_and_offsets
+    from monitor.assessment.spool import OnDisk
 
     _, _, at_once = cases.get()
-    day = DayAssessment(case_plan.satellite, AssessmentConfig())
-    for g in reversed(case_plan.cris):  # the later granule first
-        day.add(replace(case_plan, cris=[g], viirs={g.key: case_plan.viirs[g.key]}, skipped=[]))
-    batched = day.result()
+    cfg = AssessmentConfig()
+    with DayAssessment(case_plan.satellite, cfg) as day:
+        for g in reversed(case_plan.cris):  # the later granule first
+            day.add(replace(case_plan, cris=[g], viirs={g.key: case_plan.viirs[g.key]}, skipped=[]))
+        batched = day.result()
+        kept = day.samples + day.probe
+        assert kept and all(
+            isinstance(s.bt_viirs_k, OnDisk) and isinstance(s.annuli_rad, OnDisk) for s in kept
+        )
+
+        def in_memory(samples):
+            return [replace(s, bt_viirs_k=s.bt_viirs_k[...], annuli_rad=s.annuli_rad[...]) for s in samples]
+
+        in_time = sorted(day.samples, key=lambda s: s.info.start)
+        probe = sorted(day.probe, key=lambda s: s.info.start)
+        memory = cost_and_offsets(in_memory(in_time), cfg, day.skipped, day.satellite, in_memory(probe))
+        spool = kept[0].bt_viirs_k.path.parent
     assert [g.granule_id for g in batched.granules] == [g.granule_id for g in at_once.granules]
     assert [f.to_dict() for f in batched.fors] == [f.to_dict() for f in at_once.fors]
+    assert [f.to_dict() for f in memory.fors] == [f.to_dict() for f in batched.fors]
+    assert not spool.exists()  # removed with the day

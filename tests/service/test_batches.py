@@ -10,6 +10,7 @@ import time
 import pytest
 from prometheus_client import generate_latest
 
+from monitor.assessment.assess import DayAssessment
 from monitor.config.file import load_config
 from monitor.core.records import DayPrecision
 from monitor.core.vocabulary import DayStop
@@ -28,10 +29,11 @@ def scaled(cases, seconds_per_batch=0.0):
     """A stand-in estimate: the cached case's result with every sigma ONE_GRANULE_URAD / sqrt(granules)."""
     _, _, reference = cases.get()
 
-    class Scaled:
+    class Scaled(DayAssessment):  # the batches, fetching and recording are real; the estimate stands in
         batches: list = []
 
         def __init__(self, satellite, config, workers):
+            super().__init__(satellite, config, workers)
             self.granules = 0
 
         def add(self, case, *args, **kw):

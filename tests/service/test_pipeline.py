@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from monitor.assessment.assess import DayAssessment
 from monitor.config.file import load_config
 from monitor.core.vocabulary import EventKind
 from monitor.service.pipeline import days_to_run, run_day
@@ -56,10 +57,7 @@ def test_run_is_recorded_and_idempotent(cases, tmp_path, monkeypatch):
     assert store.latest_precision("j01") == first.precision
     seen = []
 
-    class SameNumbers:  # the rerun pays for no second assessment: the recording is tested
-        def __init__(self, satellite, config, workers):
-            pass
-
+    class SameNumbers(DayAssessment):  # the rerun pays for no second assessment: the recording is tested
         def add(self, case, *args, **kw):
             seen.append(len(case.cris))
 
