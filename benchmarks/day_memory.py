@@ -1,14 +1,14 @@
 """Peak memory of a long simulated day assessed in batches: does it grow with the granules?
 
-    python -m benchmarks.day_memory [--granules 100] [--keep 14] [--seed 1] [--rows FILE]
+    python -m benchmarks.day_memory [--granules 100] [--keep 14] [--seed 1] [--data DIR] [--rows FILE]
 
-A day of *granules* simulated CrIS granules (clouds on the ground, the paper profile) is collocated by a
-:class:`~monitor.assessment.assess.DayAssessment` in batches of *keep*, as the daily run does with a
-precision target, with the default configuration (the footprint kernel and the parallax probe: two
-collocations per granule). The estimate is made after the first batch (the paper's 14-granule day) and after
-the last. Printed: the process's peak resident memory (VmHWM, the simulation's reset away) after each, and
-the seconds. The daily run re-estimates after every batch; the estimate's memory is that of its granule
-count, so the last one is the peak either way.
+A day of *granules* simulated CrIS granules (clouds on the ground, the paper profile; simulated in *data*
+once and reused) is collocated by a :class:`~monitor.assessment.assess.DayAssessment` in batches of *keep*,
+as the daily run does with a precision target, with the default configuration (the footprint kernel and
+the parallax probe: two collocations per granule). The estimate is made after the first batch (the paper's
+14-granule day) and after the last. Printed: the process's peak resident memory (VmHWM, the simulation's
+reset away) after each, and the seconds. The daily run re-estimates after every batch; the estimate's
+memory is that of its granule count, so the last one is the peak either way.
 """
 
 from __future__ import annotations
@@ -33,19 +33,22 @@ def main() -> None:
     p.add_argument("--granules", type=int, default=100)
     p.add_argument("--keep", type=int, default=14)
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--data", help="simulate the case here, or reuse the one simulated here before")
     p.add_argument("--rows", help="append the JSON row here")
     args = p.parse_args()
     cfg = AssessmentConfig()
     with tempfile.TemporaryDirectory(prefix="crisgeo-memory-") as tmp:
+        data = Path(args.data or tmp)
         t0 = time.perf_counter()
-        simulate_case(Path(tmp), granules=args.granules, profile="paper", seed=args.seed)
+        if not (data / "truth.json").exists():
+            simulate_case(data, granules=args.granules, profile="paper", seed=args.seed)
         simulated_s = time.perf_counter() - t0
         warm_up()
         if not reset_peak_rss():
             raise SystemExit(
                 "this system cannot reset the peak memory count: the simulation's would be counted"
             )
-        case = plan([Path(tmp)])
+        case = plan([data])
         points = []
         t0 = time.perf_counter()
         with DayAssessment(case.satellite, cfg, cfg.workers) as day:
