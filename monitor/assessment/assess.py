@@ -211,11 +211,10 @@ def for_samples(
     """The estimator's input for FOR k (0-based): every usable FOV of it over the granules (*band*, the
     satellite's I5 band, for the footprint kernel)."""
     m = len(offsets_rad(cfg))
-    d, cris, granule, scan, fov, annuli = [], [], [], [], [], []
+    d, granule, scan, fov, annuli = [], [], [], [], []
     for g_i, s in enumerate(samples):
         use = s.usable[:, k]  # (nscan, 9)
         d.append((s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]).astype(np.float64))
-        cris.append(s.bt_cris_k[:, k][use].astype(np.float64))
         scans, fovs = np.nonzero(use)  # the scan and FOV of each sample
         granule.append(np.full(scans.size, g_i))
         scan.append(scans)
@@ -225,7 +224,7 @@ def for_samples(
     footprint = len(KERNELS[cfg.kernel]) > 1
     return ForSamples(
         np.concatenate(d) if d else np.empty((0, m, m)),
-        np.concatenate(cris) if cris else np.empty(0),
+        _cris_k(samples, k),
         np.concatenate(granule) if granule else np.empty(0, int),
         np.concatenate(scan) if scan else np.empty(0, int),
         np.concatenate(annuli) if footprint and annuli else None,
@@ -341,7 +340,7 @@ def paired(
 
 
 def _cris_k(samples: list[GranuleSamples], k: int) -> np.ndarray:
-    """The CrIS BT (K) of FOR k's usable FOVs over the granules (what :func:`for_samples` puts in cris_k)."""
+    """The CrIS BT (K) of FOR k's usable FOVs over the granules, in order (the samples' cris_k)."""
     return np.concatenate([s.bt_cris_k[:, k][s.usable[:, k]] for s in samples] or [np.empty(0)]).astype(
         np.float64
     )
