@@ -37,8 +37,9 @@ FOR on the rows thus aligned: the FOR offset is the rows' common turn, and the r
 surface still finds apart plus the move.
 
 **The uncertainty** is the delete-one-granule jackknife (:mod:`monitor.estimation.jackknife`): each replicate
-repeats the estimate (its own weights, its own refined minimum) without one granule, so the scene-to-scene
-part of the error enters by construction.
+repeats the estimate (its own weights, its own refined minimum) without one granule (a run of consecutive
+granules on a day of more than :data:`~monitor.estimation.jackknife.MAX_GROUPS`), so the scene-to-scene part
+of the error enters by construction.
 """
 
 from __future__ import annotations
@@ -142,8 +143,9 @@ class ForEstimate:
     footprint: Footprint | None = None
     rows: tuple[float, float] = (np.nan, np.nan)  # the rows ahead minus behind (steps), FOV_ROWS
     rows_sigma: tuple[float, float] = (np.nan, np.nan)
-    # the offsets' jackknife replicates (G, 2) and the granule each leaves out (G,), where the groups are
-    # granules: the day's correlation of consecutive granules is estimated from them (jackknife.py)
+    # the offsets' jackknife replicates (G, 2) and the first and last granule each leaves out (G, 2), where
+    # the groups are granules or runs of them: the day's correlation of consecutive granules is estimated
+    # from them (jackknife.py)
     replicates: np.ndarray | None = None
     granules: np.ndarray | None = None
     cone: tuple[float, float] = (

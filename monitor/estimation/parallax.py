@@ -20,11 +20,12 @@ were 250 urad apart chose f = 1.9 for a truth of ~1.3).
 f is searched on :data:`FRACTIONS` and refined by the parabola through the least three; it stays within
 them (0 where the cost prefers no lift).
 
-Its uncertainty is derived like the offsets': the delete-one-granule jackknife of f (each replicate
-searched again about the day's f), sigma_f^2 = (G - 1)/G sum (f_g - mean)^2. The lift is kept only where
-it lowers the day's cost by more than twice the jackknife sigma of that gain; else the day is estimated
-without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules nothing can be judged: no
-lift. A day whose clouds lie on the ground can prefer a small lift by a hair of its cost, which would turn
+Its uncertainty is derived like the offsets': the delete-one-granule jackknife of f (each replicate searched
+again about the day's f; a run of consecutive granules per replicate on a long day,
+:func:`monitor.estimation.jackknife.granule_runs`), sigma_f^2 = (G - 1)/G sum (f_g - mean)^2. The lift is kept
+only where it lowers the day's cost by more than twice the jackknife sigma of that gain; else the day is
+estimated without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules nothing can be judged:
+no lift. A day whose clouds lie on the ground can prefer a small lift by a hair of its cost, which would turn
 its rows apart by tens of urad: the test keeps it at none. sigma_f reaches every offset through that offset's
 sensitivity to f, by the delta method: sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference
 over +-:data:`SENSITIVITY_STEP` of that scaled cone's minimum (the FOR's, and each FOV row's for the rows'
@@ -51,6 +52,7 @@ from monitor.estimation.estimate import (
     fitted_response,
     through,
 )
+from monitor.estimation.jackknife import granule_runs
 from monitor.instrument.footprint import HALF_WIDTH_50_RAD, top_hat_weights, widths_of_weights
 
 FRACTIONS = np.linspace(0.0, 2.5, 11)
@@ -93,14 +95,14 @@ def _compact(s: ForSamples) -> ForSamples:
 
 
 def day_cost(
-    s0: list[ForSamples], s1: list[ForSamples], f: float, cost: Cost, without: int | None = None
+    s0: list[ForSamples], s1: list[ForSamples], f: float, cost: Cost, without: np.ndarray | None = None
 ) -> float:
     """The sum over the FORs and their FOV rows (:data:`ROWS`; the FOR where the samples do not say their
-    FOV), each with 3 samples or more, of their cost minimum (K) at fraction *f*; *without* granule that
-    one's samples (a jackknife replicate)."""
+    FOV), each with 3 samples or more, of their cost minimum (K) at fraction *f*; *without* granules
+    (ids) those ones' samples (a jackknife replicate)."""
     total = 0.0
     for a, b in zip(s0, s1, strict=True):
-        keep = np.ones(len(a), bool) if without is None else a.granule != without
+        keep = np.ones(len(a), bool) if without is None else ~np.isin(a.granule, without)
         groups = [keep] if a.fov is None else [keep & np.isin(a.fov, fovs) for fovs in ROWS]
         for sel in groups:
             if sel.sum() >= 3:
@@ -113,7 +115,7 @@ def day_fraction(
     s0: list[ForSamples],
     s1: list[ForSamples],
     cost: Cost,
-    without: int | None = None,
+    without: np.ndarray | None = None,
     near: float | None = None,
 ) -> float:
     """The fraction of the probe's lift at which the day's cost is least (module docstring): searched on
@@ -134,11 +136,12 @@ def day_lift(s0: list[ForSamples], s1: list[ForSamples], cost: Cost) -> tuple[fl
     declined) where the lift's gain in cost is not significant, or cannot be judged (fewer than 3
     granules: sigma NaN)."""
     f = day_fraction(s0, s1, cost)
-    granules = [int(g) for g in np.unique(np.concatenate([a.granule for a in s0]))]
+    granules = np.unique(np.concatenate([a.granule for a in s0]))
     if len(granules) < 3:
         return 0.0, float("nan")
-    f_g = np.array([day_fraction(s0, s1, cost, g, near=f) for g in granules])
-    gain_g = np.array([day_cost(s0, s1, 0.0, cost, g) - day_cost(s0, s1, f, cost, g) for g in granules])
+    runs = granule_runs(granules)
+    f_g = np.array([day_fraction(s0, s1, cost, g, near=f) for g in runs])
+    gain_g = np.array([day_cost(s0, s1, 0.0, cost, g) - day_cost(s0, s1, f, cost, g) for g in runs])
     sigma_f, sigma_gain = _jackknife_sigma(f_g), _jackknife_sigma(gain_g)
     if day_cost(s0, s1, 0.0, cost) - day_cost(s0, s1, f, cost) <= 2.0 * sigma_gain:
         return 0.0, max(sigma_f, f)

@@ -20,7 +20,7 @@ from monitor.estimation.intercal import (
     reach_steps,
     variance_scale,
 )
-from monitor.estimation.jackknife import Jackknife
+from monitor.estimation.jackknife import MAX_GROUPS, Jackknife, t_factor
 
 
 def _law(v, bias_k=0.8, gain=-0.02, curvature_k=0.3):
@@ -108,15 +108,21 @@ def test_the_variance_model_is_found_from_the_residuals():
 
 
 def test_the_jackknife_sigma_matches_the_scatter_of_independent_days():
-    """The jackknife's sigma of the bias and gain over 80 groups is the spread over fresh days (within
-    30 %)."""
+    """The jackknife's sigma of the bias and gain from 80 granules (left out in MAX_GROUPS runs), its mean
+    over ten days, is the spread over fresh days times the t's factor for the runs (within 20 %)."""
     rng = np.random.default_rng(7)
     cals = [intercalibrate(*_day(rng)) for _ in range(60)]
-    c, v, s = _day(rng)
-    jack = Jackknife.of(np.arange(len(c)) % 80, np.zeros(len(c)))
-    cal = intercalibrate(c, v, s, jack)
-    assert cal.sigma_bias_k == pytest.approx(np.std([x.bias_k for x in cals]), rel=0.3)
-    assert cal.sigma_gain_pct == pytest.approx(np.std([x.gain_pct for x in cals]), rel=0.3)
+    fits = []
+    for _ in range(10):
+        c, v, s = _day(rng)
+        jack = Jackknife.of(np.arange(len(c)) % 80, np.zeros(len(c)))
+        fits.append(intercalibrate(c, v, s, jack))
+    assert jack.groups == MAX_GROUPS
+    factor = t_factor(MAX_GROUPS - 1)
+    for name, sigma in (("bias_k", "sigma_bias_k"), ("gain_pct", "sigma_gain_pct")):
+        spread = np.std([getattr(x, name) for x in cals])
+        assert np.mean([getattr(x, sigma) for x in fits]) == pytest.approx(factor * spread, rel=0.2)
+    cal = fits[-1]
     assert cal.bias_k == pytest.approx(0.8, abs=4 * cal.sigma_bias_k)
     assert cal.gain_pct == pytest.approx(-2.0, abs=4 * cal.sigma_gain_pct)
     assert np.isnan(intercalibrate(c[:3], v[:3], s[:3]).bias_k)  # too few samples: no fit

@@ -1,16 +1,19 @@
 """The delete-one-granule jackknife: the standard error of a mean exactly (with the t's small-sample
-factor), granules as groups from four, scans below; errors over their sigma of unit variance."""
+factor), granules as groups from four, scans below, runs of granules on a long day; errors over their sigma
+of unit variance."""
 
 import numpy as np
 import pytest
 from scipy import stats
 
 from monitor.estimation.jackknife import (
+    MAX_GROUPS,
     MIN_GRANULES,
     Jackknife,
     adjacent_correlation,
     correlation_factor,
     follows_in_time,
+    granule_runs,
 )
 
 
@@ -55,6 +58,45 @@ def test_the_groups_are_granules_from_three_else_scans():
     assert Jackknife.of(np.zeros(9, int), np.arange(9) % 3) is None  # three groups: no sigma to state
 
 
+@pytest.mark.parametrize("granules", [MAX_GROUPS, MAX_GROUPS + 1, 100, 225])
+def test_a_long_day_leaves_out_runs_of_consecutive_granules(granules):
+    """Up to MAX_GROUPS granules one each; beyond, MAX_GROUPS runs that cover every granule once, in order,
+    of lengths differing by at most one."""
+    ids = np.repeat(np.arange(granules), 3)
+    runs = granule_runs(ids)
+    assert len(runs) == min(granules, MAX_GROUPS)
+    assert np.array_equal(np.concatenate(runs), np.arange(granules))
+    assert max(map(len, runs)) - min(map(len, runs)) <= 1
+    jack = Jackknife.of(ids, np.zeros(ids.size))
+    assert jack.groups == len(runs)
+    assert jack.granules.tolist() == [[r[0], r[-1]] for r in runs]
+    # each sample is left out by exactly the replicate of its run
+    left_out = np.argmin(jack.counts, axis=0)
+    assert np.array_equal(jack.granules[left_out, 0] <= ids, np.ones(ids.size, bool))
+    assert np.array_equal(ids <= jack.granules[left_out, 1], np.ones(ids.size, bool))
+    assert np.all(jack.counts.sum(axis=0) == len(runs) - 1)
+
+
+def test_runs_of_a_long_day_keep_the_sigmas_honest():
+    """Days of 100 granules whose scene errors correlate by 0.5 from one to the next: the delete-a-group
+    jackknife over 20 runs covers |error| <= 2 sigma for >= 93 %, and reads what is left of the
+    correlation between runs (it counts within a run)."""
+    rng = np.random.default_rng(12)
+    granules = np.arange(100)
+    follows = follows_in_time(32.0 * granules)
+    jack = Jackknife.of(granules, np.zeros(100))
+    covered, found = [], []
+    for _ in range(300):
+        series = _errors(rng, 100, 0.5)
+        reps = (jack.counts @ series.T) / jack.counts.sum(axis=1, keepdims=True)
+        r = adjacent_correlation([(jack.granules, reps)], follows)
+        found.append(r)
+        sigma = jack.sigma(reps) * correlation_factor(MAX_GROUPS, r)
+        covered += list(np.abs(series.mean(axis=1)) <= 2 * sigma)
+    assert np.mean(covered) >= 0.93
+    assert np.mean(found) < 0.25  # far below the granules' 0.5: it stays within the runs
+
+
 def test_nan_replicates_are_left_out():
     jack = Jackknife.of(np.arange(6), np.zeros(6))
     kept = [1.0, 2.0, 3.0, 4.0, 6.0]  # five remain: nu = 4
@@ -68,13 +110,20 @@ def test_consecutive_granules_follow_each_other():
     assert follows_in_time(starts).tolist() == [False, True, True, False, True, False]
 
 
-def _day(rng, granules, rho, series=60):
-    """*series* (FOR-directions) of delete-one replicates of the mean of *granules* consecutive granules
-    whose scene errors are an AR(1) of lag-one correlation *rho*; the truth is 0."""
+def _errors(rng, granules, rho, series=60):
+    """*series* (FOR-directions) of the scene errors of *granules* consecutive granules, an AR(1) of lag-one
+    correlation *rho* (series, granules)."""
     e = np.empty((series, granules))
     e[:, 0] = rng.normal(0.0, 1.0, series)
     for g in range(1, granules):
         e[:, g] = rho * e[:, g - 1] + np.sqrt(1 - rho**2) * rng.normal(0.0, 1.0, series)
+    return e
+
+
+def _day(rng, granules, rho, series=60):
+    """*series* (FOR-directions) of delete-one replicates of the mean of *granules* consecutive granules
+    whose scene errors are an AR(1) of lag-one correlation *rho*; the truth is 0."""
+    e = _errors(rng, granules, rho, series)
     reps = (e.sum(axis=1, keepdims=True) - e) / (granules - 1)
     return e.mean(axis=1), reps.T
 
@@ -91,7 +140,7 @@ def test_the_days_correlation_of_consecutive_granules_is_read_and_counted(rho):
     found, covered, plain = [], [], []
     for _ in range(300):
         mean, reps = _day(rng, 12, rho)
-        r = adjacent_correlation([(granules, reps)], follows)
+        r = adjacent_correlation([(jack.granules, reps)], follows)
         found.append(r)
         sigma = jack.sigma(reps)
         covered += list(np.abs(mean) <= 2 * sigma * correlation_factor(12, r))
@@ -103,4 +152,4 @@ def test_the_days_correlation_of_consecutive_granules_is_read_and_counted(rho):
     if rho:
         assert np.mean(plain) < 0.8  # what the correlation costs when ignored
     # granules hours apart: no neighbours, no correlation counted
-    assert adjacent_correlation([(granules, reps)], follows_in_time(3600.0 * granules)) == 0.0
+    assert adjacent_correlation([(jack.granules, reps)], follows_in_time(3600.0 * granules)) == 0.0
