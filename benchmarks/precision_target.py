@@ -2,11 +2,14 @@
 a target below it, batch by batch, to the reason it stopped, and its offsets against the truth.
 
     python -m benchmarks.precision_target [--granules 8] [--keep 4] [--fraction 0.75] [--clouds lapse:6.5]
-                                          [--seed 41] [--rows FILE]
+                                          [--seed 41] [--data DIR] [--rows FILE]
 
 The daily pipeline itself runs (``run_day`` on a local tree of the simulated granules, a store in a
 temporary state directory): ranking, batches, the stop, the run summary. The target is *fraction* times
 the sigma the first batch of *keep* granules reaches, so the day needs about keep / fraction^2 granules.
+Every simulated granule is a candidate (``scenes.candidates`` and ``max_granules``); the other keys are the
+defaults (``schedule.run_budget_min`` 240, ``source.daily_budget_mb``: simulated granules cost no bytes).
+*data* keeps the simulated day for another run (simulated there once).
 """
 
 from __future__ import annotations
@@ -28,14 +31,16 @@ from monitor.service.store.sqlite import Store
 from monitor.simulate.case import simulate_case
 
 
-def _day(root: Path, data: Path, name: str, keep: int, target: float | None) -> RunOutcome:
-    """One run of the daily pipeline over the simulated tree, with its own state directory."""
+def _day(root: Path, data: Path, name: str, keep: int, target: float | None, granules: int) -> RunOutcome:
+    """One run of the daily pipeline over the simulated tree (*granules* of them, every one a candidate),
+    with its own state directory."""
     state = root / name
     config = state / "c.yaml"
     state.mkdir()
     config.write_text(
         f"satellites: [j01]\nstate_dir: {state}\nsource: {{kind: local, path: {data}}}\n"
-        f"scenes: {{keep: {keep}, target_sigma_urad: {'null' if target is None else target}}}\n"
+        f"scenes: {{keep: {keep}, candidates: {granules}, max_granules: {granules}, "
+        f"target_sigma_urad: {'null' if target is None else target}}}\n"
     )
     cfg = load_config(config)
     assert cfg.store.sqlite is not None  # derived from state_dir
@@ -50,18 +55,23 @@ def main() -> None:
     p.add_argument("--fraction", type=float, default=0.75)
     p.add_argument("--clouds", default="lapse:6.5")
     p.add_argument("--seed", type=int, default=41)
+    p.add_argument("--data", help="simulate the day here, or reuse the one simulated here before")
     p.add_argument("--rows", help="append the JSON row here")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="crisgeo-precision-") as tmp:
         root = Path(tmp)
-        truth = simulate_case(
-            root / "data", granules=args.granules, profile="random", seed=args.seed, cloud_heights=args.clouds
-        )
-        first = _day(root, root / "data", "one-batch", args.keep, None)
+        data = Path(args.data) if args.data else root / "data"
+        if (data / "truth.json").exists():
+            truth = json.loads((data / "truth.json").read_text())
+        else:
+            truth = simulate_case(
+                data, granules=args.granules, profile="random", seed=args.seed, cloud_heights=args.clouds
+            )
+        first = _day(root, data, "one-batch", args.keep, None, args.granules)
         assert first.precision is not None and first.precision.sigma_urad is not None, first.reason
         target = round(args.fraction * first.precision.sigma_urad, 1)
         t0 = time.perf_counter()
-        day = _day(root, root / "data", "target", args.keep, target)
+        day = _day(root, data, "target", args.keep, target, args.granules)
         seconds = time.perf_counter() - t0
     assert day.result is not None and day.precision is not None, day.reason
     ta = np.array([f["d_alpha_urad"] for f in truth["fors"]])
