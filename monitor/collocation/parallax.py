@@ -91,15 +91,6 @@ def lifted(
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _ecef(la: float, lo: float, hh: float) -> tuple[float, float, float]:
-    """WGS84 geodetic (rad, rad, m) to ECEF (m): :func:`monitor.geometry.wgs84.geodetic_to_ecef`."""
-    s = math.sin(la)
-    n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * s * s)
-    r = (n + hh) * math.cos(la)
-    return r * math.cos(lo), r * math.sin(lo), (n * (1.0 - wgs84.E2) + hh) * s
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
     """ECEF (m) to WGS84 geodetic (rad, rad, m) by three of Bowring's iterations, enough within ~10 km of the
     ellipsoid: :func:`monitor.geometry.wgs84.ecef_to_geodetic`."""
@@ -128,10 +119,12 @@ def _lift_scans(
     out_h: np.ndarray,
 ) -> None:
     """Write into *out_** the lifted pixels (lift > 0) of every scan whose spacecraft position is known
-    (:func:`lifted`). Per scan, two passes over its lifted pixels: the first reads whether the columns come
-    in time order with the scan angle or against it (the sign of the least-squares slope of the angle over
-    the column; forward where all lie in one column), the second places each pixel, the spacecraft taken
-    at the pixel's time: the scan's middle plus its scan angle over the rotation rate."""
+    (:func:`lifted`). Per scan, two passes over its lifted pixels: the first places each GEO point in ECEF
+    (:func:`monitor.geometry.wgs84.geodetic_to_ecef`, the ellipsoid's normal with it) and reads its scan
+    angle, and whether the columns come in time order with the scan angle or against it (the sign of the
+    least-squares slope of the angle over the column; forward where all lie in one column); the second
+    moves each point, the spacecraft taken at the pixel's time: the scan's middle plus its scan angle over
+    the rotation rate."""
     cols = lat.shape[1]
     for k in numba.prange(lat.shape[0] // VIIRS_DETECTORS):
         sx, sy, sz = sat[k, 0], sat[k, 1], sat[k, 2]
@@ -143,15 +136,23 @@ def _lift_scans(
         ax, ay, az = vy * sz - vz * sy, vz * sx - vx * sz, vx * sy - vy * sx  # velocity x position
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         ax, ay, az = ax / norm, ay / norm, az / norm
-        rows = range(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS)
+        row0 = k * VIIRS_DETECTORS
+        point = np.empty((VIIRS_DETECTORS, cols, 7))  # ECEF (m), the normal, the scan angle (rad)
         count, sum_c, sum_a, sum_ca = 0, 0.0, 0.0, 0.0
         first, last = cols, -1
-        for r in rows:
+        for i in range(VIIRS_DETECTORS):
             for c in range(cols):
-                if lift[r, c] > 0:
-                    px, py, pz = _ecef(lat[r, c], lon[r, c], h[r, c])
+                if lift[row0 + i, c] > 0:
+                    la, lo, hh = lat[row0 + i, c], lon[row0 + i, c], h[row0 + i, c]
+                    sin_la, cos_la, cos_lo, sin_lo = math.sin(la), math.cos(la), math.cos(lo), math.sin(lo)
+                    n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * sin_la * sin_la)
+                    r = (n + hh) * cos_la
+                    px, py, pz = r * cos_lo, r * sin_lo, (n * (1.0 - wgs84.E2) + hh) * sin_la
                     lx, ly, lz = px - sx, py - sy, pz - sz
                     angle = math.atan2(lx * ax + ly * ay + lz * az, lx * nx + ly * ny + lz * nz)
+                    q = point[i, c]
+                    q[0], q[1], q[2], q[6] = px, py, pz, angle
+                    q[3], q[4], q[5] = cos_la * cos_lo, cos_la * sin_lo, sin_la
                     count += 1
                     sum_c += c
                     sum_a += angle
@@ -163,23 +164,20 @@ def _lift_scans(
         if last > first:
             slope = count * sum_ca - sum_c * sum_a
             order = 1.0 if slope > 0 else (-1.0 if slope < 0 else 0.0)
-        for r in rows:
+        for i in range(VIIRS_DETECTORS):
             for c in range(cols):
-                if lift[r, c] > 0:
-                    la, lo = lat[r, c], lon[r, c]
-                    px, py, pz = _ecef(la, lo, h[r, c])
-                    lx, ly, lz = px - sx, py - sy, pz - sz
-                    angle = math.atan2(lx * ax + ly * ay + lz * az, lx * nx + ly * ny + lz * nz)
-                    t = order * angle / ROTATION_RAD_S
-                    wx, wy, wz = sx + vx * t - px, sy + vy * t - py, sz + vz * t - pz  # to the spacecraft
+                if lift[row0 + i, c] > 0:
+                    q = point[i, c]
+                    t = order * q[6] / ROTATION_RAD_S
+                    wx, wy, wz = (
+                        sx + vx * t - q[0],
+                        sy + vy * t - q[1],
+                        sz + vz * t - q[2],
+                    )  # to the spacecraft
                     norm = math.sqrt(wx * wx + wy * wy + wz * wz)
                     wx, wy, wz = wx / norm, wy / norm, wz / norm
-                    cos_zen = (
-                        wx * math.cos(la) * math.cos(lo)
-                        + wy * math.cos(la) * math.sin(lo)
-                        + wz * math.sin(la)
-                    )
-                    d = lift[r, c] / cos_zen
-                    out_lat[r, c], out_lon[r, c], out_h[r, c] = _geodetic(
-                        px + d * wx, py + d * wy, pz + d * wz
-                    )
+                    d = lift[row0 + i, c] / (
+                        wx * q[3] + wy * q[4] + wz * q[5]
+                    )  # along the view: lift / cos(zen)
+                    x, y, z = _geodetic(q[0] + d * wx, q[1] + d * wy, q[2] + d * wz)
+                    out_lat[row0 + i, c], out_lon[row0 + i, c], out_h[row0 + i, c] = x, y, z
