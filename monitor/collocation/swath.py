@@ -299,10 +299,12 @@ def _weigh_scan(
     centre: np.ndarray,
     radius: np.ndarray,
     top: np.ndarray,
+    keep_area: bool,
 ) -> None:
-    """Pass 2 for scan k: vector footprints with the scan overlap removed, radiance NaN where either is
-    unusable, the bounding sphere (centre, radius + 1 m for the float32 rounding) of each block's usable
-    pixels (NaN where it has none), and the height of the scan's highest usable pixel (top[k], m).
+    """Pass 2 for scan k: vector footprints with the scan overlap removed (into *area* where *keep_area*),
+    radiance NaN where either is unusable, the bounding sphere (centre, radius + 1 m for the float32
+    rounding) of each block's usable pixels (NaN where it has none), and the height of the scan's highest
+    usable pixel (top[k], m).
 
     Each footprint is the cross product of half the differences of the pixel's neighbours along the scan
     and across the detectors; the rows it needs are held as float64 lines of coordinates padded with NaN
@@ -339,7 +341,8 @@ def _weigh_scan(
             foot[2, c] = (a0 * b1 - a1 * b0) * s
         for c in range(cols):
             x0, x1, x2 = foot[0, c], foot[1, c], foot[2, c]
-            area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
+            if keep_area:
+                area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
             if not (math.isfinite(x0) and math.isfinite(x1) and math.isfinite(x2)):
                 radiance[r, c] = np.nan
             if math.isfinite(radiance[r, c]):
@@ -376,10 +379,11 @@ def _weigh(
     centre: np.ndarray,
     radius: np.ndarray,
     top: np.ndarray,
+    keep_area: bool,
 ) -> None:
     """Pass 2 (:func:`_weigh_scan`), scans in parallel."""
     for k in numba.prange(radiance.shape[0] // VIIRS_DETECTORS):
-        _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top)
+        _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top, keep_area)
 
 
 def _np_half_diff(p: np.ndarray, axis: int) -> np.ndarray:
@@ -521,14 +525,12 @@ def swath_piece(
     radius = np.empty(centre.shape[:2])
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
-        _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
+        _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top, True)
     if seen is not None:  # searched and tested where they see, weighted by their GEO footprints
         h = np.asarray(seen[2], f32)
         _ecef(*(np.asarray(a, f32) for a in seen[:2]), h, pos)
-        with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
-            _weigh(
-                pos, h, radiance, ends_first, ends_last, step, have, np.empty_like(area), centre, radius, top
-            )
+        with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):  # the footprints at the GEO points kept
+            _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top, False)
 
     scan = pos.reshape(nscan, VIIRS_DETECTORS, cols, 3)
     mid = scan[nscan // 2]
