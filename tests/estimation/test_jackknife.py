@@ -14,6 +14,7 @@ from monitor.estimation.jackknife import (
     correlation_factor,
     follows_in_time,
     granule_runs,
+    uncertainty_note,
 )
 
 
@@ -95,6 +96,12 @@ def test_runs_of_a_long_day_keep_the_sigmas_honest():
         covered += list(np.abs(series.mean(axis=1)) <= 2 * sigma)
     assert np.mean(covered) >= 0.93
     assert np.mean(found) < 0.25  # far below the granules' 0.5: it stays within the runs
+
+
+def test_the_note_says_how_the_granules_were_left_out():
+    assert "delete-one-granule jackknife over 14 granules" in uncertainty_note(14, 0.0)
+    assert f"over 100 granules in {MAX_GROUPS} runs" in uncertainty_note(100, 0.3)
+    assert "scans within them resampled" in uncertainty_note(2, 0.0)
 
 
 def test_nan_replicates_are_left_out():
