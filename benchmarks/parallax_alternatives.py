@@ -1,10 +1,13 @@
 """The parallax correction's alternatives on simulated cases: no lift, an assumed lift (the probe's 180 m/K,
-6.5 K/km seen through the window channel), and the lift the day's cost chooses (the default). For each:
-the FOR offsets' RMS and worst error per direction, and the rows' (ahead minus behind) median error
-against the truth. The two collocations (none, the probe's) are made once per case. Prints one JSON row per
-case and alternative.
+6.5 K/km seen through the window channel), the lift the day's cost chooses (the default), and that lift with
+each FOR's high clouds left out (``--leave-out-above-km``: the samples the learnt lift puts higher than
+that above the FOR's warm scenes, its 95th percentile of CrIS BT; none on a day whose lift is declined).
+For each: the FOR offsets' RMS and worst error per direction, and the rows' (ahead minus behind) median
+error against the truth. The two collocations (none, the probe's) are made once per case. Prints one JSON
+row per case and alternative.
 
-    .venv/bin/python -m benchmarks.parallax_alternatives CASE_DIR... [--rows FILE]
+    .venv/bin/python -m benchmarks.parallax_alternatives CASE_DIR... [--leave-out-above-km 8 5 3]
+                                                         [--workers 2] [--rows FILE]
 
 A case directory is one ``crisgeo simulate`` (or ``benchmarks.acceptance --keep``) wrote, with truth.json.
 """
@@ -13,6 +16,8 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +27,8 @@ from monitor.assessment.assess import collocate_plan, cost_and_offsets, paired
 from monitor.collocation.parallax import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult
+from monitor.estimation import parallax
+from monitor.estimation.estimate import ForSamples
 from monitor.sdr.pairing import plan
 
 
@@ -42,13 +49,32 @@ def errors(result: AssessmentResult, truth: dict) -> dict:
     }
 
 
-def alternatives(case: Path) -> list[dict]:
-    """The rows of one case: none, assumed, learnt."""
+def without_high_clouds(above_km: float) -> Callable[[ForSamples, ForSamples, float], ForSamples]:
+    """:func:`monitor.estimation.parallax.blend` with the samples the lift at *f* puts more than *above_km*
+    above the FOR's warm scenes (95th percentile of its CrIS BT) left out (all kept at f = 0)."""
+    blend = parallax.blend
+
+    def blended(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
+        s = blend(s0, s1, f)
+        if f <= 0 or len(s) < 3:
+            return s
+        keep = s.cris_k >= np.percentile(s.cris_k, 95) - above_km * 1e3 / (f * PROBE_M_PER_K)
+        some = [None if a is None else a[keep] for a in (s.annuli_rad, s.fov)]
+        return replace(
+            s, d_k=s.d_k[keep], cris_k=s.cris_k[keep], granule=s.granule[keep], scan=s.scan[keep],
+            annuli_rad=some[0], fov=some[1],
+        )  # fmt: skip
+
+    return blended
+
+
+def alternatives(case: Path, leave_out_above_km: list[float], workers: int) -> list[dict]:
+    """The rows of one case: none, assumed, learnt, and learnt without the clouds above each height."""
     truth = json.loads((case / "truth.json").read_text())
-    cfg = AssessmentConfig()
+    cfg = AssessmentConfig(workers=workers)
     sat = truth["satellite"]
-    ground = collocate_plan(plan([case]), cfg, workers=2)
-    probe = collocate_plan(plan([case]), cfg, workers=2, lift_m_per_k=PROBE_M_PER_K)
+    ground = collocate_plan(plan([case]), cfg, workers=workers)
+    probe = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
     pairs = paired(ground, probe)
     assert pairs is not None
     base = {"commit": commit(), "case": case.name, "clouds": truth.get("cloud_heights", "ground")}
@@ -62,16 +88,33 @@ def alternatives(case: Path) -> list[dict]:
         },
     ]
     rows[1]["m_per_k"] = PROBE_M_PER_K
+    blend = parallax.blend
+    try:
+        for above_km in leave_out_above_km:
+            # the assessment blends each FOR through this module: its samples are thinned there
+            parallax.blend = without_high_clouds(above_km)  # type: ignore[assignment]
+            result = cost_and_offsets(ground, cfg, satellite=sat, probe=probe)
+            rows.append(
+                {
+                    **base,
+                    "alternative": f"learnt, clouds above {above_km:g} km left out",
+                    **errors(result, truth),
+                }
+            )
+    finally:
+        parallax.blend = blend
     return rows
 
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("cases", nargs="+", type=Path)
+    p.add_argument("--leave-out-above-km", nargs="*", type=float, default=[])
+    p.add_argument("--workers", type=int, default=2)
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()
     for case in args.cases:
-        for row in alternatives(case):
+        for row in alternatives(case, args.leave_out_above_km, args.workers):
             emit(row, args.rows)
 
 
