@@ -34,18 +34,19 @@ class SceneConfig(Section):
     )
     keep: int = key(
         14,
-        "Granules assessed per batch, the most informative per byte first; without target_sigma_urad the "
-        "day's only batch (the paper uses 14).",
+        "Granules of the first batch, the most informative per byte first, and the fewest of any later "
+        "one; without target_sigma_urad the day's only batch (the paper uses 14).",
         1,
         200,
     )
     min_inhomogeneity_k: float = key(0.5, "A granule whose VIIRS-BT spread is below this is not used.", 0, 50)
     target_sigma_urad: float | None = key(
         None,
-        "The day's precision goal: the median per-FOR jackknife sigma (urad, worse direction). Batches of "
-        "keep granules are assessed until it is reached, max_granules are assessed, the candidates are "
-        "spent, or the next batch would pass source.daily_budget_mb or schedule.run_budget_min. None: one "
-        "batch.",
+        "The day's precision goal: the median per-FOR jackknife sigma (urad, worse direction). Batches "
+        "are assessed until it is reached, max_granules are assessed, the candidates are spent, or keep "
+        "more granules would pass source.daily_budget_mb or schedule.run_budget_min; after the first "
+        "(keep), each takes what 1/sqrt(N) says the target needs, at least keep and at most the day so "
+        "far. None: one batch.",
         1.0,
         10000.0,
     )

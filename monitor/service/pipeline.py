@@ -32,7 +32,7 @@ from monitor.sdr.engpkt import load_library
 from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 from monitor.service import logs
-from monitor.service.scenes import Candidate, batch_decisions, rank_scenes
+from monitor.service.scenes import Candidate, batch_decisions, next_batch, rank_scenes
 from monitor.service.schedule import catch_up, no_data_horizon
 from monitor.service.sources import ALL_PRODUCTS, ListedFile, Source, SourceError
 from monitor.service.store.sqlite import Store
@@ -349,23 +349,27 @@ def assess_in_batches(
     progress: Callable[[object], None] | None = None,
     assessor: Assessor | None = None,
 ) -> tuple[AssessmentResult, DayPrecision, list[SceneDecision]]:
-    """Fetch and assess the *ranked* candidates in batches of ``scenes.keep`` until the day's sigma
+    """Fetch and assess the *ranked* candidates in batches until the day's sigma
     (:meth:`AssessmentResult.day_sigma_urad`) reaches ``scenes.target_sigma_urad`` (without a target: one
-    batch), ``scenes.max_granules`` are assessed, the candidates are spent, or the next batch, as costly
-    in bytes and seconds as the costliest so far, would pass ``source.daily_budget_mb`` or
-    ``schedule.run_budget_min`` (counted from *started*, the run's ``perf_counter``). Returns the
-    estimate over every batch, how far it went, and the candidates' decisions. *timings* gains the
-    seconds of ``fetch`` and ``assess``."""
+    batch of ``scenes.keep``), ``scenes.max_granules`` are assessed, the candidates are spent, or not even
+    ``scenes.keep`` more granules, each as costly in bytes and seconds as the costliest per granule so
+    far, fit in ``source.daily_budget_mb`` or ``schedule.run_budget_min`` (counted from *started*, the
+    run's ``perf_counter``). The first batch is ``scenes.keep``; each next one aims at the target
+    (:func:`monitor.service.scenes.next_batch`), as far as the budgets allow. Returns the estimate over
+    every batch, how far it went, and the candidates' decisions. *timings* gains the seconds of
+    ``fetch`` and ``assess``."""
     s = cfg.scenes
     a = cfg.assessment
     with (assessor or DayAssessment)(satellite, a, a.workers) as estimate:  # its spool removed at the end
         budget_bytes = cfg.source.daily_budget_mb * 1e6
         budget_s = cfg.schedule.run_budget_min * 60.0
-        taken = batches = 0
-        costliest_s = costliest_bytes = 0.0
+        sizes: list[int] = []
+        size = s.keep
+        worst_s = worst_bytes = 0.0  # the costliest granule so far (its batch's cost over its count)
         label = f"{satellite} {day}"
         while True:
-            batch = ranked[taken : taken + min(s.keep, s.max_granules - taken)]
+            taken = sum(sizes)
+            batch = ranked[taken : taken + size]
             t1, bytes1 = time.perf_counter(), source.spent_bytes
             logs.stage("fetch")
             case = fetch_plan(
@@ -375,19 +379,23 @@ def assess_in_batches(
             logs.stage("assess")
             LOG.info(
                 "batch %d: assessing %d CrIS granule(s) against %d VIIRS granule(s)",
-                batches + 1, len(case.cris), len(case.viirs_all),
+                len(sizes) + 1, len(case.cris), len(case.viirs_all),
             )  # fmt: skip
             estimate.add(case, progress or ProgressLines(f"{label}: assessed granules", len(case.cris)), stop)
             result = estimate.result()
             t3 = time.perf_counter()
             timings["fetch"] = timings.get("fetch", 0.0) + t2 - t1
             timings["assess"] = timings.get("assess", 0.0) + t3 - t2
-            taken, batches = taken + len(batch), batches + 1
-            costliest_s = max(costliest_s, t3 - t1)
-            costliest_bytes = max(costliest_bytes, source.spent_bytes - bytes1)
+            sizes.append(len(batch))
+            taken += len(batch)
+            worst_s = max(worst_s, (t3 - t1) / len(batch))
+            worst_bytes = max(worst_bytes, (source.spent_bytes - bytes1) / len(batch))
             sigma = result.day_sigma_urad()
             if stop():
                 raise StopRequested
+            left = min(len(ranked), s.max_granules) - taken
+            fit_bytes = (budget_bytes - source.spent_bytes) // worst_bytes if worst_bytes else left
+            fit_s = (budget_s - (t3 - started)) // worst_s if worst_s else left
             if s.target_sigma_urad is None:
                 why = DayStop.ONE_BATCH
             elif sigma is not None and sigma <= s.target_sigma_urad:
@@ -396,24 +404,26 @@ def assess_in_batches(
                 why = DayStop.CANDIDATES
             elif taken >= s.max_granules:
                 why = DayStop.MAX_GRANULES
-            elif source.spent_bytes + costliest_bytes > budget_bytes:
+            elif fit_bytes < min(s.keep, left):
                 why = DayStop.BYTES
-            elif t3 - started + costliest_s > budget_s:
+            elif fit_s < min(s.keep, left):
                 why = DayStop.TIME
             else:
+                size = int(min(next_batch(taken, sigma, s.target_sigma_urad, s.keep), left, fit_bytes, fit_s))
                 LOG.info(
-                    "after %d granule(s) the day's sigma is %s urad; target %g",
+                    "after %d granule(s) the day's sigma is %s urad; target %g: the next batch takes %d",
                     taken,
                     sigma,
                     s.target_sigma_urad,
+                    size,
                 )
                 continue
-            precision = DayPrecision(taken, batches, sigma, s.target_sigma_urad, why)
+            precision = DayPrecision(taken, len(sizes), sigma, s.target_sigma_urad, why)
             LOG.info("precision: %s", precision.text())
             return (
                 result,
                 precision,
-                batch_decisions(ranked, taken, s.keep, f"the day stopped at {taken} ({why})"),
+                batch_decisions(ranked, sizes, f"the day stopped at {taken} ({why})"),
             )
 
 

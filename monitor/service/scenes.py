@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
+import math
 from collections import Counter
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -139,17 +140,31 @@ def bytes_of(c: Candidate, covering: Counter[str]) -> float:
     )
 
 
-def batch_decisions(ranked: list[Candidate], assessed: int, batch: int, why_not: str) -> list[SceneDecision]:
-    """The decisions of the *ranked* candidates once a day has assessed the first *assessed* in batches of
-    *batch*: chosen with their rank and batch, the rest rejected for *why_not* (why the day stopped)."""
+def next_batch(taken: int, sigma_urad: float | None, target_urad: float, keep: int) -> int:
+    """How many granules the next batch takes, after *taken* have given the day's sigma *sigma_urad*
+    (None: not estimable yet) against *target_urad*: what 1 / sqrt(N) says the target needs,
+    taken * (sigma / target)^2 - taken, at least *keep* and at most *taken* (the day at most doubles).
+    The estimate is made again after each batch, and it grows with the day, so batches that grow with it
+    keep a long day's estimates linear in its granules; the ranking puts the most informative granules
+    first, so the sigma falls more slowly than 1 / sqrt(N) and the aim falls short rather than beyond."""
+    if sigma_urad is None or taken == 0:
+        return keep
+    needed = math.ceil(taken * (sigma_urad / target_urad) ** 2 - 1e-9) - taken
+    return max(keep, min(needed, taken))
+
+
+def batch_decisions(ranked: list[Candidate], sizes: list[int], why_not: str) -> list[SceneDecision]:
+    """The decisions of the *ranked* candidates once a day has assessed its first ones in batches of
+    *sizes*: chosen with their rank and batch, the rest rejected for *why_not* (why the day stopped)."""
+    batch_of = np.repeat(np.arange(1, len(sizes) + 1), sizes)
     return [
         SceneDecision(
             c.key,
             Decision.CHOSEN,
-            f"inhomogeneity {c.score_k:.2f} K, rank {i + 1}, batch {i // batch + 1}",
+            f"inhomogeneity {c.score_k:.2f} K, rank {i + 1}, batch {batch_of[i]}",
             c.score_k,
         )
-        if i < assessed
+        if i < len(batch_of)
         else SceneDecision(c.key, Decision.REJECTED, f"not assessed: {why_not}", c.score_k)
         for i, c in enumerate(ranked)
     ]

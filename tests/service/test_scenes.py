@@ -3,7 +3,7 @@ information per byte, decisions."""
 
 import datetime as dt
 
-from monitor.service.scenes import batch_decisions, bytes_of, rank_scenes
+from monitor.service.scenes import batch_decisions, bytes_of, next_batch, rank_scenes
 from monitor.service.sources import ALL_PRODUCTS
 from monitor.service.sources.local import LocalSource
 
@@ -23,7 +23,7 @@ def test_every_candidate_gets_a_decision_and_the_best_per_byte_come_first(cases)
     assert all(vs.product == "SVI05" and vg.product == "GITCO" for c in ranked for vs, vg in c.viirs)
     # one VIIRS granule covers both: the order is the score's
     assert ranked[0].score_k >= ranked[1].score_k
-    kept = batch_decisions(ranked, assessed=1, batch=1, why_not="the day stopped at 1 (one batch)")
+    kept = batch_decisions(ranked, sizes=[1], why_not="the day stopped at 1 (one batch)")
     assert [d.decision for d in kept] == ["chosen", "rejected"]
     assert kept[0].reason.endswith("rank 1, batch 1") and "one batch" in kept[1].reason
 
@@ -57,3 +57,18 @@ def test_candidates_are_spread_over_the_day(cases):
     chosen, decisions = rank_scenes(listing, source, "j01", candidates=1, min_score_k=0.0)
     assert len(chosen) == 1
     assert [d.decision for d in decisions].count("not considered") == 1
+
+
+def test_the_next_batch_aims_at_the_target_and_at_most_doubles_the_day():
+    assert next_batch(14, 5.0, 4.0, keep=14) == 14  # 1/sqrt(N) needs 22: 8 more, but at least keep
+    assert next_batch(28, 6.0, 4.0, keep=14) == 28  # needs 63: at most the day so far
+    assert next_batch(56, 5.0, 4.0, keep=14) == 32  # needs 87.5 -> 88
+    assert next_batch(100, 4.2, 4.0, keep=14) == 14
+    assert next_batch(14, None, 4.0, keep=14) == 14  # no sigma yet
+
+
+def test_the_decisions_name_each_granules_batch(cases):
+    source, listing = _listing(cases)
+    ranked, _ = rank_scenes(listing, source, "j01", candidates=40, min_score_k=0.0)
+    kept = batch_decisions(ranked, sizes=[1, 1], why_not="target reached")
+    assert [d.reason.split(", ")[-1] for d in kept] == ["batch 1", "batch 2"]
