@@ -32,9 +32,9 @@ import numba
 import numpy as np
 from scipy.ndimage import maximum_filter, uniform_filter
 
+from monitor.collocation.geodesy import ecef_m, geodetic_rad_m
 from monitor.core.constants import VIIRS_DETECTORS, VIIRS_SCAN_US
 from monitor.core.threads import KERNEL_LOCK
-from monitor.geometry import wgs84
 
 REFERENCE_HALF_PX = 40  # +-40 pixels: ~15 km at nadir, wider than a CrIS cone's reach from its edge
 PROBE_M_PER_K = 180.0  # the second collocation's lift: 6.5 K/km seen through a window transmittance ~0.85
@@ -90,22 +90,6 @@ def lifted(
     return lat, lon, h
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
-    """ECEF (m) to WGS84 geodetic (rad, rad, m) by three of Bowring's iterations, enough within ~10 km of the
-    ellipsoid: :func:`monitor.geometry.wgs84.ecef_to_geodetic`."""
-    p = math.hypot(x, y)
-    lat = math.atan2(z, p * (1.0 - wgs84.E2))
-    for _ in range(3):
-        s = math.sin(lat)
-        n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * s * s)
-        h = p * math.cos(lat) + z * s - wgs84.A_M**2 / n
-        lat = math.atan2(z, p * (1.0 - wgs84.E2 * n / (n + h)))
-    s = math.sin(lat)
-    n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * s * s)
-    return lat, math.atan2(y, x), p * math.cos(lat) + z * s - wgs84.A_M**2 / n
-
-
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _lift_scans(
     lat: np.ndarray,
@@ -120,7 +104,7 @@ def _lift_scans(
 ) -> None:
     """Write into *out_** the lifted pixels (lift > 0) of every scan whose spacecraft position is known
     (:func:`lifted`). Per scan, two passes over its lifted pixels: the first places each GEO point in ECEF
-    (:func:`monitor.geometry.wgs84.geodetic_to_ecef`, the ellipsoid's normal with it) and reads its scan
+    (:func:`monitor.collocation.geodesy.ecef_m`, the ellipsoid's normal with it) and reads its scan
     angle, and whether the columns come in time order with the scan angle or against it (the sign of the
     least-squares slope of the angle over the column; forward where all lie in one column); the second
     moves each point, the spacecraft taken at the pixel's time: the scan's middle plus its scan angle over
@@ -144,15 +128,13 @@ def _lift_scans(
             for c in range(cols):
                 if lift[row0 + i, c] > 0:
                     la, lo, hh = lat[row0 + i, c], lon[row0 + i, c], h[row0 + i, c]
-                    sin_la, cos_la, cos_lo, sin_lo = math.sin(la), math.cos(la), math.cos(lo), math.sin(lo)
-                    n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * sin_la * sin_la)
-                    r = (n + hh) * cos_la
-                    px, py, pz = r * cos_lo, r * sin_lo, (n * (1.0 - wgs84.E2) + hh) * sin_la
+                    px, py, pz = ecef_m(la, lo, hh)
+                    cos_la = math.cos(la)
                     lx, ly, lz = px - sx, py - sy, pz - sz
                     angle = math.atan2(lx * ax + ly * ay + lz * az, lx * nx + ly * ny + lz * nz)
                     q = point[i, c]
                     q[0], q[1], q[2], q[6] = px, py, pz, angle
-                    q[3], q[4], q[5] = cos_la * cos_lo, cos_la * sin_lo, sin_la
+                    q[3], q[4], q[5] = cos_la * math.cos(lo), cos_la * math.sin(lo), math.sin(la)
                     count += 1
                     sum_c += c
                     sum_a += angle
@@ -179,5 +161,5 @@ def _lift_scans(
                     d = lift[row0 + i, c] / (
                         wx * q[3] + wy * q[4] + wz * q[5]
                     )  # along the view: lift / cos(zen)
-                    x, y, z = _geodetic(q[0] + d * wx, q[1] + d * wy, q[2] + d * wz)
+                    x, y, z = geodetic_rad_m(q[0] + d * wx, q[1] + d * wy, q[2] + d * wz)
                     out_lat[row0 + i, c], out_lon[row0 + i, c], out_h[row0 + i, c] = x, y, z

@@ -41,6 +41,7 @@ from numpy.typing import ArrayLike
 from scipy.ndimage import minimum_filter1d
 from scipy.spatial import cKDTree
 
+from monitor.collocation.geodesy import ecef_m
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.core.threads import KERNEL_LOCK
 from monitor.geometry import wgs84
@@ -123,19 +124,13 @@ class ViirsSwath:
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _ecef(lat: np.ndarray, lon: np.ndarray, h: np.ndarray, out: np.ndarray) -> None:
-    """WGS84 geodetic (rad, rad, m; float32 arrays) to ECEF float32 *out* (..., 3): wgs84.geodetic_to_ecef."""
+    """WGS84 geodetic (rad, rad, m; float32 arrays) to ECEF float32 *out* (..., 3): `.geodesy.ecef_m`."""
     rows, cols = lat.shape
     for r in range(rows):
         for c in range(cols):
-            la = np.float64(lat[r, c])
-            lo = np.float64(lon[r, c])
-            hh = np.float64(h[r, c])
-            s = math.sin(la)
-            n = wgs84.A_M / math.sqrt(1.0 - wgs84.E2 * s * s)
-            rr = (n + hh) * math.cos(la)
-            out[r, c, 0] = rr * math.cos(lo)
-            out[r, c, 1] = rr * math.sin(lo)
-            out[r, c, 2] = (n * (1.0 - wgs84.E2) + hh) * s
+            out[r, c, 0], out[r, c, 1], out[r, c, 2] = ecef_m(
+                np.float64(lat[r, c]), np.float64(lon[r, c]), np.float64(h[r, c])
+            )
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
