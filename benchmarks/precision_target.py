@@ -6,7 +6,8 @@ a target below it, batch by batch, to the reason it stopped, and its offsets aga
 
 The daily pipeline itself runs (``run_day`` on a local tree of the simulated granules, a store in a
 temporary state directory): ranking, batches, the stop, the run summary. The target is *fraction* times
-the sigma the first batch of *keep* granules reaches, so the day needs about keep / fraction^2 granules.
+the sigma the first batch of *keep* granules reaches, rounded down to 0.1 urad, so the day needs about
+keep / fraction^2 granules.
 Every simulated granule is a candidate (``scenes.candidates`` and ``max_granules``); the other keys are the
 defaults (``schedule.run_budget_min`` 240, ``source.daily_budget_mb``: simulated granules cost no bytes).
 *data* keeps the simulated day for another run (simulated there once).
@@ -17,6 +18,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import json
+import math
 import tempfile
 import time
 from pathlib import Path
@@ -69,7 +71,7 @@ def main() -> None:
             )
         first = _day(root, data, "one-batch", args.keep, None, args.granules)
         assert first.precision is not None and first.precision.sigma_urad is not None, first.reason
-        target = round(args.fraction * first.precision.sigma_urad, 1)
+        target = math.floor(10 * args.fraction * first.precision.sigma_urad) / 10  # at most the fraction
         t0 = time.perf_counter()
         day = _day(root, data, "target", args.keep, target, args.granules)
         seconds = time.perf_counter() - t0
