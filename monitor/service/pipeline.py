@@ -364,11 +364,10 @@ def assess_in_batches(
         budget_bytes = cfg.source.daily_budget_mb * 1e6
         budget_s = cfg.schedule.run_budget_min * 60.0
         sizes: list[int] = []
-        size = s.keep
+        taken, size = 0, s.keep
         worst_s = worst_bytes = 0.0  # the costliest granule so far (its batch's cost over its count)
         label = f"{satellite} {day}"
         while True:
-            taken = sum(sizes)
             batch = ranked[taken : taken + size]
             t1, bytes1 = time.perf_counter(), source.spent_bytes
             logs.stage("fetch")
