@@ -21,7 +21,7 @@ import numpy as np
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.inputs import offsets_rad
-from monitor.collocation.collocate import ANNULI, los_ecef
+from monitor.collocation.collocate import ANNULI, box_half_widths_rad, los_ecef
 from monitor.config.assessment import AssessmentConfig
 
 
@@ -29,8 +29,7 @@ def shares(beta_rad: float, pixels: int, seed: int = 0) -> dict:
     """The shares in all/some/none of each disc, and the disc solves per pixel now and with an oracle, for
     a FOV at alpha 0 and *beta_rad*, *pixels* directions uniform in the kernel's tangent box."""
     off = offsets_rad(AssessmentConfig())
-    big, h = float(np.abs(off).max()), max(ANNULI)
-    half_a, half_b = big + 1.02 * h / math.cos(beta_rad), big + 1.02 * h  # the kernel's box
+    half_a, half_b = box_half_widths_rad(beta_rad, off, ANNULI)  # the kernel's box
     rng = np.random.default_rng(seed)
     a = rng.uniform(-half_a, half_a, pixels)
     b = rng.uniform(beta_rad - half_b, beta_rad + half_b, pixels)
@@ -48,7 +47,7 @@ def shares(beta_rad: float, pixels: int, seed: int = 0) -> dict:
     return {
         "commit": commit(),
         "beta_deg": round(math.degrees(beta_rad), 1),
-        "grid_reach_mrad": round(big * math.sqrt(2) * 1e3, 2),
+        "grid_reach_mrad": round(float(np.abs(off).max()) * math.sqrt(2) * 1e3, 2),
         "discs_mrad": [round(r * 1e3, 2) for r in discs],
         "all_in": [round(float(x), 3) for x in all_in.mean(1)],
         "some": [round(float(x), 3) for x in some.mean(1)],

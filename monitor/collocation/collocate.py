@@ -71,6 +71,16 @@ def reach_rad(offsets_rad: np.ndarray, radii_rad: tuple[float, ...] = TOP_HAT) -
     return max(radii_rad) + float(np.abs(offsets_rad).max()) * math.sqrt(2.0) * 1.02
 
 
+def box_half_widths_rad(
+    beta_rad: np.ndarray | float, offsets_rad: np.ndarray, radii_rad: tuple[float, ...] = TOP_HAT
+) -> tuple[np.ndarray | float, float]:
+    """Half-widths (rad) in alpha and beta of the box about a FOV's (alpha, beta) that holds the union of its
+    perturbed discs: the grid's reach plus the largest disc (2 % wider; in alpha over cos beta, the SBF
+    alpha of a fixed angle growing with the cross-track angle)."""
+    big, h_max = float(np.abs(offsets_rad).max()), max(radii_rad)
+    return big + 1.02 * h_max / np.cos(beta_rad), big + 1.02 * h_max
+
+
 def los_ecef(sbf_to_ecef: np.ndarray, alpha_rad: np.ndarray, beta_rad: np.ndarray) -> np.ndarray:
     """Unit LOS (F, 3) in ECEF of FOVs at SBF angles alpha_rad, beta_rad (F,) (equations 1-2)."""
     t = np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(np.shape(alpha_rad))], -1)
@@ -345,7 +355,6 @@ def cone_sums(
     mat = np.ascontiguousarray(sbf_to_ecef, np.float64)
     if list(radii_rad) != sorted(radii_rad):
         raise ValueError(f"disc radii must increase: {radii_rad}")
-    h_max = max(radii_rad)
     big = np.abs(offsets_rad).max()
     if m > 1 and big * big / (offsets_rad[1] - offsets_rad[0]) > MAX_GRID_SPREAD_RAD * (1 + 1e-9):
         raise ValueError(
@@ -360,8 +369,7 @@ def cone_sums(
     rng = np.where(ok_fov, fov_range_m if fov_range_m is not None else t, 1e6)
     cz = fov_cos_zen if fov_cos_zen is not None else np.abs(np.sum(wgs84.geodetic_up(centre) * los0, -1))
     cz = np.where(ok_fov, cz, 1.0)
-    half_a = big + 1.02 * h_max / np.cos(beta_rad)
-    half_b = big + 1.02 * h_max
+    half_a, half_b = box_half_widths_rad(beta_rad, offsets_rad, radii_rad)
     box = np.tan(np.stack([alpha_rad - half_a, alpha_rad + half_a, beta_rad - half_b, beta_rad + half_b], -1))
     tan_a = np.tan(offsets_rad[None, :] + alpha_rad[:, None])
     tan_b = np.tan(offsets_rad[None, :] + beta_rad[:, None])
