@@ -32,12 +32,12 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit
+from monitor.archive.configured import make_source
+from monitor.archive.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
 from monitor.collocation.collocate import warm_up
 from monitor.config.file import load_config
 from monitor.core.satellites import SATELLITES
 from monitor.service.pipeline import run_day
-from monitor.service.sources.configured import make_source
-from monitor.service.sources.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
 from monitor.service.store.sqlite import Store
 from monitor.simulate import LAYOUTS
 from monitor.simulate.case import DEFAULT_START, simulate_case

@@ -26,9 +26,9 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit, emit
+from monitor.archive.local import LocalSource
 from monitor.config.file import load_config
 from monitor.service.pipeline import RunOutcome, run_day
-from monitor.service.sources.local import LocalSource
 from monitor.service.store.sqlite import Store
 from monitor.simulate.case import simulate_case
 

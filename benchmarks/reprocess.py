@@ -20,10 +20,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from monitor.archive.local import SimulatedSource
 from monitor.collocation.collocate import warm_up
 from monitor.config.file import load_config
 from monitor.service.reprocess import period_days, reprocess
-from monitor.service.sources.local import SimulatedSource
 
 FIRST_DAY = dt.date(2024, 3, 1)
 MISSION_SATELLITE_DAYS = 3 * 3653  # 10 years of S-NPP, NOAA-20 and NOAA-21

@@ -15,7 +15,7 @@ import numpy as np
 
 
 class RemoteGranule(Protocol):
-    """A granule file read where it lies, a range at a time (``monitor.service.sources.ranged``): its base
+    """A granule file read where it lies, a range at a time (``monitor.archive.ranged``): its base
     name (a JPSS file name), ``str()`` naming it in errors (its key), and a binary file object to read it
     through. When a read of that object fails, its ``failure`` says why (the transport's reason, naming the
     key)."""

@@ -29,16 +29,17 @@ from apscheduler.triggers.cron import CronTrigger
 
 from alerts.alertmanager import post_state
 from alerts.engine import deliver, evaluate
+from monitor.archive.configured import make_source
 from monitor.config.keys import parse_listen
 from monitor.config.model import Config
+from monitor.core import logcontext
 from monitor.core.vocabulary import EventKind, RunStatus
-from monitor.service import allocator, logs
+from monitor.service import allocator
 from monitor.service.endpoint import Endpoint
 from monitor.service.health import Health
 from monitor.service.lock import InstanceLock
 from monitor.service.metrics import ServiceMetrics
 from monitor.service.pipeline import RunOutcome, days_to_run, run_day
-from monitor.service.sources.configured import make_source
 from monitor.service.store.sqlite import Store
 from monitor.service.store.timeseries import drain_outbox
 from monitor.version import __version__
@@ -91,7 +92,7 @@ class Service:
         the alerts and regenerate the report."""
         today = today or dt.datetime.now(UTC).date()
         try:
-            with self.store() as store, logs.context(satellite=satellite, day=day.isoformat()):
+            with self.store() as store, logcontext.context(satellite=satellite, day=day.isoformat()):
                 LOG.info("run %s %s", satellite, day)
                 sd_notify(f"STATUS=assessing {satellite} {day}")
                 with self.health.job(f"run {satellite} {day}", self.cfg.schedule.run_budget_min * 60):

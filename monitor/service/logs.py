@@ -7,7 +7,7 @@ is kept on one line: the lines of a traceback are joined with `` | `` (one entry
 On a terminal, times are UTC and say so (``2026-11-25T03:30:01Z``), as every time the service prints.
 
 JSON lines carry the context of the satellite-day they belong to as fields (``satellite``, ``day``,
-``stage``, ``run_id``), set by :func:`context` around the work.
+``stage``, ``run_id``), set by :func:`monitor.core.logcontext.context` around the work.
 
 Libraries speak at WARNING and above: APScheduler alone would write two INFO lines for every 30 s
 heartbeat, ~5,800 lines a day (``-v`` brings them back, with everything at DEBUG).
@@ -15,42 +15,17 @@ heartbeat, ~5,800 lines a day (``-v`` brings them back, with everything at DEBUG
 
 from __future__ import annotations
 
-import contextvars
 import datetime as dt
 import json
 import logging
 import os
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
+
+from monitor.core import logcontext
 
 # syslog priorities of the logging levels (RFC 5424: 2 critical, 3 error, 4 warning, 6 info, 7 debug)
 PRIORITY = {logging.CRITICAL: 2, logging.ERROR: 3, logging.WARNING: 4, logging.INFO: 6, logging.DEBUG: 7}
 QUIET_LIBRARIES = ("apscheduler", "urllib3", "distributed", "numba", "matplotlib", "h5py", "asyncio")
-
-_context: contextvars.ContextVar[dict | None] = contextvars.ContextVar("crisgeo_log_context", default=None)
-
-
-def _fields() -> dict:
-    return _context.get() or {}
-
-
-@contextmanager
-def context(**fields: object) -> Iterator[None]:
-    """Add *fields* (satellite, day, stage, run_id) to every line logged inside the block."""
-    token = _context.set({**_fields(), **{k: v for k, v in fields.items() if v is not None}})
-    try:
-        yield
-    finally:
-        _context.reset(token)
-
-
-def stage(name: str) -> None:
-    """Name the stage of the satellite-day under way; only inside :func:`context`, which ends it (outside
-    one the name would stay on every later line of the thread)."""
-    if _context.get() is None:
-        raise RuntimeError("logs.stage outside logs.context")
-    _context.set({**_fields(), "stage": name})
 
 
 def priority(levelno: int) -> int:
@@ -93,7 +68,7 @@ class JsonFormatter(logging.Formatter):
             "priority": priority(record.levelno),
             "logger": record.name,
             "message": record.getMessage(),
-            **{k: str(v) for k, v in _fields().items()},
+            **{k: str(v) for k, v in logcontext.fields().items()},
         }
         if record.exc_info:
             doc["exception"] = self.formatException(record.exc_info)

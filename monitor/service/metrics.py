@@ -66,7 +66,7 @@ disable_created_metrics()  # a counter's start time is not a series anyone graph
 
 
 class Counts(Protocol):
-    """What the metrics read of a run's counts (:class:`monitor.service.pipeline.RunCounts`)."""
+    """What the metrics read of a run's counts (:class:`monitor.assessment.day.RunCounts`)."""
 
     @property
     def downloaded(self) -> int: ...

@@ -1,7 +1,7 @@
 """``crisgeo reprocess``: assess a whole period on a Dask cluster; this process alone writes the store.
 
-One task per satellite-day runs :func:`monitor.service.pipeline.compute_day` (list, fingerprint, select,
-fetch, assess) on a worker and returns its :class:`~monitor.service.pipeline.DayWork`; the client records each
+One task per satellite-day runs :func:`monitor.assessment.compute_day` (list, fingerprint, select,
+fetch, assess) on a worker and returns its :class:`~monitor.assessment.DayWork`; the client records each
 as it arrives with :func:`monitor.service.pipeline.record_day`, the path of the daily run (ledger row, results
 and outbox lines in one transaction). Days already done (``ok``, or found empty for good) are skipped unless
 forced, so a second call does nothing and an interrupted call resumes. SIGINT/SIGTERM cancel what is
@@ -19,13 +19,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from monitor.archive.configured import make_source
+from monitor.assessment import DayWork, ProgressLines, compute_day
 from monitor.config.model import Config
 from monitor.core.vocabulary import RunStatus
 from monitor.service.allocator import reuse_freed_memory
 from monitor.service.lock import InstanceLock
-from monitor.service.pipeline import DayWork, ProgressLines, RunOutcome, compute_day, record_day
+from monitor.service.pipeline import RunOutcome, record_day
 from monitor.service.schedule import no_data_horizon
-from monitor.service.sources.configured import make_source
 from monitor.service.store.sqlite import Store
 
 if TYPE_CHECKING:

@@ -5,12 +5,13 @@ import datetime as dt
 import numpy as np
 import pytest
 
+from monitor.archive.local import LocalSource
+from monitor.assessment.day import day_fingerprint
 from monitor.config.file import load_config
 from monitor.core.changes import all_changes, preceding_change
 from monitor.mapping import fingerprint as fpr
 from monitor.sdr import read_file
-from monitor.service.pipeline import day_fingerprint, record_fingerprint
-from monitor.service.sources.local import LocalSource
+from monitor.service.pipeline import record_fingerprint
 from monitor.service.store.sqlite import Store
 from monitor.simulate.case import SimulationSpec, simulate_case
 

@@ -10,6 +10,7 @@ import time
 import pytest
 from prometheus_client import generate_latest
 
+from monitor.archive.local import LocalSource
 from monitor.assessment.assess import DayAssessment
 from monitor.config.file import load_config
 from monitor.core.records import DayPrecision
@@ -17,7 +18,6 @@ from monitor.core.vocabulary import DayStop
 from monitor.service.metrics import ServiceMetrics
 from monitor.service.pipeline import run_day
 from monitor.service.report.html import ReportOptions, build_report
-from monitor.service.sources.local import LocalSource
 from monitor.service.status import status_report
 from monitor.service.store.sqlite import Store
 from tests.service.test_pipeline import DAY, TODAY

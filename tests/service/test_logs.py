@@ -12,6 +12,7 @@ import time
 
 import pytest
 
+from monitor.core import logcontext
 from monitor.service import logs
 from tests.invoke import ROOT
 
@@ -76,8 +77,8 @@ def test_text_lines_are_stamped_in_utc_whatever_the_zone(captured, monkeypatch):
 def test_json_lines_carry_the_satellite_day_they_belong_to(captured):
     out = captured("json")
     log = logging.getLogger("monitor.pipeline")
-    with logs.context(satellite="j01", day="2024-06-01", run_id=7):
-        logs.stage("fetch")
+    with logcontext.context(satellite="j01", day="2024-06-01", run_id=7):
+        logcontext.stage("fetch")
         log.info("fetched")
     log.info("outside")
     inside, outside = (json.loads(line) for line in out.getvalue().splitlines())
@@ -123,9 +124,9 @@ def test_the_daemon_under_systemd_marks_a_failed_run_as_an_error_and_does_not_fl
 
 def test_a_day_computed_alone_leaves_no_context_behind(tmp_path, captured):
     """compute_day (as the reprocessing workers call it) names its stages in its own context only."""
+    from monitor.archive.local import LocalSource
+    from monitor.assessment import compute_day
     from monitor.config.file import load_config
-    from monitor.service.pipeline import compute_day
-    from monitor.service.sources.local import LocalSource
 
     out = captured("json")
     cfg = tmp_path / "c.yaml"

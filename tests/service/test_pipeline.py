@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
+from monitor.archive.local import LocalSource
 from monitor.assessment.assess import DayAssessment
 from monitor.config.file import load_config
 from monitor.core.vocabulary import EventKind
 from monitor.service.pipeline import days_to_run, run_day
-from monitor.service.sources.local import LocalSource
 from monitor.service.store.sqlite import Store
 from tests.conftest import tree_with_truncated
 
@@ -139,7 +139,6 @@ def test_source_failure_is_a_failed_run_and_an_event(tmp_path):
 def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp_path, monkeypatch):
     """Any exception inside a satellite-day stops at that day: the run is failed with its reason, the
     failure alert fires, the catch-up goes on with the next day."""
-    import monitor.service.pipeline as pipeline
     from monitor.service.daemon import Service
     from monitor.simulate.case import simulate_case
 
@@ -158,13 +157,14 @@ def test_a_poison_day_is_recorded_alerted_and_the_next_day_still_runs(cases, tmp
     log = tmp_path / "alerts.log"
     cfg = make_config(tmp_path, tree, f"alerts: {{log: {log}}}\n")
 
-    class Poisoned(pipeline.DayAssessment):
-        def add(self, case, *args, **kw):
-            if case.cris[0].key.startswith("j01_d20240601"):
-                raise RuntimeError("poison granule")
-            super().add(case, *args, **kw)
+    add = DayAssessment.add
 
-    monkeypatch.setattr(pipeline, "DayAssessment", Poisoned)
+    def poisoned(self, case, *args, **kw):
+        if case.cris[0].key.startswith("j01_d20240601"):
+            raise RuntimeError("poison granule")
+        add(self, case, *args, **kw)
+
+    monkeypatch.setattr(DayAssessment, "add", poisoned)
     outcomes = list(Service(cfg).catch_up("j01", today=DAY + dt.timedelta(days=2)))
     assert [(o.day, o.status) for o in outcomes][-2:] == [(DAY, "failed"), (DAY + dt.timedelta(days=1), "ok")]
     assert outcomes[-2].reason == "unexpected RuntimeError: poison granule"

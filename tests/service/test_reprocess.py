@@ -6,11 +6,11 @@ import threading
 
 import pytest
 
+from monitor.archive.local import LocalSource
 from monitor.config.file import load_config
 from monitor.service import allocator
 from monitor.service.pipeline import run_day
 from monitor.service.reprocess import _client, day_task, period_days, reprocess
-from monitor.service.sources.local import LocalSource
 from monitor.service.store.sqlite import Store
 
 pytestmark = pytest.mark.servers

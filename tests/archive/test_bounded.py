@@ -1,6 +1,6 @@
 """The stall window of a transfer (no server: a clock the test moves)."""
 
-from monitor.service.sources.bounded import StallWatch
+from monitor.archive.bounded import StallWatch
 from tests.conftest import Clock
 
 
@@ -38,8 +38,8 @@ def test_the_simulated_source_keeps_only_its_newest_days(tmp_path, monkeypatch):
     import time
 
     import monitor.simulate.case
+    from monitor.archive.local import IN_USE_S, SimulatedSource
     from monitor.config.source import SourceConfig
-    from monitor.service.sources.local import IN_USE_S, SimulatedSource
 
     def fake_case(target, **kw):
         target.mkdir(parents=True)
@@ -59,8 +59,8 @@ def test_the_download_cache_is_cut_to_its_size_least_recently_used_first(tmp_pat
     import os
     import time
 
+    from monitor.archive.nodd import NoddSource
     from monitor.config.source import SourceConfig
-    from monitor.service.sources.nodd import NoddSource
 
     src = NoddSource(SourceConfig(kind="nodd", cache_max_mb=2.5), tmp_path / "cache")
     folder = tmp_path / "cache" / "GITCO"

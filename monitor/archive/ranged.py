@@ -42,7 +42,7 @@ from typing import Any
 
 from fsspec.caching import MMapCache
 
-from monitor.service.sources import ListedFile, SourceError
+from monitor.archive import ListedFile, SourceError
 
 BLOCK_BYTES = 1 << 20  # 1 MiB: HDF5 metadata and the start and end of each array cost at most a block each
 RANGES_FOLDER = "ranges"

@@ -3,13 +3,13 @@
 Keys are ``<product folder>/YYYY/MM/DD/<file>``, e.g. ``CrIS-SDR-GEO/2024/06/01/GCRSO_j01_...h5``
 (docs/archive.md). Listings are narrowed with a file-name prefix and followed through continuation
 tokens (a day holds more than the 1000 keys of one page). With ``read: ranges`` (the default) a granule
-is read in place, one HTTP range request per run of missing blocks (:mod:`monitor.service.sources.ranged`);
+is read in place, one HTTP range request per run of missing blocks (:mod:`monitor.archive.ranged`);
 with ``read: whole`` downloads go to ``<name>.part`` and are renamed only when complete, of the listed
 size and, where the listing's ETag is a plain MD5, of that digest. A per-day byte budget bounds what
 one run may download, and cached files older than the retention go.
 
 Everything a server says is bounded in wall-clock time and size, so that no listing, download or range
-hangs or grows without end (:mod:`monitor.service.sources.bounded` cuts a request at its deadline, body
+hangs or grows without end (:mod:`monitor.archive.bounded` cuts a request at its deadline, body
 included): a listing page, and the headers of any answer, come within ``timeout_s``; every request of a run
 ends by the run deadline (``source.run_deadline_min``); a download or a range must keep up ``min_rate_kb_s``
 over every sliding window of ``stall_window_s`` and may not bring more bytes than listed or asked for
@@ -40,14 +40,14 @@ from urllib.parse import urljoin, urlsplit
 import requests
 import urllib3
 
+from monitor.archive import BudgetExceeded, ListedFile, SourceError, listed, ranged
+from monitor.archive.bounded import BoundedSession, DeadlinePassed, StallWatch
+from monitor.archive.ranged import BLOCK_LIST, RANGES_FOLDER
 from monitor.config.source import SourceConfig
 from monitor.core.errors import StopRequested
 from monitor.core.vocabulary import ReadMode
 from monitor.sdr.granules import GranuleRef
 from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
-from monitor.service.sources import BudgetExceeded, ListedFile, SourceError, listed, ranged
-from monitor.service.sources.bounded import BoundedSession, DeadlinePassed, StallWatch
-from monitor.service.sources.ranged import BLOCK_LIST, RANGES_FOLDER
 
 LOG = logging.getLogger("monitor.sources.nodd")  # the name journal filters know, kept
 S3_NS = "{http://s3.amazonaws.com/doc/2006-03-01/}"

@@ -6,7 +6,7 @@ over the granule's FORs, of the standard deviation of the 9 FOV BTs (K). Clouds 
 coastlines score high; uniform scenes carry no information and score near the noise. Granules
 without VIIRS I5 and GEO coverage in the listing are skipped before anything is fetched. The usable ones
 are ranked by information per byte (:func:`bytes_of`), the order in which the daily run assesses them in
-batches (:func:`monitor.service.pipeline.assess_in_batches`). Every candidate gets a decision and its reason.
+batches (:func:`monitor.assessment.day.assess_in_batches`). Every candidate gets a decision and its reason.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from monitor.archive import BudgetExceeded, ListedFile, Source, SourceError
 from monitor.core.errors import DataError
 from monitor.core.records import SceneDecision
 from monitor.core.vocabulary import Decision
@@ -27,7 +28,6 @@ from monitor.instrument.spectral import i5_band
 from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import GranuleFiles, granule_files
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
-from monitor.service.sources import BudgetExceeded, ListedFile, Source, SourceError
 
 LOG = logging.getLogger("monitor.scenes")  # the name journal filters know, kept
 COVER_MARGIN = dt.timedelta(seconds=10)

@@ -3,9 +3,9 @@ information per byte, decisions."""
 
 import datetime as dt
 
-from monitor.service.scenes import batch_decisions, bytes_of, next_batch, rank_scenes
-from monitor.service.sources import ALL_PRODUCTS
-from monitor.service.sources.local import LocalSource
+from monitor.archive import ALL_PRODUCTS
+from monitor.archive.local import LocalSource
+from monitor.assessment.scenes import batch_decisions, bytes_of, next_batch, rank_scenes
 
 DAY = dt.date(2024, 6, 1)
 

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import pytest
 
+from monitor.archive import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
+from monitor.archive.configured import make_source
+from monitor.archive.nodd import NoddSource
+from monitor.assessment import compute_day
 from monitor.config.file import load_config
 from monitor.config.source import SourceConfig
 from monitor.core.vocabulary import RunStatus
-from monitor.service.pipeline import compute_day
-from monitor.service.sources import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
-from monitor.service.sources.configured import make_source
-from monitor.service.sources.nodd import NoddSource
 from tests.servers import S3Server, nodd_key
 
 DAY = dt.date(2024, 6, 1)

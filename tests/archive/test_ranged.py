@@ -9,16 +9,16 @@ import h5py
 import numpy as np
 import pytest
 
+from monitor.archive import SourceError
+from monitor.archive.configured import make_source
+from monitor.archive.nodd import NoddSource
+from monitor.archive.ranged import BLOCK_BYTES, BLOCK_LIST
+from monitor.assessment import compute_day
 from monitor.config.file import load_config
 from monitor.config.source import SourceConfig
 from monitor.core.satellites import SATELLITES
 from monitor.core.vocabulary import RunStatus
 from monitor.sdr import GranuleError, read_file
-from monitor.service.pipeline import compute_day
-from monitor.service.sources import SourceError
-from monitor.service.sources.configured import make_source
-from monitor.service.sources.nodd import NoddSource
-from monitor.service.sources.ranged import BLOCK_BYTES, BLOCK_LIST
 from tests.servers import MotoS3, S3Server, nodd_key
 
 pytestmark = pytest.mark.servers

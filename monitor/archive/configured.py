@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from monitor.archive import Source
+from monitor.archive.local import LocalSource, SimulatedSource
+from monitor.archive.nodd import NoddSource
 from monitor.config.model import Config
-from monitor.service.sources import Source
-from monitor.service.sources.local import LocalSource, SimulatedSource
-from monitor.service.sources.nodd import NoddSource
 
 
 def make_source(cfg: Config) -> Source:

@@ -10,9 +10,9 @@ import time
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
+from monitor.archive import ListedFile, listed, on_day
 from monitor.config.source import CalibrationDifference, SourceConfig
 from monitor.sdr.products import CRIS_PRODUCTS
-from monitor.service.sources import ListedFile, listed, on_day
 
 LOG = logging.getLogger("monitor.sources.local")  # the name journal filters know, kept
 IN_USE_S = 600.0  # a simulated day listed this recently may still be read by a run
