@@ -22,7 +22,7 @@ import logging
 import requests
 
 from monitor.config.alerts import AlertSettings
-from monitor.core.records import History
+from monitor.history.records import History
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc

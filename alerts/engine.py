@@ -27,10 +27,10 @@ from alerts.rules import (
     stale_finding,
 )
 from monitor.config.alerts import AlertSettings
-from monitor.core.changes import all_changes
-from monitor.core.records import Alert, History, Silence
 from monitor.core.tables import Column, text_table
 from monitor.core.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
+from monitor.history.changes import all_changes
+from monitor.history.records import Alert, History, Silence
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc

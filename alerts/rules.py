@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monitor.config.alerts import RuleSettings
-from monitor.core.changes import preceding_change
 from monitor.core.constants import N_FOR
-from monitor.core.records import History
 from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
+from monitor.history.changes import preceding_change
+from monitor.history.records import History
 
 UTC = dt.timezone.utc
 

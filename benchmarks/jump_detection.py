@@ -24,7 +24,7 @@ import numpy as np
 
 from alerts.rules import COMPONENTS, detect_jumps
 from monitor.config.alerts import RuleSettings
-from monitor.core.changes import Change, preceding_change
+from monitor.history.changes import Change, preceding_change
 from monitor.simulate.profiles import paper_profile
 
 START = dt.date(2023, 1, 1)

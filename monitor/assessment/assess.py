@@ -34,11 +34,11 @@ from monitor.assessment.inputs import (
 from monitor.assessment.spool import OnDisk, Spool
 from monitor.collocation import collocate, swath
 from monitor.collocation.parallax import PROBE_M_PER_K
+from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, N_FOR
 from monitor.core.errors import AssessmentError, StopRequested
 from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo, Skipped
-from monitor.core.threads import parallel_threads
 from monitor.estimation import parallax
 from monitor.estimation.estimate import ForSamples, day_offsets
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note

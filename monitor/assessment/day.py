@@ -24,8 +24,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.config.model import Config
 from monitor.core import logcontext
 from monitor.core.errors import DataError, StopRequested
-from monitor.core.records import DayPrecision, SceneDecision
-from monitor.core.result import AssessmentResult
+from monitor.core.result import AssessmentResult, DayPrecision, SceneDecision
 from monitor.core.vocabulary import DayStop, RunStatus
 from monitor.mapping import fingerprint as fpr
 from monitor.sdr import read_file

@@ -22,7 +22,7 @@ import numpy as np
 
 from monitor.archive import BudgetExceeded, ListedFile, Source, SourceError
 from monitor.core.errors import DataError
-from monitor.core.records import SceneDecision
+from monitor.core.result import SceneDecision
 from monitor.core.vocabulary import Decision
 from monitor.instrument.spectral import i5_band
 from monitor.sdr import GranuleError, read_file

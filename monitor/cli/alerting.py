@@ -101,7 +101,7 @@ def cmd_alerts(args: argparse.Namespace) -> int:
 )
 def cmd_events(args: argparse.Namespace) -> int:
     """crisgeo events: list the known changes, or add one to the calendar."""
-    from monitor.core.changes import Change, add_to_calendar, listing
+    from monitor.history.changes import Change, add_to_calendar, listing
 
     cfg = load(args)
     if cfg.events_file is None:

@@ -39,8 +39,8 @@ import numpy as np
 
 from monitor.collocation import parallax
 from monitor.collocation.swath import BLOCK_PX, SwathPiece, ViirsSwath, swath_piece
+from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, MAX_GRID_SPREAD_RAD, VIIRS_DETECTORS
-from monitor.core.threads import KERNEL_LOCK
 from monitor.geometry import wgs84
 from monitor.instrument.spectral import PARALLEL_FROM, i5_band
 

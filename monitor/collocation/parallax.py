@@ -33,8 +33,8 @@ import numpy as np
 from scipy.ndimage import maximum_filter, uniform_filter
 
 from monitor.collocation.geodesy import ecef_m, geodetic_rad_m
+from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS, VIIRS_SCAN_US
-from monitor.core.threads import KERNEL_LOCK
 
 REFERENCE_HALF_PX = 40  # +-40 pixels: ~15 km at nadir, wider than a CrIS cone's reach from its edge
 PROBE_M_PER_K = 180.0  # the second collocation's lift: 6.5 K/km seen through a window transmittance ~0.85

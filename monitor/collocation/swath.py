@@ -42,8 +42,8 @@ from scipy.ndimage import minimum_filter1d
 from scipy.spatial import cKDTree
 
 from monitor.collocation.geodesy import ecef_m
+from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
-from monitor.core.threads import KERNEL_LOCK
 from monitor.geometry import wgs84
 
 BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of VIIRS_DETECTORS)

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DIAMETER_URAD, URAD
+from monitor.core.vocabulary import DayStop, Decision
 
 FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
 FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
@@ -395,3 +396,47 @@ class AssessmentResult:
     @classmethod
     def from_json(cls, text: str) -> "AssessmentResult":
         return cls.from_dict(json.loads(text))
+
+
+@dataclass(frozen=True)
+class SceneDecision:
+    """What scene selection decided for one CrIS granule, why, and its inhomogeneity score (K) where it was
+    scored."""
+
+    granule: str
+    decision: Decision
+    reason: str
+    score_k: float | None = None
+
+
+@dataclass(frozen=True)
+class DayPrecision:
+    """How far a satellite-day went for its precision: the granules assessed in how many batches, the sigma
+    they reached (urad, :meth:`monitor.core.result.AssessmentResult.day_sigma_urad`), the target (None:
+    none set), why it stopped, and the bytes read per assessed granule (MB). Stored in the run's summary
+    (``precision``), shown by ``status``, the report and ``/metrics``."""
+
+    granules: int
+    batches: int
+    sigma_urad: float | None
+    target_sigma_urad: float | None
+    stop: DayStop
+    mb_per_granule: float | None = None
+
+    def text(self) -> str:
+        """One line: ``24 granules in 2 batches, sigma 61 urad (target 60): target reached``."""
+        sigma = "no sigma" if self.sigma_urad is None else f"sigma {self.sigma_urad:.0f} urad"
+        target = "" if self.target_sigma_urad is None else f" (target {self.target_sigma_urad:g})"
+        per = "" if self.mb_per_granule is None else f", {self.mb_per_granule:.0f} MB per granule"
+        return f"{self.granules} granules in {self.batches} batch(es), {sigma}{target}{per}: {self.stop}"
+
+    def to_dict(self) -> dict:
+        """The JSON of the run summary's ``precision``."""
+        return {**asdict(self), "stop": str(self.stop)}
+
+    @classmethod
+    def from_summary(cls, summary: str | None) -> "DayPrecision | None":
+        """The precision a run's stored summary (JSON) records; None where it records none (runs before
+        the batches, days without results)."""
+        body = json.loads(summary).get("precision") if summary else None
+        return None if body is None else cls(**{**body, "stop": DayStop(body["stop"])})

@@ -17,9 +17,9 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
+from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.errors import DataError
 from monitor.core.satellites import SATELLITES
-from monitor.core.threads import KERNEL_LOCK
 from monitor.sdr.products import cris_lw_wavenumbers_cm1
 
 C1 = 1.191042972e-5  # 2hc^2, mW/(m2 sr cm-4)

@@ -28,9 +28,9 @@ import numpy as np
 
 from monitor.config.outputs import ExportConfig
 from monitor.core.constants import N_FOR
-from monitor.core.records import History
 from monitor.core.result import RELIABILITY_FLAGS, ForOffset, measures
 from monitor.core.satellites import satellite as satellite_info
+from monitor.history.records import History
 from monitor.service.store.sqlite import Store
 from monitor.version import __version__
 

@@ -56,8 +56,7 @@ from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 from prometheus_client.metrics_core import Metric
 
 from monitor.core.constants import URAD
-from monitor.core.records import DayPrecision
-from monitor.core.result import Family, ForOffset, measures
+from monitor.core.result import DayPrecision, Family, ForOffset, measures
 from monitor.core.vocabulary import DayStop, RunStatus
 from monitor.service.store.alerts import AlertState
 from monitor.service.store.sqlite import Store

@@ -27,11 +27,10 @@ from monitor.assessment import (
 from monitor.config.model import Config
 from monitor.config.schedule import ScheduleConfig
 from monitor.core import logcontext
-from monitor.core.changes import all_changes
 from monitor.core.errors import DataError
-from monitor.core.records import DayPrecision
-from monitor.core.result import AssessmentResult
+from monitor.core.result import AssessmentResult, DayPrecision
 from monitor.core.vocabulary import EventKind, RunStatus
+from monitor.history.changes import all_changes
 from monitor.service.schedule import catch_up, no_data_horizon
 from monitor.service.store.sqlite import Store
 from monitor.service.store.timeseries import change_lines, drain_outbox, result_lines, target_name

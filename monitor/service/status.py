@@ -14,10 +14,10 @@ from dataclasses import asdict, dataclass
 from enum import IntEnum
 
 from monitor.config.model import Config
-from monitor.core.records import DayPrecision, Run, Silence
-from monitor.core.result import ForOffset
+from monitor.core.result import DayPrecision, ForOffset
 from monitor.core.tables import BRIEF, for_table
 from monitor.core.vocabulary import Rule, RunStatus, Severity
+from monitor.history.records import Run, Silence
 from monitor.service.lock import holder
 from monitor.service.schedule import next_run
 from monitor.service.store.alerts import AlertState

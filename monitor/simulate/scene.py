@@ -34,7 +34,7 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.core.threads import KERNEL_LOCK
+from monitor.compiled.threads import KERNEL_LOCK
 from monitor.instrument.spectral import planck_radiance
 from monitor.simulate import terrain
 from monitor.simulate.clouds import CEILING_M, FLAT, CloudHeights

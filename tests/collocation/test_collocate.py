@@ -7,8 +7,8 @@ import pytest
 
 from monitor.assessment.inputs import KERNELS, SwathCache, piece
 from monitor.collocation import collocate, swath
+from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
-from monitor.core.threads import parallel_threads
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.geometry.perturb import perturbation_grid

@@ -8,9 +8,9 @@ import pytest
 
 from monitor.assessment.inputs import SwathCache, offsets_rad, piece, reach_us
 from monitor.collocation import collocate, swath
+from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_DETECTORS
-from monitor.core.threads import parallel_threads
 from monitor.geometry import wgs84
 from monitor.geometry.inverse import granule_geometry
 from monitor.instrument.spectral import i5_band

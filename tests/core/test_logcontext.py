@@ -10,7 +10,8 @@ def test_fields_nest_and_end_with_their_block():
     with logcontext.context(satellite="j01", day="2024-06-01", run_id=None):
         with logcontext.context(run_id=3):
             logcontext.stage("fetch")
-            assert logcontext.fields() == {"satellite": "j01", "day": "2024-06-01", "run_id": 3, "stage": "fetch"}
+            expected = {"satellite": "j01", "day": "2024-06-01", "run_id": 3, "stage": "fetch"}
+            assert logcontext.fields() == expected
         assert "stage" not in logcontext.fields() and "run_id" not in logcontext.fields()
     assert logcontext.fields() == {}
 

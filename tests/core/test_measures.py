@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from monitor.core.records import ForSeries
 from monitor.core.result import NAN, Family, ForOffset, measured, measures
 from monitor.core.tables import field_column, text_table
+from monitor.history.records import ForSeries
 from monitor.service.metrics import _StoreCollector
 from monitor.service.store.schema import result_columns
 from monitor.service.store.sqlite import Store

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 import requests
 
-from monitor.core.changes import Change
+from monitor.history.changes import Change
 from monitor.service.store.sqlite import Store
 from monitor.service.store.timeseries import change_lines, result_lines
 from monitor.simulate.history import fill_store

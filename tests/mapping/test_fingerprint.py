@@ -8,7 +8,7 @@ import pytest
 from monitor.archive.local import LocalSource
 from monitor.assessment.day import day_fingerprint
 from monitor.config.file import load_config
-from monitor.core.changes import all_changes, preceding_change
+from monitor.history.changes import all_changes, preceding_change
 from monitor.mapping import fingerprint as fpr
 from monitor.sdr import read_file
 from monitor.service.pipeline import record_fingerprint

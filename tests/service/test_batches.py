@@ -13,7 +13,7 @@ from prometheus_client import generate_latest
 from monitor.archive.local import LocalSource
 from monitor.assessment.assess import DayAssessment
 from monitor.config.file import load_config
-from monitor.core.records import DayPrecision
+from monitor.core.result import DayPrecision
 from monitor.core.vocabulary import DayStop
 from monitor.service.metrics import ServiceMetrics
 from monitor.service.pipeline import run_day

@@ -28,13 +28,13 @@ from typing import Any
 import numpy as np
 
 from monitor.config.model import Config
-from monitor.core.changes import Change, all_changes
 from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
-from monitor.core.records import Alert, DayPrecision, ForSeries
-from monitor.core.result import RELIABILITY_FLAGS, ForOffset
+from monitor.core.result import RELIABILITY_FLAGS, DayPrecision, ForOffset
 from monitor.core.satellites import SATELLITES
 from monitor.core.tables import FOR_COLUMNS, REPORT
 from monitor.core.vocabulary import RunStatus
+from monitor.history.changes import Change, all_changes
+from monitor.history.records import Alert, ForSeries
 from monitor.service.report import plots
 from monitor.service.store.alerts import AlertState
 from monitor.service.store.sqlite import Store

@@ -8,8 +8,8 @@ import sqlite3
 from contextlib import AbstractContextManager
 from typing import Any, Protocol
 
-from monitor.core.records import Alert, Delivery, FindingRecord, Silence, iso
 from monitor.core.vocabulary import AlertStatus, DeliveryStatus
+from monitor.history.records import Alert, Delivery, FindingRecord, Silence, iso
 
 
 class SilenceError(ValueError):

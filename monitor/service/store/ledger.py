@@ -6,8 +6,9 @@ from __future__ import annotations
 import datetime as dt
 import json
 
-from monitor.core.records import DayPrecision, Event, Run
+from monitor.core.result import DayPrecision
 from monitor.core.vocabulary import DONE, EventKind, RunStatus
+from monitor.history.records import Event, Run
 from monitor.service.store.database import Database
 
 

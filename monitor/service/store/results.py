@@ -12,9 +12,9 @@ from typing import Any
 import numpy as np
 
 from monitor.core.constants import N_FOR
-from monitor.core.records import DayPrecision, ForSeries, GranuleRow, SelectionRow
-from monitor.core.result import MEASURED_FIELDS, AssessmentResult, DifferenceBin, ForOffset
+from monitor.core.result import MEASURED_FIELDS, AssessmentResult, DayPrecision, DifferenceBin, ForOffset
 from monitor.core.vocabulary import RunStatus
+from monitor.history.records import ForSeries, GranuleRow, SelectionRow
 from monitor.service.store.ledger import RunLedger
 
 RESULT_FIELDS = MEASURED_FIELDS  # the results table has a column for each

@@ -33,8 +33,8 @@ from influxdb_client.client.exceptions import InfluxDBError
 from influxdb_client.client.write_api import SYNCHRONOUS
 
 from monitor.config.outputs import PublishConfig
-from monitor.core.changes import Change
 from monitor.core.result import ForOffset, measures
+from monitor.history.changes import Change
 from monitor.service.store.sqlite import Store
 
 LOG = logging.getLogger("monitor.store.timeseries")  # the name journal filters know, kept

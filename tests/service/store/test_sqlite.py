@@ -5,7 +5,7 @@ from dataclasses import astuple
 import numpy as np
 import pytest
 
-from monitor.core.records import SceneDecision
+from monitor.core.result import SceneDecision
 from monitor.core.vocabulary import Decision
 from monitor.service.store.schema import MIGRATIONS
 from monitor.service.store.sqlite import Store

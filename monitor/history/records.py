@@ -10,7 +10,7 @@ from __future__ import annotations
 import datetime as dt
 import json
 from contextlib import AbstractContextManager
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -19,8 +19,6 @@ import numpy as np
 from monitor.core.result import RELIABILITY_FLAGS, ForOffset
 from monitor.core.vocabulary import (
     AlertStatus,
-    DayStop,
-    Decision,
     DeliveryStatus,
     EventKind,
     RunStatus,
@@ -227,50 +225,6 @@ class GranuleRow:
         """The GranuleRow of a row of the store."""
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
-
-
-@dataclass(frozen=True)
-class SceneDecision:
-    """What scene selection decided for one CrIS granule, why, and its inhomogeneity score (K) where it was
-    scored."""
-
-    granule: str
-    decision: Decision
-    reason: str
-    score_k: float | None = None
-
-
-@dataclass(frozen=True)
-class DayPrecision:
-    """How far a satellite-day went for its precision: the granules assessed in how many batches, the sigma
-    they reached (urad, :meth:`monitor.core.result.AssessmentResult.day_sigma_urad`), the target (None:
-    none set), why it stopped, and the bytes read per assessed granule (MB). Stored in the run's summary
-    (``precision``), shown by ``status``, the report and ``/metrics``."""
-
-    granules: int
-    batches: int
-    sigma_urad: float | None
-    target_sigma_urad: float | None
-    stop: DayStop
-    mb_per_granule: float | None = None
-
-    def text(self) -> str:
-        """One line: ``24 granules in 2 batches, sigma 61 urad (target 60): target reached``."""
-        sigma = "no sigma" if self.sigma_urad is None else f"sigma {self.sigma_urad:.0f} urad"
-        target = "" if self.target_sigma_urad is None else f" (target {self.target_sigma_urad:g})"
-        per = "" if self.mb_per_granule is None else f", {self.mb_per_granule:.0f} MB per granule"
-        return f"{self.granules} granules in {self.batches} batch(es), {sigma}{target}{per}: {self.stop}"
-
-    def to_dict(self) -> dict:
-        """The JSON of the run summary's ``precision``."""
-        return {**asdict(self), "stop": str(self.stop)}
-
-    @classmethod
-    def from_summary(cls, summary: str | None) -> "DayPrecision | None":
-        """The precision a run's stored summary (JSON) records; None where it records none (runs before
-        the batches, days without results)."""
-        body = json.loads(summary).get("precision") if summary else None
-        return None if body is None else cls(**{**body, "stop": DayStop(body["stop"])})
 
 
 @dataclass(frozen=True)

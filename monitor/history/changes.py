@@ -21,8 +21,8 @@ from pathlib import Path
 
 import yaml
 
-from monitor.core.records import History
 from monitor.core.satellites import SATELLITES
+from monitor.history.records import History
 
 UTC = dt.timezone.utc
 INSTRUMENTS = ("cris", "viirs", "common")
