@@ -19,7 +19,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from monitor.service.report.html import ReportOptions, build_report
+from monitor.service.outputs.report.html import ReportOptions, build_report
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
 

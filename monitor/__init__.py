@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 from monitor.version import __version__
 
 if TYPE_CHECKING:
-    from monitor.service.export import ResultStore
+    from monitor.service.outputs.export import ResultStore
 
 __all__ = ["AssessmentResult", "assess_paths", "open_store", "__version__"]
 
@@ -36,6 +36,7 @@ def __getattr__(name: str) -> Any:  # the public API, imported when first used (
 def open_store(path: str | os.PathLike, create: bool = False) -> ResultStore:
     """The service's SQLite store at *path*, e.g. ``open_store(p).to_xarray("j01")`` in a notebook. A
     missing store is an error (a typo must not start an empty history) unless *create*."""
-    from monitor.service.export import ResultStore
+    from monitor.service.outputs.export import ResultStore
+    from monitor.service.store.sqlite import Store
 
-    return ResultStore(path, create=create)
+    return ResultStore(Store(path, create=create))

@@ -7,7 +7,7 @@ import re
 import matplotlib
 import pytest
 
-from monitor import open_store
+from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
 from tests.invoke import ROOT
 
@@ -27,7 +27,7 @@ def test_the_notebook_examples_run_on_a_store_of_any_length(tmp_path, days):
     import matplotlib.pyplot as plt
 
     db = tmp_path / "crisgeo.sqlite"
-    with open_store(db, create=True) as store:
+    with Store(db) as store:
         fill_store(store, ["j01"], dt.date(2026, 11, 22), days, step_day=None, seed=3)
     snippets = _snippets()
     assert snippets, "docs/results.md lost its notebook examples"

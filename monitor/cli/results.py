@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
 )
 def cmd_export(args: argparse.Namespace) -> int:
     """crisgeo export: the results as NetCDF or CSV."""
-    from monitor.service.export import ExportFormatError, NothingToExport, export
+    from monitor.service.outputs.export import ExportFormatError, NothingToExport, export
 
     cfg = load(args)
     sats = satellites_of(cfg, args.satellite)
@@ -71,7 +71,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     """crisgeo report: write the HTML report."""
     import time
 
-    from monitor.service.report.html import build_report, options_from_config
+    from monitor.service.outputs.report.html import build_report, options_from_config
 
     cfg = load(args)
     satellites_of(cfg, args.satellite)

@@ -53,7 +53,7 @@ class Family:
     label: str = ""
 
 
-# the /metrics families of the per-FOR fields (:mod:`monitor.service.metrics` adds the FOR's labels)
+# the /metrics families of the per-FOR fields (:mod:`monitor.service.outputs.metrics` adds the FOR's labels)
 OFFSET_RADIANS = Family(
     "crisgeo_for_offset_radians",
     "Latest LOS offset per FOR (spacecraft frame; the turn to apply to the CrIS LOS)",

@@ -38,10 +38,10 @@ from monitor.service import allocator
 from monitor.service.endpoint import Endpoint
 from monitor.service.health import Health
 from monitor.service.lock import InstanceLock
-from monitor.service.metrics import ServiceMetrics
+from monitor.service.outputs.metrics import ServiceMetrics
+from monitor.service.outputs.timeseries import drain_outbox
 from monitor.service.pipeline import RunOutcome, days_to_run, run_day
 from monitor.service.store.sqlite import Store
-from monitor.service.store.timeseries import drain_outbox
 from monitor.version import __version__
 
 LOG = logging.getLogger("monitor.service")  # the name journal filters know, kept
@@ -126,7 +126,7 @@ class Service:
         """Rewrite the HTML report into ``report_dir``; a report problem never stops the service."""
         if not self.cfg.report_dir:
             return
-        from monitor.service.report.html import (  # matplotlib: when first needed
+        from monitor.service.outputs.report.html import (  # matplotlib: when first needed
             build_report,
             options_from_config,
         )

@@ -1,7 +1,7 @@
 """The daemon's one HTTP endpoint (``http.listen``, loopback by default): metrics, health, the report.
 
     GET /           what is served here, as a short text
-    GET /metrics    Prometheus text format (:mod:`monitor.service.metrics`)
+    GET /metrics    Prometheus text format (:mod:`monitor.service.outputs.metrics`)
     GET /healthz    200 {"status": "ok", ...} or 503 {"status": "unhealthy", "problems": [...]}
     GET /report/    the HTML report, read-only (files under ``report_dir``; no listings, no dotfiles such as
                     the temporary ``.name.part`` of a file being rewritten, nothing outside)
@@ -35,7 +35,7 @@ INDEX = (
 
 
 class Registered(Protocol):
-    """What the endpoint serves of the metrics (:class:`monitor.service.metrics.ServiceMetrics`, a
+    """What the endpoint serves of the metrics (:class:`monitor.service.outputs.metrics.ServiceMetrics`, a
     neighbour)."""
 
     registry: CollectorRegistry
@@ -117,7 +117,7 @@ class _V6Server(ThreadingHTTPServer):
 
 
 class Endpoint:
-    """Serves *metrics* (:class:`monitor.service.metrics.ServiceMetrics`), *health*
+    """Serves *metrics* (:class:`monitor.service.outputs.metrics.ServiceMetrics`), *health*
     (:class:`monitor.service.health.Health`) and the files under *report_dir* on (host, port); port 0 takes a
     free one (see :attr:`address`)."""
 

@@ -31,9 +31,9 @@ from monitor.core.errors import DataError
 from monitor.core.result import AssessmentResult, DayPrecision
 from monitor.core.vocabulary import EventKind, RunStatus
 from monitor.history.changes import all_changes
+from monitor.service.outputs.timeseries import change_lines, day_lines, drain_outbox, target_name
 from monitor.service.schedule import catch_up, no_data_horizon
 from monitor.service.store.sqlite import Store
-from monitor.service.store.timeseries import change_lines, drain_outbox, result_lines, target_name
 
 LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
 
@@ -137,11 +137,8 @@ def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.dat
             w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts, w.precision
         )
         if w.status == RunStatus.OK and w.result is not None:  # an ok day always has its result
-            lines = {
-                target_name(p): result_lines(p.measurement, w.satellite, w.day, w.result.fors)
-                for p in cfg.store.publish
-            }
-            store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, lines, w.precision)
+            queued = day_lines(cfg.store.publish, w.satellite, w.day, w.result)
+            store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, queued, w.precision)
             publish_changes(cfg, store, w.satellite)
         elif w.status == RunStatus.NO_DATA:
             s = cfg.schedule

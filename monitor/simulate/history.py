@@ -105,5 +105,5 @@ def fill_store(
             step = step_urad if step_day is not None and i >= step_day else 0.0
             result = day_result(sat, day, rng, step, with_cube=cubes == "all" or i == days - 1)
             run = store.begin_run(sat, day)
-            store.save_day(run, sat, day, result, [], {})
+            store.save_day(run, sat, day, result)
     return out

@@ -47,12 +47,12 @@ def test_spec_severity_uses_the_uncertainty(tmp_path):
     fors[27] = _for(28, 0.2, 1.6, sig=0.2)  # 1.6 - 2 x 0.2 < 1.5: warning
     fors[29] = _for(30, -0.7, 4.4, sig=0.1)  # critical
     fors[28] = _for(29, 0.1, 3.0, flags=("flat",))  # unreliable: never alerts
-    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors), [], {})
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors))
     f = spec_finding(s, "j01", RuleSettings())
     assert f.severity == "critical" and f.data["fors"] == [28, 30]
     assert "within 2 sigma" in f.lines[0] and "within 2 sigma" not in f.lines[1]
     fors[29] = _for(30, -0.7, 1.55, sig=0.1)
-    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors), [], {})
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors))
     assert spec_finding(s, "j01", RuleSettings()).severity == "warning"
 
 
@@ -65,7 +65,7 @@ def test_stale_and_failure(tmp_path):
     assert f.severity == "critical" and "HTTP 503" in f.lines[0]
     later = dt.datetime.now(UTC) + dt.timedelta(hours=40)
     assert "no successful assessment" in stale_finding(s, "j01", RuleSettings(), later).lines[0]
-    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result([_for(k, 0, 0) for k in range(1, 31)]), [], {})
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result([_for(k, 0, 0) for k in range(1, 31)]))
     assert (
         failure_finding(s, "j01") is None
         and stale_finding(s, "j01", RuleSettings(), dt.datetime.now(UTC)) is None
@@ -81,7 +81,7 @@ def test_metadata_changes_name_the_instrument(tmp_path):
     for i, (vl, eng) in enumerate([("1171", "a"), ("1171", "b"), ("2042", "c")]):
         day = DAY + dt.timedelta(days=i)
         g = _granule(f"J{i}", [cris[0], cris[1].format(eng)], [viirs_lut.format(vl)])
-        s.save_day(s.begin_run("j01", day), "j01", day, _result([_for(1, 0, 0)], [g]), [], {})
+        s.save_day(s.begin_run("j01", day), "j01", day, _result([_for(1, 0, 0)], [g]))
     changes = metadata_changes(s, "j01")
     assert len(changes) == 1  # the engineering-packet backup AUX changes every run and is ignored
     assert changes[0].instrument == "viirs" and "2042" in changes[0].description
@@ -108,7 +108,7 @@ def test_a_bias_jump_after_a_viirs_lut_change_is_a_calibration_jump_attributed_t
                 for k in range(1, 31)
             ]
             g = _granule(f"J{day}", cris, [lut.format("2042" if day >= split else "1171")])
-            s.save_day(s.begin_run("j01", day), "j01", day, _result(fors, [g]), [], {})
+            s.save_day(s.begin_run("j01", day), "j01", day, _result(fors, [g]))
         changes = metadata_changes(s, "j01")
         found = jump_findings(s, "j01", changes, RuleSettings(), days[-1], CALIBRATION)
         assert jump_findings(s, "j01", changes, RuleSettings(), days[-1], GEOLOCATION) == []

@@ -13,7 +13,7 @@ from tests.invoke import ROOT, run_crisgeo
 @pytest.fixture
 def config_with_history(tmp_path):
     """A configuration of j01 and a store holding 12 simulated days from 2025-03-01."""
-    from monitor import open_store
+    from monitor.service.store.sqlite import Store
     from monitor.simulate.history import fill_store
 
     (tmp_path / "events.yaml").write_text("# the team's calendar\nevents:\n  # none yet\n  []\n")
@@ -22,7 +22,7 @@ def config_with_history(tmp_path):
         f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
         f"alerts: {{events_file: {tmp_path / 'events.yaml'}}}\n"
     )
-    with open_store(tmp_path / "state" / "crisgeo.sqlite", create=True) as store:
+    with Store(tmp_path / "state" / "crisgeo.sqlite") as store:
         fill_store(store, ["j01"], dt.date(2025, 3, 1), 12, step_day=6, seed=3)
     return cfg
 
@@ -196,15 +196,15 @@ def test_a_day_outside_the_mission_is_bad_input_and_records_nothing(
     config_with_history, capsys, argv, message
 ):
     """A typo'd date: exit 2, one line, no run in the ledger and no alert (nothing sent, nothing queued)."""
-    from monitor import open_store
     from monitor.service.store.alerts import AlertState
+    from monitor.service.store.sqlite import Store
 
     state = config_with_history.parent / "state"
-    with open_store(state / "crisgeo.sqlite") as store:
+    with Store(state / "crisgeo.sqlite", create=False) as store:
         before = store.runs("j01"), AlertState(store).all(), AlertState(store).deliveries()
     assert main([argv[0], "--config", str(config_with_history), *argv[1:]]) == 2
     assert message in _one_line(capsys)
-    with open_store(state / "crisgeo.sqlite") as store:
+    with Store(state / "crisgeo.sqlite", create=False) as store:
         assert (store.runs("j01"), AlertState(store).all(), AlertState(store).deliveries()) == before
 
 

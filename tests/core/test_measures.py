@@ -11,10 +11,10 @@ import pytest
 from monitor.core.result import NAN, Family, ForOffset, measured, measures
 from monitor.core.tables import field_column, text_table
 from monitor.history.records import ForSeries
-from monitor.service.metrics import _StoreCollector
+from monitor.service.outputs.metrics import _StoreCollector
+from monitor.service.outputs.timeseries import result_lines
 from monitor.service.store.schema import result_columns
 from monitor.service.store.sqlite import Store
-from monitor.service.store.timeseries import result_lines
 
 STRAY = Family("crisgeo_for_stray_light_kelvin", "Latest stray light per FOR")
 
@@ -75,7 +75,7 @@ def test_a_new_field_reaches_the_tables_with_its_unit():
 
 def test_a_new_field_reaches_the_export_with_its_unit_and_meaning():
     pytest.importorskip("xarray")
-    from monitor.service.export import to_xarray
+    from monitor.service.outputs.export import to_xarray
 
     fors = _fors()
     values = {m.name: np.array([[getattr(f, m.name) for f in fors]]) for m in measures(WithStrayLight)}

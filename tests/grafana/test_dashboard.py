@@ -10,8 +10,8 @@ import pytest
 import requests
 
 from monitor.history.changes import Change
+from monitor.service.outputs.timeseries import change_lines, result_lines
 from monitor.service.store.sqlite import Store
-from monitor.service.store.timeseries import change_lines, result_lines
 from monitor.simulate.history import fill_store
 from tests.servers import influxdb1, influxql
 
@@ -141,7 +141,7 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
 
     from alerts.rules import Finding
     from monitor.service.health import Health
-    from monitor.service.metrics import ServiceMetrics
+    from monitor.service.outputs.metrics import ServiceMetrics
     from monitor.service.store.alerts import AlertState
     from tests.servers import victoria_metrics, wait_for
 

@@ -15,9 +15,9 @@ from monitor.assessment.assess import DayAssessment
 from monitor.config.file import load_config
 from monitor.core.result import DayPrecision
 from monitor.core.vocabulary import DayStop
-from monitor.service.metrics import ServiceMetrics
+from monitor.service.outputs.metrics import ServiceMetrics
+from monitor.service.outputs.report.html import ReportOptions, build_report
 from monitor.service.pipeline import run_day
-from monitor.service.report.html import ReportOptions, build_report
 from monitor.service.status import status_report
 from monitor.service.store.sqlite import Store
 from tests.service.test_pipeline import DAY, TODAY

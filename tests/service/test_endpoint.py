@@ -292,7 +292,7 @@ def test_a_satellite_that_never_succeeded_is_visible_to_the_dead_mans_rule(tmp_p
     from prometheus_client import generate_latest
 
     from monitor.service.health import Health
-    from monitor.service.metrics import ServiceMetrics
+    from monitor.service.outputs.metrics import ServiceMetrics
 
     db = tmp_path / "s.sqlite"
     with Store(db) as store:

@@ -60,7 +60,7 @@ def state(tmp_path):
 def _save(store, fors):
     result = day_result("j01", DAY, np.random.default_rng(3), 0.0, with_cube=False)
     result = dataclasses.replace(result, fors=fors)
-    store.save_day(store.begin_run("j01", DAY), "j01", DAY, result, [], {})
+    store.save_day(store.begin_run("j01", DAY), "j01", DAY, result)
 
 
 def test_the_first_line_carries_the_reason_and_the_perfdata(state):

@@ -153,7 +153,7 @@ def test_calibration_jump_fires_on_a_calibration_step_and_not_on_a_change_of_sce
                     dataclasses.replace(g, granule_id=f"{g.granule_id}-{day}") for g in results[name].granules
                 ],
             )
-            store.save_day(store.begin_run("j01", day), "j01", day, result, [], {})
+            store.save_day(store.begin_run("j01", day), "j01", day, result)
         found = jump_findings(store, "j01", [], RuleSettings(), days[-1], CALIBRATION)
         if not fires:
             assert found == [], [f.lines for f in found]

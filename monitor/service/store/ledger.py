@@ -5,15 +5,24 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import sqlite3
+from contextlib import AbstractContextManager
+from typing import TYPE_CHECKING
 
 from monitor.core.result import DayPrecision
 from monitor.core.vocabulary import DONE, EventKind, RunStatus
 from monitor.history.records import Event, Run
-from monitor.service.store.database import Database
 
 
-class RunLedger(Database):
-    """The ledger of runs and the service events of a store."""
+class RunLedger:
+    """The ledger of runs and the service events of a store (a part of
+    :class:`monitor.service.store.sqlite.Store`, over its file)."""
+
+    db: sqlite3.Connection
+    if TYPE_CHECKING:  # of the Database the parts are put together with
+
+        def transaction(self) -> AbstractContextManager[sqlite3.Connection]: ...
+        def _now(self) -> str: ...
 
     # -- runs (the ledger)
     def begin_run(self, satellite: str, day: dt.date) -> int:

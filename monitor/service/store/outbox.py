@@ -2,11 +2,29 @@
 
 from __future__ import annotations
 
-from monitor.service.store.database import Database
+import sqlite3
+from contextlib import AbstractContextManager
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 
-class Outbox(Database):
-    """The outbox of a store."""
+@dataclass(frozen=True)
+class QueuedLines:
+    """Time-series lines for one publishing *target* (:func:`monitor.service.outputs.timeseries.target_name`),
+    queued with the day that produced them."""
+
+    target: str
+    lines: list[str]
+
+
+class Outbox:
+    """The outbox of a store (a part of :class:`monitor.service.store.sqlite.Store`, over its file)."""
+
+    db: sqlite3.Connection
+    if TYPE_CHECKING:  # of the Database the parts are put together with
+
+        def transaction(self) -> AbstractContextManager[sqlite3.Connection]: ...
+        def _now(self) -> str: ...
 
     # -- outbox
     def queue_lines(self, target: str, satellite: str | None, lines: list) -> None:

@@ -7,15 +7,25 @@ from __future__ import annotations
 
 import datetime as dt
 import json
-from typing import Any
+import sqlite3
+from collections.abc import Sequence
+from contextlib import AbstractContextManager
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from monitor.core.constants import N_FOR
-from monitor.core.result import MEASURED_FIELDS, AssessmentResult, DayPrecision, DifferenceBin, ForOffset
+from monitor.core.result import (
+    MEASURED_FIELDS,
+    AssessmentResult,
+    DayPrecision,
+    DifferenceBin,
+    ForOffset,
+    SceneDecision,
+)
 from monitor.core.vocabulary import RunStatus
 from monitor.history.records import ForSeries, GranuleRow, SelectionRow
-from monitor.service.store.ledger import RunLedger
+from monitor.service.store.outbox import QueuedLines
 
 RESULT_FIELDS = MEASURED_FIELDS  # the results table has a column for each
 
@@ -24,8 +34,18 @@ def _num(v: object) -> object:
     return None if v is None or (isinstance(v, float) and not np.isfinite(v)) else v
 
 
-class Results(RunLedger):
-    """The per-day results of a store (a day's results close its run in the ledger, in one transaction)."""
+class Results:
+    """The per-day results of a store (a part of :class:`monitor.service.store.sqlite.Store`, over its file;
+    a day's results close its run in the ledger, in one transaction)."""
+
+    db: sqlite3.Connection
+    if TYPE_CHECKING:  # of the Database and the RunLedger the parts are put together with
+
+        def transaction(self) -> AbstractContextManager[sqlite3.Connection]: ...
+        def _now(self) -> str: ...
+        def _finish(
+            self, run_id: int, status: RunStatus, reason: str | None, n_granules: int, summary: dict | None
+        ) -> None: ...
 
     # -- results
     def save_day(
@@ -34,12 +54,13 @@ class Results(RunLedger):
         satellite: str,
         day: dt.date,
         result: AssessmentResult,
-        selection: list,
-        outbox_lines: dict,
+        selection: Sequence[SceneDecision] = (),
+        queued: Sequence[QueuedLines] = (),
         precision: DayPrecision | None = None,
     ) -> None:
-        """Replace the day's results, granules, selection and cube, queue its points, close the run (its
-        summary: reliable FORs, the worst error, the *precision* reached), in one transaction."""
+        """Replace the day's results, granules, scene *selection* and cube, queue its time-series lines
+        (*queued*, derived by the outputs from *result*), close the run (its summary: reliable FORs, the
+        worst error, the *precision* reached), in one transaction."""
         d = day.isoformat()
         with self.transaction():
             for table in ("results", "granules", "selection", "cost_cubes", "skipped", "difference_bins"):
@@ -79,18 +100,10 @@ class Results(RunLedger):
                         vm.get("software_version"),
                     ),
                 )
-            for s in selection:
+            for c in selection:
                 self.db.execute(
                     "INSERT INTO selection VALUES (?, ?, ?, ?, ?, ?, ?)",
-                    (
-                        satellite,
-                        d,
-                        run_id,
-                        s.granule,
-                        _num(s.score_k),
-                        s.decision,
-                        s.reason,
-                    ),
+                    (satellite, d, run_id, c.granule, _num(c.score_k), c.decision, c.reason),
                 )
             for b in result.difference_bins:
                 self.db.execute(
@@ -115,11 +128,11 @@ class Results(RunLedger):
                     ),
                 )
             self.db.execute("DELETE FROM outbox WHERE satellite=? AND day=?", (satellite, d))
-            for target, lines in outbox_lines.items():
-                for line in lines:
+            for q in queued:
+                for line in q.lines:
                     self.db.execute(
                         "INSERT INTO outbox (target, satellite, day, line, created) VALUES (?, ?, ?, ?, ?)",
-                        (target, satellite, d, line, self._now()),
+                        (q.target, satellite, d, line, self._now()),
                     )
             self._finish(
                 run_id,

@@ -5,10 +5,12 @@ lives in this package."""
 
 from __future__ import annotations
 
+from monitor.service.store.database import Database
+from monitor.service.store.ledger import RunLedger
 from monitor.service.store.outbox import Outbox
 from monitor.service.store.results import Results
 
 
-class Store(Results, Outbox):
-    """The SQLite store: its file, ledger, results and outbox. One connection per Store; use from one
-    thread at a time."""
+class Store(Database, RunLedger, Results, Outbox):
+    """The SQLite store: its file (:class:`Database`) with its parts side by side, each over that file: the
+    ledger, the results and the outbox. One connection per Store; use from one thread at a time."""

@@ -7,6 +7,7 @@ import pytest
 
 from monitor.core.result import SceneDecision
 from monitor.core.vocabulary import Decision
+from monitor.service.store.outbox import QueuedLines
 from monitor.service.store.schema import MIGRATIONS
 from monitor.service.store.sqlite import Store
 from tests.invoke import run_crisgeo
@@ -41,7 +42,7 @@ def test_save_day_replaces_and_queues(cases, tmp_path):
             DAY,
             result,
             [SceneDecision("g", Decision.CHOSEN, "rank 1", 1.0)],
-            {"influx2:http://x": ["m f=1 1"] * 30},
+            [QueuedLines("influx2:http://x", ["m f=1 1"] * 30)],
         )
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 30
     assert s.outbox_size() == 30 and len(s.granules("j01", DAY)) == 2
@@ -61,7 +62,7 @@ def test_the_intercalibration_and_its_bins_are_stored_with_the_day(cases, tmp_pa
     _, _, result = cases.get()
     assert result.difference_bins and any(np.isfinite(f.bias_k) for f in result.fors)
     s = Store(tmp_path / "i.sqlite")
-    s.save_day(s.begin_run("j01", DAY), "j01", DAY, result, [], {})
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, result)
     stored = s.day_result("j01", DAY)
     for name in ("bias_k", "sigma_bias_k", "gain_pct", "sigma_gain_pct", "curvature_k", "sigma_curvature_k"):
         np.testing.assert_array_equal(
@@ -113,7 +114,7 @@ def test_failed_transaction_leaves_nothing(cases, tmp_path):
     s = Store(tmp_path / "d.sqlite")
     run = s.begin_run("j01", DAY)
     with pytest.raises(sqlite3.Error):
-        s.save_day(run, "j01", DAY, result, [SceneDecision(None, None, None)], {})  # NOT NULL violated
+        s.save_day(run, "j01", DAY, result, [SceneDecision(None, None, None)])  # NOT NULL violated
     assert s.db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0
     assert s.runs()[0].status == "running"
     assert s.interrupt_stale_runs() == 1 and s.runs()[0].status == "interrupted"

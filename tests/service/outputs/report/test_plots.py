@@ -6,7 +6,7 @@ import matplotlib.dates as mdates
 import numpy as np
 import pytest
 
-from monitor.service.report import plots
+from monitor.service.outputs.report import plots
 
 DAY = dt.date(2026, 11, 24)
 

@@ -9,14 +9,14 @@ the sign convention stated once (the global attribute ``sign_convention``), and 
 (title, summary, references to the method paper, history, date_created, time coverage, platform,
 instrument, source, id; institution, creator, license and the like from the ``export`` section of the
 configuration). The compliance checker's CF-1.8 check passes, and its ACDD-1.3 check leaves only what
-does not apply (tests/service/test_export.py): no CF standard name exists for these quantities, and the file
-is per scan position, not per place (no geospatial bounds). xarray and h5netcdf are an optional extra:
-``pip install 'crisgeo-monitor[export]'``.
+does not apply (tests/service/outputs/test_export.py): no CF standard name exists for these quantities,
+and the file is per scan position, not per place (no geospatial bounds). xarray and h5netcdf are an
+optional extra: ``pip install 'crisgeo-monitor[export]'``.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Self
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -45,15 +45,28 @@ FORMATS = {".nc": "netcdf", ".nc4": "netcdf", ".csv": "csv"}  # the suffix of --
 FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
 
 
-class ResultStore(Store):
-    """The store as a notebook opens it (:func:`monitor.open_store`): the :class:`Store` and its results
-    as xarray."""
+class ResultStore:
+    """The store as a notebook opens it (:func:`monitor.open_store`): its results as xarray, over the
+    SQLite store (``.store``); a context manager that closes it."""
+
+    def __init__(self, store: Store) -> None:
+        self.store = store
 
     def to_xarray(
         self, satellite: str, since: dt.date | None = None, until: dt.date | None = None
     ) -> xr.Dataset:
         """The per-FOR results of *satellite* as a CF-style xarray Dataset."""
-        return to_xarray(self, satellite, since, until)
+        return to_xarray(self.store, satellite, since, until)
+
+    def close(self) -> None:
+        """Close the store."""
+        self.store.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 def to_xarray(

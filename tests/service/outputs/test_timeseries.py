@@ -5,14 +5,15 @@ import datetime as dt
 import pytest
 
 from monitor.config.outputs import PublishConfig
-from monitor.service.store.sqlite import Store
-from monitor.service.store.timeseries import (
+from monitor.service.outputs.timeseries import (
     Influx2Writer,
     PublishError,
+    day_lines,
     drain_outbox,
     result_lines,
     target_name,
 )
+from monitor.service.store.sqlite import Store
 from tests.servers import free_port, influxdb1, influxql, victoria_metrics, vm_export, wait_for
 
 DAY = dt.date(2024, 6, 1)
@@ -20,14 +21,7 @@ DAY = dt.date(2024, 6, 1)
 
 def _queue(store, cfg, result, day=DAY):
     run = store.begin_run("j01", day)
-    store.save_day(
-        run,
-        "j01",
-        day,
-        result,
-        [],
-        {target_name(cfg): result_lines(cfg.measurement, "j01", day, result.fors)},
-    )
+    store.save_day(run, "j01", day, result, [], day_lines([cfg], "j01", day, result))
 
 
 def test_lines_have_fixed_types_and_skip_non_finite(cases):

@@ -12,7 +12,7 @@ xr = pytest.importorskip("xarray")
 
 @pytest.fixture
 def store_with_days(tmp_path):
-    from monitor import open_store
+    from monitor.service.store.sqlite import Store
     from monitor.simulate.history import fill_store
 
     cfg = tmp_path / "c.yaml"
@@ -20,7 +20,7 @@ def store_with_days(tmp_path):
         f"satellites: [j01, npp]\nstate_dir: {tmp_path / 'state'}\n"
         f"source: {{kind: local, path: {tmp_path}}}\n"
     )
-    store = open_store(tmp_path / "state" / "crisgeo.sqlite", create=True)
+    store = Store(tmp_path / "state" / "crisgeo.sqlite")
     fill_store(store, ["j01"], dt.date(2025, 3, 1), 12, step_day=6, seed=3)
     return cfg, store
 
@@ -102,7 +102,7 @@ def test_the_netcdf_is_cf_1_8_and_acdd(store_with_days, tmp_path):
     cc = pytest.importorskip("compliance_checker.runner")
     from compliance_checker.runner import CheckSuite, ComplianceChecker
 
-    from monitor.service.export import export
+    from monitor.service.outputs.export import export
 
     _, store = store_with_days
     out = export(store, "j01", tmp_path / "j01.nc", "netcdf")
@@ -172,7 +172,7 @@ def test_acdd_1_3_leaves_only_what_does_not_apply(store_with_days, tmp_path):
 def test_time_is_first_and_unlimited_and_the_sign_is_stated_once(store_with_days, tmp_path):
     import h5netcdf
 
-    from monitor.service.export import SIGN_CONVENTION, export
+    from monitor.service.outputs.export import SIGN_CONVENTION, export
 
     _, store = store_with_days
     out = export(store, "j01", tmp_path / "j01.nc")
@@ -203,3 +203,20 @@ def test_the_format_follows_the_name_of_the_file(store_with_days, tmp_path, caps
     csv_out = tmp_path / "z.csv"
     assert main(["export", "--config", str(cfg), "--satellite", "j01", "--out", str(csv_out)]) == 0
     assert csv_out.read_text().startswith("time,scan_position,")  # CSV, not NetCDF
+
+
+def test_the_notebook_store_opens_an_existing_store_and_closes_it(tmp_path):
+    """``monitor.open_store``: the results as xarray over the SQLite store, which it closes after a block."""
+    import sqlite3
+
+    from monitor import open_store
+    from monitor.service.store.sqlite import Store
+    from monitor.simulate.history import fill_store
+
+    with Store(tmp_path / "s.sqlite") as store:
+        fill_store(store, ["j01"], dt.date(2026, 11, 22), 2, step_day=None, seed=3)
+    with open_store(tmp_path / "s.sqlite") as nb:
+        ds = nb.to_xarray("j01")
+        assert ds.sizes["time"] == 2 and ds.sizes["scan_position"] == 30
+    with pytest.raises(sqlite3.ProgrammingError):
+        nb.store.db.execute("SELECT 1")

@@ -33,8 +33,9 @@ from influxdb_client.client.exceptions import InfluxDBError
 from influxdb_client.client.write_api import SYNCHRONOUS
 
 from monitor.config.outputs import PublishConfig
-from monitor.core.result import ForOffset, measures
+from monitor.core.result import AssessmentResult, ForOffset, measures
 from monitor.history.changes import Change
+from monitor.service.store.outbox import QueuedLines
 from monitor.service.store.sqlite import Store
 
 LOG = logging.getLogger("monitor.store.timeseries")  # the name journal filters know, kept
@@ -57,6 +58,16 @@ def result_lines(measurement: str, satellite: str, day: dt.date, fors: Iterable[
         p = p.field("reliable", bool(f.reliable))
         lines.append(p.time(when, WritePrecision.S).to_line_protocol())
     return lines
+
+
+def day_lines(
+    publish: Iterable[PublishConfig], satellite: str, day: dt.date, result: AssessmentResult
+) -> list[QueuedLines]:
+    """The lines of a day's *result* for each configured time-series store, queued with the day's results
+    (:meth:`monitor.service.store.sqlite.Store.save_day`)."""
+    return [
+        QueuedLines(target_name(p), result_lines(p.measurement, satellite, day, result.fors)) for p in publish
+    ]
 
 
 def change_lines(measurement: str, changes: Iterable[Change]) -> list[str]:

@@ -15,7 +15,7 @@ from alerts.rules import Finding
 from monitor.cli import main
 from monitor.core.result import AssessmentResult
 from monitor.core.vocabulary import Rule, Severity
-from monitor.service.report.html import ReportOptions, build_report
+from monitor.service.outputs.report.html import ReportOptions, build_report
 from monitor.service.store.alerts import AlertState
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
@@ -86,7 +86,7 @@ def test_days_stored_before_the_intercalibration_say_so_and_plot_none(store, tmp
     build_report(store, tmp_path / "rep", ReportOptions(satellites=["j01"]))
     result = store.day_result("j01", day)
     bare = AssessmentResult("j01", "", "", [dataclasses.replace(f, bias_k=math.nan) for f in result])
-    store.save_day(store.begin_run("j01", day), "j01", day, bare, [], {})
+    store.save_day(store.begin_run("j01", day), "j01", day, bare)
     build_report(store, tmp_path / "rep", ReportOptions(satellites=["j01"]))
     sat = tmp_path / "rep" / "j01"
     assert "No intercalibration stored" in (sat / "index.html").read_text()
