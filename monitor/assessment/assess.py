@@ -38,10 +38,11 @@ from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, N_FOR
 from monitor.core.errors import AssessmentError, StopRequested
-from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo, Skipped
+from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
 from monitor.estimation import parallax
-from monitor.estimation.estimate import ForSamples, day_offsets
+from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
+from monitor.estimation.offsets import DayLift, day_offsets
 from monitor.geometry.ground import offset_km
 from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry
@@ -270,27 +271,27 @@ def cost_and_offsets(
             lambda k: parallax.blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
         )
         m_per_k = f * PROBE_M_PER_K
+    used = samples if pairs is None else pairs[0]
+    lift = DayLift(
+        m_per_k,
+        np.nan_to_num(spread) * cfg.step_urad,
+        np.array([_cold_height_km(_cris_k(used, k), m_per_k) for k in range(N_FOR)]),
+    )
     day = day_offsets(
         per_for,
         cfg,
         cfg.step_urad,
         lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
         follows_in_time([_seconds(s.info.start) for s in samples]),
+        lift,
     )
-    used = samples if pairs is None else pairs[0]
-    fors = [
-        _with_lift_spread(
-            f, np.nan_to_num(e) * cfg.step_urad, m_per_k, _cold_height_km(_cris_k(used, k), m_per_k)
-        )
-        for k, (f, e) in enumerate(zip(day.fors, spread, strict=True))
-    ]
     starts = [s.info.start for s in samples]
     ends = [s.info.end for s in samples]
     return AssessmentResult(
         satellite=satellite,
         start=min(starts) if starts else "",
         end=max(ends) if ends else "",
-        fors=fors,
+        fors=day.fors,
         granules=[s.info for s in samples],
         skipped=[Skipped(str(a), str(b)) for a, b in (skipped or [])],
         half_steps=cfg.half_steps,
@@ -307,21 +308,6 @@ def _seconds(iso: str) -> float:
         return dt.datetime.fromisoformat(iso).timestamp()
     except ValueError:
         return np.nan
-
-
-def _with_lift_spread(f: ForOffset, spread_urad: np.ndarray, m_per_k: float, height_km: float) -> ForOffset:
-    """*f* with the sigma that the day's lift adds (urad: FOR alpha, beta; rows alpha, beta) in quadrature,
-    and the lift it was estimated at (:mod:`monitor.estimation.parallax`)."""
-    a, b, ra, rb = spread_urad
-    return replace(
-        f,
-        sigma_alpha_urad=float(np.hypot(f.sigma_alpha_urad, a)),
-        sigma_beta_urad=float(np.hypot(f.sigma_beta_urad, b)),
-        sigma_fov_rows_alpha_urad=float(np.hypot(f.sigma_fov_rows_alpha_urad, ra)),
-        sigma_fov_rows_beta_urad=float(np.hypot(f.sigma_fov_rows_beta_urad, rb)),
-        parallax_m_per_k=m_per_k,
-        parallax_height_km=height_km,
-    )
 
 
 def paired(
@@ -356,7 +342,7 @@ def _cold_height_km(cris_k: np.ndarray, m_per_k: float) -> float:
 
 class PerFor(Sequence[ForSamples]):
     """The 30 FORs' samples, each built when indexed (read from the day's spool, blended): one FOR of a
-    long day in memory at a time, not the day (:func:`~monitor.estimation.estimate.day_offsets`)."""
+    long day in memory at a time, not the day (:func:`~monitor.estimation.offsets.day_offsets`)."""
 
     def __init__(self, build: Callable[[int], ForSamples]) -> None:
         self._build = build

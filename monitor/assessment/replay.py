@@ -28,8 +28,9 @@ from monitor.core.constants import N_FOR, N_FOV, URAD
 from monitor.core.errors import DataError
 from monitor.core.result import FLAG_TOP_HAT, AssessmentResult, GranuleInfo
 from monitor.core.vocabulary import Kernel
-from monitor.estimation.estimate import ForSamples, day_offsets
+from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
+from monitor.estimation.offsets import day_offsets
 from monitor.sdr.names import parse_name
 
 # key: (axes, what it is); axes name the dimensions in the file's order

@@ -262,11 +262,11 @@ class ForOffset:
 
     @classmethod
     def from_dict(cls, d: dict) -> "ForOffset":
-        names = cls.__dataclass_fields__
-        kw = {k: d[k] for k in names if k in d and k != "for_index"}
-        kw = {k: (float("nan") if v is None else v) for k, v in kw.items()}
-        kw["flags"] = tuple(d.get("flags", ()))
-        return cls(for_index=int(d["for"]), **kw)
+        """The record of :meth:`to_dict` (or of a stored row: ``for``, ``flags`` and the measured fields),
+        where None is what was not measured: NaN, or 0 for a count."""
+        kw = {k: d[k] for k in MEASURED_FIELDS if k in d}
+        kw = {k: (v if v is not None else 0 if k in COUNT_FIELDS else float("nan")) for k, v in kw.items()}
+        return cls(for_index=int(d["for"]), flags=tuple(d.get("flags", ())), **kw)
 
 
 def measures(record: type = ForOffset) -> tuple[Measure, ...]:
@@ -280,8 +280,9 @@ def measures(record: type = ForOffset) -> tuple[Measure, ...]:
     )
 
 
-# the measured fields of a FOR (all but its index and flags), in the order of the dataclass
+# the measured fields of a FOR (all but its index and flags), in the order of the dataclass; those counted
 MEASURED_FIELDS = tuple(m.name for m in measures())
+COUNT_FIELDS = frozenset(m.name for m in measures() if m.kind is int)
 
 
 @dataclass(frozen=True)

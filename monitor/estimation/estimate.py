@@ -44,33 +44,23 @@ of the error enters by construction.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.ndimage import shift as shift_grid
 
-from monitor.config.assessment import AssessmentConfig
-from monitor.core.constants import DEFAULT_STEP_RAD, URAD
+from monitor.core.constants import DEFAULT_STEP_RAD
 from monitor.core.result import (
     FLAG_EDGE,
-    FLAG_FEW_SAMPLES,
     FLAG_FLAT,
-    FLAG_GAIN_UNDETERMINED,
-    FLAG_TOP_HAT,
-    FLAG_UNCERTAIN,
     FLAG_UNCONVERGED,
-    DifferenceBin,
-    ForOffset,
 )
-from monitor.core.vocabulary import Cost, Kernel
-from monitor.estimation import jackknife, refine
+from monitor.core.vocabulary import Cost
+from monitor.estimation import refine
 from monitor.estimation.intercal import (
     NO_FIT,
     Intercalibration,
     collocation_spread_k,
-    difference_bins,
     intercalibrate,
     reach_steps,
 )
@@ -521,159 +511,3 @@ def estimate(
         best.x, best.y, sigma, best.flags, best.g, d_opt, best.refined, cal, fp,
         rows, rows_sigma, replicates, None if jack is None else jack.granules, cone,
     )  # fmt: skip
-
-
-def floor_urad(
-    cfg: AssessmentConfig, used: Kernel, cone_error_urad: tuple[float, float]
-) -> tuple[float, float]:
-    """What the estimator itself leaves beside the jackknife's scatter (urad, in-track and cross-track), added
-    in quadrature: ``sigma_floor_urad`` where configured; else nothing where the kernel *used* is the
-    configured one, and for a cone's estimate where the footprint is configured the day's own measure of
-    the cone's error, *cone_error_urad* (the RMS of cone minus footprint over the FORs that fitted a
-    response; 0 where none did)."""
-    if cfg.sigma_floor_urad is not None:
-        return cfg.sigma_floor_urad, cfg.sigma_floor_urad
-    return (0.0, 0.0) if used == cfg.kernel else cone_error_urad
-
-
-@dataclass(frozen=True)
-class DayEstimate:
-    """The 30 FORs' offsets of a day, their cost surfaces (30, m, m; NaN where none), the CrIS - VIIRS
-    difference in BT bins pooled over the FORs refined (the paper's Figure 15) and the correlation of
-    consecutive granules the sigmas count."""
-
-    fors: list[ForOffset]
-    cost_cube_k: np.ndarray
-    difference_bins: list[DifferenceBin]
-    correlation: float = 0.0  # of consecutive granules' replicates (jackknife.adjacent_correlation)
-
-
-KmOf = Callable[[int, float, float], tuple[float, float, np.ndarray]]
-
-
-def day_offsets(
-    per_for: Sequence[ForSamples],
-    cfg: AssessmentConfig,
-    step_urad: float,
-    km: KmOf | None = None,
-    follows: np.ndarray | None = None,
-) -> DayEstimate:
-    """Every FOR's estimate as a :class:`~monitor.core.result.ForOffset`: angles in urad with the jackknife
-    sigma (granules that directly follow one another, *follows* (granules,) bool, counted as fewer by the
-    day's correlation of their replicates: :mod:`monitor.estimation.jackknife`) and ``floor_urad`` in
-    quadrature, flags, the intercalibration; in km where *km* (FOR index 0-based, turn in rad) gives the
-    mean in-track and cross-track km of a turn and its Jacobian (km/rad), NaN without. *per_for* may build
-    each FOR's samples when indexed (a long day's are read from disk): each is taken once, and dropped once
-    estimated."""
-    reach = reach_steps(step_urad * URAD)
-
-    def one(k: int) -> tuple[ForEstimate | None, np.ndarray]:
-        """FOR k's estimate (None with fewer than 3 samples) and its samples' CrIS BT."""
-        s = per_for[k]
-        return (
-            estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty, reach) if len(s) >= 3 else None
-        ), s.cris_k
-
-    # the FORs are independent: estimated on the assessment's threads (numpy and the compiled BT inversion
-    # leave the interpreter's lock), each the same numbers as alone
-    with ThreadPoolExecutor(max_workers=max(1, cfg.workers), thread_name_prefix="estimate") as pool:
-        estimates, cris = (list(x) for x in zip(*pool.map(one, range(len(per_for))), strict=True))
-    m = next((e.cost.shape[0] for e in estimates if e is not None), 2 * cfg.half_steps + 1)
-    cube = np.full((len(per_for), m, m), np.nan)
-    series = [
-        (e.granules, e.replicates)
-        for e in estimates
-        if e is not None and e.granules is not None and e.replicates is not None
-    ]
-    rho = jackknife.adjacent_correlation(series, follows) if follows is not None else 0.0
-    cone = np.array([(e.cone[0] - e.x, e.cone[1] - e.y) for e in estimates if e is not None and e.footprint])
-    cone_error_urad = (
-        (
-            float(np.sqrt(np.mean(cone[:, 0] ** 2))) * step_urad,
-            float(np.sqrt(np.mean(cone[:, 1] ** 2))) * step_urad,
-        )
-        if len(cone)
-        else (0.0, 0.0)
-    )
-    fors = []
-    pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
-    for k, cris_k in enumerate(cris):
-        n = len(cris_k)
-        flags = [FLAG_FEW_SAMPLES] if n < max(cfg.min_samples, 3) else []
-        x = y = sig_a = sig_b = np.nan
-        g = np.full((m, m), np.nan)
-        cal = NO_FIT
-        widths = [np.nan] * 4
-        rows = [np.nan] * 4  # ahead minus behind: alpha, beta, and their sigmas (steps)
-        best = estimates[k]
-        if best is not None:
-            if best.footprint is not None:
-                fp = best.footprint
-                widths = [
-                    w / URAD
-                    for w in (fp.width_50_rad, fp.sigma_width_50_rad, fp.width_10_rad, fp.sigma_width_10_rad)
-                ]
-            # every sigma of the FOR from the same replicates: the same count of independent granules
-            factor = 1.0 if best.granules is None else jackknife.correlation_factor(len(best.granules), rho)
-            g, x, y, cal = best.cost, best.x, best.y, best.intercalibration
-            sig_a, sig_b = (factor * v for v in best.sigma)
-            widths[1], widths[3] = factor * widths[1], factor * widths[3]
-            cal = replace(
-                cal,
-                sigma_bias_k=factor * cal.sigma_bias_k,
-                sigma_gain_pct=factor * cal.sigma_gain_pct,
-                sigma_curvature_k=factor * cal.sigma_curvature_k,
-            )
-            rows = [*best.rows, *(factor * v for v in best.rows_sigma)]
-            if cal.gain_undetermined:
-                flags.append(FLAG_GAIN_UNDETERMINED)
-            cube[k] = g
-            flags += best.flags
-            if best.refined:
-                pooled.append((cris_k, best.d_opt + cris_k))
-            # the kernel used: the footprint where a response was fitted, else the cone (too few FOVs, cone
-            # means, no refined minimum), said in the flags, its floor the cone's
-            used = Kernel.FOOTPRINT if best.footprint is not None else Kernel.TOP_HAT
-            if used != cfg.kernel:
-                flags.append(FLAG_TOP_HAT)
-            floor = floor_urad(cfg, used, cone_error_urad)
-            sig_a = float(np.hypot(sig_a * step_urad, floor[0]))
-            sig_b = float(np.hypot(sig_b * step_urad, floor[1]))
-            if max(sig_a, sig_b) > cfg.max_sigma_urad:
-                flags.append(FLAG_UNCERTAIN)
-        d_alpha, d_beta = x * step_urad, y * step_urad
-        it = ct = s_it = s_ct = np.nan
-        if km is not None:
-            it, ct, jac = km(k, d_alpha * URAD, d_beta * URAD)
-            if np.isfinite(sig_a):
-                s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * URAD)
-                s_ct = float(np.hypot(jac[1, 0] * sig_a, jac[1, 1] * sig_b) * URAD)
-        fors.append(
-            ForOffset(
-                for_index=k + 1,
-                d_alpha_urad=float(d_alpha),
-                d_beta_urad=float(d_beta),
-                sigma_alpha_urad=float(sig_a),
-                sigma_beta_urad=float(sig_b),
-                in_track_km=float(it),
-                cross_track_km=float(ct),
-                total_km=float(np.hypot(it, ct)),
-                sigma_in_track_km=float(s_it),
-                sigma_cross_track_km=float(s_ct),
-                n_samples=int(n),
-                cost_min_k=float(np.nanmin(g)) if n >= 3 else np.nan,
-                cost_zero_k=float(g[m // 2, m // 2]) if n >= 3 else np.nan,
-                **asdict(cal),  # the intercalibration's fields are the FOR's (Intercalibration)
-                response_width_50_urad=float(widths[0]),
-                sigma_response_width_50_urad=float(widths[1]),
-                response_width_10_urad=float(widths[2]),
-                sigma_response_width_10_urad=float(widths[3]),
-                fov_rows_alpha_urad=rows[0] * step_urad,
-                fov_rows_beta_urad=rows[1] * step_urad,
-                sigma_fov_rows_alpha_urad=rows[2] * step_urad,
-                sigma_fov_rows_beta_urad=rows[3] * step_urad,
-                flags=tuple(sorted(set(flags))),
-            )
-        )
-    bins = difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True))) if pooled else []
-    return DayEstimate(fors, cube, bins, rho)

@@ -53,7 +53,7 @@ with the day's variances.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import optimize
@@ -92,6 +92,15 @@ class Intercalibration:
     sigma_gain_pct: float
     curvature_k: float
     sigma_curvature_k: float
+
+    def sigmas_scaled(self, factor: float) -> Intercalibration:
+        """The same fit with every sigma times *factor* (the jackknife's count of independent granules)."""
+        return replace(
+            self,
+            sigma_bias_k=factor * self.sigma_bias_k,
+            sigma_gain_pct=factor * self.sigma_gain_pct,
+            sigma_curvature_k=factor * self.sigma_curvature_k,
+        )
 
     @property
     def gain_undetermined(self) -> bool:

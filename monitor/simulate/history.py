@@ -17,7 +17,9 @@ from monitor.core.constants import (
     CALIBRATION_REFERENCE_K,
     N_FOR,
 )
-from monitor.core.result import FLAG_FLAT, AssessmentResult, DifferenceBin, ForOffset
+from monitor.core.result import FLAG_FLAT, AssessmentResult, DifferenceBin
+from monitor.estimation.intercal import Intercalibration
+from monitor.estimation.offsets import NAN4, for_offset
 from monitor.simulate.profiles import paper_profile
 
 KM_PER_URAD = 0.00083  # at nadir; enough for a picture
@@ -38,29 +40,16 @@ def day_result(
     fors = []
     for k in range(N_FOR):
         it, ct = d_alpha[k] * KM_PER_URAD, d_beta[k] * KM_PER_URAD * stretch[k]
+        flags = (FLAG_FLAT,) if rng.random() < 0.01 else ()
+        # the intercalibration: bias and its sigma, gain and its sigma, curvature and its sigma
+        bias, gain = float(BIAS_K + rng.normal(0, 0.02)), float(GAIN_PCT + rng.normal(0, 0.05))
+        cal = Intercalibration(bias, 0.01, gain, 0.03, CURVATURE_K, 0.03)
+        ground = (it, ct, 0.01, 0.012 * stretch[k])
         fors.append(
-            ForOffset(
-                k + 1,
-                float(d_alpha[k]),
-                float(d_beta[k]),
-                12.0,
-                14.0,
-                float(it),
-                float(ct),
-                float(np.hypot(it, ct)),
-                0.01,
-                0.012 * stretch[k],
-                500,
-                0.8,
-                1.2,
-                (FLAG_FLAT,) if rng.random() < 0.01 else (),
-                bias_k=float(BIAS_K + rng.normal(0, 0.02)),
-                sigma_bias_k=0.01,
-                gain_pct=float(GAIN_PCT + rng.normal(0, 0.05)),
-                sigma_gain_pct=0.03,
-                curvature_k=CURVATURE_K,
-                sigma_curvature_k=0.03,
-            )
+            for_offset(
+                k + 1, 500, (d_alpha[k], d_beta[k]), (12.0, 14.0), ground, (0.8, 1.2), cal, NAN4, NAN4,
+                (np.nan, np.nan), flags,
+            )  # fmt: skip
         )
     cube = None
     if with_cube:

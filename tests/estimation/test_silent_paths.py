@@ -10,6 +10,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import FLAG_FLAT, FLAG_TOP_HAT, FLAG_UNCONVERGED
 from monitor.core.vocabulary import Cost
 from monitor.estimation import estimate as est
+from monitor.estimation import offsets
 from monitor.instrument import footprint
 from tests.estimation.test_estimate import STEP_RAD, _samples
 
@@ -24,7 +25,7 @@ def test_too_few_fovs_for_the_footprint_is_the_cones_estimate_flagged_with_the_c
     assert len(few) < est.MIN_FOOTPRINT_SAMPLES
     enough = _samples(footprint.super_gaussian(), n=160)
     cfg = AssessmentConfig(min_samples=10)
-    alone, fitted = est.day_offsets([few, enough], cfg, STEP_URAD).fors
+    alone, fitted = offsets.day_offsets([few, enough], cfg, STEP_URAD).fors
     assert FLAG_TOP_HAT in alone.flags and alone.reliable  # said, and still usable
     assert FLAG_TOP_HAT not in fitted.flags and np.isfinite(fitted.response_width_50_urad)
     day = est.estimate(enough, Cost.REGRESSION)
@@ -32,7 +33,7 @@ def test_too_few_fovs_for_the_footprint_is_the_cones_estimate_flagged_with_the_c
     assert cone_error.max() > 1.0  # the smooth truth moves the cone's minimum
     assert alone.sigma_alpha_urad >= cone_error[0] and alone.sigma_beta_urad >= cone_error[1]
     # a day without a fitted response has no measure of it: the jackknife's sigma alone
-    (bare,) = est.day_offsets([few], cfg, STEP_URAD).fors
+    (bare,) = offsets.day_offsets([few], cfg, STEP_URAD).fors
     jack = est.estimate(few, Cost.REGRESSION).sigma
     assert bare.sigma_alpha_urad == pytest.approx(jack[0] * STEP_URAD)
 

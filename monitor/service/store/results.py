@@ -10,7 +10,7 @@ import json
 import sqlite3
 from collections.abc import Sequence
 from contextlib import AbstractContextManager
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -154,12 +154,12 @@ class Results:
             "SELECT * FROM results WHERE satellite=? AND day=? ORDER BY for_index",
             (satellite, day.isoformat()),
         ).fetchall()
-        out = []
-        for r in rows:
-            kw: dict[str, Any] = {k: (float("nan") if r[k] is None else r[k]) for k in RESULT_FIELDS}
-            kw["n_samples"] = int(r["n_samples"] or 0)
-            out.append(ForOffset(for_index=r["for_index"], flags=tuple(json.loads(r["flags"])), **kw))
-        return out
+        return [
+            ForOffset.from_dict(
+                {**{k: r[k] for k in RESULT_FIELDS}, "for": r["for_index"], "flags": json.loads(r["flags"])}
+            )
+            for r in rows
+        ]
 
     def difference_bins(self, satellite: str, day: dt.date) -> list[DifferenceBin]:
         """CrIS minus VIIRS against the CrIS BT at the optimum on *satellite*'s *day* (Figure 15)."""

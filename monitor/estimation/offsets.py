@@ -1,0 +1,243 @@
+"""A day's per-FOR offsets: each FOR's estimate (:mod:`monitor.estimation.estimate`) made a record.
+
+Every :class:`~monitor.core.result.ForOffset` of the science is built here, by :func:`for_offset`, from its
+parts: the turn and its sigma (urad, in the spacecraft body frame: alpha in-track, beta cross-track), its
+displacement on the ground (km), the cost, the intercalibration, the fitted response, the FOV rows and the
+day's parallax lift. Every sigma is final when it is put in: the jackknife's (counted as fewer granules by
+the day's correlation of consecutive replicates), the estimator's floor and the spread the day's lift adds,
+in quadrature, before the km sigmas are derived from them and before the uncertainty flag is judged.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import N_FOR, URAD
+from monitor.core.result import (
+    FLAG_FEW_SAMPLES,
+    FLAG_GAIN_UNDETERMINED,
+    FLAG_TOP_HAT,
+    FLAG_UNCERTAIN,
+    DifferenceBin,
+    ForOffset,
+)
+from monitor.core.vocabulary import Kernel
+from monitor.estimation import jackknife
+from monitor.estimation.estimate import ForEstimate, ForSamples, estimate
+from monitor.estimation.intercal import NO_FIT, Intercalibration, difference_bins, reach_steps
+
+NAN4 = (np.nan,) * 4
+
+
+def floor_urad(
+    cfg: AssessmentConfig, used: Kernel, cone_error_urad: tuple[float, float]
+) -> tuple[float, float]:
+    """What the estimator itself leaves beside the jackknife's scatter (urad, in-track and cross-track), added
+    in quadrature: ``sigma_floor_urad`` where configured; else nothing where the kernel *used* is the
+    configured one, and for a cone's estimate where the footprint is configured the day's own measure of
+    the cone's error, *cone_error_urad* (the RMS of cone minus footprint over the FORs that fitted a
+    response; 0 where none did)."""
+    if cfg.sigma_floor_urad is not None:
+        return cfg.sigma_floor_urad, cfg.sigma_floor_urad
+    return (0.0, 0.0) if used == cfg.kernel else cone_error_urad
+
+
+@dataclass(frozen=True)
+class DayLift:
+    """The day's parallax lift as the FORs' records carry it (:mod:`monitor.estimation.parallax`): the lift
+    a VIIRS pixel got per K colder than its clear-sky neighbourhood (m/K; NaN: not collocated lifted), the
+    sigma the lift's own uncertainty adds to each FOR (urad, (N_FOR, 4): FOR alpha, beta; rows alpha,
+    beta) and the height each FOR's cold scenes were put at (km, (N_FOR,))."""
+
+    m_per_k: float
+    spread_urad: np.ndarray
+    height_km: np.ndarray
+
+
+NO_LIFT = DayLift(np.nan, np.zeros((N_FOR, 4)), np.full(N_FOR, np.nan))
+
+
+@dataclass(frozen=True)
+class DayEstimate:
+    """The 30 FORs' offsets of a day, their cost surfaces (30, m, m; NaN where none), the CrIS - VIIRS
+    difference in BT bins pooled over the FORs refined (the paper's Figure 15) and the correlation of
+    consecutive granules the sigmas count."""
+
+    fors: list[ForOffset]
+    cost_cube_k: np.ndarray
+    difference_bins: list[DifferenceBin]
+    correlation: float = 0.0  # of consecutive granules' replicates (jackknife.adjacent_correlation)
+
+
+KmOf = Callable[[int, float, float], tuple[float, float, np.ndarray]]
+
+
+def for_offset(
+    for_index: int,
+    n_samples: int,
+    turn_urad: tuple[float, float],
+    sigma_urad: tuple[float, float],
+    ground_km: tuple[float, float, float, float],
+    cost_k: tuple[float, float],
+    cal: Intercalibration,
+    response_urad: Sequence[float],
+    rows_urad: Sequence[float],
+    lift: tuple[float, float],
+    flags: Iterable[str],
+) -> ForOffset:
+    """The record of FOR *for_index* (1..30) from its parts: the *turn_urad* (alpha, beta) and its final
+    *sigma_urad*; *ground_km* (in-track, cross-track, their sigmas); *cost_k* (at the minimum, at no turn);
+    the intercalibration *cal*; *response_urad* (full width at 50 % and its sigma, at 10 % and its sigma);
+    *rows_urad* (rows ahead minus behind, alpha and beta, and their sigmas); *lift* (m/K, height km); its
+    *flags*. Non-finite parts stay NaN: nothing was measured there."""
+    it, ct, s_it, s_ct = ground_km
+    return ForOffset(
+        for_index=for_index,
+        d_alpha_urad=float(turn_urad[0]),
+        d_beta_urad=float(turn_urad[1]),
+        sigma_alpha_urad=float(sigma_urad[0]),
+        sigma_beta_urad=float(sigma_urad[1]),
+        in_track_km=float(it),
+        cross_track_km=float(ct),
+        total_km=float(np.hypot(it, ct)),
+        sigma_in_track_km=float(s_it),
+        sigma_cross_track_km=float(s_ct),
+        n_samples=int(n_samples),
+        cost_min_k=float(cost_k[0]),
+        cost_zero_k=float(cost_k[1]),
+        bias_k=cal.bias_k,
+        sigma_bias_k=cal.sigma_bias_k,
+        gain_pct=cal.gain_pct,
+        sigma_gain_pct=cal.sigma_gain_pct,
+        curvature_k=cal.curvature_k,
+        sigma_curvature_k=cal.sigma_curvature_k,
+        response_width_50_urad=float(response_urad[0]),
+        sigma_response_width_50_urad=float(response_urad[1]),
+        response_width_10_urad=float(response_urad[2]),
+        sigma_response_width_10_urad=float(response_urad[3]),
+        fov_rows_alpha_urad=float(rows_urad[0]),
+        fov_rows_beta_urad=float(rows_urad[1]),
+        sigma_fov_rows_alpha_urad=float(rows_urad[2]),
+        sigma_fov_rows_beta_urad=float(rows_urad[3]),
+        parallax_m_per_k=float(lift[0]),
+        parallax_height_km=float(lift[1]),
+        flags=tuple(sorted(set(flags))),
+    )
+
+
+def _cone_error_urad(estimates: list[ForEstimate | None], step_urad: float) -> tuple[float, float]:
+    """The RMS over the FORs that fitted a response of the cone's optimum minus the footprint's (urad)."""
+    cone = np.array([(e.cone[0] - e.x, e.cone[1] - e.y) for e in estimates if e is not None and e.footprint])
+    if not len(cone):
+        return 0.0, 0.0
+    return (
+        float(np.sqrt(np.mean(cone[:, 0] ** 2))) * step_urad,
+        float(np.sqrt(np.mean(cone[:, 1] ** 2))) * step_urad,
+    )
+
+
+def day_offsets(
+    per_for: Sequence[ForSamples],
+    cfg: AssessmentConfig,
+    step_urad: float,
+    km: KmOf | None = None,
+    follows: np.ndarray | None = None,
+    lift: DayLift = NO_LIFT,
+) -> DayEstimate:
+    """Every FOR's estimate as a :class:`~monitor.core.result.ForOffset` (:func:`for_offset`): angles in urad
+    with the jackknife sigma (granules that directly follow one another, *follows* (granules,) bool, counted
+    as fewer by the day's correlation of their replicates: :mod:`monitor.estimation.jackknife`), the floor
+    and the day's *lift* spread in quadrature, flags, the intercalibration; in km where *km* (FOR index
+    0-based, turn in rad) gives the mean in-track and cross-track km of a turn and its Jacobian (km/rad),
+    NaN without. *per_for* may build each FOR's samples when indexed (a long day's are read from disk): each
+    is taken once, and dropped once estimated."""
+    reach = reach_steps(step_urad * URAD)
+
+    def one(k: int) -> tuple[ForEstimate | None, np.ndarray]:
+        """FOR k's estimate (None with fewer than 3 samples) and its samples' CrIS BT."""
+        s = per_for[k]
+        return (
+            estimate(s, cfg.cost, cfg.flat_contrast, cfg.uncertainty, reach) if len(s) >= 3 else None
+        ), s.cris_k
+
+    # the FORs are independent: estimated on the assessment's threads (numpy and the compiled BT inversion
+    # leave the interpreter's lock), each the same numbers as alone
+    with ThreadPoolExecutor(max_workers=max(1, cfg.workers), thread_name_prefix="estimate") as pool:
+        estimates, cris = (list(x) for x in zip(*pool.map(one, range(len(per_for))), strict=True))
+    m = next((e.cost.shape[0] for e in estimates if e is not None), 2 * cfg.half_steps + 1)
+    cube = np.full((len(per_for), m, m), np.nan)
+    series = [
+        (e.granules, e.replicates)
+        for e in estimates
+        if e is not None and e.granules is not None and e.replicates is not None
+    ]
+    rho = jackknife.adjacent_correlation(series, follows) if follows is not None else 0.0
+    cone_error_urad = _cone_error_urad(estimates, step_urad)
+    fors = []
+    pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
+    for k, cris_k in enumerate(cris):
+        n = len(cris_k)
+        flags = [FLAG_FEW_SAMPLES] if n < max(cfg.min_samples, 3) else []
+        x = y = sig_a = sig_b = np.nan
+        g = np.full((m, m), np.nan)
+        cal = NO_FIT
+        widths = list(NAN4)
+        rows = list(NAN4)  # ahead minus behind: alpha, beta, and their sigmas (urad)
+        spread = lift.spread_urad[k]
+        best = estimates[k]
+        if best is not None:
+            if best.footprint is not None:
+                fp = best.footprint
+                widths = [
+                    w / URAD
+                    for w in (fp.width_50_rad, fp.sigma_width_50_rad, fp.width_10_rad, fp.sigma_width_10_rad)
+                ]
+            # every sigma of the FOR from the same replicates: the same count of independent granules
+            factor = 1.0 if best.granules is None else jackknife.correlation_factor(len(best.granules), rho)
+            g, x, y, cal = best.cost, best.x, best.y, best.intercalibration.sigmas_scaled(factor)
+            widths[1], widths[3] = factor * widths[1], factor * widths[3]
+            rows_sigma = (factor * v * step_urad for v in best.rows_sigma)
+            rows = [
+                *(v * step_urad for v in best.rows),
+                *(float(np.hypot(v, s)) for v, s in zip(rows_sigma, spread[2:], strict=True)),
+            ]
+            if cal.gain_undetermined:
+                flags.append(FLAG_GAIN_UNDETERMINED)
+            cube[k] = g
+            flags += best.flags
+            if best.refined:
+                pooled.append((cris_k, best.d_opt + cris_k))
+            # the kernel used: the footprint where a response was fitted, else the cone (too few FOVs, cone
+            # means, no refined minimum), said in the flags, its floor the cone's
+            used = Kernel.FOOTPRINT if best.footprint is not None else Kernel.TOP_HAT
+            if used != cfg.kernel:
+                flags.append(FLAG_TOP_HAT)
+            floor = floor_urad(cfg, used, cone_error_urad)
+            sig_a = float(np.hypot(np.hypot(factor * best.sigma[0] * step_urad, floor[0]), spread[0]))
+            sig_b = float(np.hypot(np.hypot(factor * best.sigma[1] * step_urad, floor[1]), spread[1]))
+            if max(sig_a, sig_b) > cfg.max_sigma_urad:
+                flags.append(FLAG_UNCERTAIN)
+        d_alpha, d_beta = x * step_urad, y * step_urad
+        ground = NAN4
+        if km is not None:
+            it, ct, jac = km(k, d_alpha * URAD, d_beta * URAD)
+            s_it = s_ct = np.nan
+            if np.isfinite(sig_a):
+                s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * URAD)
+                s_ct = float(np.hypot(jac[1, 0] * sig_a, jac[1, 1] * sig_b) * URAD)
+            ground = (it, ct, s_it, s_ct)
+        cost = (float(np.nanmin(g)), float(g[m // 2, m // 2])) if n >= 3 else (np.nan, np.nan)
+        height = lift.height_km[k]
+        fors.append(
+            for_offset(
+                k + 1, n, (d_alpha, d_beta), (sig_a, sig_b), ground, cost, cal, widths, rows,
+                (lift.m_per_k, height), flags,
+            )  # fmt: skip
+        )
+    bins = difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True))) if pooled else []
+    return DayEstimate(fors, cube, bins, rho)
