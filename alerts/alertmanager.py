@@ -21,7 +21,7 @@ import logging
 
 import requests
 
-from monitor.config.alerts import AlertSettings
+from monitor.config.alert_settings import AlertSettings
 from monitor.history.records import History
 
 LOG = logging.getLogger(__name__)

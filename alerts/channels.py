@@ -19,7 +19,7 @@ from pathlib import Path
 
 import requests
 
-from monitor.config.alerts import AlertSettings, EmailSettings, SlackSettings
+from monitor.config.alert_settings import AlertSettings, EmailSettings, SlackSettings
 from monitor.config.keys import env_secret
 
 LOG = logging.getLogger(__name__)

@@ -26,7 +26,7 @@ from alerts.rules import (
     spec_finding,
     stale_finding,
 )
-from monitor.config.alerts import AlertSettings
+from monitor.config.alert_settings import AlertSettings
 from monitor.core.tables import Column, text_table
 from monitor.core.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
 from monitor.history.changes import all_changes

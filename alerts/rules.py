@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.config.alerts import RuleSettings
+from monitor.config.alert_settings import RuleSettings
 from monitor.core.constants import N_FOR
 from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 from monitor.history.changes import preceding_change

@@ -46,7 +46,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
 from monitor.instrument import footprint
 from monitor.simulate.case import simulate_case
-from monitor.simulate.orbit import PASSES
+from monitor.simulate.sun_synchronous import PASSES
 
 # name: (gain, bias K, curvature K at 250/310 K) of CrIS against VIIRS (SimulationSpec.cris_*): the issue's
 # range, gains -3..+3 %, biases up to 2 K, curvatures up to 0.5 K over 250-310 K

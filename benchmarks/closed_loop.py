@@ -29,7 +29,7 @@ from monitor.assessment.assess import assess_paths
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import URAD
 from monitor.core.result import AssessmentResult
-from monitor.geometry.instrument import EngineeringPacket
+from monitor.geometry.ep_model import EngineeringPacket
 from monitor.mapping.optimize import Optimization, optimize
 from monitor.mapping.regeolocate import regeolocate_file
 from monitor.sdr.engpkt import load_ep

@@ -23,7 +23,7 @@ import sys
 import numpy as np
 
 from alerts.rules import COMPONENTS, detect_jumps
-from monitor.config.alerts import RuleSettings
+from monitor.config.alert_settings import RuleSettings
 from monitor.history.changes import Change, preceding_change
 from monitor.simulate.profiles import paper_profile
 

@@ -1,5 +1,6 @@
 """What lifting one VIIRS granule's pixels to their cloud heights costs: the clear-sky reference and the
-lift (``parallax.lift_m``), then the lifted points (``parallax.lifted``), on 1 and 2 threads.
+lift (``monitor.collocation.lift.lift_m``), then the lifted points (``monitor.collocation.lift.lifted``),
+on 1 and 2 threads.
 
     python -m benchmarks.lift_time --data DIR [--granule 3] [--repeat 3] [--rows FILE]
 
@@ -23,8 +24,8 @@ import numpy as np
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.inputs import read_viirs
-from monitor.collocation import parallax
-from monitor.collocation.parallax import PROBE_M_PER_K
+from monitor.collocation import lift as pixel_lift
+from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.sdr.pairing import plan
 
 
@@ -51,23 +52,23 @@ def main() -> None:
     lat, lon, h = geo.lat_rad, geo.lon_rad, geo.height_m
     few = slice(0, 64)  # two scans: compiled here, not timed
     ones = np.ones_like(sdr.bt_k[few])
-    parallax.lifted(lat[few], lon[few], h[few], ones, geo.sc_position_m[:2], geo.sc_velocity_m_s[:2])
-    lift = parallax.lift_m(sdr.bt_k, sdr.good, PROBE_M_PER_K)
+    pixel_lift.lifted(lat[few], lon[few], h[few], ones, geo.sc_position_m[:2], geo.sc_velocity_m_s[:2])
+    lift = pixel_lift.lift_m(sdr.bt_k, sdr.good, PROBE_M_PER_K)
     row = {
         "commit": commit(),
         "pixels": int(lift.size),
         "lifted_share": round(float(np.mean(lift > 0)), 3),
         "lift_m_s": round(
-            _median_s(lambda: parallax.lift_m(sdr.bt_k, sdr.good, PROBE_M_PER_K), args.repeat), 2
+            _median_s(lambda: pixel_lift.lift_m(sdr.bt_k, sdr.good, PROBE_M_PER_K), args.repeat), 2
         ),
     }
     args_lifted = (lat, lon, h, lift, geo.sc_position_m, geo.sc_velocity_m_s)
     for threads in (1, 2):
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
         row[f"lifted_s_{threads}_threads"] = round(
-            _median_s(lambda: parallax.lifted(*args_lifted), args.repeat), 2
+            _median_s(lambda: pixel_lift.lifted(*args_lifted), args.repeat), 2
         )
-    points = parallax.lifted(*args_lifted)
+    points = pixel_lift.lifted(*args_lifted)
     row["checksum"] = hashlib.sha256(b"".join(np.ascontiguousarray(a).tobytes() for a in points)).hexdigest()[
         :16
     ]

@@ -24,7 +24,7 @@ import numpy as np
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import collocate_plan, cost_and_offsets, paired
-from monitor.collocation.parallax import PROBE_M_PER_K
+from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult
 from monitor.estimation import parallax

@@ -1,7 +1,7 @@
 """What a perfect parallax correction would give: the clouds-with-height case assessed with each VIIRS pixel
 lifted to the true height of what it sees, against the day's learnt lift.
 
-The learnt correction (``monitor/collocation/parallax.py``) lifts a pixel by kappa times how much colder it is
+The learnt correction (``monitor/collocation/lift.py``) lifts a pixel by kappa times how much colder it is
 than its clear-sky neighbourhood; on clouds with height the FOR offsets still miss the accuracy bounds
 (docs/science.md). This bench asks whether better heights could close the gap, or whether something no
 height removes is left (the sides of clouds hiding what behind them one instrument sees and the other does
@@ -28,7 +28,7 @@ import numpy as np
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import assess_paths
-from monitor.collocation import parallax
+from monitor.collocation import lift as pixel_lift
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_COLUMNS
 from monitor.estimation import parallax as day_parallax
@@ -63,7 +63,8 @@ def _recording(self, origin, los):
 
 
 def _true_lift(lifted):
-    """``parallax.lifted`` with each row's lift replaced by the recorded truth (0 where none)."""
+    """``monitor.collocation.lift.lifted`` with each row's lift replaced by the recorded truth (0 where
+    none)."""
 
     def wrapped(lat_rad, lon_rad, height_m, lift, sat_m, velocity_m_s):
         lat = np.degrees(np.asarray(lat_rad, np.float64)).astype(np.float32)
@@ -120,10 +121,10 @@ def main() -> int:
     )
     cfg = AssessmentConfig()
     shipped = _scores(assess_paths([root], cfg), truth)
-    parallax.lifted = _true_lift(parallax.lifted)
+    pixel_lift.lifted = _true_lift(pixel_lift.lifted)
     day_parallax.day_lift = lambda s0, s1, cost: (1.0, float("nan"))
     oracle = _scores(assess_paths([root], cfg), truth)
-    print(f"oracle rows matched {parallax.lifted.rows}/{parallax.lifted.total}")
+    print(f"oracle rows matched {pixel_lift.lifted.rows}/{pixel_lift.lifted.total}")
     for name, s in (("shipped", shipped), ("true heights", oracle)):
         print(
             f"{name:<13} RMS {s['rms_urad'][0]:5.1f} / {s['rms_urad'][1]:5.1f} urad, worst "

@@ -44,7 +44,7 @@ from aiosmtpd.controller import Controller
 
 from monitor.core.vocabulary import RunStatus
 from monitor.sdr.products import PRODUCTS
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 from tests.servers import S3Server, Webhook, free_port, victoria_metrics, vm_export
 

@@ -33,7 +33,7 @@ from monitor.assessment.inputs import (
 )
 from monitor.assessment.spool import OnDisk, Spool
 from monitor.collocation import collocate, swath
-from monitor.collocation.parallax import PROBE_M_PER_K
+from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, N_FOR
@@ -43,8 +43,8 @@ from monitor.estimation import parallax
 from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
 from monitor.estimation.offsets import DayLift, day_offsets
+from monitor.geometry.ep_model import FOV5
 from monitor.geometry.ground import offset_km
-from monitor.geometry.instrument import FOV5
 from monitor.geometry.inverse import FovGeometry
 from monitor.instrument.spectral import I5Band, i5_band
 from monitor.sdr import (
@@ -376,7 +376,7 @@ def _collocate_run(
     lift_m_per_k: float = 0.0,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
     """Collocate a time-ordered run of CrIS granules, the VIIRS pixels lifted by *lift_m_per_k*
-    (:mod:`monitor.collocation.parallax`); returns (samples, skipped)."""
+    (:mod:`monitor.collocation.lift`); returns (samples, skipped)."""
     band = i5_band(satellite)
     cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k)
     samples, skipped = [], []

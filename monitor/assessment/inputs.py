@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.collocation import collocate, parallax, swath
+from monitor.collocation import collocate, lift, swath
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import Kernel
 from monitor.geometry.inverse import FovGeometry, granule_geometry
@@ -65,7 +65,7 @@ class SwathCache:
     """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept. *spans* holds, by key,
     the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`). Every
     piece has its pixels lifted by *lift_m_per_k* (m per K colder than the clear-sky reference:
-    :mod:`monitor.collocation.parallax`; 0, at their GEO points)."""
+    :mod:`monitor.collocation.lift`; 0, at their GEO points)."""
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
@@ -228,9 +228,9 @@ def piece(
     seen = None
     if cache.lift_m_per_k:
         with stage(timings, "parallax"):
-            lift = parallax.lift_m(sdr.bt_k, sdr.good, cache.lift_m_per_k)
-            seen = parallax.lifted(
-                geo.lat_rad, geo.lon_rad, geo.height_m, lift, geo.sc_position_m, geo.sc_velocity_m_s
+            height_m = lift.lift_m(sdr.bt_k, sdr.good, cache.lift_m_per_k)
+            seen = lift.lifted(
+                geo.lat_rad, geo.lon_rad, geo.height_m, height_m, geo.sc_position_m, geo.sc_velocity_m_s
             )
     with stage(timings, "geometry"):
         piece = swath.swath_piece(

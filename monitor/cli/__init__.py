@@ -14,9 +14,9 @@ import sys
 from collections.abc import Sequence
 
 # the command groups register their commands (monitor.cli.registry) when imported
-from monitor.cli import alerting, mapping, operations, results, science  # noqa: F401
+from monitor.cli import alerting, mapping, operations, review, science  # noqa: F401
+from monitor.cli.manual import PrintReference
 from monitor.cli.output import PipedOutput
-from monitor.cli.reference import PrintReference
 from monitor.cli.registry import COMMANDS, EXIT_ALREADY_RUNNING, EXIT_BAD_INPUT, EXIT_FAIL, BadInput
 from monitor.core.errors import DataError
 from monitor.service import allocator, logs

@@ -40,7 +40,7 @@ RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices'
 def cmd_alerts(args: argparse.Namespace) -> int:
     """crisgeo alerts: list, silence, unsilence, evaluate."""
     from alerts.engine import alerts_view, evaluate_and_deliver
-    from monitor.service.store.alerts import AlertState, SilenceError
+    from monitor.service.store.alert_state import AlertState, SilenceError
     from monitor.service.store.sqlite import Store
 
     now = dt.datetime.now(dt.timezone.utc)

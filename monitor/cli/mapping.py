@@ -14,7 +14,7 @@ from monitor.config.assessment import FingerprintConfig
 from monitor.core.errors import DataError
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    from monitor.geometry.instrument import EngineeringPacket
+    from monitor.geometry.ep_model import EngineeringPacket
     from monitor.mapping.fingerprint import DayPrint, EpMatch
     from monitor.mapping.residuals import OwnResiduals, ResidualTable
 

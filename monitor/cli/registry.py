@@ -15,7 +15,7 @@ from monitor.config.model import Config
 from monitor.core.vocabulary import Cost, Kernel
 
 if TYPE_CHECKING:
-    from monitor.geometry.instrument import (
+    from monitor.geometry.ep_model import (
         EngineeringPacket,  # the commands import what they run when they run it: crisgeo starts fast
     )
     from monitor.service.store.sqlite import Store

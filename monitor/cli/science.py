@@ -26,7 +26,7 @@ from monitor.core.constants import N_FOV, PAPER_GRANULES
 from monitor.core.satellites import SATELLITES
 from monitor.instrument.footprint import SHAPES as FOOTPRINTS
 from monitor.simulate import LAYOUTS
-from monitor.simulate.orbit import PASSES
+from monitor.simulate.sun_synchronous import PASSES
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
     from monitor.instrument.footprint import Response

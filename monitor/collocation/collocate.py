@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from monitor.collocation import parallax
+from monitor.collocation import lift
 from monitor.collocation.swath import BLOCK_PX, SwathPiece, ViirsSwath, swath_piece
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, MAX_GRID_SPREAD_RAD, VIIRS_DETECTORS
@@ -412,7 +412,7 @@ def warm_up() -> float:
     ground = wgs84.geodetic_to_ecef(np.radians(0.06), np.radians(0.03), 0.0)
     sat = ground * (1 + 833e3 / np.linalg.norm(ground))
     scans = np.tile(sat, (rows // VIIRS_DETECTORS, 1))
-    parallax.lifted(lat, lon, zeros, zeros + 1e3, scans, np.cross(scans, [0.0, 0.0, 1.0]))
+    lift.lifted(lat, lon, zeros, zeros + 1e3, scans, np.cross(scans, [0.0, 0.0, 1.0]))
     z = -ground / np.linalg.norm(ground)
     x = np.cross([0.0, 0.0, 1.0], z)
     sbf = np.stack([x, np.cross(z, x), z], axis=1)

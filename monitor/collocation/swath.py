@@ -462,7 +462,7 @@ def swath_piece(
     (:func:`scans_between`), each with the same weights as in the whole granule (the scans next to those
     kept are their halos).
     *seen*, (lat_rad, lon_rad, height_m) like the pixels', are the 3-D points the pixels see (a cloud above
-    the GEO point: :mod:`monitor.collocation.parallax`): the pixels are searched and tested there, and
+    the GEO point: :mod:`monitor.collocation.lift`): the pixels are searched and tested there, and
     weighted by their footprints at the GEO points (a pixel's solid angle does not change along its line
     of sight, but the steps between a lifted pixel and its neighbours would tilt its footprint).
     """

@@ -13,7 +13,7 @@ from pydantic import (
     model_validator,
 )
 
-from monitor.config.alerts import AlertSettings, Links
+from monitor.config.alert_settings import AlertSettings, Links
 from monitor.config.assessment import AssessmentConfig, FingerprintConfig, SceneConfig
 from monitor.config.keys import FilePath, KeyProblem, Section, Url, key
 from monitor.config.outputs import ExportConfig, HttpConfig, StoreConfig

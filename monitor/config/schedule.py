@@ -1,5 +1,5 @@
 """The ``schedule`` section: when the daemon runs and which days it (re)assesses (the days themselves:
-:mod:`monitor.service.schedule`)."""
+:mod:`monitor.service.timetable`)."""
 
 from __future__ import annotations
 

@@ -246,7 +246,8 @@ class SelectionRow:
 
 
 class AlertLedger(Protocol):
-    """The alert state, silences and delivery queue (:class:`monitor.service.store.alerts.AlertState`)."""
+    """The alert state, silences and delivery queue
+    (:class:`monitor.service.store.alert_state.AlertState`)."""
 
     def get(self, fingerprint: str) -> Alert | None: ...
     def firing(self, satellite: str | None = None) -> list[Alert]: ...

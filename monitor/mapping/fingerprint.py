@@ -26,7 +26,7 @@ import numpy as np
 from monitor.core.constants import PROCESSING_CHANGE_URAD, URAD
 from monitor.core.errors import DataError
 from monitor.core.tables import Column, text_table
-from monitor.geometry.instrument import FOV5, fov5_angles
+from monitor.geometry.ep_model import FOV5, fov5_angles
 from monitor.geometry.inverse import granule_geometry
 from monitor.sdr import CrisGeoGranule, GranuleError, read_file
 from monitor.sdr.engpkt import load_library

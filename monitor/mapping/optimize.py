@@ -17,7 +17,7 @@ from monitor.core.constants import N_FOR, URAD
 from monitor.core.errors import DataError
 from monitor.core.result import AssessmentResult, ForOffset
 from monitor.core.tables import Column, text_table
-from monitor.geometry.instrument import EngineeringPacket, corrected_ssm_angles
+from monitor.geometry.ep_model import EngineeringPacket, corrected_ssm_angles
 
 
 @dataclass(frozen=True)

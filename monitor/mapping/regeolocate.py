@@ -21,12 +21,12 @@ import numpy as np
 
 from monitor.core.constants import N_FOR
 from monitor.core.errors import DataError
-from monitor.geometry import instrument, wgs84
+from monitor.geometry import ep_model, wgs84
+from monitor.geometry.ep_model import EngineeringPacket
 from monitor.geometry.geolocate import GroundView, geolocate_fovs
-from monitor.geometry.instrument import EngineeringPacket
 from monitor.mapping.residuals import OwnResiduals, ResidualTable
 from monitor.sdr import read_file
-from monitor.sdr.errors import GranuleError
+from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import CrisGeoGranule
 from monitor.sdr.products import PRODUCTS
 
@@ -50,7 +50,7 @@ def geolocate_granule(
         raise DataError(f"{g.meta.path}: granule of {g.meta.platform}, EP {ep.version} of {ep.satellite}")
     if residuals is not None and residuals.satellite != ep.satellite:
         raise DataError(f"residual table of {residuals.satellite}, EP {ep.version} of {ep.satellite}")
-    los = instrument.los_spacecraft(ep)
+    los = ep_model.los_spacecraft(ep)
     if residuals is not None:
         los = residuals.table_for(g).apply(los)
     return geolocate_fovs(

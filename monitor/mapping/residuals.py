@@ -1,6 +1,6 @@
 """Geolocation beyond the engineering packet: a per-FOR residual table of the FOV-5 line of sight.
 
-The EP model (:mod:`monitor.geometry.instrument`) reproduces the operational CrIS geolocation to tens of
+The EP model (:mod:`monitor.geometry.ep_model`) reproduces the operational CrIS geolocation to tens of
 metres, but not the scene-mirror servo corrections IDPS computes from telemetry carried only in the raw
 data records (docs/jpss-formats.md 2.3: per-FOR cross-track residuals of -30..+64 urad, a constant ~+28 urad
 in-track on NOAA-20). Those show in the GEO files themselves: the fingerprint
@@ -36,8 +36,8 @@ import numpy as np
 
 from monitor.core.constants import N_FOR, PROCESSING_CHANGE_URAD, URAD
 from monitor.core.errors import DataError
+from monitor.geometry.ep_model import EngineeringPacket, fov5_angles
 from monitor.geometry.frames import los_angles, los_from_angles
-from monitor.geometry.instrument import EngineeringPacket, fov5_angles
 from monitor.mapping.fingerprint import DayPrint, day_print, granule_print
 from monitor.sdr import CrisGeoGranule
 

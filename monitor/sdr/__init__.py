@@ -1,6 +1,6 @@
 """Readers for JPSS IDPS HDF5 products (CrIS SDR/GEO, VIIRS I5 SDR and I-band GEO). Files, not frames."""
 
-from monitor.sdr.errors import GranuleError
+from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import (
     CrisGeoGranule,
     CrisSdrGranule,

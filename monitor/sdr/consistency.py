@@ -52,7 +52,7 @@ from monitor.core.constants import CRIS_SCAN_US, VIIRS_SCAN_US
 from monitor.core.satellites import SATELLITES
 from monitor.geometry import orbit, wgs84
 from monitor.geometry.inverse import satellite_from_fov
-from monitor.sdr.errors import GranuleError
+from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import (
     CrisGeoGranule,
     CrisSdrGranule,

@@ -1,7 +1,7 @@
 """Engineering-packet files: the decoded EP XML of LW-GEO and a YAML file of the same content.
 
 Both hold angles in microradians under the EP's own element names; the model
-(:class:`monitor.geometry.instrument.EngineeringPacket`) holds radians. The table ``_ANGLES`` says
+(:class:`monitor.geometry.ep_model.EngineeringPacket`) holds radians. The table ``_ANGLES`` says
 where each model field lives in a file, so XML and YAML are read by the same code. The mounting
 angles are not part of a real EP: for XML they come from ``MOUNTING_URAD`` by ``InstrumentId``, a
 YAML file carries them under ``ScToSbf``. Writing keeps the input's format: an XML output is the input
@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 from monitor.core.constants import N_FOR, N_FOV, URAD
 from monitor.core.errors import DataError
 from monitor.core.satellites import SATELLITES
-from monitor.geometry.instrument import EngineeringPacket
+from monitor.geometry.ep_model import EngineeringPacket
 
 # (model field, path in the EP, number of values); a triple/pair path lists its components.
 _ANGLES = (

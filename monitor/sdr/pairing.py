@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from monitor.core.errors import DataError
-from monitor.sdr.errors import GranuleError
+from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import GranuleMeta, GranuleRef, as_ref
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR

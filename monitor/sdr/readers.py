@@ -19,7 +19,7 @@ import numpy as np
 
 from monitor.core.satellites import SATELLITES
 from monitor.sdr import consistency
-from monitor.sdr.errors import GranuleError
+from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import (
     _GRANULE_TYPES,
     GranuleMeta,

@@ -32,8 +32,8 @@ from monitor.core.result import AssessmentResult, DayPrecision
 from monitor.core.vocabulary import EventKind, RunStatus
 from monitor.history.changes import all_changes
 from monitor.service.outputs.timeseries import change_lines, day_lines, drain_outbox, target_name
-from monitor.service.schedule import catch_up, no_data_horizon
 from monitor.service.store.sqlite import Store
+from monitor.service.timetable import catch_up, no_data_horizon
 
 LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
 

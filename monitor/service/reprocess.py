@@ -26,8 +26,8 @@ from monitor.core.vocabulary import RunStatus
 from monitor.service.allocator import reuse_freed_memory
 from monitor.service.lock import InstanceLock
 from monitor.service.pipeline import RunOutcome, record_day
-from monitor.service.schedule import no_data_horizon
 from monitor.service.store.sqlite import Store
+from monitor.service.timetable import no_data_horizon
 
 if TYPE_CHECKING:
     from distributed import Client, LocalCluster

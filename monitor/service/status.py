@@ -19,9 +19,9 @@ from monitor.core.tables import BRIEF, for_table
 from monitor.core.vocabulary import Rule, RunStatus, Severity
 from monitor.history.records import Run, Silence
 from monitor.service.lock import holder
-from monitor.service.schedule import next_run
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
+from monitor.service.timetable import next_run
 
 
 class NagiosState(IntEnum):

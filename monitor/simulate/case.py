@@ -54,7 +54,7 @@ from monitor.core.constants import (
 from monitor.core.errors import DataError, StopRequested
 from monitor.core.satellites import satellite as satellite_info
 from monitor.geometry import frames, wgs84
-from monitor.geometry.instrument import EngineeringPacket, fov5_angles, los_spacecraft
+from monitor.geometry.ep_model import EngineeringPacket, fov5_angles, los_spacecraft
 from monitor.instrument.footprint import EllipticalResponse, RadialResponse, Response
 from monitor.instrument.spectral import C1, C2, i5_band, planck_radiance
 from monitor.sdr import iet
@@ -62,12 +62,12 @@ from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
 from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
 from monitor.simulate import complete
-from monitor.simulate import instrument as ins
+from monitor.simulate import scan_geometry as ins
 from monitor.simulate.clouds import CloudHeights
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
-from monitor.simulate.orbit import PASSES, CircularOrbit, find_pass
 from monitor.simulate.profiles import load_profile
 from monitor.simulate.scene import Scene, spectra, transmittance
+from monitor.simulate.sun_synchronous import PASSES, CircularOrbit, find_pass
 
 UTC = dt.timezone.utc
 DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)

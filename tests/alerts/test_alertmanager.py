@@ -8,8 +8,8 @@ import requests
 
 from alerts.alertmanager import post_state
 from alerts.rules import Finding
-from monitor.config.alerts import AlertSettings, Links
-from monitor.service.store.alerts import AlertState
+from monitor.config.alert_settings import AlertSettings, Links
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 from tests.servers import Webhook, alertmanager, wait_for
 

@@ -3,7 +3,7 @@ import email
 import pytest
 
 from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
-from monitor.config.alerts import EmailSettings, SlackSettings
+from monitor.config.alert_settings import EmailSettings, SlackSettings
 from tests.alerts.conftest import PASSWORD, USER
 from tests.invoke import run_crisgeo
 
@@ -123,8 +123,8 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     import threading
 
     from alerts.engine import deliver
-    from monitor.config.alerts import AlertSettings
-    from monitor.service.store.alerts import AlertState
+    from monitor.config.alert_settings import AlertSettings
+    from monitor.service.store.alert_state import AlertState
     from monitor.service.store.sqlite import Store
 
     monkeypatch.setenv("T_SLACK", webhook.url)
@@ -168,7 +168,7 @@ def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
     import datetime as dt
     import os
 
-    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.alert_state import AlertState
     from monitor.service.store.sqlite import Store
 
     cfg = tmp_path / "c.yaml"

@@ -83,7 +83,7 @@ alerts:
 
 def test_channel_down_gets_the_message_later(two_days, webhook, monkeypatch, tmp_path):
     from alerts.engine import deliver
-    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.alert_state import AlertState
     from monitor.service.store.sqlite import Store
 
     monkeypatch.setenv("T_HOOK", webhook.url)

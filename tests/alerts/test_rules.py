@@ -7,7 +7,7 @@ import pytest
 from alerts.engine import findings_for
 from alerts.rules import CALIBRATION, GEOLOCATION, failure_finding, jump_findings, spec_finding, stale_finding
 from benchmarks.jump_detection import false_alarms, jump_trial
-from monitor.config.alerts import AlertSettings, RuleSettings
+from monitor.config.alert_settings import AlertSettings, RuleSettings
 from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.history.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
 from monitor.service.store.sqlite import Store

@@ -3,7 +3,7 @@
 import pytest
 import yaml
 
-from monitor.config.alerts import AlertSettings, EmailSettings, RuleSettings, SlackSettings
+from monitor.config.alert_settings import AlertSettings, EmailSettings, RuleSettings, SlackSettings
 from monitor.config.file import load_config
 from monitor.config.keys import ConfigError
 

@@ -3,7 +3,7 @@
 import numpy as np
 
 from monitor.assessment.assess import collocate_plan, cost_and_offsets
-from monitor.collocation.parallax import PROBE_M_PER_K
+from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan
 

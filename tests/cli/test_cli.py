@@ -124,7 +124,7 @@ def test_status_json_and_nagios_exit_codes(tmp_path, capsys, monkeypatch):
     import datetime as dt
 
     from alerts.rules import Finding
-    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.alert_state import AlertState
     from monitor.service.store.sqlite import Store
 
     cfg = _status_config(tmp_path)

@@ -196,7 +196,7 @@ def test_a_day_outside_the_mission_is_bad_input_and_records_nothing(
     config_with_history, capsys, argv, message
 ):
     """A typo'd date: exit 2, one line, no run in the ledger and no alert (nothing sent, nothing queued)."""
-    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.alert_state import AlertState
     from monitor.service.store.sqlite import Store
 
     state = config_with_history.parent / "state"

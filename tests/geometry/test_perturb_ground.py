@@ -3,7 +3,7 @@ import pytest
 
 from monitor.geometry import frames, perturb
 from monitor.geometry.ground import offset_km
-from monitor.simulate.orbit import CircularOrbit
+from monitor.simulate.sun_synchronous import CircularOrbit
 
 
 def test_grid_is_the_papers():

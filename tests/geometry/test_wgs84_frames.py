@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from monitor.geometry import frames, wgs84
-from monitor.simulate.orbit import CircularOrbit, earth_rotation_angle
+from monitor.simulate.sun_synchronous import CircularOrbit, earth_rotation_angle
 
 
 def test_geodetic_ecef_round_trip():

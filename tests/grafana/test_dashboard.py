@@ -142,7 +142,7 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
     from alerts.rules import Finding
     from monitor.service.health import Health
     from monitor.service.outputs.metrics import ServiceMetrics
-    from monitor.service.store.alerts import AlertState
+    from monitor.service.store.alert_state import AlertState
     from tests.servers import victoria_metrics, wait_for
 
     db = tmp_path / "s.sqlite"

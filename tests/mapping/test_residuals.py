@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from monitor.core.constants import URAD
-from monitor.geometry.instrument import fov5_angles
+from monitor.geometry.ep_model import fov5_angles
 from monitor.mapping import fingerprint as fpr
 from monitor.mapping import residuals
 from monitor.mapping.regeolocate import compare_with_files

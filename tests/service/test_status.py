@@ -12,7 +12,7 @@ from monitor.config.file import load_config
 from monitor.core.result import ForOffset
 from monitor.service.lock import InstanceLock
 from monitor.service.status import NagiosState, status_report
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import day_result
 

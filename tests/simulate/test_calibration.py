@@ -9,7 +9,7 @@ import pytest
 
 from alerts.rules import CALIBRATION, jump_findings
 from monitor.assessment.assess import assess_paths
-from monitor.config.alerts import RuleSettings
+from monitor.config.alert_settings import RuleSettings
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import CALIBRATION_REFERENCE_K
 from monitor.core.vocabulary import Cost

@@ -6,8 +6,8 @@ import pytest
 from monitor.core.errors import DataError
 from monitor.sdr import read_file
 from monitor.simulate.case import simulate_case
-from monitor.simulate.instrument import cris_los_sbf, viirs_bowtie_deleted, viirs_column_geometry
 from monitor.simulate.profiles import load_profile, paper_profile
+from monitor.simulate.scan_geometry import cris_los_sbf, viirs_bowtie_deleted, viirs_column_geometry
 
 
 def test_paper_profile_shape():

@@ -6,7 +6,7 @@ import pytest
 
 from monitor.core.errors import DataError
 from monitor.geometry import wgs84
-from monitor.simulate import instrument as ins
+from monitor.simulate import scan_geometry as ins
 from monitor.simulate.case import SimulationSpec, Simulator
 from monitor.simulate.clouds import CEILING_M, CloudHeights
 from monitor.simulate.scene import Scene

@@ -58,7 +58,7 @@ from prometheus_client.metrics_core import Metric
 from monitor.core.constants import URAD
 from monitor.core.result import DayPrecision, Family, ForOffset, measures
 from monitor.core.vocabulary import DayStop, RunStatus
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 
 disable_created_metrics()  # a counter's start time is not a series anyone graphs

@@ -12,7 +12,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Literal, Self
 
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.schema import MIGRATIONS, result_columns
 
 UTC = dt.timezone.utc

@@ -44,8 +44,8 @@ MIGRATIONS = [
         satellite TEXT NOT NULL, day TEXT NOT NULL, computed TEXT NOT NULL, body TEXT NOT NULL,
         PRIMARY KEY (satellite, day));
     """,
-    # 3: the alert tables (monitor/service/store/alerts.py), until now created by the alert state itself: IF
-    # NOT EXISTS keeps the rows of stores that have them; alert_meta, their own version table, goes
+    # 3: the alert tables (monitor/service/store/alert_state.py), until now created by the alert state
+    # itself: IF NOT EXISTS keeps the rows of stores that have them; alert_meta, their own version table, goes
     """
     CREATE TABLE IF NOT EXISTS alert_state (
         fingerprint TEXT PRIMARY KEY, rule TEXT NOT NULL, satellite TEXT NOT NULL, grp TEXT, severity TEXT,

@@ -36,7 +36,7 @@ from monitor.core.vocabulary import RunStatus
 from monitor.history.changes import Change, all_changes
 from monitor.history.records import Alert, ForSeries
 from monitor.service.outputs.report import plots
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 
 UTC = dt.timezone.utc

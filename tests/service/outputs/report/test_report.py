@@ -16,7 +16,7 @@ from monitor.cli import main
 from monitor.core.result import AssessmentResult
 from monitor.core.vocabulary import Rule, Severity
 from monitor.service.outputs.report.html import ReportOptions, build_report
-from monitor.service.store.alerts import AlertState
+from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
 from tests.servers import chromium_driver

@@ -8,7 +8,7 @@ import pytest
 from monitor.core.errors import DataError
 from monitor.core.satellites import SATELLITES, satellite
 from monitor.geometry import wgs84
-from monitor.simulate.orbit import CircularOrbit, find_pass
+from monitor.simulate.sun_synchronous import CircularOrbit, find_pass
 
 T0 = dt.datetime(2025, 3, 1, tzinfo=dt.timezone.utc).timestamp()
 

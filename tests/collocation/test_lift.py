@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from monitor.collocation.parallax import REFERENCE_HALF_PX, ROTATION_RAD_S, lift_m, lifted, reference_k
+from monitor.collocation.lift import REFERENCE_HALF_PX, ROTATION_RAD_S, lift_m, lifted, reference_k
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.geometry import wgs84
 

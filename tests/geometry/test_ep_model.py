@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from monitor.core.errors import DataError
-from monitor.geometry import instrument as ins
+from monitor.geometry import ep_model as ins
 from monitor.geometry import wgs84
 from monitor.geometry.frames import los_angles, los_from_angles
 from monitor.geometry.geolocate import geolocate_fovs

@@ -7,7 +7,7 @@ import pytest
 
 from alerts.rules import Finding
 from monitor.core.vocabulary import EventKind
-from monitor.service.store.alerts import AlertState, SilenceError
+from monitor.service.store.alert_state import AlertState, SilenceError
 from monitor.service.store.schema import MIGRATIONS
 from monitor.service.store.sqlite import Store
 

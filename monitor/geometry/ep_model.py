@@ -1,7 +1,7 @@
 """The CrIS instrument line-of-sight model of an engineering packet (EP), and its inverse.
 
 Wang et al. 2017, section 4.1 (equations 9-23) and table 2, with the conventions that reproduce IDPS
-GCRSO from the real EPs (docs/jpss-formats.md 2.2 and 2.3, checked in ``tests/geometry/test_instrument.py``):
+GCRSO from the real EPs (docs/jpss-formats.md 2.2 and 2.3, checked in ``tests/geometry/test_ep_model.py``):
 
 * IOAR (interferometer optical axis reference): a FOV's LOS is ``Ry(pitch) Rz(yaw) [1, 0, 0]`` with
   ``yaw = -(CrosstrackOffset_i + LosRelativeYaw)`` and ``pitch = IntrackOffset_i + LosRelativePitch``.
