@@ -67,20 +67,20 @@ EXTRA_PASSES = {"dateline": ("night", 180.0)}
 
 def run_case(
     root: Path,
-    size,
-    profile,
-    ground,
-    pass_name,
-    seed,
-    workers,
-    keep,
-    mismatch="none",
-    cost=DEFAULT_COST.value,
-    shape="top-hat",
-    kernel=DEFAULT_KERNEL.value,
-    clouds="ground",
-    rows_urad=0.0,
-):
+    size: int,
+    profile: str,
+    ground: str,
+    pass_name: str,
+    seed: int,
+    workers: int,
+    keep: bool,
+    mismatch: str = "none",
+    cost: str = DEFAULT_COST.value,
+    shape: str = "top-hat",
+    kernel: str = DEFAULT_KERNEL.value,
+    clouds: str = "ground",
+    rows_urad: float = 0.0,
+) -> dict:
     orbit_pass, lon = EXTRA_PASSES.get(pass_name, (pass_name, None))
     gain, bias_k, curve_k = MISMATCHES[mismatch]
     case = root / f"{profile}_{ground}_{pass_name}_{seed}_{size}_{mismatch}_{shape}_{clouds}_{rows_urad:g}"
@@ -145,7 +145,7 @@ def run_case(
     }
 
 
-def _key(r) -> tuple:
+def _key(r: dict) -> tuple:
     return (
         r["size"],
         r["ground"],
@@ -161,7 +161,7 @@ def _key(r) -> tuple:
     )
 
 
-def recovery(row) -> str:
+def recovery(row: dict) -> str:
     """The intercalibration of a row against the injected values: how many reliable FORs determine a gain
     (intercal.GAIN_RESOLUTION_PCT), and over those the median and worst bias and gain (bounded by RECOVERY,
     NO_DIFFERENCE where none was injected) and curvature (where the row has it)."""
@@ -186,12 +186,12 @@ def recovery(row) -> str:
     return "  " + ", ".join(parts) + ("  within" if within else "  OUT")
 
 
-def verdict(row) -> tuple[bool, str]:
+def verdict(row: dict) -> tuple[bool, str]:
     ea, eb = np.array(row["err_alpha_urad"]), np.array(row["err_beta_urad"])
     rms_max, abs_max = BOUNDS.get(row["size"], SMALL_BOUNDS)
     rms = np.sqrt(np.nanmean(ea**2)), np.sqrt(np.nanmean(eb**2))
     worst = np.nanmax(np.abs(ea)), np.nanmax(np.abs(eb))
-    ok = max(rms) <= rms_max and max(worst) <= abs_max and np.all(np.isfinite(ea + eb))
+    ok = bool(max(rms) <= rms_max and max(worst) <= abs_max and np.all(np.isfinite(ea + eb)))
     line = (
         f"{row.get('footprint', 'top-hat'):<14} {row.get('kernel', 'top-hat'):<9} "
         f"{row.get('mismatch', 'none'):<17} {row.get('cost', 'stdev'):<10} "
@@ -202,7 +202,7 @@ def verdict(row) -> tuple[bool, str]:
     return ok, line
 
 
-def rows_read(row) -> str:
+def rows_read(row: dict) -> str:
     """How the FOV rows' product reads the injected row error (ahead minus behind, in-track; none
     cross-track): per direction the median error and the share of FORs within 2 sigma (issue 42: >= 90 %,
     median within 40 urad, median sigma <= 60 urad)."""
@@ -217,7 +217,7 @@ def rows_read(row) -> str:
     return f"  rows {row['clouds']} {row['fov_rows_alpha_urad']:+g}: " + ", ".join(parts)
 
 
-def calibration(rows) -> str:
+def calibration(rows: list[dict]) -> str:
     """The uncertainty table: coverage of 2 sigma and median sigma / RMS error, per case size."""
     lines = [f"{'gran':>4} {'cases':>5} {'|e|<=2s':>8} {'med s/rms':>10} {'worst s/rms':>11}"]
     for size in sorted({r["size"] for r in rows}, reverse=True):

@@ -49,7 +49,7 @@ class LoopReport:
     pitch_error_urad: np.ndarray  # recovered minus true ActualIntrackAnglePitch
     seconds: dict
 
-    def residual(self):
+    def residual(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(d_alpha_urad, d_beta_urad, in_track_km, cross_track_km) (30,) of the second assessment."""
         f = self.second.fors
         return (
@@ -84,7 +84,7 @@ def _link_or_copy(src: Path, dst: Path) -> None:
 
 
 def run_closed_loop(
-    work_dir,
+    work_dir: str | Path,
     true_ep: EngineeringPacket,
     ground_ep: EngineeringPacket,
     granules: int = 14,

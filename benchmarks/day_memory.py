@@ -18,6 +18,7 @@ import tempfile
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import DayAssessment
@@ -49,7 +50,7 @@ def main() -> None:
                 "this system cannot reset the peak memory count: the simulation's would be counted"
             )
         case = plan([data])
-        points = []
+        points: list[dict[str, Any]] = []
         t0 = time.perf_counter()
         with DayAssessment(case.satellite, cfg, cfg.workers) as day:
             for first in range(0, len(case.cris), args.keep):

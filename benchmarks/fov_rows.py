@@ -110,7 +110,7 @@ def simulated(root: Path, clouds: str, seed: int, granules: int, keep: bool) -> 
         )
     cfg = AssessmentConfig()
     samples = collocate_plan(plan([case]), cfg, workers=2)
-    paper = stdev_rows([(s.bt_viirs_k, s.bt_cris_k, s.usable) for s in samples], cfg.step_urad)
+    paper = stdev_rows([(s.bt_viirs_k[...], s.bt_cris_k, s.usable) for s in samples], cfg.step_urad)
     alone = [cost_and_offsets([s], cfg, satellite=s.info.cris_meta["platform"]) for s in samples]
     day = cost_and_offsets(samples, cfg, satellite=samples[0].info.cris_meta["platform"])
     cris = np.concatenate([s.bt_cris_k[s.usable] for s in samples])

@@ -30,7 +30,7 @@ from monitor.simulate.profiles import paper_profile
 START = dt.date(2023, 1, 1)
 
 
-def noise_series(rng, n_days: int):
+def noise_series(rng: np.random.Generator, n_days: int) -> tuple[list[dt.date], dict[str, np.ndarray]]:
     """(days, {component: (n_days, 30) km}) of a stable instrument with realistic scatter."""
     k = np.arange(30)
     sig_in = np.full(30, 0.12)
@@ -49,7 +49,7 @@ def noise_series(rng, n_days: int):
     return [START + dt.timedelta(days=i) for i in range(n_days)], out
 
 
-def inert_changes(rng, n_days: int, satellite="j01"):
+def inert_changes(rng: np.random.Generator, n_days: int, satellite: str = "j01") -> list[Change]:
     """Calendar entries that change nothing in the geolocation (about six a year)."""
     days = sorted(rng.choice(np.arange(30, n_days), size=max(1, n_days // 60), replace=False))
     return [
@@ -65,10 +65,16 @@ def inert_changes(rng, n_days: int, satellite="j01"):
     ]
 
 
-def alerts_day_by_day(days, values, changes, s: RuleSettings, start: int = 25) -> dict:
+def alerts_day_by_day(
+    days: list[dt.date],
+    values: dict[str, np.ndarray],
+    changes: list[Change],
+    s: RuleSettings,
+    start: int = 25,
+) -> dict:
     """Every jump split day found by daily evaluations (data one day late), with the first day seen."""
     change_days = sorted({c.time.date() for c in changes})
-    seen = {}
+    seen: dict[dt.date, tuple[dt.date, dict]] = {}
     for t in range(start, len(days)):
         sub = {c: v[: t + 1] for c, v in values.items()}
         for j in detect_jumps(days[: t + 1], sub, change_days, s):
@@ -76,7 +82,9 @@ def alerts_day_by_day(days, values, changes, s: RuleSettings, start: int = 25) -
     return seen
 
 
-def jump_trial(rng, jump_km: float, s: RuleSettings):
+def jump_trial(
+    rng: np.random.Generator, jump_km: float, s: RuleSettings
+) -> tuple[bool, bool, int | None]:
     n = 60
     days, values = noise_series(rng, n)
     event = 40
@@ -106,7 +114,7 @@ def jump_trial(rng, jump_km: float, s: RuleSettings):
     return delay <= 3, attributed is not None and attributed.instrument == instrument, delay
 
 
-def false_alarms(rng, years: int, s: RuleSettings) -> list[int]:
+def false_alarms(rng: np.random.Generator, years: int, s: RuleSettings) -> list[int]:
     out = []
     for _ in range(years):
         days, values = noise_series(rng, 365 + 30)

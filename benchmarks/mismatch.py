@@ -18,6 +18,7 @@ import numpy as np
 
 from monitor.assessment.assess import assess_paths
 from monitor.config.assessment import AssessmentConfig
+from monitor.core.result import AssessmentResult
 from monitor.core.vocabulary import Cost, Kernel
 from monitor.simulate.case import simulate_case
 from tests.conftest import truth_arrays
@@ -26,7 +27,7 @@ from tests.conftest import truth_arrays
 DIFFERENCES = [(0.0, 0.0, 0.0), (0.03, 0.0, 0.0), (-0.03, 1.5, 0.0), (0.01, 0.0, 0.5), (0.0, 2.0, -0.5)]
 
 
-def errors(result, truth) -> str:
+def errors(result: AssessmentResult, truth: dict) -> str:
     """RMS in-track / cross-track and worst FOR (urad) over the reliable FORs."""
     ta, tb = truth_arrays(truth)
     ok = np.array([f.reliable for f in result.fors])
@@ -36,7 +37,7 @@ def errors(result, truth) -> str:
     return f"{np.sqrt(np.mean(ea**2)):.1f}/{np.sqrt(np.mean(eb**2)):.1f}, {worst:.0f} ({ok.sum()} FORs)"
 
 
-def main(argv=None) -> None:
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     ap.add_argument("--granules", type=int, default=6)
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2])

@@ -37,7 +37,7 @@ from monitor.archive.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
 from monitor.collocation.collocate import warm_up
 from monitor.config.file import load_config
 from monitor.core.satellites import SATELLITES
-from monitor.service.pipeline import run_day
+from monitor.service.pipeline import RunOutcome, run_day
 from monitor.service.store.sqlite import Store
 from monitor.simulate import LAYOUTS
 from monitor.simulate.case import DEFAULT_START, simulate_case
@@ -61,7 +61,7 @@ def simulate(root: Path, granules: int, layout: str) -> list[Path]:
     return [out / n for n in json.loads((out / "truth.json").read_text())["files"]]
 
 
-def run(root: Path, url: str, name: str, read: str, granules: int):
+def run(root: Path, url: str, name: str, read: str, granules: int) -> tuple[RunOutcome, float]:
     """compute_day on the bucket, from an empty store (the cache kept across runs of one *name*)."""
     state = root / name / "state"
     state.mkdir(parents=True, exist_ok=True)
@@ -76,6 +76,7 @@ def run(root: Path, url: str, name: str, read: str, granules: int):
     )
     cfg = load_config(config)
     t0 = time.perf_counter()
+    assert cfg.store.sqlite is not None  # the state folder's store
     with Store(cfg.store.sqlite) as store:
         out = run_day(cfg, store, make_source(cfg), SATELLITE, DAY, dt.date.today())
         (recorded,) = store.runs()
@@ -97,7 +98,7 @@ def held_by_product(cache: Path) -> dict:
     return out
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--granules", type=int, nargs="+", default=[1, 14])
     ap.add_argument("--layouts", nargs="+", default=list(LAYOUTS), choices=LAYOUTS)
@@ -133,7 +134,7 @@ def main(argv=None) -> int:
                 whole.result is not None
                 and first.result is not None
                 and [f.to_dict() for f in whole.result.fors] == [f.to_dict() for f in first.result.fors]
-                and np.array_equal(whole.result.cost_cube_k, first.result.cost_cube_k)
+                and np.array_equal(np.asarray(whole.result.cost_cube_k), np.asarray(first.result.cost_cube_k))
             )
             for label, w, secs in (
                 ("whole", whole, whole_s),

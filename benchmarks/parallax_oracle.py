@@ -22,7 +22,9 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Protocol, cast
 
 import numpy as np
 
@@ -31,6 +33,7 @@ from monitor.assessment.assess import assess_paths
 from monitor.collocation import lift as pixel_lift
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_COLUMNS
+from monitor.core.result import AssessmentResult
 from monitor.estimation import parallax as day_parallax
 from monitor.simulate import case as sim
 from monitor.simulate.case import simulate_case
@@ -47,13 +50,15 @@ def _key(lat_deg: np.ndarray, lon_deg: np.ndarray) -> list[tuple[float, float]]:
     return list(zip(lat.tolist(), lon.tolist(), strict=True))
 
 
-def _recording(self, origin, los):
-    """The simulator's ``_seen`` (its body, for clouds with height), also recording per pixel row the
+def _recording(
+    self: sim.Simulator, origin: np.ndarray, los: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The simulator's ``seen`` (its body, for clouds with height), also recording per pixel row the
     geodetic height of what the rays meet: on flat ground, the lift a perfect correction would apply."""
     _, s_lat, s_lon, s_h = self.scene.intersect(origin, los)
     if los.shape[-2] != VIIRS_COLUMNS:  # CrIS's rays: not recorded
         return s_lat, s_lon, self.scene.height_m(s_lat, s_lon)
-    lat, lon, _ = self._surface(origin, los)
+    lat, lon, _ = self.surface(origin, los)
     rows_lat = np.degrees(lat).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     rows_lon = np.degrees(lon).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     lift = np.nan_to_num(s_h, nan=0.0).reshape(-1, VIIRS_COLUMNS)
@@ -62,11 +67,27 @@ def _recording(self, origin, los):
     return s_lat, s_lon, self.scene.height_m(s_lat, s_lon)
 
 
-def _true_lift(lifted):
+class _Counted(Protocol):
+    """The true lift's wrapper, counting the pixel rows it found a truth for."""
+
+    rows: int
+    total: int
+
+    def __call__(self, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+def _true_lift(lifted: Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray]]) -> _Counted:
     """``monitor.collocation.lift.lifted`` with each row's lift replaced by the recorded truth (0 where
     none)."""
 
-    def wrapped(lat_rad, lon_rad, height_m, lift, sat_m, velocity_m_s):
+    def wrapped(
+        lat_rad: np.ndarray,
+        lon_rad: np.ndarray,
+        height_m: np.ndarray,
+        lift: np.ndarray,
+        sat_m: np.ndarray,
+        velocity_m_s: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         lat = np.degrees(np.asarray(lat_rad, np.float64)).astype(np.float32)
         lon = np.degrees(np.asarray(lon_rad, np.float64)).astype(np.float32)
         truth = np.zeros(np.shape(lift), np.float32)
@@ -78,15 +99,16 @@ def _true_lift(lifted):
                 found += 1
         # only where GEO has a position (the deleted bow-tie pixels and fill rows have none)
         truth = np.where(np.isfinite(lat) & np.isfinite(lon) & (np.abs(lat) <= 90.0), truth, 0.0)
-        wrapped.rows += found
-        wrapped.total += len(truth)
+        counted.rows += found
+        counted.total += len(truth)
         return lifted(lat_rad, lon_rad, height_m, truth, sat_m, velocity_m_s)
 
-    wrapped.rows = wrapped.total = 0
-    return wrapped
+    counted = cast(_Counted, wrapped)
+    counted.rows = counted.total = 0
+    return counted
 
 
-def _scores(result, truth) -> dict:
+def _scores(result: AssessmentResult, truth: dict) -> dict:
     ta = np.array([f["d_alpha_urad"] for f in truth["fors"]])
     tb = np.array([f["d_beta_urad"] for f in truth["fors"]])
     ea = np.array([f.d_alpha_urad for f in result.fors]) - ta
@@ -110,7 +132,7 @@ def main() -> int:
     p.add_argument("--rows", help="append the JSON line here")
     args = p.parse_args()
     root = Path(tempfile.mkdtemp(prefix="crisgeo-oracle-"))
-    sim.Simulator._seen = _recording
+    sim.Simulator.seen = _recording  # type: ignore[method-assign]  # the oracle's recording seam
     t0 = time.perf_counter()
     truth = simulate_case(
         root, granules=args.granules, profile="paper", seed=args.seed, cloud_heights=args.clouds,
@@ -121,10 +143,11 @@ def main() -> int:
     )
     cfg = AssessmentConfig()
     shipped = _scores(assess_paths([root], cfg), truth)
-    pixel_lift.lifted = _true_lift(pixel_lift.lifted)
+    true_lift = _true_lift(pixel_lift.lifted)
+    pixel_lift.lifted = true_lift  # type: ignore[assignment]  # the same call, counted
     day_parallax.day_lift = lambda s0, s1, cost: (1.0, float("nan"))
     oracle = _scores(assess_paths([root], cfg), truth)
-    print(f"oracle rows matched {pixel_lift.lifted.rows}/{pixel_lift.lifted.total}")
+    print(f"oracle rows matched {true_lift.rows}/{true_lift.total}")
     for name, s in (("shipped", shipped), ("true heights", oracle)):
         print(
             f"{name:<13} RMS {s['rms_urad'][0]:5.1f} / {s['rms_urad'][1]:5.1f} urad, worst "

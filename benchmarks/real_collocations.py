@@ -23,44 +23,43 @@ import numpy as np
 from monitor.assessment.replay import assess_collocations, for_samples, read_collocation
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import CALIBRATION_REFERENCE_K, N_FOR
+from monitor.core.result import AssessmentResult
 from monitor.core.vocabulary import Kernel
 from monitor.estimation.estimate import estimate
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data" / "real" / "collocations_j01_20181022"
 
 
-def splits(files, cfg, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+def splits(files: list[Path], cfg: AssessmentConfig, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """Normalised differences of the halves' offsets over *n* random splits (FOR-directions, NaN kept), and
     per split the difference of the halves' median biases (K: what a change of scenes alone does to the
     series calibration_jump watches)."""
     rng = np.random.default_rng(seed)
-    z, apart_k = [], []
+    z: list[float] = []
+    apart_k: list[float] = []
     for _ in range(n):
         p = rng.permutation(len(files))
         half = len(files) // 2
         a, b = (assess_collocations([files[i] for i in idx], cfg).fors for idx in (p[:half], p[half:]))
         apart_k.append(np.nanmedian([f.bias_k for f in a]) - np.nanmedian([f.bias_k for f in b]))
         for fa, fb in zip(a, b, strict=True):
-            for axis in ("alpha", "beta"):
-                diff = getattr(fa, f"d_{axis}_urad") - getattr(fb, f"d_{axis}_urad")
-                z.append(
-                    diff / np.hypot(getattr(fa, f"sigma_{axis}_urad"), getattr(fb, f"sigma_{axis}_urad"))
-                )
+            z.append((fa.d_alpha_urad - fb.d_alpha_urad) / np.hypot(fa.sigma_alpha_urad, fb.sigma_alpha_urad))
+            z.append((fa.d_beta_urad - fb.d_beta_urad) / np.hypot(fa.sigma_beta_urad, fb.sigma_beta_urad))
     return np.array(z), np.array(apart_k)
 
 
-def intercalibration(day, files, cfg) -> list[str]:
+def intercalibration(day: AssessmentResult, files: list[Path], cfg: AssessmentConfig) -> list[str]:
     """The product's intercalibration (monitor/estimation/intercal.py) against an ordinary least-squares
     fit of C - V on V over every sample at each FOR's optimum, pooled (what the product did until
     2026-11-26)."""
     granules = [read_collocation(f) for f in files]
-    c, v = [], []
+    cs, vs = [], []
     for k in range(N_FOR):
         s = for_samples(granules, k)
         e = estimate(s, cfg.cost, cfg.flat_contrast, uncertainty=False)
-        c.append(s.cris_k)
-        v.append(e.d_opt + s.cris_k)
-    c, v = np.concatenate(c), np.concatenate(v)
+        cs.append(s.cris_k)
+        vs.append(e.d_opt + s.cris_k)
+    c, v = np.concatenate(cs), np.concatenate(vs)
     gain, bias = np.polyfit(v - CALIBRATION_REFERENCE_K, c - v, 1)
     bias_k = np.array([f.bias_k for f in day.fors])
     determined = [f for f in day.fors if np.isfinite(f.gain_pct)]
@@ -74,7 +73,7 @@ def intercalibration(day, files, cfg) -> list[str]:
     ]
 
 
-def resolution(files, cfg) -> list[str]:
+def resolution(files: list[Path], cfg: AssessmentConfig) -> list[str]:
     """What N consecutive real granules resolve: the median per-FOR sigma over every window of N."""
     out = [f"{'granules':>8} {'windows':>7} {'sigma in-track':>15} {'sigma cross-track':>18}  (urad, median)"]
     for n in range(4, len(files) + 1):

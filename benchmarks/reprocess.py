@@ -23,13 +23,14 @@ from pathlib import Path
 from monitor.archive.local import SimulatedSource
 from monitor.collocation.collocate import warm_up
 from monitor.config.file import load_config
+from monitor.config.model import Config
 from monitor.service.reprocess import period_days, reprocess
 
 FIRST_DAY = dt.date(2024, 3, 1)
 MISSION_SATELLITE_DAYS = 3 * 3653  # 10 years of S-NPP, NOAA-20 and NOAA-21
 
 
-def _config(root: Path, name: str, granules: int):
+def _config(root: Path, name: str, granules: int) -> Config:
     path = root / f"{name}.yaml"
     path.write_text(
         f"satellites: [j01]\nstate_dir: {root / name}\n"
@@ -38,7 +39,7 @@ def _config(root: Path, name: str, granules: int):
     return load_config(path)
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--days", type=int, default=4)
     ap.add_argument("--granules", type=int, default=4, help="CrIS granules per day (the daily run keeps 14)")
@@ -75,7 +76,7 @@ def main(argv=None) -> int:
     for n, rate in sorted(rates.items()):
         if one and n > 1:
             print(f"efficiency at {n} workers: {rate / (n * one):.2f} (days/hour per worker over 1 worker's)")
-    best_n = max(rates, key=rates.get)
+    best_n = max(rates, key=lambda n: rates[n])
     per_worker = rates[best_n] / best_n
     print(
         f"10 years x 3 satellites = {MISSION_SATELLITE_DAYS} satellite-days of {args.granules} granules: "

@@ -38,11 +38,13 @@ import tempfile
 import threading
 import time
 from contextlib import ExitStack
+from http.server import BaseHTTPRequestHandler
 from pathlib import Path
 
 from aiosmtpd.controller import Controller
+from aiosmtpd.smtp import Envelope
 
-from monitor.core.vocabulary import RunStatus
+from monitor.core.vocabulary import DeliveryStatus, RunStatus
 from monitor.sdr.products import PRODUCTS
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
@@ -66,7 +68,7 @@ class SimulatingS3(S3Server):
         self.lock = threading.Lock()
         self.made: list = []
 
-    def _list(self, h, bucket, q):
+    def _list(self, h: BaseHTTPRequestHandler, bucket: str, q: dict[str, list[str]]) -> None:
         prefix = q.get("prefix", [""])[0]
         if self._fails(prefix):
             return self._unavailable(h)
@@ -75,7 +77,7 @@ class SimulatingS3(S3Server):
             self._simulate(dt.date(int(m[1]), int(m[2]), int(m[3])))
         return super()._list(h, bucket, q)
 
-    def _get(self, h, bucket, key):
+    def _get(self, h: BaseHTTPRequestHandler, bucket: str, key: str) -> None:
         if self._fails(key):
             return self._unavailable(h)
         return super()._get(h, bucket, key)
@@ -83,15 +85,15 @@ class SimulatingS3(S3Server):
     def _fails(self, key: str) -> bool:
         m = DAY_IN_PREFIX.search("/" + key)
         cris = key.startswith((FOLDER["GCRSO"] + "/", FOLDER["SCRIF"] + "/"))
-        return bool(m) and cris and dt.date(int(m[1]), int(m[2]), int(m[3])) in self.failing
+        return m is not None and cris and dt.date(int(m[1]), int(m[2]), int(m[3])) in self.failing
 
     @staticmethod
-    def _unavailable(h):
+    def _unavailable(h: BaseHTTPRequestHandler) -> None:
         h.send_response(503)
         h.send_header("Content-Length", "0")
         h.end_headers()
 
-    def _simulate(self, day: dt.date):
+    def _simulate(self, day: dt.date) -> None:
         from monitor.simulate.case import simulate_case
 
         with self.lock:
@@ -124,14 +126,14 @@ class SimulatingS3(S3Server):
 class Smtp:
     """An SMTP server that accepts (and counts) messages, or answers 451 while ``failing``."""
 
-    def __init__(self):
-        self.messages = []
+    def __init__(self) -> None:
+        self.messages: list[bytes | str | None] = []
         self.refused = 0
         self.failing = False
         self.port = free_port()
         self.controller = Controller(self, hostname="127.0.0.1", port=self.port)
 
-    async def handle_DATA(self, server, session, envelope):
+    async def handle_DATA(self, server: object, session: object, envelope: Envelope) -> str:
         if self.failing:
             self.refused += 1
             return "451 4.3.0 try again later"
@@ -152,7 +154,7 @@ def proc_sample(pid: int) -> dict | None:
     return {
         "rss_mb": rss_kb / 1024,
         "open_files": len(os.listdir(f"/proc/{pid}/fd")),
-        "threads": int(re.search(r"Threads:\s+(\d+)", status)[1]),
+        "threads": int(threads[1]) if (threads := re.search(r"Threads:\s+(\d+)", status)) else 0,
     }
 
 
@@ -247,7 +249,7 @@ alerts:
     return path
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--days", type=int, default=90)
     ap.add_argument("--granules", type=int, default=1, help="CrIS granules simulated per day")
@@ -301,7 +303,7 @@ def main(argv=None) -> int:
                 with Store(state) as store:
                     runs = store.runs("j01")
                     outbox = store.outbox_size()
-                    pending = len(AlertState(store).deliveries("pending"))
+                    pending = len(AlertState(store).deliveries(DeliveryStatus.PENDING))
                 finished = [r for r in runs if r.finished]
                 current = dt.date.fromisoformat(runs[-1].day) if runs else first
                 ok_days = {r.day for r in runs if r.status == RunStatus.OK}
@@ -351,7 +353,7 @@ def main(argv=None) -> int:
             runs = store.runs("j01")
             deliveries = AlertState(store).deliveries()
         ok = [r for r in runs if r.status == RunStatus.OK]
-        per_day = {}
+        per_day: dict[str, int] = {}
         for r in ok:
             per_day[r.day] = per_day.get(r.day, 0) + 1
         if sorted(per_day) != [d.isoformat() for d in days]:

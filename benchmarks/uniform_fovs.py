@@ -16,7 +16,7 @@ import argparse
 
 import numpy as np
 
-from monitor.assessment.assess import _collocate_run
+from monitor.assessment.assess import collocate_run
 from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan
 
@@ -31,7 +31,7 @@ def main() -> None:
     args = p.parse_args()
     case = plan([args.data])
     cris = case.cris[: args.granules] if args.granules else case.cris
-    samples, _ = _collocate_run(cris, case.viirs, case.viirs_all, case.satellite, AssessmentConfig())
+    samples, _ = collocate_run(cris, case.viirs, case.viirs_all, case.satellite, AssessmentConfig())
     ranges = []
     for s in samples:
         bt = s.bt_viirs_k[s.usable]

@@ -364,7 +364,7 @@ class PerFor(Sequence[ForSamples]):
         return self._build(k % N_FOR)
 
 
-def _collocate_run(
+def collocate_run(
     cris: list[GranuleFiles],
     viirs: dict[str, list[GranuleFiles]],
     viirs_all: list[GranuleFiles],
@@ -439,7 +439,7 @@ def collocate_plan(
     benchmarks that estimate otherwise."""
     cfg = cfg or AssessmentConfig()
     with parallel_threads(workers):
-        run = _collocate_run(
+        run = collocate_run(
             case.cris, case.viirs, case.viirs_all, case.satellite, cfg, lift_m_per_k=lift_m_per_k
         )
     return run[0]
@@ -485,9 +485,9 @@ class DayAssessment:
         cfg = self.cfg
         run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
         with parallel_threads(self.workers):
-            samples, skipped = _collocate_run(*run, progress, should_stop, timings)
+            samples, skipped = collocate_run(*run, progress, should_stop, timings)
             # the pixels lifted by the probe's height per K (monitor.estimation.parallax chooses the day's)
-            probe = _collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else []
+            probe = collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else []
         self.skipped += list(case.skipped) + skipped
         self.samples += [s.kept_in(self._spool) for s in samples]
         self.probe += [s.kept_in(self._spool) for s in probe]

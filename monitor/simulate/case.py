@@ -388,7 +388,7 @@ class Simulator:
         zen, az, _ = complete.view_angles(lat_rad, lon_rad, 0.0, sun, direction=True)
         return {"SolarZenithAngle": zen.astype(np.float32), "SolarAzimuthAngle": az.astype(np.float32)}
 
-    def _surface(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def surface(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is
         one."""
         if not self.spec.terrain:
@@ -397,11 +397,11 @@ class Simulator:
             return lat, lon, np.zeros(lat.shape)
         return self.scene.intersect(origin, los, clouds=False)[1:]
 
-    def _seen(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def seen(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What each ray sees: geodetic (lat_rad, lon_rad) of the first cloud or terrain it meets, and the
         terrain height (m) there (the flat scene's temperature is a function of the three)."""
         if self.scene.clouds.flat:
-            return self._surface(origin, los)
+            return self.surface(origin, los)
         _, lat, lon, _ = self.scene.intersect(origin, los)
         return lat, lon, self.scene.height_m(lat, lon)
 
@@ -454,7 +454,7 @@ class Simulator:
         ahead = np.broadcast_to(in_track_ecef[:, :, None, :], los_ecef.shape)
         weights = self._fov_weights(np.arctan2(np.sum(ahead * e2, -1), np.sum(ahead * e1, -1)))
         origin = np.broadcast_to(sat[..., None, :], dirs.shape)
-        temp = self.scene.temperature_k(*self._seen(origin, dirs)).reshape(-1, n)
+        temp = self.scene.temperature_k(*self.seen(origin, dirs)).reshape(-1, n)
         w = weights.reshape(-1, n)
         nfov = temp.shape[0]
         pos = (np.clip(temp, T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (T_BINS_K[1] - T_BINS_K[0])
@@ -498,8 +498,8 @@ class Simulator:
             r, _, m = self.state(tt)  # (n, 6400, 3), (n, 6400, 3, 3)
             los = np.einsum("scij,dcj->sdci", m, los_sbf)
             origin = np.broadcast_to(r[:, None], los.shape)
-            lat, lon, h = self._surface(origin, los)
-            seen = (lat, lon, h) if self.scene.clouds.flat else self._seen(origin, los)
+            lat, lon, h = self.surface(origin, los)
+            seen = (lat, lon, h) if self.scene.clouds.flat else self.seen(origin, los)
             temp = self.scene.temperature_k(*seen)
             lrad = np.interp(temp, T_BINS_K, self.band_table)
             bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, temp.shape)

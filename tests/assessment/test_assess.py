@@ -65,12 +65,12 @@ def test_result_fields_and_km(cases):
 
 
 def test_too_few_samples_are_flagged(cases):
-    from monitor.assessment.assess import _collocate_run, cost_and_offsets
+    from monitor.assessment.assess import collocate_run, cost_and_offsets
     from monitor.sdr.pairing import plan
 
     out, _, _ = cases.get("paper", 1)
     case = plan([out])
-    samples, _ = _collocate_run(case.cris[:1], case.viirs, case.viirs_all, "j01", AssessmentConfig())
+    samples, _ = collocate_run(case.cris[:1], case.viirs, case.viirs_all, "j01", AssessmentConfig())
     samples[0].usable[:, :, 1:] = False  # keep FOV 1 only: 4 samples per FOR
     result = cost_and_offsets(samples, AssessmentConfig(uncertainty=False), satellite="j01")
     assert all(FLAG_FEW_SAMPLES in f.flags and not f.reliable for f in result.fors)
