@@ -22,6 +22,7 @@ import logging
 import requests
 
 from monitor.config.alert_settings import AlertSettings
+from monitor.core.vocabulary import Severity
 from monitor.history.records import History
 
 LOG = logging.getLogger(__name__)
@@ -41,6 +42,8 @@ def alertmanager_alerts(store: History, settings: AlertSettings, now: dt.datetim
     horizon = now - dt.timedelta(hours=am.validity_hours)
     out = []
     for a in state.all():
+        if a.severity == Severity.INFO:  # recorded, never sent
+            continue
         if a.status == "firing":
             if state.silenced(a.rule, a.satellite, now) is not None:
                 continue

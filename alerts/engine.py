@@ -51,8 +51,8 @@ def findings_for(store: History, satellite: str, settings: AlertSettings, now: d
     latest = store.latest_day(satellite)
     if latest is not None:
         changes = all_changes(store, satellite, settings.events_file)
-        out += jump_findings(store, satellite, changes, s, latest)
-        out += jump_findings(store, satellite, changes, s, latest, CALIBRATION)
+        out += jump_findings(store, satellite, changes, s)
+        out += jump_findings(store, satellite, changes, s, CALIBRATION)
     out += processing_change_findings(store, satellite, s, latest or now.date())
     return out
 
@@ -152,7 +152,8 @@ def evaluate(
                     kind = Notice.REPEAT
                 else:
                     kind = None
-                notify = kind is not None and not quiet
+                # a finding of severity info (a step below the practical size) is recorded, never sent
+                notify = kind is not None and not quiet and f.severity != Severity.INFO
                 state.upsert(f, now, notified=notify)
                 if notify:
                     items.append((kind, f))
@@ -160,7 +161,7 @@ def evaluate(
             for prev in state.firing(sat):
                 if prev.fingerprint not in current:
                     state.resolve(prev.fingerprint, now)
-                    if state.silenced(prev.rule, sat, now) is None:
+                    if state.silenced(prev.rule, sat, now) is None and prev.severity != Severity.INFO:
                         items.append(
                             (
                                 Notice.RESOLVED,

@@ -1,5 +1,5 @@
-"""Alert rules: specification breach, jumps of the offsets or of the CrIS-VIIRS bias (with the change that
-preceded them), stale data, failed runs.
+"""Alert rules: specification breach, steps of the offsets or of the CrIS-VIIRS bias (tested with their
+sigmas, :mod:`alerts.steps`, named after the known change they follow), stale data, failed runs.
 
 Each rule turns what the store holds into findings, one per satellite (and per jump). A finding is
 identified by rule + satellite + group, which is what the alert state tracks.
@@ -8,57 +8,70 @@ identified by rule + satellite + group, which is what the alert state tracks.
 from __future__ import annotations
 
 import datetime as dt
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from alerts.steps import StepRules, detect
 from monitor.config.alert_settings import RuleSettings
-from monitor.core.constants import N_FOR
 from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
-from monitor.history.changes import preceding_change
+from monitor.history.changes import Change
 from monitor.history.records import History
 
 UTC = dt.timezone.utc
+CHANGED = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS/VIIRS common"}
 
 
 @dataclass(frozen=True)
 class Watched:
-    """A daily per-FOR quantity a jump rule watches: its stored *components* (field, label), *unit*, the
-    smallest step that counts (the RuleSettings key *min_step_key*) and the floor of its day-to-day scatter
-    (*floor*, in *unit*: a series quieter than that is not made oversensitive)."""
+    """A daily per-FOR quantity a jump rule watches: its stored fields per direction with their sigmas'
+    fields, the directions' labels, its unit, and its practical size (the RuleSettings key, in *unit*)."""
 
     rule: Rule
     what: str
-    components: tuple
+    fields: tuple[str, ...]
+    sigmas: tuple[str, ...]
+    labels: tuple[str, ...]
     unit: str
-    min_step_key: str
-    floor: float
+    practical_key: str
+    digits: int  # decimals its sizes are shown with
 
-    def min_step(self, s: RuleSettings) -> float:
-        return float(getattr(s, self.min_step_key))
+    def rules(self, s: RuleSettings) -> StepRules:
+        """The step detector's parameters for this quantity under the settings *s*."""
+        return StepRules(
+            rate_per_year=s.false_detections_per_year,
+            rate_at_change=s.false_detection_at_change,
+            baseline_days=s.pre_days,
+            min_baseline_days=s.min_pre_days,
+            discovery_days=s.discovery_days,
+            size_days=s.post_days,
+            practical=float(getattr(s, self.practical_key)),
+            attribution_days=s.attribution_days,
+        )
 
 
 GEOLOCATION = Watched(
     Rule.JUMP,
     "geolocation",
-    (("in_track_km", "in-track"), ("cross_track_km", "cross-track")),
-    "km",
-    "min_jump_km",
-    0.02,
+    ("d_alpha_urad", "d_beta_urad"),
+    ("sigma_alpha_urad", "sigma_beta_urad"),
+    ("in-track", "cross-track"),
+    "urad",
+    "practical_step_urad",
+    0,
 )
 # the CrIS-VIIRS BT bias at 280 K (monitor/estimation/intercal.py): a VIIRS LUT or a CrIS calibration change
 # moves it
 CALIBRATION = Watched(
-    Rule.CALIBRATION_JUMP, "CrIS-VIIRS calibration", (("bias_k", "bias"),), "K", "min_bias_jump_k", 0.01
+    Rule.CALIBRATION_JUMP,
+    "CrIS-VIIRS calibration",
+    ("bias_k",),
+    ("sigma_bias_k",),
+    ("bias",),
+    "K",
+    "min_bias_jump_k",
+    3,
 )
-COMPONENTS = GEOLOCATION.components
-GROUPS = {
-    "FOR 1-10": range(0, 10),
-    "FOR 11-20": range(10, 20),
-    "FOR 21-30": range(20, N_FOR),
-    "all FORs": range(N_FOR),
-}
 
 
 @dataclass
@@ -113,144 +126,87 @@ def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | N
     )
 
 
-def _series(store: History, satellite: str, watched: Watched) -> tuple[list, dict[str, np.ndarray]]:
+def watched_series(store: History, satellite: str, watched: Watched) -> tuple[list, np.ndarray, np.ndarray]:
+    """The days, values and sigmas (days, N_FOR, directions) of the *watched* quantity, NaN where a FOR is
+    not stored or flagged unreliable."""
     series = store.series(satellite)
-    reliable = series.reliable()
-    return series.days, {c: np.where(reliable, series.values[c], np.nan) for c, _ in watched.components}
-
-
-def step_test(
-    y: np.ndarray, days: list, split: dt.date, s: RuleSettings, floor: float = GEOLOCATION.floor
-) -> tuple[float, float] | None:
-    """(delta, z) of a step at *split* in the daily series *y*, or None when the windows are too short.
-
-    Robust two-sample comparison: difference of medians after/before the split, scaled by the MAD of
-    the pre-split days (floored at *floor*, 20 m for the offsets) with the sampling error of a median
-    (sqrt(pi/2) / sqrt(n)).
-    """
-    d = np.array([x.toordinal() for x in days])
-    k = split.toordinal()
-    pre = y[(d < k) & (d >= k - s.pre_days) & np.isfinite(y)]
-    post = y[(d >= k) & (d < k + s.post_days) & np.isfinite(y)]
-    if len(pre) < s.min_pre_days or len(post) < s.min_post_days:
-        return None
-    delta = float(np.median(post) - np.median(pre))
-    scale = max(1.4826 * float(np.median(np.abs(pre - np.median(pre)))), floor)
-    se = scale * math.sqrt(math.pi / 2) * math.sqrt(1 / len(pre) + 1 / len(post))
-    return delta, delta / se
-
-
-def detect_jumps(
-    days: list, values: dict, change_days: list, s: RuleSettings, watched: Watched = GEOLOCATION
-) -> list[dict]:
-    """Steps in the FOR-group series of the *watched* quantity, at known change days (lower threshold) and
-    blind in the recent window.
-
-    Returns one dict per split day found: split, groups [(group, component, delta, z)], fors (per-FOR
-    deltas of the components that jumped), known (whether the split is a change day).
-    """
-    if not days:
-        return []
-    last = days[-1]
-    candidates = {}
-    for c in change_days:
-        if last - dt.timedelta(days=s.change_window_days) <= c <= last:
-            candidates[c] = True
-    for k in range(s.blind_window_days):
-        candidates.setdefault(last - dt.timedelta(days=k), False)
-    found = []
-    for split, known in sorted(candidates.items()):
-        threshold = s.jump_z_at_change if known else s.jump_z
-        hits = []
-        for comp, label in watched.components:
-            for g, idx in GROUPS.items():
-                sub = values[comp][:, list(idx)]
-                ok = np.sum(np.isfinite(sub), axis=1) >= len(idx) / 2
-                with np.errstate(all="ignore"):
-                    y = np.where(ok, np.nanmean(sub, axis=1), np.nan)
-                t = step_test(y, days, split, s, watched.floor)
-                if t and abs(t[0]) >= watched.min_step(s) and abs(t[1]) >= threshold:
-                    hits.append((g, label, t[0], t[1]))
-        if hits:
-            fors: dict[int, list] = {}
-            for comp, label in watched.components:
-                if not any(h[1] == label for h in hits):
-                    continue
-                for i in range(N_FOR):
-                    t = step_test(values[comp][:, i], days, split, s, watched.floor)
-                    if t and abs(t[0]) >= watched.min_step(s):
-                        fors.setdefault(i + 1, []).append((label, t[0]))
-            found.append(
-                {
-                    "split": split,
-                    "groups": hits,
-                    "fors": fors,
-                    "known": known,
-                    "score": max(abs(h[3]) for h in hits),
-                }
-            )
-    # one step is seen at every split day whose windows straddle it (a sharp step, days after it too, while
-    # the reference median is still the old level): one per cluster, a known change first, else the strongest
-    found.sort(key=lambda j: j["split"])
-    kept: list[dict] = []
-    for j in found:
-        if kept and (j["split"] - kept[-1]["split"]).days < s.post_days:
-            if (j["known"], j["score"]) > (kept[-1]["known"], kept[-1]["score"]):
-                kept[-1] = j
-            continue
-        kept.append(j)
-    return kept
+    reliable = series.reliable()[..., None]
+    y = np.stack([series.values[f] for f in watched.fields], axis=-1)
+    sig = np.stack([series.values[f] for f in watched.sigmas], axis=-1)
+    return series.days, np.where(reliable, y, np.nan), np.where(reliable, sig, np.nan)
 
 
 def jump_findings(
     store: History,
     satellite: str,
-    changes: list,
+    changes: list[Change],
     s: RuleSettings,
-    today: dt.date,
     watched: Watched = GEOLOCATION,
 ) -> list[Finding]:
-    """A finding per recent step in the FOR-group series of the *watched* quantity (the offsets, or the
-    CrIS-VIIRS bias: :data:`CALIBRATION`), attributed to the change before it."""
-    days, values = _series(store, satellite, watched)
-    jumps = detect_jumps(days, values, sorted({c.time.date() for c in changes}), s, watched)
-    u = watched.unit
+    """A finding per step of the *watched* quantity (the LOS offsets, or the CrIS-VIIRS bias:
+    :data:`CALIBRATION`) whose split lies in the baseline's length before the latest day
+    (:func:`alerts.steps.detect`), named after the known change it follows; a warning when it reaches the
+    practical size, else recorded (severity info)."""
+    days, y, sig = watched_series(store, satellite, watched)
+    if not np.isfinite(y).any():  # nothing measured (e.g. no intercalibration)
+        return []
+    found = detect(days, y, sig, [c.time.date() for c in changes], watched.rules(s))
+    u, practical, n = watched.unit, watched.rules(s).practical, watched.digits
     out = []
-    for j in jumps:
-        if (today - j["split"]).days > s.active_days:
-            continue
-        change = preceding_change(changes, j["split"], s.attribution_days)
+    for step in found:
+        change = changes[step.change] if step.change is not None else None
         cause = (
-            f"preceded by {change.label()}"
+            f"at {change.label()}"
             if change
-            else f"no known change in the {s.attribution_days} days before it"
+            else f"no known change within {s.attribution_days} day(s) of it"
         )
-        who = (
-            {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS/VIIRS common"}[change.instrument]
-            if change
-            else "unknown"
+        label = watched.labels[step.direction]
+        head = (
+            f"{satellite}: {watched.what} step from {step.split}, {label} {step.pooled:+.{n}f} +- "
+            f"{step.pooled_sigma:.{n}f} {u} over {step.group}"
         )
-        groups = "; ".join(f"{g} {label} {d:+.2f} {u} (z {z:+.1f})" for g, label, d, z in j["groups"])
-        lines = [f"step from {j['split']}: {groups}", f"attribution: {cause}"]
+        lines = [
+            f"step from {step.split}, found on {step.seen}: {step.group} {label} {step.pooled:+.{n}f} +- "
+            f"{step.pooled_sigma:.{n}f} {u} (z {step.z:.1f})"
+            + ("" if step.paged else f"; below the practical size {practical:g} {u}: recorded"),
+            f"attribution: {cause}",
+        ]
         lines += [
-            f"FOR {k:2d}: " + ", ".join(f"{label} {d:+.2f} {u}" for label, d in v)
-            for k, v in sorted(j["fors"].items())
+            f"FOR {k + 1:2d}: "
+            + ", ".join(
+                f"{watched.labels[c]} {step.size[k, c]:+.{n}f} +- {step.sigma[k, c]:.{n}f} {u}"
+                for c in range(len(watched.fields))
+            )
+            for k in range(step.size.shape[0])
+            if np.isfinite(step.size[k]).any()
         ]
         out.append(
             Finding(
                 watched.rule,
                 satellite,
-                Severity.WARNING,
-                f"{satellite}: {watched.what} jump from {j['split']} ({who} change before it)"
-                if change
-                else f"{satellite}: {watched.what} jump from {j['split']} with no known change before it",
+                Severity.WARNING if step.paged else Severity.INFO,
+                head + (f" ({CHANGED[change.instrument]} {change.kind})" if change else " (no known change)"),
                 lines,
-                group=j["split"].isoformat(),
+                group=step.split.isoformat(),
                 data={
-                    "split": j["split"].isoformat(),
+                    "split": step.split.isoformat(),
+                    "seen": step.seen.isoformat(),
                     "instrument": change.instrument if change else None,
-                    "fors": sorted(j["fors"]),
                     "change": change.label() if change else None,
+                    "group": step.group,
+                    "direction": label,
+                    "z": step.z,
+                    "size": step.pooled,
+                    "sigma": step.pooled_sigma,
+                    "unit": u,
+                    "paged": step.paged,
+                    "fors": {
+                        watched.labels[c]: {
+                            "size": [None if not np.isfinite(v) else float(v) for v in step.size[:, c]],
+                            "sigma": [None if not np.isfinite(v) else float(v) for v in step.sigma[:, c]],
+                        }
+                        for c in range(len(watched.fields))
+                    },
                 },
             )
         )

@@ -3,8 +3,9 @@ messages."""
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 from pydantic import (
     BaseModel,
@@ -15,9 +16,18 @@ from pydantic import (
 )
 
 from monitor.config.keys import Address, EnvName, FilePath, KeyProblem, Section, Text, Url, key
-from monitor.core.constants import (
-    SPEC_KM,
-)
+from monitor.core.constants import REFERENCE_ALTITUDE_M, SPEC_KM, URAD
+
+LOG = logging.getLogger("monitor.config")
+# the earlier jump rule's keys: what became of each
+RETIRED = {
+    "min_jump_km": "read as practical_step_urad",
+    "jump_z": "the blind test's threshold comes from false_detections_per_year",
+    "jump_z_at_change": "the threshold at a known change comes from false_detection_at_change",
+    "min_post_days": "a step is tried from its first day on (discovery_days)",
+    "blind_window_days": "discovery_days says how long a step is tried after its date",
+    "change_window_days": "a known change is tried in the discovery_days after it",
+}
 
 
 class RuleSettings(Section):
@@ -30,39 +40,80 @@ class RuleSettings(Section):
         0.01,
         100.0,
     )
-    min_jump_km: float = key(
-        0.25, "Smallest step (median after minus median before) that counts as a jump.", 0.001, 100.0
+    false_detections_per_year: float = key(
+        1.0,
+        "Steps the jump rules may find per satellite-year on a stable instrument, on days without a known "
+        "change (recorded or paged): their blind test's threshold comes from it.",
+        0.01,
+        365.0,
+    )
+    false_detection_at_change: float = key(
+        0.05,
+        "Chance that a known change which moved nothing is found as a step at its date: the threshold of "
+        "the test at a known change.",
+        0.0001,
+        0.5,
+    )
+    practical_step_urad: float = key(
+        50.0,
+        "Smallest LOS step (pooled over the FORs that found it) that is paged; a smaller one is recorded and "
+        "shown (severity info), not sent.",
+        0.0,
+        100000.0,
     )
     min_bias_jump_k: float = key(
         0.05,
-        "Smallest step of the daily CrIS-VIIRS BT bias at 280 K that counts as a calibration jump (the "
-        "calibration_jump rule: a VIIRS LUT or CrIS calibration change). Half the 0.1 K step it must see; "
-        "a change of scenes alone moves the bias by < 0.01 K (real halves, docs/science.md).",
-        0.001,
+        "Smallest step of the daily CrIS-VIIRS BT bias at 280 K (pooled over the FORs that found it) that "
+        "the calibration_jump rule pages (a VIIRS LUT or CrIS calibration change); a smaller one is "
+        "recorded. Half the 0.1 K step it must see.",
+        0.0,
         100.0,
     )
-    jump_z: float = key(
-        5.0,
-        "Step size in units of its standard error that counts as a jump, on any day of the "
-        "recent window (blind search).",
-        1.0,
-        100.0,
+    pre_days: int = key(
+        21,
+        "The baseline: days before a candidate step that form the reference; a step's alert resolves once "
+        "its new level has held this long.",
+        2,
+        365,
     )
-    jump_z_at_change: float = key(
-        3.5, "The same at the date of a known change (events calendar, fingerprint).", 1.0, 100.0
+    min_pre_days: int = key(7, "Fewest assessed baseline days for a step to be tested.", 2, 365)
+    discovery_days: int = key(
+        3, "Days after a step (its first day included) within which the blind test tries it.", 1, 14
     )
-    pre_days: int = key(21, "Days before a candidate step that form the reference.", 2, 365)
-    min_pre_days: int = key(7, "Fewest assessed days before a step for the test to run.", 2, 365)
-    min_post_days: int = key(2, "Fewest assessed days after a step for the test to run.", 1, 365)
-    post_days: int = key(14, "Days after a candidate step compared with the reference.", 1, 365)
-    blind_window_days: int = key(7, "Recent days tried as step dates without a known change.", 1, 365)
-    change_window_days: int = key(30, "Known changes this recent are tried as step dates.", 1, 3650)
+    post_days: int = key(14, "Days after a step its size per FOR is measured over.", 1, 365)
     attribution_days: int = key(
-        10, "A jump is attributed to a known change at most this many days before it.", 0, 365
+        1,
+        "A step is attributed to a known change whose day is at most this many days from its date (the "
+        "date is found within a day).",
+        0,
+        365,
     )
-    active_days: int = key(14, "A jump or processing change older than this no longer fires.", 1, 3650)
+    active_days: int = key(14, "A processing change older than this no longer fires.", 1, 3650)
     stale_hours: float = key(36.0, "No completed run for this long fires the stale rule.", 1.0, 8760.0)
     repeat_hours: float = key(24.0, "A firing alert is notified again after this long.", 0.1, 8760.0)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _retired(cls, data: Any) -> Any:
+        """Keys of the earlier jump rule, read with a warning: ``min_jump_km`` as ``practical_step_urad`` (at
+        nadir), the z thresholds and windows ignored (the thresholds come from the false-detection rates)."""
+        if not isinstance(data, dict) or not RETIRED.keys() & data.keys():
+            return data
+        data = dict(data)
+        if "min_jump_km" in data:
+            km = data.pop("min_jump_km")
+            if isinstance(km, int | float) and "practical_step_urad" not in data:
+                data["practical_step_urad"] = float(km) * 1000.0 / REFERENCE_ALTITUDE_M / URAD
+                LOG.warning(
+                    "alerts.min_jump_km (%s km) is read as alerts.practical_step_urad %.0f (at nadir); "
+                    "rename it",
+                    km,
+                    data["practical_step_urad"],
+                )
+        for name in RETIRED.keys() & data.keys():
+            data.pop(name)
+            LOG.warning("alerts.%s is no longer used: %s; remove it", name, RETIRED[name])
+        return data
 
     @model_validator(mode="after")
     def _consistent(self) -> RuleSettings:

@@ -57,6 +57,7 @@ class Rule(StrEnum):
 class Severity(StrEnum):
     """How urgent an alert is."""
 
+    INFO = "info"  # recorded and shown, never sent (a step below the practical size)
     WARNING = "warning"
     CRITICAL = "critical"
 

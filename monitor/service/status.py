@@ -224,8 +224,10 @@ def status_report(
         s.last_run is not None and s.last_run.status == RunStatus.FAILED for s in sats
     )
     daemon = holder(cfg.state_dir, "daemon")
+    # a recorded step (severity info) is shown, not a problem
+    warned = any(a.severity != Severity.INFO for a in firing)
     return Status(
-        NagiosState.CRITICAL if critical else NagiosState.WARNING if firing else NagiosState.OK,
+        NagiosState.CRITICAL if critical else NagiosState.WARNING if warned else NagiosState.OK,
         tuple(sats),
         daemon,
         None if daemon is None else next_run(cfg.schedule, now),

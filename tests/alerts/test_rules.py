@@ -6,7 +6,6 @@ import pytest
 
 from alerts.engine import findings_for
 from alerts.rules import CALIBRATION, GEOLOCATION, failure_finding, jump_findings, spec_finding, stale_finding
-from benchmarks.jump_detection import false_alarms, jump_trial
 from monitor.config.alert_settings import AlertSettings, RuleSettings
 from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo
 from monitor.history.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
@@ -104,22 +103,25 @@ def test_a_bias_jump_after_a_viirs_lut_change_is_a_calibration_jump_attributed_t
         for day in days:
             bias = 0.2 + rng.normal(0.0, 0.02, 30) + (step_k if day >= split else 0.0)
             fors = [
-                dataclasses.replace(_for(k, 0.1, 0.2), bias_k=float(bias[k - 1]), gain_pct=0.1)
+                dataclasses.replace(
+                    _for(k, 0.1, 0.2), bias_k=float(bias[k - 1]), sigma_bias_k=0.02, gain_pct=0.1
+                )
                 for k in range(1, 31)
             ]
             g = _granule(f"J{day}", cris, [lut.format("2042" if day >= split else "1171")])
             s.save_day(s.begin_run("j01", day), "j01", day, _result(fors, [g]))
         changes = metadata_changes(s, "j01")
-        found = jump_findings(s, "j01", changes, RuleSettings(), days[-1], CALIBRATION)
-        assert jump_findings(s, "j01", changes, RuleSettings(), days[-1], GEOLOCATION) == []
+        found = jump_findings(s, "j01", changes, RuleSettings(), CALIBRATION)
+        assert jump_findings(s, "j01", changes, RuleSettings(), GEOLOCATION) == []
         if not step_k:
             assert found == []
             continue
         (f,) = found
         assert f.rule == "calibration_jump" and f.data["split"] == split.isoformat()
         assert f.data["instrument"] == "viirs" and "2042" in f.data["change"]
-        assert "CrIS-VIIRS calibration jump" in f.summary and "+0.30 K" in f.lines[0]
-        assert f.data["fors"] == list(range(1, 31))
+        assert "CrIS-VIIRS calibration step" in f.summary and "bias +0.30" in f.lines[0]
+        sizes = f.data["fors"]["bias"]
+        assert all(abs(v - 0.3) < 4 * e for v, e in zip(sizes["size"], sizes["sigma"], strict=True))
         rules = [x.rule for x in findings_for(s, "j01", AlertSettings(), dt.datetime.now(UTC))]
         assert "calibration_jump" in rules and "jump" not in rules
 
@@ -148,10 +150,46 @@ def test_shipped_calendar_holds_the_known_history():
     )
 
 
-def test_jumps_found_and_attributed_and_noise_stays_quiet():
-    """A reduced run of benchmarks/jump_detection.py (the full figures are in the issue notes)."""
-    rng = np.random.default_rng(7)
-    s = RuleSettings()
-    res = [jump_trial(rng, 0.3, s) for _ in range(12)]
-    assert sum(r[0] for r in res) >= 11 and all(r[1] for r in res if r[0])
-    assert sum(false_alarms(rng, 1, s)) <= 1
+def _offsets_day(store, day, alpha, beta, sigma):
+    fors = [
+        dataclasses.replace(
+            _for(k + 1, 0.1, 0.2), d_alpha_urad=float(alpha[k]), d_beta_urad=float(beta[k]),
+            sigma_alpha_urad=sigma, sigma_beta_urad=sigma,
+        )
+        for k in range(30)
+    ]  # fmt: skip
+    store.save_day(store.begin_run("j01", day), "j01", day, _result(fors))
+
+
+def test_a_step_at_an_ep_upload_is_paged_once_naming_it_and_a_small_one_only_recorded(tmp_path):
+    """Through the store and evaluate, day by day: 300 urad cross-track on FORs 11-13 from an EP upload at
+    noon on day 80 (sigma 120): the first message names the upload, within 3 days; 10 urad on every FOR at
+    sigma 5 is recorded (severity info) and sends nothing."""
+    from alerts.engine import evaluate
+
+    days = [DAY + dt.timedelta(days=i) for i in range(84)]
+    upload = days[80]
+    (tmp_path / "events.yaml").write_text(
+        f"events:\n  - {{satellite: j01, time: '{upload}T12:00:00Z', instrument: cris, kind: ep_upload, "
+        "description: EP v116}\n"
+    )
+    cfg = AlertSettings.model_validate({"events_file": str(tmp_path / "events.yaml")})
+    rng = np.random.default_rng(11)
+    big, small = Store(tmp_path / "big.sqlite"), Store(tmp_path / "small.sqlite")
+    sent = []
+    for i, day in enumerate(days):
+        beta = rng.normal(0.0, 120.0, 30)
+        beta[10:13] += 300.0 * (i > 80) + 150.0 * (i == 80)
+        _offsets_day(big, day, rng.normal(0.0, 120.0, 30), beta, 120.0)
+        _offsets_day(small, day, rng.normal(0.0, 5.0, 30) + 10.0 * (i >= 80), rng.normal(0.0, 5.0, 30), 5.0)
+        now = dt.datetime.combine(day + dt.timedelta(days=1), dt.time(4), UTC)
+        if i >= 60:
+            sent += [(i, m) for _, m in evaluate(big, cfg, ["j01"], now)]
+            assert evaluate(small, cfg, ["j01"], now) == []
+    (first, message), *_ = sent
+    assert 80 <= first <= 82 and "step from " + str(upload) in message["text"]
+    assert "EP v116" in message["text"] and "no known change" not in message["text"]
+    (alert,) = [a for a in big.alert_state().all() if a.rule == "jump"]
+    assert alert.grp == str(upload) and alert.severity == "warning"
+    (recorded,) = [a for a in small.alert_state().all() if a.rule == "jump"]
+    assert recorded.severity == "info" and recorded.status == "firing" and recorded.grp == str(upload)

@@ -49,7 +49,10 @@ def test_channel_defaults_come_from_the_model(tmp_path):
     [
         ({"spec_km": 0}, "alerts.spec_km: 0 is not within 0.01..100"),
         ({"pre_days": 5, "min_pre_days": 7}, "alerts.min_pre_days: 7 is more than alerts.pre_days (5)"),
-        ({"jump_z": "high"}, "alerts.jump_z: expected float, got str 'high'"),
+        (
+            {"false_detections_per_year": "high"},
+            "alerts.false_detections_per_year: expected float, got str 'high'",
+        ),
         ({"spec_kms": 1.0}, "alerts.spec_kms: unknown key"),
         ({"email": {"to": ["a@example.org"]}}, "alerts.email.host: missing"),
         ({"email": {"host": "h", "to": "a@example.org"}}, "alerts.email.to: expected list"),

@@ -165,7 +165,7 @@ BAD = [  # (where, value or a function of the document, the key the one-line err
     ("alerts.stale_hours", 0, "alerts.stale_hours"),
     ("alerts.pre_days", 1.5, "alerts.pre_days"),
     ("alerts.min_pre_days", 100, "alerts.min_pre_days"),
-    ("alerts.jump_z", float("inf"), "alerts.jump_z"),
+    ("alerts.practical_step_urad", float("inf"), "alerts.practical_step_urad"),
     ("alerts.colour", "red", "alerts.colour"),
     ("alerts.email", "smtp.example.org", "alerts.email"),
     ("alerts.email.port", 70000, "alerts.email.port"),

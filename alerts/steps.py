@@ -1,0 +1,403 @@
+"""Steps in a daily per-FOR series, tested with the sigmas the assessment reports.
+
+**The model.** On assessed day t the value of FOR k in direction c (in-track alpha and cross-track beta, in
+urad; or the CrIS-VIIRS bias, in K) is its level plus an error
+
+    e[t, k, c] = lambda_c * s[t, k, c] * (sqrt(rho_c) g[t, c] + sqrt(1 - rho_c) h[t, k, c]),
+
+s the reported sigma, lambda_c the scale of the real scatter to the reported one, rho_c the share of the
+error variance that the FORs of one day have in common (their scenes are shared), g and h unit AR(1)
+series over calendar days with lag-one correlation phi. The three are fitted from the history, never
+assumed (:func:`fit_noise`): from first differences of consecutive days, so a step costs one outlier,
+with medians, so outliers cost nothing. lambda checks the reported sigmas against the day-to-day scatter:
+sigmas too small make lambda > 1, so such days cannot page; honest ones give lambda ~ 1.
+
+**The test.** A step at day tau seen on day T compares, per FOR and direction, the inverse-variance mean
+of the days [tau, T] with that of the baseline before tau (at most ``baseline_days``, after the last
+accepted step): D_k with variance V_k = lambda^2 u^T Phi u (u the contrast times the sigmas, Phi the
+AR(1) correlation of the days). For a group G of FORs (all 30, the three tens, every 3 adjacent, each
+alone) the step common to G is its generalised least-squares estimate under the exchangeable correlation
+rho of the D_k (:func:`pooled`): the FORs outside G then measure the shared part of the error, so a step
+of a few FORs is seen through it. z = estimate / sigma.
+
+**The thresholds** come from false-detection rates (:func:`threshold`): on each day the blind test tries
+the splits T, T-1, T-2 (a step is found within three days) for every group and both directions; the
+largest |z| of that family, simulated under the fitted rho and phi, exceeds the threshold on a fraction
+``rate_per_year / 365`` of days. At a known change (calendar, metadata, fingerprint) the day that holds it
+is left out of both windows, and its family, the first three days after it, exceeds its own threshold
+with probability ``rate_at_change``.
+
+**The replay.** The rule keeps no state: each evaluation replays the last ``2 * baseline_days`` days as the
+daily evaluations saw them (:func:`detect`), accepting steps in time order; a step starts a new baseline.
+Those whose split lies in the last ``baseline_days`` days are reported: an alert resolves once the new
+level has held for the baseline's length. A slow drift has no split: it is not a step, and is found only
+where it adds up to one within the baseline's length.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from monitor.core.constants import N_FOR
+
+# the groups of FORs pooled: all, the three tens, every 3 adjacent, each alone; (name, 0-based indices)
+GROUPS: tuple[tuple[str, tuple[int, ...]], ...] = (
+    (("FOR 1-30", tuple(range(N_FOR))),)
+    + tuple((f"FOR {i + 1}-{i + 10}", tuple(range(i, i + 10))) for i in range(0, N_FOR, 10))
+    + tuple((f"FOR {i + 1}-{i + 3}", (i, i + 1, i + 2)) for i in range(N_FOR - 2))
+    + tuple((f"FOR {i + 1}", (i,)) for i in range(N_FOR))
+)
+MEMBERS = np.array([[k in idx for k in range(N_FOR)] for _, idx in GROUPS], float)  # (groups, N_FOR)
+NULL_DRAWS = 200_000  # simulated days per threshold: ~550 beyond it at 1/365
+MIN_HISTORY_DAYS = 20  # assessed days the noise is fitted from before anything is tested
+
+
+@dataclass(frozen=True)
+class StepRules:
+    """What the detector is told: the false-detection rates (per satellite-year on unannounced days, per
+    inert known change), the baseline's length (days), the fewest baseline days a test needs, the days
+    after a split the blind test tries it (``discovery_days``), the days after a split its size is
+    measured over, and the practical size (the series' unit) below which a step is recorded, not paged."""
+
+    rate_per_year: float
+    rate_at_change: float
+    baseline_days: int
+    min_baseline_days: int
+    discovery_days: int
+    size_days: int
+    practical: float
+    attribution_days: int
+
+
+@dataclass(frozen=True)
+class Noise:
+    """The history's error, per direction: *scale* (real scatter over the reported sigma), *shared* (the
+    share of the variance common to the FORs of a day), and *lag1* (the day-to-day correlation)."""
+
+    scale: np.ndarray
+    shared: np.ndarray
+    lag1: float
+
+
+@dataclass(frozen=True)
+class Step:
+    """A step found: its *split* (the first day at the new level; for a known change, the change's day),
+    the known change's index in the changes given (None: none within ``attribution_days``), the day it
+    was first seen, the group and direction that found it with its *z* and pooled size (and sigma), and
+    per FOR and direction its size and sigma (NaN where not measured); *paged* when its pooled size
+    reaches the practical size."""
+
+    split: dt.date
+    change: int | None
+    seen: dt.date
+    group: str
+    direction: int
+    z: float
+    pooled: float
+    pooled_sigma: float
+    size: np.ndarray  # (N_FOR, directions)
+    sigma: np.ndarray
+    paged: bool
+
+
+def _robust_var(x: np.ndarray) -> float:
+    """The variance of a normal sample from its median absolute value (outliers cost nothing)."""
+    x = x[np.isfinite(x)]
+    return float((1.4826 * np.median(np.abs(x))) ** 2) if x.size >= 5 else math.nan
+
+
+def fit_noise(ordinal: np.ndarray, y: np.ndarray, s: np.ndarray) -> Noise | None:
+    """The :class:`Noise` of the days *ordinal* (T,), values *y* and sigmas *s* (T, N_FOR, C), from the
+    differences of consecutive calendar days scaled by their sigmas: their variance is
+    lambda^2 (1 - phi), their lag-one correlation -(1 - phi) / 2, and the variance of their mean over the
+    FORs of a day lambda^2 (1 - phi) (rho + (1 - rho) / K). None with fewer than MIN_HISTORY_DAYS pairs."""
+    consecutive = np.flatnonzero(np.diff(ordinal) == 1) + 1
+    if len(consecutive) < MIN_HISTORY_DAYS:
+        return None
+    d = (y[consecutive] - y[consecutive - 1]) / np.hypot(s[consecutive], s[consecutive - 1])
+    var1 = np.array([_robust_var(d[..., c]) for c in range(d.shape[-1])])  # lambda^2 (1 - phi)
+    if not np.all(np.isfinite(var1)) or np.any(var1 <= 0):
+        return None
+    u = np.clip(d / np.sqrt(var1), -5.0, 5.0)  # a step is one outlier of the differences: clipped
+    follows = np.flatnonzero(np.diff(consecutive) == 1) + 1  # difference pairs on consecutive days
+    a, b = u[follows], u[follows - 1]
+    ok = np.isfinite(a) & np.isfinite(b)
+    norm = math.sqrt(np.sum(a[ok] ** 2) * np.sum(b[ok] ** 2)) if ok.any() else 0.0
+    corr = float(np.sum(a[ok] * b[ok]) / norm) if norm > 0 else 0.0
+    lag1 = float(np.clip(1.0 + 2.0 * corr, 0.0, 0.9))
+    k = np.sum(np.isfinite(u), axis=1)  # FORs per day and direction
+    with np.errstate(all="ignore"):
+        mean = np.nansum(u, axis=1) / k
+    ratio = np.array([_robust_var(mean[:, c]) for c in range(u.shape[-1])])
+    kc = np.maximum(np.median(k, axis=0), 2)
+    shared = np.clip((ratio - 1.0 / kc) / (1.0 - 1.0 / kc), 0.0, 0.95)
+    return Noise(np.sqrt(var1 / (1.0 - lag1)), shared, lag1)
+
+
+def pooled(
+    d: np.ndarray, sigma: np.ndarray, shared: float | np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per group (:data:`GROUPS`) the generalised least-squares step common to its FORs and its sigma, from
+    per-FOR differences *d* (..., N_FOR) with sigmas *sigma* correlated by *shared* between FORs (NaN: not
+    measured). With a = 1 / sigma, f = rho / (1 - rho + n rho) over the n FORs measured and x the group's
+    indicator, x^T S^-1 d = (sum_G a^2 d - f sum_G a sum a d) / (1 - rho), x^T S^-1 x likewise (the
+    exchangeable correlation's inverse, Sherman-Morrison). Returns (estimate, sigma), (..., groups)."""
+    rho = np.asarray(shared, float)
+    a = np.where(np.isfinite(d) & np.isfinite(sigma) & (sigma > 0), 1.0 / np.where(sigma > 0, sigma, 1), 0.0)
+    dz = np.where(a > 0, d, 0.0)
+    n = np.sum(a > 0, axis=-1, keepdims=True)
+    f = rho / (1.0 - rho + n * rho)
+    total = np.sum(a * dz, axis=-1, keepdims=True)
+    a_g = a @ MEMBERS.T
+    num = ((a**2 * dz) @ MEMBERS.T - f * a_g * total) / (1.0 - rho)
+    den = ((a**2) @ MEMBERS.T - f * a_g**2) / (1.0 - rho)
+    measured = (a > 0).astype(float) @ MEMBERS.T >= np.maximum(1.0, 0.5 * MEMBERS.sum(axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        est = np.where(measured & (den > 0), num / den, np.nan)
+        sig = np.where(measured & (den > 0), 1.0 / np.sqrt(den), np.nan)
+    return est, sig
+
+
+def _ar1(ordinal: np.ndarray, lag1: float) -> np.ndarray:
+    """The AR(1) correlation of days *ordinal*: lag1 ** |days apart|."""
+    apart = np.abs(ordinal[:, None] - ordinal[None, :]).astype(float)
+    return lag1**apart if lag1 > 0 else (apart == 0).astype(float)
+
+
+def _contrast(n_pre: int, n_post: int) -> np.ndarray:
+    """Uniform weights: +1/n_post on the post days, -1/n_pre on the baseline's."""
+    return np.r_[np.full(n_pre, -1.0 / n_pre), np.full(n_post, 1.0 / n_post)]
+
+
+@lru_cache(maxsize=1024)
+def threshold(
+    probability: float,
+    shared: float,
+    lag1: float,
+    baseline: int,
+    discovery: int,
+    known: bool,
+    directions: int,
+) -> float:
+    """The |z| the family of one evaluation day exceeds with *probability* under the null: for the blind
+    test the splits T - discovery + 1 .. T seen on day T; for a known change the first *discovery* days
+    after it (the change's day left out). Simulated (:data:`NULL_DRAWS` days, a fixed seed) for every group
+    and direction, the FORs correlated by *shared*, the days by *lag1*, uniform sigmas."""
+    if known:  # baseline days, the change's day, then the days after it
+        rows = [np.r_[_contrast(baseline, j), np.zeros(discovery - j)] for j in range(1, discovery + 1)]
+        ordinal = np.r_[np.arange(baseline), baseline + 1 + np.arange(discovery)]
+    else:  # a baseline of its own before each split, the splits' post days ending on the last day
+        span = baseline + discovery
+        rows = []
+        for j in range(1, discovery + 1):
+            c = np.zeros(span)
+            c[span - j - baseline : span - j] = -1.0 / baseline
+            c[span - j :] = 1.0 / j
+            rows.append(c)
+        ordinal = np.arange(span)
+    c = np.array(rows)
+    cov = c @ _ar1(ordinal, lag1) @ c.T
+    sd = np.sqrt(np.diag(cov))
+    chol = np.linalg.cholesky(cov / np.outer(sd, sd) + 1e-12 * np.eye(len(sd))).astype(np.float32)
+    # uniform sigmas: a group's z is (S_G - f n_G S) / sqrt((n_G - f n_G^2)(1 - rho)) (see pooled), S_G the
+    # sum of its FORs' standardised differences, S that of all
+    n_g = MEMBERS.sum(axis=1).astype(np.float32)
+    f = shared / (1.0 - shared + N_FOR * shared)
+    norm = np.sqrt((n_g - f * n_g**2) * (1.0 - shared)).astype(np.float32)
+    members = MEMBERS.T.astype(np.float32)
+    rng = np.random.default_rng(20261127)
+    peaks = []
+    for chunk in np.array_split(np.arange(NULL_DRAWS), 20):
+        shape = (len(rows), len(chunk), directions)
+        g = rng.standard_normal((*shape, 1), dtype=np.float32)
+        h = rng.standard_normal((*shape, N_FOR), dtype=np.float32)
+        e = np.float32(math.sqrt(shared)) * g + np.float32(math.sqrt(1.0 - shared)) * h
+        e = np.tensordot(chol, e, axes=(1, 0))  # the splits correlated as their windows overlap
+        z = (e @ members - np.float32(f) * n_g * e.sum(axis=-1, keepdims=True)) / norm
+        peaks.append(np.abs(z).max(axis=(0, 2, 3)))
+    return float(np.quantile(np.concatenate(peaks), 1.0 - probability))
+
+
+@dataclass(frozen=True)
+class _Window:
+    """A test's days as calendar ordinals: the baseline [pre_from, pre_to), the post days [post_from,
+    post_to]; *known* for a known change's test (its day left out between the two)."""
+
+    pre_from: int
+    pre_to: int
+    post_from: int
+    post_to: int
+    known: bool = False
+
+
+def _ar1_factor(n: np.ndarray, lag1: float) -> np.ndarray:
+    """The variance of the mean of *n* consecutive days of an AR(1) series over that of white noise:
+    1 + 2 sum_{j<n} (1 - j / n) lag1^j."""
+    j = np.arange(1, 64)
+    n = np.maximum(n, 1)
+    return 1.0 + 2.0 * np.sum(np.clip(1.0 - j / n[..., None], 0.0, None) * lag1**j, axis=-1)
+
+
+def _ar1_cross(n_pre: np.ndarray, n_post: np.ndarray, gap: np.ndarray, lag1: float) -> np.ndarray:
+    """The covariance of the means of n_pre days and of the n_post days that follow *gap* days after them
+    (1: the next day), for an AR(1) series of unit variance."""
+    if lag1 <= 0:
+        return np.zeros(np.broadcast(n_pre, n_post, gap).shape)
+    a, b = np.maximum(n_pre, 1), np.maximum(n_post, 1)
+    return lag1**gap * (1 - lag1**a) * (1 - lag1**b) / ((1 - lag1) ** 2 * a * b)
+
+
+def _differences(
+    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, windows: list[_Window], noise: Noise
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per window, FOR and direction the inverse-variance mean of the post days minus that of the
+    baseline, and its sigma ((P, N_FOR, C) each), from running sums over the days. The sigma is
+    lambda * sqrt(F(n_post) / W_post + F(n_pre) / W_pre - 2 s_pre s_post C): W the windows' summed
+    inverse variances, F the AR(1) factor of a window's mean (:func:`_ar1_factor`), C the covariance of
+    the two means (:func:`_ar1_cross`), s the windows' RMS sigmas; exact for days in a row with equal
+    sigmas, and for any sigmas without day-to-day correlation."""
+    ok = np.isfinite(y) & np.isfinite(s) & (s > 0)
+    w = np.where(ok, 1.0 / np.where(ok, s, 1.0) ** 2, 0.0)
+    zero = np.zeros((1, *y.shape[1:]))
+    cw = np.concatenate([zero, np.cumsum(w, axis=0)])
+    cwy = np.concatenate([zero, np.cumsum(w * np.where(ok, y, 0.0), axis=0)])
+    cn = np.concatenate([zero, np.cumsum(ok, axis=0)])
+    edges = np.array([[w_.pre_from, w_.pre_to, w_.post_from, w_.post_to + 1] for w_ in windows])
+    p0, p1, q0, q1 = (np.searchsorted(ordinal, edges[:, i]) for i in range(4))
+    w_pre, w_post = cw[p1] - cw[p0], cw[q1] - cw[q0]
+    n_pre, n_post = cn[p1] - cn[p0], cn[q1] - cn[q0]
+    enough = (w_pre > 0) & (w_post > 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = (cwy[q1] - cwy[q0]) / w_post - (cwy[p1] - cwy[p0]) / w_pre
+        gap = (edges[:, 2] - edges[:, 1] + 1)[:, None, None].astype(float)  # calendar days
+        cross = _ar1_cross(n_pre, n_post, gap, noise.lag1) * np.sqrt(n_pre / w_pre * n_post / w_post)
+        factor = _ar1_factor(np.arange(len(ordinal) + 1), noise.lag1)  # by the count of days
+        f_pre, f_post = factor[n_pre.astype(int)], factor[n_post.astype(int)]
+        var = f_post / w_post + f_pre / w_pre - 2 * cross
+    sig = np.sqrt(np.maximum(var, 0.0)) * noise.scale
+    return np.where(enough, d, np.nan), np.where(enough, sig, np.nan)
+
+
+def _peaks(
+    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, windows: list[_Window], noise: Noise
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per window the largest |z| over the groups and directions, where (group, direction), and every
+    group's estimate and sigma ((P, C, groups))."""
+    d, sig = _differences(ordinal, y, s, windows, noise)
+    est, est_sig = pooled(np.swapaxes(d, 1, 2), np.swapaxes(sig, 1, 2), noise.shared[:, None])
+    z = np.abs(est / est_sig)
+    flat = np.where(np.isfinite(z), z, -1.0).reshape(len(windows), -1)
+    best = flat.argmax(axis=1)
+    c, g = np.unravel_index(best, z.shape[1:])
+    return flat.max(axis=1), g, c, est, est_sig
+
+
+def detect(
+    days: list[dt.date],
+    y: np.ndarray,
+    s: np.ndarray,
+    change_days: list[dt.date],
+    rules: StepRules,
+) -> list[Step]:
+    """The steps of the series *y* with sigmas *s* (assessed days *days*, ascending; (T, N_FOR, C), NaN
+    where nothing reliable was measured) that the daily evaluations up to the last day would have found,
+    given the known changes' days *change_days*, whose split lies in the last ``baseline_days`` days (see
+    the module docstring)."""
+    if len(days) < MIN_HISTORY_DAYS:
+        return []
+    ordinal = np.array([d.toordinal() for d in days])
+    last = int(ordinal[-1])
+    start = last - 2 * rules.baseline_days + 1  # the replay's first day
+    fit = ordinal < start
+    if fit.sum() < MIN_HISTORY_DAYS:
+        fit = ordinal <= last - rules.discovery_days
+    # a day's sigma is not believed below half the FOR's usual one (a day whose sigmas are too small)
+    with np.errstate(all="ignore"):
+        typical = np.nanmedian(np.where(fit[:, None, None], s, np.nan), axis=0)
+    s = np.fmax(s, 0.5 * typical)
+    noise = fit_noise(ordinal[fit], y[fit], s[fit])
+    if noise is None:
+        return []
+    directions = y.shape[-1]
+    rho = round(float(np.max(noise.shared)) * 20) / 20  # the thresholds on a grid of 0.05
+    phi = round(noise.lag1 * 20) / 20
+    b, k = rules.baseline_days, rules.discovery_days
+    blind = threshold(rules.rate_per_year / 365.0, rho, phi, b, k, False, directions)
+    at_change = threshold(rules.rate_at_change, rho, phi, b, k, True, directions)
+    changes = sorted({c.toordinal() for c in change_days})
+    replay = [int(t) for t in ordinal[ordinal >= start]]
+    accepted: list[tuple[_Window, int, float, int, int]] = []  # (window, seen, z, group, direction)
+    broken = -(10**9)  # where the latest accepted step's new level begins: no baseline reaches before it
+    while replay:
+        windows: list[_Window] = []
+        seen: list[int] = []
+        for t in replay:
+            for x in changes:
+                if 1 <= t - x <= k and x >= broken:
+                    windows.append(_Window(max(x - b, broken), x, x + 1, t, known=True))
+                    seen.append(t)
+            for tau in ordinal[(ordinal > t - k) & (ordinal <= t) & (ordinal > broken)]:
+                windows.append(_Window(max(int(tau) - b, broken), int(tau), int(tau), t))
+                seen.append(t)
+        counts = [
+            np.count_nonzero((ordinal >= w.pre_from) & (ordinal < w.pre_to)) >= rules.min_baseline_days
+            for w in windows
+        ]
+        windows = [w for w, ok in zip(windows, counts, strict=True) if ok]
+        seen = [t for t, ok in zip(seen, counts, strict=True) if ok]
+        if not windows:
+            break
+        z, g, c, _, _ = _peaks(ordinal, y, s, windows, noise)
+        over = z > np.where([w.known for w in windows], at_change, blind)
+        if not over.any():
+            break
+        day = seen[int(np.flatnonzero(over)[0])]  # the first day anything is found; a known change first
+        on_day = [i for i in np.flatnonzero(over) if seen[i] == day]
+        known = [i for i in on_day if windows[i].known]
+        i = known[0] if known else max(on_day, key=lambda j: z[j])
+        accepted.append((windows[i], day, float(z[i]), int(g[i]), int(c[i])))
+        broken = windows[i].post_from
+        replay = [t for t in replay if t > day]
+    return [_step(ordinal, y, s, noise, changes, rules, accepted, i) for i in range(len(accepted))
+            if accepted[i][0].post_from > last - b]  # fmt: skip
+
+
+def _step(
+    ordinal: np.ndarray,
+    y: np.ndarray,
+    s: np.ndarray,
+    noise: Noise,
+    changes: list[int],
+    rules: StepRules,
+    accepted: list[tuple[_Window, int, float, int, int]],
+    i: int,
+) -> Step:
+    """The *i*-th accepted step measured over its baseline and up to ``size_days`` after it (before the
+    next one), attributed to a known change within ``attribution_days`` of its split."""
+    w, seen, z, g, c = accepted[i]
+    split = w.pre_to  # the known change's day, or the first day at the new level
+    following = accepted[i + 1][0].pre_to if i + 1 < len(accepted) else int(ordinal[-1]) + 1
+    sized = _Window(w.pre_from, w.pre_to, w.post_from, min(following - 1, w.post_from + rules.size_days - 1))
+    d, sig = _differences(ordinal, y, s, [sized], noise)
+    _, _, _, est, est_sig = _peaks(ordinal, y, s, [sized], noise)
+    near = [j for j, x in enumerate(changes) if abs(split - x) <= rules.attribution_days]
+    change = changes.index(split) if w.known else (near[0] if near else None)
+    pooled_size = float(est[0, c, g])
+    return Step(
+        dt.date.fromordinal(split),
+        change,
+        dt.date.fromordinal(seen),
+        GROUPS[g][0],
+        c,
+        z,
+        pooled_size,
+        float(est_sig[0, c, g]),
+        d[0],
+        sig[0],
+        bool(abs(pooled_size) >= rules.practical),
+    )
