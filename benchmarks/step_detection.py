@@ -66,15 +66,18 @@ class Case:
     fors: str = "all"
     direction: int = 0
     change: str = "none"
+    quantity: str = "los"  # or "bias": the CrIS-VIIRS bias (sigma, size in K)
+    los_step_urad: float = 0.0  # for the bias: the LOS's own step on the same day (all FORs, in-track)
 
 
 def history(case: Case, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, list[int]]:
-    """(values, sigmas) (DAYS, N_FOR, 2) urad of *case*, and the FORs (0-based) its step moved."""
+    """(values, sigmas) (DAYS, N_FOR, 2) urad of *case* (its bias's: (DAYS, N_FOR, 1) K), and the FORs
+    (0-based) its step moved."""
     scale, shared, lag1 = NOISES[case.noise]
     alpha, beta = paper_profile()
-    level = np.stack([alpha, beta], axis=-1) / 3.0
-    g = rng.standard_normal((DAYS, 1, 2))
-    h = rng.standard_normal((DAYS, N_FOR, 2))
+    level = np.stack([alpha, beta], axis=-1) / 3.0 if case.quantity == "los" else np.full((N_FOR, 1), -0.155)
+    g = rng.standard_normal((DAYS, 1, level.shape[-1]))
+    h = rng.standard_normal((DAYS, N_FOR, level.shape[-1]))
     e = np.sqrt(shared) * g + np.sqrt(1.0 - shared) * h
     for t in range(1, DAYS):  # AR(1), unit variance
         e[t] = lag1 * e[t - 1] + np.sqrt(1.0 - lag1**2) * e[t]
@@ -94,8 +97,11 @@ class MemoryHistory:
     index): the store's series and latest day; no runs, events or granules (the rules that read those
     find nothing)."""
 
-    def __init__(self, y: np.ndarray, s: np.ndarray) -> None:
+    def __init__(
+        self, y: np.ndarray, s: np.ndarray, bias: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> None:
         self.y, self.s, self.today = y, s, 0
+        self.bias = bias  # (bias, sigma) (DAYS, N_FOR) K, or none
         self.days = [START + dt.timedelta(days=i) for i in range(len(y))]
 
     def latest_day(self, satellite: str) -> dt.date:
@@ -112,8 +118,8 @@ class MemoryHistory:
             "d_beta_urad": self.y[:n, :, 1],
             "sigma_alpha_urad": self.s[:n, :, 0],
             "sigma_beta_urad": self.s[:n, :, 1],
-            "bias_k": nan,
-            "sigma_bias_k": nan,
+            "bias_k": nan if self.bias is None else self.bias[0][:n],
+            "sigma_bias_k": nan if self.bias is None else self.bias[1][:n],
         }
         return ForSeries(self.days[:n], values, np.empty(0), np.ones((n, N_FOR), bool))
 
@@ -140,10 +146,17 @@ def settings(folder: Path, case: Case) -> AlertSettings:
 
 
 def findings_by_day(case: Case, seed: int, first: int, last: int) -> tuple[list[tuple[int, list]], list]:
-    """The jump findings of each evaluation from day *first* to *last* (indices), and the FORs moved."""
+    """The findings of the case's rule (jump; calibration_jump for the bias) of each evaluation from day
+    *first* to *last* (indices), and the FORs moved."""
     rng = np.random.default_rng(seed)
     y, s, moved = history(case, rng)
-    store = MemoryHistory(y, s)
+    rule = Rule.JUMP
+    if case.quantity == "bias":  # beside it the LOS, stepping on its own
+        ly, ls, _ = history(Case(120.0, "white", case.los_step_urad), rng)
+        store = MemoryHistory(ly, ls, (y[..., 0], s[..., 0]))
+        rule = Rule.CALIBRATION_JUMP
+    else:
+        store = MemoryHistory(y, s)
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         cfg = settings(Path(tmp), case)
@@ -152,7 +165,7 @@ def findings_by_day(case: Case, seed: int, first: int, last: int) -> tuple[list[
             store.today = t
             # the rules read only what MemoryHistory has (series, latest day, runs, events, granules)
             found = findings_for(cast(History, store), "j01", cfg, now + dt.timedelta(days=t + 1))
-            out.append((t, [f for f in found if f.rule == Rule.JUMP]))
+            out.append((t, [f for f in found if f.rule == rule]))
     return out, moved
 
 
@@ -184,7 +197,7 @@ def detect_trial(job: tuple[Case, int]) -> dict:
     last = [f for f in days[-1][1] if f.group == first[1].group]
     errors: list[float] = []
     if last:
-        label = ("in-track", "cross-track")[case.direction]
+        label = "bias" if case.quantity == "bias" else ("in-track", "cross-track")[case.direction]
         fors = last[0].data["fors"][label]
         truth = np.zeros(N_FOR)
         truth[moved] = case.size
@@ -232,7 +245,8 @@ def store_check(years: int) -> int:
     return bad
 
 
-FDR_CASES = [Case(5.0, "white"), Case(120.0, "white"), Case(120.0, "scale1.3"), Case(120.0, "correlated")]
+FDR_CASES = [Case(5.0, "white"), Case(120.0, "white"), Case(120.0, "scale1.3"), Case(120.0, "correlated"),
+             Case(0.007, "correlated", quantity="bias", los_step_urad=300.0)]  # fmt: skip
 
 
 def detect_cases() -> list[Case]:
@@ -250,6 +264,10 @@ def detect_cases() -> list[Case]:
             Case(120.0, "correlated", 500.0, "all", 0, "at"), Case(120.0, "correlated", 300.0, "3", 1, "at"),
             Case(120.0, "white", 300.0, "3", 0, "before"),
             Case(120.0, "white", 100.0, "all", 1, "before")]  # fmt: skip
+    # the bias: per-FOR sigma 0.007 K (the real split halves), scenes moving every FOR's bias together
+    out += [Case(0.007, "correlated", 0.1, "all", 0, "none", "bias"),
+            Case(0.007, "correlated", 0.1, "all", 0, "at", "bias"),
+            Case(0.007, "correlated", 0.0, "all", 0, "at", "bias", 300.0)]  # fmt: skip
     return out
 
 
