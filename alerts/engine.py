@@ -143,7 +143,11 @@ def evaluate(
                 prev = state.get(f.fingerprint)
                 quiet = state.silenced(f.rule, sat, now) is not None
                 kind: Notice | None
-                if prev is None or prev.status != AlertStatus.FIRING:
+                if (
+                    prev is None
+                    or prev.status != AlertStatus.FIRING
+                    or (prev.severity == Severity.INFO and f.severity != Severity.INFO)  # grew: paged now
+                ):
                     kind = Notice.FIRING
                 elif (
                     prev.last_notified is None

@@ -342,6 +342,8 @@ def detect(
                     windows.append(_Window(max(x - b, broken), x, x + 1, t, known=True))
                     seen.append(t)
             for tau in ordinal[(ordinal > t - k) & (ordinal <= t) & (ordinal > broken)]:
+                if any(tau <= x <= t for x in changes):  # a change's day in it: its own test's
+                    continue
                 windows.append(_Window(max(int(tau) - b, broken), int(tau), int(tau), t))
                 seen.append(t)
         counts = [
@@ -360,8 +362,12 @@ def detect(
         on_day = [i for i in np.flatnonzero(over) if seen[i] == day]
         known = [i for i in on_day if windows[i].known]
         i = known[0] if known else max(on_day, key=lambda j: z[j])
-        accepted.append((windows[i], day, float(z[i]), int(g[i]), int(c[i])))
-        broken = windows[i].post_from
+        w = windows[i]
+        near = [x for x in changes if abs(w.pre_to - x) <= rules.attribution_days and x >= broken]
+        if not w.known and near:  # a blind step at a known change: dated and measured as the change
+            w = _Window(max(near[0] - b, broken), near[0], near[0] + 1, day, known=True)
+        accepted.append((w, day, float(z[i]), int(g[i]), int(c[i])))
+        broken = w.post_from
         replay = [t for t in replay if t > day]
     return [_step(ordinal, y, s, noise, changes, rules, accepted, i) for i in range(len(accepted))
             if accepted[i][0].post_from > last - b]  # fmt: skip
@@ -382,7 +388,8 @@ def _step(
     w, seen, z, g, c = accepted[i]
     split = w.pre_to  # the known change's day, or the first day at the new level
     following = accepted[i + 1][0].pre_to if i + 1 < len(accepted) else int(ordinal[-1]) + 1
-    sized = _Window(w.pre_from, w.pre_to, w.post_from, min(following - 1, w.post_from + rules.size_days - 1))
+    post_from = w.post_from if w.post_from <= ordinal[-1] else w.pre_to  # on the change's day: that day
+    sized = _Window(w.pre_from, w.pre_to, post_from, min(following - 1, post_from + rules.size_days - 1))
     d, sig = _differences(ordinal, y, s, [sized], noise)
     _, _, _, est, est_sig = _peaks(ordinal, y, s, [sized], noise)
     near = [j for j, x in enumerate(changes) if abs(split - x) <= rules.attribution_days]

@@ -14,9 +14,10 @@ two give the same findings. A step is added on day 200 to every FOR or to 3 adja
 direction; with a known change (an EP upload at 12:00 UTC, so day 200 holds half the step) or without.
 
 * ``fdr``: detection episodes (a finding's split date, recorded or paged) per satellite-year with no step.
-* ``detect``: per case, the share of trials found within 3 days (by the evaluation after day 200, 201 or
-  202), paged, whose first finding names the injected change (or says no known change when there is
-  none, or when the only change is 4 days before the step), and the rms of (size - truth) / sigma.
+* ``detect``: per case, the share of trials found (recorded or paged) within 3 days (by the evaluation after
+  day 200, 201 or 202), paged within 3 days, whose first message names the injected change (or says no
+  known change when there is none, or when the only change is 4 days before the step), dated within a
+  day, and the rms of (size - truth) / sigma of the per-FOR sizes reported on day 202.
 """
 
 from __future__ import annotations
@@ -187,11 +188,14 @@ def detect_trial(job: tuple[Case, int]) -> dict:
     case, seed = job
     days, moved = findings_by_day(case, seed, STEP_DAY - 4, STEP_DAY + 2)
     split = START + dt.timedelta(days=STEP_DAY)
-    first = None
+    first = paged = None
     for t, found in days:
         near = [f for f in found if abs((dt.date.fromisoformat(f.group) - split).days) <= 1]
         if near and first is None:
             first = (t, near[0])
+        loud = [f for f in near if f.severity == "warning"]
+        if loud and paged is None:
+            paged = (t, loud[0])
     if first is None:
         return {"found": False}
     last = [f for f in days[-1][1] if f.group == first[1].group]
@@ -205,12 +209,12 @@ def detect_trial(job: tuple[Case, int]) -> dict:
             size, sigma = fors["size"][k], fors["sigma"][k]
             if size is not None and sigma:
                 errors.append((size - truth[k]) / sigma)
-    f = first[1]
+    f = (paged or first)[1]  # what the first message says (a recorded step sends none)
     return {
         "found": True,
         "delay_days": first[0] - STEP_DAY,
         "date_error_days": (dt.date.fromisoformat(f.group) - split).days,
-        "paged": f.severity == "warning",
+        "paged": paged is not None and paged[0] - STEP_DAY <= 2,
         "names_change": f.data["change"] is not None,
         "errors": errors,
     }
@@ -293,7 +297,6 @@ def main(argv: list[str] | None = None) -> int:
                        "noise_years": round(n, 1), "per_year": sum(y["episodes"] for y in years) / n,
                        "paged_per_year": sum(y["paged"] for y in years) / n,
                        "seconds": round(time.perf_counter() - t0)}  # fmt: skip
-                print(row, flush=True)
                 emit(row, args.rows)
         else:
             for case in detect_cases():
@@ -309,7 +312,6 @@ def main(argv: list[str] | None = None) -> int:
                        "date_within_1_day": sum(abs(t["date_error_days"]) <= 1 for t in found) / n_found,
                        "size_rms_z": float(np.sqrt(np.mean(errors**2))) if errors.size else None,
                        "seconds": round(time.perf_counter() - t0)}  # fmt: skip
-                print(row, flush=True)
                 emit(row, args.rows)
     return 0
 
