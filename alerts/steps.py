@@ -29,6 +29,9 @@ with probability ``rate_at_change``.
 
 **The replay.** The rule keeps no state: each evaluation replays the last ``2 * baseline_days`` days as the
 daily evaluations saw them (:func:`detect`), accepting steps in time order; a step starts a new baseline.
+The noise is fitted on the days before the replay and anew only every four weeks, on fixed dates, so that
+between refits every evaluation takes the same decisions: a split is decided once, not tried again each
+day under a fit that moved a little (each such look would be another chance of a false detection).
 Those whose split lies in the last ``baseline_days`` days are reported: an alert resolves once the new
 level has held for the baseline's length. A slow drift has no split: it is not a step, and is found only
 where it adds up to one within the baseline's length.
@@ -55,6 +58,8 @@ GROUPS: tuple[tuple[str, tuple[int, ...]], ...] = (
 MEMBERS = np.array([[k in idx for k in range(N_FOR)] for _, idx in GROUPS], float)  # (groups, N_FOR)
 NULL_DRAWS = 200_000  # simulated days per threshold: ~550 beyond it at 1/365
 MIN_HISTORY_DAYS = 20  # assessed days the noise is fitted from before anything is tested
+REFIT_DAYS = 28  # the noise is fitted anew every four weeks (detect)
+REFIT_EPOCH = dt.date(2000, 1, 3).toordinal()  # a Monday: the refits' dates
 
 
 @dataclass(frozen=True)
@@ -313,8 +318,11 @@ def detect(
     ordinal = np.array([d.toordinal() for d in days])
     last = int(ordinal[-1])
     start = last - 2 * rules.baseline_days + 1  # the replay's first day
-    fit = ordinal < start
-    if fit.sum() < MIN_HISTORY_DAYS:
+    # the noise is fitted on the days before the replay, refitted on fixed dates every REFIT_DAYS: between
+    # refits each evaluation replays the same decisions, so a split is decided once, not looked at anew
+    # every day with a slightly different fit
+    fit = ordinal < start - (start - REFIT_EPOCH) % REFIT_DAYS
+    if np.count_nonzero(fit) < MIN_HISTORY_DAYS:
         fit = ordinal <= last - rules.discovery_days
     # a day's sigma is not believed below half the FOR's usual one (a day whose sigmas are too small)
     with np.errstate(all="ignore"):
