@@ -29,9 +29,10 @@ with probability ``rate_at_change``.
 
 **The replay.** The rule keeps no state: each evaluation replays the last ``2 * baseline_days`` days as the
 daily evaluations saw them (:func:`detect`), accepting steps in time order; a step starts a new baseline.
-The noise is fitted on the days before the replay and anew only every four weeks, on fixed dates, so that
-between refits every evaluation takes the same decisions: a split is decided once, not tried again each
-day under a fit that moved a little (each such look would be another chance of a false detection).
+A split is judged by the noise fitted on the days before the refit date (every four weeks, on fixed dates)
+on or before its baseline: the fit depends on the split alone, so every evaluation decides it alike, once,
+not anew each day under a fit that moved a little (each such look would be another chance of a false
+detection).
 Those whose split lies in the last ``baseline_days`` days are reported: an alert resolves once the new
 level has held for the baseline's length. A slow drift has no split: it is not a step, and is found only
 where it adds up to one within the baseline's length.
@@ -318,25 +319,20 @@ def detect(
     ordinal = np.array([d.toordinal() for d in days])
     last = int(ordinal[-1])
     start = last - 2 * rules.baseline_days + 1  # the replay's first day
-    # the noise is fitted on the days before the replay, refitted on fixed dates every REFIT_DAYS: between
-    # refits each evaluation replays the same decisions, so a split is decided once, not looked at anew
-    # every day with a slightly different fit
-    fit = ordinal < start - (start - REFIT_EPOCH) % REFIT_DAYS
-    if np.count_nonzero(fit) < MIN_HISTORY_DAYS:
-        fit = ordinal <= last - rules.discovery_days
-    # a day's sigma is not believed below half the FOR's usual one (a day whose sigmas are too small)
-    with np.errstate(all="ignore"):
-        typical = np.nanmedian(np.where(fit[:, None, None], s, np.nan), axis=0)
-    s = np.fmax(s, 0.5 * typical)
-    noise = fit_noise(ordinal[fit], y[fit], s[fit])
-    if noise is None:
-        return []
-    directions = y.shape[-1]
-    rho = round(float(np.max(noise.shared)) * 20) / 20  # the thresholds on a grid of 0.05
-    phi = round(noise.lag1 * 20) / 20
     b, k = rules.baseline_days, rules.discovery_days
-    blind = threshold(rules.rate_per_year / 365.0, rho, phi, b, k, False, directions)
-    at_change = threshold(rules.rate_at_change, rho, phi, b, k, True, directions)
+    fits: dict[int, _Fit | None] = {}
+
+    def fitted(split: int) -> _Fit | None:
+        """The fit a test of *split* uses: the days before the refit date on or before its baseline
+        (REFIT_DAYS apart, on fixed dates), or early in a history every day before it. It depends on the
+        split alone, so every evaluation decides a split alike: once, not anew each day."""
+        anchor = split - b - (split - b - REFIT_EPOCH) % REFIT_DAYS
+        if np.count_nonzero(ordinal < anchor) < MIN_HISTORY_DAYS:
+            anchor = split
+        if anchor not in fits:
+            fits[anchor] = _fit(ordinal, y, s, ordinal < anchor, rules)
+        return fits[anchor]
+
     changes = sorted({c.toordinal() for c in change_days})
     replay = [int(t) for t in ordinal[ordinal >= start]]
     accepted: list[tuple[_Window, int, float, int, int]] = []  # (window, seen, z, group, direction)
@@ -354,22 +350,32 @@ def detect(
                     continue
                 windows.append(_Window(max(int(tau) - b, broken), int(tau), int(tau), t))
                 seen.append(t)
-        counts = [
+        usable = [
             np.count_nonzero((ordinal >= w.pre_from) & (ordinal < w.pre_to)) >= rules.min_baseline_days
+            and fitted(w.pre_to) is not None
             for w in windows
         ]
-        windows = [w for w, ok in zip(windows, counts, strict=True) if ok]
-        seen = [t for t, ok in zip(seen, counts, strict=True) if ok]
+        windows = [w for w, ok in zip(windows, usable, strict=True) if ok]
+        seen = [t for t, ok in zip(seen, usable, strict=True) if ok]
         if not windows:
             break
-        z, g, c, _, _ = _peaks(ordinal, y, s, windows, noise)
-        over = z > np.where([w.known for w in windows], at_change, blind)
+        z, g, c, limit = (np.zeros(len(windows)) for _ in range(4))
+        by_fit: dict[int, list[int]] = {}
+        for i, w in enumerate(windows):
+            by_fit.setdefault(id(fitted(w.pre_to)), []).append(i)
+        for members in by_fit.values():
+            f = fitted(windows[members[0]].pre_to)
+            assert f is not None
+            zz, gg, cc, _, _ = _peaks(ordinal, y, f.sigma, [windows[i] for i in members], f.noise)
+            z[members], g[members], c[members] = zz, gg, cc
+            limit[members] = [f.at_change if windows[i].known else f.blind for i in members]
+        over = z > limit
         if not over.any():
             break
         day = seen[int(np.flatnonzero(over)[0])]  # the first day anything is found; a known change first
         on_day = [i for i in np.flatnonzero(over) if seen[i] == day]
         known = [i for i in on_day if windows[i].known]
-        i = known[0] if known else max(on_day, key=lambda j: z[j])
+        i = int(known[0] if known else max(on_day, key=lambda j: z[j]))
         w = windows[i]
         near = [x for x in changes if abs(w.pre_to - x) <= rules.attribution_days and x >= broken]
         if not w.known and near:  # a blind step at a known change: dated and measured as the change
@@ -377,8 +383,45 @@ def detect(
         accepted.append((w, day, float(z[i]), int(g[i]), int(c[i])))
         broken = w.post_from
         replay = [t for t in replay if t > day]
-    return [_step(ordinal, y, s, noise, changes, rules, accepted, i) for i in range(len(accepted))
-            if accepted[i][0].post_from > last - b]  # fmt: skip
+    out = []
+    for i, (w, *_) in enumerate(accepted):
+        f = fitted(w.pre_to)
+        if w.post_from > last - b and f is not None:
+            out.append(_step(ordinal, y, f.sigma, f.noise, changes, rules, accepted, i))
+    return out
+
+
+@dataclass(frozen=True)
+class _Fit:
+    """What a test is judged by: the noise fitted, the sigmas floored at half their FOR's usual one, and
+    the thresholds of the blind test and of the test at a known change."""
+
+    noise: Noise
+    sigma: np.ndarray
+    blind: float
+    at_change: float
+
+
+def _fit(
+    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, days: np.ndarray, rules: StepRules
+) -> _Fit | None:
+    """The :class:`_Fit` of the *days* (a mask): a day's sigma is not believed below half the FOR's usual
+    one there (a day whose sigmas are too small cannot page); None when the noise cannot be fitted."""
+    with np.errstate(all="ignore"):
+        typical = np.nanmedian(np.where(days[:, None, None], s, np.nan), axis=0)
+    sigma = np.fmax(s, 0.5 * typical)
+    noise = fit_noise(ordinal[days], y[days], sigma[days])
+    if noise is None:
+        return None
+    rho = round(float(np.max(noise.shared)) * 20) / 20  # the thresholds on a grid of 0.05
+    phi = round(noise.lag1 * 20) / 20
+    b, k, c = rules.baseline_days, rules.discovery_days, y.shape[-1]
+    return _Fit(
+        noise,
+        sigma,
+        threshold(rules.rate_per_year / 365.0, rho, phi, b, k, False, c),
+        threshold(rules.rate_at_change, rho, phi, b, k, True, c),
+    )
 
 
 def _step(
