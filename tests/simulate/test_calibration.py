@@ -139,7 +139,7 @@ def test_calibration_jump_fires_on_a_calibration_step_and_not_on_a_change_of_sce
     """40 days whose scenes alternate between two granules; from day 34 either one granule's scenes alone
     (a change of scene mix) or the same scenes with CrIS 0.1 K warmer. The first is no calibration jump;
     the second is one (alerts.min_bias_jump_k 0.05 K: a 0.1 K step is not left to the rounding of a
-    threshold at 0.1)."""
+    threshold at 0.1). Paged, that is: the first may be recorded (severity info)."""
     results = {name: _assess(differing, name, Cost.REGRESSION) for name in ("agree", "other", "stepped")}
     days = [dt.date(2024, 6, 1) + dt.timedelta(days=i) for i in range(40)]
     split = days[34]
@@ -154,12 +154,14 @@ def test_calibration_jump_fires_on_a_calibration_step_and_not_on_a_change_of_sce
                 ],
             )
             store.save_day(store.begin_run("j01", day), "j01", day, result)
-        found = jump_findings(store, "j01", [], RuleSettings(), days[-1], CALIBRATION)
+        # a change of scenes may be recorded (severity info, below min_bias_jump_k), never paged
+        found = jump_findings(store, "j01", [], RuleSettings(), CALIBRATION)
+        found = [f for f in found if f.severity == "warning"]
         if not fires:
             assert found == [], [f.lines for f in found]
             continue
         # one jump, at the split or the day before it (day 33 has the other granule's scenes: either
         # reads as the last day of the old level)
         (f,) = found
-        assert f.rule == "calibration_jump" and "+0.10 K" in f.lines[0], f.lines
-        assert 0 <= (split - dt.date.fromisoformat(f.data["split"])).days <= 1, f.data
+        assert f.rule == "calibration_jump" and 0.05 <= f.data["size"] <= 0.15, f.lines
+        assert abs((split - dt.date.fromisoformat(f.data["split"])).days) <= 1, f.data
