@@ -156,9 +156,7 @@ def jump_findings(
     for step in found:
         change = changes[step.change] if step.change is not None else None
         cause = (
-            f"at {change.label()}"
-            if change
-            else f"no known change within {s.attribution_days} day(s) of it"
+            f"at {change.label()}" if change else f"no known change within {s.attribution_days} day(s) of it"
         )
         label = watched.labels[step.direction]
         head = (

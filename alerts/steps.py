@@ -145,9 +145,7 @@ def fit_noise(ordinal: np.ndarray, y: np.ndarray, s: np.ndarray) -> Noise | None
     return Noise(np.sqrt(var1 / (1.0 - lag1)), shared, lag1)
 
 
-def pooled(
-    d: np.ndarray, sigma: np.ndarray, shared: float | np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+def pooled(d: np.ndarray, sigma: np.ndarray, shared: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per group (:data:`GROUPS`) the generalised least-squares step common to its FORs and its sigma, from
     per-FOR differences *d* (..., N_FOR) with sigmas *sigma* correlated by *shared* between FORs (NaN: not
     measured). With a = 1 / sigma, f = rho / (1 - rho + n rho) over the n FORs measured and x the group's
@@ -407,12 +405,10 @@ def _fit(
 ) -> _Fit | None:
     """The :class:`_Fit` of the *days* (a mask): a day's sigma is not believed below half the FOR's usual
     one there (a day whose sigmas are too small cannot page); None when the noise cannot be fitted."""
-    with np.errstate(all="ignore"):
-        typical = np.nanmedian(np.where(days[:, None, None], s, np.nan), axis=0)
-    sigma = np.fmax(s, 0.5 * typical)
-    noise = fit_noise(ordinal[days], y[days], sigma[days])
-    if noise is None:
+    fitted = floored_noise(ordinal, y, s, days)
+    if fitted is None:
         return None
+    noise, sigma = fitted
     rho = round(float(np.max(noise.shared)) * 20) / 20  # the thresholds on a grid of 0.05
     phi = round(noise.lag1 * 20) / 20
     b, k, c = rules.baseline_days, rules.discovery_days, y.shape[-1]
@@ -422,6 +418,50 @@ def _fit(
         threshold(rules.rate_per_year / 365.0, rho, phi, b, k, False, c),
         threshold(rules.rate_at_change, rho, phi, b, k, True, c),
     )
+
+
+def floored_noise(
+    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, days: np.ndarray
+) -> tuple[Noise, np.ndarray] | None:
+    """The :class:`Noise` fitted on the *days* (a mask) and the sigmas it applies to: a day's sigma is not
+    believed below half the FOR's usual one there (a day whose sigmas are too small cannot page). None
+    when the noise cannot be fitted (:func:`fit_noise`)."""
+    with np.errstate(all="ignore"):
+        typical = np.nanmedian(np.where(days[:, None, None], s, np.nan), axis=0)
+    sigma = np.fmax(s, 0.5 * typical)
+    noise = fit_noise(ordinal[days], y[days], sigma[days])
+    return None if noise is None else (noise, sigma)
+
+
+def window_mean(
+    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, first: int, last: int, noise: Noise
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per FOR and direction the inverse-variance mean of the days *first*..*last* (ordinals, both
+    included) and its sigma, lambda * sqrt(F(n) / W) (W the summed inverse variances, F the AR(1) factor
+    of the mean of n days: :func:`_ar1_factor`); NaN where no day was measured."""
+    days = (ordinal >= first) & (ordinal <= last)
+    ok = days[:, None, None] & np.isfinite(y) & np.isfinite(s) & (s > 0)
+    w = np.where(ok, 1.0 / np.where(ok, s, 1.0) ** 2, 0.0)
+    total = w.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.sum(w * np.where(ok, y, 0.0), axis=0) / total
+        sigma = np.sqrt(_ar1_factor(ok.sum(axis=0), noise.lag1) / total) * noise.scale
+    return np.where(total > 0, mean, np.nan), np.where(total > 0, sigma, np.nan)
+
+
+def move(
+    ordinal: np.ndarray,
+    y: np.ndarray,
+    s: np.ndarray,
+    before: tuple[int, int],
+    after: tuple[int, int],
+    noise: Noise,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per FOR and direction the mean of the days *after* minus that of the days *before* (ordinal ranges,
+    both ends included) and its sigma, as the jump rule measures a step (:func:`_differences`: the two
+    windows' correlation through the days' included)."""
+    d, sig = _differences(ordinal, y, s, [_Window(before[0], before[1] + 1, after[0], after[1])], noise)
+    return d[0], sig[0]
 
 
 def _step(

@@ -1,4 +1,5 @@
-"""The alerts and the known changes: list, silence, unsilence, evaluate; the events calendar."""
+"""The alerts and the known changes: list, silence, unsilence, evaluate; the events calendar and what each
+change did."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from monitor.core.satellites import SATELLITES
 from monitor.core.vocabulary import Rule
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    pass
+    from monitor.config.model import Config
 
 RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices' repr
 
@@ -83,24 +84,30 @@ def cmd_alerts(args: argparse.Namespace) -> int:
 
 @command(
     "events",
-    "list the known changes, or add one to the events calendar",
+    "list the known changes, measure what each did, or add one to the events calendar",
     arg(
         "action",
-        choices=("list", "add"),
+        choices=("list", "effects", "add"),
         nargs="?",
         default="list",
-        help="list (default): the calendar's changes and those found in the data; add: a change to the "
-        "calendar (its comments are kept)",
+        help="list (default): the calendar's changes and those found in the data; effects: per change, each "
+        "FOR's offsets before and after with sigmas, the move in urad and km, its significance, and the "
+        "move the EPs' mapping angles predict (docs/operations.md); add: a change to the calendar (its "
+        "comments are kept)",
     ),
     CONFIG,
-    arg("--satellite", choices=tuple(SATELLITES), help="list: only this satellite; add: the satellite"),
+    arg(
+        "--satellite",
+        choices=tuple(SATELLITES),
+        help="list, effects: only this satellite; add: the satellite",
+    ),
     arg("--time", type=iso_time, help="add: when (ISO 8601, UTC)"),
     arg("--instrument", choices=("cris", "viirs", "common"), help="add: the instrument changed"),
     arg("--kind", default="change", help="add: ep_upload, lut_change, software, ..."),
     arg("--description", help="add: what changed"),
 )
 def cmd_events(args: argparse.Namespace) -> int:
-    """crisgeo events: list the known changes, or add one to the calendar."""
+    """crisgeo events: list the known changes, measure what each did, or add one to the calendar."""
     from monitor.history.changes import Change, add_to_calendar, listing
 
     cfg = load(args)
@@ -120,6 +127,8 @@ def cmd_events(args: argparse.Namespace) -> int:
             raise BadInput(str(exc)) from None
         print(f"added to {cfg.events_file}")
         return EXIT_OK
+    if args.action == "effects":
+        return _effects(cfg, args.satellite)
     try:
         if not cfg.store.path.exists():  # before the first run: the calendar alone
             changes = listing(cfg.events_file, cfg.satellites, args.satellite, None)
@@ -132,4 +141,27 @@ def cmd_events(args: argparse.Namespace) -> int:
         raise BadInput(str(exc)) from None
     for c in changes:
         print(f"{c.satellite} {c.label()}")
+    return EXIT_OK
+
+
+def _effects(cfg: Config, only: str | None) -> int:
+    """Print what each known change did to the stored offsets (:mod:`alerts.effects`)."""
+    from alerts.effects import change_effects, effect_text
+    from monitor.history.changes import all_changes
+
+    if not cfg.store.path.exists():
+        raise BadInput(f"{cfg.store.path}: no store yet: nothing assessed to measure a change on")
+    with open_store(cfg) as store:
+        for sat in [only] if only else cfg.satellites:
+            try:
+                changes = all_changes(store, sat, cfg.events_file)
+            except OSError as exc:
+                raise BadInput(f"{cfg.events_file}: {exc.strerror or exc}") from None
+            except ValueError as exc:  # its message names the file and the entry
+                raise BadInput(str(exc)) from None
+            effects = change_effects(store, sat, changes, cfg.alerts)
+            if not effects:
+                print(f"{sat}: no known change with assessed days on both sides")
+            for e in effects:
+                print(f"{sat} " + "\n".join(effect_text(e)))
     return EXIT_OK

@@ -5,12 +5,9 @@ from __future__ import annotations
 import argparse
 import os
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from monitor.cli.registry import COMMANDS
-
-if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    pass
 
 
 class PrintReference(argparse.Action):

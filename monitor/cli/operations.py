@@ -7,7 +7,6 @@ import argparse
 import datetime as dt
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from monitor.cli.output import result_text
 from monitor.cli.registry import (
@@ -23,9 +22,6 @@ from monitor.cli.registry import (
 )
 from monitor.cli.types import iso_day, whole
 from monitor.core.satellites import SATELLITES
-
-if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    pass
 
 
 @command(

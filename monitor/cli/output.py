@@ -4,13 +4,10 @@ output that a pipe closed by its reader silences."""
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import Any, TextIO
 
 from monitor.core.result import AssessmentResult
 from monitor.core.tables import for_table
-
-if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    pass
 
 
 class PipedOutput:

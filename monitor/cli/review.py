@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from monitor.cli.registry import (
     CONFIG,
@@ -20,14 +19,16 @@ from monitor.cli.registry import (
 from monitor.cli.types import iso_day
 from monitor.core.satellites import SATELLITES
 
-if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    pass
-
 
 @command(
     "export",
-    "per-FOR results as CF NetCDF (xarray) or CSV",
+    "per-FOR results, or what each known change did, as CF NetCDF (xarray) or CSV",
     CONFIG,
+    arg(
+        "--changes",
+        action="store_true",
+        help="what each known change did (as crisgeo events effects shows it), not the daily results",
+    ),
     arg("--format", choices=("netcdf", "csv"), help="netcdf or csv (default: from the suffix of --out)"),
     arg("--out", required=True, help="the file to write: FILE.nc (NetCDF) or FILE.csv"),
     arg("--satellite", choices=tuple(SATELLITES)),
@@ -35,8 +36,10 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     arg("--until", type=iso_day, help="last day, YYYY-MM-DD"),
 )
 def cmd_export(args: argparse.Namespace) -> int:
-    """crisgeo export: the results as NetCDF or CSV."""
-    from monitor.service.outputs.export import ExportFormatError, NothingToExport, export
+    """crisgeo export: the results, or what each known change did, as NetCDF or CSV."""
+    from alerts.effects import change_effects
+    from monitor.history.changes import all_changes
+    from monitor.service.outputs.export import export, export_effects
 
     cfg = load(args)
     sats = satellites_of(cfg, args.satellite)
@@ -45,12 +48,24 @@ def cmd_export(args: argparse.Namespace) -> int:
     period(args.since, args.until)
     with open_store(cfg) as store:
         try:
-            path = export(store, sats[0], args.out, args.format, args.since, args.until, cfg.export)
+            if args.changes:
+                known = change_effects(
+                    store, sats[0], all_changes(store, sats[0], cfg.events_file), cfg.alerts
+                )
+                effects = [
+                    e
+                    for e in known
+                    if (args.since is None or e.day >= args.since)
+                    and (args.until is None or e.day <= args.until)
+                ]
+                path = export_effects(effects, sats[0], args.out, args.format, cfg.export)
+            else:
+                path = export(store, sats[0], args.out, args.format, args.since, args.until, cfg.export)
         except ImportError as exc:
             raise BadInput(
                 f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
             ) from None
-        except (NothingToExport, ExportFormatError) as exc:
+        except ValueError as exc:  # NothingToExport, ExportFormatError, a calendar entry: named
             raise BadInput(str(exc)) from None
         except OSError as exc:
             raise BadInput(f"--out {args.out}: {exc.strerror or exc}") from None

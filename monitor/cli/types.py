@@ -7,10 +7,6 @@ import argparse
 import datetime as dt
 import re
 from collections.abc import Callable
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
-    pass
 
 
 def iso_time(text: str) -> dt.datetime:

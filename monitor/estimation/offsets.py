@@ -235,8 +235,17 @@ def day_offsets(
         height = lift.height_km[k]
         fors.append(
             for_offset(
-                k + 1, n, (d_alpha, d_beta), (sig_a, sig_b), ground, cost, cal, widths, rows,
-                (lift.m_per_k, height), flags,
+                k + 1,
+                n,
+                (d_alpha, d_beta),
+                (sig_a, sig_b),
+                ground,
+                cost,
+                cal,
+                widths,
+                rows,
+                (lift.m_per_k, height),
+                flags,
             )  # fmt: skip
         )
     bins = difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True))) if pooled else []

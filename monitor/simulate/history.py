@@ -47,8 +47,17 @@ def day_result(
         ground = (it, ct, 0.01, 0.012 * stretch[k])
         fors.append(
             for_offset(
-                k + 1, 500, (d_alpha[k], d_beta[k]), (12.0, 14.0), ground, (0.8, 1.2), cal, NAN4, NAN4,
-                (np.nan, np.nan), flags,
+                k + 1,
+                500,
+                (d_alpha[k], d_beta[k]),
+                (12.0, 14.0),
+                ground,
+                (0.8, 1.2),
+                cal,
+                NAN4,
+                NAN4,
+                (np.nan, np.nan),
+                flags,
             )  # fmt: skip
         )
     cube = None

@@ -39,3 +39,30 @@ def test_add_refuses_an_exact_duplicate(tmp_path):
     assert (tmp_path / "events.yaml").read_text() == before
     listed = run_crisgeo("events", "--config", cfg, "--satellite", "j01").stdout
     assert listed.count("EP v116") == 1
+
+
+def test_effects_measures_what_each_change_did(tmp_path):
+    """The history of tests/alerts/test_effects.py in the configured store, the upload in the calendar: the
+    table per FOR with the EPs' prediction; before any run, one line saying there is no store."""
+    from tests.alerts.test_effects import _history
+
+    cfg = _config(tmp_path)
+    absent = run_crisgeo("events", "effects", "--config", cfg)
+    assert absent.returncode == 2 and "no store yet" in absent.stderr
+    (tmp_path / "state").mkdir()
+    store, _, _, _ = _history(tmp_path / "state")
+    store.close()
+    (tmp_path / "state" / "s.sqlite").rename(tmp_path / "state" / "crisgeo.sqlite")
+    (tmp_path / "events.yaml").write_text(
+        "events:\n  - {satellite: j01, time: '2024-04-10T12:00:00Z', instrument: cris, kind: ep_upload, "
+        "description: EP V116}\n"
+    )
+    done = run_crisgeo("events", "effects", "--config", cfg, "--satellite", "j01")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0].startswith("j01 2024-04-10: CrIS ep_upload") and "EP V116" in lines[0]
+    assert "V115" in lines[1] and "V116" in lines[1] and "chi2" in lines[1]
+    rows = [line.split() for line in lines if line.strip().split(" ")[0].isdigit()]
+    assert len(rows) == 60  # every FOR, both directions, through the end of the history
+    moved = [r for r in rows if r[1] == "in-track" and 11 <= int(r[0]) <= 20]
+    assert all(r[-3] == "yes" and r[-2] == "-80.0" for r in moved)

@@ -80,8 +80,11 @@ def test_a_for_record_is_built_in_one_place():
 # the fields that only the science fills and only the declaration publishes (no output or rule reads them
 # by name; the calibration rule reads sigma_bias_k): the intercalibration's gain and curvature sigmas, the
 # response's and the rows' sigmas, and the lift
-FILLED_ONLY = [m for m in MEASURED_FIELDS if m.startswith(("sigma_gain", "sigma_curvature", "sigma_response",
-                                                           "sigma_fov_rows", "parallax_"))]
+FILLED_ONLY = [
+    m
+    for m in MEASURED_FIELDS
+    if m.startswith(("sigma_gain", "sigma_curvature", "sigma_response", "sigma_fov_rows", "parallax_"))
+]
 
 
 @pytest.mark.parametrize("name", FILLED_ONLY)

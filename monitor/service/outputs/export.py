@@ -22,10 +22,12 @@ if TYPE_CHECKING:
     import xarray as xr
 
 import datetime as dt
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
+from alerts.effects import ChangeEffect
 from monitor.config.outputs import ExportConfig
 from monitor.core.constants import N_FOR
 from monitor.core.result import RELIABILITY_FLAGS, ForOffset, measures
@@ -179,6 +181,12 @@ def to_xarray(
             time_coverage_end=f"{last:%Y-%m-%d}T00:00:00Z",
             time_coverage_duration=f"P{(last - first).days + 1}D",
         )
+    _publish(ds, publisher)
+    return ds
+
+
+def _publish(ds: xr.Dataset, publisher: ExportConfig | None) -> None:
+    """The ACDD creator and publisher attributes from the ``export`` section of the configuration."""
     if publisher is not None:
         ds.attrs.update({k: str(v) for k, v in publisher.model_dump().items() if v is not None})
         if publisher.creator_name:  # the team that makes the data publishes it
@@ -187,6 +195,104 @@ def to_xarray(
                 **({"publisher_email": publisher.creator_email} if publisher.creator_email else {}),
                 **({"publisher_url": str(publisher.creator_url)} if publisher.creator_url else {}),
             )
+
+
+# what a change did, per direction (alerts.effects.ChangeEffect): (variable stem, attribute, unit, meaning)
+EFFECT_FIELDS = (
+    ("before", "before_urad", "urad", "offset over the days before the change"),
+    ("sigma_before", "sigma_before_urad", "urad", "1-sigma uncertainty of the offset before the change"),
+    ("after", "after_urad", "urad", "offset over the days after the change"),
+    ("sigma_after", "sigma_after_urad", "urad", "1-sigma uncertainty of the offset after the change"),
+    ("move", "move_urad", "urad", "offset after minus before"),
+    ("sigma_move", "sigma_move_urad", "urad", "1-sigma uncertainty of the move"),
+    ("move_ground", "move_km", "km", "the move on the ground"),
+    ("sigma_move_ground", "sigma_move_km", "km", "1-sigma uncertainty of the move on the ground"),
+    ("predicted", "predicted_urad", "urad", "the move the EPs' mapping angles predict"),
+)
+DIRECTION_NAMES = (("alpha", "in-track"), ("beta", "cross-track"))
+
+
+def effects_to_xarray(
+    effects: Sequence[ChangeEffect], satellite: str, publisher: ExportConfig | None = None
+) -> xr.Dataset:
+    """What each known change did (:mod:`alerts.effects`) as an xarray Dataset: dimensions ``change`` (its
+    day, its description) x ``scan_position``, a variable per quantity and direction (e.g.
+    ``move_alpha_urad``), ``significant_alpha`` and ``significant_beta`` as 0/1 flags, and per change the
+    windows, the EPs and the chi-square of the prediction."""
+    import xarray as xr
+
+    def per_direction(attr: str, c: int) -> np.ndarray:
+        rows = [getattr(e, attr) for e in effects]
+        return np.array([np.full(N_FOR, np.nan) if r is None else r[:, c] for r in rows], np.float64)
+
+    dims = ("change", "scan_position")
+    data: dict[str, tuple] = {}
+    for c, (angle, direction) in enumerate(DIRECTION_NAMES):
+        for stem, attr, unit, meaning in EFFECT_FIELDS:
+            unit_name = "km" if unit == "km" else "urad"
+            data[f"{stem}_{angle}_{unit_name}"] = (
+                dims,
+                per_direction(attr, c),
+                {"units": unit, "long_name": f"{direction} {meaning}"},
+            )
+        data[f"significant_{angle}"] = (
+            dims,
+            np.array([e.significant[:, c] for e in effects], np.int8).reshape(len(effects), N_FOR),
+            {
+                "long_name": f"{direction} move beyond z_limit sigmas",
+                "flag_values": np.array([0, 1], np.int8),
+                "flag_meanings": "not_significant significant",
+            },
+        )
+    text = lambda values: np.array(values, dtype=object)  # noqa: E731
+    span = lambda w: f"{w[0]}/{w[1]}" if w else ""  # noqa: E731
+    data |= {
+        "description": (("change",), text(["; ".join(c.label() for c in e.changes) for e in effects]), {
+            "long_name": "the known changes of the day"}),
+        "before_days": (("change",), text([span(e.before) for e in effects]), {
+            "long_name": "first/last assessed day before the change"}),
+        "after_days": (("change",), text([span(e.after) for e in effects]), {
+            "long_name": "first/last assessed day after the change"}),
+        "z_limit": (("change",), np.array([e.z_limit for e in effects]), {
+            "units": "1", "long_name": "sigmas beyond which a move is significant"}),
+        "ep_before": (("change",), text([e.ep_before or "" for e in effects]), {
+            "long_name": "the EP the LOS fingerprint before the change names"}),
+        "ep_after": (("change",), text([e.ep_after or "" for e in effects]), {
+            "long_name": "the EP the LOS fingerprint after the change names"}),
+        "chi2": (("change",), np.array([e.chi2 for e in effects]), {
+            "units": "1", "long_name": "chi-square of observed minus predicted moves"}),
+        "chi2_dof": (("change",), np.array([e.dof for e in effects], np.int32), {
+            "units": "1", "long_name": "FOR-directions in the chi-square"}),
+    }  # fmt: skip
+    ds = xr.Dataset(
+        data,
+        coords={
+            "change": np.array([np.datetime64(e.day.isoformat(), "ns") for e in effects], "datetime64[ns]"),
+            "scan_position": np.arange(1, N_FOR + 1, dtype=np.int16),
+        },
+    )
+    ds["change"].attrs.update(long_name="UTC day of the known change", axis="T")
+    ds["change"].encoding.update(units="days since 1970-01-01 00:00:00", calendar="standard", dtype="int32")
+    ds["scan_position"].attrs.update(long_name="CrIS field of regard (scan position, 1 = first of the scan)")
+    info = satellite_info(satellite)
+    now = f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ}"
+    ds.attrs.update(
+        Conventions="CF-1.8, ACDD-1.3",
+        title=f"What each known change did to the CrIS geolocation against VIIRS I5, {info.name}",
+        summary=(
+            "Per known change (EP upload, LUT change, software) and CrIS field of regard: the offsets before "
+            "and after with sigmas, the move and its significance, and the move the EPs' mapping angles "
+            "predict (crisgeo events effects; docs/operations.md)."
+        ),
+        sign_convention=SIGN_CONVENTION,
+        platform=info.name,
+        instrument="CrIS, VIIRS",
+        satellite=satellite,
+        source=f"crisgeo-monitor {__version__}",
+        date_created=now,
+        history=f"{now} exported by crisgeo-monitor {__version__}",
+    )
+    _publish(ds, publisher)
     return ds
 
 
@@ -211,23 +317,54 @@ def export(
     *out*, :data:`FORMATS`); returns the path. :class:`NothingToExport` (and no file) when the period holds
     no results, :class:`ExportFormatError` when the format and the file's name disagree; :class:`OSError`
     when *out* cannot be written."""
+    out, fmt = _target(out, fmt)
+    ds = to_xarray(store, satellite, since, until, publisher)
+    if ds.sizes["time"] == 0:
+        period = f"{since or 'the beginning'} .. {until or 'the end'}"
+        raise NothingToExport(f"no results of {satellite} in {period}: nothing written")
+    return _write(ds, out, fmt, "time", drop=("time_bnds",))
+
+
+def export_effects(
+    effects: Sequence[ChangeEffect],
+    satellite: str,
+    out: str | Path,
+    fmt: str | None = None,
+    publisher: ExportConfig | None = None,
+) -> Path:
+    """Write what each known change did (*effects*, :func:`alerts.effects.change_effects`) to *out* as
+    ``netcdf`` or ``csv`` (:func:`effects_to_xarray`; CSV: a row per change and FOR); the errors of
+    :func:`export`."""
+    out, fmt = _target(out, fmt)
+    if not effects:
+        raise NothingToExport(
+            f"no known change of {satellite} with assessed days on both sides: nothing written"
+        )
+    return _write(effects_to_xarray(effects, satellite, publisher), out, fmt, "change")
+
+
+def _target(out: str | Path, fmt: str | None) -> tuple[Path, str]:
+    """The file and its format: *fmt*, else the suffix of *out* (:data:`FORMATS`); they must agree, and the
+    folder must exist."""
     out = Path(out)
     by_suffix = FORMATS.get(out.suffix.lower())
     if fmt is None and by_suffix is None:
         raise ExportFormatError(f"--out {out}: name it .nc or .csv, or give --format")
     if fmt is not None and by_suffix is not None and fmt != by_suffix:
         raise ExportFormatError(f"--out {out}: a {out.suffix} file cannot hold --format {fmt}")
-    fmt = fmt or by_suffix
     if not out.parent.is_dir():
         raise FileNotFoundError(f"the folder {out.parent} does not exist")
-    ds = to_xarray(store, satellite, since, until, publisher)
-    if ds.sizes["time"] == 0:
-        period = f"{since or 'the beginning'} .. {until or 'the end'}"
-        raise NothingToExport(f"no results of {satellite} in {period}: nothing written")
+    return out, fmt or str(by_suffix)
+
+
+def _write(ds: xr.Dataset, out: Path, fmt: str, unlimited: str, drop: tuple[str, ...] = ()) -> Path:
+    """*ds* to *out* through a partial file (a reader never sees half of it), the dimension *unlimited*
+    first and unlimited in NetCDF (later files append along it); CSV without the *drop* variables (bounds,
+    which a table cannot hold)."""
     tmp = out.with_name(out.name + ".part")
     if fmt == "netcdf":
-        ds.to_netcdf(tmp, engine="h5netcdf", unlimited_dims=["time"])
+        ds.to_netcdf(tmp, engine="h5netcdf", unlimited_dims=[unlimited])
     else:
-        ds.drop_vars("time_bnds").to_dataframe().reset_index().to_csv(tmp, index=False)
+        ds.drop_vars(list(drop)).to_dataframe().reset_index().to_csv(tmp, index=False)
     tmp.replace(out)
     return out

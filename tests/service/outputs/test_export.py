@@ -220,3 +220,42 @@ def test_the_notebook_store_opens_an_existing_store_and_closes_it(tmp_path):
         assert ds.sizes["time"] == 2 and ds.sizes["scan_position"] == 30
     with pytest.raises(sqlite3.ProgrammingError):
         nb.store.db.execute("SELECT 1")
+
+
+def test_what_each_change_did_exports_as_cf_netcdf_and_csv(store_with_days, tmp_path):
+    """``crisgeo export --changes``: the EP upload of the calendar on the step's day, per FOR: the 800 urad
+    cross-track move of FORs 21-30, significant there only; CF-1.8 clean; a CSV row per change and FOR."""
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    from monitor.cli import main
+
+    cfg, _ = store_with_days
+    (tmp_path / "events.yaml").write_text(
+        "events:\n  - {satellite: j01, time: '2025-03-07T12:00:00Z', instrument: cris, kind: ep_upload, "
+        "description: EP V116}\n"
+    )
+    cfg.write_text(cfg.read_text() + f"alerts: {{events_file: {tmp_path / 'events.yaml'}}}\n")
+    nc, csv = tmp_path / "changes.nc", tmp_path / "changes.csv"
+    for out in (nc, csv):
+        assert (
+            main(["export", "--changes", "--config", str(cfg), "--satellite", "j01", "--out", str(out)]) == 0
+        )
+    ds = xr.open_dataset(nc, engine="h5netcdf")
+    assert ds.sizes["change"] == 1 and "EP V116" in str(ds.description.values[0])
+    assert str(ds.before_days.values[0]) == "2025-03-01/2025-03-06"
+    assert str(ds.after_days.values[0]) == "2025-03-08/2025-03-12"
+    move = ds.move_beta_urad.values[0]
+    assert np.all(np.abs(move[20:] - 800.0) < 5 * ds.sigma_move_beta_urad.values[0][20:])
+    assert ds.significant_beta.values[0][20:].all() and not ds.significant_beta.values[0][:20].any()
+    assert ds.move_ground_beta_km.attrs["units"] == "km" and np.all(
+        ds.move_ground_beta_km.values[0][20:] > 0.5
+    )
+    CheckSuite.load_all_available_checkers()
+    report = tmp_path / "cf.json"
+    ok, errors = ComplianceChecker.run_checker(
+        str(nc), ["cf:1.8"], verbose=0, criteria="normal", output_filename=str(report), output_format="json"
+    )
+    assert ok and not errors, report.read_text()[:3000]
+    lines = csv.read_text().splitlines()
+    assert len(lines) == 31 and lines[0].startswith("change,scan_position,")
+    assert main(["export", "--changes", "--config", str(cfg), "--until", "2025-03-06", "--out", str(nc)]) == 2

@@ -27,6 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from alerts.effects import EFFECT_COLUMNS, ChangeEffect, change_effects
+from monitor.config.alert_settings import RuleSettings
 from monitor.config.model import Config
 from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
 from monitor.core.result import RELIABILITY_FLAGS, DayPrecision, ForOffset
@@ -46,6 +48,7 @@ h1{font-size:1.5em}h2{font-size:1.15em;margin-top:1.6em;border-bottom:1px solid 
 table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0}td,th{border:1px solid #ddd;padding:2px
 7px;text-align:right}
 th{background:#f3f3f3}td.l,th.l{text-align:left}tr.out td{background:#fde2e1}tr.flag td{color:#999}
+tr.sig td{font-weight:bold}
 img{max-width:100%;border:1px solid #eee;margin:0.3em 0}.note{color:#666;font-size:0.85em}
 .ok{color:#1a7f37}.bad{color:#c62828;font-weight:bold}
 """
@@ -53,9 +56,11 @@ img{max-width:100%;border:1px solid #eee;margin:0.3em 0}.note{color:#666;font-si
 
 @dataclass
 class ReportOptions:
-    """What the report shows: satellites, period, calendar, specification, FORs over time."""
+    """What the report shows: satellites, period, calendar, specification, FORs over time, and the alert
+    rules' windows a change's effect is measured over."""
 
     spec_km: float = SPEC_KM
+    rules: RuleSettings = field(default_factory=RuleSettings)
     trend_fors: tuple = (1, 15, 30)
     since: dt.date | None = None
     until: dt.date | None = None
@@ -69,9 +74,11 @@ def options_from_config(
     since: dt.date | None = None,
     until: dt.date | None = None,
 ) -> ReportOptions:
-    """Report options of a service configuration: the spec of its alert rules, its events calendar."""
+    """Report options of a service configuration: the spec and windows of its alert rules, its events
+    calendar."""
     return ReportOptions(
         spec_km=cfg.alerts.spec_km,
+        rules=cfg.alerts,
         since=since,
         until=until,
         calendar=cfg.events_file,
@@ -145,6 +152,30 @@ def _changes_table(changes: Sequence[Change]) -> str:
     )
 
 
+def _effects_section(effects: Sequence[ChangeEffect]) -> str:
+    """What each known change did (:mod:`alerts.effects`): per change its summary and a table per FOR and
+    direction, significant moves in bold."""
+    if not effects:
+        return "<p class=note>No known change with assessed days on both sides in this period.</p>"
+    parts = []
+    for e in reversed(effects):
+        columns = EFFECT_COLUMNS if e.predicted_urad is not None else EFFECT_COLUMNS[:-2]
+        head = "".join(
+            f"<th{' class=l' if c.align == '<' else ''}>{_e(f'{c.header} {c.unit}'.strip())}</th>"
+            for c in columns
+        )
+        rows = "".join(
+            f"<tr{' class=sig' if r.significant else ''}>"
+            + "".join(
+                f"<td{' class=l' if c.align == '<' else ''}>{_e(_blank_nan(c.text(r)))}</td>" for c in columns
+            )
+            + "</tr>"
+            for r in e.rows()
+        )
+        parts.append(f"<h3>{_e(e.title())}</h3><p>{_e(e.summary())}.</p><table><tr>{head}</tr>{rows}</table>")
+    return "".join(parts)
+
+
 def _img(name: str, alt: str) -> str:
     return f'<img src="{name}" alt="{_e(alt)}">'
 
@@ -163,9 +194,10 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
     sat_dir.mkdir(parents=True, exist_ok=True)
     name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
     series = store.series(satellite, opts.since, opts.until)
+    known = all_changes(store, satellite, opts.calendar)
     changes = [
         c
-        for c in all_changes(store, satellite, opts.calendar)
+        for c in known
         if (opts.since is None or c.time.date() >= opts.since)
         and (opts.until is None or c.time.date() <= opts.until)
     ]
@@ -310,6 +342,14 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         "<h2>CrIS-VIIRS intercalibration</h2>" + calibration_html,
         "<h2>Latest values</h2>" + _latest_table(fors, opts.spec_km),
         "<h2>Known changes</h2>" + _changes_table(changes),
+        "<h2>What each known change did</h2><p class=note>Per FOR and direction: the offsets over the "
+        f"{opts.rules.pre_days} days before the change and the {opts.rules.post_days} after it (other "
+        "changes and the change's own day left out), the move with its sigma in urad and km, whether it is "
+        "significant, and where the LOS fingerprints name both EPs the move their mapping angles predict "
+        "(crisgeo events effects).</p>"
+        + _effects_section(
+            [e for e in change_effects(store, satellite, known, opts.rules) if set(e.changes) & set(changes)]
+        ),
         f"<p class=note>Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} UTC by crisgeo report.</p>",
     ]
     _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))

@@ -109,6 +109,11 @@ def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
         "EP V116 uploaded" in page and "FOR 30 cross-track 2.5 km" in page and "out of specification" in page
     )
     assert "400 day(s) shown" in page
+    # what the upload did: the 800 urad cross-track step of FORs 21-30, significant there only
+    effect = page.split("What each known change did")[1]
+    assert "EP V116 uploaded" in effect and effect.count("<tr class=sig>") == 10
+    assert all(f"<td>{k}</td><td class=l>cross-track</td>" in effect.split("<tr class=sig>")[k - 20] for k in
+               range(21, 31))  # fmt: skip
     summary = json.loads((tmp_path / "rep" / "report.json").read_text())
     assert summary[0]["worst_for"] == 30 and summary[0]["firing"] == 1
     # --since/--until through the command line
