@@ -116,6 +116,26 @@ def test_a_step_at_a_known_change_is_named_and_the_mixed_day_left_out():
     assert step.pooled == pytest.approx(200.0, abs=4 * step.pooled_sigma)
 
 
+def test_a_step_is_reported_until_its_new_level_has_held_for_the_baseline_and_starts_a_new_one():
+    """200 urad in-track from a known change at day 100: every evaluation reports it (the alert fires) until
+    the new level has held for pre_days full days (days 101-121), none after (it resolves); a second step
+    30 days later is measured against the new level, not the old one."""
+    rng = np.random.default_rng(8)
+    y = 60.0 * _noise(rng, 170)
+    y[100:, :, 0] += 200.0
+    y[130:, :, 0] += 100.0
+    s = np.full_like(y, 60.0)
+    change = [_days(101)[100]]
+    reported = {
+        end: steps.detect(_days(end + 1), y[: end + 1], s[: end + 1], change, RULES)
+        for end in range(101, 126)
+    }
+    assert all(any(x.split == change[0] for x in reported[end]) for end in range(101, 122))
+    assert all(not any(x.split == change[0] for x in reported[end]) for end in range(122, 126))
+    second = [x for x in steps.detect(_days(133), y[:133], s[:133], change, RULES) if x.split != change[0]]
+    assert len(second) == 1 and second[0].pooled == pytest.approx(100.0, abs=4 * second[0].pooled_sigma)
+
+
 def test_small_steps_are_recorded_not_paged_and_noise_finds_nothing():
     rng = np.random.default_rng(6)
     y = 5.0 * _noise(rng, 120)
