@@ -16,7 +16,7 @@ from alerts.steps import StepRules, detect
 from monitor.config.alert_settings import RuleSettings
 from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 from monitor.history.changes import Change
-from monitor.history.records import History
+from monitor.history.records import History, last_success
 
 UTC = dt.timezone.utc
 CHANGED = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS/VIIRS common"}
@@ -214,10 +214,10 @@ def jump_findings(
 def stale_finding(store: History, satellite: str, s: RuleSettings, now: dt.datetime) -> Finding | None:
     """No successful assessment for longer than the limit (counted from the first run if none succeeded)."""
     runs = store.runs(satellite)
-    if not runs:
+    since = last_success(runs)
+    if since is None:
         return None
     ok = [r for r in runs if r.status == RunStatus.OK]
-    since = dt.datetime.fromisoformat((ok[-1].finished or ok[-1].started) if ok else runs[0].started)
     age = (now - since).total_seconds() / 3600
     if age <= s.stale_hours:
         return None

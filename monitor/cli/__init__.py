@@ -2,8 +2,9 @@
 
 Exit status: 0 success; 1 failure (a run failed, the store is unusable); 2 bad input (one line on stderr:
 arguments, configuration, data); 75 another instance holds the state directory (try again later). ``crisgeo
-status`` follows the Nagios plugin convention instead: 0 OK, 1 WARNING (a warning alert fires), 2 CRITICAL
-(a critical alert fires or the last run of a satellite failed), 3 UNKNOWN (no usable configuration or store).
+status`` follows the Nagios plugin convention instead: 0 OK, 1 WARNING (a warning alert fires, a threshold
+is passed, no success for days), 2 CRITICAL (a critical alert fires or the last run of a satellite failed), 3
+UNKNOWN (a usage error, no usable configuration or store, the timeout).
 The configuration is ``--config``, else ``$CRISGEO_CONFIG``, else ``/etc/crisgeo/monitor.yaml``.
 """
 
@@ -17,7 +18,16 @@ from collections.abc import Sequence
 from monitor.cli import alerting, mapping, operations, review, science  # noqa: F401
 from monitor.cli.manual import PrintReference
 from monitor.cli.output import PipedOutput
-from monitor.cli.registry import COMMANDS, EXIT_ALREADY_RUNNING, EXIT_BAD_INPUT, EXIT_FAIL, BadInput
+from monitor.cli.registry import (
+    COMMANDS,
+    EXIT_ALREADY_RUNNING,
+    EXIT_BAD_INPUT,
+    EXIT_FAIL,
+    EXIT_UNKNOWN,
+    BadInput,
+    Parser,
+    UsageError,
+)
 from monitor.core.errors import DataError
 from monitor.service import allocator, logs
 from monitor.version import __version__
@@ -31,7 +41,7 @@ ORDER = (
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser: the global options and one subparser per entry of :data:`COMMANDS`."""
-    p = argparse.ArgumentParser(
+    p = Parser(
         prog="crisgeo",
         description=__doc__.replace("``", ""),
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -49,7 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="text",
         help="text (no timestamp under systemd: the journal adds one) or JSON lines",
     )
-    common = argparse.ArgumentParser(add_help=False)  # -v and --log-format after the subcommand too
+    common = Parser(add_help=False)  # -v and --log-format after the subcommand too
     common.add_argument(
         "-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="debug logging"
     )
@@ -74,7 +84,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     from monitor.service.store.database import StoreError
 
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except UsageError as exc:
+        words = sys.argv[1:] if argv is None else list(argv)
+        if next((w for w in words if w in COMMANDS), None) == "status":  # a Nagios plugin: one line, stdout
+            print(f"UNKNOWN - {exc}")
+            return EXIT_UNKNOWN
+        print(exc.usage + str(exc), file=sys.stderr)
+        return EXIT_BAD_INPUT
     logs.setup(args.verbose, args.log_format)
     allocator.reuse_freed_memory()
     stdout = sys.__stdout__

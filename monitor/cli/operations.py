@@ -20,7 +20,7 @@ from monitor.cli.registry import (
     period,
     satellites_of,
 )
-from monitor.cli.types import iso_day, whole
+from monitor.cli.types import iso_day, nagios_range, whole
 from monitor.core.satellites import SATELLITES
 
 
@@ -172,37 +172,83 @@ def cmd_daemon(args: argparse.Namespace) -> int:
             check_listen(args.listen)
         except ValueError as exc:
             raise BadInput(f"--listen: {exc}") from None
-    Service(cfg).daemon(args.listen)  # a port taken or not allowed is an OSError: main says it
-    return EXIT_OK
+    service = Service(cfg)
+    service.daemon(args.listen)  # a port taken or not allowed is an OSError: main says it
+    # stopped by a signal: the shell's 128 + it (143 for systemctl stop: the unit's SuccessExitStatus)
+    return EXIT_OK if service.stopped_by is None else 128 + service.stopped_by
 
 
 @command(
     "status",
-    "last run per satellite, latest per-FOR table, next run, outbox size",
+    "last run per satellite, latest per-FOR table, next run, outbox size; a Nagios plugin",
     CONFIG,
     arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--json", action="store_true", help="machine-readable status"),
+    arg(
+        "-w",
+        "--warning",
+        type=nagios_range,
+        help="WARNING range of the worst error, km (monitoring-plugins syntax; default: the specification)",
+    ),
+    arg("-c", "--critical", type=nagios_range, help="CRITICAL range of the worst error, km (default: none)"),
+    arg(
+        "--warning-fors",
+        type=nagios_range,
+        help="WARNING range of the count of FORs beyond the specification",
+    ),
+    arg(
+        "--critical-fors",
+        type=nagios_range,
+        help="CRITICAL range of the count of FORs beyond the specification",
+    ),
+    arg(
+        "--stale-days",
+        type=float,
+        default=2.0,
+        help="WARNING after this many days without a successful assessment (default 2)",
+    ),
+    arg("-t", "--timeout", type=float, default=30.0, help="UNKNOWN after this many seconds (default 30)"),
 )
 def cmd_status(args: argparse.Namespace) -> int:
     """crisgeo status: the state of every satellite, as text or JSON, with Nagios exit codes."""
     import json
+    import signal
+    from types import FrameType
+
+    from nagiosplugin import Range
 
     from monitor.config.keys import ConfigError
-    from monitor.service.status import NagiosState, status_report
+    from monitor.service.status import NagiosState, Thresholds, status_report
     from monitor.service.store.database import StoreError
     from monitor.service.store.sqlite import Store
 
+    class Expired(Exception):
+        """-t ran out (not a TimeoutError: that is an OSError, the machine's fault to main)."""
+
+    def expired(signum: int, frame: FrameType | None) -> None:
+        raise Expired(f"no answer within {args.timeout:g} s (-t)")
+
+    signal.signal(signal.SIGALRM, expired)
     try:
+        signal.setitimer(signal.ITIMER_REAL, args.timeout)
         cfg = load(args)
         sats = satellites_of(cfg, args.satellite)
-        store = Store(cfg.store.path, create=False)
-    except (BadInput, ConfigError, StoreError) as exc:
+        with Store(cfg.store.path, create=False) as store:
+            thresholds = Thresholds(
+                args.warning or Range(f"{cfg.alerts.spec_km:g}"),
+                args.critical,
+                args.warning_fors,
+                args.critical_fors,
+                args.stale_days,
+            )
+            status = status_report(cfg, store, sats, thresholds=thresholds)
+    except (BadInput, ConfigError, StoreError, Expired) as exc:
         if args.json:
             print(json.dumps({"state": "UNKNOWN", "exit": NagiosState.UNKNOWN, "error": str(exc)}))
         else:
             print(f"UNKNOWN - {exc}")
         return NagiosState.UNKNOWN
-    with store:
-        status = status_report(cfg, store, sats)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
     print(json.dumps(status.to_dict(), indent=1, default=str) if args.json else status.text())
     return status.state

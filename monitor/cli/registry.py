@@ -8,7 +8,7 @@ import datetime as dt
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 from monitor.config.assessment import AssessmentConfig, FingerprintConfig
 from monitor.config.model import Config
@@ -39,11 +39,30 @@ EXIT_OK, EXIT_FAIL, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_ALREADY_RUNNING = 75  # sysexits EX_TEMPFAIL
 
 
+EXIT_UNKNOWN = 3  # crisgeo status, a Nagios plugin: UNKNOWN (a usage error, no usable configuration or store)
+
+
 DEFAULT_CONFIG = "/etc/crisgeo/monitor.yaml"
 
 
 class BadInput(Exception):
     """An error in what the user gave; reported as one line, exit status 2."""
+
+
+class UsageError(Exception):
+    """A command line the parser refuses: the usage of the (sub)command and the message (:class:`Parser`)."""
+
+    def __init__(self, usage: str, message: str) -> None:
+        super().__init__(message)
+        self.usage = usage
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse's parser, but a refused command line raises :class:`UsageError` instead of exiting 2: the
+    exit status is the command's convention (``status``: Nagios UNKNOWN), decided in one place, main."""
+
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(self.format_usage(), f"{self.prog}: error: {message}")
 
 
 def options(model: type[SectionT], flags: str, **values: Any) -> SectionT:

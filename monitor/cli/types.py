@@ -8,6 +8,8 @@ import datetime as dt
 import re
 from collections.abc import Callable
 
+from nagiosplugin import Range
+
 
 def iso_time(text: str) -> dt.datetime:
     try:
@@ -60,3 +62,14 @@ def longitude(text: str) -> float:
     if not -180.0 <= lon <= 180.0:  # NaN fails too
         raise argparse.ArgumentTypeError(f"{text}: not a longitude within -180..180 deg")
     return lon
+
+
+def nagios_range(text: str) -> Range:
+    """A monitoring-plugins threshold range: ``10`` (alert outside 0..10), ``10:`` (below 10), ``~:10``
+    (above 10), ``10:20`` (outside), ``@10:20`` (inside)."""
+    try:
+        return Range(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"not a threshold range (10, 10:, ~:10, 10:20, @10:20): {text!r}"
+        ) from None

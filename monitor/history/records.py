@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+from collections.abc import Sequence
 from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from pathlib import Path
@@ -173,6 +174,16 @@ class Run:
         """The Run of a row of the store."""
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, "status": RunStatus(row["status"])})
+
+
+def last_success(runs: Sequence[Run]) -> dt.datetime | None:
+    """When the latest successful run (status ok) of *runs* (in order) finished, UTC; if none succeeded,
+    when the first began; None without runs. Empty days (no data at the source) are not a success."""
+    if not runs:
+        return None
+    ok = [r for r in runs if r.status == RunStatus.OK]
+    since = dt.datetime.fromisoformat((ok[-1].finished or ok[-1].started) if ok else runs[0].started)
+    return since if since.tzinfo else since.replace(tzinfo=dt.timezone.utc)
 
 
 @dataclass(frozen=True)

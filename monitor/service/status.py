@@ -5,6 +5,9 @@ the outbox; and the Nagios state of it all (0 OK, 1 WARNING, 2 CRITICAL, 3 UNKNO
 The state is what the alerts say, silenced or not: a silence quiets the notifications, as a Nagios
 acknowledgement or an Alertmanager silence does, and is shown beside the state, never folded into it.
 The Nagios line (:meth:`Status.nagios_line`) follows the plugin convention: ``STATE - reason | perfdata``.
+On top of the alerts, the monitoring-plugins thresholds (:class:`Thresholds`: ranges on the worst error and
+on the FORs beyond the specification, parsed by ``nagiosplugin.Range``) and staleness (no successful
+assessment for ``stale_days``) raise the state; nothing lowers what an alert says.
 """
 
 from __future__ import annotations
@@ -13,11 +16,13 @@ import datetime as dt
 from dataclasses import asdict, dataclass
 from enum import IntEnum
 
+from nagiosplugin import Range
+
 from monitor.config.model import Config
 from monitor.core.result import DayPrecision, ForOffset
 from monitor.core.tables import BRIEF, for_table
 from monitor.core.vocabulary import Rule, RunStatus, Severity
-from monitor.history.records import Run, Silence
+from monitor.history.records import Run, Silence, last_success
 from monitor.service.lock import holder
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
@@ -31,6 +36,34 @@ class NagiosState(IntEnum):
     WARNING = 1
     CRITICAL = 2
     UNKNOWN = 3
+
+
+@dataclass(frozen=True)
+class Thresholds:
+    """``crisgeo status -w/-c``: monitoring-plugins ranges (``10``: outside 0..10 alerts, ``~:10``,
+    ``10:20``, ``@10:20``: inside alerts) on the worst error (km) and on the count of FORs beyond the
+    specification, each for WARNING and CRITICAL (None: not checked); and the days without a successful
+    assessment after which a satellite is WARNING."""
+
+    warning_km: Range | None = None
+    critical_km: Range | None = None
+    warning_fors: Range | None = None
+    critical_fors: Range | None = None
+    stale_days: float = 2.0
+
+    def state(self, worst_km: float | None, fors_beyond: int) -> NagiosState:
+        """The state these ranges give the worst error and the FORs beyond the specification."""
+        checks = ((self.critical_km, worst_km, NagiosState.CRITICAL), (self.critical_fors, fors_beyond,
+                  NagiosState.CRITICAL), (self.warning_km, worst_km, NagiosState.WARNING),
+                  (self.warning_fors, fors_beyond, NagiosState.WARNING))  # fmt: skip
+        for limit, value, state in checks:
+            if limit is not None and value is not None and not limit.match(value):
+                return state
+        return NagiosState.OK
+
+    def text(self, limit: Range | None) -> str:
+        """A range as perfdata writes it (empty: none)."""
+        return "" if limit is None else str(limit)
 
 
 @dataclass(frozen=True)
@@ -62,6 +95,7 @@ class SatelliteStatus:
     alerts: tuple[FiringAlert, ...]
     spec_km: float
     precision: DayPrecision | None = None  # how far the latest ok run went, and why it stopped
+    stale_since: dt.datetime | None = None  # no successful assessment since (UTC): past the stale limit
 
     @property
     def beyond_spec(self) -> tuple[ForOffset, ...]:
@@ -81,6 +115,10 @@ class SatelliteStatus:
         out = []
         if self.last_run is not None and self.last_run.status == RunStatus.FAILED:
             out.append(f"{self.satellite}: run of {self.last_run.day} failed: {self.last_run.reason or '?'}")
+        if self.stale_since is not None:
+            out.append(
+                f"{self.satellite}: no successful assessment since {self.stale_since:%Y-%m-%d %H:%M} UTC"
+            )
         for a in self.alerts:
             if a.rule == Rule.SPEC and self.beyond_spec:
                 text = (
@@ -92,14 +130,19 @@ class SatelliteStatus:
             out.append(f"{text}{a.silenced_text()}")
         return out
 
-    def perfdata(self) -> list[str]:
+    def perfdata(self, t: Thresholds) -> list[str]:
         """Nagios performance data: FORs beyond the specification and the worst error (km), with the
-        specification as the warning and critical thresholds."""
+        warning and critical ranges in force."""
         if self.latest_day is None:
             return []
-        out = [f"{self.satellite}_fors_beyond_spec={len(self.beyond_spec)};;1;0;{len(self.fors)}"]
+        out = [
+            f"{self.satellite}_fors_beyond_spec={len(self.beyond_spec)};{t.text(t.warning_fors)};"
+            f"{t.text(t.critical_fors)};0;{len(self.fors)}"
+        ]
         if self.worst_km is not None:
-            out.append(f"{self.satellite}_worst_km={self.worst_km:.3f};{self.spec_km:g};{self.spec_km:g};0")
+            out.append(
+                f"{self.satellite}_worst_km={self.worst_km:.3f};{t.text(t.warning_km)};{t.text(t.critical_km)};0"
+            )
         return out
 
 
@@ -113,17 +156,27 @@ class Status:
     daemon_pid: int | None
     next_run_utc: dt.datetime | None
     outbox: int
+    thresholds: Thresholds = Thresholds()
 
     def nagios_line(self) -> str:
         """``STATE - reasons | perfdata``: the first line a Nagios plugin prints."""
         reasons = [r for s in self.satellites for r in s.reasons()]
+        t = self.thresholds
+        reasons += [
+            f"{s.satellite}: worst {s.worst_km:.2f} km, {len(s.beyond_spec)} FOR(s) beyond {s.spec_km:g} km "
+            f"(thresholds: {state.name})"
+            for s in self.satellites
+            if (state := t.state(s.worst_km, len(s.beyond_spec))) != NagiosState.OK
+            and s.worst_km is not None
+            and not any(a.rule == Rule.SPEC for a in s.alerts)  # its reason names the worst already
+        ]
         if not reasons:
             reasons = [
                 f"{s.satellite}: {s.latest_day or 'no day yet'}"
                 + (f", worst {s.worst_km:.2f} km" if s.worst_km is not None else "")
                 for s in self.satellites
             ]
-        perf = " ".join(p for s in self.satellites for p in s.perfdata())
+        perf = " ".join(p for s in self.satellites for p in s.perfdata(self.thresholds))
         return f"{self.state.name} - {'; '.join(reasons)}" + (f" | {perf}" if perf else "")
 
     def text(self) -> str:
@@ -191,10 +244,16 @@ class Status:
 
 
 def status_report(
-    cfg: Config, store: Store, satellites: list[str] | None = None, now: dt.datetime | None = None
+    cfg: Config,
+    store: Store,
+    satellites: list[str] | None = None,
+    now: dt.datetime | None = None,
+    thresholds: Thresholds | None = None,
 ) -> Status:
-    """The :class:`Status` of *satellites* (default: the configured ones) at *now*."""
+    """The :class:`Status` of *satellites* (default: the configured ones) at *now*, the *thresholds*
+    (default: WARNING beyond the specification, stale after 2 days) over the alerts."""
     now = now or dt.datetime.now(dt.timezone.utc)
+    t = thresholds or Thresholds(warning_km=Range(f"{cfg.alerts.spec_km:g}"))
     runs = {r.satellite: r for r in store.last_runs()}
     chosen = list(satellites or cfg.satellites)
     state = AlertState(store)
@@ -218,6 +277,7 @@ def status_report(
                 alerts,
                 cfg.alerts.spec_km,
                 store.latest_precision(sat),
+                _stale_since(store, sat, now, t.stale_days),
             )
         )
     critical = any(a.severity == Severity.CRITICAL for a in firing) or any(
@@ -225,11 +285,21 @@ def status_report(
     )
     daemon = holder(cfg.state_dir, "daemon")
     # a recorded step (severity info) is shown, not a problem
-    warned = any(a.severity != Severity.INFO for a in firing)
+    warned = any(a.severity != Severity.INFO for a in firing) or any(s.stale_since for s in sats)
+    by_alerts = NagiosState.CRITICAL if critical else NagiosState.WARNING if warned else NagiosState.OK
+    by_thresholds = [t.state(s.worst_km, len(s.beyond_spec)) for s in sats]
     return Status(
-        NagiosState.CRITICAL if critical else NagiosState.WARNING if warned else NagiosState.OK,
+        max([by_alerts, *by_thresholds]),
         tuple(sats),
         daemon,
         None if daemon is None else next_run(cfg.schedule, now),
         store.outbox_size(),
+        t,
     )
+
+
+def _stale_since(store: Store, satellite: str, now: dt.datetime, days: float) -> dt.datetime | None:
+    """When *satellite* was last assessed successfully (:func:`monitor.history.records.last_success`), if
+    that is more than *days* before *now*; else None."""
+    since = last_success(store.runs(satellite))
+    return since if since is not None and (now - since).total_seconds() > days * 86400 else None

@@ -248,3 +248,21 @@ def test_check_config_speaks_to_the_operators_habits(tmp_path):
     assert r.stderr.splitlines() == [
         "crisgeo check-config: warning: alerts.slack.webhook_env: CRISGEO_TEST_UNSET_HOOK is not set"
     ]
+
+
+@pytest.mark.parametrize(
+    "argv,message",
+    [
+        (["--satellite", "n21"], "argument --satellite: invalid choice: 'n21'"),
+        (["--bogus"], "unrecognized arguments: --bogus"),
+        (["-w", "abc"], "not a threshold range"),
+        (["-t", "0.000001"], "no answer within 1e-06 s (-t)"),
+    ],
+)
+def test_status_usage_errors_and_its_timeout_are_nagios_unknown(config_with_history, capsys, argv, message):
+    """A Nagios plugin's usage error or expired timeout is UNKNOWN (3), one line on stdout; the same typo in
+    another command stays bad input (2)."""
+    code = main(["status", "--config", str(config_with_history), *argv])
+    out = capsys.readouterr().out.splitlines()
+    assert code == 3 and len(out) == 1 and out[0].startswith("UNKNOWN - ") and message in out[0], out
+    assert main(["report", "--config", str(config_with_history), "--satellite", "n21"]) == 2

@@ -11,7 +11,7 @@ from alerts.rules import Finding
 from monitor.config.file import load_config
 from monitor.core.result import ForOffset
 from monitor.service.lock import InstanceLock
-from monitor.service.status import NagiosState, status_report
+from monitor.service.status import NagiosState, Thresholds, status_report
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import day_result
@@ -75,7 +75,7 @@ def test_the_first_line_carries_the_reason_and_the_perfdata(state):
     assert status.state == NagiosState.CRITICAL
     assert status.nagios_line() == (
         "CRITICAL - j01: 1 FOR(s) beyond 1.5 km (worst 4.52 km) "
-        "| j01_fors_beyond_spec=1;;1;0;30 j01_worst_km=4.520;1.5;1.5;0"
+        "| j01_fors_beyond_spec=1;;;0;30 j01_worst_km=4.520;1.5;;0"
     )
     assert status.to_dict()["satellites"]["j01"]["fors_beyond_spec"] == [30]
 
@@ -121,3 +121,35 @@ def test_the_table_has_a_units_row_and_prints_gaps(state):
     assert text[header].split()[:-1] == ["FOR", "d_alpha", "d_beta", "in-trk", "x-trk", "total"]
     assert text[header + 1].split() == ["urad", "urad", "km", "km", "km"]
     assert text[header + 2].split()[1] == "nan"
+
+
+def test_thresholds_and_staleness_raise_the_state_as_the_plugin_guidelines_say(state):
+    """-w/-c on the worst error and on the FORs beyond the specification (monitoring-plugins ranges), and no
+    successful assessment for stale_days: each raises the state; none lowers an alert's."""
+    from nagiosplugin import Range
+
+    cfg, store = state
+    fors = [dataclasses.replace(_for(0.2, 0.3), for_index=k + 1) for k in range(30)]
+    fors[5] = dataclasses.replace(_for(1.2, -0.4), for_index=6)
+    _save(store, fors)
+    fresh = dt.datetime.now(dt.timezone.utc)  # the run was recorded just now
+    assert status_report(cfg, store, now=fresh).state == NagiosState.OK  # 1.2 km: within the default, 1.5
+
+    def state(**ranges):
+        return status_report(cfg, store, now=fresh, thresholds=Thresholds(**ranges))
+
+    assert state(warning_km=Range("1.0")).state == NagiosState.WARNING
+    critical = state(warning_km=Range("1.0"), critical_km=Range("1.1"))
+    assert critical.state == NagiosState.CRITICAL
+    assert critical.nagios_line() == (
+        "CRITICAL - j01: worst 1.20 km, 0 FOR(s) beyond 1.5 km (thresholds: CRITICAL) "
+        "| j01_fors_beyond_spec=0;;;0;30 j01_worst_km=1.200;1.0;1.1;0"
+    )
+    assert state(critical_fors=Range("@0:0")).state == NagiosState.CRITICAL  # no FOR beyond: inside alerts
+    assert state(warning_km=Range("@1.0:")).state == NagiosState.WARNING
+    assert state(warning_km=Range("2")).state == NagiosState.OK
+    # three days after the only run: stale beyond 2 days, not beyond 5
+    late = fresh + dt.timedelta(days=3)
+    stale = status_report(cfg, store, now=late)
+    assert stale.state == NagiosState.WARNING and "no successful assessment since" in stale.nagios_line()
+    assert status_report(cfg, store, now=late, thresholds=Thresholds(stale_days=5)).state == NagiosState.OK
