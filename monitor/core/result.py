@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import typing
+from collections.abc import Iterable
 from dataclasses import MISSING, asdict, dataclass, field, fields
 from typing import Any
 
@@ -236,6 +237,14 @@ class ForOffset:
         """Whether no flag of RELIABILITY_FLAGS is set: the offset may be trusted and alerted on."""
         return not any(f in RELIABILITY_FLAGS for f in self.flags)
 
+    @property
+    def worst_km(self) -> float:
+        """The larger of the in-track and cross-track errors on the ground, in magnitude (km): what the
+        specification judges (:meth:`spec_breaches`); NaN when neither was measured. "Worst" on every
+        surface is this; the total (their root sum of squares) is shown as the total, never judged."""
+        errors = [abs(e) for e in (self.in_track_km, self.cross_track_km) if math.isfinite(e)]
+        return max(errors) if errors else math.nan
+
     def spec_breaches(self, spec_km: float) -> tuple[SpecBreach, ...]:
         """The one definition of "out of spec": a reliable FOR whose in-track or cross-track error on the
         ground exceeds *spec_km* in magnitude, each direction on its own (the specification is per
@@ -441,3 +450,9 @@ class DayPrecision:
         the batches, days without results)."""
         body = json.loads(summary).get("precision") if summary else None
         return None if body is None else cls(**{**body, "stop": DayStop(body["stop"])})
+
+
+def worst_for(fors: Iterable[ForOffset]) -> ForOffset | None:
+    """The reliable FOR of *fors* with the largest :attr:`ForOffset.worst_km` (None: none measured)."""
+    ok = [f for f in fors if f.reliable and math.isfinite(f.worst_km)]
+    return max(ok, key=lambda f: f.worst_km) if ok else None

@@ -28,7 +28,7 @@ from monitor.config.model import Config
 from monitor.config.schedule import ScheduleConfig
 from monitor.core import logcontext
 from monitor.core.errors import DataError
-from monitor.core.result import AssessmentResult, DayPrecision
+from monitor.core.result import AssessmentResult, DayPrecision, worst_for
 from monitor.core.vocabulary import EventKind, RunStatus
 from monitor.history.changes import all_changes
 from monitor.service.outputs.timeseries import change_lines, day_lines, drain_outbox, target_name
@@ -65,8 +65,11 @@ class RunOutcome:
         )
         if self.result is not None:
             ok = [f for f in self.result.fors if f.reliable]
-            worst = max((f.total_km for f in ok), default=float("nan"))
-            parts.append(f"reliable FORs {len(ok)}/{len(self.result.fors)}, worst {worst:.2f} km")
+            worst = worst_for(ok)
+            parts.append(
+                f"reliable FORs {len(ok)}/{len(self.result.fors)}, worst "
+                + ("-" if worst is None else f"{worst.worst_km:.2f} km (FOR {worst.for_index})")
+            )
         if self.precision is not None:
             parts.append(self.precision.text())
         if t:

@@ -19,7 +19,7 @@ from enum import IntEnum
 from nagiosplugin import Range
 
 from monitor.config.model import Config
-from monitor.core.result import DayPrecision, ForOffset
+from monitor.core.result import DayPrecision, ForOffset, worst_for
 from monitor.core.tables import BRIEF, for_table
 from monitor.core.vocabulary import Rule, RunStatus, Severity
 from monitor.history.records import Run, Silence, last_success
@@ -104,10 +104,9 @@ class SatelliteStatus:
 
     @property
     def worst_km(self) -> float | None:
-        """The largest in-track or cross-track error (km) of the latest day's reliable FORs."""
-        errors = [abs(v) for f in self.fors if f.reliable for v in (f.in_track_km, f.cross_track_km)]
-        errors = [v for v in errors if v == v]
-        return max(errors) if errors else None
+        """The worst error of the latest day (:func:`monitor.core.result.worst_for`), km."""
+        worst = worst_for(self.fors)
+        return None if worst is None else worst.worst_km
 
     def reasons(self) -> list[str]:
         """What makes the state, one phrase each: the failed last run, each alert firing (silences

@@ -31,7 +31,7 @@ from alerts.effects import EFFECT_COLUMNS, ChangeEffect, change_effects
 from monitor.config.alert_settings import RuleSettings
 from monitor.config.model import Config
 from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, SPEC_KM
-from monitor.core.result import RELIABILITY_FLAGS, DayPrecision, ForOffset
+from monitor.core.result import RELIABILITY_FLAGS, DayPrecision, ForOffset, worst_for
 from monitor.core.satellites import SATELLITES
 from monitor.core.tables import FOR_COLUMNS, REPORT
 from monitor.core.vocabulary import RunStatus
@@ -232,13 +232,11 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
     fors = store.day_result(satellite, latest)
     reliable = [f.reliable for f in fors]
     col = lambda k: np.array([getattr(f, k) for f in fors], float)  # noqa: E731
-    worst = max(
-        (f for f in fors if f.reliable and np.isfinite(f.total_km)), key=lambda f: f.total_km, default=None
-    )
+    worst = worst_for(fors)
     summary.update(
         latest=latest.isoformat(),
         days=len(days),
-        worst_km=None if worst is None else worst.total_km,
+        worst_km=None if worst is None else worst.worst_km,
         worst_for=None if worst is None else worst.for_index,
     )
     title = f"{name}, {latest.isoformat()}"
@@ -307,7 +305,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
             worst.d_alpha_urad,
             worst.d_beta_urad,
             f"{title}: worst FOR {worst.for_index}, "
-            f"{worst.total_km:.2f} km" + (f" (run {runs[-1].id})" if runs else ""),
+            f"{worst.worst_km:.2f} km" + (f" (run {runs[-1].id})" if runs else ""),
         )
         figures.add("cost.png")
         cost_html = (
@@ -318,14 +316,14 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         )
     status = (
         "<span class=bad>out of specification</span>"
-        if worst is not None and worst.total_km > opts.spec_km
+        if any(f.spec_breaches(opts.spec_km) for f in fors)
         else "<span class=ok>within specification</span>"
     )
     flagged = [f.for_index for f in fors if any(x in RELIABILITY_FLAGS for x in f.flags)]
     parts += [
         f"<p>Latest day {latest.isoformat()}: {status}; worst reliable FOR "
         f"{'-' if worst is None else worst.for_index} at "
-        f"{'-' if worst is None else format(worst.total_km, '.2f')} km "
+        f"{'-' if worst is None else format(worst.worst_km, '.2f')} km in-track or cross-track "
         f"(spec {opts.spec_km:g} km). {len(days)} day(s) shown. Flagged FORs: "
         f"{', '.join(map(str, flagged)) or 'none'}.</p>",
         _precision(store.latest_precision(satellite)),
@@ -429,7 +427,7 @@ def build_report(store: Store, out_dir: str | os.PathLike[str], opts: ReportOpti
     body = (
         "<h1>crisgeo-monitor: CrIS geolocation against VIIRS</h1>"
         "<table><tr><th class=l>satellite</th><th class=l>latest day</th><th>days</th>"
-        f"<th>worst FOR km</th><th>firing alerts</th></tr>{rows}</table>"
+        f"<th>worst km (in- or cross-track)</th><th>firing alerts</th></tr>{rows}</table>"
         f"<p class=note>Specification {opts.spec_km:g} km. Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} "
         "UTC.</p>"
     )

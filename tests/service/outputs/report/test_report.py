@@ -116,6 +116,15 @@ def test_years_with_a_step_a_change_and_an_alert(store, tmp_path):
                range(21, 31))  # fmt: skip
     summary = json.loads((tmp_path / "rep" / "report.json").read_text())
     assert summary[0]["worst_for"] == 30 and summary[0]["firing"] == 1
+    # "worst" as status has it: the larger direction of the worst reliable FOR, not the total
+    from monitor.config.file import load_config as _load
+    from monitor.service.status import status_report
+
+    status_cfg = tmp_path / "status.yaml"
+    status_cfg.write_text(f"satellites: [j01]\nstate_dir: {tmp_path / 'x'}\nsource: {{kind: simulated}}\n")
+    assert summary[0]["worst_km"] == status_report(_load(status_cfg), store).satellites[0].worst_km
+    latest = store.day_result("j01", days[-1])
+    assert summary[0]["worst_km"] < max(f.total_km for f in latest if f.reliable)
     # --since/--until through the command line
     cfg = tmp_path / "c.yaml"
     cfg.write_text(
