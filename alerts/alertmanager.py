@@ -29,7 +29,8 @@ LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
 
 
-def _iso(t: dt.datetime) -> str:
+def timestamp(t: dt.datetime) -> str:
+    """*t* as Alertmanager's API writes times: RFC 3339 in UTC, to the second."""
     return t.astimezone(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
 
 
@@ -69,8 +70,8 @@ def alertmanager_alerts(store: History, settings: AlertSettings, now: dt.datetim
         alert = {
             "labels": labels,
             "annotations": annotations,
-            "startsAt": _iso(dt.datetime.fromisoformat(a.started) if a.started else now),
-            "endsAt": _iso(ends),
+            "startsAt": timestamp(dt.datetime.fromisoformat(a.started) if a.started else now),
+            "endsAt": timestamp(ends),
         }
         if settings.links.dashboard_url:
             alert["generatorURL"] = settings.links.dashboard_url

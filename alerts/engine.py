@@ -196,10 +196,16 @@ class DeliveryCounts:
     sent: int = 0
     retry: int = 0
     failed: int = 0
+    held: tuple[str, ...] = ()  # alerts firing that were not sent again: notified within repeat_hours
 
     def text(self) -> str:
-        """``queued 1, sent 3, to retry 0, failed 0``."""
-        return f"queued {self.queued}, sent {self.sent}, to retry {self.retry}, failed {self.failed}"
+        """``queued 1, sent 3, to retry 0, failed 0``, and the alerts held back by the repeat interval."""
+        line = f"queued {self.queued}, sent {self.sent}, to retry {self.retry}, failed {self.failed}"
+        if self.held:
+            line += "; not sent again within the repeat interval (alerts.repeat_hours): " + "; ".join(
+                self.held
+            )
+        return line
 
 
 def deliver(
@@ -239,11 +245,30 @@ def evaluate_and_deliver(
     store: History, settings: AlertSettings, satellites: Iterable[str], now: dt.datetime | None = None
 ) -> DeliveryCounts:
     """Evaluate the rules, queue, deliver; the counts (queued, sent, to retry, failed)."""
+    now = now or dt.datetime.now(UTC)
     queued = evaluate(store, settings, satellites, now)
     counts = deliver(store, settings, now)
     counts.queued = len(queued)
+    counts.held = held_back(store, settings, now)
     post_state(store, settings, now)
     return counts
+
+
+def held_back(store: History, settings: AlertSettings, now: dt.datetime) -> tuple[str, ...]:
+    """The alerts firing, sent before *now* and not silenced, that the repeat interval keeps from being sent
+    again at *now*: each as ``id (sent T, again from T')``."""
+    state = store.alert_state()
+    repeat = dt.timedelta(hours=settings.repeat_hours)
+    out = []
+    for a in state.firing():
+        if a.severity == Severity.INFO or a.last_notified is None or state.silenced(a.rule, a.satellite, now):
+            continue
+        sent = dt.datetime.fromisoformat(a.last_notified)
+        if sent < now < sent + repeat:
+            out.append(
+                f"{a.fingerprint} (sent {sent:%Y-%m-%d %H:%M}, again from {sent + repeat:%Y-%m-%d %H:%M} UTC)"
+            )
+    return tuple(out)
 
 
 @dataclass(frozen=True)

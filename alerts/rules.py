@@ -88,8 +88,8 @@ class Finding:
 
     @property
     def fingerprint(self) -> str:
-        """rule:satellite:group, the identity the alert state tracks."""
-        return f"{self.rule}:{self.satellite}:{self.group}"
+        """rule:satellite, and :group where there is one: the identity the alert state tracks."""
+        return ":".join(p for p in (self.rule, self.satellite, self.group) if p)
 
 
 def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | None:

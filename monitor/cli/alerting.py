@@ -7,7 +7,7 @@ import argparse
 import datetime as dt
 from typing import TYPE_CHECKING
 
-from monitor.cli.registry import CONFIG, EXIT_OK, BadInput, arg, command, load, open_store
+from monitor.cli.registry import CONFIG, EXIT_FAIL, EXIT_OK, BadInput, arg, command, load, open_store
 from monitor.cli.types import iso_time, until
 from monitor.core.satellites import SATELLITES
 from monitor.core.vocabulary import Rule
@@ -20,15 +20,16 @@ RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices'
 
 @command(
     "alerts",
-    "the alerts: list them, silence or unsilence a rule, evaluate the rules now",
+    "the alerts: list them, silence or unsilence a rule, evaluate the rules now, send a test notification",
     arg(
         "action",
-        choices=("list", "silence", "unsilence", "evaluate"),
+        choices=("list", "silence", "unsilence", "evaluate", "test"),
         nargs="?",
         default="list",
         help="list (default): firing, silenced and recently resolved alerts and the silences in force; "
         "silence: quiet --rule/--satellite until --until, with --reason; unsilence: end silence --id; "
-        "evaluate: evaluate the rules and deliver now",
+        "evaluate: evaluate the rules and deliver now; test: a marked test message through each configured "
+        "channel (or --channel), reported per channel (exit 1 if one was not delivered)",
     ),
     CONFIG,
     arg("--rule", choices=RULES, help="silence: the rule (default: every rule)"),
@@ -37,14 +38,29 @@ RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices'
     arg("--reason", default="", help="silence: why (shown with the silence)"),
     arg("--id", type=int, help="unsilence: the silence's number (crisgeo alerts list shows it)"),
     arg("--json", action="store_true", help="list: as JSON"),
+    arg("--channel", choices=("email", "slack", "alertmanager"), help="test: only this channel"),
 )
 def cmd_alerts(args: argparse.Namespace) -> int:
-    """crisgeo alerts: list, silence, unsilence, evaluate."""
+    """crisgeo alerts: list, silence, unsilence, evaluate, test."""
     from alerts.engine import alerts_view, evaluate_and_deliver
     from monitor.service.store.alert_state import AlertState, SilenceError
     from monitor.service.store.sqlite import Store
 
     now = dt.datetime.now(dt.timezone.utc)
+    if args.action == "test":  # reads and writes nothing of the store
+        from alerts.probe import probe
+
+        try:
+            outcomes = probe(load(args).alerts, args.channel, now)
+        except ValueError as exc:
+            raise BadInput(str(exc)) from None
+        if not outcomes:
+            raise BadInput(
+                "no notification channel configured (alerts.email, alerts.slack, alerts.alertmanager)"
+            )
+        for o in outcomes:
+            print(o.text())
+        return EXIT_OK if all(o.delivered for o in outcomes) else EXIT_FAIL
     if args.action == "list":
         cfg = load(args)
         with open_store(cfg) as store:

@@ -69,6 +69,11 @@ MIGRATIONS = [
     # 5: the CrIS spatial response seen at each FOR's optimum: its columns, like every measured field's, are
     # the declaration's (result_columns)
     "",
+    # 6: an alert's id has no trailing separator when it has no group ("spec:j01", was "spec:j01:"); the
+    # silences are keyed on rule and satellite, not on the id, and keep working
+    """
+    UPDATE alert_state SET fingerprint = rtrim(fingerprint, ':') WHERE fingerprint LIKE '%:';
+    """,
 ]
 
 

@@ -83,7 +83,8 @@ def test_a_store_of_schema_2_with_the_old_alert_tables_keeps_its_alerts(tmp_path
     db.close()
     with Store(path) as store:
         assert store.schema_version == len(MIGRATIONS)
-        assert AlertState(store).firing("j01")[0].summary == "old"
+        (alert,) = AlertState(store).firing("j01")
+        assert alert.summary == "old" and alert.fingerprint == "spec:j01"  # no trailing separator
         tables = {r[0] for r in store.db.execute("SELECT name FROM sqlite_master WHERE type='table'")}
         assert "alert_meta" not in tables and {"silences", "deliveries"} <= tables
         (event,) = store.events(EventKind.RUN_FAILED)
