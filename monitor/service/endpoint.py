@@ -1,7 +1,8 @@
 """The daemon's one HTTP endpoint (``http.listen``, loopback by default): metrics, health, the report.
 
     GET /           what is served here, as a short text
-    GET /metrics    Prometheus text format (:mod:`monitor.service.outputs.metrics`)
+    GET /metrics    Prometheus text format, or OpenMetrics when the Accept header asks for it (negotiated as
+                    prometheus-client's own handler does: :mod:`monitor.service.outputs.metrics`)
     GET /healthz    200 {"status": "ok", ...} or 503 {"status": "unhealthy", "problems": [...]}
     GET /report/    the HTML report, read-only (files under ``report_dir``; no listings, no dotfiles such as
                     the temporary ``.name.part`` of a file being rewritten, nothing outside)
@@ -23,7 +24,8 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any, Protocol
 
-from prometheus_client import CONTENT_TYPE_LATEST, CollectorRegistry, generate_latest
+from prometheus_client import CollectorRegistry
+from prometheus_client.exposition import choose_encoder
 
 LOG = logging.getLogger("monitor.endpoint")  # the name journal filters know, kept
 INDEX = (
@@ -75,7 +77,8 @@ class _Handler(SimpleHTTPRequestHandler):
         if path == "/":
             self._send(200, INDEX, "text/plain; charset=utf-8", head)
         elif path == "/metrics":
-            self._send(200, generate_latest(self.endpoint.metrics.registry), CONTENT_TYPE_LATEST, head)
+            encode, content_type = choose_encoder(self.headers.get("Accept", ""))
+            self._send(200, encode(self.endpoint.metrics.registry), content_type, head)
         elif path == "/healthz":
             problems = self.endpoint.health.problems()
             body = {

@@ -181,4 +181,6 @@ def run_day(
     with logcontext.context(satellite=satellite, day=day.isoformat(), run_id=run_id):
         work = compute_day(cfg, source, satellite, day, should_stop, progress, assessor)
         with logcontext.context(stage="record"):
-            return record_day(cfg, store, run_id, work, today)
+            outcome = record_day(cfg, store, run_id, work, today)
+        store.record_stages(run_id, outcome.timings)
+        return outcome

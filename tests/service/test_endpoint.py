@@ -179,6 +179,11 @@ def test_metrics_after_a_run(served):
     assert _samples(fams["crisgeo_build_info"])[0].labels["version"]
     text = requests.get(url + "/metrics", timeout=10).text
     assert "_created" not in text and "_km" not in text and "_urad" not in text and "percent" not in text
+    assert "process_start_time_seconds" in fams and "python_info" in fams
+    # content negotiation, as prometheus-client's own handler does it
+    om = requests.get(url + "/metrics", headers={"Accept": "application/openmetrics-text"}, timeout=10)
+    assert om.headers["Content-Type"].startswith("application/openmetrics-text")
+    assert om.text.rstrip().endswith("# EOF")
 
 
 @pytest.mark.servers

@@ -2,13 +2,16 @@
 
 What lives in the store (the run ledger, the latest per-FOR offsets, the alerts firing, the outbox) is read
 at each scrape, so it survives restarts and agrees with ``crisgeo status``; what only the process knows
-(stage durations of the last run, downloads since start) is kept in its own gauges and counters.
+(downloads since start) is kept in its own counters. The process and platform collectors of
+prometheus-client (``process_*``, ``python_*``) come along, and the endpoint negotiates the text and
+OpenMetrics formats as prometheus-client's own handler does.
 
     crisgeo_last_success_timestamp_seconds{satellite}     end of the latest ok run, 0 if none yet
     crisgeo_watched_since_timestamp_seconds{satellite}    start of its first run (or of this process)
     crisgeo_runs_total{satellite,outcome}                 finished runs in the ledger by outcome (only grows)
     crisgeo_runs_in_progress{satellite}                   runs under way
-    crisgeo_run_duration_seconds{satellite,stage}         stages of the latest run of this process
+    crisgeo_run_duration_seconds{satellite,stage}         stages of the latest run (from the store: kept
+                                                          over a restart)
     crisgeo_downloaded_granules_total{satellite}          files downloaded whole by this process
     crisgeo_downloaded_bytes_total{satellite}             bytes downloaded by this process (files and ranges)
     crisgeo_nodd_requests_total{satellite}                HTTP requests to NODD by this process
@@ -51,7 +54,15 @@ import math
 from collections.abc import Callable, Iterable, Iterator
 from typing import Protocol
 
-from prometheus_client import CollectorRegistry, Counter, Gauge, disable_created_metrics
+from prometheus_client import (
+    GC_COLLECTOR,
+    PLATFORM_COLLECTOR,
+    PROCESS_COLLECTOR,
+    CollectorRegistry,
+    Counter,
+    Gauge,
+    disable_created_metrics,
+)
 from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 from prometheus_client.metrics_core import Metric
 
@@ -76,14 +87,11 @@ class Counts(Protocol):
 
 
 class Outcome(Protocol):
-    """What the metrics read of a run (:class:`monitor.service.pipeline.RunOutcome`): its satellite, the
-    seconds of its stages, its counts. Typed so, the metrics and the pipeline (one floor) do not import each
-    other."""
+    """What the metrics read of a run (:class:`monitor.service.pipeline.RunOutcome`): its satellite and its
+    counts. Typed so, the metrics and the pipeline (one floor) do not import each other."""
 
     @property
     def satellite(self) -> str: ...
-    @property
-    def timings(self) -> dict: ...
     @property
     def counts(self) -> Counts: ...
 
@@ -124,6 +132,7 @@ class _StoreCollector:
             latest = {s: store.latest_day(s) for s in self.satellites}
             precision = {s: store.latest_precision(s) for s in self.satellites}
             fors = {s: store.day_result(s, d) for s, d in latest.items() if d is not None}
+            stages = store.latest_stages()
         g = GaugeMetricFamily(
             "crisgeo_last_success_timestamp_seconds",
             "End of the latest successful run (Unix time), 0 before the first",
@@ -139,6 +148,15 @@ class _StoreCollector:
             since.add_metric([sat], first.get(sat, self.started).timestamp())
         yield g
         yield since
+        duration = GaugeMetricFamily(
+            "crisgeo_run_duration_seconds",
+            "Wall time of each stage of the latest run",
+            labels=["satellite", "stage"],
+        )
+        for sat in self.satellites:
+            for stage, secs in stages.get(sat, {}).items():
+                duration.add_metric([sat, stage], secs)
+        yield duration
         c = CounterMetricFamily(
             "crisgeo_runs", "Finished runs in the ledger by outcome", labels=["satellite", "outcome"]
         )
@@ -264,12 +282,8 @@ class ServiceMetrics:
         self.registry.register(
             _StoreCollector(open_store, satellites, health, dt.datetime.now(dt.timezone.utc), spec_km)
         )
-        self.duration = Gauge(
-            "crisgeo_run_duration_seconds",
-            "Wall time of each stage of the latest run",
-            ["satellite", "stage"],
-            registry=self.registry,
-        )
+        for standard in (PROCESS_COLLECTOR, PLATFORM_COLLECTOR, GC_COLLECTOR):  # process_*, python_*
+            self.registry.register(standard)
         self.granules = Counter(
             "crisgeo_downloaded_granules",
             "Files downloaded whole by this process",
@@ -297,9 +311,7 @@ class ServiceMetrics:
             self.requests.labels(sat)
 
     def record(self, outcome: Outcome) -> None:
-        """Take in a :class:`monitor.service.pipeline.RunOutcome`."""
-        for stage, secs in outcome.timings.items():
-            self.duration.labels(outcome.satellite, stage).set(secs)
+        """Take in a :class:`monitor.service.pipeline.RunOutcome`'s downloads."""
         self.granules.labels(outcome.satellite).inc(outcome.counts.downloaded)
         self.bytes.labels(outcome.satellite).inc(outcome.counts.bytes)
         self.requests.labels(outcome.satellite).inc(outcome.counts.requests)

@@ -54,6 +54,24 @@ class RunLedger:
             (self._now(), status, reason, n_granules, json.dumps(summary) if summary else None, run_id),
         )
 
+    def record_stages(self, run_id: int, stages: dict[str, float]) -> None:
+        """Keep the wall seconds of run *run_id*'s stages with it (``stages`` in its summary), so that
+        ``/metrics`` shows the latest run's after a restart too."""
+        with self.transaction():
+            row = self.db.execute("SELECT summary FROM runs WHERE id=?", (run_id,)).fetchone()
+            doc = json.loads(row["summary"]) if row is not None and row["summary"] else {}
+            doc["stages"] = {k: round(float(v), 3) for k, v in stages.items()}
+            self.db.execute("UPDATE runs SET summary=? WHERE id=?", (json.dumps(doc), run_id))
+
+    def latest_stages(self) -> dict[str, dict[str, float]]:
+        """Per satellite the stages' wall seconds of its latest run that recorded them."""
+        out: dict[str, dict[str, float]] = {}
+        for r in self.db.execute(
+            "SELECT satellite, summary FROM runs WHERE summary LIKE '%\"stages\"%' ORDER BY id"
+        ):
+            out[r["satellite"]] = json.loads(r["summary"])["stages"]
+        return out
+
     def interrupt_stale_runs(self) -> int:
         """Mark runs left 'running' by a killed process as 'interrupted'; returns how many."""
         with self.transaction():
