@@ -153,12 +153,14 @@ def for_samples(granules: list[Collocation], k: int) -> ForSamples:
 
 
 def granule_info(g: Collocation) -> GranuleInfo:
-    """What the result records of one collocation file."""
+    """What the result records of one collocation file; its times (UTC, ISO 8601) from the granule's name
+    (empty for another name)."""
     n = g.usable.size
+    name = parse_name(g.path.name.removesuffix(".npz"))
     return GranuleInfo(
         granule_id=g.path.name,
-        start="",
-        end="",
+        start=name.start.isoformat() if name else "",
+        end=name.end.isoformat() if name else "",
         cris_geo="",
         cris_sdr=g.path.name,
         viirs=[],
@@ -221,12 +223,13 @@ def assess_collocations(
     fors = day.fors
     if cfg.kernel != Kernel.TOP_HAT:  # the cone's estimate where the footprint is configured: said per FOR
         fors = [replace(f, flags=tuple(sorted({*f.flags, FLAG_TOP_HAT}))) for f in fors]
+    infos = [granule_info(g) for g in granules]
     return AssessmentResult(
         satellite=satellite,
-        start="",
-        end="",
+        start=min((i.start for i in infos if i.start), default=""),
+        end=max((i.end for i in infos if i.end), default=""),
         fors=fors,
-        granules=[granule_info(g) for g in granules],
+        granules=infos,
         half_steps=first.half_steps,
         step_urad=first.step_rad / URAD,
         cost_cube_k=day.cost_cube_k,

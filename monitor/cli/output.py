@@ -47,7 +47,10 @@ class PipedOutput:
 
 def result_text(result: AssessmentResult) -> str:
     """What ``crisgeo assess`` and ``crisgeo run`` print of an assessment."""
-    lines = [f"{result.satellite} {result.start} .. {result.end}, {len(result.granules)} granules"]
+    who = f"{result.satellite} " if result.satellite else ""
+    span = f"{result.start} .. {result.end}" if result.start else "time range unknown"
+    lines = [f"{who}{span}, {len(result.granules)} granules"]
     lines += for_table(result.fors)
     lines += [f"skipped {s.item}: {s.reason}" for s in result.skipped]
+    lines += [f"note: {n}" for n in result.notes]  # e.g. why the km columns are empty (nan)
     return "\n".join(lines)

@@ -43,6 +43,13 @@ def test_the_ten_real_granules_give_offsets_and_say_what_they_lack():
     assert any("no parallax correction" in n for n in r.notes)
     assert all(np.isnan(f.parallax_m_per_k) and np.isnan(f.parallax_height_km) for f in r.fors)
     assert sum(g.n_usable for g in r.granules) > 0.9 * 10 * 4 * 30 * 9
+    # the granules' time range from their names, as crisgeo assess prints it with the notes under the table
+    assert r.start == "2018-10-22T00:23:59.900000+00:00" and r.end == "2018-10-22T00:29:17.700000+00:00"
+    from monitor.cli.output import result_text
+
+    text = result_text(r).splitlines()
+    assert text[0] == "j01 2018-10-22T00:23:59.900000+00:00 .. 2018-10-22T00:29:17.700000+00:00, 10 granules"
+    assert any(line.startswith("note: km fields empty") for line in text[33:])
     # the intercalibration on the uniform scenes (warm ocean, a few K wide): no gain determined to 0.1 %,
     # a bias with its sigma, the same at every FOR within a few sigma (docs/science.md: -0.16 K)
     assert all("gain_undetermined" in f.flags and np.isnan(f.gain_pct) for f in r.fors)
