@@ -59,7 +59,7 @@ def iso(t: dt.datetime) -> str:
 
 @dataclass(frozen=True)
 class Alert:
-    """One alert: identified by *fingerprint* (rule:satellite:group); *status* firing or resolved; times ISO
+    """One alert: identified by *fingerprint* (rule:satellite[:group]); *status* firing or resolved; times ISO
     8601 UTC; *lines* the finding's detail lines."""
 
     fingerprint: str

@@ -1,4 +1,6 @@
-"""The self-contained HTML trend report: one page per satellite plus an index, images beside them.
+"""The self-contained HTML trend report: one page per satellite plus an index. Each page carries its figures
+(data: URIs), so ``<sat>/index.html`` alone can be mailed or opened from an attachment; the figures are
+written beside it as well.
 
 Layout of the output directory (the alert messages link ``<sat>/index.html`` and attach
 ``<sat>/trend.png``)::
@@ -11,14 +13,16 @@ Layout of the output directory (the alert messages link ``<sat>/index.html`` and
     <sat>/trend.png          chosen FORs over time, spec band, changes and alerts
     <sat>/cost.png           figure 5c: the cost surface of the latest run's worst FOR
 
-The pages use no script, font or style sheet from elsewhere: they open from disk.
+The pages use no script, font, style sheet or image from elsewhere: they open from disk, or from a mail.
 """
 
 from __future__ import annotations
 
+import base64
 import datetime as dt
 import html
 import json
+import logging
 import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -34,14 +38,17 @@ from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, S
 from monitor.core.result import RELIABILITY_FLAGS, DayPrecision, ForOffset, worst_for
 from monitor.core.satellites import SATELLITES
 from monitor.core.tables import FOR_COLUMNS, REPORT
-from monitor.core.vocabulary import RunStatus
+from monitor.core.vocabulary import Rule, RunStatus
 from monitor.history.changes import Change, all_changes
-from monitor.history.records import Alert, ForSeries
+from monitor.history.records import Alert, ForSeries, Run
 from monitor.service.outputs.report import plots
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 
 UTC = dt.timezone.utc
+LOG = logging.getLogger(__name__)
+# a satellite's page with its figures inside: 0.6 MB for 400 days (7 figures); mail servers commonly take 10
+PAGE_BUDGET_BYTES = 1_000_000
 CSS = """
 body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:1.5em auto;max-width:1100px;color:#222}
 h1{font-size:1.5em}h2{font-size:1.15em;margin-top:1.6em;border-bottom:1px solid #ccc}
@@ -176,8 +183,22 @@ def _effects_section(effects: Sequence[ChangeEffect]) -> str:
     return "".join(parts)
 
 
-def _img(name: str, alt: str) -> str:
-    return f'<img src="{name}" alt="{_e(alt)}">'
+def _alert_day(alert: Alert, runs: Sequence[Run]) -> dt.date | None:
+    """The day an alert started on, in the data: a step's date (its group), else the latest day whose run
+    had ended successfully when it started (the day whose result raised it); None before any."""
+    if alert.rule in (Rule.JUMP, Rule.CALIBRATION_JUMP) and alert.grp:
+        return dt.date.fromisoformat(alert.grp)
+    ended = [
+        r for r in runs if r.status == RunStatus.OK and r.finished and r.finished <= (alert.started or "")
+    ]
+    return max((dt.date.fromisoformat(r.day) for r in ended), default=None)
+
+
+def _img(path: Path, alt: str) -> str:
+    """The figure at *path* inside the page (a data: URI): the page alone carries it, so it can be mailed;
+    the file stays beside it for the e-mail's attachment and the dashboard's link."""
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    return f'<img src="data:image/png;base64,{data}" alt="{_e(alt)}" title="{_e(path.name)}">'
 
 
 def _precision(p: DayPrecision | None) -> str:
@@ -203,11 +224,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
     ]
     state = AlertState(store)
     firing = state.firing(satellite)
-    alert_times = sorted(
-        dt.datetime.fromisoformat(r.started).replace(tzinfo=None)
-        for r in state.all()
-        if r.satellite == satellite and r.started
-    )
+    alerts = [a for a in state.all() if a.satellite == satellite and a.started]
     parts = [
         '<p><a href="../index.html">all satellites</a></p><h1>CrIS geolocation against VIIRS I5: '
         f"{_e(name)}</h1>"
@@ -269,14 +286,9 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         marks,
         span,
     )
-    # an alert fires after the run of the day it concerns: mark it on the last day plotted at that time
-    lo, hi = dt.datetime.combine(days[0], dt.time()), dt.datetime.combine(days[-1], dt.time())
+    started = [_alert_day(a, store.runs(satellite)) for a in alerts]
     alert_days = sorted(
-        {
-            min(max(dt.datetime.combine(t.date(), dt.time()) - dt.timedelta(days=1), lo), hi)
-            for t in alert_times
-            if t.date() >= days[0]
-        }
+        {dt.datetime.combine(d, dt.time()) for d in started if d is not None and days[0] <= d <= days[-1]}
     )
     plots.trend_lines(
         sat_dir / "trend.png",
@@ -309,7 +321,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         )
         figures.add("cost.png")
         cost_html = (
-            _img("cost.png", f"cost surface of FOR {worst.for_index}")
+            _img(sat_dir / "cost.png", f"cost surface of FOR {worst.for_index}")
             + f"<p class=note>G_min {worst.cost_min_k:.3f} K against {worst.cost_zero_k:.3f} K as "
             "geolocated; "
             "a sharp, closed minimum is a trustworthy result, a flat or open one is flagged.</p>"
@@ -329,11 +341,11 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         _precision(store.latest_precision(satellite)),
         "<h2>Active alerts</h2>" + _alerts_table(firing),
         "<h2>Latest per-FOR offsets</h2>"
-        + _img("latest_km.png", "per-FOR km")
-        + _img("latest_urad.png", "per-FOR urad"),
+        + _img(sat_dir / "latest_km.png", "per-FOR km")
+        + _img(sat_dir / "latest_urad.png", "per-FOR urad"),
         "<h2>Over time</h2>"
-        + _img("heatmap.png", "FOR x day heat maps")
-        + _img("trend.png", "chosen FORs over time"),
+        + _img(sat_dir / "heatmap.png", "FOR x day heat maps")
+        + _img(sat_dir / "trend.png", "chosen FORs over time"),
         "<p class=note>Dotted vertical lines: known changes (purple CrIS, green VIIRS, brown common); "
         "red triangles: alerts.</p>",
         "<h2>Cost surface of the worst FOR</h2>" + cost_html,
@@ -350,7 +362,11 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         ),
         f"<p class=note>Generated {dt.datetime.now(UTC):%Y-%m-%d %H:%M} UTC by crisgeo report.</p>",
     ]
-    _write(sat_dir / "index.html", _page(f"crisgeo {name}", "\n".join(parts)))
+    page = _page(f"crisgeo {name}", "\n".join(parts))
+    if len(page) > PAGE_BUDGET_BYTES:
+        LOG.warning("%s: %d kB, beyond the %d kB a mail may carry", sat_dir / "index.html", len(page) // 1000,
+                    PAGE_BUDGET_BYTES // 1000)  # fmt: skip
+    _write(sat_dir / "index.html", page)
     _drop_figures_except(sat_dir, figures)
     return summary
 
@@ -379,7 +395,7 @@ def _calibration(
             CALIBRATION_BIN_K,
             f"{name}, {latest.isoformat()}: CrIS - VIIRS I5 at the optimum, all refined FORs",
         )
-        out.append(_img("calibration_bins.png", "CrIS minus VIIRS against CrIS BT"))
+        out.append(_img(sat_dir / "calibration_bins.png", "CrIS minus VIIRS against CrIS BT"))
     reliable = series.reliable()
     bias = np.where(reliable, series.values["bias_k"], np.nan)
     if np.isfinite(bias).any():
@@ -391,7 +407,7 @@ def _calibration(
             marks,
             span,
         )
-        out.append(_img("calibration_trend.png", "CrIS minus VIIRS bias and gain over time"))
+        out.append(_img(sat_dir / "calibration_trend.png", "CrIS minus VIIRS bias and gain over time"))
     if not out:
         return "<p class=note>No intercalibration stored for this period (assessed before it was kept).</p>"
     return "".join(out) + (

@@ -116,15 +116,12 @@ def latest_urad(
     return _save(fig, Path(path))
 
 
-MIN_SPAN_DAYS = 7  # a short history is drawn on a week: one day is a column, not a day stretched over hours
-
-
 def _days_axis(ax: Axes, days: Sequence[dt.date]) -> None:
-    """Limit the date axis to the days shown (each its whole day, at least :data:`MIN_SPAN_DAYS` ending
-    at the last): matplotlib would widen a lone day to years, and an image's to hours."""
-    x1 = mdates.date2num(days[-1] + dt.timedelta(hours=12))
-    x0 = min(mdates.date2num(days[0] - dt.timedelta(hours=12)), x1 - MIN_SPAN_DAYS)
-    ax.set_xlim(x0, x1)
+    """Limit the date axis to the days shown, each its whole day (drawn centred on its 00:00): the axis
+    spans the data and no more (matplotlib would widen a lone day to years, a change far back to decades)."""
+    ax.set_xlim(
+        mdates.date2num(days[0] - dt.timedelta(hours=12)), mdates.date2num(days[-1] + dt.timedelta(hours=12))
+    )
     locator = mdates.AutoDateLocator(minticks=3, maxticks=8, interval_multiples=True)
     ax.xaxis.set_major_locator(locator)
     ax.xaxis.set_major_formatter(mdates.ConciseDateFormatter(locator))

@@ -1,4 +1,5 @@
-"""The report's time axes: one day reads as one day on a week's axis, neither years nor hours wide."""
+"""The report's time axes span the data: the days shown, each whole, neither padded nor widened by a change
+far back."""
 
 import datetime as dt
 
@@ -26,7 +27,7 @@ def limits(monkeypatch):
 
 
 @pytest.mark.parametrize("n_days", [1, 3, 40])
-def test_a_short_history_spans_a_week_ending_at_its_last_day(limits, tmp_path, n_days):
+def test_the_axis_spans_the_days_shown_and_no_more(limits, tmp_path, n_days):
     days = [DAY - dt.timedelta(days=n_days - 1 - k) for k in range(n_days)]
     rng = np.random.default_rng(1)
     km = rng.normal(0, 0.5, (n_days, 30))
@@ -37,4 +38,4 @@ def test_a_short_history_spans_a_week_ending_at_its_last_day(limits, tmp_path, n
     last = mdates.date2num(dt.datetime.combine(DAY, dt.time(12)))  # days are drawn centred on 00:00
     for x0, x1 in limits:
         assert x1 == pytest.approx(last)  # the last day's end: its column is whole
-        assert x1 - x0 == pytest.approx(max(plots.MIN_SPAN_DAYS, n_days), abs=1e-6)
+        assert x1 - x0 == pytest.approx(n_days, abs=1e-6)

@@ -15,7 +15,7 @@ from alerts.rules import Finding
 from monitor.cli import main
 from monitor.core.result import AssessmentResult
 from monitor.core.vocabulary import Rule, Severity
-from monitor.service.outputs.report.html import ReportOptions, build_report
+from monitor.service.outputs.report.html import PAGE_BUDGET_BYTES, ReportOptions, build_report
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
@@ -175,12 +175,23 @@ def test_report_in_headless_chromium(store, tmp_path):
                 assert len(images) == 7  # km, urad, heat map, trend, cost, intercalibration x 2
             errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
             assert not errors, errors
-        driver.get((tmp_path / "rep" / "j01" / "index.html").as_uri())
+        # the page alone, as a mail attachment opens it: every figure is inside it, within the budget
+        mailed = tmp_path / "mailed" / "crisgeo-j01.html"
+        mailed.parent.mkdir()
+        shutil.copy(tmp_path / "rep" / "j01" / "index.html", mailed)
+        assert mailed.stat().st_size <= PAGE_BUDGET_BYTES
+        driver.get(mailed.as_uri())
+        images = driver.execute_script(
+            "return Array.from(document.images).map(i => [i.src.slice(0, 22), i.complete, i.naturalWidth]);"
+        )
+        assert len(images) == 7 and all(
+            src == "data:image/png;base64," and ok and width > 0 for src, ok, width in images
+        ), images
         shot = tmp_path / "report_j01.png"
         assert driver.save_screenshot(str(shot)) and shot.read_bytes()[:8] == PNG
         # a broken image is noticed: the check above can fail
-        (tmp_path / "rep" / "j01" / "trend.png").write_bytes(b"not a png")
-        driver.get((tmp_path / "rep" / "j01" / "index.html").as_uri())
+        mailed.write_text(mailed.read_text().replace("base64,iVBOR", "base64,AAAA", 1))
+        driver.get(mailed.as_uri())
         WebDriverWait(driver, 30).until(
             lambda d: d.execute_script("return Array.from(document.images).every(i => i.complete);")
         )
@@ -190,3 +201,25 @@ def test_report_in_headless_chromium(store, tmp_path):
         driver.quit()
     if os.environ.get("CRISGEO_SCREENSHOT_DIR"):
         shutil.copy(shot, os.environ["CRISGEO_SCREENSHOT_DIR"])
+
+
+def test_an_alerts_marker_sits_on_the_day_it_started():
+    """A spec alert raised by the run of day 2 (it started after that run ended, before day 3's) is marked
+    on day 2, however late the report is drawn; a step's alert on the step's date."""
+    from monitor.core.vocabulary import AlertStatus, RunStatus
+    from monitor.history.records import Alert, Run
+    from monitor.service.outputs.report.html import _alert_day
+
+    runs = [
+        Run(i, "j01", f"2026-01-0{i}", f"2026-01-0{i + 1}T03:00:00+00:00", f"2026-01-0{i + 1}T03:30:00+00:00",
+            RunStatus.OK, None, 3, None)
+        for i in (1, 2, 3)
+    ]  # fmt: skip
+
+    def alert(rule, started, grp=None):
+        return Alert(f"{rule}:j01", rule, "j01", grp, None, AlertStatus.FIRING, started, None, None, "", [])
+
+    assert _alert_day(alert("spec", "2026-01-03T04:00:00+00:00"), runs) == dt.date(2026, 1, 2)
+    assert _alert_day(alert("spec", "2026-01-03T03:10:00+00:00"), runs) == dt.date(2026, 1, 1)
+    assert _alert_day(alert("jump", "2026-01-04T04:00:00+00:00", "2026-01-02"), runs) == dt.date(2026, 1, 2)
+    assert _alert_day(alert("spec", "2026-01-01T00:00:00+00:00"), runs) is None
