@@ -65,6 +65,7 @@ def test_wheel_installs_the_shipped_files(tmp_path):
         "configs/monitor.yaml",
         "configs/events.yaml",
         "configs/grafana/crisgeo-dashboard.json",
+        "configs/grafana/crisgeo-prometheus-dashboard.json",
         "configs/grafana/provisioning/datasources/crisgeo.yaml",
         "configs/ep/j01_nominal.yaml",
         "configs/prometheus/crisgeo-rules.yml",
