@@ -8,9 +8,11 @@ raises for a problem of the day's data or source: it becomes the work's status a
 
 from __future__ import annotations
 
+import contextvars
 import datetime as dt
 import logging
 import shutil
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -71,6 +73,39 @@ class ProgressLines:
         if self.done >= self.total or now - self.last >= self.every_s:
             self.last = now
             LOG.info("%s: %d/%d after %.0f s", self.what, self.done, self.total, now - self.t0)
+
+
+class Heartbeat:
+    """A line every *every_s* seconds while a satellite-day is computed, naming what it is doing and how
+    long the day has taken: the stages without items to count (simulating the day's granules, the day's
+    estimate after its granules are collocated) are otherwise silent for a minute and more. A context
+    manager; :meth:`stage` names each stage (the log lines' ``stage`` field too)."""
+
+    def __init__(self, label: str, every_s: float = 15.0) -> None:
+        self.label, self.every_s = label, every_s
+        self.doing = "starting"
+        self.t0 = time.monotonic()
+        self._done = threading.Event()
+        self._thread = threading.Thread(
+            target=contextvars.copy_context().run, args=(self._beat,), name="heartbeat", daemon=True
+        )
+
+    def stage(self, name: str, doing: str) -> None:
+        """Enter the stage *name* (the lines' field), described as *doing* (the heartbeat's words)."""
+        logcontext.stage(name)
+        self.doing = doing
+
+    def _beat(self) -> None:
+        while not self._done.wait(self.every_s):
+            LOG.info("%s: %s, %.0f s into the day", self.label, self.doing, time.monotonic() - self.t0)
+
+    def __enter__(self) -> Heartbeat:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._done.set()
+        self._thread.join()
 
 
 @dataclass
@@ -175,8 +210,11 @@ def compute_day(
     its stand-in) one satellite-day, touching no store. Never raises for a problem of the day's data or
     source: it becomes the work's status and reason. Its log lines carry the satellite, day and stage (and
     only its own: the context ends with it)."""
-    with logcontext.context(satellite=satellite, day=day.isoformat()):
-        return _compute_day(cfg, source, satellite, day, should_stop, progress, assessor)
+    with (
+        logcontext.context(satellite=satellite, day=day.isoformat()),
+        Heartbeat(f"{satellite} {day}") as beat,
+    ):
+        return _compute_day(cfg, source, satellite, day, should_stop, progress, assessor, beat)
 
 
 def _compute_day(
@@ -187,12 +225,13 @@ def _compute_day(
     should_stop: Callable[[], bool] | None,
     progress: Callable[[object], None] | None,
     assessor: Assessor,
+    beat: Heartbeat,
 ) -> DayWork:
     stop = should_stop or (lambda: False)
     w = DayWork(satellite, day, RunStatus.OK)
     t0 = time.perf_counter()
     try:
-        logcontext.stage("list")
+        beat.stage("list", "listing the day's granules")
         check_room(cfg)
         source.start_day(stop)
         listing = source.list_day(satellite, day, ALL_PRODUCTS)
@@ -207,11 +246,11 @@ def _compute_day(
         if stop():
             raise StopRequested
         t1 = time.perf_counter()
-        logcontext.stage("fingerprint")
+        beat.stage("fingerprint", "reading the LOS fingerprint")
         w.fingerprint = day_fingerprint(cfg, source, satellite, day, listing)
         w.timings["fingerprint"] = time.perf_counter() - t1
         t1 = time.perf_counter()
-        logcontext.stage("select")
+        beat.stage("select", "ranking the scenes")
         ranked, w.decisions = rank_scenes(
             listing, source, satellite, cfg.scenes.candidates, cfg.scenes.min_inhomogeneity_k
         )
@@ -221,7 +260,7 @@ def _compute_day(
             w.reason = "no usable scene: " + "; ".join(sorted({d.reason for d in w.decisions}))[:500]
             return w
         w.result, w.precision, decided = assess_in_batches(
-            cfg, source, satellite, day, ranked, t0, w.timings, stop, progress, assessor
+            cfg, source, satellite, day, ranked, t0, w.timings, stop, progress, assessor, beat
         )
         w.decisions += decided
         w.counts.selected = w.precision.granules
@@ -255,8 +294,9 @@ def assess_in_batches(
     started: float,
     timings: dict,
     stop: Callable[[], bool],
-    progress: Callable[[object], None] | None = None,
-    assessor: Assessor = DayAssessment,
+    progress: Callable[[object], None] | None,
+    assessor: Assessor,
+    beat: Heartbeat,
 ) -> tuple[AssessmentResult, DayPrecision, list[SceneDecision]]:
     """Fetch and assess the *ranked* candidates in batches until the day's sigma
     (:meth:`AssessmentResult.day_sigma_urad`) reaches ``scenes.target_sigma_urad`` (without a target: one
@@ -266,7 +306,7 @@ def assess_in_batches(
     run's ``perf_counter``). The first batch is ``scenes.keep``; each next one aims at the target
     (:func:`monitor.assessment.scenes.next_batch`), as far as the budgets allow. Returns the estimate over
     every batch, how far it went, and the candidates' decisions. *timings* gains the seconds of
-    ``fetch`` and ``assess``."""
+    ``fetch`` and ``assess`` (the granules collocated, then the day's estimate); *beat* hears each."""
     s = cfg.scenes
     a = cfg.assessment
     with assessor(satellite, a, a.workers) as estimate:  # its spool removed at the end
@@ -279,17 +319,18 @@ def assess_in_batches(
         while True:
             batch = ranked[taken : taken + size]
             t1, bytes1 = time.perf_counter(), source.spent_bytes
-            logcontext.stage("fetch")
+            beat.stage("fetch", "fetching the scenes")
             case = fetch_plan(
                 source, satellite, batch, stop, ProgressLines(f"{label}: fetched scenes", len(batch))
             )
             t2 = time.perf_counter()
-            logcontext.stage("assess")
+            beat.stage("assess", "collocating the granules")
             LOG.info(
                 "batch %d: assessing %d CrIS granule(s) against %d VIIRS granule(s)",
                 len(sizes) + 1, len(case.cris), len(case.viirs_all),
             )  # fmt: skip
             estimate.add(case, progress or ProgressLines(f"{label}: assessed granules", len(case.cris)), stop)
+            beat.stage("estimate", "estimating the day's offsets")
             result = estimate.result()
             t3 = time.perf_counter()
             timings["fetch"] = timings.get("fetch", 0.0) + t2 - t1
