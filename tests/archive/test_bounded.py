@@ -53,6 +53,17 @@ def test_the_simulated_source_keeps_only_its_newest_days(tmp_path, monkeypatch):
             if d.name != (dt.date(2024, 6, 1) + dt.timedelta(days=k)).isoformat():
                 os.utime(d, (time.time() - IN_USE_S - 60,) * 2)
     assert sorted(d.name for d in (tmp_path / "j01").iterdir()) == ["2024-06-04", "2024-06-05", "2024-06-06"]
+    # one source's own days, one after another (the demo's catch-up): done with once the next is listed,
+    # unless another run listed them since (it may read them still)
+    mine = SimulatedSource(tmp_path / "own", SourceConfig(kind="simulated", retention_days=1))
+    mine.list_day("j01", dt.date(2024, 6, 1), ("GCRSO",))
+    mine.list_day("j01", dt.date(2024, 6, 2), ("GCRSO",))
+    assert sorted(d.name for d in (tmp_path / "own" / "j01").iterdir()) == ["2024-06-02"]
+    other = SimulatedSource(tmp_path / "own", SourceConfig(kind="simulated", retention_days=1))
+    other.list_day("j01", dt.date(2024, 6, 2), ("GCRSO",))  # another run reads it now
+    time.sleep(0.01)
+    mine.list_day("j01", dt.date(2024, 6, 3), ("GCRSO",))
+    assert sorted(d.name for d in (tmp_path / "own" / "j01").iterdir()) == ["2024-06-02", "2024-06-03"]
 
 
 def test_the_download_cache_is_cut_to_its_size_least_recently_used_first(tmp_path):
