@@ -239,8 +239,19 @@ def store_check(years: int) -> int:
             for t in range(DAYS):
                 day = START + dt.timedelta(days=t)
                 fors = [
-                    for_offset(k + 1, 100, (y[t, k, 0], y[t, k, 1]), (s[t, k, 0], s[t, k, 1]), NAN4,
-                               (0.1, 0.2), NO_FIT, NAN4, NAN4, (np.nan, np.nan), ())  # fmt: skip
+                    for_offset(
+                        k + 1,
+                        100,
+                        (y[t, k, 0], y[t, k, 1]),
+                        (s[t, k, 0], s[t, k, 1]),
+                        NAN4,
+                        (0.1, 0.2),
+                        NO_FIT,
+                        NAN4,
+                        NAN4,
+                        (np.nan, np.nan),
+                        (),
+                    )  # fmt: skip
                     for k in range(N_FOR)
                 ]
                 result = AssessmentResult("j01", "", "", fors, [])
@@ -286,6 +297,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--trials", type=int, default=40, help="trials per detection case")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--rows", help="append the JSON lines here")
+    ap.add_argument(
+        "--only",
+        action="append",
+        metavar="QUANTITY:NOISE:SIGMA",
+        help="fdr: only these cases (e.g. los:scale1.3:120)",
+    )
     args = ap.parse_args(argv)
     if args.mode == "store":
         bad = store_check(args.years)
@@ -295,10 +312,13 @@ def main(argv: list[str] | None = None) -> int:
     with ProcessPoolExecutor(args.workers) as pool:
         if args.mode == "fdr":
             for case in FDR_CASES:
+                if args.only and f"{case.quantity}:{case.noise}:{case.sigma:g}" not in args.only:
+                    continue
                 seeds = [(case, 1000 * (2 + FDR_CASES.index(case)) + i) for i in range(args.years)]
                 years = list(pool.map(fdr_year, seeds, chunksize=4))
                 n = sum(y["years"] for y in years)
-                row = {"commit": commit(), "mode": "fdr", "noise": case.noise, "sigma_urad": case.sigma,
+                row = {"commit": commit(), "mode": "fdr", "quantity": case.quantity, "noise": case.noise,
+                       "sigma": case.sigma,
                        "noise_years": round(n, 1), "per_year": sum(y["episodes"] for y in years) / n,
                        "paged_per_year": sum(y["paged"] for y in years) / n,
                        "seconds": round(time.perf_counter() - t0)}  # fmt: skip
