@@ -65,3 +65,15 @@ def test_the_readme_shows_the_table_the_demo_prints():
     header, units = for_table([])[:2]
     i = readme.index(header.rstrip())
     assert readme[i + 1] == units.rstrip()
+
+
+def test_sizing_is_stated_once_and_linked():
+    """The cost of a satellite-day and of the demo is in docs/performance.md's "Sizing"; the README and the
+    operations guide link to it instead of stating figures of their own."""
+    perf = (ROOT / "docs" / "performance.md").read_text()
+    assert "\n## Sizing\n" in perf
+    for page in (ROOT / "README.md", ROOT / "docs" / "operations.md"):
+        text = page.read_text()
+        assert "performance.md#sizing" in text, page.name
+        figure = r"\b\d+(\.\d+)? ?(GB|CPU-s)\b"
+        assert not re.search(figure + r".*assessment|assessment.*" + figure, text), page
