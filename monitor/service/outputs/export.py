@@ -131,18 +131,16 @@ def to_xarray(
     ds["time_bnds"].encoding.update(
         units="days since 1970-01-01 00:00:00", calendar="standard", dtype="int32"
     )
-    info = satellite_info(satellite)
-    now = f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ}"
     ds.attrs.update(
-        Conventions="CF-1.8, ACDD-1.3",
-        title=f"CrIS geolocation assessed against VIIRS I5, {info.name}",
-        summary=(
+        _identity(
+            satellite,
+            f"CrIS geolocation assessed against VIIRS I5, {satellite_info(satellite).name}",
             "Daily per-field-of-regard offsets of the CrIS line of sight (in-track alpha, cross-track beta, "
             "urad) and the geolocation errors on the ground (km), found by perturbing the CrIS line of sight "
             "21 x 21 times per FOV, collocating VIIRS I5 pixels in each perturbed footprint and minimising "
-            "a cost of the CrIS minus VIIRS brightness temperature differences."
+            "a cost of the CrIS minus VIIRS brightness temperature differences.",
+            f"from {store.path.name}",
         ),
-        sign_convention=SIGN_CONVENTION,
         comment=(
             "One value per assessed UTC day and CrIS scan position; flags set mark values not to be trusted "
             "(few samples, grid edge, flat cost, uncertain). The specification is 1.5 km in-track and "
@@ -161,14 +159,8 @@ def to_xarray(
             "doi:10.1002/2016JD025812"
         ),
         keywords="CrIS, VIIRS, geolocation, line of sight, JPSS, calibration",
-        platform=info.name,
-        instrument="CrIS, VIIRS",
-        satellite=satellite,
         method="LOS perturbation assessment, Wang et al. 2017, JGR 122:519",
-        source=f"crisgeo-monitor {__version__}",
         processing_level="L2 monitoring product (from CrIS SDR/GEO and VIIRS I5 SDR/GEO)",
-        date_created=now,
-        history=f"{now} exported from {store.path.name} by crisgeo-monitor {__version__}",
         product_version=__version__,
     )
     if series.days:
@@ -183,6 +175,24 @@ def to_xarray(
         )
     _publish(ds, publisher)
     return ds
+
+
+def _identity(satellite: str, title: str, summary: str, origin: str = "") -> dict[str, str]:
+    """The global attributes every export carries: the conventions, its *title* and *summary*, the sign
+    convention, the platform and instruments, the software and when it was made (from *origin*)."""
+    now = f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ}"
+    return {
+        "Conventions": "CF-1.8, ACDD-1.3",
+        "title": title,
+        "summary": summary,
+        "sign_convention": SIGN_CONVENTION,
+        "platform": satellite_info(satellite).name,
+        "instrument": "CrIS, VIIRS",
+        "satellite": satellite,
+        "source": f"crisgeo-monitor {__version__}",
+        "date_created": now,
+        "history": f"{now} exported {origin + ' ' if origin else ''}by crisgeo-monitor {__version__}",
+    }
 
 
 def _publish(ds: xr.Dataset, publisher: ExportConfig | None) -> None:
@@ -274,23 +284,15 @@ def effects_to_xarray(
     ds["change"].attrs.update(long_name="UTC day of the known change", axis="T")
     ds["change"].encoding.update(units="days since 1970-01-01 00:00:00", calendar="standard", dtype="int32")
     ds["scan_position"].attrs.update(long_name="CrIS field of regard (scan position, 1 = first of the scan)")
-    info = satellite_info(satellite)
-    now = f"{dt.datetime.now(dt.timezone.utc):%Y-%m-%dT%H:%M:%SZ}"
     ds.attrs.update(
-        Conventions="CF-1.8, ACDD-1.3",
-        title=f"What each known change did to the CrIS geolocation against VIIRS I5, {info.name}",
-        summary=(
+        _identity(
+            satellite,
+            "What each known change did to the CrIS geolocation against VIIRS I5, "
+            + satellite_info(satellite).name,
             "Per known change (EP upload, LUT change, software) and CrIS field of regard: the offsets before "
             "and after with sigmas, the move and its significance, and the move the EPs' mapping angles "
-            "predict (crisgeo events effects; docs/operations.md)."
-        ),
-        sign_convention=SIGN_CONVENTION,
-        platform=info.name,
-        instrument="CrIS, VIIRS",
-        satellite=satellite,
-        source=f"crisgeo-monitor {__version__}",
-        date_created=now,
-        history=f"{now} exported by crisgeo-monitor {__version__}",
+            "predict (crisgeo events effects; docs/operations.md).",
+        )
     )
     _publish(ds, publisher)
     return ds
