@@ -228,7 +228,7 @@ def cmd_status(args: argparse.Namespace) -> int:
     def expired(signum: int, frame: FrameType | None) -> None:
         raise Expired(f"no answer within {args.timeout:g} s (-t)")
 
-    signal.signal(signal.SIGALRM, expired)
+    previous = signal.signal(signal.SIGALRM, expired)
     try:
         signal.setitimer(signal.ITIMER_REAL, args.timeout)
         cfg = load(args)
@@ -250,5 +250,6 @@ def cmd_status(args: argparse.Namespace) -> int:
         return NagiosState.UNKNOWN
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
     print(json.dumps(status.to_dict(), indent=1, default=str) if args.json else status.text())
     return status.state
