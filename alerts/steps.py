@@ -25,7 +25,10 @@ the splits T, T-1, T-2 (a step is found within three days) for every group and b
 largest |z| of that family, simulated under the fitted rho and phi, exceeds the threshold on a fraction
 ``rate_per_year / 365`` of days. At a known change (calendar, metadata, fingerprint) the day that holds it
 is left out of both windows, and its family, the first three days after it, exceeds its own threshold
-with probability ``rate_at_change``.
+with probability ``rate_at_change``. The simulation computes the z's as the rule does, with a noise
+fitted from as many days as the rule had (:func:`_simulated_fits`): a fit from a few weeks misjudges
+rho and lambda by several per cent, which at |z| ~ 4.5 multiplies the false detections, so a young
+history is judged by a higher threshold.
 
 **The replay.** The rule keeps no state: each evaluation replays the last ``2 * baseline_days`` days as the
 daily evaluations saw them (:func:`detect`), accepting steps in time order; a step starts a new baseline.
@@ -112,9 +115,14 @@ class Step:
 
 
 def _robust_var(x: np.ndarray) -> float:
-    """The variance of a normal sample from its median absolute value (outliers cost nothing)."""
+    """The variance of a normal sample of zero mean, its values winsorised at 3.5 times the scale their
+    median absolute value gives: nearly as precise as the plain variance (the rule's thresholds pay for
+    the fit's error), while an outlier costs at most 12 / n of it."""
     x = x[np.isfinite(x)]
-    return float((1.4826 * np.median(np.abs(x))) ** 2) if x.size >= 5 else math.nan
+    if x.size < 5:
+        return math.nan
+    clip = 3.5 * 1.4826 * float(np.median(np.abs(x)))
+    return float(np.mean(np.minimum(x**2, clip**2)))
 
 
 def fit_noise(ordinal: np.ndarray, y: np.ndarray, s: np.ndarray) -> Noise | None:
@@ -178,6 +186,34 @@ def _contrast(n_pre: int, n_post: int) -> np.ndarray:
     return np.r_[np.full(n_pre, -1.0 / n_pre), np.full(n_post, 1.0 / n_post)]
 
 
+# the fits' lengths (days) thresholds are simulated for
+FIT_DAYS = (MIN_HISTORY_DAYS + 1, 30, 40, 50, 60, 75, 90, 105, 120, 140, 160, 180, 210, 240, 270, 300, 365)
+FIT_DRAWS = 50  # simulated fits per threshold: the fitted noise's own error
+
+
+def fit_days_bucket(n: int) -> int:
+    """The length of :data:`FIT_DAYS` a fit of *n* days is judged as: the next shorter one (its noise is
+    known no better than that), a year for longer fits."""
+    return max([b for b in FIT_DAYS if b <= n], default=FIT_DAYS[0])
+
+
+def _simulated_fits(shared: float, lag1: float, fit_days: int, directions: int) -> list[Noise]:
+    """:data:`FIT_DRAWS` noises :func:`fit_noise` fits on *fit_days* days in a row of unit sigmas whose
+    true noise is scale 1, *shared* and *lag1* (a fixed seed): the spread of what the rule would believe."""
+    rng = np.random.default_rng(20261128)
+    out = []
+    for _ in range(FIT_DRAWS):
+        g = rng.standard_normal((fit_days, 1, directions))
+        h = rng.standard_normal((fit_days, N_FOR, directions))
+        e = math.sqrt(shared) * g + math.sqrt(1.0 - shared) * h
+        for t in range(1, fit_days):
+            e[t] = lag1 * e[t - 1] + math.sqrt(1.0 - lag1**2) * e[t]
+        fit = fit_noise(np.arange(fit_days), e, np.ones_like(e))
+        assert fit is not None  # fit_days > MIN_HISTORY_DAYS days in a row
+        out.append(fit)
+    return out
+
+
 @lru_cache(maxsize=1024)
 def threshold(
     probability: float,
@@ -187,11 +223,18 @@ def threshold(
     discovery: int,
     known: bool,
     directions: int,
+    fit_days: int,
 ) -> float:
     """The |z| the family of one evaluation day exceeds with *probability* under the null: for the blind
     test the splits T - discovery + 1 .. T seen on day T; for a known change the first *discovery* days
     after it (the change's day left out). Simulated (:data:`NULL_DRAWS` days, a fixed seed) for every group
-    and direction, the FORs correlated by *shared*, the days by *lag1*, uniform sigmas."""
+    and direction, the FORs correlated by *shared*, the days by *lag1*, uniform sigmas.
+
+    The z's are those the rule computes: with a noise fitted on *fit_days* days, not the true one. The
+    draws are split among :data:`FIT_DRAWS` fits of simulated histories (:func:`_simulated_fits`); each
+    scales a split's contrast by its fit's sigma (lambda_f sqrt(c^T Phi_f c) against the true
+    sqrt(c^T Phi c)) and pools with its fit's rho. A fit's error thus raises the threshold as much as it
+    raises the rate of false detections: most in a history's first weeks, little after a year."""
     if known:  # baseline days, the change's day, then the days after it
         rows = [np.r_[_contrast(baseline, j), np.zeros(discovery - j)] for j in range(1, discovery + 1)]
         ordinal = np.r_[np.arange(baseline), baseline + 1 + np.arange(discovery)]
@@ -206,23 +249,26 @@ def threshold(
         ordinal = np.arange(span)
     c = np.array(rows)
     cov = c @ _ar1(ordinal, lag1) @ c.T
-    sd = np.sqrt(np.diag(cov))
-    chol = np.linalg.cholesky(cov / np.outer(sd, sd) + 1e-12 * np.eye(len(sd))).astype(np.float32)
-    # uniform sigmas: a group's z is (S_G - f n_G S) / sqrt((n_G - f n_G^2)(1 - rho)) (see pooled), S_G the
-    # sum of its FORs' standardised differences, S that of all
+    chol = np.linalg.cholesky(cov + 1e-12 * np.eye(len(cov))).astype(np.float32)  # the contrasts' truth
     n_g = MEMBERS.sum(axis=1).astype(np.float32)
-    f = shared / (1.0 - shared + N_FOR * shared)
-    norm = np.sqrt((n_g - f * n_g**2) * (1.0 - shared)).astype(np.float32)
     members = MEMBERS.T.astype(np.float32)
     rng = np.random.default_rng(20261127)
     peaks = []
-    for chunk in np.array_split(np.arange(NULL_DRAWS), 20):
+    fits = _simulated_fits(shared, lag1, fit_days, directions)
+    for fit, chunk in zip(fits, np.array_split(np.arange(NULL_DRAWS), len(fits)), strict=True):
+        believed = fit.scale * np.sqrt(np.einsum("ij,jk,ik->i", c, _ar1(ordinal, fit.lag1), c))[:, None]
         shape = (len(rows), len(chunk), directions)
         g = rng.standard_normal((*shape, 1), dtype=np.float32)
         h = rng.standard_normal((*shape, N_FOR), dtype=np.float32)
         e = np.float32(math.sqrt(shared)) * g + np.float32(math.sqrt(1.0 - shared)) * h
         e = np.tensordot(chol, e, axes=(1, 0))  # the splits correlated as their windows overlap
-        z = (e @ members - np.float32(f) * n_g * e.sum(axis=-1, keepdims=True)) / norm
+        e /= believed.astype(np.float32)[:, None, :, None]
+        # uniform sigmas: a group's z is (S_G - f n_G S) / sqrt((n_G - f n_G^2)(1 - rho)) (see pooled), S_G
+        # the sum of its FORs' standardised differences, S that of all; rho the fit's, per direction
+        rho = fit.shared.astype(np.float32)[:, None]  # (directions, 1)
+        f = rho / (1.0 - rho + N_FOR * rho)
+        norm = np.sqrt((n_g - f * n_g**2) * (1.0 - rho))  # (directions, groups)
+        z = (e @ members - f * n_g * e.sum(axis=-1, keepdims=True)) / norm
         peaks.append(np.abs(z).max(axis=(0, 2, 3)))
     return float(np.quantile(np.concatenate(peaks), 1.0 - probability))
 
@@ -412,11 +458,12 @@ def _fit(
     rho = round(float(np.max(noise.shared)) * 20) / 20  # the thresholds on a grid of 0.05
     phi = round(noise.lag1 * 20) / 20
     b, k, c = rules.baseline_days, rules.discovery_days, y.shape[-1]
+    n = fit_days_bucket(int(np.count_nonzero(days)))
     return _Fit(
         noise,
         sigma,
-        threshold(rules.rate_per_year / 365.0, rho, phi, b, k, False, c),
-        threshold(rules.rate_at_change, rho, phi, b, k, True, c),
+        threshold(rules.rate_per_year / 365.0, rho, phi, b, k, False, c, n),
+        threshold(rules.rate_at_change, rho, phi, b, k, True, c, n),
     )
 
 
