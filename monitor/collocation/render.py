@@ -1,0 +1,132 @@
+"""What a CrIS FOV row sees of a VIIRS column whose pixels stand at a height: hidden ground out, walls in.
+
+The point lift (:mod:`monitor.collocation.lift`) moves each pixel up its VIIRS line of sight to the height
+its BT implies and lets the cone test look at the lifted points from CrIS. From an outer FOV row's slant
+view that still counts ground a lifted cloud hides, and misses the cloud's side (its wall) that the view
+meets (docs/science.md, "Clouds have height"). This module renders instead, along one VIIRS column (the
+pixels of one scan angle, sorted along the track): what the ray of a CrIS FOV row that meets the ground at
+each pixel's GEO point meets first. The cone test can then keep every pixel at its GEO point and give it
+the radiance the FOV row sees there: the rays through a ground patch are the rays the patch's solid angle
+holds, so hidden ground drops out and walls come in by themselves.
+
+**The geometry, in one column's vertical plane along the track** (x along the track, m; z up, m; the
+cross-track component is the same for both instruments, which look from one spacecraft at one scan
+angle). Pixel j's GEO point is x_j; VIIRS saw it along the ray x = x_j + z b_j (b_j the in-track tangent
+of its view from the vertical, towards the spacecraft). Standing at height h_j, its column occupies
+
+    |x - T_j| <= w_j / 2,  0 <= z <= h_j,   T_j = x_j + h_j b_j,
+
+(w_j its along-track width). The CrIS row's ray that meets the ground at x_i is x = x_i + z a_i. It is
+inside column j horizontally for z in an interval [z_lo, z_hi] (all z when a_i = 0 and |x_i - T_j| <=
+w_j / 2). Coming down from the spacecraft, it meets column j first at
+
+    z*_j = min(h_j, z_hi)   if that is >= max(z_lo, 0):
+
+its top when z*_j = h_j (the pixel's own BT), its side wall otherwise, at height z_hi, whose BT the height
+law gives: the clear-sky reference minus z / kappa (kappa m per K, :func:`monitor.collocation.lift.lift_m`).
+What the ray sees is the column with the highest z*: anything lower on the ray is hidden behind it. Ties
+(flat ground, z* = 0) go to the column whose top centre is nearest the ray.
+
+Only columns within the reach of the ray matter: |x_i - x_j| <= w_j / 2 + h_max (|a_i| + |b_j|), a few
+pixels for clouds below 20 km and views within 0.05 of the vertical; the sweep looks no farther.
+Compiled, in parallel over the columns.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from monitor.compiled.threads import KERNEL_LOCK
+
+
+def render_columns(
+    x_m: np.ndarray,
+    width_m: np.ndarray,
+    height_m: np.ndarray,
+    bt_k: np.ndarray,
+    reference_k: np.ndarray,
+    viirs_tan: np.ndarray,
+    cris_tan: np.ndarray,
+    m_per_k: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The BT (K) a CrIS FOV row's ray meeting the ground at each pixel's GEO point sees first, and what
+    it meets there (0: that pixel's own top, 1: another column's top, 2: a wall; see the module
+    docstring), for columns of pixels sorted along the track: all arrays (n, columns), x_m ascending in
+    each column (NaN: no pixel; its BT is NaN), *height_m* >= 0 the pixels' heights, *viirs_tan* and
+    *cris_tan* the in-track tangents of the VIIRS ray of each pixel and of the CrIS row's ray at each
+    GEO point (towards the spacecraft, positive along +x), *reference_k* the clear-sky reference BT the
+    walls' temperatures are counted down from at *m_per_k* (m per K)."""
+    arrays = [np.ascontiguousarray(a, np.float64) for a in (x_m, width_m, height_m, bt_k, reference_k)]
+    tans = [np.ascontiguousarray(a, np.float64) for a in (viirs_tan, cris_tan)]
+    seen = np.full(np.shape(x_m), np.nan)
+    kind = np.zeros(np.shape(x_m), np.int8)
+    with KERNEL_LOCK:
+        _render(*arrays, *tans, float(m_per_k), seen, kind)
+    return seen, kind
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _first_hit(x: float, a: float, t: float, half: float, h: float) -> float:
+    """The highest z (m) at which the ray x + z a is inside the column |x - t| <= half, 0 <= z <= h;
+    -1 when it never is."""
+    if a == 0.0:
+        return h if abs(x - t) <= half else -1.0
+    z1 = (t - half - x) / a
+    z2 = (t + half - x) / a
+    lo, hi = min(z1, z2), max(z1, z2)
+    top = min(h, hi)
+    return top if top >= max(lo, 0.0) else -1.0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _render(
+    x: np.ndarray,
+    w: np.ndarray,
+    h: np.ndarray,
+    bt: np.ndarray,
+    ref: np.ndarray,
+    b: np.ndarray,
+    a: np.ndarray,
+    m_per_k: float,
+    seen: np.ndarray,
+    kind: np.ndarray,
+) -> None:
+    """Fill *seen* and *kind* (:func:`render_columns`), one column a task."""
+    n, ncol = x.shape
+    for c in numba.prange(ncol):
+        h_max, b_max, w_max = 0.0, 0.0, 0.0
+        for j in range(n):
+            if math.isfinite(x[j, c]):
+                h_max = max(h_max, h[j, c])
+                b_max = max(b_max, abs(b[j, c]))
+                w_max = max(w_max, w[j, c])
+        for i in range(n):
+            xi, ai = x[i, c], a[i, c]
+            if not (math.isfinite(xi) and math.isfinite(ai)):
+                continue
+            reach = 0.5 * w_max + h_max * (abs(ai) + b_max)
+            best_z, best_d, best_j, best_wall = -1.0, math.inf, -1, False
+            for step in (-1, 1):
+                j = i if step == 1 else i - 1
+                while 0 <= j < n:
+                    xj = x[j, c]
+                    if math.isfinite(xj):
+                        if abs(xj - xi) > reach:
+                            break
+                        t = xj + h[j, c] * b[j, c]
+                        z = _first_hit(xi, ai, t, 0.5 * w[j, c], h[j, c])
+                        if z >= 0.0:
+                            d = abs(xi + h[j, c] * ai - t)  # the ray's distance from the top's centre
+                            if z > best_z + 1e-6 or (abs(z - best_z) <= 1e-6 and d < best_d):
+                                best_z, best_d, best_j = z, d, j
+                                best_wall = z < h[j, c] - 1e-6
+                    j += step
+            if best_j < 0:  # in no column (a gap between pixels): its own pixel
+                seen[i, c], kind[i, c] = bt[i, c], 0
+            elif best_wall:
+                seen[i, c], kind[i, c] = ref[best_j, c] - best_z / m_per_k, 2
+            else:
+                seen[i, c], kind[i, c] = bt[best_j, c], 0 if best_j == i else 1
