@@ -90,6 +90,57 @@ def lifted(
     return lat, lon, h
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def scan_points(
+    lat: np.ndarray,
+    lon: np.ndarray,
+    h: np.ndarray,
+    mask: np.ndarray,
+    row0: int,
+    sat: np.ndarray,
+    vel: np.ndarray,
+    point: np.ndarray,
+) -> float:
+    """For the pixels of the scan starting at row *row0* where *mask* (32, cols) holds, write into *point*
+    (32, cols, 7) the GEO point in ECEF (m, :func:`monitor.collocation.geodesy.ecef_m`), the ellipsoid's
+    normal there and the scan angle (rad) seen from the scan's spacecraft position *sat* (3,) with
+    velocity *vel*; return whether the columns come in time order with the scan angle (1) or against it
+    (-1: the sign of the least-squares slope of the angle over the column; 1 where all lie in one column
+    or it is flat), 0 when no pixel is masked. A pixel is seen from the spacecraft at the scan's middle
+    plus the velocity times order x angle / ROTATION_RAD_S."""
+    sx, sy, sz = sat[0], sat[1], sat[2]
+    vx, vy, vz = vel[0], vel[1], vel[2]
+    norm = math.sqrt(sx * sx + sy * sy + sz * sz)
+    nx, ny, nz = -sx / norm, -sy / norm, -sz / norm  # nadir
+    ax, ay, az = vy * sz - vz * sy, vz * sx - vx * sz, vx * sy - vy * sx  # velocity x position
+    norm = math.sqrt(ax * ax + ay * ay + az * az)
+    ax, ay, az = ax / norm, ay / norm, az / norm
+    count, sum_c, sum_a, sum_ca = 0, 0.0, 0.0, 0.0
+    first, last = mask.shape[1], -1
+    for i in range(mask.shape[0]):
+        for c in range(mask.shape[1]):
+            if mask[i, c]:
+                la, lo, hh = lat[row0 + i, c], lon[row0 + i, c], h[row0 + i, c]
+                px, py, pz = ecef_m(la, lo, hh)
+                cos_la = math.cos(la)
+                lx, ly, lz = px - sx, py - sy, pz - sz
+                angle = math.atan2(lx * ax + ly * ay + lz * az, lx * nx + ly * ny + lz * nz)
+                q = point[i, c]
+                q[0], q[1], q[2], q[6] = px, py, pz, angle
+                q[3], q[4], q[5] = cos_la * math.cos(lo), cos_la * math.sin(lo), math.sin(la)
+                count += 1
+                sum_c += c
+                sum_a += angle
+                sum_ca += c * angle
+                first, last = min(first, c), max(last, c)
+    if count == 0:
+        return 0.0
+    if last > first:
+        slope = count * sum_ca - sum_c * sum_a
+        return -1.0 if slope < 0 else 1.0
+    return 1.0
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _lift_scans(
     lat: np.ndarray,
@@ -103,49 +154,21 @@ def _lift_scans(
     out_h: np.ndarray,
 ) -> None:
     """Write into *out_** the lifted pixels (lift > 0) of every scan whose spacecraft position is known
-    (:func:`lifted`). Per scan, two passes over its lifted pixels: the first places each GEO point in ECEF
-    (:func:`monitor.collocation.geodesy.ecef_m`, the ellipsoid's normal with it) and reads its scan
-    angle, and whether the columns come in time order with the scan angle or against it (the sign of the
-    least-squares slope of the angle over the column; forward where all lie in one column); the second
-    moves each point, the spacecraft taken at the pixel's time: the scan's middle plus its scan angle over
-    the rotation rate."""
+    (:func:`lifted`). Per scan, two passes over its lifted pixels: the first places each GEO point and
+    reads its scan angle and the columns' time order (:func:`scan_points`); the second moves each point,
+    the spacecraft taken at the pixel's time: the scan's middle plus its scan angle over the rotation
+    rate."""
     cols = lat.shape[1]
     for k in numba.prange(lat.shape[0] // VIIRS_DETECTORS):
         sx, sy, sz = sat[k, 0], sat[k, 1], sat[k, 2]
         if not (math.isfinite(sx) and math.isfinite(sy) and math.isfinite(sz)):
             continue
         vx, vy, vz = vel[k, 0], vel[k, 1], vel[k, 2]
-        norm = math.sqrt(sx * sx + sy * sy + sz * sz)
-        nx, ny, nz = -sx / norm, -sy / norm, -sz / norm  # nadir
-        ax, ay, az = vy * sz - vz * sy, vz * sx - vx * sz, vx * sy - vy * sx  # velocity x position
-        norm = math.sqrt(ax * ax + ay * ay + az * az)
-        ax, ay, az = ax / norm, ay / norm, az / norm
         row0 = k * VIIRS_DETECTORS
         point = np.empty((VIIRS_DETECTORS, cols, 7))  # ECEF (m), the normal, the scan angle (rad)
-        count, sum_c, sum_a, sum_ca = 0, 0.0, 0.0, 0.0
-        first, last = cols, -1
-        for i in range(VIIRS_DETECTORS):
-            for c in range(cols):
-                if lift[row0 + i, c] > 0:
-                    la, lo, hh = lat[row0 + i, c], lon[row0 + i, c], h[row0 + i, c]
-                    px, py, pz = ecef_m(la, lo, hh)
-                    cos_la = math.cos(la)
-                    lx, ly, lz = px - sx, py - sy, pz - sz
-                    angle = math.atan2(lx * ax + ly * ay + lz * az, lx * nx + ly * ny + lz * nz)
-                    q = point[i, c]
-                    q[0], q[1], q[2], q[6] = px, py, pz, angle
-                    q[3], q[4], q[5] = cos_la * math.cos(lo), cos_la * math.sin(lo), math.sin(la)
-                    count += 1
-                    sum_c += c
-                    sum_a += angle
-                    sum_ca += c * angle
-                    first, last = min(first, c), max(last, c)
-        if count == 0:
+        order = scan_points(lat, lon, h, lift[row0 : row0 + VIIRS_DETECTORS] > 0, row0, sat[k], vel[k], point)
+        if order == 0.0:
             continue
-        order = 1.0
-        if last > first:
-            slope = count * sum_ca - sum_c * sum_a
-            order = 1.0 if slope > 0 else (-1.0 if slope < 0 else 0.0)
         for i in range(VIIRS_DETECTORS):
             for c in range(cols):
                 if lift[row0 + i, c] > 0:

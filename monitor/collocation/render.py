@@ -39,7 +39,105 @@ import math
 import numba
 import numpy as np
 
+from monitor.collocation.lift import ROTATION_RAD_S, scan_points
 from monitor.compiled.threads import KERNEL_LOCK
+from monitor.core.constants import VIIRS_DETECTORS
+
+
+def view_tangents(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    good: np.ndarray,
+    sat_m: np.ndarray,
+    velocity_m_s: np.ndarray,
+    cris_alpha_rad: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per pixel of a VIIRS granule (rows of 32-detector scans; *good* where usable) the along-track
+    coordinate x of its GEO point (m: arc length along the orbit's direction at the point's distance from
+    the orbit plane, from the first scan's spacecraft; NaN where unusable), the in-track tangent b of its
+    VIIRS ray, and per CrIS FOV row (in-track SBF angles *cris_alpha_rad*, rad, positive ahead) the
+    in-track tangent a of that row's ray to the same GEO point: the horizontal along-track run per unit
+    of height towards the spacecraft, positive along +x (:func:`render_columns`).
+
+    VIIRS sees the pixel from the spacecraft at the pixel's time (scan *sat_m*, *velocity_m_s* (nscan, 3)
+    ECEF at the scan's middle, :func:`monitor.collocation.lift.scan_points`). The CrIS row sees it from the
+    point of the track where its in-track angle is alpha: from S moved along x_sbf (the velocity without
+    its nadir part) by Delta s = (P - S) . x_sbf - tan(alpha) (P - S) . z_sbf, so that
+    (P - S') . x_sbf = tan(alpha) (P - S') . z_sbf, the SBF taken at S' (three steps: its nadir turns by
+    Delta s / (R_earth + altitude)). A difference of in-track angles between the two instruments is
+    about 1 + range / R_earth times larger at the ground (the local vertical turns along the track too):
+    21.6 mrad for an outer row at nadir."""
+    rows, cols = np.shape(lat_rad)
+    sat = np.ascontiguousarray(sat_m, np.float64)
+    vel = np.ascontiguousarray(velocity_m_s, np.float64)
+    finite = np.flatnonzero(np.all(np.isfinite(sat), axis=1) & np.all(np.isfinite(vel), axis=1))
+    x = np.full((rows, cols), np.nan)
+    b = np.full((rows, cols), np.nan, np.float32)
+    a = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
+    if finite.size == 0:
+        return x, b, a
+    e1 = sat[finite[0]] / np.linalg.norm(sat[finite[0]])
+    e2 = vel[finite[0]] - (vel[finite[0]] @ e1) * e1
+    e2 /= np.linalg.norm(e2)
+    axes = np.stack([e1, e2, np.cross(e1, e2)])
+    geo = [np.ascontiguousarray(v, np.float64) for v in (lat_rad, lon_rad, height_m)]
+    tan_alpha = np.tan(np.asarray(cris_alpha_rad, np.float64))
+    with KERNEL_LOCK:
+        _tangents(*geo, np.ascontiguousarray(good, np.bool_), sat, vel, axes, tan_alpha, x, b, a)
+    return x, b, a
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _tangents(
+    lat: np.ndarray,
+    lon: np.ndarray,
+    h: np.ndarray,
+    good: np.ndarray,
+    sat: np.ndarray,
+    vel: np.ndarray,
+    axes: np.ndarray,
+    tan_alpha: np.ndarray,
+    x: np.ndarray,
+    b: np.ndarray,
+    a: np.ndarray,
+) -> None:
+    """Fill *x*, *b* and *a* (:func:`view_tangents`), one scan a task."""
+    cols = lat.shape[1]
+    for k in numba.prange(lat.shape[0] // VIIRS_DETECTORS):
+        if not (np.all(np.isfinite(sat[k])) and np.all(np.isfinite(vel[k]))):
+            continue
+        row0 = k * VIIRS_DETECTORS
+        point = np.empty((VIIRS_DETECTORS, cols, 7))
+        order = scan_points(lat, lon, h, good[row0 : row0 + VIIRS_DETECTORS], row0, sat[k], vel[k], point)
+        if order == 0.0:
+            continue
+        s = sat[k]
+        v = vel[k]
+        for i in range(VIIRS_DETECTORS):
+            for c in range(cols):
+                if not good[row0 + i, c]:
+                    continue
+                q = point[i, c]
+                p = q[:3]
+                up = q[3:6]
+                track = v - (v @ up) * up  # the along-track horizontal at the point
+                track = track / math.sqrt(track @ track)
+                r = math.sqrt(p @ p)
+                off = math.asin(min(max((p @ axes[2]) / r, -1.0), 1.0))
+                x[row0 + i, c] = r * math.cos(off) * math.atan2(p @ axes[1], p @ axes[0])
+                sv = s + v * (order * q[6] / ROTATION_RAD_S)  # VIIRS at the pixel's time
+                d = sv - p
+                b[row0 + i, c] = (d @ track) / (d @ up)
+                for j in range(tan_alpha.shape[0]):
+                    dr = d.copy()
+                    for _ in range(3):  # the SBF turns with the spacecraft's move: 11 % of it, then 1 %
+                        sr = p + dr
+                        zs = -sr / math.sqrt(sr @ sr)  # the SBF's z (nadir), x (the velocity without it)
+                        xs = v - (v @ zs) * zs
+                        xs = xs / math.sqrt(xs @ xs)
+                        dr = dr + (-(dr @ xs) + tan_alpha[j] * (dr @ zs)) * xs  # Delta s along x
+                    a[j, row0 + i, c] = (dr @ track) / (dr @ up)
 
 
 def render_columns(

@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from monitor.collocation.render import render_columns
+from monitor.collocation.lift import lifted
+from monitor.collocation.render import render_columns, view_tangents
+from tests.collocation.test_lift import scan_geometry
 
 M_PER_K = 150.0
 
@@ -82,3 +84,25 @@ def test_a_tall_cloud_hides_the_ground_behind_it_and_shows_its_wall():
     assert kind[109] == 2 and bt[109] < seen[109] < ref[109]  # the far edge: rays pass under the top
     assert seen[109] == pytest.approx(ref[109] - (41062.5 - x[109]) / 0.0215 / M_PER_K)
     assert np.all(kind[110:] == 0) and np.all(kind[:99] == 0) and np.all(kind[100:109] == 1)
+
+
+def test_the_view_tangents_follow_the_lines_of_sight():
+    """b is the along-track run per metre of height of a pixel lifted up its VIIRS line of sight; a CrIS row
+    at a detector's own in-track angle sees that pixel along VIIRS's line (a = b); an outer row's 19.1 mrad
+    are ~21.6 mrad at the ground at nadir (1 + range / R_earth), towards -x for the row ahead."""
+    lat, lon, h, origin, sat, v = scan_geometry()
+    good = np.ones(lat.shape, bool)
+    c, i = 200, 3  # a column near nadir, a detector near the scan's edge
+    own = np.arctan(np.tan((i - 15.5) * 4.5e-4) / np.cos(np.linspace(-0.9, 0.9, 400)[c]))
+    x, b, a = view_tangents(lat, lon, h, good, sat[None], v[None], np.array([own, 0.0191, -0.0191]))
+    assert a[0, i, c] == pytest.approx(b[i, c], abs=1e-6)
+    up = np.full(lat.shape, 10_000.0, np.float32)
+    la, lo, hh = lifted(lat, lon, h, up, sat[None], v[None])
+    x_up, _, _ = view_tangents(la, lo, np.zeros_like(hh), good, sat[None], v[None], np.zeros(1))
+    run = (x_up - x) * 6_371e3 / (6_371e3 + 10e3) / 10_000.0  # x_up is on the ellipsoid below the point
+    assert np.abs(run - b).max() < 2e-4  # of tangents ~0.007
+    ground = (a[1:, :, c] - b[:, c]).mean(axis=1)
+    assert ground[0] == pytest.approx(-0.0191 * (1 + 833 / 6378), rel=0.005)
+    assert ground[1] == pytest.approx(-ground[0], rel=0.03)
+    assert np.all(np.diff(x[:, c]) > 0)  # the detectors in along-track order, 375 m apart
+    assert np.median(np.diff(x[:, c])) == pytest.approx(833e3 * 4.5e-4, rel=0.02)
