@@ -58,7 +58,12 @@ def lift_m(bt_k: np.ndarray, good: np.ndarray, m_per_k: float) -> np.ndarray:
     reference it is (0 where unusable)."""
     if m_per_k == 0.0:
         return np.zeros(bt_k.shape, np.float32)
-    cooling = np.nan_to_num(reference_k(bt_k, good) - bt_k, nan=0.0)
+    return height_above_m(bt_k, good, reference_k(bt_k, good), m_per_k)
+
+
+def height_above_m(bt_k: np.ndarray, good: np.ndarray, reference_k: np.ndarray, m_per_k: float) -> np.ndarray:
+    """Each pixel's height (m) above its GEO point given its clear-sky *reference_k* (:func:`lift_m`)."""
+    cooling = np.nan_to_num(reference_k - bt_k, nan=0.0)
     return np.where(good, m_per_k * np.maximum(cooling, 0.0), 0.0).astype(np.float32)
 
 

@@ -39,9 +39,62 @@ import math
 import numba
 import numpy as np
 
-from monitor.collocation.lift import ROTATION_RAD_S, scan_points
+from monitor.collocation.lift import ROTATION_RAD_S, height_above_m, reference_k, scan_points
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
+
+COLUMNS_PER_PASS = 512  # columns rendered at a time: the sort's and the tangents' arrays stay ~60 MB
+
+
+def rendered_bt(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    bt_k: np.ndarray,
+    good: np.ndarray,
+    sat_m: np.ndarray,
+    velocity_m_s: np.ndarray,
+    cris_alpha_rad: np.ndarray,
+    m_per_k: float,
+) -> np.ndarray:
+    """The BT (K, float32 (rows, cols) per CrIS FOV row: (len(cris_alpha_rad), rows, cols)) that each
+    CrIS FOV row (in-track SBF angle *cris_alpha_rad*) sees along its ray to each GEO point of a VIIRS
+    granule (rows of 32-detector scans, GEO (lat_rad, lon_rad, height_m), BT *bt_k*, usable where
+    *good*; NaN elsewhere), each pixel standing *m_per_k* m per K colder than its clear-sky reference
+    above its GEO point (:func:`monitor.collocation.lift.lift_m`), and its sides at the reference minus
+    their height over *m_per_k*: :func:`view_tangents`, then :func:`render_columns` on each column sorted
+    along the track (the scans' bow-tie overlap interleaves their rows there). A pixel's along-track width
+    is its column's median detector step."""
+    rows, cols = np.shape(bt_k)
+    out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
+    usable = np.asarray(good, bool) & np.isfinite(bt_k)
+    reference = reference_k(bt_k, usable)  # over the whole granule: it looks 40 pixels around
+    for c0 in range(0, cols, COLUMNS_PER_PASS):
+        part = slice(c0, min(c0 + COLUMNS_PER_PASS, cols))
+        ok = usable[:, part]
+        bt = np.asarray(bt_k[:, part], np.float64)
+        ref = reference[:, part]
+        x, b, a = view_tangents(
+            lat_rad[:, part], lon_rad[:, part], height_m[:, part], ok, sat_m, velocity_m_s, cris_alpha_rad
+        )
+        x = np.where(ok, x, np.nan)
+        steps = np.abs(np.diff(x.reshape(rows // VIIRS_DETECTORS, VIIRS_DETECTORS, -1), axis=1))
+        with np.errstate(all="ignore"):
+            width = np.broadcast_to(np.nanmedian(steps, axis=(0, 1)), x.shape)
+        order = np.argsort(np.where(np.isfinite(x), x, np.inf), axis=0, kind="stable")
+
+        def along(v: np.ndarray, order: np.ndarray = order) -> np.ndarray:
+            return np.take_along_axis(np.asarray(v, np.float64), order, axis=0)
+
+        xs, ws, hs, bts, refs, bs = (
+            along(v) for v in (x, width, height_above_m(bt, ok, ref, m_per_k), bt, ref, b)
+        )
+        for j in range(len(cris_alpha_rad)):
+            seen, _ = render_columns(xs, ws, hs, bts, refs, bs, along(a[j]), m_per_k)
+            unsorted = np.empty_like(seen)
+            np.put_along_axis(unsorted, order, seen, axis=0)
+            out[j, :, part] = np.where(ok, unsorted, np.nan)
+    return out
 
 
 def view_tangents(

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from monitor.collocation.lift import lifted
-from monitor.collocation.render import render_columns, view_tangents
+from monitor.collocation.render import render_columns, rendered_bt, view_tangents
 from tests.collocation.test_lift import scan_geometry
 
 M_PER_K = 150.0
@@ -15,7 +15,7 @@ def _marched(x, w, h, bt, ref, b, a, dz=0.5):
     through the columns within 12 pixels: (BT, kind) as render_columns reports them."""
     seen, kind = np.full(len(x), np.nan), np.zeros(len(x), np.int8)
     t = x + h * b
-    z = np.arange(h.max() + dz, -dz / 2, -dz)[:, None]
+    z = np.r_[np.arange(h.max() + dz, dz / 2, -dz), 0.0][:, None]
     for i in range(len(x)):
         near = np.arange(max(i - 12, 0), min(i + 13, len(x)))
         inside = (np.abs(x[i] + z * a[i] - t[near]) <= w[near] / 2) & (h[near] >= z)  # (z, near)
@@ -106,3 +106,34 @@ def test_the_view_tangents_follow_the_lines_of_sight():
     assert ground[1] == pytest.approx(-ground[0], rel=0.03)
     assert np.all(np.diff(x[:, c]) > 0)  # the detectors in along-track order, 375 m apart
     assert np.median(np.diff(x[:, c])) == pytest.approx(833e3 * 4.5e-4, rel=0.02)
+
+
+def test_a_granule_is_rendered_as_each_row_sees_it():
+    """A cloud band 10 km high (65 K colder at 150 m/K) across one scan: each row's picture is what a ray
+    march through each column meets (sorted along the track, the column's detector step as the width);
+    the row ahead sees the band farther ahead than VIIRS put it (its rays meet the top ~210 m farther on,
+    a wall fills some of the rest), the row behind farther back, the centre row where VIIRS put it; flat
+    scenes are left as they are."""
+    lat, lon, h, origin, sat, v = scan_geometry()
+    good = np.ones(lat.shape, bool)
+    bt = np.full(lat.shape, 295.0, np.float32)
+    bt[10:21] = 230.0
+    alphas = np.array([-0.0191, 0.0, 0.0191])
+    flat = rendered_bt(lat, lon, h, np.full_like(bt, 280.0), good, sat[None], v[None], alphas, M_PER_K)
+    assert np.all(flat == 280.0)
+    seen = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K)
+    assert seen.shape == (3, *bt.shape) and seen.dtype == np.float32
+    x, b, a = view_tangents(lat, lon, h, good, sat[None], v[None], alphas)
+    height = (295.0 - bt) * M_PER_K
+    for c in (20, 200, 390):
+        width = np.full(32, np.median(np.diff(x[:, c])))
+        for j in range(3):
+            march, _ = _marched(
+                x[:, c], width, height[:, c], bt[:, c], np.full(32, 295.0), b[:, c], a[j, :, c]
+            )
+            assert seen[j, :, c] == pytest.approx(march, abs=0.01), (c, j)
+    cold = 295.0 - seen[:, :, 150:250]  # columns near nadir
+    centroid = np.sum(cold * x[None, :, 150:250], axis=(1, 2)) / np.sum(cold, axis=(1, 2))
+    band = np.sum((295.0 - bt[:, 150:250]) * x[:, 150:250]) / np.sum(295.0 - bt[:, 150:250])
+    behind, centre, ahead = centroid - band
+    assert -375.0 < behind < -10.0 and 10.0 < ahead < 375.0 and ahead - behind > 100.0 and abs(centre) < 20.0
