@@ -23,9 +23,10 @@ of a few FORs is seen through it. z = estimate / sigma.
 **The thresholds** come from false-detection rates (:func:`threshold`): on each day the blind test tries
 the splits T, T-1, T-2 (a step is found within three days) for every group and both directions; the
 largest |z| of that family, simulated under the fitted rho and phi, exceeds the threshold on a fraction
-``rate_per_year / 365`` of days. At a known change (calendar, metadata, fingerprint) the day that holds it
-is left out of both windows, and its family, the first three days after it, exceeds its own threshold
-with probability ``rate_at_change``. The simulation computes the z's as the rule does, with a noise
+``rate_per_year / 365`` of days (:data:`RATE_MARGIN` of it: the rate is a bound). At a known change
+(calendar, metadata, fingerprint) the day that holds it is left out of both windows, and its family,
+the first three days after it, exceeds its own threshold with probability ``rate_at_change`` (its
+margin likewise). The simulation computes the z's as the rule does, with a noise
 fitted from as many days as the rule had (:func:`_simulated_fits`): a fit from a few weeks misjudges
 rho and lambda by several per cent, which at |z| ~ 4.5 multiplies the false detections, so a young
 history is judged by a higher threshold.
@@ -64,6 +65,9 @@ NULL_DRAWS = 200_000  # simulated days per threshold: ~550 beyond it at 1/365
 MIN_HISTORY_DAYS = 20  # assessed days the noise is fitted from before anything is tested
 REFIT_DAYS = 28  # the noise is fitted anew every four weeks (detect)
 REFIT_EPOCH = dt.date(2000, 1, 3).toordinal()  # a Monday: the refits' dates
+# the thresholds are simulated for this share of the configured rates: the rates are bounds ("at most"),
+# and the noise model (Gaussian, one AR(1) for the shared and the own error) is not the history itself
+RATE_MARGIN = 0.8
 
 
 @dataclass(frozen=True)
@@ -462,8 +466,8 @@ def _fit(
     return _Fit(
         noise,
         sigma,
-        threshold(rules.rate_per_year / 365.0, rho, phi, b, k, False, c, n),
-        threshold(rules.rate_at_change, rho, phi, b, k, True, c, n),
+        threshold(RATE_MARGIN * rules.rate_per_year / 365.0, rho, phi, b, k, False, c, n),
+        threshold(RATE_MARGIN * rules.rate_at_change, rho, phi, b, k, True, c, n),
     )
 
 
