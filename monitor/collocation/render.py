@@ -23,7 +23,8 @@ w_j / 2). Coming down from the spacecraft, it meets column j first at
     z*_j = min(h_j, z_hi)   if that is >= max(z_lo, 0):
 
 its top when z*_j = h_j (the pixel's own BT), its side wall otherwise, at height z_hi, whose BT the height
-law gives: the clear-sky reference minus z / kappa (kappa m per K, :func:`monitor.collocation.lift.lift_m`).
+law gives: the clear-sky reference minus z / kappa (kappa m per K,
+:func:`monitor.collocation.lift.height_above_m`).
 What the ray sees is the column with the highest z*: anything lower on the ray is hidden behind it. Ties
 (flat ground, z* = 0) go to the column whose top centre is nearest the ray.
 
@@ -61,14 +62,15 @@ def rendered_bt(
     CrIS FOV row (in-track SBF angle *cris_alpha_rad*) sees along its ray to each GEO point of a VIIRS
     granule (rows of 32-detector scans, GEO (lat_rad, lon_rad, height_m), BT *bt_k*, usable where
     *good*; NaN elsewhere), each pixel standing *m_per_k* m per K colder than its clear-sky reference
-    above its GEO point (:func:`monitor.collocation.lift.lift_m`), and its sides at the reference minus
-    their height over *m_per_k*: :func:`view_tangents`, then :func:`render_columns` on each column sorted
-    along the track (the scans' bow-tie overlap interleaves their rows there). A pixel's along-track width
-    is its column's median detector step."""
+    above its GEO point (:func:`monitor.collocation.lift.height_above_m`), and its sides at the
+    reference minus their height over *m_per_k*: :func:`view_tangents`, then :func:`render_columns` on
+    each column sorted along the track (the scans' bow-tie overlap interleaves their rows there). A
+    pixel's along-track width is its column's median detector step."""
     rows, cols = np.shape(bt_k)
     out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
     usable = np.asarray(good, bool) & np.isfinite(bt_k)
     reference = reference_k(bt_k, usable)  # over the whole granule: it looks 40 pixels around
+    height = height_above_m(bt_k, usable, reference, m_per_k)
     for c0 in range(0, cols, COLUMNS_PER_PASS):
         part = slice(c0, min(c0 + COLUMNS_PER_PASS, cols))
         ok = usable[:, part]
@@ -86,9 +88,7 @@ def rendered_bt(
         def along(v: np.ndarray, order: np.ndarray = order) -> np.ndarray:
             return np.take_along_axis(np.asarray(v, np.float64), order, axis=0)
 
-        xs, ws, hs, bts, refs, bs = (
-            along(v) for v in (x, width, height_above_m(bt, ok, ref, m_per_k), bt, ref, b)
-        )
+        xs, ws, hs, bts, refs, bs = (along(v) for v in (x, width, height[:, part], bt, ref, b))
         for j in range(len(cris_alpha_rad)):
             seen, _ = render_columns(xs, ws, hs, bts, refs, bs, along(a[j]), m_per_k)
             unsorted = np.empty_like(seen)

@@ -1,6 +1,7 @@
 """The compiled interval formulation of the cone test against a brute-force angle test on every pixel."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -311,3 +312,23 @@ def test_two_threads_may_assess_at_once():
     root = ROOT
     r = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True)
     assert r.returncode == 0 and "both threads done" in r.stdout, r.stderr[-2000:]
+
+
+def test_each_fov_row_adds_the_view_rendered_for_it(scene):
+    """A piece holding one radiance per FOV row: a FOV sums the view of its row, and a piece of one view
+    serves every row."""
+    fg, viirs = scene
+    views = swath.ViirsSwath(
+        [
+            replace(p, radiance=np.concatenate([p.radiance, 0.5 * p.radiance, 2.0 * p.radiance]))
+            for p in viirs.pieces
+        ]
+    )
+    idx = (1, 15, 4)
+    offsets = perturbation_grid(2, 1e-4)
+    own = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets).mean()
+    for row, factor in enumerate((1.0, 0.5, 2.0)):
+        got = collocate.cone_sums(*_one_fov(views, fg, idx), offsets, fov_row=np.array([row])).mean()
+        np.testing.assert_allclose(got, factor * own, rtol=1e-6)
+        same = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets, fov_row=np.array([row])).mean()
+        np.testing.assert_array_equal(same, own)
