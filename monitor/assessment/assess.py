@@ -21,12 +21,10 @@ from typing import overload
 import numpy as np
 
 from monitor.assessment.inputs import (
-    FOV_ROW,
     KERNELS,
     GranuleInputs,
     SwathCache,
     Timings,
-    fov_row_alpha_rad,
     load_swath,
     offsets_rad,
     read_inputs,
@@ -111,10 +109,7 @@ def collocate_granule(
     geo, sdr, fg, valid, fill, bt_cris = (
         inputs.geo, inputs.sdr, inputs.fg, inputs.valid, inputs.fill, inputs.bt_cris_k
     )  # fmt: skip
-    pieces = load_swath(
-        viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs, inputs.span_us,
-        fov_row_alpha_rad(fg, valid),
-    )  # fmt: skip
+    pieces = load_swath(viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs, inputs.span_us)
     with stage(timings, "collocation"):
         bt_viirs, coverage, annuli = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
     usable = (
@@ -179,7 +174,6 @@ def _collocate_fors(
         KERNELS[cfg.kernel],
         fov_range_m=np.where(valid, geo.range_m, 1e6).ravel(),
         fov_cos_zen=np.cos(fill["zenith_rad"]).ravel(),
-        fov_row=np.broadcast_to(FOV_ROW, shape).ravel(),
     )
     cone = KERNELS[cfg.kernel].index(FOV_HALF_ANGLE_RAD)
     bt_viirs = band.bt_from_radiance(cones.mean(cone)).astype(np.float32).reshape(shape + (m, m))

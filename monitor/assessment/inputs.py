@@ -203,15 +203,6 @@ def _run_span(spans: dict[str, Span], key: str, span_us: Span | None) -> Span | 
     return _widen(spans.get(key), span_us) if span_us is not None else None
 
 
-FOV_ROW = np.arange(9) // 3  # the row of each FOV (0-based): 0 FOVs 1-3 (behind), 1 4-6, 2 7-9 (ahead)
-
-
-def fov_row_alpha_rad(fg: FovGeometry, valid: np.ndarray) -> np.ndarray:
-    """The in-track SBF angle (rad) of each CrIS FOV row (FOVs 1-3, 4-6, 7-9; :data:`FOV_ROW`), the
-    median over the granule's valid FOVs: what a row's view of clouds with height is rendered for."""
-    return np.array([np.median(fg.alpha_rad[valid & (FOV_ROW == r)]) for r in range(3)])
-
-
 def piece(
     v: GranuleFiles,
     viirs_all: list[GranuleFiles],
@@ -221,12 +212,11 @@ def piece(
     timings: Timings = None,
     raw: RawViirs | None = None,
     span_us: Span | None = None,
-    row_alpha_rad: np.ndarray | None = None,
 ) -> swath.SwathPiece:
     """The granule prepared out to at least *view_rad* from nadir, with its scans of the IET span
     *span_us* (None: all): from the cache, or prepared out to view_rad + VIEW_MARGIN_RAD (so that the next
     CrIS granule's slightly wider reach finds it ready) with the scans the whole run needs. With the
-    cache's lift, rendered for the CrIS FOV rows at *row_alpha_rad* (:func:`fov_row_alpha_rad`)."""
+    cache's lift, rendered for the in-track angles :data:`monitor.collocation.render.VIEW_ALPHA_RAD`."""
     cached = cache.pieces.get(v.key)
     if cached is not None and cached.view_rad >= view_rad and (span_us is None or cached.covers(*span_us)):
         return cached
@@ -239,18 +229,17 @@ def piece(
     assert geo.height_m is not None  # zeros for the ellipsoid product (ViirsGeoGranule)
     seen = None
     if cache.lift_m_per_k:
-        if row_alpha_rad is None:
-            raise ValueError("a lifted swath is rendered for the CrIS FOV rows: give their in-track angles")
         with stage(timings, "parallax"):
             seen = render.rendered_bt(
                 geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, geo.sc_position_m,
-                geo.sc_velocity_m_s, row_alpha_rad, cache.lift_m_per_k,
+                geo.sc_velocity_m_s, render.VIEW_ALPHA_RAD, cache.lift_m_per_k,
             )  # fmt: skip
     with stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
             sat_m=geo.sc_position_m, view_rad=view_rad + collocate.VIEW_MARGIN_RAD,
             scan_start_us=geo.start_time_us, span_us=run_span, seen_bt_k=seen,
+            view_alpha_rad=render.VIEW_ALPHA_RAD,
         )  # fmt: skip
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))
@@ -267,17 +256,13 @@ def load_swath(
     timings: Timings = None,
     raw: dict[str, RawViirs] | None = None,
     span_us: Span | None = None,
-    row_alpha_rad: np.ndarray | None = None,
 ) -> swath.ViirsSwath:
     """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*) out
     to *view_rad* from nadir and over the IET span *span_us*, from the raw granules in *raw* (key ->
-    :func:`read_viirs`) or read here; rendered for the FOV rows at *row_alpha_rad* with a lift."""
+    :func:`read_viirs`) or read here."""
     raw = raw or {}
     return swath.ViirsSwath(
-        [
-            piece(v, viirs_all, band, cache, view_rad, timings, raw.get(v.key), span_us, row_alpha_rad)
-            for v in viirs
-        ]
+        [piece(v, viirs_all, band, cache, view_rad, timings, raw.get(v.key), span_us) for v in viirs]
     )
 
 

@@ -45,6 +45,10 @@ from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
 
 COLUMNS_PER_PASS = 512  # columns rendered at a time: the sort's and the tangents' arrays stay ~60 MB
+# The in-track SBF angles (rad) a granule is rendered for. CrIS's 3 x 3 FOVs turn with the scan angle
+# (image rotation): at nadir the rows look -19, 0 and +19 mrad in-track, at the scan's ends its corner FOVs
+# -41 and +41. A FOV adds the two views about its own angle, weighted linearly (collocate.cone_sums).
+VIEW_ALPHA_RAD = np.linspace(-0.04, 0.04, 5)
 
 
 def rendered_bt(
@@ -107,38 +111,62 @@ def view_tangents(
     cris_alpha_rad: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per pixel of a VIIRS granule (rows of 32-detector scans; *good* where usable) the along-track
-    coordinate x of its GEO point (m: arc length along the orbit's direction at the point's distance from
-    the orbit plane, from the first scan's spacecraft; NaN where unusable), the in-track tangent b of its
-    VIIRS ray, and per CrIS FOV row (in-track SBF angles *cris_alpha_rad*, rad, positive ahead) the
-    in-track tangent a of that row's ray to the same GEO point: the horizontal along-track run per unit
-    of height towards the spacecraft, positive along +x (:func:`render_columns`).
+    coordinate x of its GEO point (m, along the first scan's SBF x axis; NaN where unusable), the in-track
+    tangent b of its VIIRS ray, and per in-track SBF angle of *cris_alpha_rad* (rad, positive ahead) the
+    in-track tangent a of a CrIS ray at that angle to the same GEO point: the horizontal run along the
+    column per unit of height towards the spacecraft, positive along +x (:func:`render_columns`).
 
-    VIIRS sees the pixel from the spacecraft at the pixel's time (scan *sat_m*, *velocity_m_s* (nscan, 3)
-    ECEF at the scan's middle, :func:`monitor.collocation.lift.scan_points`). The CrIS row sees it from the
-    point of the track where its in-track angle is alpha: from S moved along x_sbf (the velocity without
-    its nadir part) by Delta s = (P - S) . x_sbf - tan(alpha) (P - S) . z_sbf, so that
-    (P - S') . x_sbf = tan(alpha) (P - S') . z_sbf, the SBF taken at S' (three steps: its nadir turns by
-    Delta s / (R_earth + altitude)). A difference of in-track angles between the two instruments is
-    about 1 + range / R_earth times larger at the ground (the local vertical turns along the track too):
-    21.6 mrad for an outer row at nadir."""
+    The SBF during a scan is VIIRS's: it scans the SBF's y-z plane (:func:`_scan_normal`); the columns
+    run along its x axis on the ground. VIIRS sees the pixel from the spacecraft at the pixel's time
+    (scan *sat_m*, *velocity_m_s* (nscan, 3) ECEF at the scan's middle,
+    :func:`monitor.collocation.lift.scan_points`).
+    CrIS at angle alpha sees it from the point S' of the track where (P - S') . x_sbf =
+    tan(alpha) (P - S') . z_sbf, the SBF taken at S' (three steps: its nadir turns by the move over
+    R_earth + altitude). A difference of in-track angles between the two instruments is about
+    1 + range / R_earth times larger at the ground (the local vertical turns along the track too): 21.6 mrad
+    for an outer row at nadir."""
     rows, cols = np.shape(lat_rad)
     sat = np.ascontiguousarray(sat_m, np.float64)
     vel = np.ascontiguousarray(velocity_m_s, np.float64)
-    finite = np.flatnonzero(np.all(np.isfinite(sat), axis=1) & np.all(np.isfinite(vel), axis=1))
     x = np.full((rows, cols), np.nan)
     b = np.full((rows, cols), np.nan, np.float32)
     a = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
-    if finite.size == 0:
-        return x, b, a
-    e1 = sat[finite[0]] / np.linalg.norm(sat[finite[0]])
-    e2 = vel[finite[0]] - (vel[finite[0]] @ e1) * e1
-    e2 /= np.linalg.norm(e2)
-    axes = np.stack([e1, e2, np.cross(e1, e2)])
     geo = [np.ascontiguousarray(v, np.float64) for v in (lat_rad, lon_rad, height_m)]
     tan_alpha = np.tan(np.asarray(cris_alpha_rad, np.float64))
     with KERNEL_LOCK:
-        _tangents(*geo, np.ascontiguousarray(good, np.bool_), sat, vel, axes, tan_alpha, x, b, a)
+        _tangents(*geo, np.ascontiguousarray(good, np.bool_), sat, vel, tan_alpha, x, b, a)
     return x, b, a
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _scan_normal(
+    point: np.ndarray, good: np.ndarray, s: np.ndarray, v: np.ndarray, order: float
+) -> np.ndarray:
+    """The SBF's x axis during one scan: the normal of the plane VIIRS's centre detectors (15 and 16)
+    sweep, from their lines of sight at the scan's two farthest columns (the spacecraft at each pixel's
+    time), turned towards the velocity. VIIRS scans the SBF's y-z plane; the SBF is yawed against the
+    ECEF velocity (~3.5 degrees at the equator), which at a 50 degree scan angle is ~70 mrad in-track.
+    NaN when no column holds both."""
+    out = np.full(3, np.nan)
+    first, last = -1, -1
+    for c in range(good.shape[1]):
+        if good[15, c] and good[16, c]:
+            last = c
+            if first < 0:
+                first = c
+    if first < 0 or last == first:
+        return out
+    rays = np.empty((2, 3))
+    for n, c in enumerate((first, last)):
+        ray = np.zeros(3)
+        for i in (15, 16):
+            q = point[i, c]
+            d = q[:3] - (s + v * (order * q[6] / ROTATION_RAD_S))
+            ray += d / math.sqrt(d @ d)
+        rays[n] = ray
+    normal = np.cross(rays[0], rays[1])
+    normal /= math.sqrt(normal @ normal)
+    return normal if normal @ v > 0 else -normal
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
@@ -149,47 +177,63 @@ def _tangents(
     good: np.ndarray,
     sat: np.ndarray,
     vel: np.ndarray,
-    axes: np.ndarray,
     tan_alpha: np.ndarray,
     x: np.ndarray,
     b: np.ndarray,
     a: np.ndarray,
 ) -> None:
-    """Fill *x*, *b* and *a* (:func:`view_tangents`), one scan a task."""
+    """Fill *x*, *b* and *a* (:func:`view_tangents`), one scan a task; x along the first scan's SBF x."""
     cols = lat.shape[1]
+    axis0 = np.full(3, np.nan)
+    for k in range(lat.shape[0] // VIIRS_DETECTORS):  # the first scan with an SBF: x's axis
+        if np.all(np.isfinite(sat[k])) and np.all(np.isfinite(vel[k])):
+            point = np.empty((VIIRS_DETECTORS, cols, 7))
+            rows = good[k * VIIRS_DETECTORS : (k + 1) * VIIRS_DETECTORS]
+            order = scan_points(lat, lon, h, rows, k * VIIRS_DETECTORS, sat[k], vel[k], point)
+            if order != 0.0:
+                axis0 = _scan_normal(point, rows, sat[k], vel[k], order)
+                if np.all(np.isfinite(axis0)):
+                    break
+    if not np.all(np.isfinite(axis0)):
+        return
     for k in numba.prange(lat.shape[0] // VIIRS_DETECTORS):
         if not (np.all(np.isfinite(sat[k])) and np.all(np.isfinite(vel[k]))):
             continue
         row0 = k * VIIRS_DETECTORS
+        rows = good[row0 : row0 + VIIRS_DETECTORS]
         point = np.empty((VIIRS_DETECTORS, cols, 7))
-        order = scan_points(lat, lon, h, good[row0 : row0 + VIIRS_DETECTORS], row0, sat[k], vel[k], point)
+        order = scan_points(lat, lon, h, rows, row0, sat[k], vel[k], point)
         if order == 0.0:
             continue
         s = sat[k]
         v = vel[k]
+        xs = _scan_normal(point, rows, s, v, order)
+        if not np.all(np.isfinite(xs)):
+            continue
         for i in range(VIIRS_DETECTORS):
             for c in range(cols):
-                if not good[row0 + i, c]:
+                if not rows[i, c]:
                     continue
                 q = point[i, c]
                 p = q[:3]
                 up = q[3:6]
-                track = v - (v @ up) * up  # the along-track horizontal at the point
+                track = xs - (xs @ up) * up  # the SBF's x on the horizontal at the point: a column's way
                 track = track / math.sqrt(track @ track)
-                r = math.sqrt(p @ p)
-                off = math.asin(min(max((p @ axes[2]) / r, -1.0), 1.0))
-                x[row0 + i, c] = r * math.cos(off) * math.atan2(p @ axes[1], p @ axes[0])
-                sv = s + v * (order * q[6] / ROTATION_RAD_S)  # VIIRS at the pixel's time
-                d = sv - p
+                x[row0 + i, c] = p @ axis0
+                d = s + v * (order * q[6] / ROTATION_RAD_S) - p  # to VIIRS at the pixel's time
                 b[row0 + i, c] = (d @ track) / (d @ up)
                 for j in range(tan_alpha.shape[0]):
                     dr = d.copy()
                     for _ in range(3):  # the SBF turns with the spacecraft's move: 11 % of it, then 1 %
                         sr = p + dr
-                        zs = -sr / math.sqrt(sr @ sr)  # the SBF's z (nadir), x (the velocity without it)
-                        xs = v - (v @ zs) * zs
-                        xs = xs / math.sqrt(xs @ xs)
-                        dr = dr + (-(dr @ xs) + tan_alpha[j] * (dr @ zs)) * xs  # Delta s along x
+                        zs = -sr / math.sqrt(sr @ sr)
+                        xj = xs - (xs @ zs) * zs
+                        xj = xj / math.sqrt(xj @ xj)
+                        zs = zs - (zs @ xj) * xj
+                        zs = zs / math.sqrt(zs @ zs)
+                        # along the track by dt: (P - S') . x = tan(alpha) (P - S') . z
+                        dt = (-(dr @ xj) + tan_alpha[j] * (dr @ zs)) / (v @ xj - tan_alpha[j] * (v @ zs))
+                        dr = dr + dt * v
                     a[j, row0 + i, c] = (dr @ track) / (dr @ up)
 
 

@@ -32,7 +32,7 @@ Python exception check in every loop that keeps the compiler from vectorising it
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numba
@@ -69,15 +69,15 @@ class SwathPiece:
     """One VIIRS granule (rows of 32-detector scans) ready for collocation.
 
     ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (views, rows, cols) I5
-    band radiance mW/(m2 sr cm-1), NaN where unusable: one view, the pixels' own, or one per CrIS FOV row
-    (what each sees there, :func:`swath_piece`); area_vec_m2 (rows, cols, 3) float32 the vector footprint
-    with scan overlap removed. block_centre_m (rows/4, ceil(cols/4), 3) and block_radius_m bound the usable
-    pixels of each 4 x 4 block (NaN where it has none). Per column: the smallest column spacing within
-    +-200 columns (col_spacing_m), the along-track advance of a scan (advance_m) and the detector step
-    (det_step_m), all m; max_height_m the highest usable pixel. They size the search windows.
-    The piece holds the granule's columns from *first_column* on that are seen within *view_rad* of nadir
-    (inf: all columns), and its scans from *first_scan* on that cover the IET span *span_us* (start of the
-    first scan, start of the scan after the last; -inf and inf at the granule's ends).
+    band radiance mW/(m2 sr cm-1), NaN where unusable: one view, the pixels' own, or one per in-track SBF
+    angle of *view_alpha_rad* (what a CrIS ray at that angle sees there, :func:`swath_piece`); area_vec_m2
+    (rows, cols, 3) float32 the vector footprint with scan overlap removed. block_centre_m (rows/4,
+    ceil(cols/4), 3) and block_radius_m bound the usable pixels of each 4 x 4 block (NaN where it has none).
+    Per column: the smallest column spacing within +-200 columns (col_spacing_m), the along-track advance of a
+    scan (advance_m) and the detector step (det_step_m), all m; max_height_m the highest usable pixel. They
+    size the search windows. The piece holds the granule's columns from *first_column* on that are seen within
+    *view_rad* of nadir (inf: all columns), and its scans from *first_scan* on that cover the IET span
+    *span_us* (start of the first scan, start of the scan after the last; -inf and inf at the granule's ends).
     """
 
     ecef_m: np.ndarray
@@ -96,6 +96,7 @@ class SwathPiece:
     view_rad: float = math.inf
     first_scan: int = 0
     span_us: tuple = (-math.inf, math.inf)
+    view_alpha_rad: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -447,6 +448,7 @@ def swath_piece(
     scan_start_us: np.ndarray | None = None,
     span_us: tuple[float, float] | None = None,
     seen_bt_k: np.ndarray | None = None,
+    view_alpha_rad: np.ndarray | None = None,
 ) -> SwathPiece:
     """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
 
@@ -460,10 +462,11 @@ def swath_piece(
     of each scan *scan_start_us* (IET us), only the scans observed between t0 and t1
     (:func:`scans_between`), each with the same weights as in the whole granule (the scans next to those
     kept are their halos).
-    *seen_bt_k* (views, rows, cols), when given, is the BT each CrIS FOV row sees along its ray to each GEO
-    point (clouds with height: :func:`monitor.collocation.render.rendered_bt`): the piece then holds one
-    radiance per view (*radiance* (views, rows, cols)), each unusable where the pixel is; else one
-    (1, rows, cols), the pixels' own.
+    *seen_bt_k* (views, rows, cols), when given, is the BT a CrIS ray at each in-track SBF angle of
+    *view_alpha_rad* (views,) sees along its way to each GEO point (clouds with height:
+    :func:`monitor.collocation.render.rendered_bt`): the piece then holds one radiance per view
+    (*radiance* (views, rows, cols)), each unusable where the pixel is; else one (1, rows, cols), the
+    pixels' own.
     """
     scans = slice(None)
     if scan_start_us is not None and span_us is not None:
@@ -520,8 +523,9 @@ def swath_piece(
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
         _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
-    views = radiance[None]
-    if seen_bt_k is not None:
+    views, angles = radiance[None], np.zeros(1)
+    if seen_bt_k is not None and view_alpha_rad is not None:
+        angles = np.asarray(view_alpha_rad, np.float64)
         seen = (np.asarray(seen_bt_k, np.float64) - t_min) / t_step
         inside = np.isfinite(seen) & (seen >= 0) & (seen <= len(table) - 1)
         views = np.interp(np.where(inside, seen, 0.0), np.arange(len(table)), table).astype(f32)
@@ -555,4 +559,5 @@ def swath_piece(
         view_rad,
         scans.start or 0,
         covered_us,
+        angles,
     )

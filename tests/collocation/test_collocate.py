@@ -314,21 +314,28 @@ def test_two_threads_may_assess_at_once():
     assert r.returncode == 0 and "both threads done" in r.stdout, r.stderr[-2000:]
 
 
-def test_each_fov_row_adds_the_view_rendered_for_it(scene):
-    """A piece holding one radiance per FOV row: a FOV sums the view of its row, and a piece of one view
-    serves every row."""
+def test_each_fov_adds_the_views_about_its_own_in_track_angle(scene):
+    """A piece rendered for three in-track angles (here: its radiance, halved, doubled): a FOV at an angle
+    between two views adds their linear blend, one beyond the ends the nearest; a piece of one view
+    serves every FOV."""
     fg, viirs = scene
-    views = swath.ViirsSwath(
-        [
-            replace(p, radiance=np.concatenate([p.radiance, 0.5 * p.radiance, 2.0 * p.radiance]))
-            for p in viirs.pieces
-        ]
-    )
     idx = (1, 15, 4)
+    alpha = fg.alpha_rad[idx]
     offsets = perturbation_grid(2, 1e-4)
     own = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets).mean()
-    for row, factor in enumerate((1.0, 0.5, 2.0)):
-        got = collocate.cone_sums(*_one_fov(views, fg, idx), offsets, fov_row=np.array([row])).mean()
+    for angles, factor in (
+        ((alpha - 0.01, alpha + 0.01, alpha + 0.03), 0.75),
+        ((alpha + 0.01, alpha + 0.02, alpha + 0.03), 1.0),
+    ):
+        views = swath.ViirsSwath(
+            [
+                replace(
+                    p,
+                    radiance=np.concatenate([p.radiance, 0.5 * p.radiance, 2 * p.radiance]),
+                    view_alpha_rad=np.array(angles),
+                )
+                for p in viirs.pieces
+            ]
+        )
+        got = collocate.cone_sums(*_one_fov(views, fg, idx), offsets).mean()
         np.testing.assert_allclose(got, factor * own, rtol=1e-6)
-        same = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets, fov_row=np.array([row])).mean()
-        np.testing.assert_array_equal(same, own)
