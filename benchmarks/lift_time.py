@@ -1,14 +1,13 @@
-"""What drawing one VIIRS granule as the CrIS FOV rows see it costs: the pixels' heights over the clear-sky
-reference, their view tangents, the columns sorted along the track and rendered for each of the three rows
-(``monitor.collocation.render.rendered_bt``), on 1 and 2 threads.
+"""What lifting one VIIRS granule's pixels to their cloud heights costs: the clear-sky reference and the
+lift (``monitor.collocation.lift.lift_m``), then the lifted points (``monitor.collocation.lift.lifted``),
+on 1 and 2 threads.
 
     python -m benchmarks.lift_time --data DIR [--granule 3] [--repeat 3] [--rows FILE]
 
 *data* is a simulated case (``crisgeo simulate``, ``benchmarks.day_memory --data``); the granule is the
 *granule*-th VIIRS granule of its plan, read whole. The kernels are compiled (or loaded from numba's cache)
-on a few scans first. Printed: the median seconds of *repeat* calls, the share of pixels standing above
-their GEO points, and a checksum of the rendered BT so that two codes can be compared for the same
-numbers. The rows before 0285fa0 timed the point lift this replaced (``lifted_s_*``).
+on a few scans first. Printed: the median seconds of *repeat* calls, and a checksum of the lifted points
+so that two codes can be compared for the same numbers.
 """
 
 from __future__ import annotations
@@ -25,11 +24,9 @@ import numpy as np
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.inputs import read_viirs
-from monitor.collocation import lift, render
+from monitor.collocation import lift as pixel_lift
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.sdr.pairing import plan
-
-ROW_ALPHA_RAD = np.array([-0.0191, 0.0, 0.0191])  # the CrIS FOV rows' in-track angles, behind to ahead
 
 
 def _median_s(call: Callable[[], object], repeat: int) -> float:
@@ -52,27 +49,29 @@ def main() -> None:
     case = plan([Path(args.data)])
     geo, sdr, _, _ = read_viirs(case.viirs_all[args.granule], case.viirs_all)
     assert geo.height_m is not None
-    lat, lon, h, bt, good = geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good
-    sat, vel = geo.sc_position_m, geo.sc_velocity_m_s
-
-    def rendered(rows: slice = slice(None), scans: slice = slice(None)) -> np.ndarray:
-        return render.rendered_bt(
-            lat[rows], lon[rows], h[rows], bt[rows], good[rows], sat[scans], vel[scans], ROW_ALPHA_RAD,
-            PROBE_M_PER_K,
-        )  # fmt: skip
-
-    rendered(slice(0, 64), slice(0, 2))  # two scans: compiled here, not timed
-    height = lift.height_above_m(sdr.bt_k, sdr.good, lift.reference_k(sdr.bt_k, sdr.good), PROBE_M_PER_K)
+    lat, lon, h = geo.lat_rad, geo.lon_rad, geo.height_m
+    few = slice(0, 64)  # two scans: compiled here, not timed
+    ones = np.ones_like(sdr.bt_k[few])
+    pixel_lift.lifted(lat[few], lon[few], h[few], ones, geo.sc_position_m[:2], geo.sc_velocity_m_s[:2])
+    lift = pixel_lift.lift_m(sdr.bt_k, sdr.good, PROBE_M_PER_K)
     row = {
         "commit": commit(),
-        "pixels": int(height.size),
-        "lifted_share": round(float(np.mean(height > 0)), 3),
+        "pixels": int(lift.size),
+        "lifted_share": round(float(np.mean(lift > 0)), 3),
+        "lift_m_s": round(
+            _median_s(lambda: pixel_lift.lift_m(sdr.bt_k, sdr.good, PROBE_M_PER_K), args.repeat), 2
+        ),
     }
+    args_lifted = (lat, lon, h, lift, geo.sc_position_m, geo.sc_velocity_m_s)
     for threads in (1, 2):
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-        row[f"rendered_s_{threads}_threads"] = round(_median_s(rendered, args.repeat), 2)
-    seen = rendered()
-    row["checksum"] = hashlib.sha256(np.ascontiguousarray(seen).tobytes()).hexdigest()[:16]
+        row[f"lifted_s_{threads}_threads"] = round(
+            _median_s(lambda: pixel_lift.lifted(*args_lifted), args.repeat), 2
+        )
+    points = pixel_lift.lifted(*args_lifted)
+    row["checksum"] = hashlib.sha256(b"".join(np.ascontiguousarray(a).tobytes() for a in points)).hexdigest()[
+        :16
+    ]
     emit(row, args.rows)
 
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import assess_paths
-from monitor.collocation import render
+from monitor.collocation import lift as pixel_lift
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_COLUMNS
 from monitor.core.result import AssessmentResult
@@ -68,32 +68,29 @@ def _recording(
 
 
 class _Counted(Protocol):
-    """The true heights' wrapper, counting the pixel rows it found a truth for."""
+    """The true lift's wrapper, counting the pixel rows it found a truth for."""
 
     rows: int
     total: int
 
-    def __call__(self, *args: np.ndarray | float) -> np.ndarray: ...
+    def __call__(self, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
 
 
-def _true_heights(rendered: Callable[..., np.ndarray]) -> _Counted:
-    """``monitor.collocation.render.rendered_bt`` with each pixel standing at the recorded truth of its row
-    (0 where none) instead of the height its BT implies; the walls keep the day's law."""
+def _true_lift(lifted: Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray]]) -> _Counted:
+    """``monitor.collocation.lift.lifted`` with each row's lift replaced by the recorded truth (0 where
+    none)."""
 
     def wrapped(
         lat_rad: np.ndarray,
         lon_rad: np.ndarray,
         height_m: np.ndarray,
-        bt_k: np.ndarray,
-        good: np.ndarray,
+        lift: np.ndarray,
         sat_m: np.ndarray,
         velocity_m_s: np.ndarray,
-        cris_alpha_rad: np.ndarray,
-        m_per_k: float,
-    ) -> np.ndarray:
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         lat = np.degrees(np.asarray(lat_rad, np.float64)).astype(np.float32)
         lon = np.degrees(np.asarray(lon_rad, np.float64)).astype(np.float32)
-        truth = np.zeros(np.shape(bt_k), np.float32)
+        truth = np.zeros(np.shape(lift), np.float32)
         found = 0
         for i, key in enumerate(_key(lat, lon)):
             row = TRUTH.get(key)
@@ -104,14 +101,7 @@ def _true_heights(rendered: Callable[..., np.ndarray]) -> _Counted:
         truth = np.where(np.isfinite(lat) & np.isfinite(lon) & (np.abs(lat) <= 90.0), truth, 0.0)
         counted.rows += found
         counted.total += len(truth)
-        own = render.height_above_m
-        render.height_above_m = lambda *_: truth  # the rendering's heights
-        try:
-            return rendered(
-                lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k
-            )
-        finally:
-            render.height_above_m = own
+        return lifted(lat_rad, lon_rad, height_m, truth, sat_m, velocity_m_s)
 
     counted = cast(_Counted, wrapped)
     counted.rows = counted.total = 0
@@ -153,8 +143,8 @@ def main() -> int:
     )
     cfg = AssessmentConfig()
     shipped = _scores(assess_paths([root], cfg), truth)
-    true_lift = _true_heights(render.rendered_bt)
-    render.rendered_bt = true_lift  # type: ignore[assignment]  # the same call, counted
+    true_lift = _true_lift(pixel_lift.lifted)
+    pixel_lift.lifted = true_lift  # type: ignore[assignment]  # the same call, counted
     day_parallax.day_lift = lambda s0, s1, cost: (1.0, float("nan"))
     oracle = _scores(assess_paths([root], cfg), truth)
     print(f"oracle rows matched {true_lift.rows}/{true_lift.total}")

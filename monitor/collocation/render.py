@@ -28,6 +28,9 @@ law gives: the clear-sky reference minus z / kappa (kappa m per K,
 What the ray sees is the column with the highest z*: anything lower on the ray is hidden behind it. Ties
 (flat ground, z* = 0) go to the column whose top centre is nearest the ray.
 
+The assessment does not use this yet: its probe collocation still lifts each pixel to a point
+(:mod:`monitor.collocation.lift`) until the day's lift learnt from rendered views is measured.
+
 Only columns within the reach of the ray matter: |x_i - x_j| <= w_j / 2 + h_max (|a_i| + |b_j|), a few
 pixels for clouds below 20 km and views within 0.05 of the vertical; the sweep looks no farther.
 Compiled, in parallel over the columns.
@@ -45,10 +48,6 @@ from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
 
 COLUMNS_PER_PASS = 512  # columns rendered at a time: the sort's and the tangents' arrays stay ~60 MB
-# The in-track SBF angles (rad) a granule is rendered for. CrIS's 3 x 3 FOVs turn with the scan angle
-# (image rotation): at nadir the rows look -19, 0 and +19 mrad in-track, at the scan's ends its corner FOVs
-# -41 and +41. A FOV adds the two views about its own angle, weighted linearly (collocate.cone_sums).
-VIEW_ALPHA_RAD = np.linspace(-0.04, 0.04, 5)
 
 
 def rendered_bt(
