@@ -33,9 +33,8 @@ column of a ray's height), and the rows' views agree with a brute-force march wi
 GEO points at nadir, 99.9 % at 0.3 across and 99.7 % at the swath's edge (1.1 across; a ray there crosses
 35 columns, so a granule's first and last MARGIN_COLUMNS are rendered with their neighbours), where the
 pixels' own BT is more than 5 K off at 0.4-0.9 %. Not yet used by the assessment (issue 57): it is slow
-(1024 columns near nadir, 5 views: 9.5 s on the 2-core machine with one core busy, where the point lift
-lifts a whole granule in 2.9 s), and a granule's first and last rows are rendered without the next
-granule's pixels.
+(a whole granule at 5 views: 36 s, 66 CPU s on the 2-core machine, where the point lift lifts one in 2.9
+s), and a granule's first and last rows are rendered without the next granule's pixels.
 """
 
 from __future__ import annotations
@@ -280,31 +279,31 @@ def render_height_field(
     top_k = np.full((rows, cols * SUB), np.nan)
     seen = np.full((len(cris_tan), rows, cols), np.nan, np.float32)
     with KERNEL_LOCK:
-        _splat(x, xs, count, *args, top_m, top_k)
+        _splat(x, xs, rank, count, *args, top_m, top_k)
         _march(
-            x, xs, count, spacing, args[1], np.ascontiguousarray(cris_tan, np.float64), slant_sorted,
+            x, xs, rank, count, spacing, args[1], np.ascontiguousarray(cris_tan, np.float64), slant_sorted,
             slant_h, slant_rank, top_m, top_k, float(m_per_k), seen,
         )  # fmt: skip
     return seen
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _nearest(xs: np.ndarray, c: int, n: int, value: float) -> int:
-    """The index of the value nearest *value* among xs[:n, c] (ascending)."""
-    lo, hi = 0, n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if xs[mid, c] <= value:
-            lo = mid
-        else:
-            hi = mid
-    return lo if value - xs[lo, c] <= xs[hi, c] - value else hi
+def _nearest(xs: np.ndarray, c: int, n: int, value: float, hint: int) -> int:
+    """The index of the value nearest *value* among xs[:n, c] (ascending; the lower one of two as near),
+    walked to from *hint* (a ray's own row's place there is a step or two away)."""
+    k = min(max(hint, 0), n - 1)
+    while k + 1 < n and abs(xs[k + 1, c] - value) < abs(xs[k, c] - value):
+        k += 1
+    while k > 0 and abs(xs[k - 1, c] - value) <= abs(xs[k, c] - value):
+        k -= 1
+    return k
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _splat(
     x: np.ndarray,
     xs: np.ndarray,
+    rank: np.ndarray,
     count: np.ndarray,
     b: np.ndarray,
     across: np.ndarray,
@@ -325,14 +324,14 @@ def _splat(
             if f < 0 or c2 >= cols or count[c2] == 0:
                 continue
             base = x[r, c2] if math.isfinite(x[r, c2]) else x[r, c]
-            k = _nearest(xs, c2, count[c2], base + h[r, c] * b[r, c])
+            k = _nearest(xs, c2, count[c2], base + h[r, c] * b[r, c], rank[r, c2])
             if not h[r, c] <= top_m[k, f]:  # NaN: none yet
                 top_m[k, f] = h[r, c]
                 top_k[k, f] = bt[r, c]
     _fill(xs, count, top_m, top_k)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _fill(xs: np.ndarray, count: np.ndarray, top_m: np.ndarray, top_k: np.ndarray) -> None:
     """Give the cells no VIIRS hit stands on (NaN height: the splat's rounding skipped them, or VIIRS did
     not see there) the lower of the nearest hits across the track within FILL_CELLS (0 and NaN where
@@ -340,7 +339,7 @@ def _fill(xs: np.ndarray, count: np.ndarray, top_m: np.ndarray, top_k: np.ndarra
     cols = xs.shape[1]
     hit_m = top_m.copy()
     hit_k = top_k.copy()
-    for f in range(cols * SUB):
+    for f in numba.prange(cols * SUB):
         c = min(int(round(f / SUB)), cols - 1)
         for k in range(count[c]):
             if math.isfinite(hit_m[k, f]):
@@ -352,7 +351,7 @@ def _fill(xs: np.ndarray, count: np.ndarray, top_m: np.ndarray, top_k: np.ndarra
                     c2 = int(round(f2 / SUB))
                     if f2 < 0 or c2 >= cols or count[c2] == 0:
                         break
-                    k2 = k if c2 == c else _nearest(xs, c2, count[c2], xs[k, c])
+                    k2 = k if c2 == c else _nearest(xs, c2, count[c2], xs[k, c], k)
                     if math.isfinite(hit_m[k2, f2]):
                         if hit_m[k2, f2] < best_m:
                             best_m, best_k = hit_m[k2, f2], hit_k[k2, f2]
@@ -365,6 +364,7 @@ def _fill(xs: np.ndarray, count: np.ndarray, top_m: np.ndarray, top_k: np.ndarra
 def _march(
     x: np.ndarray,
     xs: np.ndarray,
+    rank: np.ndarray,
     count: np.ndarray,
     spacing: np.ndarray,
     across: np.ndarray,
@@ -411,15 +411,15 @@ def _march(
                 for n in range(steps + 1):
                     z = z_top * (1.0 - n / steps)
                     if last >= 0 and tops_m[last] > z:  # did it pass below that top before it left?
-                        if _cell_at(x, xs, count, across, r, c, av, tops_m[last]) == last:
+                        if _cell_at(x, xs, rank, count, across, r, c, av, tops_m[last]) == last:
                             value = tops_k[last]
                             break
-                    cell = _cell_at(x, xs, count, across, r, c, av, z)
+                    cell = _cell_at(x, xs, rank, count, across, r, c, av, z)
                     if cell >= 0 and tops_m[cell] >= z:  # in a column: find where it came in
                         low = z
                         for _ in range(BISECTIONS):
                             mid = 0.5 * (low + above)
-                            inner = _cell_at(x, xs, count, across, r, c, av, mid)
+                            inner = _cell_at(x, xs, rank, count, across, r, c, av, mid)
                             if inner >= 0 and tops_m[inner] >= mid:
                                 low, cell = mid, inner
                             else:
@@ -434,6 +434,7 @@ def _march(
 def _cell_at(
     x: np.ndarray,
     xs: np.ndarray,
+    rank: np.ndarray,
     count: np.ndarray,
     across: np.ndarray,
     r: int,
@@ -449,7 +450,7 @@ def _cell_at(
     if f < 0 or c2 >= cols or count[c2] == 0:
         return -1
     base = x[r, c2] if math.isfinite(x[r, c2]) else x[r, c]
-    return _nearest(xs, c2, count[c2], base + z * a) * (cols * SUB) + f  # top_m.flat's index
+    return _nearest(xs, c2, count[c2], base + z * a, rank[r, c2]) * (cols * SUB) + f  # tops_m's index
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
