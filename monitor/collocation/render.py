@@ -69,9 +69,10 @@ def rendered_bt(
 ) -> np.ndarray:
     """The BT (K, float32 (len(cris_alpha_rad), rows, cols)) that a CrIS ray at each in-track SBF angle
     of *cris_alpha_rad* sees on its way to each GEO point of a VIIRS granule (rows of 32-detector scans,
-    GEO (lat_rad, lon_rad, height_m), BT *bt_k*, usable where *good*; NaN elsewhere, and where it sees
-    ground that VIIRS did not), each pixel standing *m_per_k* m per K colder than its clear-sky reference
-    (:func:`monitor.collocation.lift.height_above_m`): :func:`view_tangents`, then
+    GEO (lat_rad, lon_rad, height_m), BT *bt_k*, usable where *good*; NaN elsewhere; ground VIIRS did
+    not see shows its nearest neighbour's across the track, :func:`_fill`), each pixel standing *m_per_k*
+    m per K colder than its clear-sky reference (:func:`monitor.collocation.lift.height_above_m`):
+    :func:`view_tangents`, then
     :func:`render_height_field`, :data:`COLUMNS_PER_PASS` columns at a time with the
     :data:`MARGIN_COLUMNS` about them that their rays can cross."""
     rows, cols = np.shape(bt_k)
@@ -253,28 +254,21 @@ def render_height_field(
     m_per_k: float,
 ) -> np.ndarray:
     """What a CrIS ray at each in-track tangent of *cris_tan* (views, rows, cols) sees on its way to each
-    GEO point (float32 (views, rows, cols), K; NaN where x is, and where it reaches ground VIIRS did not
-    see): the granule's pixels (rows, cols; *x_m* their along-track GEO coordinate, NaN where unusable)
-    seen by VIIRS at *height_m* along rays of in-track tangent *viirs_tan* and *across_per_m* columns per
-    metre of height (:func:`view_tangents`), make a field of vertical columns (:func:`_splat`); each CrIS
-    ray is marched down through it from its top (:func:`_march`). Walls are their column's top's BT plus
-    their depth below it over *m_per_k* (m per K)."""
+    GEO point (float32 (views, rows, cols), K; NaN where x is, and where it reaches a cell no hit stands
+    near, :func:`_fill`). The granule's pixels (rows, cols; *x_m* their along-track GEO coordinate, NaN
+    where unusable), seen by VIIRS at *height_m* along rays of in-track tangent *viirs_tan* and
+    *across_per_m* columns per metre of height (:func:`view_tangents`), make a field of vertical columns
+    (:func:`_splat`); each CrIS ray is marched down through it (:func:`_march`). Walls are their column's
+    top's BT plus their depth below it over *m_per_k* (m per K)."""
     rows, cols = np.shape(x_m)
     x = np.ascontiguousarray(x_m, np.float64)
-    order = np.argsort(np.where(np.isfinite(x), x, np.inf), axis=0, kind="stable")
-    xs = np.take_along_axis(x, order, axis=0)
-    rank = np.empty((rows, cols), np.int64)
-    np.put_along_axis(rank, order, np.arange(rows)[:, None].repeat(cols, 1), axis=0)
+    xs, rank, order = _along(x)
     count = np.isfinite(xs).sum(axis=0).astype(np.int64)
     with np.errstate(all="ignore"):
         spacing = np.nan_to_num(np.nanmedian(np.diff(xs, axis=0), axis=0), nan=400.0)
     args = [np.ascontiguousarray(v, np.float64) for v in (viirs_tan, across_per_m, height_m, bt_k)]
-    slant = x + args[2] * args[0]  # where VIIRS met each pixel, along the track
-    slant_order = np.argsort(np.where(np.isfinite(slant), slant, np.inf), axis=0, kind="stable")
-    slant_sorted = np.take_along_axis(slant, slant_order, axis=0)
+    slant_sorted, slant_rank, slant_order = _along(x + args[2] * args[0])  # where VIIRS met each pixel
     slant_h = np.take_along_axis(args[2], slant_order, axis=0)
-    slant_rank = np.empty((rows, cols), np.int64)
-    np.put_along_axis(slant_rank, slant_order, np.arange(rows)[:, None].repeat(cols, 1), axis=0)
     top_m = np.full((rows, cols * SUB), np.nan)
     top_k = np.full((rows, cols * SUB), np.nan)
     seen = np.full((len(cris_tan), rows, cols), np.nan, np.float32)
@@ -285,6 +279,15 @@ def render_height_field(
             slant_h, slant_rank, top_m, top_k, float(m_per_k), seen,
         )  # fmt: skip
     return seen
+
+
+def _along(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each column of *v* (rows, cols) sorted ascending (NaN last), each row's place in its column's
+    order, and the order."""
+    order = np.argsort(np.where(np.isfinite(v), v, np.inf), axis=0, kind="stable")
+    rank = np.empty(np.shape(v), np.int64)
+    np.put_along_axis(rank, order, np.arange(len(v))[:, None].repeat(np.shape(v)[1], 1), axis=0)
+    return np.take_along_axis(v, order, axis=0), rank, order
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
