@@ -80,10 +80,13 @@ def run_case(
     kernel: str = DEFAULT_KERNEL.value,
     clouds: str = "ground",
     rows_urad: float = 0.0,
+    edges: str = "soft",
+    parallax: bool = True,
 ) -> dict:
     orbit_pass, lon = EXTRA_PASSES.get(pass_name, (pass_name, None))
     gain, bias_k, curve_k = MISMATCHES[mismatch]
-    case = root / f"{profile}_{ground}_{pass_name}_{seed}_{size}_{mismatch}_{shape}_{clouds}_{rows_urad:g}"
+    name = f"{profile}_{ground}_{pass_name}_{seed}_{size}_{mismatch}_{shape}_{clouds}_{rows_urad:g}"
+    case = root / (name + ("" if edges == "soft" else f"_{edges}"))
     if keep and (case / "truth.json").exists():  # a kept case is assessed again, not simulated again
         truth = json.loads((case / "truth.json").read_text())
     else:
@@ -100,10 +103,11 @@ def run_case(
             cris_nonlinear_k=curve_k,
             cris_response=None if shape == "top-hat" else footprint.shape(shape),
             cloud_heights=clouds,
+            cloud_edges=edges,
             fov_rows_alpha_urad=rows_urad,
         )
     t0 = time.perf_counter()
-    cfg = AssessmentConfig(cost=Cost(cost), kernel=Kernel(kernel))
+    cfg = AssessmentConfig(cost=Cost(cost), kernel=Kernel(kernel), parallax=parallax)
     result = assess_paths([case], cfg, workers=workers)
     secs = time.perf_counter() - t0
     (case / "result.json").write_text(result.to_json(with_cube=False))
@@ -136,6 +140,8 @@ def run_case(
         "curvature_k": [f.curvature_k for f in result.fors],
         "sigma_curvature_k": [f.sigma_curvature_k for f in result.fors],
         "clouds": clouds,
+        "edges": edges,
+        "parallax": parallax,
         "parallax_m_per_k": result.fors[0].parallax_m_per_k,
         "fov_rows_alpha_urad": rows_urad,
         "rows_err_alpha_urad": [f.fov_rows_alpha_urad - rows_urad for f in result.fors],
@@ -158,6 +164,8 @@ def _key(r: dict) -> tuple:
         r.get("kernel", "top-hat"),
         r.get("clouds", "ground"),
         r.get("fov_rows_alpha_urad", 0.0),
+        r.get("edges", "soft"),
+        r.get("parallax", True),
     )
 
 
@@ -258,6 +266,11 @@ def main() -> int:
         "--rows-error", type=float, nargs="+", default=[0.0],
         help="FOV rows ahead minus behind turned in-track by this much in the truth, urad",
     )  # fmt: skip
+    p.add_argument(
+        "--edges", choices=("soft", "sharp"), default="soft",
+        help="how sharply the truth's clouds end (monitor.simulate.scene.EDGES)",
+    )  # fmt: skip
+    p.add_argument("--no-parallax", action="store_true", help="assess with AssessmentConfig(parallax=False)")
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--keep", help="directory to keep the cases and results in")
     p.add_argument("--rows", help="append one JSON line per case here (errors and sigmas per FOR)")
@@ -300,12 +313,14 @@ def main() -> int:
             args.kernel,
             clouds,
             rows_urad,
+            args.edges,
+            not args.no_parallax,
         )
         row = done.get(key)
         if row is None:
             row = run_case(
                 root, size, profile, ground, pass_name, seed, args.workers, args.keep, mismatch, args.cost,
-                shape, args.kernel, clouds, rows_urad,
+                shape, args.kernel, clouds, rows_urad, args.edges, not args.no_parallax,
             )  # fmt: skip
             if args.rows:
                 with open(args.rows, "a") as fh:

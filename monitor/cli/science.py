@@ -57,6 +57,12 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
         "tropical (a profile that is not linear); default ground (flat clouds, no parallax)",
     ),
     arg(
+        "--cloud-edges",
+        default="soft",
+        metavar="EDGES",
+        help="soft (the cover fades over a few km) or sharp (blobs cut within a fine cell); default soft",
+    ),
+    arg(
         "--fov-rows-urad",
         type=float,
         default=0.0,
@@ -102,6 +108,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         layout=args.layout,
         cris_response=_footprint(args.footprint),
         cloud_heights=args.clouds,
+        cloud_edges=args.cloud_edges,
         fov_rows_alpha_urad=args.fov_rows_urad,
     )
     if (args.true_ep is None) != (args.ground_ep is None):

@@ -66,7 +66,7 @@ from monitor.simulate import scan_geometry as ins
 from monitor.simulate.clouds import CloudHeights
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
 from monitor.simulate.profiles import load_profile
-from monitor.simulate.scene import Scene, spectra, transmittance
+from monitor.simulate.scene import EDGES, Scene, spectra, transmittance
 from monitor.simulate.sun_synchronous import PASSES, CircularOrbit, find_pass
 
 UTC = dt.timezone.utc
@@ -132,6 +132,8 @@ class SimulationSpec:
     cris_response: Response | tuple[Response, ...] | None = None
     # the height of the cloud tops (monitor.simulate.clouds): ground (flat), lapse:G (K/km) or tropical
     cloud_heights: str = "ground"
+    # how sharply the clouds' cover ends (monitor.simulate.scene.EDGES): "soft" or "sharp"
+    cloud_edges: str = "soft"
     # the true LOS of FOVs 7-9 turned +half this in-track, of FOVs 1-3 -half, unknown to GEO (urad)
     fov_rows_alpha_urad: float = 0.0
 
@@ -166,6 +168,8 @@ class SimulationSpec:
         if isinstance(self.cris_response, tuple) and len(self.cris_response) != N_FOV:
             raise DataError(f"a response per FOV needs {N_FOV}, not {len(self.cris_response)}")
         CloudHeights.parse(self.cloud_heights)  # a law it does not know is a DataError now, not mid-case
+        if self.cloud_edges not in EDGES:
+            raise DataError(f"cloud edges {self.cloud_edges!r}: not one of {', '.join(EDGES)}")
         if self.pass_lon_deg is not None and self.orbit_pass is None:
             raise DataError("a pass longitude needs an orbit pass")
         if (self.true_ep is None) != (self.ground_ep is None):
@@ -249,6 +253,7 @@ class Simulator:
             terrain=spec.terrain,
             night=night,
             clouds=CloudHeights.parse(spec.cloud_heights),
+            edges=spec.cloud_edges,
         )
         self.band = i5_band(spec.satellite)
         self.nu = cris_lw_wavenumbers_cm1()
@@ -678,6 +683,7 @@ def simulate_case(
         "pass_lon_deg": spec.pass_lon_deg,
         "terrain": spec.terrain,
         "cloud_heights": spec.cloud_heights,
+        "cloud_edges": spec.cloud_edges,
         "fov_rows_alpha_urad": spec.fov_rows_alpha_urad,
         "cris_calibration": {
             "bias_k": spec.cris_bias_k,

@@ -48,6 +48,9 @@ LAND_DAY_K, LAND_NIGHT_K = 6.0, -5.0
 MAX_SLOPE = 0.4
 MAX_HEIGHT_M = 4000.0
 CLOUD_PER_M = 0.15e-3  # more cloud over high ground: the cloud field's threshold drops 0.15 per km
+# the cloud field's values over which the cover rises from 0 to 1 (the field has unit variance): "soft"
+# edges blend cloud and surface over a few km, "sharp" ones within a fine cell (the blobs of a 1 km grid)
+EDGES = {"soft": 0.6, "sharp": 0.02}
 
 
 def _random_field(rng: np.random.Generator, n: int, slope: float, low_cut: float) -> np.ndarray:
@@ -124,10 +127,11 @@ def _terrain_m(land: float, relief: float, ridges: float, land_threshold: float,
     return coast * min(plateau + ridge, MAX_HEIGHT_M) * gain
 
 
-@numba.vectorize(["float64(float64, float64, float64)"], cache=True)
-def _cover(cloud: float, threshold: float, ground_m: float) -> float:
-    """Cloud cover 0..1 of the cloud field's value (more cloud over high ground), soft at the edges."""
-    return min(max((cloud - threshold + CLOUD_PER_M * ground_m) / 0.6, 0.0), 1.0)
+@numba.vectorize(["float64(float64, float64, float64, float64)"], cache=True)
+def _cover(cloud: float, threshold: float, ground_m: float, edge: float) -> float:
+    """Cloud cover 0..1 of the cloud field's value (more cloud over high ground), rising from 0 to 1 over
+    *edge* of the field's values (:data:`EDGES`)."""
+    return min(max((cloud - threshold + CLOUD_PER_M * ground_m) / edge, 0.0), 1.0)
 
 
 @numba.vectorize(["float64(float64)"], cache=True)
@@ -147,9 +151,9 @@ def _surface_m(x, y, z, fields, params, law_k, law_m, clouds, buf):  # type: ign
     """Height (m) of the surface a ray meets at unit normal (x, y, z): the terrain, and with *clouds* the
     cloud standing on it (cover x its top's height above the terrain: tops and sides). *fields* the cloud,
     surface and shape fields' (flat, n, scale); *params* (cloud threshold, land threshold, relief gain,
-    terrain 0/1); the law's knots (cooling K, height m); *buf* (3,) scratch."""
+    terrain 0/1, cover edge); the law's knots (cooling K, height m); *buf* (3,) scratch."""
     cloud, surf, shape = fields
-    cloud_threshold, land_threshold, gain, terrain = params
+    cloud_threshold, land_threshold, gain, terrain, edge = params
     ground = 0.0
     if terrain:
         _sample(x, y, z, shape[0], shape[1], shape[2], buf)
@@ -157,7 +161,7 @@ def _surface_m(x, y, z, fields, params, law_k, law_m, clouds, buf):  # type: ign
     if not clouds:
         return ground
     _sample(x, y, z, cloud[0], cloud[1], cloud[2], buf)
-    cover = _cover(buf[0], cloud_threshold, ground)
+    cover = _cover(buf[0], cloud_threshold, ground, edge)
     if cover <= 0.0:
         return ground
     _sample(x, y, z, surf[0], surf[1], surf[2], buf)
@@ -258,7 +262,8 @@ class Scene:
 
     ``temperature_k(lat_rad, lon_rad, height_m)`` and ``height_m(lat_rad, lon_rad)`` (zero without
     *terrain*); *night* makes land colder than the sea instead of warmer. *clouds* stands the cloud tops at
-    the height their temperature implies (``top_m``, the surface a line of sight meets first).
+    the height their temperature implies (``top_m``, the surface a line of sight meets first). *edges*
+    (:data:`EDGES`) how sharply the clouds' cover ends.
     """
 
     def __init__(
@@ -269,8 +274,10 @@ class Scene:
         terrain: bool = False,
         night: bool = False,
         clouds: CloudHeights = FLAT,
+        edges: str = "soft",
     ):
         rng = np.random.default_rng(seed)
+        self.edge = EDGES[edges]
         self.terrain = terrain
         self.clouds = clouds
         self.land_offset_k = LAND_NIGHT_K if night else LAND_DAY_K
@@ -317,7 +324,7 @@ class Scene:
     def _compiled(self, clouds: bool) -> tuple:
         """The arguments of :func:`_surface_m` after the point: fields, parameters, law, *clouds*."""
         fields = tuple((f.flat, f.n, f.scale) for f in (self.cloud, self.surface, self.shape))
-        params = (self.cloud_threshold, self.land_threshold, self.relief_gain, float(self.terrain))
+        params = (self.cloud_threshold, self.land_threshold, self.relief_gain, float(self.terrain), self.edge)
         law_k, law_m = self.clouds.knots()
         return fields, params, law_k, law_m, clouds and not self.clouds.flat
 
@@ -356,7 +363,7 @@ class Scene:
         land = self.shape(xyz)[..., 0]
         h = np.zeros(np.shape(lat_rad), np.float32) if height_m is None else np.asarray(height_m, np.float32)
         top, texture = np.moveaxis(self.surface(xyz), -1, 0)
-        cover = _cover(self.cloud(xyz)[..., 0], self.cloud_threshold, h)
+        cover = _cover(self.cloud(xyz)[..., 0], self.cloud_threshold, h, self.edge)
         land_frac = np.clip((land - self.land_threshold) / 0.05, 0.0, 1.0)
         surface = _air_k(xyz[2]) + land_frac * (self.land_offset_k + 3.0 * texture) - LAPSE_K_PER_M * h
         return (surface * (1 - cover) + np.minimum(_top_k(top), surface) * cover).astype(np.float32)

@@ -7,6 +7,7 @@ import pytest
 from monitor.core.errors import DataError
 from monitor.geometry import wgs84
 from monitor.simulate import scan_geometry as ins
+from monitor.simulate import scene as scene_module
 from monitor.simulate.case import SimulationSpec, Simulator
 from monitor.simulate.clouds import CEILING_M, CloudHeights
 from monitor.simulate.scene import Scene
@@ -88,3 +89,19 @@ def test_the_rows_can_be_turned_where_geo_does_not_see():
     assert np.allclose(moved[:, 3:6], 0.0, atol=1e-6)
     assert np.array_equal(plain.los_geo, turned.los_geo)  # GEO does not know
     assert np.allclose(ins.cris_los_sbf(), plain.los_true)
+
+
+def test_sharp_edges_cut_the_cover_where_soft_ones_fade_it():
+    # 100 km along a parallel, 250 m apart, across the edges of a few clouds
+    lat = np.full(400, 0.1)
+    lon = 0.3 + np.arange(400) * 250.0 / 6.371e6
+    soft, sharp = Scene(4), Scene(4, edges="sharp")
+    ground = Scene(4, cloud_fraction=0.0).temperature_k(lat, lon)  # no cloud anywhere
+    top = np.minimum(scene_module._top_k(soft.surface(scene_module._unit_vectors(lat, lon))[..., 0]), ground)
+    cover = {s.edge: (ground - s.temperature_k(lat, lon)) / (ground - top) for s in (soft, sharp)}
+    partial = {edge: np.mean((c > 0.01) & (c < 0.99)) for edge, c in cover.items()}
+    assert partial[soft.edge] > 0.2 and partial[sharp.edge] < partial[soft.edge] / 10
+    clear = cover[soft.edge] < 1e-6  # the same clouds: where the soft cover is none, so is the sharp
+    assert clear.mean() > 0.2 and np.all(cover[sharp.edge][clear] < 1e-6)
+    with pytest.raises(DataError, match="'crisp'"):
+        SimulationSpec(cloud_edges="crisp")
