@@ -1,0 +1,90 @@
+"""What the day's lift decision sees on simulated cases: the fraction of the probe's lift the day's cost
+prefers, and the gain in cost there with its jackknife sigma, for the day and for each FOV row (ahead,
+centre, behind), beside the case's truth (its cloud law, edges, the footprint's full width at half peak).
+The rule (:func:`monitor.estimation.parallax.day_lift`) keeps the lift where the day and each of the rows
+ahead and behind gain more than 2 sigma. Prints one JSON row per case.
+
+    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--rows FILE]
+
+A case directory is one ``crisgeo simulate`` (or ``benchmarks.acceptance --keep``) wrote, with truth.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.provenance import commit, emit
+from monitor.assessment.assess import collocate_plan, for_samples, paired
+from monitor.collocation.lift import PROBE_M_PER_K
+from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import N_FOR
+from monitor.estimation import parallax
+from monitor.estimation.jackknife import granule_runs
+from monitor.instrument.spectral import i5_band
+from monitor.sdr.pairing import plan
+
+ROW_NAMES = ("ahead", "centre", "behind")  # parallax.ROWS
+
+
+def decision(case: Path, workers: int) -> dict:
+    """The row of one case (module docstring)."""
+    truth = json.loads((case / "truth.json").read_text())
+    cfg = AssessmentConfig(workers=workers)
+    pairs = paired(
+        collocate_plan(plan([case]), cfg, workers=workers),
+        collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K),
+    )
+    assert pairs is not None
+    band = i5_band(truth["satellite"])
+    cones = [
+        parallax.matched_cone(
+            for_samples(pairs[0], k, cfg, band), for_samples(pairs[1], k, cfg, band), cfg.cost
+        )
+        for k in range(N_FOR)
+    ]
+    s0, s1 = [a for a, _ in cones], [b for _, b in cones]
+    f = parallax.day_fraction(s0, s1, cfg.cost)
+    runs = granule_runs(np.unique(np.concatenate([a.granule for a in s0])))
+    gain = parallax.row_costs(s0, s1, 0.0, cfg.cost) - parallax.row_costs(s0, s1, f, cfg.cost)
+    gain_g = np.array(
+        [
+            parallax.row_costs(s0, s1, 0.0, cfg.cost, g) - parallax.row_costs(s0, s1, f, cfg.cost, g)
+            for g in runs
+        ]
+    )
+    sigma = [parallax._jackknife_sigma(gain_g[:, r]) for r in range(len(parallax.ROWS))]
+    kept, _ = parallax.day_lift(s0, s1, cfg.cost)
+    row = {
+        "commit": commit(),
+        "case": case.name,
+        "clouds": truth.get("cloud_heights", "ground"),
+        "edges": truth.get("cloud_edges", "soft"),
+        "footprint_width50_deg": None  # None: the paper's top-hat cone
+        if truth.get("cris_response") is None
+        else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
+        "granules": len(runs),
+        "preferred_m_per_k": round(f * PROBE_M_PER_K, 1),
+        "day_gain_sigmas": round(float(gain.sum() / parallax._jackknife_sigma(gain_g.sum(axis=1))), 1),
+        "kept_m_per_k": round(kept * PROBE_M_PER_K, 1),
+    }
+    for name, g, s in zip(ROW_NAMES, gain, sigma, strict=True):
+        row[f"{name}_gain_sigmas"] = round(float(g / s), 1)
+    return row
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("cases", nargs="+", type=Path)
+    p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--rows", help="append the JSON rows to this file")
+    args = p.parse_args()
+    for case in args.cases:
+        emit(decision(case, args.workers), args.rows)
+
+
+if __name__ == "__main__":
+    main()
