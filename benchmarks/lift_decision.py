@@ -1,8 +1,9 @@
 """What the day's lift decision sees on simulated cases: the fraction of the probe's lift the day's cost
 prefers, and the gain in cost there with its jackknife sigma, for the day and for each FOV row (ahead,
 centre, behind), beside the case's truth (its cloud law, edges, the footprint's full width at half peak).
-The rule (:func:`monitor.estimation.parallax.day_lift`) keeps the lift where the day and each of the rows
-ahead and behind gain more than 2 sigma. Prints one JSON row per case.
+The rule (:func:`monitor.estimation.parallax.day_lift`) keeps the lift where the day gains more than 2
+sigma; the rows' gains are what a rule by rows would see (docs/science.md, "What the day's cost cannot
+tell apart"). Prints one JSON row per case.
 
     .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--rows FILE]
 

@@ -23,20 +23,13 @@ them (0 where the cost prefers no lift).
 Its uncertainty is derived like the offsets': the delete-one-granule jackknife of f (each replicate searched
 again about the day's f; a run of consecutive granules per replicate on a long day,
 :func:`monitor.estimation.jackknife.granule_runs`), sigma_f^2 = (G - 1)/G sum (f_g - mean)^2. The lift is kept
-only where it lowers the day's cost by more than twice the jackknife sigma of that gain, and each of the rows
-ahead and behind (:data:`OUTER`) by more than twice its own; else the day is estimated without it (f = 0) and
-sigma_f is the f declined. A high cloud shows from both sides: the rows ahead and behind see it 19 mrad
-forward and back of VIIRS, and each gains from the lift. A day's cost can also prefer a lift that no height is
-behind, where the texture or the footprint buys cost in the centre row or in one outer row: on flat days with
-sharp cloud edges (6 granules) the day's gain was 1.4-4.4 sigma, and two of four kept a lift of 40 and 70 m/K;
-the outer rows' gains were within -0.5..1.7 sigma each. Days with clouds with height gained 6.6 sigma or more
-in each outer row (docs/science.md, "When the day takes the lift"). With fewer than 3 granules nothing can be
-judged: no lift. A day whose clouds lie on the ground can prefer a small lift by a hair of its cost, which
-would turn its rows apart by tens of urad: the test keeps it at none. sigma_f reaches every offset through
-that offset's sensitivity to f, by the delta method: sigma^2 += (dx/df sigma_f)^2, where dx/df is the central
-difference over +-:data:`SENSITIVITY_STEP` of that scaled cone's minimum (the FOR's, and each FOV row's for
-the rows' difference). The rows ahead and behind move apart by ~230 urad per unit of f, the FOR offsets by far
-less.
+only where it lowers the day's cost by more than twice the jackknife sigma of that gain; else the day is
+estimated without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules nothing can be judged:
+no lift. A day whose clouds lie on the ground can prefer a small lift by a hair of its cost, which would turn
+its rows apart by tens of urad: the test keeps it at none. sigma_f reaches every offset through that offset's
+sensitivity to f, by the delta method: sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference
+over +-:data:`SENSITIVITY_STEP` of that scaled cone's minimum (the FOR's, and each FOV row's for the rows'
+difference). The rows ahead and behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
 
 Measured (docs/science.md, "The FOV rows and clouds with height"): the lift follows the simulated laws (232
 m/K for tops at 5 K/km, 127-151 at 8, 192 for the tropical profile) and is declined on flat clouds, terrain
@@ -65,7 +58,6 @@ from monitor.instrument.footprint import HALF_WIDTH_50_RAD, top_hat_weights, wid
 FRACTIONS = np.linspace(0.0, 2.5, 11)
 SENSITIVITY_STEP = 0.1
 ROWS = ((6, 7, 8), (3, 4, 5), (0, 1, 2))  # FOVs 7-9 ahead, 4-6, 1-3 behind
-OUTER = (0, 2)  # the rows of ROWS that see a cloud's parallax from ahead and from behind
 
 
 def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
@@ -153,21 +145,17 @@ def day_fraction(
 
 def day_lift(s0: list[ForSamples], s1: list[ForSamples], cost: Cost) -> tuple[float, float]:
     """The day's fraction of the probe's lift and its jackknife sigma (module docstring): (0, the f
-    declined) where the lift's gain in cost is not significant, in the day and in each of the rows ahead
-    and behind, or cannot be judged (fewer than 3 granules: sigma NaN)."""
+    declined) where the lift's gain in cost is not significant, or cannot be judged (fewer than 3
+    granules: sigma NaN)."""
     f = day_fraction(s0, s1, cost)
     granules = np.unique(np.concatenate([a.granule for a in s0]))
     if len(granules) < 3:
         return 0.0, float("nan")
     runs = granule_runs(granules)
     f_g = np.array([day_fraction(s0, s1, cost, g, near=f) for g in runs])
-    gain_g = np.array([row_costs(s0, s1, 0.0, cost, g) - row_costs(s0, s1, f, cost, g) for g in runs])
-    gain = row_costs(s0, s1, 0.0, cost) - row_costs(s0, s1, f, cost)
-    sigma_f = _jackknife_sigma(f_g)
-    significant = gain.sum() > 2.0 * _jackknife_sigma(gain_g.sum(axis=1))
-    if any(a.fov is not None for a in s0):  # the rows that see a cloud from either side
-        significant &= all(gain[r] > 2.0 * _jackknife_sigma(gain_g[:, r]) for r in OUTER)
-    if not significant:
+    gain_g = np.array([day_cost(s0, s1, 0.0, cost, g) - day_cost(s0, s1, f, cost, g) for g in runs])
+    sigma_f, sigma_gain = _jackknife_sigma(f_g), _jackknife_sigma(gain_g)
+    if day_cost(s0, s1, 0.0, cost) - day_cost(s0, s1, f, cost) <= 2.0 * sigma_gain:
         return 0.0, max(sigma_f, f)
     return f, sigma_f
 

@@ -6,7 +6,7 @@ import pytest
 
 from monitor.core.vocabulary import Cost
 from monitor.estimation.estimate import ForSamples
-from monitor.estimation.parallax import blend, day_fraction, day_lift, sensitivity
+from monitor.estimation.parallax import ROWS, blend, day_cost, day_fraction, day_lift, row_costs, sensitivity
 
 M = 21
 
@@ -57,18 +57,16 @@ def test_a_lift_that_gains_nothing_significant_is_declined_and_its_size_is_the_s
     )
 
 
-@pytest.mark.parametrize("rows", [(3, 4, 5), (6, 7, 8), (0, 1, 2, 3, 4, 5)])
-def test_a_lift_the_rows_ahead_and_behind_do_not_both_want_is_declined(rows):
-    """A day whose cost prefers a lift only in some rows (the texture or the footprint buying cost in the
-    centre row, or in one outer row) is not a day of high clouds: those are seen from ahead and behind."""
-    fors = [pair(0.8, 0.5, seed=k) for k in range(6)]
-    for a, b in fors:
-        other = ~np.isin(a.fov, rows)
-        b.d_k[other] = a.d_k[other]  # the lift changes nothing in the other rows
+def test_the_day_cost_is_its_rows_costs_summed():
+    fors = [pair(0.8, 0.5, seed=k) for k in range(3)]
     s0, s1 = [a for a, _ in fors], [b for _, b in fors]
-    assert day_fraction(s0, s1, Cost.STDEV) > 0.5  # the day's cost alone would take it
-    f, sigma = day_lift(s0, s1, Cost.STDEV)
-    assert f == 0.0 and sigma > 0.5
+    rows = row_costs(s0, s1, 0.3, Cost.STDEV)
+    assert rows.shape == (len(ROWS),) and rows.sum() == pytest.approx(day_cost(s0, s1, 0.3, Cost.STDEV))
+    for a, b in fors:  # the lift no longer changes the rows behind: only their cost moves
+        behind = np.isin(a.fov, ROWS[2])
+        b.d_k[behind] = a.d_k[behind]
+    moved = row_costs(s0, s1, 0.3, Cost.STDEV)
+    assert np.allclose(moved[:2], rows[:2]) and moved[2] != pytest.approx(rows[2])
 
 
 def test_the_sensitivity_is_how_far_the_minimum_moves_per_unit_fraction():
