@@ -46,6 +46,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import DEFAULT_COST, DEFAULT_KERNEL, Cost, Kernel
 from monitor.instrument import footprint
 from monitor.simulate.case import simulate_case
+from monitor.simulate.scene import EDGES
 from monitor.simulate.sun_synchronous import PASSES
 
 # name: (gain, bias K, curvature K at 250/310 K) of CrIS against VIIRS (SimulationSpec.cris_*): the issue's
@@ -267,7 +268,7 @@ def main() -> int:
         help="FOV rows ahead minus behind turned in-track by this much in the truth, urad",
     )  # fmt: skip
     p.add_argument(
-        "--edges", choices=("soft", "sharp"), default="soft",
+        "--edges", choices=tuple(EDGES), default="soft",
         help="how sharply the truth's clouds end (monitor.simulate.scene.EDGES)",
     )  # fmt: skip
     p.add_argument("--no-parallax", action="store_true", help="assess with AssessmentConfig(parallax=False)")
