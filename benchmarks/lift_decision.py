@@ -24,7 +24,7 @@ from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
 from monitor.estimation import parallax
-from monitor.estimation.jackknife import granule_runs
+from monitor.estimation.jackknife import granule_runs, jackknife_sigma
 from monitor.instrument.spectral import i5_band
 from monitor.sdr.pairing import plan
 
@@ -57,7 +57,7 @@ def decision(case: Path, workers: int) -> dict:
             for g in runs
         ]
     )
-    sigma = [parallax._jackknife_sigma(gain_g[:, r]) for r in range(len(parallax.ROWS))]
+    sigma = [jackknife_sigma(gain_g[:, r]) for r in range(len(parallax.ROWS))]
     kept, _ = parallax.day_lift(s0, s1, cfg.cost)
     row = {
         "commit": commit(),
@@ -69,7 +69,7 @@ def decision(case: Path, workers: int) -> dict:
         else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
         "granules": len(runs),
         "preferred_m_per_k": round(f * PROBE_M_PER_K, 1),
-        "day_gain_sigmas": round(float(gain.sum() / parallax._jackknife_sigma(gain_g.sum(axis=1))), 1),
+        "day_gain_sigmas": round(float(gain.sum() / jackknife_sigma(gain_g.sum(axis=1))), 1),
         "kept_m_per_k": round(kept * PROBE_M_PER_K, 1),
     }
     for name, g, s in zip(ROW_NAMES, gain, sigma, strict=True):

@@ -30,12 +30,13 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import gc
 import hashlib
 import io
 import json
 import os
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -49,6 +50,38 @@ RANGES_FOLDER = "ranges"
 BLOCK_LIST = ".blocks"
 
 Fetch = Callable[[ListedFile, int, int], bytes]
+
+
+class _CyclicGcPaused:
+    """Automatic cyclic garbage collection held off while any thread is inside (nesting, across threads).
+
+    h5py calls :class:`RangedReader` holding its global lock, and a fetch waits for threads of its own (the
+    request's watchdog, :meth:`monitor.archive.bounded.BoundedSession.guard`). A collection that starts on
+    such a thread and frees an h5py object waits for that lock: both threads then wait for ever (h5py issue
+    2019; seen here in a CI run as a watchdog that never started). Explicit ``gc.collect()`` still runs."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._inside = 0
+        self._was_enabled = False
+
+    @contextlib.contextmanager
+    def __call__(self) -> Iterator[None]:
+        with self._lock:  # nothing allocated under it: no collection can start here
+            self._inside += 1
+            if self._inside == 1:
+                self._was_enabled = gc.isenabled()
+                gc.disable()
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._inside -= 1
+                if self._inside == 0 and self._was_enabled:
+                    gc.enable()
+
+
+no_cyclic_gc = _CyclicGcPaused()
 
 
 def forget(path: Path) -> None:
@@ -179,7 +212,8 @@ class RangedReader(io.RawIOBase):
         if end <= self.pos:
             return 0
         try:
-            data = self.cache._fetch(self.pos, end)
+            with no_cyclic_gc():
+                data = self.cache._fetch(self.pos, end)
             self._verify()
         except (SourceError, OSError, ValueError) as exc:
             self.failure = str(exc) if isinstance(exc, SourceError) else f"{self.granule}: {exc}"

@@ -96,6 +96,13 @@ def follows_in_time(starts_s: Sequence[float]) -> np.ndarray:
     return (gap > 0) & (gap <= 1.5 * CRIS_GRANULE_US * 1e-6)
 
 
+def jackknife_sigma(replicates: np.ndarray) -> float:
+    """The delete-one jackknife standard error from the G replicates' estimates: sqrt((G - 1)/G sum
+    (x_g - mean)^2)."""
+    g = len(replicates)
+    return float(np.sqrt((g - 1) / g * np.sum((replicates - replicates.mean()) ** 2)))
+
+
 def granule_runs(granules: np.ndarray) -> list[np.ndarray]:
     """The granules each replicate leaves out, from the granule of every sample *granules* (ids in time
     order): each its own up to :data:`MAX_GROUPS` granules, else MAX_GROUPS runs of consecutive ones whose

@@ -52,7 +52,7 @@ from monitor.estimation.estimate import (
     fitted_response,
     through,
 )
-from monitor.estimation.jackknife import granule_runs
+from monitor.estimation.jackknife import granule_runs, jackknife_sigma
 from monitor.instrument.footprint import HALF_WIDTH_50_RAD, top_hat_weights, widths_of_weights
 
 FRACTIONS = np.linspace(0.0, 2.5, 11)
@@ -154,7 +154,7 @@ def day_lift(s0: list[ForSamples], s1: list[ForSamples], cost: Cost) -> tuple[fl
     runs = granule_runs(granules)
     f_g = np.array([day_fraction(s0, s1, cost, g, near=f) for g in runs])
     gain_g = np.array([day_cost(s0, s1, 0.0, cost, g) - day_cost(s0, s1, f, cost, g) for g in runs])
-    sigma_f, sigma_gain = _jackknife_sigma(f_g), _jackknife_sigma(gain_g)
+    sigma_f, sigma_gain = jackknife_sigma(f_g), jackknife_sigma(gain_g)
     if day_cost(s0, s1, 0.0, cost) - day_cost(s0, s1, f, cost) <= 2.0 * sigma_gain:
         return 0.0, max(sigma_f, f)
     return f, sigma_f
@@ -164,12 +164,6 @@ def _lifted(d0: np.ndarray, d1: np.ndarray, f: float) -> np.ndarray:
     """The surfaces (float64) at fraction *f* of the probe's lift from those at none and at the probe's."""
     d0 = d0.astype(np.float64)
     return d0 + f * (d1 - d0)
-
-
-def _jackknife_sigma(replicates: np.ndarray) -> float:
-    """The delete-one jackknife standard error from the replicates' estimates."""
-    g = len(replicates)
-    return float(np.sqrt((g - 1) / g * np.sum((replicates - replicates.mean()) ** 2)))
 
 
 def sensitivity(s0: ForSamples, s1: ForSamples, f: float, cost: Cost) -> np.ndarray:

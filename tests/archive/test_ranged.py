@@ -4,6 +4,8 @@ cache; faults from the hostile test server (tests/servers.py S3Server)."""
 import datetime as dt
 import json
 import os
+import subprocess
+import sys
 
 import h5py
 import numpy as np
@@ -174,3 +176,56 @@ def test_reprocessing_workers_read_their_own_ranges(moto, tmp_path, monkeypatch)
     (out,) = outcomes
     assert out.counts.bytes > 0 and out.counts.requests > 0 and out.counts.downloaded == 0
     assert list((cfg.cache_dir / "ranges").rglob(f"*{BLOCK_LIST}"))  # the worker's block cache
+
+
+_GC_IN_A_SERVICE_THREAD = """
+import gc, sys, threading
+from pathlib import Path
+import h5py
+import numpy as np
+from monitor.archive import listed
+from monitor.archive.ranged import RangedGranule
+
+root = Path(sys.argv[1])
+name = "GCRSO_j01_d20240601_t1200000_e1200298_b33867_c20240601123036800000_oebc_ops.h5"
+with h5py.File(root / "source.h5", "w") as h5:
+    h5["x"] = np.arange(1000.0)
+data = (root / "source.h5").read_bytes()
+
+class Cycle:
+    pass
+
+def collect_soon():
+    gc.set_threshold(1)  # the next allocation starts a collection, here
+    [[] for _ in range(100)]
+    gc.set_threshold(700)
+
+def fetch(f, start, end):
+    # garbage in a cycle that holds an h5py object, and a thread the fetch waits for whose allocations
+    # start a collection (as the request's watchdog does): the collection frees the h5py object
+    c = Cycle()
+    c.me, c.prop = c, h5py.h5p.create(h5py.h5p.FILE_ACCESS)
+    del c
+    worker = threading.Thread(target=collect_soon)
+    worker.start()
+    worker.join()
+    return data[start:end]
+
+granule = RangedGranule(listed(name, len(data), name), fetch, root / "cache")
+with h5py.File(granule.open(), "r") as h5:
+    print(h5["x"][-1])
+"""
+
+
+def test_a_collection_on_a_thread_the_fetch_waits_for_does_not_hang_the_read(tmp_path):
+    """h5py holds its global lock while it reads through the file object; a garbage collection on a thread
+    the fetch waits for that frees an h5py object would wait for it for ever (h5py issue 2019). Run apart,
+    so that a hang fails the test instead of the suite."""
+    done = subprocess.run(
+        [sys.executable, "-c", _GC_IN_A_SERVICE_THREAD, str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "999.0"
