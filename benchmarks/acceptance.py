@@ -83,11 +83,14 @@ def run_case(
     rows_urad: float = 0.0,
     edges: str = "soft",
     parallax: bool = True,
+    wind_m_s: float = 0.0,
+    emissivity: float = 1.0,
 ) -> dict:
     orbit_pass, lon = EXTRA_PASSES.get(pass_name, (pass_name, None))
     gain, bias_k, curve_k = MISMATCHES[mismatch]
     name = f"{profile}_{ground}_{pass_name}_{seed}_{size}_{mismatch}_{shape}_{clouds}_{rows_urad:g}"
-    case = root / (name + ("" if edges == "soft" else f"_{edges}"))
+    weather = ("" if edges == "soft" else f"_{edges}") + (f"_wind{wind_m_s:g}" if wind_m_s else "")
+    case = root / (name + weather + (f"_e{emissivity:g}" if emissivity != 1.0 else ""))
     if keep and (case / "truth.json").exists():  # a kept case is assessed again, not simulated again
         truth = json.loads((case / "truth.json").read_text())
     else:
@@ -106,6 +109,8 @@ def run_case(
             cloud_heights=clouds,
             cloud_edges=edges,
             fov_rows_alpha_urad=rows_urad,
+            wind_in_track_m_s=wind_m_s,
+            cloud_emissivity=emissivity,
         )
     t0 = time.perf_counter()
     cfg = AssessmentConfig(cost=Cost(cost), kernel=Kernel(kernel), parallax=parallax)
@@ -143,6 +148,8 @@ def run_case(
         "clouds": clouds,
         "edges": edges,
         "parallax": parallax,
+        "wind_in_track_m_s": wind_m_s,
+        "cloud_emissivity": emissivity,
         "parallax_m_per_k": result.fors[0].parallax_m_per_k,
         "fov_rows_alpha_urad": rows_urad,
         "rows_err_alpha_urad": [f.fov_rows_alpha_urad - rows_urad for f in result.fors],
@@ -167,6 +174,8 @@ def _key(r: dict) -> tuple:
         r.get("fov_rows_alpha_urad", 0.0),
         r.get("edges", "soft"),
         r.get("parallax", True),
+        r.get("wind_in_track_m_s", 0.0),
+        r.get("cloud_emissivity", 1.0),
     )
 
 
@@ -272,6 +281,8 @@ def main() -> int:
         help="how sharply the truth's clouds end (monitor.simulate.scene.EDGES)",
     )  # fmt: skip
     p.add_argument("--no-parallax", action="store_true", help="assess with AssessmentConfig(parallax=False)")
+    p.add_argument("--wind", type=float, default=0.0, help="the truth's clouds move along the track, m/s")
+    p.add_argument("--cloud-emissivity", type=float, default=1.0, help="the truth's clouds' emissivity")
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--keep", help="directory to keep the cases and results in")
     p.add_argument("--rows", help="append one JSON line per case here (errors and sigmas per FOR)")
@@ -316,12 +327,15 @@ def main() -> int:
             rows_urad,
             args.edges,
             not args.no_parallax,
+            args.wind,
+            args.cloud_emissivity,
         )
         row = done.get(key)
         if row is None:
             row = run_case(
                 root, size, profile, ground, pass_name, seed, args.workers, args.keep, mismatch, args.cost,
-                shape, args.kernel, clouds, rows_urad, args.edges, not args.no_parallax,
+                shape, args.kernel, clouds, rows_urad, args.edges, not args.no_parallax, args.wind,
+                args.cloud_emissivity,
             )  # fmt: skip
             if args.rows:
                 with open(args.rows, "a") as fh:

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Protocol, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import assess_paths
@@ -51,14 +52,14 @@ def _key(lat_deg: np.ndarray, lon_deg: np.ndarray) -> list[tuple[float, float]]:
 
 
 def _recording(
-    self: sim.Simulator, origin: np.ndarray, los: np.ndarray
+    self: sim.Simulator, origin: np.ndarray, los: np.ndarray, unix_s: ArrayLike, ground: sim.Point
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The simulator's ``seen`` (its body, for clouds with height), also recording per pixel row the
+    """The simulator's ``met`` (its body, for clouds with height), also recording per pixel row the
     geodetic height of what the rays meet: on flat ground, the lift a perfect correction would apply."""
-    _, s_lat, s_lon, s_h = self.scene.intersect(origin, los)
+    _, s_lat, s_lon, s_h = self.scene.intersect(origin, los, unix_s=unix_s)
     if los.shape[-2] != VIIRS_COLUMNS:  # CrIS's rays: not recorded
         return s_lat, s_lon, self.scene.height_m(s_lat, s_lon)
-    lat, lon, _ = self.surface(origin, los)
+    lat, lon, _ = ground
     rows_lat = np.degrees(lat).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     rows_lon = np.degrees(lon).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     lift = np.nan_to_num(s_h, nan=0.0).reshape(-1, VIIRS_COLUMNS)
@@ -132,7 +133,7 @@ def main() -> int:
     p.add_argument("--rows", help="append the JSON line here")
     args = p.parse_args()
     root = Path(tempfile.mkdtemp(prefix="crisgeo-oracle-"))
-    sim.Simulator.seen = _recording  # type: ignore[method-assign]  # the oracle's recording seam
+    sim.Simulator.met = _recording  # type: ignore[method-assign]  # the oracle's recording seam
     t0 = time.perf_counter()
     truth = simulate_case(
         root, granules=args.granules, profile="paper", seed=args.seed, cloud_heights=args.clouds,

@@ -63,6 +63,22 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
         help="soft (the cover fades over a few km) or sharp (blobs cut within a fine cell); default soft",
     ),
     arg(
+        "--wind",
+        type=float,
+        default=0.0,
+        metavar="M_S",
+        help="the clouds move this fast along the track (m/s, + in the direction of flight) between the "
+        "two instruments' views; default 0",
+    ),
+    arg(
+        "--cloud-emissivity",
+        type=float,
+        default=1.0,
+        metavar="E",
+        help="every cloud's emissivity, 0 < E <= 1: below 1 the ground shows through (thin cirrus); "
+        "default 1 (opaque)",
+    ),
+    arg(
         "--fov-rows-urad",
         type=float,
         default=0.0,
@@ -110,6 +126,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         cloud_heights=args.clouds,
         cloud_edges=args.cloud_edges,
         fov_rows_alpha_urad=args.fov_rows_urad,
+        wind_in_track_m_s=args.wind,
+        cloud_emissivity=args.cloud_emissivity,
     )
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")

@@ -66,7 +66,7 @@ from monitor.simulate import scan_geometry as ins
 from monitor.simulate.clouds import CloudHeights
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
 from monitor.simulate.profiles import load_profile
-from monitor.simulate.scene import EDGES, Scene, spectra, transmittance
+from monitor.simulate.scene import EDGES, Scene, Wind, spectra, transmittance
 from monitor.simulate.sun_synchronous import PASSES, CircularOrbit, find_pass
 
 UTC = dt.timezone.utc
@@ -139,6 +139,11 @@ class SimulationSpec:
     cloud_edges: str = "soft"
     # the true LOS of FOVs 7-9 turned +half this in-track, of FOVs 1-3 -half, unknown to GEO (urad)
     fov_rows_alpha_urad: float = 0.0
+    # the clouds move this fast along the track (m/s, + in the direction of flight) between the two
+    # instruments' views; the land stays
+    wind_in_track_m_s: float = 0.0
+    # every cloud's emissivity: below 1 the ground behind shows through (a sky of thin cirrus)
+    cloud_emissivity: float = 1.0
 
     def compressed(self, instrument: str) -> bool:
         """Whether the datasets of *instrument* (CrIS, VIIRS) are written gzip-compressed."""
@@ -173,6 +178,10 @@ class SimulationSpec:
         CloudHeights.parse(self.cloud_heights)  # a law it does not know is a DataError now, not mid-case
         if self.cloud_edges not in EDGES:
             raise DataError(f"cloud edges {self.cloud_edges!r}: not one of {', '.join(EDGES)}")
+        if not 0.0 < self.cloud_emissivity <= 1.0:
+            raise DataError(f"cloud emissivity {self.cloud_emissivity!r}: not in (0, 1]")
+        if not math.isfinite(self.wind_in_track_m_s):
+            raise DataError(f"wind {self.wind_in_track_m_s!r} m/s: not a number")
         if self.pass_lon_deg is not None and self.orbit_pass is None:
             raise DataError("a pass longitude needs an orbit pass")
         if (self.true_ep is None) != (self.ground_ep is None):
@@ -212,6 +221,7 @@ def _utc(unix_s: float) -> dt.datetime:
     return dt.datetime.fromtimestamp(unix_s, UTC)
 
 
+Point = tuple[np.ndarray, np.ndarray, np.ndarray]  # geodetic (lat_rad, lon_rad, h_m)
 TOP_HAT_CONE = RadialResponse((0.0, FOV_HALF_ANGLE_RAD), (1.0, 1.0))
 
 
@@ -257,6 +267,7 @@ class Simulator:
             night=night,
             clouds=CloudHeights.parse(spec.cloud_heights),
             edges=spec.cloud_edges,
+            wind=self._wind(),
         )
         self.band = i5_band(spec.satellite)
         self.nu = cris_lw_wavenumbers_cm1()
@@ -276,6 +287,12 @@ class Simulator:
             rows = np.zeros(N_FOV)
             rows[6:9], rows[0:3] = 0.5, -0.5  # FOVs 7-9 ahead, 1-3 behind
             self.los_true = ins.turned(self.los_true, rows * spec.fov_rows_alpha_urad * URAD, 0.0)
+
+    def _wind(self) -> Wind:
+        """The clouds' :class:`Wind` along the track: about the orbit's normal at the case's start."""
+        r, v = self.orbit.state_ecef(self.t0)
+        axis = frames.unit(np.cross(r, v))
+        return Wind((float(axis[0]), float(axis[1]), float(axis[2])), self.spec.wind_in_track_m_s, self.t0)
 
     def attitude_rad(self, unix_s: ArrayLike) -> np.ndarray:
         """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift."""
@@ -306,7 +323,7 @@ class Simulator:
         zen, az, rng_m = wgs84.zenith_azimuth(ground, sat)
         height = self.scene.height_m(lat, lon)  # reported only: GCRSO points are on the ellipsoid
         if spec.cris_sdr:
-            radiance = self._cris_spectra(sat, true_ecef, m[..., :, 0])
+            radiance = self._cris_spectra(sat, true_ecef, m[..., :, 0], for_unix)
             radiance += self.rng.normal(0.0, spec.cris_noise, radiance.shape)
 
         for_iet = _iet_us(for_unix)
@@ -396,7 +413,7 @@ class Simulator:
         zen, az, _ = complete.view_angles(lat_rad, lon_rad, 0.0, sun, direction=True)
         return {"SolarZenithAngle": zen.astype(np.float32), "SolarAzimuthAngle": az.astype(np.float32)}
 
-    def surface(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def surface(self, origin: np.ndarray, los: np.ndarray) -> Point:
         """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is
         one."""
         if not self.spec.terrain:
@@ -405,13 +422,29 @@ class Simulator:
             return lat, lon, np.zeros(lat.shape)
         return self.scene.intersect(origin, los, clouds=False)[1:]
 
-    def seen(self, origin: np.ndarray, los: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """What each ray sees: geodetic (lat_rad, lon_rad) of the first cloud or terrain it meets, and the
-        terrain height (m) there (the flat scene's temperature is a function of the three)."""
+    def met(self, origin: np.ndarray, los: np.ndarray, unix_s: ArrayLike, ground: Point) -> Point:
+        """Where each ray at *unix_s* meets the first cloud or terrain, the clouds where the wind has them
+        then: geodetic (lat_rad, lon_rad) and the terrain height (m) there (the flat scene's temperature is
+        a function of the three); with clouds on the ground, *ground* (:meth:`surface`)."""
         if self.scene.clouds.flat:
-            return self.surface(origin, los)
-        _, lat, lon, _ = self.scene.intersect(origin, los)
+            return ground
+        _, lat, lon, _ = self.scene.intersect(origin, los, unix_s=unix_s)
         return lat, lon, self.scene.height_m(lat, lon)
+
+    def seen(
+        self, origin: np.ndarray, los: np.ndarray, unix_s: ArrayLike, ground: Point | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The temperatures (K) each ray at *unix_s* sees and the weights of their radiances: what it
+        meets (:meth:`met`); with clouds of emissivity below 1 also the ground behind them
+        (:meth:`surface`, or *ground* if already known), so (2, ...) both. Radiances add with these
+        weights; temperatures must not (the radiance is not linear in them)."""
+        ground = ground or self.surface(origin, los)
+        temp = self.scene.temperature_k(*self.met(origin, los, unix_s, ground), unix_s=unix_s)
+        e = self.spec.cloud_emissivity
+        if e == 1.0:
+            return temp[None], np.ones((1,) + (1,) * temp.ndim)
+        behind = self.scene.temperature_k(*ground, cloudy=False)
+        return np.stack([temp, behind]), np.array([e, 1.0 - e]).reshape((2,) + (1,) * temp.ndim)
 
     @property
     def _fov_disk(self) -> tuple[np.ndarray, np.ndarray]:
@@ -447,10 +480,13 @@ class Simulator:
                 out[..., k, f, :] = resp.at(along[..., k, f, :], across[..., k, f, :], turn)
         return out
 
-    def _cris_spectra(self, sat: np.ndarray, los_ecef: np.ndarray, in_track_ecef: np.ndarray) -> np.ndarray:
+    def _cris_spectra(
+        self, sat: np.ndarray, los_ecef: np.ndarray, in_track_ecef: np.ndarray, for_unix: np.ndarray
+    ) -> np.ndarray:
         """LW spectra (nscan, 30, 9, 717) averaged over each true FOV on the scene (the top-hat cone, or
-        weighted by the spatial response out to its reach), not the VIIRS grid; *in_track_ecef* (nscan, 30,
-        3), the SBF x axis, orients an elliptical response."""
+        weighted by the spatial response out to its reach) as it is at each FOR's time *for_unix* (nscan,
+        30), not the VIIRS grid; *in_track_ecef* (nscan, 30, 3), the SBF x axis, orients an elliptical
+        response."""
         x, y = self._fov_disk
         n = len(x)
         helper = np.where(np.abs(los_ecef[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
@@ -462,15 +498,20 @@ class Simulator:
         ahead = np.broadcast_to(in_track_ecef[:, :, None, :], los_ecef.shape)
         weights = self._fov_weights(np.arctan2(np.sum(ahead * e2, -1), np.sum(ahead * e1, -1)))
         origin = np.broadcast_to(sat[..., None, :], dirs.shape)
-        temp = self.scene.temperature_k(*self.seen(origin, dirs)).reshape(-1, n)
+        temps, parts = self.seen(origin, dirs, for_unix[:, :, None, None])
         w = weights.reshape(-1, n)
-        nfov = temp.shape[0]
-        pos = (np.clip(temp, T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (T_BINS_K[1] - T_BINS_K[0])
-        b0 = np.floor(pos).astype(np.int64)
-        w1 = pos - b0
+        nfov = w.shape[0]
+        hist = np.zeros(nfov * len(T_BINS_K))
         rows = np.repeat(np.arange(nfov), n) * len(T_BINS_K)
-        hist = np.bincount(rows + b0.ravel(), (w * (1 - w1)).ravel(), nfov * len(T_BINS_K))
-        hist += np.bincount(rows + b0.ravel() + 1, (w * w1).ravel(), nfov * len(T_BINS_K))
+        for temp, part in zip(temps, parts, strict=True):  # the cloud, and the ground behind a thin one
+            pos = (np.clip(temp.reshape(-1, n), T_BINS_K[0], T_BINS_K[-1] - 1e-6) - T_BINS_K[0]) / (
+                T_BINS_K[1] - T_BINS_K[0]
+            )
+            b0 = np.floor(pos).astype(np.int64)
+            w1 = pos - b0
+            wp = w * np.broadcast_to(part, temp.shape).reshape(-1, n)
+            hist += np.bincount(rows + b0.ravel(), (wp * (1 - w1)).ravel(), hist.size)
+            hist += np.bincount(rows + b0.ravel() + 1, (wp * w1).ravel(), hist.size)
         mean_planck = hist.reshape(nfov, -1) @ self.planck_table / w.sum(axis=1, keepdims=True)
         radiance = spectra(self.nu, mean_planck)
         if not self.spec.calibrated:  # each channel's BT as CrIS would report it
@@ -507,10 +548,9 @@ class Simulator:
             los = np.einsum("scij,dcj->sdci", m, los_sbf)
             origin = np.broadcast_to(r[:, None], los.shape)
             lat, lon, h = self.surface(origin, los)
-            seen = (lat, lon, h) if self.scene.clouds.flat else self.seen(origin, los)
-            temp = self.scene.temperature_k(*seen)
-            lrad = np.interp(temp, T_BINS_K, self.band_table)
-            bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, temp.shape)
+            temps, parts = self.seen(origin, los, tt[:, None, :], (lat, lon, h))
+            lrad = sum(p * np.interp(t, T_BINS_K, self.band_table) for t, p in zip(temps, parts, strict=True))
+            bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, lat.shape)
             rows = slice(s0 * VIIRS_DETECTORS, (s0 + lat.shape[0]) * VIIRS_DETECTORS)
             lat_out[rows] = np.degrees(lat).reshape(-1, VIIRS_COLUMNS)
             lon_out[rows] = np.degrees(lon).reshape(-1, VIIRS_COLUMNS)
@@ -688,6 +728,8 @@ def simulate_case(
         "cloud_heights": spec.cloud_heights,
         "cloud_edges": spec.cloud_edges,
         "fov_rows_alpha_urad": spec.fov_rows_alpha_urad,
+        "wind_in_track_m_s": spec.wind_in_track_m_s,
+        "cloud_emissivity": spec.cloud_emissivity,
         "cris_calibration": {
             "bias_k": spec.cris_bias_k,
             "gain": spec.cris_gain,

@@ -28,6 +28,7 @@ Spectra add a simple atmosphere: R(nu) = tau(nu) B(nu, T) + (1 - tau(nu)) B(nu, 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numba
@@ -146,12 +147,27 @@ def _air_k(sin_lat: float) -> float:
     return 301.0 - 12.0 * sin_lat * sin_lat
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _turned(x, y, z, axis, c, s):  # type: ignore[no-untyped-def]
+    """Unit vector (x, y, z) turned about unit *axis* (3,) by the angle of cosine *c* and sine *s*
+    (Rodrigues)."""
+    kx, ky, kz = axis[0], axis[1], axis[2]
+    dot = (kx * x + ky * y + kz * z) * (1.0 - c)
+    return (
+        x * c + (ky * z - kz * y) * s + kx * dot,
+        y * c + (kz * x - kx * z) * s + ky * dot,
+        z * c + (kx * y - ky * x) * s + kz * dot,
+    )
+
+
 @numba.njit(cache=True, nogil=True)
-def _surface_m(x, y, z, fields, params, law_k, law_m, clouds, buf):  # type: ignore[no-untyped-def]
+def _surface_m(x, y, z, c, s, fields, params, axis, law_k, law_m, clouds, buf):  # type: ignore[no-untyped-def]
     """Height (m) of the surface a ray meets at unit normal (x, y, z): the terrain, and with *clouds* the
-    cloud standing on it (cover x its top's height above the terrain: tops and sides). *fields* the cloud,
-    surface and shape fields' (flat, n, scale); *params* (cloud threshold, land threshold, relief gain,
-    terrain 0/1, cover edge); the law's knots (cooling K, height m); *buf* (3,) scratch."""
+    cloud standing on it (cover x its top's height above the terrain: tops and sides), the clouds' fields
+    read where the wind had them at the scene's reference time: (x, y, z) turned about *axis* (3,) by
+    the angle of cosine *c* and sine *s* (:class:`Wind`). *fields* the cloud, surface and shape fields'
+    (flat, n, scale); *params* (cloud threshold, land threshold, relief gain, terrain 0/1, cover edge);
+    the law's knots (cooling K, height m); *buf* (3,) scratch."""
     cloud, surf, shape = fields
     cloud_threshold, land_threshold, gain, terrain, edge = params
     ground = 0.0
@@ -160,6 +176,7 @@ def _surface_m(x, y, z, fields, params, law_k, law_m, clouds, buf):  # type: ign
         ground = _terrain_m(buf[0], buf[1], buf[2], land_threshold, gain)
     if not clouds:
         return ground
+    x, y, z = _turned(x, y, z, axis, c, s)
     _sample(x, y, z, cloud[0], cloud[1], cloud[2], buf)
     cover = _cover(buf[0], cloud_threshold, ground, edge)
     if cover <= 0.0:
@@ -182,15 +199,16 @@ def _piecewise(x: float, knots_x: np.ndarray, knots_y: np.ndarray) -> float:
 
 
 @numba.njit(cache=True, nogil=True)
-def _surface_points(x, y, z, fields, params, law_k, law_m, clouds, out):  # type: ignore[no-untyped-def]
-    """out (P,) = :func:`_surface_m` at unit normals (x, y, z) (P,)."""
+def _surface_points(x, y, z, turn, fields, params, axis, law_k, law_m, clouds, out):  # type: ignore[no-untyped-def]
+    """out (P,) = :func:`_surface_m` at unit normals (x, y, z) (P,), the wind's turn (cos, sin) (P,)."""
     buf = np.empty(3, np.float32)
+    c, s = turn
     for k in range(x.shape[0]):
-        out[k] = _surface_m(x[k], y[k], z[k], fields, params, law_k, law_m, clouds, buf)
+        out[k] = _surface_m(x[k], y[k], z[k], c[k], s[k], fields, params, axis, law_k, law_m, clouds, buf)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _above_m(r, x, n0, n1, n2, h0, c1, c2, fields, params, law_k, law_m, clouds, buf):  # type: ignore[no-untyped-def]
+def _above_m(r, x, n0, n1, n2, h0, c1, c2, turn, fields, params, axis, law_k, law_m, clouds, buf):  # type: ignore[no-untyped-def]
     """Height (m) of ray *r* above the surface (:func:`_surface_m`) at fraction *x* of its span
     (:class:`monitor.simulate.terrain.RayGeometry`: the normal below it and its height are quadratics)."""
     nx = n0[r, 0] + x * (n1[r, 0] + x * n2[r, 0])
@@ -198,26 +216,32 @@ def _above_m(r, x, n0, n1, n2, h0, c1, c2, fields, params, law_k, law_m, clouds,
     nz = n0[r, 2] + x * (n1[r, 2] + x * n2[r, 2])
     norm = np.sqrt(nx * nx + ny * ny + nz * nz)
     height = h0[r] + x * (c1[r] + x * c2[r])
-    return height - _surface_m(nx / norm, ny / norm, nz / norm, fields, params, law_k, law_m, clouds, buf)
+    c, s = turn[0][r], turn[1][r]
+    return height - _surface_m(
+        nx / norm, ny / norm, nz / norm, c, s, fields, params, axis, law_k, law_m, clouds, buf
+    )
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
-def _march(ray, steps, fields, params, law_k, law_m, clouds, iterations, tolerance_m, out):  # type: ignore[no-untyped-def]
+def _march(ray, turn, steps, fields, params, axis, law_k, law_m, clouds, iterations, tolerance_m, out):  # type: ignore[no-untyped-def]
     """out (R,) = the distance along each ray of :class:`monitor.simulate.terrain.RayGeometry` *ray* to
-    its first crossing of the surface (:func:`_surface_m`): march *steps* (R,) equal steps from the top
+    its first crossing of the surface (:func:`_surface_m`, the wind's turn (cos, sin) (R,) of each ray's
+    time): march *steps* (R,) equal steps from the top
     shell to the ellipsoid; the first that ends on or below the surface brackets the crossing, which
     regula falsi (Illinois) finds to *tolerance_m*."""
     t_top, span, n0, n1, n2, h0, c1, c2 = ray
     # a parallel loop takes arrays, not tuples of them: taken apart here, put together in the loop
     (cloud, cloud_n, cloud_s), (surf, surf_n, surf_s), (shape, shape_n, shape_s) = fields
+    cos_turn, sin_turn = turn
     for r in numba.prange(t_top.shape[0]):
         fields = ((cloud, cloud_n, cloud_s), (surf, surf_n, surf_s), (shape, shape_n, shape_s))
+        turn = (cos_turn, sin_turn)
         buf = np.empty(3, np.float32)
         a, ga = 0.0, 0.0
         b, gb = 1.0, 0.0
         for k in range(int(steps[r]) + 1):
             x = min(k / steps[r], 1.0)
-            g = _above_m(r, x, n0, n1, n2, h0, c1, c2, fields, params, law_k, law_m, clouds, buf)
+            g = _above_m(r, x, n0, n1, n2, h0, c1, c2, turn, fields, params, axis, law_k, law_m, clouds, buf)
             if g > 0.0 and k < steps[r]:
                 a, ga = x, g
             else:
@@ -226,7 +250,7 @@ def _march(ray, steps, fields, params, law_k, law_m, clouds, iterations, toleran
         c, last = b, 0
         for _ in range(iterations):
             c = b if gb == 0.0 else b - gb * (b - a) / (gb - ga)
-            gc = _above_m(r, c, n0, n1, n2, h0, c1, c2, fields, params, law_k, law_m, clouds, buf)
+            gc = _above_m(r, c, n0, n1, n2, h0, c1, c2, turn, fields, params, axis, law_k, law_m, clouds, buf)
             if abs(gc) < tolerance_m:
                 break
             if gc > 0:
@@ -257,13 +281,34 @@ class _Triplanar:
         return out.reshape(shape + (self.flat.shape[2],))
 
 
+@dataclass(frozen=True)
+class Wind:
+    """Clouds carried at *speed_m_s* along a great circle: at unix time t they stand where they stood at
+    *reference_s*, turned about the unit ECEF *axis* by speed (t - reference) / Earth radius (positive:
+    the sense of the right hand about *axis*; about the orbit's normal, the direction of flight)."""
+
+    axis: tuple[float, float, float]
+    speed_m_s: float
+    reference_s: float
+
+    def turn_back(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(cos, sin) of the angle that turns a point at *unix_s* back to where its clouds were at the
+        reference time."""
+        angle = -self.speed_m_s / (EARTH_RADIUS_KM * 1e3) * (np.asarray(unix_s, float) - self.reference_s)
+        return np.cos(angle), np.sin(angle)
+
+
+STILL = Wind((0.0, 0.0, 1.0), 0.0, 0.0)
+
+
 class Scene:
     """Emitting temperature and terrain of the synthetic Earth.
 
-    ``temperature_k(lat_rad, lon_rad, height_m)`` and ``height_m(lat_rad, lon_rad)`` (zero without
-    *terrain*); *night* makes land colder than the sea instead of warmer. *clouds* stands the cloud tops at
-    the height their temperature implies (``top_m``, the surface a line of sight meets first). *edges*
-    (:data:`EDGES`) how sharply the clouds' cover ends.
+    ``temperature_k(lat_rad, lon_rad, height_m, unix_s)`` and ``height_m(lat_rad, lon_rad)`` (zero
+    without *terrain*); *night* makes land colder than the sea instead of warmer. *clouds* stands the
+    cloud tops at the height their temperature implies (``top_m``, the surface a line of sight meets
+    first). *edges* (:data:`EDGES`) how sharply the clouds' cover ends; *wind* carries the clouds (not the
+    land) over the ground.
     """
 
     def __init__(
@@ -275,9 +320,12 @@ class Scene:
         night: bool = False,
         clouds: CloudHeights = FLAT,
         edges: str = "soft",
+        wind: Wind = STILL,
     ):
         rng = np.random.default_rng(seed)
         self.edge = EDGES[edges]
+        self.wind = wind
+        self._axis = np.asarray(wind.axis, np.float64)
         self.terrain = terrain
         self.clouds = clouds
         self.land_offset_k = LAND_NIGHT_K if night else LAND_DAY_K
@@ -322,50 +370,83 @@ class Scene:
         return MAX_HEIGHT_M if self.clouds.flat else max(MAX_HEIGHT_M, CEILING_M)
 
     def _compiled(self, clouds: bool) -> tuple:
-        """The arguments of :func:`_surface_m` after the point: fields, parameters, law, *clouds*."""
+        """The arguments of :func:`_surface_m` after the point and the wind's turn: fields, parameters,
+        the wind's axis, law, *clouds*."""
         fields = tuple((f.flat, f.n, f.scale) for f in (self.cloud, self.surface, self.shape))
         params = (self.cloud_threshold, self.land_threshold, self.relief_gain, float(self.terrain), self.edge)
         law_k, law_m = self.clouds.knots()
-        return fields, params, law_k, law_m, clouds and not self.clouds.flat
+        return fields, params, self._axis, law_k, law_m, clouds and not self.clouds.flat
 
-    def top_m(self, lat_rad: ArrayLike, lon_rad: ArrayLike) -> np.ndarray:
-        """Height (m) of the surface a line of sight meets at geodetic *lat_rad*, *lon_rad*: the terrain,
-        or a cloud's top or side standing on it (cover x the top's height above the terrain)."""
+    def _turn_back(self, unix_s: ArrayLike, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+        """The wind's (cos, sin) turn back to the reference time (:meth:`Wind.turn_back`) at *unix_s*
+        broadcast to *shape*, flattened."""
+        return tuple(  # type: ignore[return-value]
+            np.ascontiguousarray(np.broadcast_to(a, shape), np.float64).ravel()
+            for a in self.wind.turn_back(unix_s)
+        )
+
+    def top_m(self, lat_rad: ArrayLike, lon_rad: ArrayLike, unix_s: ArrayLike = 0.0) -> np.ndarray:
+        """Height (m) of the surface a line of sight meets at geodetic *lat_rad*, *lon_rad* at *unix_s*: the
+        terrain, or a cloud's top or side standing on it (cover x the top's height above the terrain)."""
         x, y, z = (np.ascontiguousarray(c, np.float64).ravel() for c in _unit_vectors(lat_rad, lon_rad))
         out = np.empty(x.size)
-        _surface_points(x, y, z, *self._compiled(True), out)
+        _surface_points(x, y, z, self._turn_back(unix_s, np.shape(lat_rad)), *self._compiled(True), out)
         return out.reshape(np.shape(lat_rad)).astype(np.float32)
 
     def intersect(
-        self, origin_m: np.ndarray, los: np.ndarray, clouds: bool = True
+        self, origin_m: np.ndarray, los: np.ndarray, clouds: bool = True, unix_s: ArrayLike = 0.0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Distance (m) along unit *los* (..., 3) from ECEF *origin_m* to the first surface it meets (the
-        terrain, and with *clouds* the clouds standing on it), and that point's geodetic (lat_rad,
-        lon_rad, h_m); NaN where the ray misses the Earth. Terrain alone is met once: one bracket; clouds
-        are bracketed by marching (:mod:`monitor.simulate.terrain`)."""
+        terrain, and with *clouds* the clouds standing on it where the wind has them at *unix_s*,
+        broadcast to the rays), and that point's geodetic (lat_rad, lon_rad, h_m); NaN where the ray
+        misses the Earth. Terrain alone is met once: one bracket; clouds are bracketed by marching
+        (:mod:`monitor.simulate.terrain`)."""
         tall = clouds and not self.clouds.flat
+        cos_turn, sin_turn = self._turn_back(unix_s, np.shape(los)[:-1])
         return terrain.first_crossing(
             origin_m,
             los,
             self.ceiling_m if tall else MAX_HEIGHT_M,
             terrain.MARCH_STEP_M if tall else np.inf,
-            lambda ray, steps, out: _locked(
-                _march, ray, steps, *self._compiled(clouds), terrain.ITERATIONS, terrain.TOLERANCE_M, out
+            lambda ray, steps, index, out: _locked(
+                _march,
+                ray,
+                (cos_turn[index], sin_turn[index]),
+                steps,
+                *self._compiled(clouds),
+                terrain.ITERATIONS,
+                terrain.TOLERANCE_M,
+                out,
             ),
             None if tall else self.height_m,
         )
 
     def temperature_k(
-        self, lat_rad: ArrayLike, lon_rad: ArrayLike, height_m: ArrayLike | None = None
+        self,
+        lat_rad: ArrayLike,
+        lon_rad: ArrayLike,
+        height_m: ArrayLike | None = None,
+        unix_s: ArrayLike = 0.0,
+        cloudy: bool = True,
     ) -> np.ndarray:
-        """Emitting temperature (K) at geodetic *lat_rad*, *lon_rad* and terrain height *height_m*."""
+        """Emitting temperature (K) at geodetic *lat_rad*, *lon_rad* and terrain height *height_m*, the
+        clouds where the wind has them at *unix_s*; not *cloudy*: the ground's, as if no cloud were
+        there."""
         xyz = _unit_vectors(lat_rad, lon_rad)
         land = self.shape(xyz)[..., 0]
         h = np.zeros(np.shape(lat_rad), np.float32) if height_m is None else np.asarray(height_m, np.float32)
-        top, texture = np.moveaxis(self.surface(xyz), -1, 0)
-        cover = _cover(self.cloud(xyz)[..., 0], self.cloud_threshold, h, self.edge)
+        texture = self.surface(xyz)[..., 1]
         land_frac = np.clip((land - self.land_threshold) / 0.05, 0.0, 1.0)
         surface = _air_k(xyz[2]) + land_frac * (self.land_offset_k + 3.0 * texture) - LAPSE_K_PER_M * h
+        if not cloudy:
+            return surface.astype(np.float32)
+        moved = xyz
+        if self.wind.speed_m_s:
+            shape = np.shape(lat_rad)
+            c, s = (a.reshape(shape) for a in self._turn_back(unix_s, shape))
+            moved = _turned(*xyz, self._axis, c, s)
+        top = self.surface(moved)[..., 0]
+        cover = _cover(self.cloud(moved)[..., 0], self.cloud_threshold, h, self.edge)
         return (surface * (1 - cover) + np.minimum(_top_k(top), surface) * cover).astype(np.float32)
 
 

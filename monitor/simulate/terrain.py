@@ -77,7 +77,8 @@ def _normal(lat_rad: np.ndarray, lon_rad: np.ndarray) -> np.ndarray:
     return np.stack([c * np.cos(lon_rad), c * np.sin(lon_rad), np.sin(lat_rad)], -1)
 
 
-March = Callable[[RayGeometry, np.ndarray, np.ndarray], None]  # (rays, steps, out t) -> None
+# (rays, steps, each ray's index among the ones given, out t) -> None
+March = Callable[[RayGeometry, np.ndarray, np.ndarray, np.ndarray], None]
 
 
 def first_crossing(
@@ -90,7 +91,8 @@ def first_crossing(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Distance (m) along unit *los* (..., 3) from ECEF *origin_m* to the first crossing of a surface at
     most *top_m* high, and the point's geodetic (lat_rad, lon_rad, h_m); NaN where the ray misses the
-    Earth. *march(rays, steps, out)* finds each ray's crossing in *steps* equal steps from the shell down
+    Earth. *march(rays, steps, index, out)* finds each ray's crossing (*index*: the rays' places among
+    those given, flattened) in *steps* equal steps from the shell down
     (steps of at most *step_m* of ground distance; inf: one bracket). Given *floor_height(lat_rad,
     lon_rad)*, the surface is met once: a ray whose ellipsoid point has no surface above it ends there."""
     o = np.ascontiguousarray(np.broadcast_to(np.asarray(origin_m, float), np.shape(los)).reshape(-1, 3))
@@ -108,7 +110,7 @@ def first_crossing(
         ground_m = np.sqrt(np.maximum(ray.span**2 - (top_m + SHELL_MARGIN_M) ** 2, 0.0))
         steps = np.maximum(np.ceil(ground_m / step_m), 1.0)
         hit = np.empty(act.size)
-        march(ray, steps, hit)
+        march(ray, steps, act, hit)
         t[act] = hit
         lat[act], lon[act], h[act] = wgs84.ecef_to_geodetic(
             o[act] + hit[:, None] * d[act], NEAR_SURFACE_ITERATIONS

@@ -6,11 +6,12 @@ import pytest
 
 from monitor.core.errors import DataError
 from monitor.geometry import wgs84
+from monitor.simulate import case as sim_module
 from monitor.simulate import scan_geometry as ins
 from monitor.simulate import scene as scene_module
 from monitor.simulate.case import SimulationSpec, Simulator
 from monitor.simulate.clouds import CEILING_M, CloudHeights
-from monitor.simulate.scene import Scene
+from monitor.simulate.scene import Scene, Wind
 
 
 def test_the_laws_turn_a_top_temperature_into_a_height():
@@ -105,3 +106,78 @@ def test_sharp_edges_cut_the_cover_where_soft_ones_fade_it():
     assert clear.mean() > 0.2 and np.all(cover[sharp.edge][clear] < 1e-6)
     with pytest.raises(DataError, match="'crisp'"):
         SimulationSpec(cloud_edges="crisp")
+
+
+def test_the_wind_carries_the_clouds_and_leaves_the_ground():
+    # along the equator of a scene of sea, a wind about the z axis carries the clouds east
+    still = Scene(4, land_fraction=0.0, clouds=CloudHeights.parse("lapse:6.5"), edges="sharp")
+    windy = Scene(
+        4, land_fraction=0.0, clouds=still.clouds, edges="sharp", wind=Wind((0.0, 0.0, 1.0), 30.0, 0.0)
+    )
+    lat = np.zeros(4000)
+    lon = 0.3 + np.arange(4000) * 100.0 / 6.371e6  # 400 km, 100 m apart
+    moved_rad = 30.0 * 100.0 / 6.371e6  # 3 km in 100 s
+    assert np.allclose(windy.top_m(lat, lon + moved_rad, 100.0), still.top_m(lat, lon), atol=0.5)
+    assert np.allclose(windy.temperature_k(lat, lon + moved_rad, unix_s=100.0), still.temperature_k(lat, lon))
+    assert np.array_equal(windy.top_m(lat, lon, 0.0), still.top_m(lat, lon))  # at the reference time
+    cloudy = still.top_m(lat, lon) > 3000.0
+    moved = np.abs(windy.top_m(lat, lon, 100.0) - still.top_m(lat, lon)) > 1000.0  # an edge passed
+    assert 0.1 < cloudy.mean() < 0.9 and moved.mean() > 0.02
+    # the ground stays: without its clouds the scene is the same at every time
+    assert np.array_equal(
+        windy.temperature_k(lat, lon, unix_s=100.0, cloudy=False), still.temperature_k(lat, lon, cloudy=False)
+    )
+    # a ray at a time meets the clouds where the wind has them then
+    sat = wgs84.geodetic_to_ecef(0.0, 0.4, 833e3)
+    ground = wgs84.geodetic_to_ecef(np.zeros(2000), 0.4 + np.linspace(-0.05, 0.05, 2000))
+    los = (ground - sat) / np.linalg.norm(ground - sat, axis=1, keepdims=True)
+    _, lat_hit, lon_hit, h = windy.intersect(sat, los, unix_s=100.0)
+    assert np.abs(h - windy.top_m(lat_hit, lon_hit, 100.0)).max() < 1.0 and (h > 3000).mean() > 0.1
+    assert np.abs(h - still.top_m(lat_hit, lon_hit)).max() > 1000.0
+
+
+def test_the_case_wind_blows_along_the_track():
+    sim = Simulator(SimulationSpec(granules=1, profile="zero", wind_in_track_m_s=20.0))
+    r, v = sim.orbit.state_ecef(sim.t0)
+    axis = np.array(sim.scene.wind.axis)
+    assert abs(axis @ r) < 1e-9 * np.linalg.norm(r) and abs(axis @ v) < 1e-9 * np.linalg.norm(v)
+    c, s = sim.scene.wind.turn_back(sim.t0 + 100.0)  # 2 km in 100 s, turned back: against the flight
+    back = scene_module._turned(*(r / np.linalg.norm(r)), axis, c, s)
+    assert np.dot(
+        np.array(back) * 6.371e6 - r / np.linalg.norm(r) * 6.371e6, v / np.linalg.norm(v)
+    ) == pytest.approx(-2000.0, rel=1e-3)
+    for wrong in ({"wind_in_track_m_s": float("nan")}, {"cloud_emissivity": 0.0}, {"cloud_emissivity": 1.2}):
+        with pytest.raises(DataError, match=repr(next(iter(wrong.values())))):
+            SimulationSpec(**wrong)
+
+
+def test_thin_clouds_let_the_ground_behind_them_show():
+    opaque = Simulator(
+        SimulationSpec(granules=1, profile="zero", cloud_heights="lapse:6.5", cloud_edges="sharp")
+    )
+    thin = Simulator(
+        SimulationSpec(
+            granules=1, profile="zero", cloud_heights="lapse:6.5", cloud_edges="sharp", cloud_emissivity=0.4
+        )
+    )
+    r, _ = opaque.orbit.state_ecef(opaque.t0)
+    lat0, lon0, _ = wgs84.ecef_to_geodetic(r)
+    rng = np.random.default_rng(5)
+    ground = wgs84.geodetic_to_ecef(
+        lat0 + rng.uniform(-0.05, 0.05, 3000), lon0 + rng.uniform(-0.05, 0.05, 3000)
+    )
+    los = (ground - r) / np.linalg.norm(ground - r, axis=1, keepdims=True)
+    (t_cloud,), (w,) = opaque.seen(r, los, opaque.t0)
+    assert w.all() == 1.0
+    temps, weights = thin.seen(r, los, thin.t0)
+    assert np.array_equal(temps[0], t_cloud) and np.allclose(weights.ravel(), [0.4, 0.6])
+    cloudy = t_cloud < temps[1] - 5.0
+    assert 0.1 < cloudy.mean() < 0.9
+    assert np.mean(temps[1] == t_cloud) > 0.2  # where a ray meets no cloud, it sees the same ground either way
+    # a thin cloud's brightness temperature lies between its top's and the ground's: it reads too low
+    band_k = [thin.band.bt_from_radiance(np.interp(t, sim_module.T_BINS_K, thin.band_table)) for t in temps]
+    radiance = 0.4 * np.interp(temps[0], sim_module.T_BINS_K, thin.band_table)
+    mixed_k = thin.band.bt_from_radiance(
+        radiance + 0.6 * np.interp(temps[1], sim_module.T_BINS_K, thin.band_table)
+    )
+    assert np.all((mixed_k[cloudy] > band_k[0][cloudy] + 2.0) & (mixed_k[cloudy] < band_k[1][cloudy]))
