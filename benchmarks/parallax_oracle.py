@@ -58,14 +58,14 @@ def _recording(
     geodetic height of what the rays meet: on flat ground, the lift a perfect correction would apply."""
     _, s_lat, s_lon, s_h = self.scene.intersect(origin, los, unix_s=unix_s)
     if los.shape[-2] != VIIRS_COLUMNS:  # CrIS's rays: not recorded
-        return s_lat, s_lon, self.scene.height_m(s_lat, s_lon)
+        return s_lat, s_lon, s_h
     lat, lon, _ = ground
     rows_lat = np.degrees(lat).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     rows_lon = np.degrees(lon).astype(np.float32).reshape(-1, VIIRS_COLUMNS)
     lift = np.nan_to_num(s_h, nan=0.0).reshape(-1, VIIRS_COLUMNS)
     for key, row in zip(_key(rows_lat, rows_lon), lift, strict=True):
         TRUTH[key] = row.astype(np.float32)
-    return s_lat, s_lon, self.scene.height_m(s_lat, s_lon)
+    return s_lat, s_lon, s_h
 
 
 class _Counted(Protocol):

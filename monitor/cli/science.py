@@ -75,8 +75,8 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
         type=float,
         default=1.0,
         metavar="E",
-        help="every cloud's emissivity, 0 < E <= 1: below 1 the ground shows through (thin cirrus); "
-        "default 1 (opaque)",
+        help="the emissivity of the clouds met above 7 km (cirrus), 0 < E <= 1: below 1 the ground shows "
+        "through; lower clouds stay opaque; default 1",
     ),
     arg(
         "--fov-rows-urad",

@@ -77,6 +77,7 @@ VIIRS_GRANULE_S = VIIRS_SCANS * ins.VIIRS_SCAN_S
 # finer than VIIRS's 375 m pixels; with 512 a flat sharp-edged 6-granule day read 17.2 / 10.4 urad RMS with no
 # lift, with 4096 7.0 / 5.2 (seed 5, zero profile, 2026-11-28)
 CONE_SAMPLES = {"soft": 512, "sharp": 4096}
+CIRRUS_BASE_M = 7000.0  # a cloud met above this is cirrus: SimulationSpec.cloud_emissivity; below, opaque
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
@@ -142,7 +143,7 @@ class SimulationSpec:
     # the clouds move this fast along the track (m/s, + in the direction of flight) between the two
     # instruments' views; the land stays
     wind_in_track_m_s: float = 0.0
-    # every cloud's emissivity: below 1 the ground behind shows through (a sky of thin cirrus)
+    # the emissivity of the clouds above CIRRUS_BASE_M (thin cirrus): below 1 the ground shows through
     cloud_emissivity: float = 1.0
 
     def compressed(self, instrument: str) -> bool:
@@ -424,27 +425,28 @@ class Simulator:
 
     def met(self, origin: np.ndarray, los: np.ndarray, unix_s: ArrayLike, ground: Point) -> Point:
         """Where each ray at *unix_s* meets the first cloud or terrain, the clouds where the wind has them
-        then: geodetic (lat_rad, lon_rad) and the terrain height (m) there (the flat scene's temperature is
-        a function of the three); with clouds on the ground, *ground* (:meth:`surface`)."""
+        then: geodetic (lat_rad, lon_rad, h_m); with clouds on the ground, *ground* (:meth:`surface`)."""
         if self.scene.clouds.flat:
             return ground
-        _, lat, lon, _ = self.scene.intersect(origin, los, unix_s=unix_s)
-        return lat, lon, self.scene.height_m(lat, lon)
+        return self.scene.intersect(origin, los, unix_s=unix_s)[1:]
 
     def seen(
         self, origin: np.ndarray, los: np.ndarray, unix_s: ArrayLike, ground: Point | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """The temperatures (K) each ray at *unix_s* sees and the weights of their radiances: what it
-        meets (:meth:`met`); with clouds of emissivity below 1 also the ground behind them
-        (:meth:`surface`, or *ground* if already known), so (2, ...) both. Radiances add with these
-        weights; temperatures must not (the radiance is not linear in them)."""
+        """The temperatures (K) each ray at *unix_s* sees and the weights of their radiances, (n, ...) both:
+        what it meets (:meth:`met`; the scene's temperature is a function of its latitude, longitude and
+        the terrain's height there), and where that is a thin cloud (above :data:`CIRRUS_BASE_M`, of
+        emissivity below 1) also the ground behind it (:meth:`surface`, or *ground* if already known).
+        Radiances add with these weights; temperatures must not (the radiance is not linear in them)."""
         ground = ground or self.surface(origin, los)
-        temp = self.scene.temperature_k(*self.met(origin, los, unix_s, ground), unix_s=unix_s)
-        e = self.spec.cloud_emissivity
-        if e == 1.0:
-            return temp[None], np.ones((1,) + (1,) * temp.ndim)
+        lat, lon, hit_m = self.met(origin, los, unix_s, ground)
+        terrain_m = hit_m if self.scene.clouds.flat else self.scene.height_m(lat, lon)
+        temp = self.scene.temperature_k(lat, lon, terrain_m, unix_s=unix_s)
+        if self.spec.cloud_emissivity == 1.0:
+            return temp[None], np.ones((1,) + temp.shape)
+        thin = np.where(np.nan_to_num(hit_m) > CIRRUS_BASE_M, self.spec.cloud_emissivity, 1.0)
         behind = self.scene.temperature_k(*ground, cloudy=False)
-        return np.stack([temp, behind]), np.array([e, 1.0 - e]).reshape((2,) + (1,) * temp.ndim)
+        return np.stack([temp, behind]), np.stack([thin, 1.0 - thin])
 
     @property
     def _fov_disk(self) -> tuple[np.ndarray, np.ndarray]:

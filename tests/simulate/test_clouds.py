@@ -168,16 +168,21 @@ def test_thin_clouds_let_the_ground_behind_them_show():
     )
     los = (ground - r) / np.linalg.norm(ground - r, axis=1, keepdims=True)
     (t_cloud,), (w,) = opaque.seen(r, los, opaque.t0)
-    assert w.all() == 1.0
+    assert np.all(w == 1.0)
     temps, weights = thin.seen(r, los, thin.t0)
-    assert np.array_equal(temps[0], t_cloud) and np.allclose(weights.ravel(), [0.4, 0.6])
-    cloudy = t_cloud < temps[1] - 5.0
-    assert 0.1 < cloudy.mean() < 0.9
-    assert np.mean(temps[1] == t_cloud) > 0.2  # where a ray meets no cloud, it sees the same ground either way
+    assert np.array_equal(temps[0], t_cloud) and np.allclose(weights.sum(axis=0), 1.0)
+    hit_m = thin.met(r, los, thin.t0, thin.surface(r, los))[2]
+    high = hit_m > sim_module.CIRRUS_BASE_M  # cirrus: thin; the clouds below stay opaque
+    assert 0.1 < high.mean() < 0.9 and 0.05 < np.mean((hit_m > 1000) & ~high)
+    assert np.all(weights[0][high] == 0.4) and np.all(weights[0][~high] == 1.0)
+    assert (
+        np.mean(temps[1] == t_cloud) > 0.2
+    )  # where a ray meets no cloud, it sees the same ground either way
     # a thin cloud's brightness temperature lies between its top's and the ground's: it reads too low
     band_k = [thin.band.bt_from_radiance(np.interp(t, sim_module.T_BINS_K, thin.band_table)) for t in temps]
-    radiance = 0.4 * np.interp(temps[0], sim_module.T_BINS_K, thin.band_table)
-    mixed_k = thin.band.bt_from_radiance(
-        radiance + 0.6 * np.interp(temps[1], sim_module.T_BINS_K, thin.band_table)
+    radiance = sum(
+        w * np.interp(t, sim_module.T_BINS_K, thin.band_table) for t, w in zip(temps, weights, strict=True)
     )
-    assert np.all((mixed_k[cloudy] > band_k[0][cloudy] + 2.0) & (mixed_k[cloudy] < band_k[1][cloudy]))
+    mixed_k = thin.band.bt_from_radiance(radiance)
+    assert np.all((mixed_k[high] > band_k[0][high] + 2.0) & (mixed_k[high] < band_k[1][high]))
+    assert np.allclose(mixed_k[~high], band_k[0][~high], atol=1e-3)
