@@ -1,0 +1,136 @@
+"""The renderer against the simulator's own ray tracing: what a CrIS FOV row's ray to each VIIRS GEO point
+meets, rendered from VIIRS's pixels at their true heights, beside the truth.
+
+The collocation's renderer (:mod:`monitor.collocation.render`) stands every VIIRS pixel as a column at the
+height of what VIIRS met and marches each CrIS ray down through them. Here it is given the true heights (the
+simulator's own intersection of each VIIRS ray), so every difference from the truth is the renderer's.
+The truth at a GEO point P for the in-track SBF angle alpha: the spacecraft at the time t' when P lies at
+alpha in its SBF (a secant search on the simulator's own orbit and attitude), its ray to P marched through
+the simulator's scene, and the band BT of what it meets. Beside it, "geo" is VIIRS's own BT at P (no
+correction: the parallax left).
+
+For each angle it prints the RMS of the per-pixel error (K), the RMS over 400 discs of 7 km radius (a CrIS
+FOV's size) of the disc-mean error (K: what the cost sees), and the share of pixels more than 5 K off by
+detector (0-7 and 24-31: a scan's edges; 8-23 its middle). One JSON row.
+
+    .venv/bin/python -m benchmarks.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
+        [--scans 8] [--rows FILE]
+
+The scene is VIIRS's first granule of a one-granule case, from its 11th scan on; no noise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from benchmarks.provenance import commit, emit
+from monitor.collocation import render
+from monitor.core.constants import VIIRS_COLUMNS, VIIRS_DETECTORS
+from monitor.geometry import frames, wgs84
+from monitor.simulate import scan_geometry as ins
+from monitor.simulate.case import T_BINS_K, SimulationSpec, Simulator
+
+ALPHA_RAD = np.array([19.1e-3, 0.0, -19.1e-3])  # the rows ahead, the centre, the rows behind
+DISC_M = 7000.0
+EDGE_DETECTORS = np.r_[0:8, 24:32]
+
+
+def _band_bt(sim: Simulator, temp_k: np.ndarray) -> np.ndarray:
+    """VIIRS I5 BT (K) of emitting temperatures *temp_k* through the simulator's atmosphere."""
+    return sim.band.bt_from_radiance(np.interp(temp_k, T_BINS_K, sim.band_table))
+
+
+def _view_time(sim: Simulator, p: np.ndarray, t: np.ndarray, alpha: float) -> np.ndarray:
+    """When the spacecraft sees ECEF points *p* (N, 3) at in-track SBF angle *alpha*: a secant search from
+    the VIIRS times *t*."""
+
+    def miss(ts: np.ndarray) -> np.ndarray:
+        r, _, m = sim.state(ts)
+        sbf = np.einsum("nji,nj->ni", m, p - r)
+        return sbf[:, 0] / sbf[:, 2] - np.tan(alpha)
+
+    ta, fa = t, miss(t)
+    tb = t + 1.0
+    fb = miss(tb)
+    for _ in range(5):
+        step = np.divide(fb * (tb - ta), fb - fa, out=np.zeros_like(fb), where=fb != fa)
+        ta, fa, tb = tb, fb, tb - step
+        fb = miss(tb)
+    return tb
+
+
+def measure(clouds: str, edges: str, seed: int, scans: int) -> dict:
+    """The row (module docstring)."""
+    sim = Simulator(SimulationSpec(granules=1, seed=seed, cloud_heights=clouds, cloud_edges=edges))
+    theta, col_dt = ins.viirs_column_geometry()
+    a_det = ins.viirs_detector_angles_rad()
+    local = frames.unit(np.stack([np.tan(a_det), np.zeros_like(a_det), np.ones_like(a_det)], -1))
+    los_sbf = np.einsum("cij,dj->dci", frames.rot_x(-theta), local)
+    scan_start = float(sim.viirs_granule_starts()[0]) + (10 + np.arange(scans)) * ins.VIIRS_SCAN_S
+    pixel_s = scan_start[:, None] + col_dt[None, :]
+    r, _, m = sim.state(pixel_s)
+    los = np.einsum("scij,dcj->sdci", m, los_sbf)
+    origin = np.broadcast_to(r[:, None], los.shape)
+    lat, lon, _ = sim.surface(origin, los)
+    t3 = np.broadcast_to(pixel_s[:, None, :], lat.shape)
+    _, hit_lat, hit_lon, hit_m = sim.scene.intersect(origin, los, unix_s=t3)
+    temp = sim.scene.temperature_k(hit_lat, hit_lon, sim.scene.height_m(hit_lat, hit_lon), t3)
+    shape = (scans * VIIRS_DETECTORS, VIIRS_COLUMNS)
+    lat, lon, hit_m, times = (np.asarray(v).reshape(shape) for v in (lat, lon, hit_m, t3))
+    bt = _band_bt(sim, temp).reshape(shape)
+    good = ~np.tile(ins.viirs_bowtie_deleted(), (scans, 1)) & np.isfinite(lat)
+    sat, vel = sim.orbit.state_ecef(scan_start + ins.VIIRS_EARTH_VIEW_S / 2)
+    x, b, a, across = render.view_tangents(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
+    law_k_per_km = float(clouds.split(":")[1]) if clouds.startswith("lapse:") else 6.5
+    per_k = (_band_bt(sim, np.array([270.5])) - _band_bt(sim, np.array([269.5])))[0]
+    m_per_k = 1.0 / (law_k_per_km * 1e-3 * per_k)  # the law, in metres per kelvin of band BT
+    t0 = time.perf_counter()
+    height = np.where(good, np.nan_to_num(hit_m), 0.0)
+    rendered = render.render_height_field(np.where(good, x, np.nan), b, across, height, bt, a, m_per_k)
+    render_s = time.perf_counter() - t0
+    p = wgs84.geodetic_to_ecef(lat[good], lon[good], np.zeros(int(good.sum())))
+    centres = p[np.random.default_rng(1).choice(len(p), 400, replace=False)]
+    discs = cKDTree(p).query_ball_point(centres, DISC_M)
+    detector = np.broadcast_to((np.arange(shape[0]) % VIIRS_DETECTORS)[:, None], shape)[good]
+    edge = np.isin(detector, EDGE_DETECTORS)
+    row: dict = {"commit": commit(), "clouds": clouds, "edges": edges, "seed": seed, "scans": scans}
+    row |= {"m_per_k": m_per_k, "render_s": render_s}
+    for j, alpha in enumerate(ALPHA_RAD):
+        t_view = _view_time(sim, p, times[good], alpha)
+        r_view, _, _ = sim.state(t_view)
+        _, v_lat, v_lon, _ = sim.scene.intersect(r_view, frames.unit(p - r_view), unix_s=t_view)
+        truth = _band_bt(sim, sim.scene.temperature_k(v_lat, v_lon, sim.scene.height_m(v_lat, v_lon), t_view))
+        out = {}
+        for name, field in (("render", rendered[j][good].astype(float)), ("geo", bt[good])):
+            err = field - truth
+            disc = [np.nanmean(err[d]) for d in discs if len(d) > 500]
+            off = np.abs(err) > 5.0
+            out[name] = {
+                "pixel_rms_k": float(np.sqrt(np.nanmean(err**2))),
+                "disc_rms_k": float(np.sqrt(np.nanmean(np.square(disc)))),
+                "off_5k_scan_edges": float(np.mean(off[edge])),
+                "off_5k_scan_middle": float(np.mean(off[~edge])),
+                "nan": float(np.mean(~np.isfinite(field))),
+            }
+        row[f"alpha_{alpha * 1e3:+.1f}_mrad"] = out
+    return row
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--clouds", default="lapse:6.5")
+    p.add_argument("--edges", default="sharp")
+    p.add_argument("--seed", type=int, default=11)
+    p.add_argument("--scans", type=int, default=8)
+    p.add_argument("--rows", help="append the JSON row here")
+    args = p.parse_args()
+    emit(measure(args.clouds, args.edges, args.seed, args.scans), args.rows)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
