@@ -22,6 +22,10 @@ stands at cover x that height, so the scene is one surface ``top_m(lat, lon)``, 
 above it, with steep sides at the cloud edges; the emitting temperature of a point on it is the flat
 scene's at the same (lat, lon). Clouds on the ground are the law ``ground``: the surface is the terrain.
 
+Wind (optional, :class:`Wind`): the clouds, not the land, move along a great circle; a point at time t
+reads the cloud fields where its clouds stood at the reference time, so each ray sees them where they are
+at its own time.
+
 Spectra add a simple atmosphere: R(nu) = tau(nu) B(nu, T) + (1 - tau(nu)) B(nu, T_atm).
 """
 
@@ -226,9 +230,8 @@ def _above_m(r, x, n0, n1, n2, h0, c1, c2, turn, fields, params, axis, law_k, la
 def _march(ray, turn, steps, fields, params, axis, law_k, law_m, clouds, iterations, tolerance_m, out):  # type: ignore[no-untyped-def]
     """out (R,) = the distance along each ray of :class:`monitor.simulate.terrain.RayGeometry` *ray* to
     its first crossing of the surface (:func:`_surface_m`, the wind's turn (cos, sin) (R,) of each ray's
-    time): march *steps* (R,) equal steps from the top
-    shell to the ellipsoid; the first that ends on or below the surface brackets the crossing, which
-    regula falsi (Illinois) finds to *tolerance_m*."""
+    time): march *steps* (R,) equal steps from the top shell to the ellipsoid; the first that ends on or
+    below the surface brackets the crossing, which regula falsi (Illinois) finds to *tolerance_m*."""
     t_top, span, n0, n1, n2, h0, c1, c2 = ray
     # a parallel loop takes arrays, not tuples of them: taken apart here, put together in the loop
     (cloud, cloud_n, cloud_s), (surf, surf_n, surf_s), (shape, shape_n, shape_s) = fields
