@@ -16,7 +16,8 @@ first of that column's pixels standing at their hits, each over the stretch half
 
 For each angle it prints the RMS of the per-pixel error (K), the RMS over 400 discs of 7 km radius (a CrIS
 FOV's size) of the disc-mean error (K: what the cost sees), and the share of pixels more than 5 K off by
-detector (0-7 and 24-31: a scan's edges; 8-23 its middle). One JSON row.
+detector (0-7 and 24-31: a scan's edges; 8-23 its middle), and the wall time (s) of the renderer and of the
+linear sweep for the three views. One JSON row.
 
     .venv/bin/python -m benchmarks.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
         [--scans 8] [--rows FILE]
@@ -159,20 +160,22 @@ def measure(clouds: str, edges: str, seed: int, scans: int) -> dict:
     rendered = render.render_height_field(np.where(good, x, np.nan), b, across, height, bt, a, m_per_k)
     render_s = time.perf_counter() - t0
     tangents = [v.astype(np.float64) for v in (b, a)]
-    swept = {}
+    swept, sweep_s = {}, 0.0
     for interpolate in (False, True):
         swept[interpolate] = np.full(rendered.shape, np.nan)
+        t0 = time.perf_counter()
         _sweep(
             np.where(good, x, np.nan), tangents[0], height, bt.astype(np.float64), tangents[1], m_per_k,
             interpolate, swept[interpolate],
         )  # fmt: skip
+        sweep_s = time.perf_counter() - t0  # the linear one's, compiled by the nearest one's call
     p = wgs84.geodetic_to_ecef(lat[good], lon[good], np.zeros(int(good.sum())))
     centres = p[np.random.default_rng(1).choice(len(p), 400, replace=False)]
     discs = cKDTree(p).query_ball_point(centres, DISC_M)
     detector = np.broadcast_to((np.arange(shape[0]) % VIIRS_DETECTORS)[:, None], shape)[good]
     edge = np.isin(detector, EDGE_DETECTORS)
     row: dict = {"commit": commit(), "clouds": clouds, "edges": edges, "seed": seed, "scans": scans}
-    row |= {"m_per_k": m_per_k, "render_s": render_s}
+    row |= {"m_per_k": m_per_k, "render_s": render_s, "sweep_s": sweep_s}
     for j, alpha in enumerate(ALPHA_RAD):
         t_view = _view_time(sim, p, times[good], alpha)
         r_view, _, _ = sim.state(t_view)
