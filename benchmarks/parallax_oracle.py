@@ -1,15 +1,14 @@
 """What a perfect parallax correction would give: the clouds-with-height case assessed with each VIIRS pixel
-lifted to the true height of what it sees, against the day's learnt lift.
+standing at the true height of what it sees, against the day's learnt heights.
 
-The learnt correction (``monitor/collocation/lift.py``) lifts a pixel by kappa times how much colder it is
-than its clear-sky neighbourhood; on clouds with height the FOR offsets still miss the accuracy bounds
-(docs/science.md). This bench asks whether better heights could close the gap, or whether something no
-height removes is left (the sides of clouds hiding what behind them one instrument sees and the other does
-not; a CrIS cone meeting a 3-D scene the collocation treats as a lifted sheet). It simulates the case once,
-recording for every VIIRS pixel row the height above the ground of the first cloud or terrain its ray meets
-(the simulator's own intersection), then assesses it twice with the same default configuration: as
-shipped, and with the probe collocation lifting every pixel by its true height and the day's fraction held
-at 1 (the oracle). Flat ground only (the true lift is then the hit's height).
+The learnt correction stands a pixel kappa times how much colder it is than its clear-sky neighbourhood
+above its GEO point (``monitor/collocation/lift.py``) and renders what each CrIS FOV row sees of that
+(``monitor/collocation/render.py``). This bench asks how much better heights would give, and what no height
+removes. It simulates the case once, recording for every VIIRS pixel row the height above the ground of
+the first cloud or terrain its ray meets (the simulator's own intersection), then assesses it twice with
+the same default configuration: as shipped, and with the probe collocation rendered from the true heights
+and the day's fraction held at 1 (the oracle; the walls keep the probe's law). Flat ground only (the true
+height is then the hit's). Rows of 2026-11-26 measured the point lift, which the rendering replaced.
 
     .venv/bin/python -m benchmarks.parallax_oracle [--clouds lapse:6.5] [--seed 11] [--granules 6]
 
@@ -31,7 +30,7 @@ from numpy.typing import ArrayLike
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import assess_paths
-from monitor.collocation import lift as pixel_lift
+from monitor.collocation import render
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_COLUMNS
 from monitor.core.result import AssessmentResult
@@ -69,29 +68,32 @@ def _recording(
 
 
 class _Counted(Protocol):
-    """The true lift's wrapper, counting the pixel rows it found a truth for."""
+    """The true heights' wrapper, counting the pixel rows it found a truth for."""
 
     rows: int
     total: int
 
-    def __call__(self, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+    def __call__(self, *args: np.ndarray | float) -> np.ndarray: ...
 
 
-def _true_lift(lifted: Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray]]) -> _Counted:
-    """``monitor.collocation.lift.lifted`` with each row's lift replaced by the recorded truth (0 where
-    none)."""
+def _true_heights(rendered: Callable[..., np.ndarray]) -> _Counted:
+    """``monitor.collocation.render.rendered_bt`` with each pixel standing at the recorded truth (0 where
+    none) instead of the height its BT implies; the walls keep the day's law."""
 
     def wrapped(
         lat_rad: np.ndarray,
         lon_rad: np.ndarray,
         height_m: np.ndarray,
-        lift: np.ndarray,
+        bt_k: np.ndarray,
+        good: np.ndarray,
         sat_m: np.ndarray,
         velocity_m_s: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        cris_alpha_rad: np.ndarray,
+        m_per_k: float,
+    ) -> np.ndarray:
         lat = np.degrees(np.asarray(lat_rad, np.float64)).astype(np.float32)
         lon = np.degrees(np.asarray(lon_rad, np.float64)).astype(np.float32)
-        truth = np.zeros(np.shape(lift), np.float32)
+        truth = np.zeros(np.shape(bt_k), np.float32)
         found = 0
         for i, key in enumerate(_key(lat, lon)):
             row = TRUTH.get(key)
@@ -102,7 +104,14 @@ def _true_lift(lifted: Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray]])
         truth = np.where(np.isfinite(lat) & np.isfinite(lon) & (np.abs(lat) <= 90.0), truth, 0.0)
         counted.rows += found
         counted.total += len(truth)
-        return lifted(lat_rad, lon_rad, height_m, truth, sat_m, velocity_m_s)
+        own = render.height_above_m
+        render.height_above_m = lambda *_: truth  # the recorded heights
+        try:
+            return rendered(
+                lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k
+            )
+        finally:
+            render.height_above_m = own
 
     counted = cast(_Counted, wrapped)
     counted.rows = counted.total = 0
@@ -144,8 +153,8 @@ def main() -> int:
     )
     cfg = AssessmentConfig()
     shipped = _scores(assess_paths([root], cfg), truth)
-    true_lift = _true_lift(pixel_lift.lifted)
-    pixel_lift.lifted = true_lift  # type: ignore[assignment]  # the same call, counted
+    true_lift = _true_heights(render.rendered_bt)
+    render.rendered_bt = true_lift  # type: ignore[assignment]  # the same call, counted
     day_parallax.day_lift = lambda s0, s1, cost: (1.0, float("nan"))
     oracle = _scores(assess_paths([root], cfg), truth)
     print(f"oracle rows matched {true_lift.rows}/{true_lift.total}")

@@ -1,23 +1,21 @@
 """The renderer against the simulator's own ray tracing: what a CrIS FOV row's ray to each VIIRS GEO point
 meets, rendered from VIIRS's pixels at their true heights, beside the truth.
 
-The collocation's renderer (:mod:`monitor.collocation.render`) stands every VIIRS pixel as a column at the
-height of what VIIRS met and marches each CrIS ray down through them. Here it is given the true heights (the
-simulator's own intersection of each VIIRS ray), so every difference from the truth is the renderer's.
+The collocation's renderer (:mod:`monitor.collocation.render`) sweeps each CrIS ray down each VIIRS
+column's slanted plane, the pixels standing at the height of what VIIRS met. Here it is given the true
+heights (the simulator's own intersection of each VIIRS ray), so every difference from the truth is the
+renderer's.
 The truth at a GEO point P for the in-track SBF angle alpha: the spacecraft at the time t' when P lies at
 alpha in its SBF (a secant search on the simulator's own orbit and attitude), its ray to P marched through
 the simulator's scene, and the band BT of what it meets. Beside it, "geo" is VIIRS's own BT at P (no
 correction: the parallax left).
 
-Beside the renderer, "sweep" is the simplest alternative, measured here only: each GEO point's ray in its
-own column's slanted plane (the VIIRS rays of that column lie in it, differing only in-track) meets the
-first of that column's pixels standing at their hits, each over the stretch halfway to its neighbours'
-(:func:`_sweep`; a side at the height law's temperature), no other column looked at.
-
 For each angle it prints the RMS of the per-pixel error (K), the RMS over 400 discs of 7 km radius (a CrIS
 FOV's size) of the disc-mean error (K: what the cost sees), and the share of pixels more than 5 K off by
-detector (0-7 and 24-31: a scan's edges; 8-23 its middle), and the wall time (s) of the renderer and of the
-linear sweep for the three views. One JSON row.
+detector (0-7 and 24-31: a scan's edges; 8-23 its middle), and the renderer's wall time (s) for the three
+views. One JSON row. Rows before 2026-11-28 11:30 also hold the two-dimensional column march the renderer
+was then ("render") and the sweep measured here before it replaced that ("sweep", "sweep_linear"; nearest
+and linear tops).
 
     .venv/bin/python -m benchmarks.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
         [--scans 8] [--rows FILE]
@@ -28,10 +26,8 @@ The scene is VIIRS's first granule of a one-granule case, from its 11th scan on;
 from __future__ import annotations
 
 import argparse
-import math
 import time
 
-import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -50,65 +46,6 @@ EDGE_DETECTORS = np.r_[0:8, 24:32]
 def _band_bt(sim: Simulator, temp_k: np.ndarray) -> np.ndarray:
     """VIIRS I5 BT (K) of emitting temperatures *temp_k* through the simulator's atmosphere."""
     return sim.band.bt_from_radiance(np.interp(temp_k, T_BINS_K, sim.band_table))
-
-
-@numba.njit(cache=True, parallel=True)
-def _sweep(
-    x: np.ndarray,
-    b: np.ndarray,
-    h: np.ndarray,
-    bt: np.ndarray,
-    a: np.ndarray,
-    m_per_k: float,
-    interpolate: bool,
-    out: np.ndarray,
-) -> None:
-    """out (views, rows, cols) = the sweep's BT (module docstring) of pixels at along-track GEO *x* (m,
-    NaN where unusable), VIIRS's in-track tangents *b*, heights *h* (m) and *bt* (K), for the CrIS
-    tangents *a* (views, rows, cols)."""
-    rows, cols = x.shape
-    for c in numba.prange(cols):
-        idx = np.array([r for r in range(rows) if math.isfinite(x[r, c])], np.int64)
-        n = len(idx)
-        if n < 3:
-            continue
-        hit = np.array([x[r, c] + h[r, c] * b[r, c] for r in idx])
-        order = np.argsort(hit)
-        ps, rs = hit[order], idx[order]
-        spacing = np.median(np.diff(np.sort(np.array([x[r, c] for r in idx]))))
-        h_max = max([h[r, c] for r in idx])
-        for v in range(a.shape[0]):
-            for r0 in idx:
-                s0, av = x[r0, c], a[v, r0, c]
-                reach = spacing + h_max * abs(av)
-                best_z, best = -1.0, -1
-                for j in range(np.searchsorted(ps, s0 - reach), np.searchsorted(ps, s0 + reach)):
-                    left = 0.5 * (ps[j - 1] + ps[j]) if j > 0 else -np.inf
-                    right = 0.5 * (ps[j] + ps[j + 1]) if j < n - 1 else np.inf
-                    hj = h[rs[j], c]
-                    if av == 0.0:
-                        z = hj if left <= s0 <= right else -1.0
-                    else:
-                        z1, z2 = (left - s0) / av, (right - s0) / av
-                        z = min(hj, max(z1, z2))
-                        if z < max(min(z1, z2), 0.0):
-                            z = -1.0
-                    if z > best_z:
-                        best_z, best = z, j
-                if best < 0:
-                    continue
-                hb = h[rs[best], c]
-                if hb - best_z > 1.0 or not interpolate:  # a side: the law's temperature at its depth
-                    out[v, r0, c] = bt[rs[best], c] + (hb - best_z) / m_per_k
-                    continue
-                # a top: between the two hits about where the ray meets it, linearly
-                at = s0 + best_z * av
-                k = np.searchsorted(ps, at) - 1
-                if 0 <= k < n - 1 and ps[k + 1] > ps[k]:
-                    w = (at - ps[k]) / (ps[k + 1] - ps[k])
-                    out[v, r0, c] = (1 - w) * bt[rs[k], c] + w * bt[rs[k + 1], c]
-                else:
-                    out[v, r0, c] = bt[rs[best], c]
 
 
 def _view_time(sim: Simulator, p: np.ndarray, t: np.ndarray, alpha: float) -> np.ndarray:
@@ -151,43 +88,28 @@ def measure(clouds: str, edges: str, seed: int, scans: int) -> dict:
     bt = _band_bt(sim, temp).reshape(shape)
     good = ~np.tile(ins.viirs_bowtie_deleted(), (scans, 1)) & np.isfinite(lat)
     sat, vel = sim.orbit.state_ecef(scan_start + ins.VIIRS_EARTH_VIEW_S / 2)
-    x, b, a, across = render.view_tangents(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
+    x, b, a = render.view_tangents(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
     law_k_per_km = float(clouds.split(":")[1]) if clouds.startswith("lapse:") else 6.5
     per_k = (_band_bt(sim, np.array([270.5])) - _band_bt(sim, np.array([269.5])))[0]
     m_per_k = 1.0 / (law_k_per_km * 1e-3 * per_k)  # the law, in metres per kelvin of band BT
     t0 = time.perf_counter()
     height = np.where(good, np.nan_to_num(hit_m), 0.0)
-    rendered = render.render_height_field(np.where(good, x, np.nan), b, across, height, bt, a, m_per_k)
+    rendered = render.render_height_field(np.where(good, x, np.nan), b, height, bt, a, m_per_k)
     render_s = time.perf_counter() - t0
-    tangents = [v.astype(np.float64) for v in (b, a)]
-    swept, sweep_s = {}, 0.0
-    for interpolate in (False, True):
-        swept[interpolate] = np.full(rendered.shape, np.nan)
-        t0 = time.perf_counter()
-        _sweep(
-            np.where(good, x, np.nan), tangents[0], height, bt.astype(np.float64), tangents[1], m_per_k,
-            interpolate, swept[interpolate],
-        )  # fmt: skip
-        sweep_s = time.perf_counter() - t0  # the linear one's, compiled by the nearest one's call
     p = wgs84.geodetic_to_ecef(lat[good], lon[good], np.zeros(int(good.sum())))
     centres = p[np.random.default_rng(1).choice(len(p), 400, replace=False)]
     discs = cKDTree(p).query_ball_point(centres, DISC_M)
     detector = np.broadcast_to((np.arange(shape[0]) % VIIRS_DETECTORS)[:, None], shape)[good]
     edge = np.isin(detector, EDGE_DETECTORS)
     row: dict = {"commit": commit(), "clouds": clouds, "edges": edges, "seed": seed, "scans": scans}
-    row |= {"m_per_k": m_per_k, "render_s": render_s, "sweep_s": sweep_s}
+    row |= {"m_per_k": m_per_k, "render_s": render_s}
     for j, alpha in enumerate(ALPHA_RAD):
         t_view = _view_time(sim, p, times[good], alpha)
         r_view, _, _ = sim.state(t_view)
         _, v_lat, v_lon, _ = sim.scene.intersect(r_view, frames.unit(p - r_view), unix_s=t_view)
         truth = _band_bt(sim, sim.scene.temperature_k(v_lat, v_lon, sim.scene.height_m(v_lat, v_lon), t_view))
         out = {}
-        fields = {
-            "render": rendered[j][good].astype(float),
-            "sweep": swept[False][j][good],
-            "sweep_linear": swept[True][j][good],
-            "geo": bt[good],
-        }
+        fields = {"render": rendered[j][good].astype(float), "geo": bt[good]}
         for name, field in fields.items():
             err = field - truth
             disc = [np.nanmean(err[d]) for d in discs if len(d) > 500]

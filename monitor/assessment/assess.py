@@ -243,7 +243,8 @@ def cost_and_offsets(
     probe: list[GranuleSamples] | None = None,
 ) -> AssessmentResult:
     """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*. With
-    *probe*, the same granules collocated with the VIIRS pixels lifted by PROBE_M_PER_K, the day's lift is
+    *probe*, the same granules collocated with the VIIRS pixels standing at PROBE_M_PER_K (rendered as each
+    FOV row sees them: :mod:`monitor.collocation.render`), the day's lift is
     chosen by the cost (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it."""
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
     per_for: Sequence[ForSamples] = PerFor(lambda k: for_samples(samples, k, cfg, band))
@@ -316,7 +317,7 @@ def paired(
     """The granules of both collocations with the FOVs usable in both; None (no parallax correction, said
     in the log) when the two did not collocate the same granules."""
     if [s.key for s in samples] != [s.key for s in probe]:
-        LOG.warning("parallax: the lifted collocation lost granules; the day is assessed without it")
+        LOG.warning("parallax: the rendered collocation lost granules; the day is assessed without it")
         return None
     both = [s.usable & p.usable for s, p in zip(samples, probe, strict=True)]
     return (
@@ -375,8 +376,9 @@ def collocate_run(
     timings: Timings = None,
     lift_m_per_k: float = 0.0,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
-    """Collocate a time-ordered run of CrIS granules, the VIIRS pixels lifted by *lift_m_per_k*
-    (:mod:`monitor.collocation.lift`); returns (samples, skipped)."""
+    """Collocate a time-ordered run of CrIS granules, the VIIRS pixels standing *lift_m_per_k* m per K
+    above their GEO points and rendered as each CrIS FOV row sees them (:mod:`monitor.collocation.render`;
+    0: as GEO places them); returns (samples, skipped)."""
     band = i5_band(satellite)
     cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k)
     samples, skipped = [], []
@@ -435,8 +437,8 @@ def collocate_plan(
     case: CasePlan, cfg: AssessmentConfig | None = None, workers: int = 1, lift_m_per_k: float = 0.0
 ) -> list[GranuleSamples]:
     """The collocated samples of every CrIS granule of *case*, in time order (granules that fail are left
-    out, logged), the VIIRS pixels lifted by *lift_m_per_k*: what :func:`assess_plan` estimates from, for
-    benchmarks that estimate otherwise."""
+    out, logged), the VIIRS pixels standing at *lift_m_per_k* (:func:`collocate_run`): what
+    :func:`assess_plan` estimates from, for benchmarks that estimate otherwise."""
     cfg = cfg or AssessmentConfig()
     with parallel_threads(workers):
         run = collocate_run(
@@ -447,7 +449,7 @@ def collocate_plan(
 
 class DayAssessment:
     """A day's assessment built batch by batch (:meth:`add`): each batch's CrIS granules collocated once
-    (and once more lifted, for the parallax), the estimate made over every granule so far whenever asked
+    (and once more rendered, for the parallax), the estimate made over every granule so far whenever asked
     (:meth:`result`), so that a day can stop at the precision it needs. Each granule's perturbed cones are
     kept on disk (:mod:`~monitor.assessment.spool`) until :meth:`close` (or the context's end): memory holds
     one granule's collocation and one FOR's estimate, not the day."""
@@ -486,7 +488,7 @@ class DayAssessment:
         run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
         with parallel_threads(self.workers):
             samples, skipped = collocate_run(*run, progress, should_stop, timings)
-            # the pixels lifted by the probe's height per K (monitor.estimation.parallax chooses the day's)
+            # the pixels at the probe's height per K, rendered (monitor.estimation.parallax chooses the day's)
             probe = collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else []
         self.skipped += list(case.skipped) + skipped
         self.samples += [s.kept_in(self._spool) for s in samples]

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.collocation import collocate, lift, swath
+from monitor.collocation import collocate, render, swath
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import Kernel
 from monitor.geometry.inverse import FovGeometry, granule_geometry
@@ -63,9 +63,10 @@ def stage(timings: Timings, name: str) -> Iterator[None]:
 @dataclass
 class SwathCache:
     """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept. *spans* holds, by key,
-    the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`). Every
-    piece has its pixels lifted by *lift_m_per_k* (m per K colder than the clear-sky reference:
-    :mod:`monitor.collocation.lift`; 0, at their GEO points)."""
+    the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`). With
+    *lift_m_per_k* (m per K colder than the clear-sky reference: :mod:`monitor.collocation.lift`), every
+    piece holds what each CrIS FOV row sees of its pixels standing at that height
+    (:func:`monitor.collocation.render.rendered_bt`); with 0, the pixels' own radiance."""
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
@@ -214,7 +215,8 @@ def piece(
 ) -> swath.SwathPiece:
     """The granule prepared out to at least *view_rad* from nadir, with its scans of the IET span
     *span_us* (None: all): from the cache, or prepared out to view_rad + VIEW_MARGIN_RAD (so that the next
-    CrIS granule's slightly wider reach finds it ready) with the scans the whole run needs."""
+    CrIS granule's slightly wider reach finds it ready) with the scans the whole run needs. With the
+    cache's lift, rendered for the in-track angles :data:`monitor.collocation.render.VIEW_ALPHA_RAD`."""
     cached = cache.pieces.get(v.key)
     if cached is not None and cached.view_rad >= view_rad and (span_us is None or cached.covers(*span_us)):
         return cached
@@ -228,15 +230,16 @@ def piece(
     seen = None
     if cache.lift_m_per_k:
         with stage(timings, "parallax"):
-            height_m = lift.lift_m(sdr.bt_k, sdr.good, cache.lift_m_per_k)
-            seen = lift.lifted(
-                geo.lat_rad, geo.lon_rad, geo.height_m, height_m, geo.sc_position_m, geo.sc_velocity_m_s
-            )
+            seen = render.rendered_bt(
+                geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, geo.sc_position_m,
+                geo.sc_velocity_m_s, render.VIEW_ALPHA_RAD, cache.lift_m_per_k,
+            )  # fmt: skip
     with stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
             sat_m=geo.sc_position_m, view_rad=view_rad + collocate.VIEW_MARGIN_RAD,
-            scan_start_us=geo.start_time_us, span_us=run_span, seen=seen,
+            scan_start_us=geo.start_time_us, span_us=run_span, seen_bt_k=seen,
+            view_alpha_rad=render.VIEW_ALPHA_RAD,
         )  # fmt: skip
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))

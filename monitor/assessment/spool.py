@@ -1,7 +1,7 @@
 """A day's collocated samples kept on disk while the day grows, read back one FOR at a time.
 
 A granule's VIIRS BT through every perturbed cone and, with the footprint kernel, its radiance per annulus
-take ~9.5 MB, twice that with the lifted collocation of the parallax correction: ~1.9 GB for a day of 100
+take ~9.5 MB, twice that with the rendered collocation of the parallax correction: ~1.9 GB for a day of 100
 granules if they stayed in memory. The estimate needs them one FOR at a time (a thirtieth of each granule),
 so a :class:`DayAssessment <monitor.assessment.assess.DayAssessment>` writes each granule's arrays to a
 temporary directory as it is collocated, and each read maps the file, copies the slice asked for and unmaps

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from monitor.collocation import lift
+from monitor.collocation import render
 from monitor.collocation.swath import BLOCK_PX, SwathPiece, ViirsSwath, swath_piece
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, MAX_GRID_SPREAD_RAD, VIIRS_DETECTORS
@@ -183,19 +183,22 @@ def _accumulate(
     half_bcols: np.ndarray,
     ring_g2: np.ndarray,
     order: np.ndarray,
+    view: np.ndarray,
+    view_w: np.ndarray,
     acc: np.ndarray,
 ) -> None:
     """Add the pixels of one prepared granule to each FOV's cone sums (difference arrays along j).
 
-    Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*; *reach0* the angle (rad)
-    within which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones'
-    union, and the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none).
-    *ring_g2* is cos^2 h of each disc, largest first. FOVs are taken in *order*, in chunks of
-    FOVS_PER_TASK. acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (real)
-    and weight (imaginary): +w at the first j, -w after the last. The discs are nested: where a row's
-    interval of a disc is empty, so are those of the smaller discs.
+    Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*; *reach0* the angle (rad) within
+    which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones' union, and
+    the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none). *ring_g2* is cos^2
+    h of each disc, largest first. FOVs are taken in *order*, in chunks of FOVS_PER_TASK; FOV f adds (1 -
+    view_w[f]) times the radiance of view view[f] plus view_w[f] times that of the next (radiance (views,
+    rows, cols)). acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (real) and
+    weight (imaginary): +w at the first j, -w after the last. The discs are nested: where a row's interval of
+    a disc is empty, so are those of the smaller discs.
     """
-    nrow, ncol = radiance.shape
+    ncol = radiance.shape[2]
     nbr, nbc = block_radius.shape
     m = tan_a.shape[1]
     nk = ring_g2.shape[0]
@@ -205,6 +208,9 @@ def _accumulate(
             continue
         ta = tan_a[f]
         out = acc[f]
+        seen = radiance[view[f]]
+        w_next = view_w[f]
+        seen_next = radiance[min(view[f] + 1, radiance.shape[0] - 1)]
         g2k = np.empty((nk, m))  # g2 K = cos^2 h (1 + tan^2 A_i)
         for k in range(nk):
             for i in range(m):
@@ -238,7 +244,9 @@ def _accumulate(
                     continue
                 for r in range(br * BLOCK_PX, (br + 1) * BLOCK_PX):
                     for c in range(bc * BLOCK_PX, min((bc + 1) * BLOCK_PX, ncol)):
-                        value = np.float64(radiance[r, c])
+                        value = np.float64(seen[r, c])
+                        if w_next > 0.0:
+                            value += w_next * (np.float64(seen_next[r, c]) - value)
                         if not math.isfinite(value):
                             continue
                         px = np.float64(ecef[r, c, 0]) - sx
@@ -332,6 +340,18 @@ class ConeSums:
             return np.where(w > 0, s / w, np.nan).astype(np.float32)
 
 
+def _views(view_alpha_rad: np.ndarray, alpha_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per FOV (in-track SBF angle *alpha_rad*) the view at or below its angle among *view_alpha_rad*
+    (increasing) and the linear weight of the next one (0 beyond the ends: the nearest view alone)."""
+    angles = np.asarray(view_alpha_rad, np.float64)
+    a = np.clip(np.nan_to_num(np.asarray(alpha_rad, np.float64)), angles[0], angles[-1])
+    view = np.clip(np.searchsorted(angles, a, side="right") - 1, 0, len(angles) - 1)
+    upper = angles[np.minimum(view + 1, len(angles) - 1)]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        weight = np.where(upper > angles[view], (a - angles[view]) / (upper - angles[view]), 0.0)
+    return view.astype(np.int64), weight
+
+
 def cone_sums(
     swath: ViirsSwath,
     sat_m: np.ndarray,
@@ -347,7 +367,9 @@ def cone_sums(
 
     sat_m (F, 3) and sbf_to_ecef (F, 3, 3) give each FOV's satellite position and SBF; alpha_rad,
     beta_rad (F,) its LOS angles; offsets_rad (2n+1,) the perturbation grid; *radii_rad* the discs'
-    half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`).
+    half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`). Of a piece rendered for
+    several in-track angles (clouds with height, :attr:`monitor.collocation.swath.SwathPiece.radiance`),
+    each FOV sees the two views about its own alpha, weighted linearly (the nearest beyond the ends).
     """
     nf = len(alpha_rad)
     m = len(offsets_rad)
@@ -380,6 +402,7 @@ def cone_sums(
     threads = numba.get_num_threads()
     order = np.concatenate([np.arange(t0, nf, threads) for t0 in range(threads)])
     for piece in swath.pieces:
+        view, view_w = _views(piece.view_alpha_rad, alpha_rad)
         row0, col0, dist = piece.nearest(centre)
         hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, rho)
         # a FOV whose cones cannot reach this granule's nearest usable block skips it
@@ -388,7 +411,7 @@ def cone_sums(
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
                 sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
-                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, acc,
+                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, view, view_w, acc,
             )  # fmt: skip
     solid = 2 * np.pi * (1 - np.cos(np.asarray(radii_rad[::-1], np.float64)))
     sums, weights = np.empty((nf, len(radii_rad), m, m)), np.empty((nf, len(radii_rad), m, m))
@@ -412,7 +435,8 @@ def warm_up() -> float:
     ground = wgs84.geodetic_to_ecef(np.radians(0.06), np.radians(0.03), 0.0)
     sat = ground * (1 + 833e3 / np.linalg.norm(ground))
     scans = np.tile(sat, (rows // VIIRS_DETECTORS, 1))
-    lift.lifted(lat, lon, zeros, zeros + 1e3, scans, np.cross(scans, [0.0, 0.0, 1.0]))
+    velocity = np.cross(scans, [0.0, 0.0, 1.0])
+    render.rendered_bt(lat, lon, zeros, zeros + 280.0, zeros == 0, scans, velocity, np.zeros(3), 150.0)
     z = -ground / np.linalg.norm(ground)
     x = np.cross([0.0, 0.0, 1.0], z)
     sbf = np.stack([x, np.cross(z, x), z], axis=1)

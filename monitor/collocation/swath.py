@@ -32,7 +32,7 @@ Python exception check in every loop that keeps the compiler from vectorising it
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numba
@@ -68,15 +68,16 @@ SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smal
 class SwathPiece:
     """One VIIRS granule (rows of 32-detector scans) ready for collocation.
 
-    ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (rows, cols) I5 band
-    radiance mW/(m2 sr cm-1), NaN where unusable; area_vec_m2 (rows, cols, 3) float32 the vector footprint
-    with scan overlap removed. block_centre_m (rows/4, ceil(cols/4), 3) and block_radius_m bound the usable
-    pixels of each 4 x 4 block (NaN where it has none). Per column: the smallest column spacing within
-    +-200 columns (col_spacing_m), the along-track advance of a scan (advance_m) and the detector step
-    (det_step_m), all m; max_height_m the highest usable pixel. They size the search windows.
-    The piece holds the granule's columns from *first_column* on that are seen within *view_rad* of nadir
-    (inf: all columns), and its scans from *first_scan* on that cover the IET span *span_us* (start of the
-    first scan, start of the scan after the last; -inf and inf at the granule's ends).
+    ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (views, rows, cols) I5
+    band radiance mW/(m2 sr cm-1), NaN where unusable: one view, the pixels' own, or one per in-track SBF
+    angle of *view_alpha_rad* (what a CrIS ray at that angle sees there, :func:`swath_piece`); area_vec_m2
+    (rows, cols, 3) float32 the vector footprint with scan overlap removed. block_centre_m (rows/4,
+    ceil(cols/4), 3) and block_radius_m bound the usable pixels of each 4 x 4 block (NaN where it has none).
+    Per column: the smallest column spacing within +-200 columns (col_spacing_m), the along-track advance of a
+    scan (advance_m) and the detector step (det_step_m), all m; max_height_m the highest usable pixel. They
+    size the search windows. The piece holds the granule's columns from *first_column* on that are seen within
+    *view_rad* of nadir (inf: all columns), and its scans from *first_scan* on that cover the IET span
+    *span_us* (start of the first scan, start of the scan after the last; -inf and inf at the granule's ends).
     """
 
     ecef_m: np.ndarray
@@ -95,11 +96,13 @@ class SwathPiece:
     view_rad: float = math.inf
     first_scan: int = 0
     span_us: tuple = (-math.inf, math.inf)
+    view_alpha_rad: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
     @property
     def shape(self) -> tuple[int, int]:
         """(rows, columns) of the prepared piece."""
-        return self.radiance.shape
+        rows, cols = self.radiance.shape[1:]
+        return rows, cols
 
     def covers(self, t0_us: float, t1_us: float) -> bool:
         """Whether the piece holds every scan observed between IET t0_us and t1_us."""
@@ -294,9 +297,8 @@ def _weigh_scan(
     centre: np.ndarray,
     radius: np.ndarray,
     top: np.ndarray,
-    keep_area: bool,
 ) -> None:
-    """Pass 2 for scan k: vector footprints with the scan overlap removed (into *area* where *keep_area*),
+    """Pass 2 for scan k: vector footprints with the scan overlap removed (into *area*),
     radiance NaN where either is unusable, the bounding sphere (centre, radius + 1 m for the float32
     rounding) of each block's usable pixels (NaN where it has none), and the height of the scan's highest
     usable pixel (top[k], m).
@@ -336,8 +338,7 @@ def _weigh_scan(
             foot[2, c] = (a0 * b1 - a1 * b0) * s
         for c in range(cols):
             x0, x1, x2 = foot[0, c], foot[1, c], foot[2, c]
-            if keep_area:
-                area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
+            area[r, c, 0], area[r, c, 1], area[r, c, 2] = x0, x1, x2
             if not (math.isfinite(x0) and math.isfinite(x1) and math.isfinite(x2)):
                 radiance[r, c] = np.nan
             if math.isfinite(radiance[r, c]):
@@ -374,11 +375,10 @@ def _weigh(
     centre: np.ndarray,
     radius: np.ndarray,
     top: np.ndarray,
-    keep_area: bool,
 ) -> None:
     """Pass 2 (:func:`_weigh_scan`), scans in parallel."""
     for k in numba.prange(radiance.shape[0] // VIIRS_DETECTORS):
-        _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top, keep_area)
+        _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
 
 def _np_half_diff(p: np.ndarray, axis: int) -> np.ndarray:
@@ -447,7 +447,8 @@ def swath_piece(
     view_rad: float = math.inf,
     scan_start_us: np.ndarray | None = None,
     span_us: tuple[float, float] | None = None,
-    seen: tuple[np.ndarray, ...] | None = None,
+    seen_bt_k: np.ndarray | None = None,
+    view_alpha_rad: np.ndarray | None = None,
 ) -> SwathPiece:
     """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
 
@@ -461,10 +462,11 @@ def swath_piece(
     of each scan *scan_start_us* (IET us), only the scans observed between t0 and t1
     (:func:`scans_between`), each with the same weights as in the whole granule (the scans next to those
     kept are their halos).
-    *seen*, (lat_rad, lon_rad, height_m) like the pixels', are the 3-D points the pixels see (a cloud above
-    the GEO point: :mod:`monitor.collocation.lift`): the pixels are searched and tested there, and
-    weighted by their footprints at the GEO points (a pixel's solid angle does not change along its line
-    of sight, but the steps between a lifted pixel and its neighbours would tilt its footprint).
+    *seen_bt_k* (views, rows, cols), when given, is the BT a CrIS ray at each in-track SBF angle of
+    *view_alpha_rad* (views,) sees along its way to each GEO point (clouds with height:
+    :func:`monitor.collocation.render.rendered_bt`): the piece then holds one radiance per view
+    (*radiance* (views, rows, cols)), each unusable where the pixel is; else one (1, rows, cols), the
+    pixels' own.
     """
     scans = slice(None)
     if scan_start_us is not None and span_us is not None:
@@ -478,7 +480,7 @@ def swath_piece(
         if r1 < np.shape(lat_rad)[0]:
             after = tuple(a[r1 : r1 + VIIRS_DETECTORS] for a in geo)
         lat_rad, lon_rad, height_m, bt_k, good = (a[r0:r1] for a in (*geo, bt_k, good))
-        seen = None if seen is None else tuple(a[r0:r1] for a in seen)
+        seen_bt_k = None if seen_bt_k is None else seen_bt_k[:, r0:r1]
         sat_m = None if sat_m is None else sat_m[first:stop]
         t = np.asarray(scan_start_us, np.int64)
         covered_us = (t[first] if first > 0 else -math.inf, t[stop] if stop < len(t) else math.inf)
@@ -489,7 +491,7 @@ def swath_piece(
         kept = view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad)
         lat_rad, lon_rad, height_m = lat_rad[:, kept], lon_rad[:, kept], height_m[:, kept]
         bt_k, good = bt_k[:, kept], good[:, kept]
-        seen = None if seen is None else tuple(a[:, kept] for a in seen)
+        seen_bt_k = None if seen_bt_k is None else seen_bt_k[:, :, kept]
         before, after = (None if b is None else tuple(a[..., kept] for a in b) for b in (before, after))
     else:
         view_rad = math.inf
@@ -520,12 +522,15 @@ def swath_piece(
     radius = np.empty(centre.shape[:2])
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
-        _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top, True)
-    if seen is not None:  # searched and tested where they see, weighted by their GEO footprints
-        h = np.asarray(seen[2], f32)
-        _ecef(*(np.asarray(a, f32) for a in seen[:2]), h, pos)
-        with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):  # the footprints at the GEO points kept
-            _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top, False)
+        _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
+    views, angles = radiance[None], np.zeros(1)
+    if seen_bt_k is not None and view_alpha_rad is not None:
+        angles = np.asarray(view_alpha_rad, np.float64)
+        grid_k = t_min + t_step * np.arange(len(table))
+        views = np.empty((len(angles), rows, cols), f32)
+        for v in range(len(angles)):  # a view at a time: one float64 copy of a granule, not five
+            views[v] = np.interp(seen_bt_k[v], grid_k, table, left=np.nan, right=np.nan)
+        views[:, ~np.isfinite(radiance)] = np.nan
 
     scan = pos.reshape(nscan, VIIRS_DETECTORS, cols, 3)
     mid = scan[nscan // 2]
@@ -540,7 +545,7 @@ def swath_piece(
     tree = cKDTree(centre[r_idx, c_idx], leafsize=64, balanced_tree=False, compact_nodes=False)
     return SwathPiece(
         pos,
-        radiance,
+        views,
         area,
         centre,
         radius,
@@ -555,4 +560,5 @@ def swath_piece(
         view_rad,
         scans.start or 0,
         covered_us,
+        angles,
     )

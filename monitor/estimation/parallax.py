@@ -1,7 +1,8 @@
 """How high the day's clouds stand, from the day's own cost: the parallax correction's scale.
 
-The collocation lifts every VIIRS pixel by kappa (m per K) times how much colder than its clear-sky
-neighbourhood it is (:mod:`monitor.collocation.lift`). kappa is the inverse of the lapse rate seen
+The collocation stands every VIIRS pixel kappa (m per K) times how much colder than its clear-sky
+neighbourhood it is above its GEO point (:mod:`monitor.collocation.lift`) and renders what each CrIS FOV
+row sees of that (:mod:`monitor.collocation.render`). kappa is the inverse of the lapse rate seen
 through the window channel; it differs from day to day, region to region, and is zero where the cold scenes
 are not high clouds (snow, cold ground, a simulated day whose clouds lie on the ground). So it is not
 assumed: the assessment collocates twice, at kappa = 0 (V0, every sample's VIIRS BT at every turn) and at

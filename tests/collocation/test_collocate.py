@@ -1,6 +1,7 @@
 """The compiled interval formulation of the cone test against a brute-force angle test on every pixel."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -311,3 +312,30 @@ def test_two_threads_may_assess_at_once():
     root = ROOT
     r = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True)
     assert r.returncode == 0 and "both threads done" in r.stdout, r.stderr[-2000:]
+
+
+def test_each_fov_adds_the_views_about_its_own_in_track_angle(scene):
+    """A piece rendered for three in-track angles (here: its radiance, halved, doubled): a FOV at an angle
+    between two views adds their linear blend, one beyond the ends the nearest; a piece of one view
+    serves every FOV."""
+    fg, viirs = scene
+    idx = (1, 15, 4)
+    alpha = fg.alpha_rad[idx]
+    offsets = perturbation_grid(2, 1e-4)
+    own = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets).mean()
+    for angles, factor in (
+        ((alpha - 0.01, alpha + 0.01, alpha + 0.03), 0.75),
+        ((alpha + 0.01, alpha + 0.02, alpha + 0.03), 1.0),
+    ):
+        views = swath.ViirsSwath(
+            [
+                replace(
+                    p,
+                    radiance=np.concatenate([p.radiance, 0.5 * p.radiance, 2 * p.radiance]),
+                    view_alpha_rad=np.array(angles),
+                )
+                for p in viirs.pieces
+            ]
+        )
+        got = collocate.cone_sums(*_one_fov(views, fg, idx), offsets).mean()
+        np.testing.assert_allclose(got, factor * own, rtol=1e-6)

@@ -1,9 +1,10 @@
-"""VIIRS pixels lifted to what they see: the clear-sky reference, the lift, and the line of sight."""
+"""How high VIIRS pixels stand: the clear-sky reference and the heights; a scan's geometry for the tests of
+what is drawn from them."""
 
 import numpy as np
 import pytest
 
-from monitor.collocation.lift import REFERENCE_HALF_PX, ROTATION_RAD_S, lift_m, lifted, reference_k
+from monitor.collocation.lift import REFERENCE_HALF_PX, ROTATION_RAD_S, height_above_m, reference_k
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.geometry import wgs84
 
@@ -34,13 +35,16 @@ def test_the_reference_is_the_clear_sky_around_and_never_a_bad_pixel():
     assert reference_k(wide, np.ones(wide.shape, bool))[0, -1] == pytest.approx(230.0)
 
 
-def test_the_lift_grows_with_the_cooling_and_is_zero_in_clear_sky():
+def test_the_height_grows_with_the_cooling_and_is_zero_in_clear_sky():
     bt, cover = cloudy_field()
     good = np.ones(bt.shape, bool)
-    lift = lift_m(bt, good, 150.0)
+    ref = reference_k(bt, good)
+    lift = height_above_m(bt, good, ref, 150.0)
     assert np.median(lift[cover == 1]) == pytest.approx(150.0 * 65, rel=0.03)
     assert np.percentile(lift[cover == 0], 99) < 150.0 * 1.5  # noise: well under a kilometre
-    assert np.all(lift_m(bt, good, 0.0) == 0) and np.all(lift_m(bt, ~good, 150.0) == 0)
+    assert np.all(height_above_m(bt, good, ref, 0.0) == 0) and np.all(
+        height_above_m(bt, ~good, ref, 150.0) == 0
+    )
 
 
 def scan_geometry(cols=400):
@@ -65,26 +69,3 @@ def scan_geometry(cols=400):
     t = wgs84.intersect_ellipsoid(origin, los)
     lat, lon = wgs84.surface_to_geodetic(origin + t[..., None] * los)
     return lat, lon, np.zeros(lat.shape), origin, sat, v
-
-
-def test_a_lifted_pixel_stands_on_its_own_line_of_sight_at_its_height():
-    lat, lon, h, origin, sat, v = scan_geometry()
-    lift = np.full(lat.shape, 10_000.0, np.float32)
-    lift[:, :50] = 0.0
-    la, lo, hh = lifted(lat, lon, h, lift, sat[None], v[None])
-    assert la.dtype == np.float32  # as the swath keeps its points
-    assert np.array_equal(la[:, :50], lat[:, :50].astype(np.float32)) and np.all(hh[:, :50] == 0)
-    point = wgs84.geodetic_to_ecef(*(np.asarray(a, np.float64) for a in (la, lo, hh)))[:, 50:]
-    ground = wgs84.geodetic_to_ecef(lat, lon, h)[:, 50:]
-    line = ground - origin[:, 50:]
-    line /= np.linalg.norm(line, axis=-1, keepdims=True)
-    off = point - ground
-    sideways = off - np.sum(off * line, axis=-1, keepdims=True) * line
-    # on the line from the spacecraft, within float32's rounding of the angles (~0.4 m each)
-    assert np.abs(np.linalg.norm(sideways, axis=-1)).max() < 1.5
-    assert np.allclose(hh[:, 50:], 10_000.0, rtol=0.005)  # at the lift (the Earth's curvature: < 0.5 %)
-    # the spacecraft position of the scan's middle alone would miss the line by tens of metres at the edge
-    mid = ground - sat
-    mid /= np.linalg.norm(mid, axis=-1, keepdims=True)
-    off_mid = off - np.sum(off * mid, axis=-1, keepdims=True) * mid
-    assert np.linalg.norm(off_mid, axis=-1).max() > 20.0

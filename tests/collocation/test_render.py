@@ -1,5 +1,5 @@
-"""What each CrIS FOV row sees of a granule whose pixels stand at a height, against a brute-force ray
-march through the scene the pixels were drawn from."""
+"""What each CrIS FOV row sees of a granule whose pixels stand at a height: the sweep against a brute-force
+ray march through the column the pixels were drawn from, the view tangents against the lines of sight."""
 
 import numpy as np
 import pytest
@@ -10,66 +10,74 @@ from tests.collocation.test_lift import scan_geometry
 
 M_PER_K = 150.0
 PIXEL_M = 375.0
+FOV_PX = 37  # a CrIS FOV's 14 km along the track
 
 
-class Blocks:
-    """A scene of opaque flat-topped clouds standing on the ground, 2-8 pixels wide and 2-12 km high, their
-    edges halfway between pixel centres, their tops and sides at the law's temperature (300 K minus height
-    over M_PER_K), over ground whose BT varies (so that hidden ground matters), on a flat Earth: x along
-    the track, y across, m."""
+class Column:
+    """One VIIRS column's slanted plane (x along the track, z up, m): a dozen opaque clouds 1-8 km wide and
+    2-12 km high standing on the ground, their tops falling to the ground over 1.5 km shoulders, tops and
+    sides at the law's temperature (300 K minus height over M_PER_K), over ground whose BT varies by 1 K
+    (so that hidden ground matters)."""
 
-    def __init__(self, rng, n=60, size=200):
-        self.h = np.zeros((size, size))
-        for _ in range(n):
-            i, j = rng.integers(0, size - 8, 2)
-            self.h[i : i + rng.integers(2, 8), j : j + rng.integers(2, 8)] = rng.uniform(2e3, 12e3)
+    def __init__(self, rng, n=12, length_m=150e3, shoulder_m=1500.0):
+        self.centre_m, self.width_m = rng.uniform(0, length_m, n), rng.uniform(1e3, 8e3, n)
+        self.top_m, self.shoulder_m = rng.uniform(2e3, 12e3, n), shoulder_m
 
-    def height(self, x, y):
-        """The scene's height (m) at (x, y); 0 off its grid."""
-        i, j = (np.floor(v / PIXEL_M + 0.5).astype(int) for v in (x, y))
-        inside = (i >= 0) & (j >= 0) & (i < self.h.shape[0]) & (j < self.h.shape[1])
-        n = self.h.shape[0] - 1
-        return np.where(inside, self.h[np.clip(i, 0, n), np.clip(j, 0, n)], 0.0)
+    def height(self, x):
+        """The height (m) at x."""
+        out = np.abs(np.asarray(x)[..., None] - self.centre_m) - self.width_m / 2  # > 0 off the plateaus
+        fall = 0.5 + 0.5 * np.cos(np.pi * np.clip(out / self.shoulder_m, 0.0, 1.0))
+        return np.max(fall * self.top_m, axis=-1)
 
-    def seen(self, x, y, along, across_m, dz=2.0):
-        """The BT (K) the rays from ground points (x, y) climbing *along* and *across_m* m per metre of
-        height meet first, and the height (m) there: marched down in steps of dz from 12.5 km."""
-        ground = 290.0 + 5.0 * np.sin(x / 700.0) * np.cos(y / 900.0)
+    def seen(self, x, tan, dz=5.0):
+        """The BT (K) the rays from ground points x climbing *tan* m per m of height meet first: marched down
+        in steps of dz from 12.5 km."""
         met = np.zeros(np.shape(x))
         done = np.zeros(np.shape(x), bool)
         for z in np.arange(12.5e3, 0.0, -dz):
-            hit = ~done & (self.height(x + z * along, y + z * across_m) >= z)
+            hit = ~done & (self.height(x + z * tan) >= z)
             met[hit], done = z, done | hit
-        return np.where(done, 300.0 - met / M_PER_K, ground), met
+        return 300.0 - met / M_PER_K - np.where(done, 0.0, 1.0 - np.sin(x / 700.0))
+
+    def pixels(self, x, tan, n=9):
+        """The BT (K) of pixels PIXEL_M long about x, seen along *tan*: the mean of n rays across each."""
+        sub = (np.arange(n) - n // 2) / n * PIXEL_M
+        return self.seen(x[:, None] + sub, np.asarray(tan)[:, None] + 0.0 * sub).mean(axis=1)
 
 
-@pytest.mark.parametrize("across_m", [0.0, 0.3, -1.1])  # nadir, 17 degrees, the swath's edge
-def test_the_rendering_is_what_a_ray_march_through_the_scene_meets(across_m):
-    """From the heights and BT VIIRS saw, the pictures of the rows behind and ahead (21.6 mrad at the
-    ground) are what a brute-force march through the scene meets, within 2 K (a wall's height is found
-    to a quarter column) at >= 99.5 % of the points, where VIIRS's own BT is more than 5 K off at >= 0.2
-    %; and VIIRS's own view is its BT."""
-    scene = Blocks(np.random.default_rng(7))
-    rows, cols = 96, 112
-    x = PIXEL_M * (np.arange(rows)[:, None] + 40) + np.zeros((rows, cols))
-    y = PIXEL_M * (np.arange(cols)[None, :] + 60) + np.zeros((rows, cols))
-    b = np.zeros((rows, cols))
-    across = np.full(x.shape, across_m / PIXEL_M)
-    bt, met = scene.seen(x, y, b, across_m)
+def _fov_rms(err):
+    """The RMS over every FOV_PX pixels along the track of the mean of *err*: what a CrIS cone sees of it."""
+    return np.sqrt(np.mean(np.convolve(err, np.ones(FOV_PX) / FOV_PX, mode="valid") ** 2))
+
+
+@pytest.mark.parametrize("seed", [7, 8])
+def test_the_sweep_gives_what_each_row_sees_at_a_fovs_scale(seed):
+    """From the BT VIIRS saw (its rays within 7 mrad of the scan plane; each pixel the mean over its
+    length) and the heights the law gives them, the rows behind and ahead (21.6 mrad at the ground) see
+    what a brute-force march through the column meets with at most half the pixels' own BT's RMS error
+    (which misses by > 1 K), and less than it over a FOV's length (measured: 15-80 % less over 37 pixels,
+    50-85 % over 19, with a warm bias of 0.05-0.1 K, seeds 7-10); VIIRS's own view is its BT."""
+    column = Column(np.random.default_rng(seed))
+    rows = 400
+    x = PIXEL_M * np.arange(float(rows))
+    b = 7e-3 * np.sin(np.arange(float(rows)) * 0.37)
+    bt = column.pixels(x, b)
+    height = M_PER_K * np.maximum(300.0 - bt, 0.0)
     views = np.array([-0.0216, 0.0216])
+    column_of = [v[:, None] for v in (x, b, height, bt)]
     seen = render_height_field(
-        x, b, across, met, bt, np.broadcast_to(views[:, None, None], (2, rows, cols)), M_PER_K
+        *column_of[:2], *column_of[2:], np.broadcast_to(views[:, None, None], (2, rows, 1)), M_PER_K
     )
-    assert seen.dtype == np.float32 and seen.shape == (2, rows, cols)
-    inner = (slice(8, -8), slice(48 if across_m < 0 else 8, -8))  # rays that stay over the granule
-    own = np.abs(render_height_field(x, b, across, met, bt, b[None], M_PER_K)[0] - bt)[inner]
-    assert np.mean(own <= 0.01) >= 0.85
-    # where VIIRS met a side across the track: found to a quarter column (312 m of a ray's height at 0.3)
-    assert own.max() <= (0.01 if across_m == 0 else 1.2)
+    assert seen.dtype == np.float32 and seen.shape == (2, rows, 1)
+    own = render_height_field(*column_of, b[None, :, None], M_PER_K)[0, :, 0]
+    assert np.mean(own == bt.astype(np.float32)) >= 0.95
+    inner = slice(40, -40)  # rays that stay over the column
     for j, view in enumerate(views):
-        truth, _ = scene.seen(x, y, np.full(x.shape, view), across_m)
-        assert np.mean(np.abs(seen[j] - truth)[inner] <= 2.0) >= 0.995, view
-        assert np.mean(np.abs(bt - truth)[inner] > 5.0) >= 0.002, view  # the rows see something else
+        truth = column.pixels(x, np.full(rows, view))
+        geo, rendered = (bt - truth)[inner], (seen[j, :, 0] - truth)[inner]
+        assert np.sqrt(np.mean(geo**2)) > 1.0, view
+        assert np.sqrt(np.mean(rendered**2)) <= 0.5 * np.sqrt(np.mean(geo**2)), view
+        assert _fov_rms(rendered) < _fov_rms(geo), view
 
 
 def test_flat_ground_is_left_as_it_is():
@@ -78,9 +86,7 @@ def test_flat_ground_is_left_as_it_is():
     x = PIXEL_M * np.arange(64)[:, None] + rng.normal(0, 20, (64, 8))
     bt = rng.uniform(250.0, 300.0, x.shape)
     a = np.broadcast_to(np.array([-0.04, 0.0, 0.04])[:, None, None], (3, *x.shape))
-    seen = render_height_field(
-        x, np.zeros(x.shape), np.full(x.shape, 1e-3), np.zeros(x.shape), bt, a, M_PER_K
-    )
+    seen = render_height_field(x, np.zeros(x.shape), np.zeros(x.shape), bt, a, M_PER_K)
     assert np.all(seen == bt.astype(np.float32))
 
 
@@ -88,13 +94,12 @@ def test_the_view_tangents_follow_the_lines_of_sight():
     """b is the along-track run per metre of height up a pixel's VIIRS line of sight (the spacecraft at the
     pixel's time); a CrIS row at a detector's own in-track angle sees that pixel along VIIRS's line
     (a = b); an outer row's 19.1 mrad are ~21.6 mrad at the ground at nadir (1 + range / R_earth),
-    towards -x for the row ahead. Across the track both climb towards nadir by the tangent of the view
-    zenith: *across* columns per metre of height."""
+    towards -x for the row ahead."""
     lat, lon, h, origin, sat, v = scan_geometry()
     good = np.ones(lat.shape, bool)
     c, i = 200, 3  # a column near nadir, a detector near the scan's edge
     own = np.arctan(np.tan((i - 15.5) * 4.5e-4) / np.cos(np.linspace(-0.9, 0.9, 400)[c]))
-    x, b, a, across = view_tangents(lat, lon, h, good, sat[None], v[None], np.array([own, 0.0191, -0.0191]))
+    x, b, a = view_tangents(lat, lon, h, good, sat[None], v[None], np.array([own, 0.0191, -0.0191]))
     assert a[0, i, c] == pytest.approx(b[i, c], abs=1e-6)
     ground = wgs84.geodetic_to_ecef(lat, lon, h)
     look = origin - ground  # to the spacecraft at each pixel's time, as the test's scan was drawn
@@ -107,11 +112,6 @@ def test_the_view_tangents_follow_the_lines_of_sight():
     assert turn[1] == pytest.approx(-turn[0], rel=0.03)
     assert np.all(np.diff(x[:, c]) > 0)  # the detectors in along-track order, 375 m apart
     assert np.median(np.diff(x[:, c])) == pytest.approx(833e3 * 4.5e-4, rel=0.02)
-    east = np.array([0.0, 1.0, 0.0]) - up[..., 1:2] * up  # along the scan, towards higher columns
-    cross = np.sum(look * east, axis=-1) / np.linalg.norm(east, axis=-1) / np.sum(look * up, axis=-1)
-    step = np.gradient(np.sum(ground * [0.0, 1.0, 0.0], axis=-1), axis=1)
-    assert across == pytest.approx(cross / step, rel=0.03, abs=1e-7)
-    assert across[16, 20] > 1e-4 and across[16, 380] < -1e-4  # towards nadir
 
 
 def test_a_granule_is_rendered_as_each_row_sees_it():
