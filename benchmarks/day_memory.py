@@ -5,10 +5,10 @@
 A day of *granules* simulated CrIS granules (clouds on the ground, the paper profile; simulated in *data*
 once and reused) is collocated by a :class:`~monitor.assessment.assess.DayAssessment` in batches of *keep*,
 as the daily run does with a precision target, with the default configuration (the footprint kernel and
-the parallax probe: two collocations per granule). The estimate is made after the first batch (the paper's
-14-granule day) and after the last. Printed: the process's peak resident memory (VmHWM, the simulation's
-reset away) after each, and the seconds. The daily run re-estimates after every batch; the estimate's
-memory is that of its granule count, so the last one is the peak either way.
+the parallax probe: both collocations of each granule in one pass). The estimate is made after the first
+batch (the paper's 14-granule day) and after the last. Printed: the process's peak resident memory (VmHWM,
+the simulation's reset away) after each, and the seconds. The daily run re-estimates after every batch;
+the estimate's memory is that of its granule count, so the last one is the peak either way.
 """
 
 from __future__ import annotations

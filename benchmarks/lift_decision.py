@@ -35,11 +35,7 @@ def decision(case: Path, workers: int) -> dict:
     """The row of one case (module docstring)."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
-    pairs = paired(
-        collocate_plan(plan([case]), cfg, workers=workers),
-        collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K),
-    )
-    assert pairs is not None
+    pairs = paired(collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K))
     band = i5_band(truth["satellite"])
     cones = [
         parallax.matched_cone(

@@ -3,8 +3,8 @@
 each FOR's high clouds left out (``--leave-out-above-km``: the samples the learnt lift puts higher than
 that above the FOR's warm scenes, its 95th percentile of CrIS BT; none on a day whose lift is declined).
 For each: the FOR offsets' RMS and worst error per direction, and the rows' (ahead minus behind) median
-error against the truth. The two collocations (none, the probe's) are made once per case. Prints one JSON
-row per case and alternative.
+error against the truth. The two collocations (none, the probe's) are made once per case, in one pass.
+Prints one JSON row per case and alternative.
 
     .venv/bin/python -m benchmarks.parallax_alternatives CASE_DIR... [--leave-out-above-km 8 5 3]
                                                          [--workers 2] [--rows FILE]
@@ -73,10 +73,9 @@ def alternatives(case: Path, leave_out_above_km: list[float], workers: int) -> l
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
     sat = truth["satellite"]
-    ground = collocate_plan(plan([case]), cfg, workers=workers)
-    probe = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
-    pairs = paired(ground, probe)
-    assert pairs is not None
+    both = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
+    ground = [replace(s, rendered=None) for s in both]
+    pairs = paired(both)
     base = {"commit": commit(), "case": case.name, "clouds": truth.get("cloud_heights", "ground")}
     rows = [
         {**base, "alternative": "none", **errors(cost_and_offsets(ground, cfg, satellite=sat), truth)},
@@ -84,7 +83,7 @@ def alternatives(case: Path, leave_out_above_km: list[float], workers: int) -> l
         {
             **base,
             "alternative": "learnt",
-            **errors(cost_and_offsets(ground, cfg, satellite=sat, probe=probe), truth),
+            **errors(cost_and_offsets(both, cfg, satellite=sat), truth),
         },
     ]
     rows[1]["m_per_k"] = PROBE_M_PER_K
@@ -93,7 +92,7 @@ def alternatives(case: Path, leave_out_above_km: list[float], workers: int) -> l
         for above_km in leave_out_above_km:
             # the assessment blends each FOR through this module: its samples are thinned there
             parallax.blend = without_high_clouds(above_km)  # type: ignore[assignment]
-            result = cost_and_offsets(ground, cfg, satellite=sat, probe=probe)
+            result = cost_and_offsets(both, cfg, satellite=sat)
             rows.append(
                 {
                     **base,

@@ -77,6 +77,8 @@ class GranuleSamples:
     beta_rad: np.ndarray
     velocity_m_s: np.ndarray
     annuli_rad: np.ndarray | OnDisk | None = None  # (nscan, 30, 9, K, m, m) radiance per annulus (footprint)
+    # the same granule with the VIIRS pixels standing at a height, rendered as each FOV row sees them
+    rendered: GranuleSamples | None = None
 
     def kept_in(self, spool: Spool) -> GranuleSamples:
         """These samples with their perturbed cones' arrays in *spool*, on disk (:mod:`spool`)."""
@@ -84,7 +86,8 @@ class GranuleSamples:
         annuli = self.annuli_rad
         if isinstance(annuli, np.ndarray):
             annuli = spool.keep(annuli)
-        return replace(self, bt_viirs_k=cones, annuli_rad=annuli)
+        rendered = None if self.rendered is None else self.rendered.kept_in(spool)
+        return replace(self, bt_viirs_k=cones, annuli_rad=annuli, rendered=rendered)
 
 
 def collocate_granule(
@@ -111,14 +114,13 @@ def collocate_granule(
     )  # fmt: skip
     pieces = load_swath(viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs, inputs.span_us)
     with stage(timings, "collocation"):
-        bt_viirs, coverage, annuli = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
-    usable = (
-        valid
-        & sdr.good
-        & np.isfinite(bt_cris)
-        & (coverage >= cfg.min_coverage)
+        cones = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
+    found = [_per_fov(c, fg, cfg, band) for c in (cones, cones.rendered) if c is not None]
+    usable = [
+        valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
         & np.all(np.isfinite(bt_viirs), axis=(-2, -1))
-    )
+        for bt_viirs, coverage, _ in found
+    ]  # fmt: skip
     info = GranuleInfo(
         granule_id=geo.meta.granule_id,
         start=geo.meta.start.isoformat(),
@@ -127,24 +129,28 @@ def collocate_granule(
         cris_sdr=cris.sdr.name,
         viirs=[v.sdr.name for v in viirs] + [v.geo.name for v in viirs],
         n_fovs=int(valid.sum()),
-        n_usable=int(usable.sum()),
+        n_usable=int(usable[0].sum()),
         cris_meta=geo.meta.to_dict(),
         viirs_meta=viirs[0].geo_meta.to_dict(),
     )
     s5 = (slice(None), slice(None), FOV5)
-    return GranuleSamples(
-        cris.key,
-        info,
-        bt_viirs,
-        bt_cris,
-        usable,
-        fg.sat_ecef_m[s5],
-        fg.sbf_to_ecef[s5],
-        fg.alpha_rad[s5],
-        fg.beta_rad[s5],
-        fg.velocity_ecef_m_s[s5],
-        annuli,
-    )
+    samples = [
+        GranuleSamples(
+            cris.key,
+            info,
+            bt_viirs,
+            bt_cris,
+            ok,
+            fg.sat_ecef_m[s5],
+            fg.sbf_to_ecef[s5],
+            fg.alpha_rad[s5],
+            fg.beta_rad[s5],
+            fg.velocity_ecef_m_s[s5],
+            annuli,
+        )
+        for (bt_viirs, _, annuli), ok in zip(found, usable, strict=True)
+    ]
+    return replace(samples[0], rendered=samples[1] if len(samples) > 1 else None)
 
 
 def _collocate_fors(
@@ -156,15 +162,12 @@ def _collocate_fors(
     cfg: AssessmentConfig,
     band: I5Band,
     should_stop: StopCheck = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone, the worst coverage per FOV (of the outermost
-    disc), and with the footprint kernel the radiance per annulus (nscan, 30, 9, K, m, m), else None (all
-    FOVs of the granule in one call of the parallel kernel)."""
+) -> collocate.ConeSums:
+    """The cone sums of every FOV of the granule (in one call of the parallel kernel), and of what each
+    sees rendered when the pieces are (:attr:`monitor.collocation.collocate.ConeSums.rendered`)."""
     if should_stop is not None and should_stop():
         raise StopRequested
-    m = len(offsets_rad(cfg))
-    shape = fg.alpha_rad.shape
-    cones = collocate.cone_sums(
+    return collocate.cone_sums(
         pieces,
         fg.sat_ecef_m.reshape(-1, 3),
         fg.sbf_to_ecef.reshape(-1, 3, 3),
@@ -175,6 +178,15 @@ def _collocate_fors(
         fov_range_m=np.where(valid, geo.range_m, 1e6).ravel(),
         fov_cos_zen=np.cos(fill["zenith_rad"]).ravel(),
     )
+
+
+def _per_fov(
+    cones: collocate.ConeSums, fg: FovGeometry, cfg: AssessmentConfig, band: I5Band
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone, the worst coverage per FOV (of the outermost
+    disc), and with the footprint kernel the radiance per annulus (nscan, 30, 9, K, m, m), else None."""
+    m = len(offsets_rad(cfg))
+    shape = fg.alpha_rad.shape
     cone = KERNELS[cfg.kernel].index(FOV_HALF_ANGLE_RAD)
     bt_viirs = band.bt_from_radiance(cones.mean(cone)).astype(np.float32).reshape(shape + (m, m))
     coverage = np.min(cones.coverage(), axis=(-2, -1)).reshape(shape)
@@ -240,17 +252,18 @@ def cost_and_offsets(
     cfg: AssessmentConfig,
     skipped: Sequence[tuple[str, str]] | None = None,
     satellite: str = "",
-    probe: list[GranuleSamples] | None = None,
 ) -> AssessmentResult:
-    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*. With
-    *probe*, the same granules collocated with the VIIRS pixels standing at PROBE_M_PER_K (rendered as each
-    FOV row sees them: :mod:`monitor.collocation.render`), the day's lift is
-    chosen by the cost (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it."""
+    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*. When
+    *cfg* asks for the parallax correction and every granule was also collocated with the VIIRS pixels
+    standing at PROBE_M_PER_K (:attr:`GranuleSamples.rendered`: rendered as each FOV row sees them,
+    :mod:`monitor.collocation.render`), the day's lift is chosen by the cost
+    (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it."""
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
     per_for: Sequence[ForSamples] = PerFor(lambda k: for_samples(samples, k, cfg, band))
     m_per_k = np.nan
     spread = np.zeros((N_FOR, 4))  # the sigma (steps) the day's lift adds: FOR alpha, beta; rows alpha, beta
-    pairs = paired(samples, probe) if probe is not None else None
+    rendered = bool(samples) and all(s.rendered is not None for s in samples)
+    pairs = paired(samples) if cfg.parallax and rendered else None
     if pairs is not None:
         s0, s1 = pairs
         cones0, cones1 = zip(
@@ -311,18 +324,16 @@ def _seconds(iso: str) -> float:
         return np.nan
 
 
-def paired(
-    samples: list[GranuleSamples], probe: list[GranuleSamples]
-) -> tuple[list[GranuleSamples], list[GranuleSamples]] | None:
-    """The granules of both collocations with the FOVs usable in both; None (no parallax correction, said
-    in the log) when the two did not collocate the same granules."""
-    if [s.key for s in samples] != [s.key for s in probe]:
-        LOG.warning("parallax: the rendered collocation lost granules; the day is assessed without it")
-        return None
-    both = [s.usable & p.usable for s, p in zip(samples, probe, strict=True)]
+def paired(samples: list[GranuleSamples]) -> tuple[list[GranuleSamples], list[GranuleSamples]]:
+    """The granules of both collocations, at the GEO points and rendered (each granule's
+    :attr:`GranuleSamples.rendered`), with the FOVs usable in both."""
+    rendered = [s.rendered for s in samples if s.rendered is not None]
+    if len(rendered) != len(samples):
+        raise ValueError("paired: a granule was not collocated rendered")
+    both = [s.usable & r.usable for s, r in zip(samples, rendered, strict=True)]
     return (
-        [replace(s, usable=u) for s, u in zip(samples, both, strict=True)],
-        [replace(p, usable=u) for p, u in zip(probe, both, strict=True)],
+        [replace(s, usable=u, rendered=None) for s, u in zip(samples, both, strict=True)],
+        [replace(r, usable=u) for r, u in zip(rendered, both, strict=True)],
     )
 
 
@@ -376,9 +387,10 @@ def collocate_run(
     timings: Timings = None,
     lift_m_per_k: float = 0.0,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
-    """Collocate a time-ordered run of CrIS granules, the VIIRS pixels standing *lift_m_per_k* m per K
-    above their GEO points and rendered as each CrIS FOV row sees them (:mod:`monitor.collocation.render`;
-    0: as GEO places them); returns (samples, skipped)."""
+    """Collocate a time-ordered run of CrIS granules with the VIIRS pixels as GEO places them; with
+    *lift_m_per_k*, in the same pass, also with the pixels standing *lift_m_per_k* m per K above their GEO
+    points and rendered as each CrIS FOV row sees them (:mod:`monitor.collocation.render`; each sample's
+    :attr:`GranuleSamples.rendered`); returns (samples, skipped)."""
     band = i5_band(satellite)
     cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k)
     samples, skipped = [], []
@@ -437,7 +449,7 @@ def collocate_plan(
     case: CasePlan, cfg: AssessmentConfig | None = None, workers: int = 1, lift_m_per_k: float = 0.0
 ) -> list[GranuleSamples]:
     """The collocated samples of every CrIS granule of *case*, in time order (granules that fail are left
-    out, logged), the VIIRS pixels standing at *lift_m_per_k* (:func:`collocate_run`): what
+    out, logged), with their rendered collocation at *lift_m_per_k* when given (:func:`collocate_run`): what
     :func:`assess_plan` estimates from, for benchmarks that estimate otherwise."""
     cfg = cfg or AssessmentConfig()
     with parallel_threads(workers):
@@ -449,15 +461,14 @@ def collocate_plan(
 
 class DayAssessment:
     """A day's assessment built batch by batch (:meth:`add`): each batch's CrIS granules collocated once
-    (and once more rendered, for the parallax), the estimate made over every granule so far whenever asked
-    (:meth:`result`), so that a day can stop at the precision it needs. Each granule's perturbed cones are
-    kept on disk (:mod:`~monitor.assessment.spool`) until :meth:`close` (or the context's end): memory holds
-    one granule's collocation and one FOR's estimate, not the day."""
+    (as GEO places the pixels and, in the same pass, rendered, for the parallax), the estimate made over
+    every granule so far whenever asked (:meth:`result`), so that a day can stop at the precision it needs.
+    Each granule's perturbed cones are kept on disk (:mod:`~monitor.assessment.spool`) until :meth:`close`
+    (or the context's end): memory holds one granule's collocation and one FOR's estimate, not the day."""
 
     def __init__(self, satellite: str, cfg: AssessmentConfig | None = None, workers: int = 1) -> None:
         self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
         self.samples: list[GranuleSamples] = []
-        self.probe: list[GranuleSamples] = []
         self.skipped: list[tuple[str, str]] = []
         self._spool = Spool()
 
@@ -486,13 +497,13 @@ class DayAssessment:
         collocation (granules go one after the other, each VIIRS granule prepared once per batch)."""
         cfg = self.cfg
         run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
+        # with the parallax correction, also the pixels at the probe's height per K, rendered, in the same
+        # pass (monitor.estimation.parallax chooses the day's)
+        lift_m_per_k = PROBE_M_PER_K if cfg.parallax else 0.0
         with parallel_threads(self.workers):
-            samples, skipped = collocate_run(*run, progress, should_stop, timings)
-            # the pixels at the probe's height per K, rendered (monitor.estimation.parallax chooses the day's)
-            probe = collocate_run(*run, None, should_stop, timings, PROBE_M_PER_K)[0] if cfg.parallax else []
+            samples, skipped = collocate_run(*run, progress, should_stop, timings, lift_m_per_k)
         self.skipped += list(case.skipped) + skipped
         self.samples += [s.kept_in(self._spool) for s in samples]
-        self.probe += [s.kept_in(self._spool) for s in probe]
         if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
             raise StopRequested
 
@@ -509,9 +520,8 @@ class DayAssessment:
                 f"{len(self.samples)} granule(s) [{files[:800]}]" + (f"; skipped: {why}" if why else "")
             )
         in_time = sorted(self.samples, key=lambda s: (s.info.start, s.key))
-        probe = sorted(self.probe, key=lambda s: (s.info.start, s.key)) if cfg.parallax else None
         with stage(timings, "cost"):
-            return cost_and_offsets(in_time, cfg, skipped, self.satellite, probe)
+            return cost_and_offsets(in_time, cfg, skipped, self.satellite)
 
 
 def assess_plan(

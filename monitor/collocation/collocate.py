@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
@@ -183,22 +183,27 @@ def _accumulate(
     half_bcols: np.ndarray,
     ring_g2: np.ndarray,
     order: np.ndarray,
+    rendered: np.ndarray,
     view: np.ndarray,
     view_w: np.ndarray,
     acc: np.ndarray,
+    acc_rendered: np.ndarray,
 ) -> None:
     """Add the pixels of one prepared granule to each FOV's cone sums (difference arrays along j).
 
     Per FOV f: satellite *sat* (3), SBF-to-ECEF *mat* (3, 3), unit LOS *los0*; *reach0* the angle (rad) within
     which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones' union, and
     the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none). *ring_g2* is cos^2
-    h of each disc, largest first. FOVs are taken in *order*, in chunks of FOVS_PER_TASK; FOV f adds (1 -
-    view_w[f]) times the radiance of view view[f] plus view_w[f] times that of the next (radiance (views,
-    rows, cols)). acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (real) and
+    h of each disc, largest first. FOVs are taken in *order*, in chunks of FOVS_PER_TASK.
+    acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (rows, cols) (real) and
     weight (imaginary): +w at the first j, -w after the last. The discs are nested: where a row's interval of
-    a disc is empty, so are those of the smaller discs.
+    a disc is empty, so are those of the smaller discs. When *acc_rendered* has FOVs, it receives the same
+    runs of what FOV f sees of the pixel rendered (:mod:`monitor.collocation.render`): (1 - view_w[f])
+    times view view[f] of *rendered* (views, rows, cols) plus view_w[f] times the next; the cone test,
+    the costly part, is made once for both.
     """
-    ncol = radiance.shape[2]
+    ncol = radiance.shape[1]
+    with_rendered = acc_rendered.shape[0] > 0
     nbr, nbc = block_radius.shape
     m = tan_a.shape[1]
     nk = ring_g2.shape[0]
@@ -208,9 +213,10 @@ def _accumulate(
             continue
         ta = tan_a[f]
         out = acc[f]
-        seen = radiance[view[f]]
+        out_rendered = acc_rendered[f if with_rendered else 0]
+        seen = rendered[view[f]]
         w_next = view_w[f]
-        seen_next = radiance[min(view[f] + 1, radiance.shape[0] - 1)]
+        seen_next = rendered[min(view[f] + 1, rendered.shape[0] - 1)]
         g2k = np.empty((nk, m))  # g2 K = cos^2 h (1 + tan^2 A_i)
         for k in range(nk):
             for i in range(m):
@@ -244,9 +250,7 @@ def _accumulate(
                     continue
                 for r in range(br * BLOCK_PX, (br + 1) * BLOCK_PX):
                     for c in range(bc * BLOCK_PX, min((bc + 1) * BLOCK_PX, ncol)):
-                        value = np.float64(seen[r, c])
-                        if w_next > 0.0:
-                            value += w_next * (np.float64(seen_next[r, c]) - value)
+                        value = np.float64(radiance[r, c])
                         if not math.isfinite(value):
                             continue
                         px = np.float64(ecef[r, c, 0]) - sx
@@ -265,6 +269,13 @@ def _accumulate(
                         weight = abs(a_dot) / (dist2 * dist)  # steradians seen from CrIS
                         dx, dy, dz = dx / dist, dy / dist, dz / dist
                         wz = complex(weight * value, weight)
+                        wr = 0j
+                        if with_rendered:
+                            view_value = np.float64(seen[r, c])
+                            if w_next > 0.0:
+                                view_value += w_next * (np.float64(seen_next[r, c]) - view_value)
+                            if math.isfinite(view_value):
+                                wr = complex(weight * view_value, weight)
                         for k in range(nk):
                             a2 = dy * dy - ring_g2[k]
                             inv_a2 = 1.0 / a2
@@ -284,6 +295,9 @@ def _accumulate(
                                 if j0 < j1:
                                     out[k, i, j0] += wz
                                     out[k, i, j1] -= wz
+                                    if with_rendered:
+                                        out_rendered[k, i, j0] += wr
+                                        out_rendered[k, i, j1] -= wr
                                     inside = True
                             if not inside:  # in no cone of this disc: in none of the smaller ones
                                 break
@@ -314,12 +328,14 @@ def _finish(acc: np.ndarray, solid: np.ndarray, sums: np.ndarray, weights: np.nd
 class ConeSums:
     """Solid-angle weighted VIIRS sums in nested discs about every perturbed LOS of a batch of F FOVs:
     *sums* (F, K, m, m) weight x radiance and *weights* (F, K, m, m) weight (sr) of disc k (radius
-    ``radii_rad[k]``, increasing), *solid_sr* (K,) each disc's solid angle."""
+    ``radii_rad[k]``, increasing), *solid_sr* (K,) each disc's solid angle; *rendered*, when the pixels
+    were rendered as each FOV row sees them standing at a height, the same discs' sums of that radiance."""
 
     radii_rad: tuple[float, ...]
     sums: np.ndarray
     weights: np.ndarray
     solid_sr: np.ndarray
+    rendered: ConeSums | None = None
 
     def mean(self, k: int = 0) -> np.ndarray:
         """The weighted mean radiance (F, m, m) in disc k; NaN where it holds no pixel."""
@@ -367,9 +383,11 @@ def cone_sums(
 
     sat_m (F, 3) and sbf_to_ecef (F, 3, 3) give each FOV's satellite position and SBF; alpha_rad,
     beta_rad (F,) its LOS angles; offsets_rad (2n+1,) the perturbation grid; *radii_rad* the discs'
-    half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`). Of a piece rendered for
-    several in-track angles (clouds with height, :attr:`monitor.collocation.swath.SwathPiece.radiance`),
-    each FOV sees the two views about its own alpha, weighted linearly (the nearest beyond the ends).
+    half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`). When the pieces are
+    rendered for several in-track angles (clouds with height,
+    :attr:`monitor.collocation.swath.SwathPiece.rendered`), the same pass sums what each FOV sees of them
+    into :attr:`ConeSums.rendered`: the two views about its own alpha, weighted linearly (the nearest beyond
+    the ends).
     """
     nf = len(alpha_rad)
     m = len(offsets_rad)
@@ -397,12 +415,19 @@ def cone_sums(
     tan_b = np.tan(offsets_rad[None, :] + beta_rad[:, None])
     ring_g2 = np.cos(np.asarray(radii_rad[::-1], np.float64)) ** 2  # the kernel takes the largest first
     acc = np.zeros((nf, len(radii_rad), m, m + 1), np.complex128)
+    rendered_pieces = sum(p.rendered is not None for p in swath.pieces)
+    if rendered_pieces not in (0, len(swath.pieces)):
+        raise ValueError("the pieces of a swath are all rendered or none")
+    acc_rendered = np.zeros((nf if rendered_pieces else 0, *acc.shape[1:]), np.complex128)
+    unrendered = np.zeros((1, 1, 1), np.float32), np.zeros(nf, np.int64), np.zeros(nf)  # views, view, weight
     # FOVs interleaved by thread count: each thread's first share is spread over the granule (the scans
     # that a VIIRS granule reaches are a contiguous part of it)
     threads = numba.get_num_threads()
     order = np.concatenate([np.arange(t0, nf, threads) for t0 in range(threads)])
     for piece in swath.pieces:
-        view, view_w = _views(piece.view_alpha_rad, alpha_rad)
+        rendered, view, view_w = unrendered
+        if piece.rendered is not None:
+            rendered, (view, view_w) = piece.rendered, _views(piece.view_alpha_rad, alpha_rad)
         row0, col0, dist = piece.nearest(centre)
         hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, rho)
         # a FOV whose cones cannot reach this granule's nearest usable block skips it
@@ -411,10 +436,19 @@ def cone_sums(
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
                 sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
-                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, view, view_w, acc,
+                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, rendered, view,
+                view_w, acc, acc_rendered,
             )  # fmt: skip
     solid = 2 * np.pi * (1 - np.cos(np.asarray(radii_rad[::-1], np.float64)))
-    sums, weights = np.empty((nf, len(radii_rad), m, m)), np.empty((nf, len(radii_rad), m, m))
+    rendered_sums = _sums(acc_rendered, solid, radii_rad) if len(acc_rendered) else None
+    return replace(_sums(acc, solid, radii_rad), rendered=rendered_sums)
+
+
+def _sums(acc: np.ndarray, solid: np.ndarray, radii_rad: tuple[float, ...]) -> ConeSums:
+    """The cone sums of difference arrays *acc* (F, discs largest first, m, m + 1), *solid* the discs'
+    solid angles in that order (:func:`_finish`)."""
+    nf, nk, m = acc.shape[0], acc.shape[1], acc.shape[2]
+    sums, weights = np.empty((nf, nk, m, m)), np.empty((nf, nk, m, m))
     with KERNEL_LOCK:
         _finish(acc, solid, sums, weights)
     return ConeSums(tuple(radii_rad), sums[:, ::-1], weights[:, ::-1], solid[::-1])

@@ -34,7 +34,7 @@ from monitor.collocation.geodesy import ecef_m
 from monitor.core.constants import VIIRS_SCAN_US
 
 REFERENCE_HALF_PX = 40  # +-40 pixels: ~15 km at nadir, wider than a CrIS cone's reach from its edge
-PROBE_M_PER_K = 180.0  # the second collocation's lift: 6.5 K/km seen through a window transmittance ~0.85
+PROBE_M_PER_K = 180.0  # the rendered collocation's lift: 6.5 K/km seen through a window transmittance ~0.85
 ROTATION_RAD_S = 2.0 * math.pi / (VIIRS_SCAN_US * 1e-6)
 
 

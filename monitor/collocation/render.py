@@ -61,6 +61,7 @@ COLUMNS_PER_PASS = 512  # columns rendered at a time: the tangents of five views
 # the scan); each FOV sees the two views about its own, weighted linearly (monitor.collocation.collocate).
 VIEW_ALPHA_RAD = np.linspace(-0.04, 0.04, 5)
 TOP_M = 1.0  # a ray that meets a stretch more than this below its top met its wall
+NEAR_HITS = 16  # a ray's reach is bounded by the highest pixel within this many hits of its own
 
 
 def rendered_bt(
@@ -280,8 +281,12 @@ def _sweep(
     out: np.ndarray,
 ) -> None:
     """Fill *out* (:func:`render_height_field`), one column a task: the column's hits p sorted along the
-    track, then per ray the stretches within its reach (the widest gap between GEO points plus the
-    highest pixel's run along the ray) tested for where it meets them, the highest meeting kept."""
+    track, then per ray the stretches within its reach tested for where it meets them, the highest
+    meeting kept. The reach: a GEO spacing behind the ray's foot (the stretch it stands on), and ahead,
+    towards the spacecraft, a spacing plus the run along the ray of the highest pixel near its foot (within
+    NEAR_HITS hits of its own in the sorted order; the column's highest where the reach goes farther): a
+    stretch farther than its own height's run is met below ground. It is found by stepping from the
+    foot's own hit, not by bisection: a few steps, where a search of 1536 hits takes eleven."""
     rows, cols = x.shape
     for c in numba.prange(cols):
         idx = np.array([r for r in range(rows) if math.isfinite(x[r, c])], np.int64)
@@ -291,14 +296,24 @@ def _sweep(
         hit = np.array([x[r, c] + h[r, c] * b[r, c] for r in idx])
         order = np.argsort(hit)
         ps, rs = hit[order], idx[order]
+        place = np.empty(rows, np.int64)  # each row's place in the sorted hits
+        for j in range(n):
+            place[rs[j]] = j
         spacing = np.median(np.diff(np.sort(np.array([x[r, c] for r in idx]))))
         h_max = max([h[r, c] for r in idx])
+        near_max = np.zeros(n)
+        for j in range(n):
+            for k in range(max(j - NEAR_HITS, 0), min(j + NEAR_HITS + 1, n)):
+                near_max[j] = max(near_max[j], h[rs[k], c])
         for v in range(a.shape[0]):
             for r0 in idx:
                 s0, av = x[r0, c], a[v, r0, c]
-                reach = spacing + h_max * abs(av)
+                own = place[r0]
+                lo, hi = _reach(ps, own, s0, av, spacing, near_max[own])
+                if lo < own - NEAR_HITS or hi > own + NEAR_HITS + 1:  # beyond what near_max bounds
+                    lo, hi = _reach(ps, own, s0, av, spacing, h_max)
                 best_z, best = -1.0, -1
-                for j in range(np.searchsorted(ps, s0 - reach), np.searchsorted(ps, s0 + reach)):
+                for j in range(lo, hi):
                     left = 0.5 * (ps[j - 1] + ps[j]) if j > 0 else -np.inf
                     right = 0.5 * (ps[j] + ps[j + 1]) if j < n - 1 else np.inf
                     hj = h[rs[j], c]
@@ -318,9 +333,34 @@ def _sweep(
                     out[v, r0, c] = bt[rs[best], c] + (top - best_z) / m_per_k
                     continue
                 at = s0 + best_z * av  # a top: the two hits about where the ray meets it, linearly
-                k = np.searchsorted(ps, at) - 1
+                k = best  # the last hit before it (a step from the stretch's own)
+                while k >= 0 and ps[k] >= at:
+                    k -= 1
+                while k + 1 < n and ps[k + 1] < at:
+                    k += 1
                 if 0 <= k < n - 1 and ps[k + 1] > ps[k]:
                     w = (at - ps[k]) / (ps[k + 1] - ps[k])
                     out[v, r0, c] = (1 - w) * bt[rs[k], c] + w * bt[rs[k + 1], c]
                 else:
                     out[v, r0, c] = bt[rs[best], c]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _reach(ps: np.ndarray, own: int, s0: float, av: float, spacing: float, h_m: float) -> tuple[int, int]:
+    """The sorted hits *ps* (from index lo to before hi) within a ray's reach (:func:`_sweep`): from s0
+    - spacing to s0 + spacing + h_m |av| towards the spacecraft (its sign of *av*), found by stepping from
+    the foot's own hit *own*."""
+    run = h_m * abs(av)
+    back, ahead = (spacing, spacing + run) if av >= 0.0 else (spacing + run, spacing)
+    n = ps.shape[0]
+    lo = own
+    while lo > 0 and ps[lo - 1] >= s0 - back:
+        lo -= 1
+    while lo < n and ps[lo] < s0 - back:
+        lo += 1
+    hi = own
+    while hi < n and ps[hi] < s0 + ahead:
+        hi += 1
+    while hi > 0 and ps[hi - 1] >= s0 + ahead:
+        hi -= 1
+    return lo, hi

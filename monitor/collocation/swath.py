@@ -68,9 +68,10 @@ SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smal
 class SwathPiece:
     """One VIIRS granule (rows of 32-detector scans) ready for collocation.
 
-    ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (views, rows, cols) I5
-    band radiance mW/(m2 sr cm-1), NaN where unusable: one view, the pixels' own, or one per in-track SBF
-    angle of *view_alpha_rad* (what a CrIS ray at that angle sees there, :func:`swath_piece`); area_vec_m2
+    ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (rows, cols) the
+    pixels' I5 band radiance mW/(m2 sr cm-1), NaN where unusable; *rendered* (views, rows, cols), when the
+    pixels stand at a height, the radiance a CrIS ray at each in-track SBF angle of *view_alpha_rad* sees on
+    its way to each GEO point (:func:`swath_piece`), NaN where the pixel is unusable; area_vec_m2
     (rows, cols, 3) float32 the vector footprint with scan overlap removed. block_centre_m (rows/4,
     ceil(cols/4), 3) and block_radius_m bound the usable pixels of each 4 x 4 block (NaN where it has none).
     Per column: the smallest column spacing within +-200 columns (col_spacing_m), the along-track advance of a
@@ -96,12 +97,13 @@ class SwathPiece:
     view_rad: float = math.inf
     first_scan: int = 0
     span_us: tuple = (-math.inf, math.inf)
-    view_alpha_rad: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    rendered: np.ndarray | None = None
+    view_alpha_rad: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def shape(self) -> tuple[int, int]:
         """(rows, columns) of the prepared piece."""
-        rows, cols = self.radiance.shape[1:]
+        rows, cols = self.radiance.shape
         return rows, cols
 
     def covers(self, t0_us: float, t1_us: float) -> bool:
@@ -464,9 +466,8 @@ def swath_piece(
     kept are their halos).
     *seen_bt_k* (views, rows, cols), when given, is the BT a CrIS ray at each in-track SBF angle of
     *view_alpha_rad* (views,) sees along its way to each GEO point (clouds with height:
-    :func:`monitor.collocation.render.rendered_bt`): the piece then holds one radiance per view
-    (*radiance* (views, rows, cols)), each unusable where the pixel is; else one (1, rows, cols), the
-    pixels' own.
+    :func:`monitor.collocation.render.rendered_bt`): the piece then holds their radiance beside the
+    pixels' own (:attr:`SwathPiece.rendered`), for both collocations in one kernel pass.
     """
     scans = slice(None)
     if scan_start_us is not None and span_us is not None:
@@ -523,7 +524,7 @@ def swath_piece(
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
         _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
-    views, angles = radiance[None], np.zeros(1)
+    views, angles = None, np.zeros(0)
     if seen_bt_k is not None and view_alpha_rad is not None:
         angles = np.asarray(view_alpha_rad, np.float64)
         grid_k = t_min + t_step * np.arange(len(table))
@@ -545,7 +546,7 @@ def swath_piece(
     tree = cKDTree(centre[r_idx, c_idx], leafsize=64, balanced_tree=False, compact_nodes=False)
     return SwathPiece(
         pos,
-        views,
+        radiance,
         area,
         centre,
         radius,
@@ -560,5 +561,6 @@ def swath_piece(
         view_rad,
         scans.start or 0,
         covered_us,
+        views,
         angles,
     )

@@ -128,7 +128,8 @@ class AssessmentConfig(Section):
         True,
         "Place each VIIRS pixel at the height its BT implies (colder than its clear-sky neighbourhood), "
         "with the day's height scale chosen by the cost: clouds with height seen by CrIS's FOV rows from "
-        "another angle (a second collocation; off: pixels at their GEO points).",
+        "another angle (the pixels rendered as each row sees them, collocated in the same pass; off: "
+        "pixels at their GEO points).",
     )
 
     @property

@@ -134,17 +134,17 @@ def test_a_day_assessed_in_batches_is_the_day_assessed_at_once(cases, case_plan)
         for g in reversed(case_plan.cris):  # the later granule first
             day.add(replace(case_plan, cris=[g], viirs={g.key: case_plan.viirs[g.key]}, skipped=[]))
         batched = day.result()
-        kept = day.samples + day.probe
+        kept = day.samples + [s.rendered for s in day.samples]
         assert kept and all(
             isinstance(s.bt_viirs_k, OnDisk) and isinstance(s.annuli_rad, OnDisk) for s in kept
         )
 
-        def in_memory(samples):
-            return [replace(s, bt_viirs_k=s.bt_viirs_k[...], annuli_rad=s.annuli_rad[...]) for s in samples]
+        def in_memory(s):
+            rendered = None if s.rendered is None else in_memory(s.rendered)
+            return replace(s, bt_viirs_k=s.bt_viirs_k[...], annuli_rad=s.annuli_rad[...], rendered=rendered)
 
         in_time = sorted(day.samples, key=lambda s: s.info.start)
-        probe = sorted(day.probe, key=lambda s: s.info.start)
-        memory = cost_and_offsets(in_memory(in_time), cfg, day.skipped, day.satellite, in_memory(probe))
+        memory = cost_and_offsets([in_memory(s) for s in in_time], cfg, day.skipped, day.satellite)
         spool = kept[0].bt_viirs_k.path.parent
     assert [g.granule_id for g in batched.granules] == [g.granule_id for g in at_once.granules]
     assert [f.to_dict() for f in batched.fors] == [f.to_dict() for f in at_once.fors]

@@ -315,9 +315,9 @@ def test_two_threads_may_assess_at_once():
 
 
 def test_each_fov_adds_the_views_about_its_own_in_track_angle(scene):
-    """A piece rendered for three in-track angles (here: its radiance, halved, doubled): a FOV at an angle
-    between two views adds their linear blend, one beyond the ends the nearest; a piece of one view
-    serves every FOV."""
+    """A piece rendered for three in-track angles (here: its radiance, halved, doubled): in the same pass
+    as the pixels' own radiance, a FOV at an angle between two views adds their linear blend, one beyond
+    the ends the nearest."""
     fg, viirs = scene
     idx = (1, 15, 4)
     alpha = fg.alpha_rad[idx]
@@ -331,11 +331,17 @@ def test_each_fov_adds_the_views_about_its_own_in_track_angle(scene):
             [
                 replace(
                     p,
-                    radiance=np.concatenate([p.radiance, 0.5 * p.radiance, 2 * p.radiance]),
+                    rendered=np.stack([p.radiance, 0.5 * p.radiance, 2 * p.radiance]),
                     view_alpha_rad=np.array(angles),
                 )
                 for p in viirs.pieces
             ]
         )
-        got = collocate.cone_sums(*_one_fov(views, fg, idx), offsets).mean()
-        np.testing.assert_allclose(got, factor * own, rtol=1e-6)
+        both = collocate.cone_sums(*_one_fov(views, fg, idx), offsets)
+        np.testing.assert_array_equal(both.mean(), own)
+        assert both.rendered is not None
+        np.testing.assert_allclose(both.rendered.mean(), factor * own, rtol=1e-6)
+        np.testing.assert_array_equal(both.rendered.weights, both.weights)
+    mixed = swath.ViirsSwath([views.pieces[0], *viirs.pieces])
+    with pytest.raises(ValueError, match="all rendered or none"):
+        collocate.cone_sums(*_one_fov(mixed, fg, idx), offsets)
