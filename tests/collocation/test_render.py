@@ -134,3 +134,52 @@ def test_a_granule_is_rendered_as_each_row_sees_it():
     band = np.sum((295.0 - bt[:, 150:250]) * x[:, 150:250]) / np.sum(295.0 - bt[:, 150:250])
     behind, centre, ahead = centroid - band
     assert -375.0 < behind < -10.0 and 10.0 < ahead < 375.0 and ahead - behind > 100.0 and abs(centre) < 20.0
+
+
+def _every_stretch(x, b, h, bt, a, m_per_k):
+    """The sweep of one column (the module docstring's three steps) with every stretch tested for every
+    ray: no reach."""
+    idx = np.flatnonzero(np.isfinite(x))
+    hit = x[idx] + h[idx] * b[idx]
+    order = np.argsort(hit, kind="stable")
+    ps, rs = hit[order], idx[order]
+    edges = np.concatenate([[-np.inf], 0.5 * (ps[1:] + ps[:-1]), [np.inf]])
+    out = np.full(a.shape, np.nan)
+    for v in range(a.shape[0]):
+        for r0 in idx:
+            s0, av = x[r0], a[v, r0]
+            z1, z2 = (edges[:-1] - s0) / av, (edges[1:] - s0) / av
+            z = np.minimum(h[rs], np.maximum(z1, z2))
+            z[z < np.maximum(np.minimum(z1, z2), 0.0)] = -1.0
+            best = int(np.argmax(z))
+            if z[best] < 0:
+                continue
+            top = h[rs[best]]
+            if top - z[best] > 1.0:
+                out[v, r0] = bt[rs[best]] + (top - z[best]) / m_per_k
+                continue
+            at = s0 + z[best] * av
+            k = int(np.searchsorted(ps, at)) - 1
+            if not 0 <= k < len(ps) - 1:  # beyond the column's first or last hit: that pixel's
+                out[v, r0] = bt[rs[best]]
+                continue
+            w = (at - ps[k]) / (ps[k + 1] - ps[k])
+            out[v, r0] = (1 - w) * bt[rs[k]] + w * bt[rs[k + 1]]
+    return out
+
+
+@pytest.mark.parametrize("steep", [0.05, 0.6])
+def test_a_rays_reach_leaves_out_no_stretch_it_could_meet(steep):
+    """The sweep tests only the stretches within a ray's reach, bounded by the pixels near its foot (and
+    by the column's highest beyond them): it renders what testing every stretch renders, for CrIS's
+    tangents (0.05) and for rays so slanted (0.6) that the reach passes the near pixels' bound."""
+    rng = np.random.default_rng(11)
+    n = 240
+    x = PIXEL_M * np.arange(n) + rng.normal(0, 30, n)
+    h = np.where(rng.random(n) < 0.3, rng.uniform(0, 12e3, n), 0.0)
+    h[n // 2] = 15e3  # one tower whose run at the steep tangent is ~24 pixels
+    b = rng.uniform(-0.01, 0.01, n)
+    bt = 290.0 - h / M_PER_K + rng.normal(0, 0.5, n)
+    a = np.stack([np.full(n, -steep), np.full(n, steep)])
+    got = render_height_field(x[:, None], b[:, None], h[:, None], bt[:, None], a[:, :, None], M_PER_K)
+    np.testing.assert_allclose(got[..., 0], _every_stretch(x, b, h, bt, a, M_PER_K), rtol=0, atol=1e-4)
