@@ -261,6 +261,10 @@ def load_swath(
     to *view_rad* from nadir and over the IET span *span_us*, from the raw granules in *raw* (key ->
     :func:`read_viirs`) or read here."""
     raw = raw or {}
+    # a time-ordered run never needs again a piece this granule does not: freed before the new ones are
+    # prepared, it does not add to the peak
+    for key in [k for k in cache.pieces if k not in {v.key for v in viirs}]:
+        del cache.pieces[key]
     return swath.ViirsSwath(
         [piece(v, viirs_all, band, cache, view_rad, timings, raw.get(v.key), span_us) for v in viirs]
     )

@@ -529,8 +529,10 @@ def swath_piece(
         angles = np.asarray(view_alpha_rad, np.float64)
         grid_k = t_min + t_step * np.arange(len(table))
         views = np.empty((len(angles), rows, cols), f32)
-        for v in range(len(angles)):  # a view at a time: one float64 copy of a granule, not five
-            views[v] = np.interp(seen_bt_k[v], grid_k, table, left=np.nan, right=np.nan)
+        for v in range(len(angles)):  # a scan at a time: no float64 copy of a granule
+            for r in range(0, rows, VIIRS_DETECTORS):
+                part = seen_bt_k[v, r : r + VIIRS_DETECTORS]
+                views[v, r : r + VIIRS_DETECTORS] = np.interp(part, grid_k, table, left=np.nan, right=np.nan)
         views[:, ~np.isfinite(radiance)] = np.nan
 
     scan = pos.reshape(nscan, VIIRS_DETECTORS, cols, 3)
