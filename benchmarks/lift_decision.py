@@ -1,9 +1,9 @@
 """What the day's lift decision sees on simulated cases: the fraction of the probe's lift the day's cost
 prefers, and the gain in cost there with its jackknife sigma, for the day and for each FOV row (ahead,
 centre, behind), beside the case's truth (its cloud law, edges, the footprint's full width at half peak).
-The rule (:func:`monitor.estimation.parallax.day_lift`) keeps the lift where the day gains more than 2
-sigma; the rows' gains are what a rule by rows would see (docs/science.md, "What the day's cost cannot
-tell apart"). Prints one JSON row per case.
+The rule (:func:`monitor.estimation.parallax.keeps`) keeps a lift of at least 50 m/K where the day
+gains more than 1 sigma; the rows' gains are what a rule by rows would see (docs/science.md, "What the
+day's cost cannot tell apart"). Prints one JSON row per case.
 
     .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--rows FILE]
 
@@ -54,7 +54,7 @@ def decision(case: Path, workers: int) -> dict:
         ]
     )
     sigma = [jackknife_sigma(gain_g[:, r]) for r in range(len(parallax.ROWS))]
-    kept, _ = parallax.day_lift(s0, s1, cfg.cost)
+    kept, _ = parallax.day_lift(s0, s1, cfg.cost, PROBE_M_PER_K)
     row = {
         "commit": commit(),
         "case": case.name,

@@ -155,7 +155,7 @@ def main() -> int:
     shipped = _scores(assess_paths([root], cfg), truth)
     true_lift = _true_heights(render.rendered_bt)
     render.rendered_bt = true_lift  # type: ignore[assignment]  # the same call, counted
-    day_parallax.day_lift = lambda s0, s1, cost: (1.0, float("nan"))
+    day_parallax.day_lift = lambda s0, s1, cost, probe_m_per_k: (1.0, float("nan"))
     oracle = _scores(assess_paths([root], cfg), truth)
     print(f"oracle rows matched {true_lift.rows}/{true_lift.total}")
     for name, s in (("shipped", shipped), ("true heights", oracle)):

@@ -273,7 +273,7 @@ def cost_and_offsets(
             ),
             strict=True,
         )
-        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost)
+        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost, PROBE_M_PER_K)
         if cfg.uncertainty and np.isfinite(sigma_f):
             spread = np.array(
                 [

@@ -24,13 +24,19 @@ them (0 where the cost prefers no lift).
 Its uncertainty is derived like the offsets': the delete-one-granule jackknife of f (each replicate searched
 again about the day's f; a run of consecutive granules per replicate on a long day,
 :func:`monitor.estimation.jackknife.granule_runs`), sigma_f^2 = (G - 1)/G sum (f_g - mean)^2. The lift is kept
-only where it lowers the day's cost by more than twice the jackknife sigma of that gain; else the day is
-estimated without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules nothing can be judged:
-no lift. A day whose clouds lie on the ground can prefer a small lift by a hair of its cost, which would turn
-its rows apart by tens of urad: the test keeps it at none. sigma_f reaches every offset through that offset's
-sensitivity to f, by the delta method: sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference
-over +-:data:`SENSITIVITY_STEP` of that scaled cone's minimum (the FOR's, and each FOV row's for the rows'
-difference). The rows ahead and behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
+(:func:`keeps`) only where it is a height a cloud could have, at least :data:`MIN_LIFT_M_PER_K` (half of
+what tops falling at the dry adiabat's 9.8 K/km give, 102 m/K: no elevated cloud's window BT falls faster
+with height), and it lowers the day's cost by more than :data:`GAIN_SIGMAS` jackknife sigma of that gain;
+else the day is estimated without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules
+nothing can be judged: no lift. A day whose clouds lie on the ground prefers a lift of 0-17 m/K under the
+rendering (a hair of its cost, which would turn its rows apart by up to ~20 urad): the size keeps it at none.
+The gain's sigma alone was the rule before (twice it): it declined a 6-granule day with tops at
+7.8 K/km and a 4-granule one at 6.5 K/km whose preferred lifts were within 5 % of their laws (1.9 and
+1.7 sigma), leaving their rows ~200 urad of parallax (docs/science.md, "What the day's cost cannot tell
+apart"). sigma_f reaches every offset through that offset's sensitivity to f, by the delta method:
+sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference over +-:data:`SENSITIVITY_STEP` of
+that scaled cone's minimum (the FOR's, and each FOV row's for the rows' difference). The rows ahead and
+behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
 
 Measured (docs/science.md, "The FOV rows and clouds with height"): the lift follows the simulated laws (232
 m/K for tops at 5 K/km, 127-151 at 8, 192 for the tropical profile) and is declined on flat clouds, terrain
@@ -58,6 +64,8 @@ from monitor.instrument.footprint import HALF_WIDTH_50_RAD, top_hat_weights, wid
 
 FRACTIONS = np.linspace(0.0, 2.5, 11)
 SENSITIVITY_STEP = 0.1
+MIN_LIFT_M_PER_K = 50.0  # half the dry adiabat's 102 m/K (9.8 K/km): a smaller law is no cloud's
+GAIN_SIGMAS = 1.0  # the day's gain in cost, in its jackknife sigmas, that keeps a lift
 ROWS = ((6, 7, 8), (3, 4, 5), (0, 1, 2))  # FOVs 7-9 ahead, 4-6, 1-3 behind
 
 
@@ -144,10 +152,18 @@ def day_fraction(
     return float(np.clip(best, FRACTIONS[0], FRACTIONS[-1]))
 
 
-def day_lift(s0: list[ForSamples], s1: list[ForSamples], cost: Cost) -> tuple[float, float]:
-    """The day's fraction of the probe's lift and its jackknife sigma (module docstring): (0, the f
-    declined) where the lift's gain in cost is not significant, or cannot be judged (fewer than 3
-    granules: sigma NaN)."""
+def keeps(lift_m_per_k: float, gain: float, sigma_gain: float) -> bool:
+    """Whether the day keeps the lift its cost prefers (module docstring): *lift_m_per_k* is a height a
+    cloud could have and its *gain* in the day's cost (K) passes :data:`GAIN_SIGMAS` times *sigma_gain*."""
+    return lift_m_per_k >= MIN_LIFT_M_PER_K and gain > GAIN_SIGMAS * sigma_gain
+
+
+def day_lift(
+    s0: list[ForSamples], s1: list[ForSamples], cost: Cost, probe_m_per_k: float
+) -> tuple[float, float]:
+    """The day's fraction of the probe's lift (*probe_m_per_k*, what *s1* was collocated at) and its
+    jackknife sigma (module docstring): (0, the f declined) where :func:`keeps` declines it, or where it
+    cannot be judged (fewer than 3 granules: sigma NaN)."""
     f = day_fraction(s0, s1, cost)
     granules = np.unique(np.concatenate([a.granule for a in s0]))
     if len(granules) < 3:
@@ -156,7 +172,7 @@ def day_lift(s0: list[ForSamples], s1: list[ForSamples], cost: Cost) -> tuple[fl
     f_g = np.array([day_fraction(s0, s1, cost, g, near=f) for g in runs])
     gain_g = np.array([day_cost(s0, s1, 0.0, cost, g) - day_cost(s0, s1, f, cost, g) for g in runs])
     sigma_f, sigma_gain = jackknife_sigma(f_g), jackknife_sigma(gain_g)
-    if day_cost(s0, s1, 0.0, cost) - day_cost(s0, s1, f, cost) <= 2.0 * sigma_gain:
+    if not keeps(f * probe_m_per_k, day_cost(s0, s1, 0.0, cost) - day_cost(s0, s1, f, cost), sigma_gain):
         return 0.0, max(sigma_f, f)
     return f, sigma_f
 

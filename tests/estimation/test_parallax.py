@@ -6,7 +6,20 @@ import pytest
 
 from monitor.core.vocabulary import Cost
 from monitor.estimation.estimate import ForSamples
-from monitor.estimation.parallax import ROWS, blend, day_cost, day_fraction, day_lift, row_costs, sensitivity
+from monitor.estimation.parallax import (
+    GAIN_SIGMAS,
+    MIN_LIFT_M_PER_K,
+    ROWS,
+    blend,
+    day_cost,
+    day_fraction,
+    day_lift,
+    keeps,
+    row_costs,
+    sensitivity,
+)
+
+PROBE_M_PER_K = 180.0  # the fraction's unit in these tests
 
 M = 21
 
@@ -39,22 +52,43 @@ def test_the_search_finds_the_fraction_the_samples_agree_at(true_f):
     s0, s1 = [a for a, _ in fors], [b for _, b in fors]
     for cost in Cost:
         assert day_fraction(s0, s1, cost) == pytest.approx(true_f, abs=0.05)
-    f, sigma = day_lift(s0, s1, Cost.STDEV)
+    f, sigma = day_lift(s0, s1, Cost.STDEV, PROBE_M_PER_K)
     assert f == pytest.approx(true_f, abs=0.05) and 0 < sigma < 0.1
 
 
 def test_a_lift_that_gains_nothing_significant_is_declined_and_its_size_is_the_sigma():
-    fors = [pair(0.1, 0.01, seed=k) for k in range(6)]  # a shallow preference for a small lift
+    fors = [pair(0.6, 0.01, seed=k) for k in range(6)]  # a shallow preference for a cloud's lift
     s0, s1 = [a for a, _ in fors], [b for _, b in fors]
     found = day_fraction(s0, s1, Cost.STDEV)
-    f, sigma = day_lift(s0, s1, Cost.STDEV)
-    assert found > 0.02 and f == 0.0 and sigma >= found
+    f, sigma = day_lift(s0, s1, Cost.STDEV, PROBE_M_PER_K)
+    assert found * PROBE_M_PER_K > MIN_LIFT_M_PER_K and f == 0.0 and sigma >= found
     few = [ForSamples(a.d_k, a.cris_k, a.granule % 2, a.scan, fov=a.fov) for a in s0]  # 2 granules: no sigma
     assert np.isnan(
         day_lift(
-            few, [ForSamples(b.d_k, b.cris_k, b.granule % 2, b.scan, fov=b.fov) for b in s1], Cost.STDEV
+            few,
+            [ForSamples(b.d_k, b.cris_k, b.granule % 2, b.scan, fov=b.fov) for b in s1],
+            Cost.STDEV,
+            PROBE_M_PER_K,
         )[1]
     )
+
+
+def test_a_lift_smaller_than_any_clouds_is_declined_however_much_it_gains():
+    fors = [pair(0.15, 0.5, seed=k) for k in range(6)]  # a sharp preference for 27 m/K
+    s0, s1 = [a for a, _ in fors], [b for _, b in fors]
+    found = day_fraction(s0, s1, Cost.STDEV)
+    assert found == pytest.approx(0.15, abs=0.05)
+    assert day_lift(s0, s1, Cost.STDEV, PROBE_M_PER_K)[0] == 0.0
+    assert day_lift(s0, s1, Cost.STDEV, 2 * MIN_LIFT_M_PER_K / found)[0] == pytest.approx(found)
+
+
+@pytest.mark.parametrize(
+    ("lift_m_per_k", "gain_sigmas", "kept"),
+    [(120.0, 1.5, True), (120.0, 0.9, False), (40.0, 9.0, False), (MIN_LIFT_M_PER_K, 1.01, True)],
+)
+def test_the_rule_asks_a_clouds_size_and_a_gain_beyond_its_sigma(lift_m_per_k, gain_sigmas, kept):
+    """*gain_sigmas* in units of the rule's own GAIN_SIGMAS."""
+    assert keeps(lift_m_per_k, gain_sigmas * GAIN_SIGMAS * 0.2, 0.2) is kept
 
 
 def test_the_day_cost_is_its_rows_costs_summed():
