@@ -3,9 +3,13 @@ prefers, and the gain in cost there with its jackknife sigma, for the day and fo
 centre, behind), beside the case's truth (its cloud law, edges, the footprint's full width at half peak).
 The rule (:func:`monitor.estimation.parallax.keeps`) keeps a lift of at least 50 m/K where the day
 gains more than 1 sigma; the rows' gains are what a rule by rows would see (docs/science.md, "What the
-day's cost cannot tell apart"). Prints one JSON row per case.
+day's cost cannot tell apart"). Prints one JSON row per case. With ``--offsets`` the row also holds what
+the day's estimate makes of the case against its truth, as the default configuration assesses it and
+with ``parallax=False`` (from the same collocation): per direction the FOR offsets' RMS and worst error,
+the share of FOR-directions within 2 sigma, the median sigma, and the rows' median error, share within 2
+sigma and median sigma (the bounds of benchmarks.acceptance).
 
-    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--rows FILE]
+    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--offsets] [--rows FILE]
 
 A case directory is one ``crisgeo simulate`` (or ``benchmarks.acceptance --keep``) wrote, with truth.json.
 """
@@ -19,10 +23,11 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import collocate_plan, for_samples, paired
+from monitor.assessment.assess import collocate_plan, cost_and_offsets, for_samples, paired
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
+from monitor.core.result import AssessmentResult
 from monitor.estimation import parallax
 from monitor.estimation.jackknife import granule_runs, jackknife_sigma
 from monitor.instrument.spectral import i5_band
@@ -31,11 +36,12 @@ from monitor.sdr.pairing import plan
 ROW_NAMES = ("ahead", "centre", "behind")  # parallax.ROWS
 
 
-def decision(case: Path, workers: int) -> dict:
+def decision(case: Path, workers: int, offsets: bool = False) -> dict:
     """The row of one case (module docstring)."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
-    pairs = paired(collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K))
+    samples = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
+    pairs = paired(samples)
     band = i5_band(truth["satellite"])
     cones = [
         parallax.matched_cone(
@@ -64,23 +70,61 @@ def decision(case: Path, workers: int) -> dict:
         if truth.get("cris_response") is None
         else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
         "granules": len(runs),
+        "law_m_per_k": _law_m_per_k(truth.get("cloud_heights", "ground")),
+        "fov_rows_alpha_urad": truth.get("fov_rows_alpha_urad", 0.0),
         "preferred_m_per_k": round(f * PROBE_M_PER_K, 1),
+        "sigma_preferred_m_per_k": round(
+            jackknife_sigma(np.array([parallax.day_fraction(s0, s1, cfg.cost, g, near=f) for g in runs]))
+            * PROBE_M_PER_K,
+            1,
+        ),
         "day_gain_sigmas": round(float(gain.sum() / jackknife_sigma(gain_g.sum(axis=1))), 1),
         "kept_m_per_k": round(kept * PROBE_M_PER_K, 1),
     }
     for name, g, s in zip(ROW_NAMES, gain, sigma, strict=True):
         row[f"{name}_gain_sigmas"] = round(float(g / s), 1)
+    if offsets:
+        plain = cfg.model_copy(update={"parallax": False})
+        row["default"] = _scores(cost_and_offsets(samples, cfg, satellite=truth["satellite"]), truth)
+        row["no_parallax"] = _scores(cost_and_offsets(pairs[0], plain, satellite=truth["satellite"]), truth)
     return row
+
+
+def _law_m_per_k(clouds: str) -> float | None:
+    """The lift a ``lapse:G`` law implies (1000 / G m per K); None for other clouds."""
+    name, _, rate = clouds.partition(":")
+    return round(1000.0 / float(rate), 1) if name == "lapse" else None
+
+
+def _scores(result: AssessmentResult, truth: dict) -> dict:
+    """The day's errors against *truth* (module docstring), in-track and cross-track pairs."""
+    fors = result.fors
+    err = np.array([[f.d_alpha_urad - t["d_alpha_urad"], f.d_beta_urad - t["d_beta_urad"]]
+                    for f, t in zip(fors, truth["fors"], strict=True)])  # fmt: skip
+    sigma = np.array([[f.sigma_alpha_urad, f.sigma_beta_urad] for f in fors])
+    rows = np.array([f.fov_rows_alpha_urad for f in fors]) - truth.get("fov_rows_alpha_urad", 0.0)
+    rows_sigma = np.array([f.sigma_fov_rows_alpha_urad for f in fors])
+    return {
+        "lift_m_per_k": round(float(fors[0].parallax_m_per_k), 1),
+        "rms_urad": np.sqrt(np.nanmean(err**2, axis=0)).round(1).tolist(),
+        "worst_urad": np.nanmax(np.abs(err), axis=0).round(1).tolist(),
+        "within_2_sigma": round(float(np.mean(np.abs(err) <= 2 * sigma)), 2),
+        "median_sigma_urad": np.nanmedian(sigma, axis=0).round(1).tolist(),
+        "rows_median_error_urad": round(float(np.nanmedian(rows)), 1),
+        "rows_within_2_sigma": round(float(np.mean(np.abs(rows) <= 2 * rows_sigma)), 2),
+        "rows_median_sigma_urad": round(float(np.nanmedian(rows_sigma)), 1),
+    }
 
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("cases", nargs="+", type=Path)
     p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--offsets", action="store_true", help="also the day's errors, default and parallax=False")
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()
     for case in args.cases:
-        emit(decision(case, args.workers), args.rows)
+        emit(decision(case, args.workers, args.offsets), args.rows)
 
 
 if __name__ == "__main__":
