@@ -1,8 +1,8 @@
 """Clouds with height through the whole assessment: the rendered collocation takes the rows' parallax away.
 
-Whether the day keeps its lift is the cost's decision (:mod:`monitor.estimation.parallax`, its tests); on
-three granules the rendered probe's gain is not significant on this case, so the test reads the probe's
-collocation itself: the day's estimate at the probe's scale, the case's law within 5 %."""
+Whether the day keeps its lift is the cost's decision (:mod:`monitor.estimation.parallax`, its tests), made
+on three granules from a gain of a sigma or two; so the test reads the probe's collocation itself: the day's
+estimate at the probe's scale, the case's law within 5 %."""
 
 from dataclasses import replace
 
