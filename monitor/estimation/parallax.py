@@ -39,8 +39,8 @@ that scaled cone's minimum (the FOR's, and each FOV row's for the rows' differen
 behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
 
 Measured on days made after the rule (docs/science.md, "The lift decision on held-back days"): declined on
-9 of 10 flat days (footprints, profiles, textures, terrain, calibration differences), kept on 11 of 12 days
-with clouds with height, within 20 % of the law on 6 of 11; a flat day whose rows are 200 urad apart keeps
+9 of 10 flat days (footprints, profiles, textures, terrain, calibration differences), kept on 13 of 14 days
+with clouds with height, within 20 % of the law on 8 of 13; a flat day whose rows are 200 urad apart keeps
 58 m/K, and a row error pulls a cloudy day's lift short.
 """
 
