@@ -9,7 +9,12 @@ with ``parallax=False`` (from the same collocation): per direction the FOR offse
 the share of FOR-directions within 2 sigma, the median sigma, and the rows' median error, share within 2
 sigma and median sigma (the bounds of benchmarks.acceptance).
 
-    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--offsets] [--rows FILE]
+    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--offsets | --probe M_PER_K]
+        [--rows FILE]
+
+``--probe`` renders the collocation at another lift than the assessment's: the fraction the day prefers
+is of the blend V0 + f (V1 - V0), so what it prefers in m/K depends on the probe (docs/science.md, "The
+lift decision on held-back days").
 
 A case directory is one ``crisgeo simulate`` (or ``benchmarks.acceptance --keep``) wrote, with truth.json.
 """
@@ -36,11 +41,11 @@ from monitor.sdr.pairing import plan
 ROW_NAMES = ("ahead", "centre", "behind")  # parallax.ROWS
 
 
-def decision(case: Path, workers: int, offsets: bool = False) -> dict:
-    """The row of one case (module docstring)."""
+def decision(case: Path, workers: int, offsets: bool = False, probe_m_per_k: float = PROBE_M_PER_K) -> dict:
+    """The row of one case (module docstring), its rendered collocation at *probe_m_per_k*."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
-    samples = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
+    samples = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=probe_m_per_k)
     pairs = paired(samples)
     band = i5_band(truth["satellite"])
     cones = [
@@ -60,7 +65,7 @@ def decision(case: Path, workers: int, offsets: bool = False) -> dict:
         ]
     )
     sigma = [jackknife_sigma(gain_g[:, r]) for r in range(len(parallax.ROWS))]
-    kept, _ = parallax.day_lift(s0, s1, cfg.cost, PROBE_M_PER_K)
+    kept, _ = parallax.day_lift(s0, s1, cfg.cost, probe_m_per_k)
     row = {
         "commit": commit(),
         "case": case.name,
@@ -72,14 +77,15 @@ def decision(case: Path, workers: int, offsets: bool = False) -> dict:
         "granules": len(runs),
         "law_m_per_k": _law_m_per_k(truth.get("cloud_heights", "ground")),
         "fov_rows_alpha_urad": truth.get("fov_rows_alpha_urad", 0.0),
-        "preferred_m_per_k": round(f * PROBE_M_PER_K, 1),
+        "probe_m_per_k": probe_m_per_k,
+        "preferred_m_per_k": round(f * probe_m_per_k, 1),
         "sigma_preferred_m_per_k": round(
             jackknife_sigma(np.array([parallax.day_fraction(s0, s1, cfg.cost, g, near=f) for g in runs]))
-            * PROBE_M_PER_K,
+            * probe_m_per_k,
             1,
         ),
         "day_gain_sigmas": round(float(gain.sum() / jackknife_sigma(gain_g.sum(axis=1))), 1),
-        "kept_m_per_k": round(kept * PROBE_M_PER_K, 1),
+        "kept_m_per_k": round(kept * probe_m_per_k, 1),
     }
     for name, g, s in zip(ROW_NAMES, gain, sigma, strict=True):
         row[f"{name}_gain_sigmas"] = round(float(g / s), 1)
@@ -121,10 +127,18 @@ def main() -> None:
     p.add_argument("cases", nargs="+", type=Path)
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--offsets", action="store_true", help="also the day's errors, default and parallax=False")
+    p.add_argument(
+        "--probe",
+        type=float,
+        default=PROBE_M_PER_K,
+        help=f"the rendered collocation's lift, m/K (the assessment's {PROBE_M_PER_K:g}; not with --offsets)",
+    )
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()
+    if args.offsets and args.probe != PROBE_M_PER_K:
+        p.error("--offsets assesses as the service does, at its own probe: give --probe without it")
     for case in args.cases:
-        emit(decision(case, args.workers, args.offsets), args.rows)
+        emit(decision(case, args.workers, args.offsets, args.probe), args.rows)
 
 
 if __name__ == "__main__":
