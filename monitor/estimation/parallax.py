@@ -28,8 +28,9 @@ again about the day's f; a run of consecutive granules per replicate on a long d
 what tops falling at the dry adiabat's 9.8 K/km give, 102 m/K: no elevated cloud's window BT falls faster
 with height), and it lowers the day's cost by more than :data:`GAIN_SIGMAS` jackknife sigma of that gain;
 else the day is estimated without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules
-nothing can be judged: no lift. A day whose clouds lie on the ground prefers a lift of 0-17 m/K under the
-rendering (a hair of its cost, which would turn its rows apart by up to ~20 urad): the size keeps it at none.
+nothing can be judged: no lift. A day whose clouds lie on the ground mostly prefers 0-17 m/K under the
+rendering (a hair of its cost, which would turn its rows apart by up to ~20 urad): the size keeps it at none;
+where it prefers more (79 m/K with a calibration difference), the gain declines it.
 The gain's sigma alone was the rule before (twice it): it declined a 6-granule day with tops at
 7.8 K/km and a 4-granule one at 6.5 K/km whose preferred lifts were within 5 % of their laws (1.9 and
 1.7 sigma), leaving their rows ~200 urad of parallax (docs/science.md, "What the day's cost cannot tell
