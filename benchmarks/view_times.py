@@ -24,15 +24,11 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from benchmarks.provenance import commit, emit
+from monitor.geometry.wgs84 import geodetic_to_ecef
 from monitor.sdr import iet
 from monitor.simulate import scan_geometry as ins
 
 ROWS = {"ahead": (6, 7, 8), "centre": (3, 4, 5), "behind": (0, 1, 2)}  # FOV index 0..8
-
-
-def _unit(lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
-    lat, lon = np.radians(lat_deg), np.radians(lon_deg)
-    return np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], -1)
 
 
 def view_times(case: Path) -> dict:
@@ -53,8 +49,9 @@ def view_times(case: Path) -> dict:
                 start = iet.iet_to_unix_us(v["StartTime"][()]) * 1e-6
             pixel_s = np.repeat(start, vlat.shape[0] // len(start))[:, None] + col_dt[None, :]
             ok = np.abs(vlat) <= 90.0
-            dist, idx = cKDTree(_unit(vlat[ok], vlon[ok])).query(_unit(lat, lon).reshape(-1, 3))
-            near = (dist * 6.371e6 < 400.0).reshape(lat.shape)  # within a pixel: this granule holds it
+            tree = cKDTree(geodetic_to_ecef(np.radians(vlat[ok]), np.radians(vlon[ok])))
+            dist_m, idx = tree.query(geodetic_to_ecef(np.radians(lat), np.radians(lon)).reshape(-1, 3))
+            near = (dist_m < 400.0).reshape(lat.shape)  # within a pixel: this granule holds it
             lag = pixel_s[ok][idx].reshape(lat.shape) - for_s[:, :, None]
             lags[-1] = np.where(near, lag, lags[-1])
     lag, rng = np.concatenate(lags), np.concatenate(ranges)

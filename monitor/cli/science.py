@@ -25,7 +25,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOV, PAPER_GRANULES
 from monitor.core.satellites import SATELLITES
 from monitor.instrument.footprint import SHAPES as FOOTPRINTS
-from monitor.simulate import LAYOUTS
+from monitor.simulate import CIRRUS_BASE_M, LAYOUTS
 from monitor.simulate.sun_synchronous import PASSES
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
@@ -75,8 +75,8 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
         type=float,
         default=1.0,
         metavar="E",
-        help="the emissivity of the clouds met above 7 km (cirrus), 0 < E <= 1: below 1 the ground shows "
-        "through; lower clouds stay opaque; default 1",
+        help=f"the emissivity of the clouds met above {CIRRUS_BASE_M / 1e3:g} km (cirrus), 0 < E <= 1: below "
+        "1 the ground shows through; lower clouds stay opaque; default 1",
     ),
     arg(
         "--fov-rows-urad",

@@ -5,4 +5,5 @@ coastlines); the CrIS GEO is computed from the erroneous ones. The CrIS truth is
 over the true FOV cone, independently of the VIIRS pixel grid (no "inverse crime", docs/science.md).
 """
 
+CIRRUS_BASE_M = 7000.0  # a cloud met above this is cirrus: SimulationSpec.cloud_emissivity; below, opaque
 LAYOUTS = ("contiguous", "gzip")  # of every dataset: uncompressed IDPS files; one gzip chunk per dataset

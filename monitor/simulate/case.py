@@ -61,7 +61,7 @@ from monitor.sdr import iet
 from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
 from monitor.sdr.names import format_name
 from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
-from monitor.simulate import complete
+from monitor.simulate import CIRRUS_BASE_M, complete
 from monitor.simulate import scan_geometry as ins
 from monitor.simulate.clouds import CloudHeights
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
@@ -77,7 +77,6 @@ VIIRS_GRANULE_S = VIIRS_SCANS * ins.VIIRS_SCAN_S
 # finer than VIIRS's 375 m pixels; with 512 a flat sharp-edged 6-granule day read 17.2 / 10.4 urad RMS with no
 # lift, with 4096 7.0 / 5.2 (seed 5, zero profile, 2026-11-28)
 CONE_SAMPLES = {"soft": 512, "sharp": 4096}
-CIRRUS_BASE_M = 7000.0  # a cloud met above this is cirrus: SimulationSpec.cloud_emissivity; below, opaque
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0

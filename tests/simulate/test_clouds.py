@@ -6,6 +6,7 @@ import pytest
 
 from monitor.core.errors import DataError
 from monitor.geometry import wgs84
+from monitor.simulate import CIRRUS_BASE_M
 from monitor.simulate import case as sim_module
 from monitor.simulate import scan_geometry as ins
 from monitor.simulate import scene as scene_module
@@ -172,7 +173,7 @@ def test_thin_clouds_let_the_ground_behind_them_show():
     temps, weights = thin.seen(r, los, thin.t0)
     assert np.array_equal(temps[0], t_cloud) and np.allclose(weights.sum(axis=0), 1.0)
     hit_m = thin.met(r, los, thin.t0, thin.surface(r, los))[2]
-    high = hit_m > sim_module.CIRRUS_BASE_M  # cirrus: thin; the clouds below stay opaque
+    high = hit_m > CIRRUS_BASE_M  # cirrus: thin; the clouds below stay opaque
     assert 0.1 < high.mean() < 0.9 and 0.05 < np.mean((hit_m > 1000) & ~high)
     assert np.all(weights[0][high] == 0.4) and np.all(weights[0][~high] == 1.0)
     assert (
