@@ -34,7 +34,10 @@ from monitor.collocation.geodesy import ecef_m
 from monitor.core.constants import VIIRS_SCAN_US
 
 REFERENCE_HALF_PX = 40  # +-40 pixels: ~15 km at nadir, wider than a CrIS cone's reach from its edge
-PROBE_M_PER_K = 180.0  # the rendered collocation's lift: 6.5 K/km seen through a window transmittance ~0.85
+# The rendered collocation's lift, above the laws of the days (128-226 m/K: tops at 7.8-5.2 K/km, seen
+# through a window transmittance of 1-0.85): the day's lift is sought on a straight line between no lift
+# and this rendering, which reads short beyond the probe (docs/science.md, "The probe above the laws").
+PROBE_M_PER_K = 260.0
 ROTATION_RAD_S = 2.0 * math.pi / (VIIRS_SCAN_US * 1e-6)
 
 

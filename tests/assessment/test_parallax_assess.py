@@ -1,18 +1,20 @@
 """Clouds with height through the whole assessment: the rendered collocation takes the rows' parallax away.
 
 Whether the day keeps its lift is the cost's decision (:mod:`monitor.estimation.parallax`, its tests), made
-on three granules from a gain of a sigma or two; so the test reads the probe's collocation itself: the day's
-estimate at the probe's scale, the case's law within 5 %."""
+on three granules from a gain of a sigma or two; so the test renders the pixels at the case's law itself (its
+6.5 K/km seen through the window, not the assessment's probe) and reads that collocation; the day's
+decision on the same samples is read for its wiring only (one scale for the day)."""
 
 from dataclasses import replace
 
 import numpy as np
 
 from monitor.assessment.assess import collocate_plan, cost_and_offsets
-from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
+
+LAW_M_PER_K = 180.0  # 1000 / 6.5 K/km through a window transmittance ~0.85
 
 
 def _rows_urad(result):
@@ -21,7 +23,7 @@ def _rows_urad(result):
 
 def test_the_rendered_collocation_takes_the_rows_parallax_away(tmp_path):
     simulate_case(tmp_path, granules=3, profile="paper", seed=3, cloud_heights="lapse:6.5")
-    samples = collocate_plan(plan([tmp_path]), lift_m_per_k=PROBE_M_PER_K)  # both, in one pass
+    samples = collocate_plan(plan([tmp_path]), lift_m_per_k=LAW_M_PER_K)  # both, in one pass
     assert all(s.rendered is not None and s.rendered.key == s.key for s in samples)
     day = cost_and_offsets(samples, AssessmentConfig(), satellite="j01")
     assert len({f.parallax_m_per_k for f in day.fors}) == 1  # one scale for the day
