@@ -227,19 +227,26 @@ def piece(
             raw = read_viirs(v, viirs_all, run_span)
     geo, sdr, halo_before, halo_after = raw
     assert geo.height_m is not None  # zeros for the ellipsoid product (ViirsGeoGranule)
+    reach_rad = view_rad + collocate.VIEW_MARGIN_RAD
     seen = None
     if cache.lift_m_per_k:
         with stage(timings, "parallax"):
+            # what the piece keeps, and a scan either side: a ray's stretches lie within ~1 km of its foot
+            scans, columns = swath.kept_pixels(
+                geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m, reach_rad,
+                geo.start_time_us, run_span,
+            )  # fmt: skip
+            first, stop, _ = scans.indices(len(geo.sc_position_m))
             seen = render.rendered_bt(
                 geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, geo.sc_position_m,
                 geo.sc_velocity_m_s, render.VIEW_ALPHA_RAD, cache.lift_m_per_k,
+                slice(max(first - 1, 0), stop + 1), columns,
             )  # fmt: skip
     with stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
-            sat_m=geo.sc_position_m, view_rad=view_rad + collocate.VIEW_MARGIN_RAD,
-            scan_start_us=geo.start_time_us, span_us=run_span, seen_bt_k=seen,
-            view_alpha_rad=render.VIEW_ALPHA_RAD,
+            sat_m=geo.sc_position_m, view_rad=reach_rad, scan_start_us=geo.start_time_us, span_us=run_span,
+            seen_bt_k=seen, view_alpha_rad=render.VIEW_ALPHA_RAD,
         )  # fmt: skip
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))

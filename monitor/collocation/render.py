@@ -74,26 +74,33 @@ def rendered_bt(
     velocity_m_s: np.ndarray,
     cris_alpha_rad: np.ndarray,
     m_per_k: float,
+    scans: slice = slice(None),
+    columns: slice = slice(None),
 ) -> np.ndarray:
     """The BT (K, float32 (len(cris_alpha_rad), rows, cols)) that a CrIS ray at each in-track SBF angle
     of *cris_alpha_rad* sees on its way to each GEO point of a VIIRS granule (rows of 32-detector scans,
     GEO (lat_rad, lon_rad, height_m), BT *bt_k*, usable where *good*; NaN elsewhere), each pixel standing
     *m_per_k* m per K colder than its clear-sky reference
     (:func:`monitor.collocation.lift.height_above_m`): :func:`view_tangents`, then
-    :func:`render_height_field`, :data:`COLUMNS_PER_PASS` columns at a time."""
+    :func:`render_height_field`, :data:`COLUMNS_PER_PASS` columns at a time. Only the pixels of *scans*
+    (step 1) and *columns* are rendered, NaN elsewhere; the clear-sky reference is the whole granule's."""
     rows, cols = np.shape(bt_k)
     out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
     usable = np.asarray(good, bool) & np.isfinite(bt_k)
     reference = reference_k(bt_k, usable)  # over the whole granule: it looks 40 pixels around
     height = height_above_m(bt_k, usable, reference, m_per_k)
-    for c0 in range(0, cols, COLUMNS_PER_PASS):
-        part = slice(c0, min(c0 + COLUMNS_PER_PASS, cols))
-        ok = usable[:, part]
+    first, stop, _ = scans.indices(rows // VIIRS_DETECTORS)
+    r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
+    c_first, c_stop, _ = columns.indices(cols)
+    for c0 in range(c_first, c_stop, COLUMNS_PER_PASS):
+        part = slice(c0, min(c0 + COLUMNS_PER_PASS, c_stop))
+        ok = usable[r, part]
         x, b, a = view_tangents(
-            lat_rad[:, part], lon_rad[:, part], height_m[:, part], ok, sat_m, velocity_m_s, cris_alpha_rad
-        )
-        out[:, :, part] = render_height_field(
-            np.where(ok, x, np.nan), b, height[:, part], bt_k[:, part], a, m_per_k
+            lat_rad[r, part], lon_rad[r, part], height_m[r, part], ok, sat_m[first:stop],
+            velocity_m_s[first:stop], cris_alpha_rad,
+        )  # fmt: skip
+        out[:, r, part] = render_height_field(
+            np.where(ok, x, np.nan), b, height[r, part], bt_k[r, part], a, m_per_k
         )
     return out
 

@@ -183,19 +183,43 @@ def _locate_scan(
     """Pass 1 for scan k: pixel points, band radiance from BT (linear in the uniform BT table, NaN outside
     it or where not *good*), and the scan's ends (slot k + 1; 0 and nscan + 1 are the halos)."""
     cols = lat.shape[1]
-    nt = table.shape[0]
     sl = slice(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS)
     _ecef(lat[sl], lon[sl], h[sl], pos[sl])
     for r in range(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS):
         for c in range(cols):
-            x = (np.float64(bt[r, c]) - t_min_k) / t_step_k
-            if good[r, c] and x >= 0.0 and x <= nt - 1:
-                i = min(int(x), nt - 2)
-                w = x - i
-                radiance[r, c] = table[i] * (1.0 - w) + table[i + 1] * w
-            else:
-                radiance[r, c] = np.nan
+            radiance[r, c] = _band_radiance(bt[r, c], table, t_min_k, t_step_k) if good[r, c] else np.nan
     _scan_ends(pos[sl], first[k + 1], last[k + 1], step[k + 1])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _band_radiance(bt_k: float, table: np.ndarray, t_min_k: float, t_step_k: float) -> float:
+    """The band radiance of *bt_k*: linear in the uniform BT table (its first BT *t_min_k*, its step
+    *t_step_k*), NaN outside it or for NaN."""
+    nt = table.shape[0]
+    x = (np.float64(bt_k) - t_min_k) / t_step_k
+    if x >= 0.0 and x <= nt - 1:
+        i = min(int(x), nt - 2)
+        w = x - i
+        return table[i] * (1.0 - w) + table[i + 1] * w
+    return np.nan
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def _views_radiance(
+    seen_bt_k: np.ndarray,
+    own: np.ndarray,
+    table: np.ndarray,
+    t_min_k: float,
+    t_step_k: float,
+    out: np.ndarray,
+) -> None:
+    """The band radiance (:func:`_band_radiance`) of the rendered views *seen_bt_k* (views, rows, cols)
+    into *out*, NaN where the pixel's own radiance *own* (rows, cols) is; rows in parallel."""
+    for r in numba.prange(seen_bt_k.shape[1]):
+        for v in range(seen_bt_k.shape[0]):
+            for c in range(seen_bt_k.shape[2]):
+                ok = math.isfinite(own[r, c])
+                out[v, r, c] = _band_radiance(seen_bt_k[v, r, c], table, t_min_k, t_step_k) if ok else np.nan
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
@@ -436,6 +460,30 @@ def scans_between(scan_start_us: ArrayLike, t0_us: float, t1_us: float) -> slice
     return slice(first, max(stop, first + 1))
 
 
+def kept_pixels(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    sat_m: np.ndarray | None = None,
+    view_rad: float = math.inf,
+    scan_start_us: np.ndarray | None = None,
+    span_us: tuple[float, float] | None = None,
+) -> tuple[slice, slice]:
+    """The scans and the columns of a granule (rows of 32-detector scans) that :func:`swath_piece` keeps
+    (its arguments of those names): the scans observed within *span_us* (:func:`scans_between`), and the
+    columns seen within *view_rad* of nadir on those scans (:func:`view_columns`); all of either where there
+    is nothing to judge it by."""
+    scans = slice(None)
+    if scan_start_us is not None and span_us is not None:
+        scans = scans_between(scan_start_us, *span_us)
+    columns = slice(None)
+    if sat_m is not None and view_rad < math.pi / 2:
+        first, stop, _ = scans.indices(np.shape(lat_rad)[0] // VIIRS_DETECTORS)
+        r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
+        columns = view_columns(lat_rad[r], lon_rad[r], height_m[r], np.asarray(sat_m)[first:stop], view_rad)
+    return scans, columns
+
+
 def swath_piece(
     lat_rad: np.ndarray,
     lon_rad: np.ndarray,
@@ -469,9 +517,7 @@ def swath_piece(
     :func:`monitor.collocation.render.rendered_bt`): the piece then holds their radiance beside the
     pixels' own (:attr:`SwathPiece.rendered`), for both collocations in one kernel pass.
     """
-    scans = slice(None)
-    if scan_start_us is not None and span_us is not None:
-        scans = scans_between(scan_start_us, *span_us)
+    scans, kept = kept_pixels(lat_rad, lon_rad, height_m, sat_m, view_rad, scan_start_us, span_us)
     if scans != slice(None) and scan_start_us is not None:
         first, stop, _ = scans.indices(len(scan_start_us))
         r0, r1 = first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS
@@ -487,9 +533,7 @@ def swath_piece(
         covered_us = (t[first] if first > 0 else -math.inf, t[stop] if stop < len(t) else math.inf)
     else:
         covered_us = (-math.inf, math.inf)
-    kept = slice(None)
     if sat_m is not None and view_rad < math.pi / 2:
-        kept = view_columns(lat_rad, lon_rad, height_m, sat_m, view_rad)
         lat_rad, lon_rad, height_m = lat_rad[:, kept], lon_rad[:, kept], height_m[:, kept]
         bt_k, good = bt_k[:, kept], good[:, kept]
         seen_bt_k = None if seen_bt_k is None else seen_bt_k[:, :, kept]
@@ -527,13 +571,9 @@ def swath_piece(
     views, angles = None, np.zeros(0)
     if seen_bt_k is not None and view_alpha_rad is not None:
         angles = np.asarray(view_alpha_rad, np.float64)
-        grid_k = t_min + t_step * np.arange(len(table))
         views = np.empty((len(angles), rows, cols), f32)
-        for v in range(len(angles)):  # a scan at a time: no float64 copy of a granule
-            for r in range(0, rows, VIIRS_DETECTORS):
-                part = seen_bt_k[v, r : r + VIIRS_DETECTORS]
-                views[v, r : r + VIIRS_DETECTORS] = np.interp(part, grid_k, table, left=np.nan, right=np.nan)
-        views[:, ~np.isfinite(radiance)] = np.nan
+        with KERNEL_LOCK:
+            _views_radiance(seen_bt_k, radiance, table, t_min, t_step, views)
 
     scan = pos.reshape(nscan, VIIRS_DETECTORS, cols, 3)
     mid = scan[nscan // 2]

@@ -136,6 +136,22 @@ def test_a_granule_is_rendered_as_each_row_sees_it():
     assert -375.0 < behind < -10.0 and 10.0 < ahead < 375.0 and ahead - behind > 100.0 and abs(centre) < 20.0
 
 
+def test_only_the_pixels_asked_for_are_rendered():
+    """The columns a swath piece keeps are rendered as in the whole granule (each column's sweep is its
+    own; only the scan's SBF axis, fitted on the rendered columns' ends, moves by a hair), the rest NaN."""
+    lat, lon, h, _, sat, v = scan_geometry()
+    good = np.ones(lat.shape, bool)
+    bt = np.full(lat.shape, 295.0, np.float32)
+    bt[10:21] = 230.0
+    alphas = np.array([-0.0191, 0.0, 0.0191])
+    whole = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K)
+    part = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, columns=slice(100, 300))
+    assert np.all(np.isnan(part[:, :, :100])) and np.all(np.isnan(part[:, :, 300:]))
+    np.testing.assert_allclose(part[:, :, 100:300], whole[:, :, 100:300], atol=0.01)
+    no_scan = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, scans=slice(1, 1))
+    assert np.all(np.isnan(no_scan))
+
+
 def _every_stretch(x, b, h, bt, a, m_per_k):
     """The sweep of one column (the module docstring's three steps) with every stretch tested for every
     ray: no reach."""
