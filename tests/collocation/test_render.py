@@ -4,7 +4,7 @@ ray march through the column the pixels were drawn from, the view tangents again
 import numpy as np
 import pytest
 
-from monitor.collocation.render import render_height_field, rendered_bt, view_tangents
+from monitor.collocation.render import TANGENT_STEP, render_height_field, rendered_bt, view_tangents
 from monitor.geometry import wgs84
 from tests.collocation.test_lift import scan_geometry
 
@@ -99,8 +99,14 @@ def test_the_view_tangents_follow_the_lines_of_sight():
     good = np.ones(lat.shape, bool)
     c, i = 200, 3  # a column near nadir, a detector near the scan's edge
     own = np.arctan(np.tan((i - 15.5) * 4.5e-4) / np.cos(np.linspace(-0.9, 0.9, 400)[c]))
-    x, b, a = view_tangents(lat, lon, h, good, sat[None], v[None], np.array([own, 0.0191, -0.0191]))
+    alphas = np.array([own, 0.0191, -0.0191])
+    first = TANGENT_STEP - c % TANGENT_STEP  # c is then a column where the views are traced
+    x, b, a = view_tangents(lat, lon, h, good, sat[None], v[None], alphas, first_column=first)
     assert a[0, i, c] == pytest.approx(b[i, c], abs=1e-6)
+    # between traced columns they are interpolated in scan angle (this scan's columns are 4.5 mrad apart,
+    # 16 times VIIRS's, so the bend between two traced ones is ~250 times a real scan's)
+    between = view_tangents(lat, lon, h, good, sat[None], v[None], alphas)[2]
+    assert c % TANGENT_STEP and np.abs(between[:, :, c] - a[:, :, c]).max() < 1e-5
     ground = wgs84.geodetic_to_ecef(lat, lon, h)
     look = origin - ground  # to the spacecraft at each pixel's time, as the test's scan was drawn
     up = wgs84.geodetic_up(ground)
