@@ -7,10 +7,13 @@ day's cost cannot tell apart"). Prints one JSON row per case. With ``--offsets``
 the day's estimate makes of the case against its truth, as the default configuration assesses it and
 with ``parallax=False`` (from the same collocation): per direction the FOR offsets' RMS and worst error,
 the share of FOR-directions within 2 sigma, the median sigma, and the rows' median error, share within 2
-sigma and median sigma (the bounds of benchmarks.acceptance).
+sigma and median sigma (the bounds of benchmarks.acceptance). With ``--at-lift`` as well, a second
+pass: the case collocated again with the pixels rendered at the lift the default kept, and assessed
+from that rendering alone (``parallax=False`` on it: f held at 1, no lift sigma), the row's
+"at_lift" (docs/science.md, "One rendering at the day's lift").
 
-    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2] [--offsets | --probe M_PER_K]
-        [--rows FILE]
+    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2]
+        [--offsets [--at-lift] | --probe M_PER_K] [--rows FILE]
 
 ``--probe`` renders the collocation at another lift than the assessment's: the fraction the day prefers
 is of the blend V0 + f (V1 - V0), so what it prefers in m/K depends on the probe (docs/science.md, "The
@@ -41,7 +44,13 @@ from monitor.sdr.pairing import plan
 ROW_NAMES = ("ahead", "centre", "behind")  # parallax.ROWS
 
 
-def decision(case: Path, workers: int, offsets: bool = False, probe_m_per_k: float = PROBE_M_PER_K) -> dict:
+def decision(
+    case: Path,
+    workers: int,
+    offsets: bool = False,
+    probe_m_per_k: float = PROBE_M_PER_K,
+    at_lift: bool = False,
+) -> dict:
     """The row of one case (module docstring), its rendered collocation at *probe_m_per_k*."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
@@ -75,7 +84,7 @@ def decision(case: Path, workers: int, offsets: bool = False, probe_m_per_k: flo
         if truth.get("cris_response") is None
         else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
         "granules": len(runs),
-        "law_m_per_k": _law_m_per_k(truth.get("cloud_heights", "ground")),
+        "law_m_per_k": law_m_per_k(truth.get("cloud_heights", "ground")),
         "fov_rows_alpha_urad": truth.get("fov_rows_alpha_urad", 0.0),
         "probe_m_per_k": probe_m_per_k,
         "preferred_m_per_k": round(f * probe_m_per_k, 1),
@@ -91,12 +100,18 @@ def decision(case: Path, workers: int, offsets: bool = False, probe_m_per_k: flo
         row[f"{name}_gain_sigmas"] = round(float(g / s), 1)
     if offsets:
         plain = cfg.model_copy(update={"parallax": False})
-        row["default"] = _scores(cost_and_offsets(samples, cfg, satellite=truth["satellite"]), truth)
+        default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
+        row["default"] = _scores(default, truth)
         row["no_parallax"] = _scores(cost_and_offsets(pairs[0], plain, satellite=truth["satellite"]), truth)
+        lift = default.fors[0].parallax_m_per_k
+        if at_lift and np.isfinite(lift) and lift > 0:
+            again = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=lift)
+            at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
+            row["at_lift"] = _scores(at, truth) | {"lift_m_per_k": round(float(lift), 1)}
     return row
 
 
-def _law_m_per_k(clouds: str) -> float | None:
+def law_m_per_k(clouds: str) -> float | None:
     """The lift a ``lapse:G`` law implies (1000 / G m per K); None for other clouds."""
     name, _, rate = clouds.partition(":")
     return round(1000.0 / float(rate), 1) if name == "lapse" else None
@@ -133,12 +148,17 @@ def main() -> None:
         default=PROBE_M_PER_K,
         help=f"the rendered collocation's lift, m/K (the assessment's {PROBE_M_PER_K:g}; not with --offsets)",
     )
+    p.add_argument(
+        "--at-lift", action="store_true", help="with --offsets: also a second pass rendered at the lift kept"
+    )
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()
     if args.offsets and args.probe != PROBE_M_PER_K:
         p.error("--offsets assesses as the service does, at its own probe: give --probe without it")
+    if args.at_lift and not args.offsets:
+        p.error("--at-lift compares offsets: give it with --offsets")
     for case in args.cases:
-        emit(decision(case, args.workers, args.offsets, args.probe), args.rows)
+        emit(decision(case, args.workers, args.offsets, args.probe, args.at_lift), args.rows)
 
 
 if __name__ == "__main__":

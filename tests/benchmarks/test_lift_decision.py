@@ -26,3 +26,12 @@ def test_a_flat_day_of_sharp_edges_seen_through_a_smooth_footprint_declines_the_
     assert row["default"]["lift_m_per_k"] == 0.0 and np.isnan(row["no_parallax"]["lift_m_per_k"])
     same = ("rms_urad", "worst_urad", "rows_median_error_urad")
     assert all(row["default"][k] == row["no_parallax"][k] for k in same), row
+
+
+def test_the_second_pass_asks_for_the_offsets(monkeypatch, tmp_path, capsys):
+    from benchmarks import lift_decision
+
+    monkeypatch.setattr("sys.argv", ["lift_decision", str(tmp_path), "--at-lift"])
+    with pytest.raises(SystemExit) as exit_:
+        lift_decision.main()
+    assert exit_.value.code == 2 and "--at-lift compares offsets" in capsys.readouterr().err
