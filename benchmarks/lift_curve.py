@@ -19,7 +19,6 @@ import argparse
 import json
 from pathlib import Path
 
-from benchmarks.lift_decision import law_m_per_k
 from benchmarks.provenance import commit, emit
 from monitor.assessment.assess import collocate_plan, for_samples, paired
 from monitor.config.assessment import AssessmentConfig
@@ -27,6 +26,7 @@ from monitor.core.constants import N_FOR
 from monitor.estimation import parallax
 from monitor.instrument.spectral import i5_band
 from monitor.sdr.pairing import plan
+from monitor.simulate.case import law_m_per_k
 
 
 def curve(case: Path, lifts_m_per_k: list[float], workers: int) -> list[dict]:
@@ -48,7 +48,7 @@ def curve(case: Path, lifts_m_per_k: list[float], workers: int) -> list[dict]:
                 "commit": commit(),
                 "case": case.name,
                 "clouds": truth.get("cloud_heights", "ground"),
-                "law_m_per_k": law_m_per_k(truth.get("cloud_heights", "ground")),
+                "law_m_per_k": law_m_per_k(truth["satellite"], truth.get("cloud_heights", "ground")),
                 "fov_rows_alpha_urad": truth.get("fov_rows_alpha_urad", 0.0),
                 "lift_m_per_k": lift,
                 "cost_unlifted_k": parallax.row_costs(s0, s1, 0.0, cfg.cost).round(4).tolist(),

@@ -10,10 +10,12 @@ the share of FOR-directions within 2 sigma, the median sigma, and the rows' medi
 sigma and median sigma (the bounds of benchmarks.acceptance). With ``--at-lift`` as well, a second
 pass: the case collocated again with the pixels rendered at the lift the default kept, and assessed
 from that rendering alone (``parallax=False`` on it: f held at 1, no lift sigma), the row's
-"at_lift" (docs/science.md, "One rendering at the day's lift").
+"at_lift" (docs/science.md, "One rendering at the day's lift"); with ``--at-law`` the same pass at the
+lift the case's law implies (:func:`monitor.simulate.case.law_m_per_k`, in m per K of band BT), the
+row's "at_law": what the offsets and the rows would read with the day's lift known.
 
     .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2]
-        [--offsets [--at-lift] | --probe M_PER_K] [--rows FILE]
+        [--offsets [--at-lift] [--at-law] | --probe M_PER_K] [--rows FILE]
 
 ``--probe`` renders the collocation at another lift than the assessment's: the fraction the day prefers
 is of the blend V0 + f (V1 - V0), so what it prefers in m/K depends on the probe (docs/science.md, "The
@@ -40,6 +42,7 @@ from monitor.estimation import parallax
 from monitor.estimation.jackknife import granule_runs, jackknife_sigma
 from monitor.instrument.spectral import i5_band
 from monitor.sdr.pairing import plan
+from monitor.simulate.case import law_m_per_k
 
 ROW_NAMES = ("ahead", "centre", "behind")  # parallax.ROWS
 
@@ -50,6 +53,7 @@ def decision(
     offsets: bool = False,
     probe_m_per_k: float = PROBE_M_PER_K,
     at_lift: bool = False,
+    at_law: bool = False,
 ) -> dict:
     """The row of one case (module docstring), its rendered collocation at *probe_m_per_k*."""
     truth = json.loads((case / "truth.json").read_text())
@@ -84,7 +88,7 @@ def decision(
         if truth.get("cris_response") is None
         else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
         "granules": len(runs),
-        "law_m_per_k": law_m_per_k(truth.get("cloud_heights", "ground")),
+        "law_m_per_k": law_m_per_k(truth["satellite"], truth.get("cloud_heights", "ground")),
         "fov_rows_alpha_urad": truth.get("fov_rows_alpha_urad", 0.0),
         "probe_m_per_k": probe_m_per_k,
         "preferred_m_per_k": round(f * probe_m_per_k, 1),
@@ -103,18 +107,16 @@ def decision(
         default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
         row["default"] = _scores(default, truth)
         row["no_parallax"] = _scores(cost_and_offsets(pairs[0], plain, satellite=truth["satellite"]), truth)
-        lift = default.fors[0].parallax_m_per_k
-        if at_lift and np.isfinite(lift) and lift > 0:
-            again = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=lift)
-            at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
-            row["at_lift"] = _scores(at, truth) | {"lift_m_per_k": round(float(lift), 1)}
+        passes = {
+            "at_lift": default.fors[0].parallax_m_per_k if at_lift else np.nan,
+            "at_law": row["law_m_per_k"] if at_law and row["law_m_per_k"] is not None else np.nan,
+        }
+        for name, lift in passes.items():
+            if np.isfinite(lift) and lift > 0:
+                again = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=lift)
+                at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
+                row[name] = _scores(at, truth) | {"lift_m_per_k": round(float(lift), 1)}
     return row
-
-
-def law_m_per_k(clouds: str) -> float | None:
-    """The lift a ``lapse:G`` law implies (1000 / G m per K); None for other clouds."""
-    name, _, rate = clouds.partition(":")
-    return round(1000.0 / float(rate), 1) if name == "lapse" else None
 
 
 def _scores(result: AssessmentResult, truth: dict) -> dict:
@@ -151,14 +153,18 @@ def main() -> None:
     p.add_argument(
         "--at-lift", action="store_true", help="with --offsets: also a second pass rendered at the lift kept"
     )
+    p.add_argument(
+        "--at-law", action="store_true", help="with --offsets: also a pass rendered at the case's law"
+    )
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()
     if args.offsets and args.probe != PROBE_M_PER_K:
         p.error("--offsets assesses as the service does, at its own probe: give --probe without it")
-    if args.at_lift and not args.offsets:
-        p.error("--at-lift compares offsets: give it with --offsets")
+    for flag in ("at_lift", "at_law"):
+        if getattr(args, flag) and not args.offsets:
+            p.error(f"--{flag.replace('_', '-')} compares offsets: give it with --offsets")
     for case in args.cases:
-        emit(decision(case, args.workers, args.offsets, args.probe, args.at_lift), args.rows)
+        emit(decision(case, args.workers, args.offsets, args.probe, args.at_lift, args.at_law), args.rows)
 
 
 if __name__ == "__main__":

@@ -56,7 +56,7 @@ from monitor.core.satellites import satellite as satellite_info
 from monitor.geometry import frames, wgs84
 from monitor.geometry.ep_model import EngineeringPacket, fov5_angles, los_spacecraft
 from monitor.instrument.footprint import EllipticalResponse, RadialResponse, Response
-from monitor.instrument.spectral import C1, C2, i5_band, planck_radiance
+from monitor.instrument.spectral import C1, C2, I5Band, i5_band, planck_radiance
 from monitor.sdr import iet
 from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
 from monitor.sdr.names import format_name
@@ -66,7 +66,7 @@ from monitor.simulate import scan_geometry as ins
 from monitor.simulate.clouds import CloudHeights
 from monitor.simulate.jpss_h5 import ProductData, date_time_attrs, write_file
 from monitor.simulate.profiles import load_profile
-from monitor.simulate.scene import EDGES, Scene, Wind, spectra, transmittance
+from monitor.simulate.scene import EDGES, T_ATM_K, Scene, Wind, spectra, transmittance
 from monitor.simulate.sun_synchronous import PASSES, CircularOrbit, find_pass
 
 UTC = dt.timezone.utc
@@ -78,6 +78,10 @@ VIIRS_GRANULE_S = VIIRS_SCANS * ins.VIIRS_SCAN_S
 # lift, with 4096 7.0 / 5.2 (seed 5, zero profile, 2026-11-28)
 CONE_SAMPLES = {"soft": 512, "sharp": 4096}
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
+# the scene's cloud tops within one standard deviation of its cloud-top field (245 +- 18 K) and its sea
+# surface from 55 deg to the equator (289-301 K): where law_m_per_k measures a law's lift
+LAW_TOPS_K = np.linspace(227.0, 263.0, 13)
+LAW_AIR_K = np.linspace(289.0, 301.0, 5)
 BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
 OBPT_U16, OBPT_F32 = 65533, -999.7
@@ -238,6 +242,35 @@ def _sunflower_disk(n: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([x, -x]), np.concatenate([y, -y])
 
 
+def _band_table(band: I5Band, nu: np.ndarray, planck_table: np.ndarray) -> np.ndarray:
+    """VIIRS band radiance of a pixel whose emitting temperature is each of T_BINS_K, seen through the
+    simulator's atmosphere (:func:`monitor.simulate.scene.transmittance`, emitting at T_ATM_K)."""
+    tau = transmittance(nu)
+    return (tau * planck_table + (1 - tau) * planck_radiance(nu, T_ATM_K)) @ band.weights
+
+
+def law_m_per_k(satellite: str, clouds: str) -> float | None:
+    """The lift (m per K) a case's cloud law *clouds* implies in the units the assessment learns it
+    (``parallax_m_per_k``: height per K of VIIRS I5 BT below the clear sky), None for clouds on the ground.
+
+    A top's height follows its emitting temperature's cooling below the air (:mod:`~.clouds`), while the
+    lift reads the band BT's: through the simulator's atmosphere the window shrinks a BT contrast to
+    0.79-0.84 of the temperatures' (warmer scenes more), so a lapse law of G K/km implies about 1230 / G
+    m/K, not 1000 / G. The slope through the origin, by least squares, of the height over the BT cooling
+    over the scene's tops (:data:`LAW_TOPS_K`) above its sea surface (:data:`LAW_AIR_K`)."""
+    law = CloudHeights.parse(clouds)
+    if law.flat:
+        return None
+    band, nu = i5_band(satellite), cris_lw_wavenumbers_cm1()
+    table = _band_table(band, nu, planck_radiance(nu[None, :], T_BINS_K[:, None]))
+    top_k, air_k = np.meshgrid(LAW_TOPS_K, LAW_AIR_K)
+    height_m = law.top_height_m(top_k, air_k).astype(np.float64)
+    cooling_k = band.bt_from_radiance(np.interp(air_k, T_BINS_K, table)) - band.bt_from_radiance(
+        np.interp(top_k, T_BINS_K, table)
+    )
+    return round(float(np.sum(height_m * cooling_k) / np.sum(cooling_k**2)), 1)
+
+
 class Simulator:
     """Builds the orbit, attitude and scene of a case and writes its granules."""
 
@@ -271,12 +304,8 @@ class Simulator:
         )
         self.band = i5_band(spec.satellite)
         self.nu = cris_lw_wavenumbers_cm1()
-        tau = transmittance(self.nu)
-        atm = (1 - tau) * planck_radiance(self.nu, 262.0)
-        # VIIRS band radiance of a pixel whose emitting temperature is T, through the same atmosphere.
-        table = planck_radiance(self.nu[None, :], T_BINS_K[:, None])
-        self.planck_table = table
-        self.band_table = (tau * table + atm) @ self.band.weights
+        self.planck_table = planck_radiance(self.nu[None, :], T_BINS_K[:, None])
+        self.band_table = _band_table(self.band, self.nu, self.planck_table)
         self.rng = rng
         if spec.true_ep is not None and spec.ground_ep is not None:
             self.los_true, self.los_geo = los_spacecraft(spec.true_ep), los_spacecraft(spec.ground_ep)

@@ -28,10 +28,11 @@ def test_a_flat_day_of_sharp_edges_seen_through_a_smooth_footprint_declines_the_
     assert all(row["default"][k] == row["no_parallax"][k] for k in same), row
 
 
-def test_the_second_pass_asks_for_the_offsets(monkeypatch, tmp_path, capsys):
+@pytest.mark.parametrize("flag", ["--at-lift", "--at-law"])
+def test_a_second_pass_asks_for_the_offsets(flag, monkeypatch, tmp_path, capsys):
     from benchmarks import lift_decision
 
-    monkeypatch.setattr("sys.argv", ["lift_decision", str(tmp_path), "--at-lift"])
+    monkeypatch.setattr("sys.argv", ["lift_decision", str(tmp_path), flag])
     with pytest.raises(SystemExit) as exit_:
         lift_decision.main()
-    assert exit_.value.code == 2 and "--at-lift compares offsets" in capsys.readouterr().err
+    assert exit_.value.code == 2 and f"{flag} compares offsets" in capsys.readouterr().err

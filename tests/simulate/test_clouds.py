@@ -187,3 +187,35 @@ def test_thin_clouds_let_the_ground_behind_them_show():
     mixed_k = thin.band.bt_from_radiance(radiance)
     assert np.all((mixed_k[high] > band_k[0][high] + 2.0) & (mixed_k[high] < band_k[1][high]))
     assert np.allclose(mixed_k[~high], band_k[0][~high], atol=1e-3)
+
+
+def test_a_laws_lift_is_what_the_band_sees_of_the_simulators_own_tops():
+    """law_m_per_k, measured from the law and the band alone, against the tops the simulator's rays meet:
+    their heights over how much colder than the clear sea below them the band sees them."""
+    sim = Simulator(
+        SimulationSpec(granules=1, profile="zero", cloud_heights="lapse:6.5", cloud_edges="sharp", seed=3)
+    )
+    r, _ = sim.orbit.state_ecef(sim.t0)
+    lat0, lon0, _ = wgs84.ecef_to_geodetic(r)
+    rng = np.random.default_rng(8)
+    ground = wgs84.geodetic_to_ecef(lat0 + rng.uniform(-0.1, 0.1, 4000), lon0 + rng.uniform(-0.1, 0.1, 4000))
+    los = (ground - r) / np.linalg.norm(ground - r, axis=1, keepdims=True)
+    surface = sim.surface(r, los)
+    (seen_k,), _ = sim.seen(r, los, sim.t0, surface)
+    hit_m = sim.met(r, los, sim.t0, surface)[2]
+    clear_k = sim.scene.temperature_k(*surface, cloudy=False)
+    band = [
+        sim.band.bt_from_radiance(np.interp(t, sim_module.T_BINS_K, sim.band_table))
+        for t in (clear_k, seen_k)
+    ]
+    top = hit_m > 2000.0
+    assert top.sum() > 200
+    cooling_k = (band[0] - band[1])[top]
+    measured = np.sum(hit_m[top] * cooling_k) / np.sum(cooling_k**2)
+    law = sim_module.law_m_per_k("j01", "lapse:6.5")
+    assert law == pytest.approx(measured, rel=0.03)
+    assert law > 1.15 * 1000 / 6.5  # the window shrinks the BT contrast: not 1000 / G
+    assert sim_module.law_m_per_k("j01", "lapse:5.2") / sim_module.law_m_per_k("j01", "lapse:7.8") == (
+        pytest.approx(1.5, rel=1e-3)
+    )
+    assert sim_module.law_m_per_k("j01", "ground") is None
