@@ -17,8 +17,14 @@ views. One JSON row. Rows before 2026-11-28 11:30 also hold the two-dimensional 
 was then ("render") and the sweep measured here before it replaced that ("sweep", "sweep_linear"; nearest
 and linear tops).
 
+With ``--reaches 40,100`` the views are also rendered from the heights the assessment would give the
+pixels (:func:`monitor.collocation.lift.height_above_m` at the law, the clear-sky reference the warmest
+3 x 3 mean within each reach), the fields "reference_40px" ...; the row's "heights" holds their bias and
+RMS (m) against the true heights over the tops above 6 km and over the pixels that see the ground
+(docs/science.md, "The clear-sky reference").
+
     .venv/bin/python -m benchmarks.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
-        [--scans 8] [--rows FILE]
+        [--scans 8] [--reaches 40,100] [--rows FILE]
 
 The scene is VIIRS's first granule of a one-granule case, from its 11th scan on; no noise.
 """
@@ -32,7 +38,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from benchmarks.provenance import commit, emit
-from monitor.collocation import render
+from monitor.collocation import lift, render
 from monitor.core.constants import VIIRS_COLUMNS, VIIRS_DETECTORS
 from monitor.geometry import frames, wgs84
 from monitor.simulate import scan_geometry as ins
@@ -67,7 +73,17 @@ def _view_time(sim: Simulator, p: np.ndarray, t: np.ndarray, alpha: float) -> np
     return tb
 
 
-def measure(clouds: str, edges: str, seed: int, scans: int) -> dict:
+def _height_errors(height_m: np.ndarray, true_m: np.ndarray) -> dict:
+    """Bias and RMS (m) of *height_m* against the true heights, over the tops above 6 km and over the
+    pixels that see the ground (true height under 100 m)."""
+    out = {}
+    for name, sel in (("tops_6km", true_m >= 6000.0), ("ground", true_m < 100.0)):
+        e = (height_m - true_m)[sel]
+        out[name] = {"bias_m": round(float(e.mean()), 0), "rms_m": round(float(np.sqrt(np.mean(e**2))), 0)}
+    return out
+
+
+def measure(clouds: str, edges: str, seed: int, scans: int, reaches_px: tuple[int, ...] = ()) -> dict:
     """The row (module docstring)."""
     sim = Simulator(SimulationSpec(granules=1, seed=seed, cloud_heights=clouds, cloud_edges=edges))
     theta, col_dt = ins.viirs_column_geometry()
@@ -96,13 +112,22 @@ def measure(clouds: str, edges: str, seed: int, scans: int) -> dict:
     height = np.where(good, np.nan_to_num(hit_m), 0.0)
     rendered = render.render_height_field(np.where(good, x, np.nan), b, height, bt, a, m_per_k)
     render_s = time.perf_counter() - t0
+    by_reach = {}  # rendered from the heights the clear-sky reference gives at each reach, at the law
+    heights = {}
+    for reach in reaches_px:
+        ref = lift.reference_k(bt.astype(np.float32), good, reach)
+        h = lift.height_above_m(bt.astype(np.float32), good, ref, m_per_k)
+        heights[f"reference_{reach}px"] = _height_errors(h[good], height[good])
+        by_reach[f"reference_{reach}px"] = render.render_height_field(
+            np.where(good, x, np.nan), b, h, bt, a, m_per_k
+        )
     p = wgs84.geodetic_to_ecef(lat[good], lon[good], np.zeros(int(good.sum())))
     centres = p[np.random.default_rng(1).choice(len(p), 400, replace=False)]
     discs = cKDTree(p).query_ball_point(centres, DISC_M)
     detector = np.broadcast_to((np.arange(shape[0]) % VIIRS_DETECTORS)[:, None], shape)[good]
     edge = np.isin(detector, EDGE_DETECTORS)
     row: dict = {"commit": commit(), "clouds": clouds, "edges": edges, "seed": seed, "scans": scans}
-    row |= {"m_per_k": m_per_k, "render_s": render_s}
+    row |= {"m_per_k": m_per_k, "render_s": render_s} | ({"heights": heights} if heights else {})
     for j, alpha in enumerate(ALPHA_RAD):
         t_view = _view_time(sim, p, times[good], alpha)
         r_view, _, _ = sim.state(t_view)
@@ -110,6 +135,7 @@ def measure(clouds: str, edges: str, seed: int, scans: int) -> dict:
         truth = _band_bt(sim, sim.scene.temperature_k(v_lat, v_lon, sim.scene.height_m(v_lat, v_lon), t_view))
         out = {}
         fields = {"render": rendered[j][good].astype(float), "geo": bt[good]}
+        fields |= {name: v[j][good].astype(float) for name, v in by_reach.items()}
         for name, field in fields.items():
             err = field - truth
             disc = [np.nanmean(err[d]) for d in discs if len(d) > 500]
@@ -131,9 +157,18 @@ def main() -> int:
     p.add_argument("--edges", default="sharp")
     p.add_argument("--seed", type=int, default=11)
     p.add_argument("--scans", type=int, default=8)
+    p.add_argument(
+        "--reaches",
+        default="",
+        help="comma-separated reaches (pixels) of the clear-sky reference to render from as well",
+    )
     p.add_argument("--rows", help="append the JSON row here")
     args = p.parse_args()
-    emit(measure(args.clouds, args.edges, args.seed, args.scans), args.rows)
+    try:
+        reaches = tuple(int(v) for v in args.reaches.split(",") if v)
+    except ValueError:
+        p.error(f"--reaches {args.reaches!r}: not comma-separated whole numbers of pixels")
+    emit(measure(args.clouds, args.edges, args.seed, args.scans, reaches), args.rows)
     return 0
 
 
