@@ -14,12 +14,13 @@ How high. A cloud's top is colder than the clear surface around it by about its 
 above its GEO point, where T_ref is the neighbourhood's clear-sky reference: the warmest BT within
 +-:data:`REFERENCE_HALF_PX` pixels (~37 km; a 3 x 3 mean first, so that one noisy pixel does not set it).
 The reach is set by the decks, not by the cone: a deck's middle beyond the reach of clear sky is its own
-reference and stands too low. Within +-40 pixels (~15 km, until 2026-11-29) the tops above 6 km of
-simulated scenes stood 1.7-4.0 km too low (RMS 3.6-6.0 km); rendered from those heights at the law, the
-outer rows' error over 7 km discs was 0.2-0.35 K, above the parallax left with no correction on three of
-four scenes. Within +-100 they stand within 0.76 km at the mean (RMS 1.2-3.4 km), and the rendering is
-as good as from the true heights (docs/science.md, "The clear-sky reference"); the price is clear
-ground standing higher (0.34-0.74 km at the mean, against 0.16-0.46), the warmest land within reach.
+reference and stands too low. Within +-40 pixels (~15 km, until 2026-11-29) the tops above 6 km of five
+simulated scenes stood 2.1-4.1 km too low at the mean (RMS 3.6-6.0 km), and the outer rows rendered from
+those heights at the law were 0.07-0.48 K off over 7 km discs (0.07-0.24 from the true heights; 0.14-0.35
+with no correction). Within +-100 the tops stand within 0.9 km at the mean (RMS 0.9-3.4 km) and the
+rendering is within 0.02 K of the true heights' on every scene; the price is the ground standing higher,
+0.33-0.73 km at the mean against 0.16-0.46, the warmest land within reach (docs/science.md, "The
+clear-sky reference").
 kappa (m per K) is not assumed: the assessment collocates at kappa = 0 and at :data:`PROBE_M_PER_K`, and
 chooses the day's kappa from its own cost (:mod:`monitor.estimation.parallax`).
 
@@ -41,9 +42,10 @@ from monitor.collocation.geodesy import ecef_m
 from monitor.core.constants import VIIRS_SCAN_US
 
 REFERENCE_HALF_PX = 100  # +-100 pixels: ~37 km at nadir, the clear sky beside a deck tens of km wide
-# The rendered collocation's lift, above the laws of the days (128-226 m/K: tops at 7.8-5.2 K/km, seen
-# through a window transmittance of 1-0.85): the day's lift is sought on a straight line between no lift
-# and this rendering, which reads short beyond the probe (docs/science.md, "The probe above the laws").
+# The rendered collocation's lift, above the laws of the days (159-239 m/K: tops at 7.8-5.2 K/km seen in
+# the simulator's band BT, monitor.simulate.case.law_m_per_k): the day's lift is sought on a straight line
+# between no lift and this rendering, which reads short beyond the probe (docs/science.md, "The probe
+# above the laws").
 PROBE_M_PER_K = 260.0
 ROTATION_RAD_S = 2.0 * math.pi / (VIIRS_SCAN_US * 1e-6)
 
