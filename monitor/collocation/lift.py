@@ -16,10 +16,10 @@ above its GEO point, where T_ref is the neighbourhood's clear-sky reference: the
 The reach is set by the decks, not by the cone: a deck's middle beyond the reach of clear sky is its own
 reference and stands too low. Within +-40 pixels (~15 km, until 2026-11-29) the tops above 6 km of five
 simulated scenes stood 2.1-4.1 km too low at the mean (RMS 3.6-6.0 km), and the outer rows rendered from
-those heights at the law were 0.07-0.48 K off over 7 km discs (0.07-0.24 from the true heights; 0.14-0.35
+those heights at the law were 0.07-0.48 K off over 7 km discs (0.07-0.23 from the true heights; 0.14-0.35
 with no correction). Within +-100 the tops stand within 0.9 km at the mean (RMS 0.9-3.4 km) and the
 rendering is within 0.02 K of the true heights' on every scene; the price is the ground standing higher,
-0.33-0.73 km at the mean against 0.16-0.46, the warmest land within reach (docs/science.md, "The
+0.33-0.73 km at the mean against 0.15-0.46, the warmest land within reach (docs/science.md, "The
 clear-sky reference").
 kappa (m per K) is not assumed: the assessment collocates at kappa = 0 and at :data:`PROBE_M_PER_K`, and
 chooses the day's kappa from its own cost (:mod:`monitor.estimation.parallax`).

@@ -90,7 +90,7 @@ def rendered_bt(
     rows, cols = np.shape(bt_k)
     out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
     usable = np.asarray(good, bool) & np.isfinite(bt_k)
-    reference = reference_k(bt_k, usable)  # over the whole granule: it looks 40 pixels around
+    reference = reference_k(bt_k, usable)  # over the whole granule: it looks 100 pixels around
     height = height_above_m(bt_k, usable, reference, m_per_k)
     first, stop, _ = scans.indices(rows // VIIRS_DETECTORS)
     r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)

@@ -39,11 +39,11 @@ sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference over +-:data
 that scaled cone's minimum (the FOR's, and each FOV row's for the rows' difference). The rows ahead and
 behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
 
-Measured on days made after the rule (docs/science.md, "The lift decision on held-back days" and "The
-probe above the laws"): declined on 9 of 10 flat days (footprints, profiles, textures, terrain, calibration
-differences), kept on 13 of 14 days with clouds with height, within 20 % of the law on 9 of 13 with the
-probe above the laws (8 with a probe of 180, whose blend extended beyond it read short); a flat day whose
-rows are 200 urad apart keeps 60 m/K, and a row error pulls a cloudy day's lift short.
+Measured on days made after the rule (docs/science.md, "The lift decision on held-back days" to "The
+clear-sky reference"): declined on 9 of 10 flat days (footprints, profiles, textures, terrain, calibration
+differences), kept on 13 of 14 days with clouds with height at 0.71-0.96 of the law in band BT (within
+20 % on 8 of 13): short on every day, the cost preferring less lift than the law; a flat day whose rows
+are 200 urad apart keeps 60 m/K, and a row error pulls a cloudy day's lift shorter.
 """
 
 from __future__ import annotations
