@@ -255,7 +255,7 @@ def law_m_per_k(satellite: str, clouds: str) -> float | None:
 
     A top's height follows its emitting temperature's cooling below the air (:mod:`~.clouds`), while the
     lift reads the band BT's: through the simulator's atmosphere the window shrinks a BT contrast to
-    0.79-0.84 of the temperatures' (warmer scenes more), so a lapse law of G K/km implies about 1230 / G
+    0.79-0.84 of the temperatures' (colder tops more), so a lapse law of G K/km implies about 1230 / G
     m/K, not 1000 / G. The slope through the origin, by least squares, of the height over the BT cooling
     over the scene's tops (:data:`LAW_TOPS_K`) above its sea surface (:data:`LAW_AIR_K`)."""
     law = CloudHeights.parse(clouds)
