@@ -26,7 +26,10 @@ RMS (m) against the true heights over the tops above 6 km and over the pixels th
     .venv/bin/python -m benchmarks.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
         [--scans 8] [--reaches 40,100] [--rows FILE]
 
-The scene is VIIRS's first granule of a one-granule case, from its 11th scan on; no noise.
+The scene is VIIRS's first granule of a one-granule case, from its 11th scan on; no noise. The walls and
+the reference's heights take the case's law in band BT (:func:`monitor.simulate.case.law_m_per_k`; rows
+before 2026-11-29 took the band's slope at 270 K, 189.2 m/K at 6.5 K/km, and 6.5 K/km's for the tropical
+profile).
 """
 
 from __future__ import annotations
@@ -42,7 +45,7 @@ from monitor.collocation import lift, render
 from monitor.core.constants import VIIRS_COLUMNS, VIIRS_DETECTORS
 from monitor.geometry import frames, wgs84
 from monitor.simulate import scan_geometry as ins
-from monitor.simulate.case import T_BINS_K, SimulationSpec, Simulator
+from monitor.simulate.case import T_BINS_K, SimulationSpec, Simulator, law_m_per_k
 
 ALPHA_RAD = np.array([19.1e-3, 0.0, -19.1e-3])  # the rows ahead, the centre, the rows behind
 DISC_M = 7000.0
@@ -105,9 +108,9 @@ def measure(clouds: str, edges: str, seed: int, scans: int, reaches_px: tuple[in
     good = ~np.tile(ins.viirs_bowtie_deleted(), (scans, 1)) & np.isfinite(lat)
     sat, vel = sim.orbit.state_ecef(scan_start + ins.VIIRS_EARTH_VIEW_S / 2)
     x, b, a = render.view_tangents(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
-    law_k_per_km = float(clouds.split(":")[1]) if clouds.startswith("lapse:") else 6.5
-    per_k = (_band_bt(sim, np.array([270.5])) - _band_bt(sim, np.array([269.5])))[0]
-    m_per_k = 1.0 / (law_k_per_km * 1e-3 * per_k)  # the law, in metres per kelvin of band BT
+    m_per_k = law_m_per_k(sim.spec.satellite, clouds)  # the law, in metres per kelvin of band BT
+    if m_per_k is None:
+        raise ValueError(f"clouds {clouds!r}: nothing stands above the ground to render")
     t0 = time.perf_counter()
     height = np.where(good, np.nan_to_num(hit_m), 0.0)
     rendered = render.render_height_field(np.where(good, x, np.nan), b, height, bt, a, m_per_k)
@@ -164,6 +167,8 @@ def main() -> int:
     )
     p.add_argument("--rows", help="append the JSON row here")
     args = p.parse_args()
+    if args.clouds == "ground":
+        p.error("--clouds ground: nothing stands above the ground to render")
     try:
         reaches = tuple(int(v) for v in args.reaches.split(",") if v)
     except ValueError:
