@@ -184,7 +184,8 @@ def _accumulate(
     ring_g2: np.ndarray,
     order: np.ndarray,
     rendered: np.ndarray,
-    view_tan: np.ndarray,
+    view: np.ndarray,
+    view_w: np.ndarray,
     acc: np.ndarray,
     acc_rendered: np.ndarray,
 ) -> None:
@@ -197,10 +198,9 @@ def _accumulate(
     acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (rows, cols) (real) and
     weight (imaginary): +w at the first j, -w after the last. The discs are nested: where a row's interval of
     a disc is empty, so are those of the smaller discs. When *acc_rendered* has FOVs, it receives the same
-    runs of what FOV f sees of the pixel rendered (:mod:`monitor.collocation.render`): of *rendered*
-    (views, rows, cols), the two views whose in-track SBF tangents *view_tan* (increasing) lie about the
-    tangent of the ray from FOV f's spacecraft to the pixel, weighted linearly in it (the nearest beyond
-    the ends); the cone test, the costly part, is made once for both.
+    runs of what FOV f sees of the pixel rendered (:mod:`monitor.collocation.render`): (1 - view_w[f])
+    times view view[f] of *rendered* (views, rows, cols) plus view_w[f] times the next; the cone test,
+    the costly part, is made once for both.
     """
     ncol = radiance.shape[1]
     with_rendered = acc_rendered.shape[0] > 0
@@ -214,7 +214,9 @@ def _accumulate(
         ta = tan_a[f]
         out = acc[f]
         out_rendered = acc_rendered[f if with_rendered else 0]
-        last_view = view_tan.shape[0] - 1
+        seen = rendered[view[f]]
+        w_next = view_w[f]
+        seen_next = rendered[min(view[f] + 1, rendered.shape[0] - 1)]
         g2k = np.empty((nk, m))  # g2 K = cos^2 h (1 + tan^2 A_i)
         for k in range(nk):
             for i in range(m):
@@ -269,20 +271,9 @@ def _accumulate(
                         wz = complex(weight * value, weight)
                         wr = 0j
                         if with_rendered:
-                            # the views about this ray's own in-track tangent, not the FOV's: across a
-                            # 14 km FOV the rays' angles span ~17 mrad, and a cloud top 10 km up stands
-                            # ~1.2 % nearer than the ground (its features look that much larger)
-                            t_ray = dx / dz
-                            v = 0
-                            while v < last_view - 1 and view_tan[v + 1] <= t_ray:
-                                v += 1
-                            w_next = (
-                                (t_ray - view_tan[v]) / (view_tan[v + 1] - view_tan[v]) if last_view else 0.0
-                            )
-                            w_next = min(max(w_next, 0.0), 1.0)
-                            view_value = np.float64(rendered[v, r, c])
+                            view_value = np.float64(seen[r, c])
                             if w_next > 0.0:
-                                view_value += w_next * (np.float64(rendered[v + 1, r, c]) - view_value)
+                                view_value += w_next * (np.float64(seen_next[r, c]) - view_value)
                             if math.isfinite(view_value):
                                 wr = complex(weight * view_value, weight)
                         for k in range(nk):
@@ -365,6 +356,18 @@ class ConeSums:
             return np.where(w > 0, s / w, np.nan).astype(np.float32)
 
 
+def _views(view_alpha_rad: np.ndarray, alpha_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per FOV (in-track SBF angle *alpha_rad*) the view at or below its angle among *view_alpha_rad*
+    (increasing) and the linear weight of the next one (0 beyond the ends: the nearest view alone)."""
+    angles = np.asarray(view_alpha_rad, np.float64)
+    a = np.clip(np.nan_to_num(np.asarray(alpha_rad, np.float64)), angles[0], angles[-1])
+    view = np.clip(np.searchsorted(angles, a, side="right") - 1, 0, len(angles) - 1)
+    upper = angles[np.minimum(view + 1, len(angles) - 1)]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        weight = np.where(upper > angles[view], (a - angles[view]) / (upper - angles[view]), 0.0)
+    return view.astype(np.int64), weight
+
+
 def cone_sums(
     swath: ViirsSwath,
     sat_m: np.ndarray,
@@ -383,8 +386,8 @@ def cone_sums(
     half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`). When the pieces are
     rendered for several in-track angles (clouds with height,
     :attr:`monitor.collocation.swath.SwathPiece.rendered`), the same pass sums what each FOV sees of them
-    into :attr:`ConeSums.rendered`: each pixel the two views about the in-track angle of the ray from the
-    FOV's spacecraft to it, weighted linearly (the nearest beyond the ends).
+    into :attr:`ConeSums.rendered`: the two views about its own alpha, weighted linearly (the nearest beyond
+    the ends).
     """
     nf = len(alpha_rad)
     m = len(offsets_rad)
@@ -416,15 +419,15 @@ def cone_sums(
     if rendered_pieces not in (0, len(swath.pieces)):
         raise ValueError("the pieces of a swath are all rendered or none")
     acc_rendered = np.zeros((nf if rendered_pieces else 0, *acc.shape[1:]), np.complex128)
-    unrendered = np.zeros((1, 1, 1), np.float32), np.zeros(1)  # views, their tangents
+    unrendered = np.zeros((1, 1, 1), np.float32), np.zeros(nf, np.int64), np.zeros(nf)  # views, view, weight
     # FOVs interleaved by thread count: each thread's first share is spread over the granule (the scans
     # that a VIIRS granule reaches are a contiguous part of it)
     threads = numba.get_num_threads()
     order = np.concatenate([np.arange(t0, nf, threads) for t0 in range(threads)])
     for piece in swath.pieces:
-        rendered, view_tan = unrendered
+        rendered, view, view_w = unrendered
         if piece.rendered is not None:
-            rendered, view_tan = piece.rendered, np.tan(np.asarray(piece.view_alpha_rad, np.float64))
+            rendered, (view, view_w) = piece.rendered, _views(piece.view_alpha_rad, alpha_rad)
         row0, col0, dist = piece.nearest(centre)
         hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, rho)
         # a FOV whose cones cannot reach this granule's nearest usable block skips it
@@ -433,8 +436,8 @@ def cone_sums(
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
                 sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
-                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, rendered, view_tan,
-                acc, acc_rendered,
+                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, rendered, view,
+                view_w, acc, acc_rendered,
             )  # fmt: skip
     solid = 2 * np.pi * (1 - np.cos(np.asarray(radii_rad[::-1], np.float64)))
     rendered_sums = _sums(acc_rendered, solid, radii_rad) if len(acc_rendered) else None

@@ -59,7 +59,7 @@ from monitor.core.constants import VIIRS_DETECTORS
 COLUMNS_PER_PASS = 512  # columns rendered at a time: the tangents of five views stay ~8 MB a pass
 # The in-track SBF angles rendered (rad). A CrIS FOV's alpha is within +-27 mrad (a corner FOV turned with
 # the scan); each FOV sees the two views about its own, weighted linearly (monitor.collocation.collocate).
-VIEW_ALPHA_RAD = np.linspace(-0.04, 0.04, 9)
+VIEW_ALPHA_RAD = np.linspace(-0.04, 0.04, 5)
 TOP_M = 1.0  # a ray that meets a stretch more than this below its top met its wall
 # a CrIS view's tangent is traced every this many columns and between them interpolated in scan angle
 # (it varies smoothly along a scan)

@@ -314,30 +314,19 @@ def test_two_threads_may_assess_at_once():
     assert r.returncode == 0 and "both threads done" in r.stdout, r.stderr[-2000:]
 
 
-def _ray_factor(viirs, sat, m, tan_views, factors):
-    """Per piece, the rendered views' factor (*factors* at the in-track SBF tangents *tan_views*, linear
-    between, the nearest beyond) at the in-track tangent of the ray from *sat* (SBF-to-ECEF *m*) to each
-    pixel."""
-    out = []
-    for p in viirs.pieces:
-        d = p.ecef_m.astype(float) - sat
-        out.append(np.interp((d @ m[:, 0]) / (d @ m[:, 2]), tan_views, factors))
-    return out
-
-
-def test_each_ray_adds_the_views_about_its_own_in_track_angle(scene):
+def test_each_fov_adds_the_views_about_its_own_in_track_angle(scene):
     """A piece rendered for three in-track angles (here: its radiance, halved, doubled): in the same pass
-    as the pixels' own radiance, each pixel adds the linear blend of the two views about the angle of the
-    ray from the FOV's spacecraft to it (brute force), the nearest beyond the ends. Not the FOV's own
-    angle: the blend at the LOS would be 0.75 of the radiance in every perturbed cone."""
+    as the pixels' own radiance, a FOV at an angle between two views adds their linear blend, one beyond
+    the ends the nearest."""
     fg, viirs = scene
     idx = (1, 15, 4)
     alpha = fg.alpha_rad[idx]
-    sat, m = fg.sat_ecef_m[idx], fg.sbf_to_ecef[idx]
-    offsets = perturbation_grid(2, 2e-3)
+    offsets = perturbation_grid(2, 1e-4)
     own = collocate.cone_sums(*_one_fov(viirs, fg, idx), offsets).mean()
-    ratios = []
-    for angles in ((alpha - 0.01, alpha + 0.01, alpha + 0.03), (alpha + 0.02, alpha + 0.03, alpha + 0.04)):
+    for angles, factor in (
+        ((alpha - 0.01, alpha + 0.01, alpha + 0.03), 0.75),
+        ((alpha + 0.01, alpha + 0.02, alpha + 0.03), 1.0),
+    ):
         views = swath.ViirsSwath(
             [
                 replace(
@@ -351,21 +340,8 @@ def test_each_ray_adds_the_views_about_its_own_in_track_angle(scene):
         both = collocate.cone_sums(*_one_fov(views, fg, idx), offsets)
         np.testing.assert_array_equal(both.mean(), own)
         assert both.rendered is not None
+        np.testing.assert_allclose(both.rendered.mean(), factor * own, rtol=1e-6)
         np.testing.assert_array_equal(both.rendered.weights, both.weights)
-        factor = _ray_factor(viirs, sat, m, np.tan(angles), (1.0, 0.5, 2.0))
-        scaled = swath.ViirsSwath(
-            [
-                replace(p, radiance=(p.radiance * f).astype(np.float32))
-                for p, f in zip(viirs.pieces, factor, strict=True)
-            ]
-        )
-        expected, _ = _brute(scaled, sat, m, alpha, fg.beta_rad[idx], offsets, collocate.TOP_HAT[0])
-        np.testing.assert_allclose(both.rendered.mean()[0], expected, rtol=2e-5)
-        ratios.append(both.rendered.mean()[0] / own[0])
-    # the cones perturbed ahead see more of the halved view: the blend follows the rays' angles (at the
-    # FOV's own angle it would be 0.75 in every cone); beyond the ends the nearest view alone
-    assert np.all(np.diff(ratios[0].mean(axis=1)) < -0.03)  # 0.5 per 20 mrad: -0.05 a 2 mrad step
-    np.testing.assert_allclose(ratios[1], 1.0, rtol=1e-6)
     mixed = swath.ViirsSwath([views.pieces[0], *viirs.pieces])
     with pytest.raises(ValueError, match="all rendered or none"):
         collocate.cone_sums(*_one_fov(mixed, fg, idx), offsets)
