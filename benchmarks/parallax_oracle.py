@@ -73,7 +73,7 @@ class _Counted(Protocol):
     rows: int
     total: int
 
-    def __call__(self, *args: np.ndarray | float) -> np.ndarray: ...
+    def __call__(self, *args: np.ndarray | float | slice) -> np.ndarray: ...
 
 
 def _true_heights(rendered: Callable[..., np.ndarray]) -> _Counted:
@@ -90,6 +90,7 @@ def _true_heights(rendered: Callable[..., np.ndarray]) -> _Counted:
         velocity_m_s: np.ndarray,
         cris_alpha_rad: np.ndarray,
         m_per_k: float,
+        *where: slice,
     ) -> np.ndarray:
         lat = np.degrees(np.asarray(lat_rad, np.float64)).astype(np.float32)
         lon = np.degrees(np.asarray(lon_rad, np.float64)).astype(np.float32)
@@ -108,7 +109,7 @@ def _true_heights(rendered: Callable[..., np.ndarray]) -> _Counted:
         render.height_above_m = lambda *_: truth  # the recorded heights
         try:
             return rendered(
-                lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k
+                lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k, *where
             )
         finally:
             render.height_above_m = own
