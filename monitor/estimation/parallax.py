@@ -43,7 +43,9 @@ Measured on days made after the rule (docs/science.md, "The lift decision on hel
 clear-sky reference"): declined on 9 of 10 flat days (footprints, profiles, textures, terrain, calibration
 differences), kept on 13 of 14 days with clouds with height at 0.71-0.96 of the law in band BT (within
 20 % on 8 of 13): short on every day, the cost preferring less lift than the law; a flat day whose rows
-are 200 urad apart keeps 60 m/K, and a row error pulls a cloudy day's lift shorter.
+are 200 urad apart keeps 60 m/K, and a row error pulls a cloudy day's lift shorter. Most of the shortfall
+is each FOV's one view for all its rays; a view per ray brings the lift to the law with a smooth
+footprint but takes it as a knob for the cone's width ("Each ray's own view").
 """
 
 from __future__ import annotations
