@@ -1,0 +1,169 @@
+"""What the collocation would give if VIIRS saw along CrIS's views: each simulated case assessed with the
+rendering replaced by the simulator's own views, the bound that no renderer of VIIRS's pixels can pass.
+
+The assessment renders, for each in-track SBF angle of :data:`monitor.collocation.render.VIEW_ALPHA_RAD`,
+the BT a CrIS ray at that angle meets on its way to each VIIRS GEO point (:func:`render.rendered_bt`,
+from the pixels' BT, a height learnt from the day and walls at the height law). Here that BT comes from
+the simulator itself instead: the spacecraft at the time it sees the GEO point at that angle (the secant
+search of :mod:`benchmarks.render_truth`), its ray marched through the case's scene, the band BT of what
+it meets plus VIIRS's noise. Everything else is the service's: the same collocation, footprint kernel,
+cost, minimum and jackknife, with the day's fraction held at 1 (``parallax=False`` on the rendered
+samples, as ``benchmarks.lift_decision --at-law`` does). What this leaves is what the view angles
+themselves leave (each FOV's one in-track angle, views 20 mrad apart blended linearly), the footprint,
+the noise and the day's scenes: the part of the error that better heights, walls or reference cannot
+remove.
+
+    .venv/bin/python -m benchmarks.ideal_views CASE_DIR... [--workers 2] [--rows FILE]
+
+A case directory is one ``crisgeo simulate`` wrote, with truth.json; its scene is simulated again from
+the truth's parameters (the seed gives the same scene). One JSON row per case: the errors as the service
+assesses it ("default") and from the ideal views ("ideal"), with the bounds' fields of
+``benchmarks.lift_decision``; "centre_view_k" is the median and 99th percentile of |ideal centre view -
+VIIRS's own BT| over the rendered pixels (a check that the scene is the case's: VIIRS's own view is within
+7 mrad of the centre's, so most pixels differ by the noise alone).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.lift_decision import _scores
+from benchmarks.provenance import commit, emit
+from benchmarks.render_truth import _band_bt, _view_time
+from monitor.assessment.assess import collocate_plan, cost_and_offsets, paired
+from monitor.collocation import render
+from monitor.collocation.lift import PROBE_M_PER_K
+from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import VIIRS_DETECTORS
+from monitor.geometry import frames, wgs84
+from monitor.sdr.pairing import plan
+from monitor.simulate.case import SimulationSpec, Simulator
+
+SCENE_FIELDS = (
+    "satellite", "granules", "seed", "profile", "orbit_pass", "pass_lon_deg", "terrain", "cloud_heights",
+    "cloud_edges", "fov_rows_alpha_urad", "wind_in_track_m_s", "cloud_emissivity",
+)  # fmt: skip
+CHUNK = 200_000  # pixels traced at once (the scene's march holds a few arrays of this many rays)
+
+
+def simulator_of(truth: dict) -> Simulator:
+    """The simulator that wrote the case of *truth* (truth.json): its scene and orbit from the same
+    parameters and seed."""
+    spec = SimulationSpec(
+        **{k: truth[k] for k in SCENE_FIELDS if k in truth}, start=dt.datetime.fromisoformat(truth["start"])
+    )
+    return Simulator(spec)
+
+
+class IdealViews:
+    """A stand-in for :func:`monitor.collocation.render.rendered_bt` with its arguments: the simulator's own
+    view of each GEO point at each in-track angle (module docstring); *m_per_k* is not used."""
+
+    def __init__(self, sim: Simulator) -> None:
+        self.sim = sim
+        self.rng = np.random.default_rng(sim.spec.seed + 1)
+        span = sim.viirs_granule_starts()
+        self.t_grid = np.arange(span[0] - 120.0, span[-1] + 300.0, 0.25)
+        self.r_grid, _, _ = sim.state(self.t_grid)
+        self.pixels = 0
+        self.trace_s = 0.0
+        self.centre_diff_k: list[np.ndarray] = []
+
+    def __call__(
+        self,
+        lat_rad: np.ndarray,
+        lon_rad: np.ndarray,
+        height_m: np.ndarray,
+        bt_k: np.ndarray,
+        good: np.ndarray,
+        sat_m: np.ndarray,
+        velocity_m_s: np.ndarray,
+        cris_alpha_rad: np.ndarray,
+        m_per_k: float,
+        scans: slice = slice(None),
+        columns: slice = slice(None),
+    ) -> np.ndarray:
+        t0 = time.perf_counter()
+        rows, cols = np.shape(bt_k)
+        out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
+        first, stop, _ = scans.indices(rows // VIIRS_DETECTORS)
+        r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
+        usable = np.zeros((rows, cols), bool)
+        usable[r, columns] = np.asarray(good, bool)[r, columns] & np.isfinite(bt_k[r, columns])
+        iy, ix = np.nonzero(usable)
+        # each pixel's scan time from its scan's spacecraft position: the search's first guess
+        scan_t = self.t_grid[
+            np.argmin(np.linalg.norm(self.r_grid[None] - np.asarray(sat_m)[:, None], axis=-1), axis=1)
+        ]
+        t_guess = scan_t[iy // VIIRS_DETECTORS]
+        p = wgs84.geodetic_to_ecef(lat_rad[iy, ix], lon_rad[iy, ix], height_m[iy, ix])
+        noise = self.sim.spec.viirs_noise_k
+        for j, alpha in enumerate(cris_alpha_rad):
+            seen = np.empty(len(iy), np.float32)
+            for c0 in range(0, len(iy), CHUNK):
+                c = slice(c0, c0 + CHUNK)
+                t_view = _view_time(self.sim, p[c], t_guess[c], float(alpha))
+                r_view, _, _ = self.sim.state(t_view)
+                scene = self.sim.scene
+                _, v_lat, v_lon, _ = scene.intersect(r_view, frames.unit(p[c] - r_view), unix_s=t_view)
+                temp = scene.temperature_k(v_lat, v_lon, scene.height_m(v_lat, v_lon), t_view)
+                seen[c] = _band_bt(self.sim, temp) + self.rng.normal(0.0, noise, len(temp))
+            out[j, iy, ix] = seen
+            if alpha == 0.0:
+                self.centre_diff_k.append(np.abs(seen - bt_k[iy, ix]))
+        self.pixels += len(iy)
+        self.trace_s += time.perf_counter() - t0
+        return out
+
+
+def measure(case: Path, workers: int) -> dict:
+    """The row of one case (module docstring)."""
+    truth = json.loads((case / "truth.json").read_text())
+    cfg = AssessmentConfig(workers=workers)
+    plain = cfg.model_copy(update={"parallax": False})
+    samples = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
+    default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
+    ideal = IdealViews(simulator_of(truth))
+    own = render.rendered_bt
+    render.rendered_bt = ideal  # the bench's seam: the truth for the rendering
+    try:
+        again = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
+    finally:
+        render.rendered_bt = own
+    at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
+    diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
+    return {
+        "commit": commit(),
+        "case": case.name,
+        "clouds": truth.get("cloud_heights", "ground"),
+        "edges": truth.get("cloud_edges", "soft"),
+        "footprint_width50_deg": None  # None: the paper's top-hat cone
+        if truth.get("cris_response") is None
+        else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
+        "granules": truth["granules"],
+        "default": _scores(default, truth),
+        "ideal": _scores(at, truth),
+        "centre_view_k": [round(float(np.nanmedian(diff)), 2), round(float(np.nanpercentile(diff, 99)), 2)],
+        "pixels_traced": ideal.pixels,
+        "trace_s": round(ideal.trace_s),
+    }
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("cases", nargs="+", type=Path)
+    p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--rows", help="append the JSON rows to this file")
+    args = p.parse_args()
+    for case in args.cases:
+        emit(measure(case, args.workers), args.rows)
+
+
+if __name__ == "__main__":
+    main()
