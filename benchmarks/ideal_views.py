@@ -27,14 +27,15 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
+import inspect
 import json
 import time
 from pathlib import Path
 
 import numpy as np
 
-from benchmarks.lift_decision import _scores
-from benchmarks.provenance import commit, emit
+from benchmarks.lift_decision import _scores, case_fields
+from benchmarks.provenance import emit
 from benchmarks.render_truth import _band_bt, _view_time
 from monitor.assessment.assess import collocate_plan, cost_and_offsets, paired
 from monitor.collocation import render
@@ -49,6 +50,7 @@ SCENE_FIELDS = (
     "satellite", "granules", "seed", "profile", "orbit_pass", "pass_lon_deg", "terrain", "cloud_heights",
     "cloud_edges", "fov_rows_alpha_urad", "wind_in_track_m_s", "cloud_emissivity",
 )  # fmt: skip
+RENDERED_BT = inspect.signature(render.rendered_bt)  # the arguments the stand-in takes
 CHUNK = 200_000  # pixels traced at once (the scene's march holds a few arrays of this many rays)
 
 
@@ -75,20 +77,14 @@ class IdealViews:
         self.trace_s = 0.0
         self.centre_diff_k: list[np.ndarray] = []
 
-    def __call__(
-        self,
-        lat_rad: np.ndarray,
-        lon_rad: np.ndarray,
-        height_m: np.ndarray,
-        bt_k: np.ndarray,
-        good: np.ndarray,
-        sat_m: np.ndarray,
-        velocity_m_s: np.ndarray,
-        cris_alpha_rad: np.ndarray,
-        m_per_k: float,
-        scans: slice = slice(None),
-        columns: slice = slice(None),
-    ) -> np.ndarray:
+    def __call__(self, *args: object, **kwargs: object) -> np.ndarray:
+        a = RENDERED_BT.bind(*args, **kwargs)
+        a.apply_defaults()
+        lat_rad, lon_rad, height_m, bt_k, good, sat_m = (
+            np.asarray(a.arguments[k]) for k in ("lat_rad", "lon_rad", "height_m", "bt_k", "good", "sat_m")
+        )
+        cris_alpha_rad = np.asarray(a.arguments["cris_alpha_rad"])
+        scans, columns = a.arguments["scans"], a.arguments["columns"]
         t0 = time.perf_counter()
         rows, cols = np.shape(bt_k)
         out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
@@ -139,13 +135,7 @@ def measure(case: Path, workers: int) -> dict:
     at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
     diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
     return {
-        "commit": commit(),
-        "case": case.name,
-        "clouds": truth.get("cloud_heights", "ground"),
-        "edges": truth.get("cloud_edges", "soft"),
-        "footprint_width50_deg": None  # None: the paper's top-hat cone
-        if truth.get("cris_response") is None
-        else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
+        **case_fields(case, truth),
         "granules": truth["granules"],
         "default": _scores(default, truth),
         "ideal": _scores(at, truth),

@@ -80,13 +80,7 @@ def decision(
     sigma = [jackknife_sigma(gain_g[:, r]) for r in range(len(parallax.ROWS))]
     kept, _ = parallax.day_lift(s0, s1, cfg.cost, probe_m_per_k)
     row = {
-        "commit": commit(),
-        "case": case.name,
-        "clouds": truth.get("cloud_heights", "ground"),
-        "edges": truth.get("cloud_edges", "soft"),
-        "footprint_width50_deg": None  # None: the paper's top-hat cone
-        if truth.get("cris_response") is None
-        else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
+        **case_fields(case, truth),
         "granules": len(runs),
         "law_m_per_k": law_m_per_k(truth["satellite"], truth.get("cloud_heights", "ground")),
         "fov_rows_alpha_urad": truth.get("fov_rows_alpha_urad", 0.0),
@@ -117,6 +111,19 @@ def decision(
                 at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
                 row[name] = _scores(at, truth) | {"lift_m_per_k": round(float(lift), 1)}
     return row
+
+
+def case_fields(case: Path, truth: dict) -> dict:
+    """The fields that name a case's row: the commit, the case and its truth's clouds and footprint."""
+    return {
+        "commit": commit(),
+        "case": case.name,
+        "clouds": truth.get("cloud_heights", "ground"),
+        "edges": truth.get("cloud_edges", "soft"),
+        "footprint_width50_deg": None  # None: the paper's top-hat cone
+        if truth.get("cris_response") is None
+        else round(truth["cris_response"][0]["full_width_deg"]["50%"], 3),
+    }
 
 
 def _scores(result: AssessmentResult, truth: dict) -> dict:
