@@ -30,7 +30,11 @@ does (one spacecraft, one scan angle; only the time, and so the in-track tangent
    per K), the temperature of the air at that height.
 
 Pixels hidden behind a higher one drop out (the ray meets the higher first), and the walls the ray meets
-come in. Nothing of the neighbouring columns is looked at: the sweep is one dimension per column.
+come in. Nothing of the neighbouring columns is looked at: the sweep is one dimension per column. That
+costs cross-track accuracy: one column index of two scans is not one line on the ground (the Earth turns
+1-2 columns under the track between scans, and the bow-tie's smile puts a scan's outer detectors a few
+hundredths of a column further out), so where scans overlap a top's BT comes from a pixel aside
+(docs/science.md, "What a perfect rendering gives").
 
 **Why this sweep, by the numbers** (``python -m benchmarks.render_truth``, the simulator's own ray-traced
 views as the truth, the true heights given; docs/science.md, "The renderer against the simulator's own
