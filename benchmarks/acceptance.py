@@ -19,7 +19,7 @@ row also holds the intercalibration recovered per FOR (bias at 280 K, gain), pri
 values (every reliable FOR within 0.05 K and 0.2 %; the curvature printed).
 
 Slow (~2-5 min per 14-granule case); not part of the test suite. ``--rows FILE`` appends one JSON line per
-case and resumes from the cases already in the file; ``benchmarks/results/acceptance_2026-11-22.jsonl`` holds
+case and resumes from the cases already in the file; ``studies/rows/acceptance_2026-11-22.jsonl`` holds
 the 25 cases of 2026-11-22 (print their tables with ``--from-rows``).
 
     .venv/bin/python benchmarks/acceptance.py [--sizes 14 6] [--seeds 1 2] [--profiles paper random zero]

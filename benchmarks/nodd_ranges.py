@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit
+from benchmarks.servers import MotoS3
 from monitor.archive.configured import make_source
 from monitor.archive.ranged import BLOCK_BYTES, BLOCK_LIST, RANGES_FOLDER
 from monitor.collocation.collocate import warm_up
@@ -41,7 +42,6 @@ from monitor.service.pipeline import RunOutcome, run_day
 from monitor.service.store.sqlite import Store
 from monitor.simulate import LAYOUTS
 from monitor.simulate.case import DEFAULT_START, simulate_case
-from tests.servers import MotoS3
 
 SATELLITE = "j01"
 DAY = DEFAULT_START.date()

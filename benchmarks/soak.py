@@ -44,11 +44,11 @@ from pathlib import Path
 from aiosmtpd.controller import Controller
 from aiosmtpd.smtp import Envelope
 
+from benchmarks.servers import S3Server, Webhook, free_port, victoria_metrics, vm_export
 from monitor.core.vocabulary import DeliveryStatus, RunStatus
 from monitor.sdr.products import PRODUCTS
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
-from tests.servers import S3Server, Webhook, free_port, victoria_metrics, vm_export
 
 ROOT = Path(__file__).resolve().parent.parent
 BUCKET = "noaa-nesdis-n20-pds"

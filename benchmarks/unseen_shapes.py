@@ -15,7 +15,7 @@ specification check says of the truth.
 
     .venv/bin/python -m benchmarks.unseen_shapes --set within > rows.jsonl      (~6 min on two cores)
 
-Rows: ``benchmarks/results/acceptance_unseen_shapes_2026-11-25.jsonl`` (within),
+Rows: ``studies/rows/acceptance_unseen_shapes_2026-11-25.jsonl`` (within),
 ``acceptance_stretched_shapes_2026-11-26.jsonl`` (stretched).
 """
 

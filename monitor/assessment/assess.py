@@ -32,7 +32,7 @@ from monitor.assessment.inputs import (
     stage,
 )
 from monitor.assessment.spool import OnDisk, Spool
-from monitor.collocation import collocate, swath
+from monitor.collocation import collocate, render, swath
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
@@ -43,6 +43,7 @@ from monitor.estimation import parallax
 from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
 from monitor.estimation.offsets import DayLift, day_offsets
+from monitor.estimation.parallax import Blend
 from monitor.geometry.ep_model import FOV5
 from monitor.geometry.ground import offset_km
 from monitor.geometry.inverse import FovGeometry
@@ -252,12 +253,37 @@ def cost_and_offsets(
     cfg: AssessmentConfig,
     skipped: Sequence[tuple[str, str]] | None = None,
     satellite: str = "",
+    probe_m_per_k: float = PROBE_M_PER_K,
+    blend: Blend = parallax.blend,
 ) -> AssessmentResult:
-    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*. When
-    *cfg* asks for the parallax correction and every granule was also collocated with the VIIRS pixels
-    standing at PROBE_M_PER_K (:attr:`GranuleSamples.rendered`: rendered as each FOV row sees them,
-    :mod:`monitor.collocation.render`), the day's lift is chosen by the cost
-    (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it."""
+    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*.
+
+    When *cfg* asks for the parallax correction and every granule was also collocated with the VIIRS
+    pixels standing at the probe's height (:attr:`GranuleSamples.rendered`: rendered as each FOV row sees
+    them, :mod:`monitor.collocation.render`), the day's lift is chosen by the cost
+    (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it.
+
+    Parameters
+    ----------
+    samples : list of GranuleSamples
+        The collocated granules, in time order.
+    cfg : AssessmentConfig
+        The assessment's configuration (grid, kernel, cost, parallax, uncertainty).
+    skipped : sequence of (str, str), optional
+        Granules left out and why, carried into the result.
+    satellite : str, optional
+        The satellite's short name (``j01``); by default the first granule's platform.
+    probe_m_per_k : float, optional
+        The lift (m per K of I5 BT) the rendered collocation was made at.
+    blend : callable, optional
+        How a FOR's two collocations are combined at the day's fraction of the probe
+        (:func:`monitor.estimation.parallax.blend`).
+
+    Returns
+    -------
+    AssessmentResult
+        Per-FOR offsets (urad, km), sigmas, flags and the day's lift.
+    """
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
     per_for: Sequence[ForSamples] = PerFor(lambda k: for_samples(samples, k, cfg, band))
     m_per_k = np.nan
@@ -273,7 +299,7 @@ def cost_and_offsets(
             ),
             strict=True,
         )
-        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost, PROBE_M_PER_K)
+        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost, probe_m_per_k)
         if cfg.uncertainty and np.isfinite(sigma_f):
             spread = np.array(
                 [
@@ -282,9 +308,9 @@ def cost_and_offsets(
                 ]
             )
         per_for = PerFor(
-            lambda k: parallax.blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
+            lambda k: blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
         )
-        m_per_k = f * PROBE_M_PER_K
+        m_per_k = f * probe_m_per_k
     used = samples if pairs is None else pairs[0]
     lift = DayLift(
         m_per_k,
@@ -386,13 +412,14 @@ def collocate_run(
     should_stop: StopCheck = None,
     timings: Timings = None,
     lift_m_per_k: float = 0.0,
+    renderer: render.Renderer = render.rendered_bt,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
     """Collocate a time-ordered run of CrIS granules with the VIIRS pixels as GEO places them; with
     *lift_m_per_k*, in the same pass, also with the pixels standing *lift_m_per_k* m per K above their GEO
     points and rendered as each CrIS FOV row sees them (:mod:`monitor.collocation.render`; each sample's
-    :attr:`GranuleSamples.rendered`); returns (samples, skipped)."""
+    :attr:`GranuleSamples.rendered`) by *renderer*; returns (samples, skipped)."""
     band = i5_band(satellite)
-    cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k)
+    cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k, renderer=renderer)
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
@@ -445,20 +472,6 @@ def collocate_run(
     return samples, skipped
 
 
-def collocate_plan(
-    case: CasePlan, cfg: AssessmentConfig | None = None, workers: int = 1, lift_m_per_k: float = 0.0
-) -> list[GranuleSamples]:
-    """The collocated samples of every CrIS granule of *case*, in time order (granules that fail are left
-    out, logged), with their rendered collocation at *lift_m_per_k* when given (:func:`collocate_run`): what
-    :func:`assess_plan` estimates from, for benchmarks that estimate otherwise."""
-    cfg = cfg or AssessmentConfig()
-    with parallel_threads(workers):
-        run = collocate_run(
-            case.cris, case.viirs, case.viirs_all, case.satellite, cfg, lift_m_per_k=lift_m_per_k
-        )
-    return run[0]
-
-
 class DayAssessment:
     """A day's assessment built batch by batch (:meth:`add`): each batch's CrIS granules collocated once
     (as GEO places the pixels and, in the same pass, rendered, for the parallax), the estimate made over
@@ -466,8 +479,32 @@ class DayAssessment:
     Each granule's perturbed cones are kept on disk (:mod:`~monitor.assessment.spool`) until :meth:`close`
     (or the context's end): memory holds one granule's collocation and one FOR's estimate, not the day."""
 
-    def __init__(self, satellite: str, cfg: AssessmentConfig | None = None, workers: int = 1) -> None:
+    def __init__(
+        self,
+        satellite: str,
+        cfg: AssessmentConfig | None = None,
+        workers: int = 1,
+        probe_m_per_k: float = PROBE_M_PER_K,
+        renderer: render.Renderer = render.rendered_bt,
+    ) -> None:
+        """
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name (``npp``, ``j01``, ``j02``).
+        cfg : AssessmentConfig, optional
+            The assessment's configuration; the defaults when None.
+        workers : int, optional
+            Threads of the compiled VIIRS preparation and collocation.
+        probe_m_per_k : float, optional
+            With the parallax correction, the lift (m per K of I5 BT below the clear sky) of the second,
+            rendered collocation from which the day's lift is found (:mod:`monitor.estimation.parallax`).
+        renderer : Renderer, optional
+            What renders the VIIRS pixels as each CrIS FOV row sees them
+            (:func:`monitor.collocation.render.rendered_bt`).
+        """
         self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
+        self.probe_m_per_k, self.renderer = probe_m_per_k, renderer
         self.samples: list[GranuleSamples] = []
         self.skipped: list[tuple[str, str]] = []
         self._spool = Spool()
@@ -499,9 +536,11 @@ class DayAssessment:
         run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
         # with the parallax correction, also the pixels at the probe's height per K, rendered, in the same
         # pass (monitor.estimation.parallax chooses the day's)
-        lift_m_per_k = PROBE_M_PER_K if cfg.parallax else 0.0
+        lift_m_per_k = self.probe_m_per_k if cfg.parallax else 0.0
         with parallel_threads(self.workers):
-            samples, skipped = collocate_run(*run, progress, should_stop, timings, lift_m_per_k)
+            samples, skipped = collocate_run(
+                *run, progress, should_stop, timings, lift_m_per_k, self.renderer
+            )
         self.skipped += list(case.skipped) + skipped
         self.samples += [s.kept_in(self._spool) for s in samples]
         if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
@@ -521,7 +560,7 @@ class DayAssessment:
             )
         in_time = sorted(self.samples, key=lambda s: (s.info.start, s.key))
         with stage(timings, "cost"):
-            return cost_and_offsets(in_time, cfg, skipped, self.satellite)
+            return cost_and_offsets(in_time, cfg, skipped, self.satellite, self.probe_m_per_k)
 
 
 def assess_plan(

@@ -66,7 +66,8 @@ class SwathCache:
     the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`). With
     *lift_m_per_k* (m per K colder than the clear-sky reference: :mod:`monitor.collocation.lift`), every
     piece holds what each CrIS FOV row sees of its pixels standing at that height
-    (:func:`monitor.collocation.render.rendered_bt`); with 0, the pixels' own radiance."""
+    (*renderer*, :func:`monitor.collocation.render.rendered_bt` unless a study gives another); with 0, the
+    pixels' own radiance."""
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
@@ -74,6 +75,7 @@ class SwathCache:
     keep: int = 2
     spans: dict = field(default_factory=dict)
     lift_m_per_k: float = 0.0
+    renderer: render.Renderer = render.rendered_bt
 
 
 def _widen(span: Span | None, other: Span | None) -> Span | None:
@@ -237,7 +239,7 @@ def piece(
                 geo.start_time_us, run_span,
             )  # fmt: skip
             first, stop, _ = scans.indices(len(geo.sc_position_m))
-            seen = render.rendered_bt(
+            seen = cache.renderer(
                 geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, geo.sc_position_m,
                 geo.sc_velocity_m_s, render.VIEW_ALPHA_RAD, cache.lift_m_per_k,
                 slice(max(first - 1, 0), stop + 1), columns,

@@ -36,7 +36,7 @@ costs cross-track accuracy: one column index of two scans is not one line on the
 hundredths of a column further out), so where scans overlap a top's BT comes from a pixel aside
 (docs/science.md, "What a perfect rendering gives").
 
-**Why this sweep, by the numbers** (``python -m benchmarks.render_truth``, the simulator's own ray-traced
+**Why this sweep, by the numbers** (``python -m studies.render_truth``, the simulator's own ray-traced
 views as the truth, the true heights given; docs/science.md, "The renderer against the simulator's own
 views"). The scale that matters is a CrIS FOV's: the RMS over 400 discs of 7 km of the mean error. On the
 outer rows the linear sweep removes 31-37 % of that error on sharp-edged clouds and 48-60 % on soft ones,
@@ -52,6 +52,7 @@ A granule's first and last rows are rendered without the next granule's pixels.
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 import numba
 import numpy as np
@@ -69,6 +70,27 @@ TOP_M = 1.0  # a ray that meets a stretch more than this below its top met its w
 # (it varies smoothly along a scan)
 TANGENT_STEP = 16
 NEAR_HITS = 16  # a ray's reach is bounded by the highest pixel within this many hits of its own
+
+
+class Renderer(Protocol):
+    """What renders a VIIRS granule as CrIS FOV rows see it: :func:`rendered_bt`'s signature. The
+    assessment takes one as an argument (:class:`monitor.assessment.DayAssessment`), so that a study can
+    put another rendering, or a truth, in its place."""
+
+    def __call__(
+        self,
+        lat_rad: np.ndarray,
+        lon_rad: np.ndarray,
+        height_m: np.ndarray,
+        bt_k: np.ndarray,
+        good: np.ndarray,
+        sat_m: np.ndarray,
+        velocity_m_s: np.ndarray,
+        cris_alpha_rad: np.ndarray,
+        m_per_k: float,
+        scans: slice = ...,
+        columns: slice = ...,
+    ) -> np.ndarray: ...
 
 
 def rendered_bt(

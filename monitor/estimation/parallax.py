@@ -50,6 +50,7 @@ footprint but takes it as a knob for the cone's width ("Each ray's own view").
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -72,6 +73,11 @@ SENSITIVITY_STEP = 0.1
 MIN_LIFT_M_PER_K = 50.0  # half the dry adiabat's 102 m/K (9.8 K/km): a smaller law is no cloud's
 GAIN_SIGMAS = 1.0  # the day's gain in cost, in its jackknife sigmas, that keeps a lift
 ROWS = ((6, 7, 8), (3, 4, 5), (0, 1, 2))  # FOVs 7-9 ahead, 4-6, 1-3 behind
+
+
+Blend = Callable[[ForSamples, ForSamples, float], ForSamples]
+"""What combines a FOR's samples at no lift and at the probe's into those at a fraction of it (:func:`blend`'s
+signature): the assessment takes one as an argument, so that a study can thin or weigh the samples."""
 
 
 def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:

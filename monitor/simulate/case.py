@@ -756,6 +756,8 @@ def simulate_case(
         "pass_lon_deg": spec.pass_lon_deg,
         "terrain": spec.terrain,
         "cloud_heights": spec.cloud_heights,
+        # the lift the clouds' law implies in the units the assessment learns it (parallax_m_per_k)
+        "law_m_per_k": law_m_per_k(spec.satellite, spec.cloud_heights),
         "cloud_edges": spec.cloud_edges,
         "fov_rows_alpha_urad": spec.fov_rows_alpha_urad,
         "wind_in_track_m_s": spec.wind_in_track_m_s,

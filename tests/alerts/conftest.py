@@ -7,7 +7,7 @@ import pytest
 from aiosmtpd.controller import Controller
 from aiosmtpd.smtp import AuthResult, LoginPassword
 
-from tests.servers import Webhook, free_port
+from benchmarks.servers import Webhook, free_port
 
 USER, PASSWORD = "crisgeo", "not-a-real-password"
 
@@ -84,7 +84,7 @@ def smtp_server(tls_cert):
 
 @pytest.fixture
 def webhook():
-    """A Slack incoming-webhook stand-in (:class:`tests.servers.Webhook`)."""
+    """A Slack incoming-webhook stand-in (:class:`benchmarks.servers.Webhook`)."""
     w = Webhook()
     try:
         yield w

@@ -8,10 +8,10 @@ import requests
 
 from alerts.alertmanager import post_state
 from alerts.rules import Finding
+from benchmarks.servers import Webhook, alertmanager, wait_for
 from monitor.config.alert_settings import AlertSettings, Links
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
-from tests.servers import Webhook, alertmanager, wait_for
 
 
 @pytest.fixture

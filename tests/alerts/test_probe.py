@@ -8,9 +8,9 @@ from email import policy
 import pytest
 import requests
 
+from benchmarks.servers import Webhook, alertmanager
 from monitor.cli import main
 from tests.alerts.conftest import PASSWORD, USER
-from tests.servers import Webhook, alertmanager
 
 pytestmark = pytest.mark.servers  # starts real servers (see pyproject markers)
 

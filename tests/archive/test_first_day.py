@@ -8,8 +8,8 @@ import subprocess
 
 import pytest
 
+from benchmarks.servers import S3Server, nodd_key
 from tests.invoke import CRISGEO, ROOT
-from tests.servers import S3Server, nodd_key
 
 pytestmark = pytest.mark.servers  # starts real servers (see pyproject markers)
 

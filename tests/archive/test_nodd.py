@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from benchmarks.servers import S3Server, nodd_key
 from monitor.archive import ALL_PRODUCTS, BudgetExceeded, SourceError, listed
 from monitor.archive.configured import make_source
 from monitor.archive.nodd import NoddSource
@@ -15,7 +16,6 @@ from monitor.assessment import compute_day
 from monitor.config.file import load_config
 from monitor.config.source import SourceConfig
 from monitor.core.vocabulary import RunStatus
-from tests.servers import S3Server, nodd_key
 
 DAY = dt.date(2024, 6, 1)
 

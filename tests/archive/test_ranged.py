@@ -1,5 +1,5 @@
 """Granules read in place from a real S3-compatible server on loopback (moto's server), through the block
-cache; faults from the hostile test server (tests/servers.py S3Server)."""
+cache; faults from the hostile test server (benchmarks/servers.py S3Server)."""
 
 import datetime as dt
 import json
@@ -11,6 +11,7 @@ import h5py
 import numpy as np
 import pytest
 
+from benchmarks.servers import MotoS3, S3Server, nodd_key
 from monitor.archive import SourceError
 from monitor.archive.configured import make_source
 from monitor.archive.nodd import NoddSource
@@ -21,7 +22,6 @@ from monitor.config.source import SourceConfig
 from monitor.core.satellites import SATELLITES
 from monitor.core.vocabulary import RunStatus
 from monitor.sdr import GranuleError, read_file
-from tests.servers import MotoS3, S3Server, nodd_key
 
 pytestmark = pytest.mark.servers
 

@@ -1,5 +1,5 @@
 """A reduced run of benchmarks/step_detection.py: the memory path is the store's path, and a step at an
-EP upload is found, dated and named (the full figures: benchmarks/results/step_detection_*.jsonl)."""
+EP upload is found, dated and named (the full figures: studies/rows/step_detection_*.jsonl)."""
 
 import pytest
 

@@ -9,11 +9,11 @@ from pathlib import Path
 import pytest
 import requests
 
+from benchmarks.servers import influxdb1, influxql
 from monitor.history.changes import Change
 from monitor.service.outputs.timeseries import change_lines, result_lines
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
-from tests.servers import influxdb1, influxql
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
@@ -140,10 +140,10 @@ def test_service_health_row_queries_the_daemon_metrics(dashboard, tmp_path):
     from prometheus_client import generate_latest
 
     from alerts.rules import Finding
+    from benchmarks.servers import victoria_metrics, wait_for
     from monitor.service.health import Health
     from monitor.service.outputs.metrics import ServiceMetrics
     from monitor.service.store.alert_state import AlertState
-    from tests.servers import victoria_metrics, wait_for
 
     db = tmp_path / "s.sqlite"
     ten_hours_ago = dt.datetime.now(UTC) - dt.timedelta(hours=10)

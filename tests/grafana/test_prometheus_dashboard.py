@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 import requests
 
+from benchmarks.servers import victoria_metrics, wait_for
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
-from tests.servers import victoria_metrics, wait_for
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.servers import require
+from benchmarks.servers import require
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 

@@ -15,9 +15,9 @@ import pytest
 import requests
 from prometheus_client.parser import text_string_to_metric_families
 
+from benchmarks.servers import chromium_driver, free_port, wait_for
 from monitor.service.store.sqlite import Store
 from tests.invoke import CRISGEO, ROOT, run_crisgeo
-from tests.servers import chromium_driver, free_port, wait_for
 
 DAY = "2024-06-01"
 

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
+from benchmarks.servers import wait_for
 from monitor.service.store.sqlite import Store
 from tests.invoke import CRISGEO, ROOT, run_crisgeo
-from tests.servers import wait_for
 
 DAY = "2024-06-01"
 

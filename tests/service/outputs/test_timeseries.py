@@ -4,6 +4,7 @@ import datetime as dt
 
 import pytest
 
+from benchmarks.servers import free_port, influxdb1, influxql, victoria_metrics, vm_export, wait_for
 from monitor.config.outputs import PublishConfig
 from monitor.service.outputs.timeseries import (
     Influx2Writer,
@@ -14,7 +15,6 @@ from monitor.service.outputs.timeseries import (
     target_name,
 )
 from monitor.service.store.sqlite import Store
-from tests.servers import free_port, influxdb1, influxql, victoria_metrics, vm_export, wait_for
 
 DAY = dt.date(2024, 6, 1)
 

@@ -12,6 +12,7 @@ import yaml
 from selenium.webdriver.support.ui import WebDriverWait
 
 from alerts.rules import Finding
+from benchmarks.servers import chromium_driver
 from monitor.cli import main
 from monitor.core.result import AssessmentResult
 from monitor.core.vocabulary import Rule, Severity
@@ -19,7 +20,6 @@ from monitor.service.outputs.report.html import PAGE_BUDGET_BYTES, ReportOptions
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 from monitor.simulate.history import fill_store
-from tests.servers import chromium_driver
 
 SATS = ["npp", "j01", "j02"]
 PNG = b"\x89PNG\r\n\x1a\n"

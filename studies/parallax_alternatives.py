@@ -6,7 +6,7 @@ For each: the FOR offsets' RMS and worst error per direction, and the rows' (ahe
 error against the truth. The two collocations (none, the probe's) are made once per case, in one pass.
 Prints one JSON row per case and alternative.
 
-    .venv/bin/python -m benchmarks.parallax_alternatives CASE_DIR... [--leave-out-above-km 8 5 3]
+    .venv/bin/python -m studies.parallax_alternatives CASE_DIR... [--leave-out-above-km 8 5 3]
                                                          [--workers 2] [--rows FILE]
 
 A case directory is one ``crisgeo simulate`` (or ``benchmarks.acceptance --keep``) wrote, with truth.json.
@@ -23,13 +23,13 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import collocate_plan, cost_and_offsets, paired
+from monitor.assessment.assess import cost_and_offsets, paired
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult
 from monitor.estimation import parallax
 from monitor.estimation.estimate import ForSamples
-from monitor.sdr.pairing import plan
+from studies.collocated import collocated
 
 
 def errors(result: AssessmentResult, truth: dict) -> dict:
@@ -73,7 +73,7 @@ def alternatives(case: Path, leave_out_above_km: list[float], workers: int) -> l
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
     sat = truth["satellite"]
-    both = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
+    both = collocated(case, cfg, workers, PROBE_M_PER_K)
     ground = [replace(s, rendered=None) for s in both]
     pairs = paired(both)
     base = {"commit": commit(), "case": case.name, "clouds": truth.get("cloud_heights", "ground")}
@@ -87,21 +87,12 @@ def alternatives(case: Path, leave_out_above_km: list[float], workers: int) -> l
         },
     ]
     rows[1]["m_per_k"] = PROBE_M_PER_K
-    blend = parallax.blend
-    try:
-        for above_km in leave_out_above_km:
-            # the assessment blends each FOR through this module: its samples are thinned there
-            parallax.blend = without_high_clouds(above_km)  # type: ignore[assignment]
-            result = cost_and_offsets(both, cfg, satellite=sat)
-            rows.append(
-                {
-                    **base,
-                    "alternative": f"learnt, clouds above {above_km:g} km left out",
-                    **errors(result, truth),
-                }
-            )
-    finally:
-        parallax.blend = blend
+    for above_km in leave_out_above_km:
+        # the assessment blends each FOR through the blend it is given: the samples are thinned there
+        result = cost_and_offsets(both, cfg, satellite=sat, blend=without_high_clouds(above_km))
+        rows.append(
+            {**base, "alternative": f"learnt, clouds above {above_km:g} km left out", **errors(result, truth)}
+        )
     return rows
 
 

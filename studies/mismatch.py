@@ -5,7 +5,7 @@ curvature (:class:`monitor.simulate.case.SimulationSpec`), assesses each with ``
 equation 8) and ``regression`` (docs/science.md), and prints the RMS error in-track / cross-track and the
 worst FOR (urad) over the reliable FORs.
 
-    PYTHONPATH=. .venv/bin/python benchmarks/mismatch.py [--granules 6] [--seeds 1 2]
+    PYTHONPATH=. .venv/bin/python studies/mismatch.py [--granules 6] [--seeds 1 2]
 """
 
 from __future__ import annotations
@@ -21,10 +21,17 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult
 from monitor.core.vocabulary import Cost, Kernel
 from monitor.simulate.case import simulate_case
-from tests.conftest import truth_arrays
 
 # (gain, bias K, curvature K): none, the issue's gains, the paper's profile, curvatures of 0.5 K
 DIFFERENCES = [(0.0, 0.0, 0.0), (0.03, 0.0, 0.0), (-0.03, 1.5, 0.0), (0.01, 0.0, 0.5), (0.0, 2.0, -0.5)]
+
+
+def truth_arrays(truth: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The case's true offsets (urad), in-track and cross-track, per FOR."""
+    return (
+        np.array([f["d_alpha_urad"] for f in truth["fors"]]),
+        np.array([f["d_beta_urad"] for f in truth["fors"]]),
+    )
 
 
 def errors(result: AssessmentResult, truth: dict) -> str:
@@ -59,3 +66,4 @@ def main(argv: list[str] | None = None) -> None:
 
 if __name__ == "__main__":
     main()
+

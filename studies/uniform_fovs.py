@@ -4,7 +4,7 @@ lever). For each usable FOV of each CrIS granule of a case, the range (max - min
 Prints, per granule and for the whole case, the quantiles of that range and the share of FOVs below each
 threshold; and the floor that skipping them would leave (the share of the collocation's work that remains).
 
-    .venv/bin/python -m benchmarks.uniform_fovs DIR [--granules N]      (DIR: a simulated case)
+    .venv/bin/python -m studies.uniform_fovs DIR [--granules N]      (DIR: a simulated case)
 
 DIR is e.g. the bench case (``crisgeo bench --granules 14 --data DIR``). Figures of 2026-11-25 in
 docs/performance.md.

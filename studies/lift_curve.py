@@ -9,7 +9,7 @@ rendering as its probe (f and the cost there): whether the day's cost over rende
 the case's law, and how far the blend's preferred lift follows its probe (docs/science.md, "One
 rendering at the day's lift"). One JSON row per lift.
 
-    .venv/bin/python -m benchmarks.lift_curve CASE_DIR --lifts 100,150,200,250,300 [--workers 2]
+    .venv/bin/python -m studies.lift_curve CASE_DIR --lifts 100,150,200,250,300 [--workers 2]
         [--rows FILE]
 """
 
@@ -20,13 +20,13 @@ import json
 from pathlib import Path
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import collocate_plan, for_samples, paired
+from monitor.assessment.assess import for_samples, paired
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
 from monitor.estimation import parallax
 from monitor.instrument.spectral import i5_band
-from monitor.sdr.pairing import plan
 from monitor.simulate.case import law_m_per_k
+from studies.collocated import collocated
 
 
 def curve(case: Path, lifts_m_per_k: list[float], workers: int) -> list[dict]:
@@ -36,7 +36,7 @@ def curve(case: Path, lifts_m_per_k: list[float], workers: int) -> list[dict]:
     band = i5_band(truth["satellite"])
     rows = []
     for lift in lifts_m_per_k:
-        p0, p1 = paired(collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=lift))
+        p0, p1 = paired(collocated(case, cfg, workers, lift))
         cones = [
             parallax.matched_cone(for_samples(p0, k, cfg, band), for_samples(p1, k, cfg, band), cfg.cost)
             for k in range(N_FOR)

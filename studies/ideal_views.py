@@ -5,20 +5,20 @@ The assessment renders, for each in-track SBF angle of :data:`monitor.collocatio
 the BT a CrIS ray at that angle meets on its way to each VIIRS GEO point (:func:`render.rendered_bt`,
 from the pixels' BT, a height learnt from the day and walls at the height law). Here that BT comes from
 the simulator itself instead: the spacecraft at the time it sees the GEO point at that angle (the secant
-search of :mod:`benchmarks.render_truth`), its ray marched through the case's scene, the band BT of what
+search of :mod:`studies.render_truth`), its ray marched through the case's scene, the band BT of what
 it meets plus VIIRS's noise. Everything else is the service's: the same collocation, footprint kernel,
 cost, minimum and jackknife, with the day's fraction held at 1 (``parallax=False`` on the rendered
-samples, as ``benchmarks.lift_decision --at-law`` does). What this leaves is what the view angles
+samples, as ``studies.lift_decision --at-law`` does). What this leaves is what the view angles
 themselves leave (each FOV's one in-track angle, views 20 mrad apart blended linearly), the footprint,
 the noise and the day's scenes: the part of the error that better heights, walls or reference cannot
 remove.
 
-    .venv/bin/python -m benchmarks.ideal_views CASE_DIR... [--workers 2] [--rows FILE]
+    .venv/bin/python -m studies.ideal_views CASE_DIR... [--workers 2] [--rows FILE]
 
 A case directory is one ``crisgeo simulate`` wrote, with truth.json; its scene is simulated again from
 the truth's parameters (the seed gives the same scene). One JSON row per case: the errors as the service
 assesses it ("default") and from the ideal views ("ideal"), with the bounds' fields of
-``benchmarks.lift_decision``; "centre_view_k" is the median and 99th percentile of |ideal centre view -
+``studies.lift_decision``; "centre_view_k" is the median and 99th percentile of |ideal centre view -
 VIIRS's own BT| over the rendered pixels (a check that the scene is the case's: VIIRS's own view is within
 7 mrad of the centre's, so most pixels differ by the noise alone).
 """
@@ -34,17 +34,17 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.lift_decision import _scores, case_fields
 from benchmarks.provenance import emit
-from benchmarks.render_truth import _band_bt, _view_time
-from monitor.assessment.assess import collocate_plan, cost_and_offsets, paired
+from monitor.assessment.assess import cost_and_offsets, paired
 from monitor.collocation import render
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.geometry import frames, wgs84
-from monitor.sdr.pairing import plan
 from monitor.simulate.case import SimulationSpec, Simulator
+from studies.collocated import collocated
+from studies.lift_decision import _scores, case_fields
+from studies.render_truth import _band_bt, _view_time
 
 SCENE_FIELDS = (
     "satellite", "granules", "seed", "profile", "orbit_pass", "pass_lon_deg", "terrain", "cloud_heights",
@@ -123,15 +123,10 @@ def measure(case: Path, workers: int) -> dict:
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
     plain = cfg.model_copy(update={"parallax": False})
-    samples = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
+    samples = collocated(case, cfg, workers, PROBE_M_PER_K)
     default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
     ideal = IdealViews(simulator_of(truth))
-    own = render.rendered_bt
-    render.rendered_bt = ideal  # the bench's seam: the truth for the rendering
-    try:
-        again = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=PROBE_M_PER_K)
-    finally:
-        render.rendered_bt = own
+    again = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=ideal)  # the truth for the rendering
     at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
     diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
     return {

@@ -1,4 +1,4 @@
-"""Real servers for the tests, on loopback: VictoriaMetrics, InfluxDB 1.x, and an S3-style HTTP server.
+"""Real servers on loopback, for the tests and the harnesses: VictoriaMetrics, InfluxDB 1.x, S3-style HTTP.
 
 The database servers come from Debian packages (``victoria-metrics``, ``influxdb``), which ``.ci/run``
 installs. Without them a test is skipped locally but fails under CI (``CI=true``).
@@ -194,7 +194,8 @@ class Webhook:
     else 500 while ``failing`` (those posts are counted in ``refused``, not received), else 200."""
 
     def __init__(self, path: str = "/services/T000/B000/secret-token"):
-        self.script, self.received = [], []
+        self.script: list = []
+        self.received: list = []
         self.failing, self.refused = False, 0
         hook = self
 
@@ -260,14 +261,16 @@ class S3Server:
     def __init__(self, root: Path, page_size: int = 3, host: str = "127.0.0.1"):
         self.root = Path(root)
         self.page_size = page_size
-        self.drop_once, self.corrupt_once = set(), set()
-        self.extra_keys, self.extra_sizes = [], {}
+        self.drop_once: set = set()
+        self.corrupt_once: set = set()
+        self.extra_keys: list = []
+        self.extra_sizes: dict = {}
         self.endless_tokens = self.repeat_token = self.gzip = self.short_ranges = self.ignore_ranges = False
         self.slow_drip_s = self.retry_after = self.lying_size = self.redirect_to = None
         self.slow_list_s = self.slow_headers_s = None
         self.drip_bytes = 64
         self.corrupt_at = 100  # the byte corrupt_once flips
-        self.requests = []
+        self.requests: list = []
         server = self
 
         class Handler(BaseHTTPRequestHandler):
@@ -426,6 +429,7 @@ def nodd_key(name: str) -> str:
     from monitor.sdr.products import PRODUCTS
 
     parsed = parse_name(name)
+    assert parsed is not None, name
     return f"{PRODUCTS[parsed.products[0]].collection}/{parsed.start:%Y/%m/%d}/{name}"
 
 

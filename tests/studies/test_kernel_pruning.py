@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from benchmarks.kernel_pruning import shares
+from studies.kernel_pruning import shares
 
 
 def test_shares_partition_each_disc_and_nest_with_the_discs() -> None:

@@ -4,10 +4,10 @@ point is VIIRS's own BT but for the noise of the two draws (the scene of another
 import numpy as np
 import pytest
 
-from benchmarks.ideal_views import IdealViews, simulator_of
 from monitor.collocation.render import VIEW_ALPHA_RAD
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.sdr import read_file
+from studies.ideal_views import IdealViews, simulator_of
 from tests.conftest import load_truth
 
 SCANS = slice(20, 22)

@@ -6,9 +6,9 @@ docs/science.md "The lift decision on held-back days"."""
 import numpy as np
 import pytest
 
-from benchmarks.lift_decision import decision
 from monitor.instrument import footprint
 from monitor.simulate.case import simulate_case
+from studies.lift_decision import decision
 
 
 @pytest.mark.slow

@@ -8,7 +8,7 @@ each FOV centre to the nearest VIIRS pixel and prints, per row (FOVs 7-9 ahead, 
 median and range of t_VIIRS - t_CrIS (s), and what a wind of 1 m/s makes of the rows ahead minus behind
 at the FOV's range (urad). Prints one JSON row.
 
-    .venv/bin/python -m benchmarks.view_times CASE_DIR [--rows FILE]
+    .venv/bin/python -m studies.view_times CASE_DIR [--rows FILE]
 
 A case directory is one ``crisgeo simulate`` wrote (the simulator's VIIRS column times; a real GITCO's
 would be read from its own scan timing).

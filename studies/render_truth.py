@@ -23,7 +23,7 @@ pixels (:func:`monitor.collocation.lift.height_above_m` at the law, the clear-sk
 RMS (m) against the true heights over the tops above 6 km and over the pixels that see the ground
 (docs/science.md, "The clear-sky reference").
 
-    .venv/bin/python -m benchmarks.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
+    .venv/bin/python -m studies.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
         [--scans 8] [--reaches 40,100] [--rows FILE]
 
 The scene is VIIRS's first granule of a one-granule case, from its 11th scan on; no noise. The walls and

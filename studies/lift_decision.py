@@ -14,7 +14,7 @@ from that rendering alone (``parallax=False`` on it: f held at 1, no lift sigma)
 lift the case's law implies (:func:`monitor.simulate.case.law_m_per_k`, in m per K of band BT), the
 row's "at_law": what the offsets and the rows would read with the day's lift known.
 
-    .venv/bin/python -m benchmarks.lift_decision CASE_DIR... [--workers 2]
+    .venv/bin/python -m studies.lift_decision CASE_DIR... [--workers 2]
         [--offsets [--at-lift] [--at-law] | --probe M_PER_K] [--rows FILE]
 
 ``--probe`` renders the collocation at another lift than the assessment's: the fraction the day prefers
@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import collocate_plan, cost_and_offsets, for_samples, paired
+from monitor.assessment.assess import cost_and_offsets, for_samples, paired
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
@@ -41,8 +41,8 @@ from monitor.core.result import AssessmentResult
 from monitor.estimation import parallax
 from monitor.estimation.jackknife import granule_runs, jackknife_sigma
 from monitor.instrument.spectral import i5_band
-from monitor.sdr.pairing import plan
 from monitor.simulate.case import law_m_per_k
+from studies.collocated import collocated
 
 ROW_NAMES = ("ahead", "centre", "behind")  # parallax.ROWS
 
@@ -58,7 +58,7 @@ def decision(
     """The row of one case (module docstring), its rendered collocation at *probe_m_per_k*."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
-    samples = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=probe_m_per_k)
+    samples = collocated(case, cfg, workers, probe_m_per_k)
     pairs = paired(samples)
     band = i5_band(truth["satellite"])
     cones = [
@@ -107,7 +107,7 @@ def decision(
         }
         for name, lift in passes.items():
             if np.isfinite(lift) and lift > 0:
-                again = collocate_plan(plan([case]), cfg, workers=workers, lift_m_per_k=lift)
+                again = collocated(case, cfg, workers, lift)
                 at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
                 row[name] = _scores(at, truth) | {"lift_m_per_k": round(float(lift), 1)}
     return row

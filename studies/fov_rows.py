@@ -11,8 +11,8 @@ tests/data/real). Simulated (``--simulate``): cases with clouds at the height th
 21 x 21 turns). Issue 42 asks sign and size to agree within a factor of 1.5 at comparable cloud-top
 temperatures (real, shared ten: -429 +- 78 urad in-track).
 
-    .venv/bin/python -m benchmarks.fov_rows [FILES.npz ...]
-    .venv/bin/python -m benchmarks.fov_rows --simulate [--clouds lapse:6.5 ground] [--seeds 5] [--granules 6]
+    .venv/bin/python -m studies.fov_rows [FILES.npz ...]
+    .venv/bin/python -m studies.fov_rows --simulate [--clouds lapse:6.5 ground] [--seeds 5] [--granules 6]
         [--keep DIR] [--rows FILE]
 """
 
@@ -27,14 +27,14 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import collocate_plan, cost_and_offsets
+from monitor.assessment.assess import cost_and_offsets
 from monitor.assessment.replay import assess_collocations, read_collocation
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR, URAD
 from monitor.core.result import AssessmentResult
 from monitor.estimation.estimate import FOV_ROWS, find_minimum
-from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
+from studies.collocated import collocated
 
 REAL = sorted((Path(__file__).parent.parent / "tests/data/real/collocations_j01_20181022").glob("*.npz"))
 
@@ -109,7 +109,7 @@ def simulated(root: Path, clouds: str, seed: int, granules: int, keep: bool) -> 
             cris_response=footprint.shape("super-gaussian"),
         )
     cfg = AssessmentConfig()
-    samples = collocate_plan(plan([case]), cfg, workers=2)
+    samples = collocated(case, cfg, 2)
     paper = stdev_rows([(s.bt_viirs_k[...], s.bt_cris_k, s.usable) for s in samples], cfg.step_urad)
     alone = [cost_and_offsets([s], cfg, satellite=s.info.cris_meta["platform"]) for s in samples]
     day = cost_and_offsets(samples, cfg, satellite=samples[0].info.cris_meta["platform"])

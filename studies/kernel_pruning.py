@@ -1,6 +1,6 @@
 """How much of the footprint kernel's per-pixel work an exact pruning could save.
 
-    python -m benchmarks.kernel_pruning [--pixels 20000] [--rows FILE]
+    python -m studies.kernel_pruning [--pixels 20000] [--rows FILE]
 
 The kernel (:func:`monitor.collocation.collocate._accumulate`) solves, for every pixel in the tangent box of
 a FOV's cones, one quadratic per grid row and disc, the discs largest first, and stops at the first disc the
