@@ -1,11 +1,17 @@
 """The ``crisgeo`` command line.
 
-Exit status: 0 success; 1 failure (a run failed, the store is unusable); 2 bad input (one line on stderr:
-arguments, configuration, data); 75 another instance holds the state directory (try again later). ``crisgeo
-status`` follows the Nagios plugin convention instead: 0 OK, 1 WARNING (a warning alert fires, a threshold
-is passed, no success for days), 2 CRITICAL (a critical alert fires or the last run of a satellite failed), 3
-UNKNOWN (a usage error, no usable configuration or store, the timeout).
-The configuration is ``--config``, else ``$CRISGEO_CONFIG``, else ``/etc/crisgeo/monitor.yaml``.
+The daily job and the service come first (run, daemon, status, check-config, alerts, events, report,
+export, reprocess, install-files), the science tools after (assess, simulate, fingerprint, geolocate,
+regeolocate, optimize, bench).
+
+Exit status: 0 success; 1 failure (a run failed, the store is unusable, the disk is full); 2 bad input (one
+line on stderr: arguments, configuration, data); 75 another instance holds the state directory (try again
+later); 130 interrupted (SIGINT), 143 terminated (SIGTERM). ``crisgeo status`` follows the Nagios plugin
+convention instead: 0 OK, 1 WARNING (a warning alert fires, a threshold is passed, no success for days), 2
+CRITICAL (a critical alert fires or the last run of a satellite failed), 3 UNKNOWN (a usage error, no usable
+configuration or store, the timeout).
+The configuration is ``--config``, else ``$CRISGEO_CONFIG``, else ``/etc/crisgeo/monitor.yaml`` (``assess``
+reads one only when given).
 """
 
 from __future__ import annotations
@@ -34,8 +40,9 @@ from monitor.version import __version__
 
 # the order of ``crisgeo --help`` and docs/cli.md
 ORDER = (
-    "simulate", "optimize", "regeolocate", "geolocate", "assess", "install-files", "check-config", "export",
-    "run", "reprocess", "daemon", "status", "alerts", "events", "fingerprint", "report", "bench",
+    "run", "daemon", "status", "check-config", "alerts", "events", "report", "export", "reprocess",
+    "install-files",
+    "assess", "simulate", "fingerprint", "geolocate", "regeolocate", "optimize", "bench",
 )  # fmt: skip
 
 

@@ -27,14 +27,15 @@ RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices'
         nargs="?",
         default="list",
         help="list (default): firing, silenced and recently resolved alerts and the silences in force; "
-        "silence: quiet --rule/--satellite until --until, with --reason; unsilence: end silence --id; "
+        "silence: quiet --rule/--satellite until --expires, with --reason; unsilence: end silence --id; "
         "evaluate: evaluate the rules and deliver now; test: a marked test message through each configured "
         "channel (or --channel), reported per channel (exit 1 if one was not delivered)",
     ),
     CONFIG,
     arg("--rule", choices=RULES, help="silence: the rule (default: every rule)"),
     arg("--satellite", choices=tuple(SATELLITES), help="silence: the satellite (default: every one)"),
-    arg("--until", type=until, help="silence: its end (ISO 8601, UTC) or how long from now (12h, 7d)"),
+    arg("--expires", type=until, help="silence: when it ends (ISO 8601, UTC) or how long from now (12h, 7d)"),
+    arg("--until", dest="expires", type=until, help=argparse.SUPPRESS),  # the earlier name, kept for scripts
     arg("--reason", default="", help="silence: why (shown with the silence)"),
     arg("--id", type=int, help="unsilence: the silence's number (crisgeo alerts list shows it)"),
     arg("--json", action="store_true", help="list: as JSON"),
@@ -75,15 +76,15 @@ def cmd_alerts(args: argparse.Namespace) -> int:
     cfg = load(args, writes=True)
     with Store(cfg.store.path) as store:
         if args.action == "silence":
-            if args.until is None or not args.reason:
-                raise BadInput("alerts silence needs --until and --reason")
+            if args.expires is None or not args.reason:
+                raise BadInput("alerts silence needs --expires and --reason")
             try:
-                AlertState(store).silence(args.rule, args.satellite, args.until, args.reason, now)
+                AlertState(store).silence(args.rule, args.satellite, args.expires, args.reason, now)
             except SilenceError as exc:
                 raise BadInput(str(exc)) from None
             print(
                 f"silenced rule={args.rule or '*'} satellite={args.satellite or '*'} until "
-                f"{args.until:%Y-%m-%d %H:%M} UTC"
+                f"{args.expires:%Y-%m-%d %H:%M} UTC"
             )
         elif args.action == "unsilence":
             if args.id is None:

@@ -81,8 +81,8 @@ def cmd_optimize(args: argparse.Namespace) -> int:
 @command(
     "regeolocate",
     "write copies of CrIS GEO files geolocated with another EP",
-    arg("files", nargs="+"),
-    arg("--ep", required=True),
+    arg("files", nargs="+", help="CrIS GEO granule files (HDF5) to geolocate again"),
+    arg("--ep", required=True, help="the engineering packet to regeolocate with (XML or YAML)"),
     arg("--out", required=True, help="output directory (never the input's)"),
     *RESIDUAL_ARGS,
 )
@@ -108,9 +108,9 @@ def cmd_regeolocate(args: argparse.Namespace) -> int:
 @command(
     "geolocate",
     "compare an EP's geolocation with CrIS GEO files' own, per FOR",
-    arg("files", nargs="+"),
-    arg("--ep", required=True),
-    arg("--json", action="store_true"),
+    arg("files", nargs="+", help="CrIS SDR and GEO granule files (HDF5)"),
+    arg("--ep", required=True, help="the engineering packet to geolocate with (XML or YAML)"),
+    arg("--json", action="store_true", help="print the geolocation as JSON"),
     *RESIDUAL_ARGS,
 )
 def cmd_geolocate(args: argparse.Namespace) -> int:
@@ -141,8 +141,8 @@ def cmd_geolocate(args: argparse.Namespace) -> int:
 @command(
     "fingerprint",
     "per-FOR LOS fingerprint (SBF angles) of CrIS GEO files",
-    arg("paths", nargs="+"),
-    arg("--json", action="store_true"),
+    arg("paths", nargs="+", help="CrIS GEO granule files or directories of one day"),
+    arg("--json", action="store_true", help="print the fingerprint and its matches as JSON"),
     arg(
         "--threshold-urad",
         type=float,

@@ -88,7 +88,7 @@ def _in_mission(sats: list[str], days: dict[str, dt.date | None]) -> None:
     "run",
     "one run of the daily job (the missed days, or --date), then exit",
     CONFIG,
-    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--date", type=iso_day, help="the UTC day to (re)assess, YYYY-MM-DD"),
 )
 def cmd_run(args: argparse.Namespace) -> int:
@@ -130,9 +130,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     CONFIG,
     arg("--since", type=iso_day, required=True, help="first day, YYYY-MM-DD"),
     arg("--until", type=iso_day, required=True, help="last day, YYYY-MM-DD"),
-    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--scheduler", help="address of a running Dask scheduler (tcp://HOST:8786); default a local cluster"),
-    arg("--workers", type=whole(1), default=2, help="processes of the local cluster (default 2)"),
+    arg("--processes", type=whole(1), default=2, help="processes of the local Dask cluster (default 2)"),
+    arg("--workers", dest="processes", type=whole(1), help=argparse.SUPPRESS),  # the earlier name, for scripts
     arg("--force", action="store_true", help="redo the days already done"),
 )
 def cmd_reprocess(args: argparse.Namespace) -> int:
@@ -144,7 +145,7 @@ def cmd_reprocess(args: argparse.Namespace) -> int:
     sats = satellites_of(cfg, args.satellite)
     period(args.since, args.until)
     _in_mission(sats, {"--since": args.since, "--until": args.until})
-    summary = run_reprocess(cfg, args.since, args.until, sats, args.scheduler, args.workers, args.force)
+    summary = run_reprocess(cfg, args.since, args.until, sats, args.scheduler, args.processes, args.force)
     for line in summary.lines():
         print(line)
     return EXIT_FAIL if summary.unfinished or summary.statuses.get(RunStatus.FAILED) else EXIT_OK

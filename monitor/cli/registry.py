@@ -113,6 +113,13 @@ WORKERS = arg(
 )
 
 
+def unset(argument: tuple[tuple[str, ...], dict[str, Any]]) -> tuple[tuple[str, ...], dict[str, Any]]:
+    """*argument* without a default (None when not given), for a command whose defaults come from a
+    configuration file: the help keeps saying what the default is."""
+    names, opts = argument
+    return names, {**opts, "default": None}
+
+
 # name -> (handler, help, arguments), in the order of ``crisgeo --help``
 COMMANDS: dict[str, tuple[Handler, str, tuple]] = {}
 

@@ -31,7 +31,7 @@ from monitor.core.satellites import SATELLITES
     ),
     arg("--format", choices=("netcdf", "csv"), help="netcdf or csv (default: from the suffix of --out)"),
     arg("--out", required=True, help="the file to write: FILE.nc (NetCDF) or FILE.csv"),
-    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--since", type=iso_day, help="first day, YYYY-MM-DD"),
     arg("--until", type=iso_day, help="last day, YYYY-MM-DD"),
 )
@@ -78,7 +78,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     "the self-contained HTML trend report (one page per satellite)",
     CONFIG,
     arg("--out", help="output directory (default: report_dir of the configuration)"),
-    arg("--satellite", choices=tuple(SATELLITES)),
+    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--since", type=iso_day, help="first day shown, YYYY-MM-DD"),
     arg("--until", type=iso_day, help="last day shown, YYYY-MM-DD"),
 )

@@ -18,7 +18,9 @@ from monitor.cli.registry import (
     arg,
     command,
     ep_file,
+    load,
     options,
+    unset,
 )
 from monitor.cli.types import iso_time, longitude, whole
 from monitor.config.assessment import AssessmentConfig
@@ -36,7 +38,7 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     "simulate",
     "write simulated CrIS/VIIRS granules with an injected LOS error",
     arg("--out", required=True, help="output directory"),
-    arg("--satellite", choices=tuple(SATELLITES), default="j01"),
+    arg("--satellite", choices=tuple(SATELLITES), default="j01", help="the satellite simulated (default j01)"),
     arg(
         "--granules",
         type=whole(1),
@@ -171,30 +173,43 @@ def _footprint(names: Sequence[str] | None) -> Response | tuple[Response, ...] |
         nargs="+",
         help="granule files or directories; or the reference implementation's collocation files (.npz)",
     ),
+    arg(
+        "--config",
+        help="assess as the daemon does with this configuration file's assessment section (default: the "
+        "section's defaults); the options below override its keys",
+    ),
     arg("--out", help="write the result JSON here"),
     arg(
         "--steps",
         type=int,
-        default=ASSESSMENT.half_steps,
-        help="perturbation steps each side of zero (grid 2n+1; collocation files carry their own grid)",
+        help=f"perturbation steps each side of zero, assessment.half_steps (default {ASSESSMENT.half_steps}; "
+        "grid 2n+1; collocation files carry their own grid)",
     ),
-    arg("--step-urad", type=float, default=ASSESSMENT.step_urad, help="perturbation step, urad"),
-    KERNEL,
-    COST,
-    WORKERS,
+    arg(
+        "--step-urad",
+        type=float,
+        help=f"perturbation step, urad, assessment.step_urad (default {ASSESSMENT.step_urad:.1f})",
+    ),
+    unset(KERNEL),
+    unset(COST),
+    unset(WORKERS),
 )
 def cmd_assess(args: argparse.Namespace) -> int:
     """crisgeo assess: assess the granules given; print the table, write the JSON."""
     from monitor.assessment.assess import assess_paths
 
+    base = load(args).assessment if args.config else ASSESSMENT
+    given = {
+        "half_steps": args.steps,
+        "step_urad": args.step_urad,
+        "kernel": args.kernel,
+        "cost": args.cost,
+        "workers": args.workers,
+    }
     cfg = options(
         AssessmentConfig,
-        "--steps/--step-urad/--workers",
-        half_steps=args.steps,
-        step_urad=args.step_urad,
-        kernel=args.kernel,
-        cost=args.cost,
-        workers=args.workers,
+        "--steps/--step-urad/--kernel/--cost/--workers",
+        **{**base.model_dump(mode="json"), **{k: v for k, v in given.items() if v is not None}},
     )
     collocations = [p for p in args.paths if p.endswith(".npz")]
     if collocations and len(collocations) != len(args.paths):
@@ -215,7 +230,12 @@ def cmd_assess(args: argparse.Namespace) -> int:
 @command(
     "bench",
     "time each stage on a simulated case; print FOVs/s and peak memory",
-    arg("--granules", type=whole(1), default=PAPER_GRANULES),
+    arg(
+        "--granules",
+        type=whole(1),
+        default=PAPER_GRANULES,
+        help=f"consecutive CrIS granules of the simulated case (default {PAPER_GRANULES})",
+    ),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
     WORKERS,

@@ -260,3 +260,75 @@ def test_reprocess_refuses_bad_input_in_one_line(tmp_path, capsys, extra, messag
     assert main(["reprocess", "--config", str(cfg), *extra]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and message in err[0]
+
+
+REAL = sorted((__import__("pathlib").Path(__file__).parents[1] / "data/real/collocations_j01_20181022").glob("*.npz"))
+
+
+def test_assess_takes_the_configuration_the_daemon_assesses_with(tmp_path, capsys):
+    """``assess --config`` assesses with the file's assessment section; an option overrides its key."""
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
+        "assessment: {cost: stdev, workers: 1}\n"
+    )
+    files = [str(p) for p in REAL[:4]]
+    out = {name: tmp_path / f"{name}.json" for name in ("config", "flag", "default", "override")}
+    assert main(["assess", "--config", str(cfg), *files, "--out", str(out["config"])]) == 0
+    assert main(["assess", "--cost", "stdev", "--workers", "1", *files, "--out", str(out["flag"])]) == 0
+    assert main(["assess", "--workers", "1", *files, "--out", str(out["default"])]) == 0
+    assert main(["assess", "--config", str(cfg), "--cost", "regression", *files, "--out", str(out["override"])]) == 0
+    capsys.readouterr()
+    fors = {k: json.loads(p.read_text())["fors"] for k, p in out.items()}
+    assert fors["config"] == fors["flag"]
+    assert fors["override"] == fors["default"]
+    assert fors["config"] != fors["default"]
+
+
+def _subparsers():
+    import argparse
+
+    from monitor.cli import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return parser, sub
+
+
+def test_every_option_and_argument_has_help():
+    import argparse
+
+    parser, sub = _subparsers()
+    missing = [
+        (name, a.option_strings or a.dest)
+        for name, sp in sub.choices.items()
+        for a in sp._actions
+        if not isinstance(a, argparse._HelpAction) and not a.help
+    ]
+    assert not missing
+
+
+def test_help_lists_the_daily_job_first_and_the_exit_codes():
+    parser, sub = _subparsers()
+    names = list(sub.choices)
+    assert names[:3] == ["run", "daemon", "status"]
+    assert names.index("reprocess") < names.index("assess") < names.index("bench")
+    text = parser.format_help()
+    for code in ("0 success", "2 bad input", "75 another instance", "130 interrupted", "143 terminated"):
+        assert code in text
+
+
+def test_one_option_name_means_one_thing():
+    """An option shared by commands has one meaning: the same destination and the same kind of value (the
+    renamed ones keep their old name hidden, for scripts)."""
+    import argparse
+
+    _, sub = _subparsers()
+    meaning: dict[str, set[str]] = {}
+    for name, sp in sub.choices.items():
+        for a in sp._actions:
+            if a.help == argparse.SUPPRESS:
+                continue
+            for o in a.option_strings:
+                meaning.setdefault(o, set()).add((a.dest, getattr(a.type, "__qualname__", str(a.type))))
+    assert {o: m for o, m in meaning.items() if len(m) > 1 and o not in ("-h", "--help")} == {}

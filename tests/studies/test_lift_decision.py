@@ -30,7 +30,7 @@ def test_a_flat_day_of_sharp_edges_seen_through_a_smooth_footprint_declines_the_
 
 @pytest.mark.parametrize("flag", ["--at-lift", "--at-law"])
 def test_a_second_pass_asks_for_the_offsets(flag, monkeypatch, tmp_path, capsys):
-    from benchmarks import lift_decision
+    from studies import lift_decision
 
     monkeypatch.setattr("sys.argv", ["lift_decision", str(tmp_path), flag])
     with pytest.raises(SystemExit) as exit_:

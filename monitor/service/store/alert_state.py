@@ -85,7 +85,7 @@ class AlertState:
         """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason; a silence
         without a reason or ending before *now* is refused (:class:`SilenceError`)."""
         if not reason.strip():
-            raise SilenceError("alerts silence needs --until and --reason")
+            raise SilenceError("alerts silence needs --expires and --reason")
         if until <= now:
             raise SilenceError("--until must be in the future")
         with self.store.transaction():
