@@ -133,7 +133,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
     arg("--scheduler", help="address of a running Dask scheduler (tcp://HOST:8786); default a local cluster"),
     arg("--processes", type=whole(1), default=2, help="processes of the local Dask cluster (default 2)"),
-    arg("--workers", dest="processes", type=whole(1), help=argparse.SUPPRESS),  # the earlier name, for scripts
+    # the earlier name, kept for scripts
+    arg("--workers", dest="processes", type=whole(1), help=argparse.SUPPRESS),
     arg("--force", action="store_true", help="redo the days already done"),
 )
 def cmd_reprocess(args: argparse.Namespace) -> int:

@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     "simulate",
     "write simulated CrIS/VIIRS granules with an injected LOS error",
     arg("--out", required=True, help="output directory"),
-    arg("--satellite", choices=tuple(SATELLITES), default="j01", help="the satellite simulated (default j01)"),
+    arg("--satellite", choices=tuple(SATELLITES), default="j01", help="the satellite (default j01)"),
     arg(
         "--granules",
         type=whole(1),

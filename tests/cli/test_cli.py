@@ -1,4 +1,5 @@
 import json
+from pathlib import Path
 
 import pytest
 
@@ -262,7 +263,7 @@ def test_reprocess_refuses_bad_input_in_one_line(tmp_path, capsys, extra, messag
     assert len(err) == 1 and message in err[0]
 
 
-REAL = sorted((__import__("pathlib").Path(__file__).parents[1] / "data/real/collocations_j01_20181022").glob("*.npz"))
+REAL = sorted((Path(__file__).parents[1] / "data/real/collocations_j01_20181022").glob("*.npz"))
 
 
 def test_assess_takes_the_configuration_the_daemon_assesses_with(tmp_path, capsys):
@@ -277,7 +278,8 @@ def test_assess_takes_the_configuration_the_daemon_assesses_with(tmp_path, capsy
     assert main(["assess", "--config", str(cfg), *files, "--out", str(out["config"])]) == 0
     assert main(["assess", "--cost", "stdev", "--workers", "1", *files, "--out", str(out["flag"])]) == 0
     assert main(["assess", "--workers", "1", *files, "--out", str(out["default"])]) == 0
-    assert main(["assess", "--config", str(cfg), "--cost", "regression", *files, "--out", str(out["override"])]) == 0
+    override = ["assess", "--config", str(cfg), "--cost", "regression", *files, "--out", str(out["override"])]
+    assert main(override) == 0
     capsys.readouterr()
     fors = {k: json.loads(p.read_text())["fors"] for k, p in out.items()}
     assert fors["config"] == fors["flag"]
@@ -325,7 +327,7 @@ def test_one_option_name_means_one_thing():
 
     _, sub = _subparsers()
     meaning: dict[str, set[str]] = {}
-    for name, sp in sub.choices.items():
+    for sp in sub.choices.values():
         for a in sp._actions:
             if a.help == argparse.SUPPRESS:
                 continue
