@@ -13,7 +13,7 @@ default, fits the response; ``top-hat`` is the paper's cone).
 The reported sigma (derived: :mod:`monitor.estimation.jackknife`, nothing fitted to these cases) against
 the errors: over all cases, the share of FOR-directions whose |error| <= 2 sigma (target >= 90 %) and, per
 case, the median sigma over the RMS error (target <= 1.5).
-CrIS-VIIRS calibration differences (``--mismatch``, issue 27): the CrIS BT departs from VIIRS's by a gain
+CrIS-VIIRS calibration differences (``--mismatch``): the CrIS BT departs from VIIRS's by a gain
 about 280 K, a bias and a curvature (:data:`MISMATCHES`); ``--cost`` picks the cost (assessment.cost). Each
 row also holds the intercalibration recovered per FOR (bias at 280 K, gain), printed against the injected
 values (every reliable FOR within 0.05 K and 0.2 %; the curvature printed).
@@ -49,7 +49,7 @@ from monitor.simulate.case import simulate_case
 from monitor.simulate.scene import EDGES
 from monitor.simulate.sun_synchronous import PASSES
 
-# name: (gain, bias K, curvature K at 250/310 K) of CrIS against VIIRS (SimulationSpec.cris_*): the issue's
+# name: (gain, bias K, curvature K at 250/310 K) of CrIS against VIIRS (SimulationSpec.cris_*): the
 # range, gains -3..+3 %, biases up to 2 K, curvatures up to 0.5 K over 250-310 K
 MISMATCHES = {
     "none": (0.0, 0.0, 0.0),
@@ -59,8 +59,8 @@ MISMATCHES = {
     "bias+2,curve-0.5": (0.0, 2.0, -0.5),
     "gain-1,bias-2": (-0.01, -2.0, 0.0),
 }
-RECOVERY = (0.05, 0.2)  # the intercalibration's bound: bias K, gain per cent (issue 27)
-NO_DIFFERENCE = (0.03, 0.1)  # where none was injected (issue 43)
+RECOVERY = (0.05, 0.2)  # the intercalibration's bound: bias K, gain per cent
+NO_DIFFERENCE = (0.03, 0.1)  # where none was injected
 BOUNDS = {14: (10.0, 25.0)}  # granules: (RMS, worst FOR) urad; smaller cases get SMALL_BOUNDS
 SMALL_BOUNDS = (12.0, 30.0)
 EXTRA_PASSES = {"dateline": ("night", 180.0)}
@@ -222,7 +222,7 @@ def verdict(row: dict) -> tuple[bool, str]:
 
 def rows_read(row: dict) -> str:
     """How the FOV rows' product reads the injected row error (ahead minus behind, in-track; none
-    cross-track): per direction the median error and the share of FORs within 2 sigma (issue 42: >= 90 %,
+    cross-track): per direction the median error and the share of FORs within 2 sigma (>= 90 %,
     median within 40 urad, median sigma <= 60 urad)."""
     if "rows_err_alpha_urad" not in row:
         return ""

@@ -12,7 +12,7 @@ lists); and whether the offsets are the whole-file run's to the bit.
 
 Loopback moves ~250 MB/s, and moto answers each range by reading the whole object (~0.25 s per request
 on a GITCO; S3 answers in tens of ms): so the transfer time is also projected at 100 MB/s and 30 ms per
-request, the issue's figures for NODD.
+request, the figures assumed for NODD.
 
     .venv/bin/python -m benchmarks.nodd_ranges [--granules 1 14] [--layouts contiguous gzip] [--keep DIR]
 """

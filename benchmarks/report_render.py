@@ -5,7 +5,7 @@
     docs/report-demo.png
 
 The first form fills a temporary store with synthetic daily results (monitor.simulate.history) and
-prints the time to build the report; the issue's bound is one minute for 3 years x 3 satellites.
+prints the time to build the report; the bound is one minute for 3 years x 3 satellites.
 The second opens a page in headless Chromium (Debian chromium + chromium-driver) and saves a PNG.
 """
 

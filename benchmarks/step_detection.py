@@ -269,7 +269,7 @@ FDR_CASES = [Case(5.0, "white"), Case(120.0, "white"), Case(120.0, "scale1.3"), 
 
 
 def detect_cases() -> list[Case]:
-    """The issue's detection cases."""
+    """The detection cases: every kind of step the rule must find."""
     out = []
     for d in (0, 1):
         out.append(Case(120.0, "white", 100.0, "all", d))

@@ -13,14 +13,8 @@ How high. A cloud's top is colder than the clear surface around it by about its 
 
 above its GEO point, where T_ref is the neighbourhood's clear-sky reference: the warmest BT within
 +-:data:`REFERENCE_HALF_PX` pixels (~37 km; a 3 x 3 mean first, so that one noisy pixel does not set it).
-The reach is set by the decks, not by the cone: a deck's middle beyond the reach of clear sky is its own
-reference and stands too low. Within +-40 pixels (~15 km, until 2026-11-29) the tops above 6 km of five
-simulated scenes stood 2.1-4.1 km too low at the mean (RMS 3.6-6.0 km), and the outer rows rendered from
-those heights at the law were 0.07-0.48 K off over 7 km discs (0.07-0.23 from the true heights; 0.14-0.35
-with no correction). Within +-100 the tops stand within 0.9 km at the mean (RMS 0.9-3.4 km) and the
-rendering is within 0.02 K of the true heights' on every scene; the price is the ground standing higher,
-0.33-0.73 km at the mean against 0.15-0.46, the warmest land within reach (docs/science.md, "The
-clear-sky reference").
+The reach is set by the decks, not by the cone: a deck's middle beyond the reach of clear sky would be its
+own reference and stand too low (docs/science.md, "Clouds with height").
 kappa (m per K) is not assumed: the assessment collocates at kappa = 0 and at :data:`PROBE_M_PER_K`, and
 chooses the day's kappa from its own cost (:mod:`monitor.estimation.parallax`).
 
@@ -42,10 +36,9 @@ from monitor.collocation.geodesy import ecef_m
 from monitor.core.constants import VIIRS_SCAN_US
 
 REFERENCE_HALF_PX = 100  # +-100 pixels: ~37 km at nadir, the clear sky beside a deck tens of km wide
-# The rendered collocation's lift, above the laws of the days (159-239 m/K: tops at 7.8-5.2 K/km seen in
-# the simulator's band BT, monitor.simulate.case.law_m_per_k): the day's lift is sought on a straight line
-# between no lift and this rendering, which reads short beyond the probe (docs/science.md, "The probe
-# above the laws").
+# The rendered collocation's lift, above the laws of real tops (159-239 m/K for tops at 7.8-5.2 K/km in
+# band BT): the day's lift is sought on a straight line between no lift and this rendering, and a straight
+# line reads a lift beyond its probe short.
 PROBE_M_PER_K = 260.0
 ROTATION_RAD_S = 2.0 * math.pi / (VIIRS_SCAN_US * 1e-6)
 

@@ -1,12 +1,11 @@
 """What a CrIS FOV row sees of a VIIRS granule whose pixels stand at a height: hidden ground out, walls in.
 
-Each pixel stands at the height its BT implies (:mod:`monitor.collocation.lift`). Moving it as a point
-up its VIIRS line of sight to that height (the correction until 2026-11-28) let the cone test look at the
-lifted points from CrIS; from an outer FOV row's slant view that still counts ground a lifted cloud hides,
-and misses the cloud's side (its wall) that the view meets (docs/science.md, "Clouds have height"). This
-module renders instead what the ray of a CrIS FOV row that meets the ground at each pixel's GEO point
-meets first. The cone test then keeps every pixel at its GEO point and gives it that radiance: the rays
-through a ground patch are the rays its solid angle holds.
+Each pixel stands at the height its BT implies (:mod:`monitor.collocation.lift`). From an outer CrIS FOV
+row's slant view (19.1 mrad ahead or behind, Wang et al. 2017 section 2.1) a high cloud hides ground that
+VIIRS saw and shows a side (its wall) that VIIRS did not. This module renders what the ray of a CrIS FOV row
+that meets the ground at each pixel's GEO point meets first (docs/science.md, "Clouds with height"). The
+cone test then keeps every pixel at its GEO point and gives it that radiance: the rays through a ground
+patch are the rays its solid angle holds.
 
 **The geometry.** Along one VIIRS column, x runs along the track on the ground (m) and z up (m). VIIRS saw
 pixel r of the column along the ray x_r + z b_r from its GEO point x_r, and met what it saw at the height
@@ -30,23 +29,14 @@ does (one spacecraft, one scan angle; only the time, and so the in-track tangent
    per K), the temperature of the air at that height.
 
 Pixels hidden behind a higher one drop out (the ray meets the higher first), and the walls the ray meets
-come in. Nothing of the neighbouring columns is looked at: the sweep is one dimension per column. That
-costs cross-track accuracy: one column index of two scans is not one line on the ground (the Earth turns
-1-2 columns under the track between scans, and the bow-tie's smile puts a scan's outer detectors a few
-hundredths of a column further out), so where scans overlap a top's BT comes from a pixel aside
-(docs/science.md, "What a perfect rendering gives").
+come in. Nothing of the neighbouring columns is looked at: the sweep is one dimension per column. One
+column index of two scans is not one line on the ground (the Earth turns 1-2 columns under the track
+between scans, and the bow-tie's smile puts a scan's outer detectors a few hundredths of a column further
+out), so where scans overlap a top's BT comes from a pixel aside: a cross-track error docs/science.md states
+among the known limitations. A granule's first and last rows are rendered without the next granule's pixels.
 
-**Why this sweep, by the numbers** (``python -m studies.render_truth``, the simulator's own ray-traced
-views as the truth, the true heights given; docs/science.md, "The renderer against the simulator's own
-views"). The scale that matters is a CrIS FOV's: the RMS over 400 discs of 7 km of the mean error. On the
-outer rows the linear sweep removes 31-37 % of that error on sharp-edged clouds and 48-60 % on soft ones,
-21-53 % on three more scenes. Three alternatives measured worse: the same sweep with the nearest hit's BT
-on tops (-5 to 27 %; the rows' views differ by 100-250 m, less than a pixel, and a nearest pixel moves an edge
-by a whole pixel or not at all), a two-dimensional march through vertical columns standing at each hit
-(it added as much error as it removed), and the rendered change added to the pixel's own BT
-(BT + S(a) - S(b): the centre view 0.13 K against 0.11). At the centre view (where the parallax is
-small) the sweep adds 0.04-0.12 K against the pixels' own 0.02-0.09, most of it where two scans overlap.
-A granule's first and last rows are rendered without the next granule's pixels.
+A study can put another rendering in this one's place (:class:`Renderer`: the assessment takes it as an
+argument); ``studies/render_truth.py`` measures this one against the simulator's own views.
 """
 
 from __future__ import annotations

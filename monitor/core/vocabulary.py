@@ -132,8 +132,8 @@ class Cost(StrEnum):
     REGRESSION = "regression"  # the residual STDEV of BT_VIIRS - BT_CrIS regressed on BT_CrIS
 
 
-# chosen by measurement (README, issue 27): equal to the paper's where CrIS and VIIRS agree, unmoved where
-# their calibrations differ
+# equal to the paper's where CrIS and VIIRS agree, unmoved where their calibrations differ (docs/science.md,
+# "Cost and minimum")
 DEFAULT_COST = Cost.REGRESSION
 # the default footprint weighting: the response fitted over annuli, which a real CrIS FOV's smooth response
 # cannot bias (docs/science.md, "The CrIS footprint")

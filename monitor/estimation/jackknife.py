@@ -22,7 +22,7 @@ a factor of 1.33 with 6 granules, 1.12 with 14 (the t quantile, not its standard
 finite for every nu >= 1 and is what the 2-sigma statements of the product test).
 
 **Long days.** Each replicate repeats the whole estimate over the samples it keeps, so G replicates of a day
-of G granules cost G^2 granules' worth: ~30 s at 14 granules, ~850 s at 100 (2026-11-26). Beyond
+of G granules cost G^2 granules' worth. Beyond
 :data:`MAX_GROUPS` granules each replicate therefore leaves out a run of consecutive granules
 (:func:`granule_runs`: H = MAX_GROUPS runs, their lengths differing by at most one), the delete-a-group
 jackknife (Kott 2001) with the same formula over H groups and nu = H - 1; its cost is H estimates, linear in

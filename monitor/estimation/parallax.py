@@ -28,24 +28,16 @@ again about the day's f; a run of consecutive granules per replicate on a long d
 what tops falling at the dry adiabat's 9.8 K/km give, 102 m/K: no elevated cloud's window BT falls faster
 with height), and it lowers the day's cost by more than :data:`GAIN_SIGMAS` jackknife sigma of that gain;
 else the day is estimated without it (f = 0) and sigma_f is the f declined. With fewer than 3 granules
-nothing can be judged: no lift. A day whose clouds lie on the ground mostly prefers 0-17 m/K under the
-rendering (a hair of its cost, which would turn its rows apart by up to ~20 urad): the size keeps it at none;
-where it prefers more (79 m/K with a calibration difference), the gain declines it.
-The gain's sigma alone was the rule before (twice it): it declined a 6-granule day with tops at
-7.8 K/km and a 4-granule one at 6.5 K/km whose preferred lifts were within 5 % of their laws (1.9 and
-1.7 sigma), leaving their rows ~200 urad of parallax (docs/science.md, "What the day's cost cannot tell
-apart"). sigma_f reaches every offset through that offset's sensitivity to f, by the delta method:
+nothing can be judged: no lift. The size keeps a flat day's hair of preferred lift at none; the gain
+declines a lift that a calibration difference or a blur of cold scenes prefers without a height behind it.
+sigma_f reaches every offset through that offset's sensitivity to f, by the delta method:
 sigma^2 += (dx/df sigma_f)^2, where dx/df is the central difference over +-:data:`SENSITIVITY_STEP` of
 that scaled cone's minimum (the FOR's, and each FOV row's for the rows' difference). The rows ahead and
 behind move apart by ~230 urad per unit of f, the FOR offsets by far less.
 
-Measured on days made after the rule (docs/science.md, "The lift decision on held-back days" to "The
-clear-sky reference"): declined on 9 of 10 flat days (footprints, profiles, textures, terrain, calibration
-differences), kept on 13 of 14 days with clouds with height at 0.71-0.96 of the law in band BT (within
-20 % on 8 of 13): short on every day, the cost preferring less lift than the law; a flat day whose rows
-are 200 urad apart keeps 60 m/K, and a row error pulls a cloudy day's lift shorter. Most of the shortfall
-is each FOV's one view for all its rays; a view per ray brings the lift to the law with a smooth
-footprint but takes it as a knob for the cone's width ("Each ray's own view").
+
+What the rule achieves on simulated and independent days, and where it falls short (a row error on a
+cloudy day is partly taken for lift): docs/science.md, "Validation" and "Known limitations".
 """
 
 from __future__ import annotations
@@ -95,12 +87,9 @@ def matched_cone(a: ForSamples, b: ForSamples, cost: Cost) -> tuple[ForSamples, 
     (elsewhere the cone's, as they came); kept compact for the day's search (float32 surfaces, no annuli:
     a day of 100 granules holds 30 of them at once).
 
-    The paper's cone wants a lift that is not there where the response is narrower than it: flat-cloud
-    days seen through responses 5 % narrower chose 259 and 191 m/K, which left 26 and 20 urad RMS in-track;
-    through a cone as wide as the response they decline it (5 urad). The response's own weights decline it
-    too, but read the lift of days with high clouds short (90 and 124 m/K against the cone's 151 and 175 at
-    8 and 6.5 K/km) and their rows ahead minus behind 73 and 90 urad short; the scaled cone chose 111 and
-    168 (2026-11-26, 6 granules; docs/science.md, "Responses off the table")."""
+    The cone is scaled because the paper's cone wants a lift that is not there where the response is
+    narrower than it, while the response's own weights read the lift of days with high clouds short
+    (studies/footprint.md)."""
     w = fitted_response(a, cost)
     width = np.nan if w is None else widths_of_weights(a.radii_rad, w)[0.5]
     if np.isfinite(width):

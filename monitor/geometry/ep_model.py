@@ -40,7 +40,7 @@ class EngineeringPacket:
 
     Triples are (roll, pitch, yaw) about (x, y, z); ``ifr_boresight_to_ssmf_rad`` is (yaw, pitch).
     ``sc_to_sbf_rad`` is the instrument mounting on the spacecraft (PCT angles); ``time_stamp_bias_ms``
-    is carried for completeness: IDPS already applies it to ``FORTime`` (docs/jpss-formats.md 2.3, item 7).
+    is carried for completeness: IDPS already applies it to ``FORTime`` (docs/jpss-formats.md 2.3, point 7).
     """
 
     satellite: str

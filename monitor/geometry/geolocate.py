@@ -3,7 +3,7 @@
 The spacecraft-level half of the geolocation, shared by every JPSS instrument: the ephemeris given
 at each scan's MidTime is propagated to each FOR time (two-body + J2), the attitude interpolated,
 the LOS taken through the OCS to ECEF and intersected with the WGS84 ellipsoid. IDPS writes GCRSO
-latitude/longitude on the plain ellipsoid (h = 0, docs/jpss-formats.md 2.3 item 8), so h_m defaults to 0.
+latitude/longitude on the plain ellipsoid (h = 0, docs/jpss-formats.md 2.3, point 8), so h_m defaults to 0.
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ on an ascending pass, by night on a descending one, 60-81 deg N or S; optionally
 180 deg to cross the antimeridian), or by default an ascending tropical pass at a random longitude.
 With terrain, VIIRS GITCO pixels are where each line of sight meets the terrain, with their Height (as
 IDPS writes them), CrIS radiances are averaged over the true FOV on the terrain, and GCRSO stays on
-the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 2.3 item 8).
+the h = 0 ellipsoid with the terrain height only reported (docs/jpss-formats.md 2.3, point 8).
 
 The CrIS FOV sees the scene through the paper's top-hat cone, or through a smooth spatial response, radially
 symmetric or elliptical (``SimulationSpec.cris_response``, :mod:`monitor.instrument.footprint`), one for all
@@ -74,8 +74,7 @@ DEFAULT_START = dt.datetime(2024, 6, 1, 12, 0, 0, tzinfo=UTC)
 CRIS_GRANULE_S = CRIS_GRANULE_US * 1e-6
 VIIRS_GRANULE_S = VIIRS_SCANS * ins.VIIRS_SCAN_S
 # points over the top-hat cone by the clouds' edges (monitor.simulate.scene.EDGES): a sharp edge needs them
-# finer than VIIRS's 375 m pixels; with 512 a flat sharp-edged 6-granule day read 17.2 / 10.4 urad RMS with no
-# lift, with 4096 7.0 / 5.2 (seed 5, zero profile, 2026-11-28)
+# finer than VIIRS's 375 m pixels, or the CrIS truth itself carries the sampling's error
 CONE_SAMPLES = {"soft": 512, "sharp": 4096}
 T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 # the scene's cloud tops within one standard deviation of its cloud-top field (245 +- 18 K) and its sea

@@ -4,7 +4,7 @@ A cloud top emits at the temperature of the air around it, so its height is wher
 temperature profile T(z) reaches the top's temperature. The profile starts from the surface air
 temperature below the cloud, ``T(z) = T_air + (P(z) - P(0))``, and the law is the shape P:
 
-- ``ground``: every cloud lies on the ground (the simulator's cases before issue 42; no parallax);
+- ``ground``: every cloud lies on the ground (no parallax);
 - ``lapse:G``: a linear profile, G K/km (6.5 is the standard atmosphere's);
 - ``tropical``: the tropical standard atmosphere (McClatchey et al. 1972, AFCRL-72-0497, table 1a), whose
   lapse rate runs from 4 K/km near 2 km to 7 K/km aloft: not linear.

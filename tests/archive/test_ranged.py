@@ -219,8 +219,8 @@ with h5py.File(granule.open(), "r") as h5:
 
 def test_a_collection_on_a_thread_the_fetch_waits_for_does_not_hang_the_read(tmp_path):
     """h5py holds its global lock while it reads through the file object; a garbage collection on a thread
-    the fetch waits for that frees an h5py object would wait for it for ever (h5py issue 2019). Run apart,
-    so that a hang fails the test instead of the suite."""
+    the fetch waits for that frees an h5py object would wait for it for ever (a known h5py bug,
+    h5py/h5py#2019). Run apart, so that a hang fails the test instead of the suite."""
     done = subprocess.run(
         [sys.executable, "-c", _GC_IN_A_SERVICE_THREAD, str(tmp_path)],
         capture_output=True,

@@ -1,4 +1,4 @@
-"""The whole loop of section 4: assess -> optimize -> regeolocate -> assess again (issue #6)."""
+"""The whole loop of section 4: assess -> optimize -> regeolocate -> assess again."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""EP identification from the LOS fingerprint (issue #7 item 3) with the EP model."""
+"""EP identification from the LOS fingerprint with the EP model."""
 
 import json
 

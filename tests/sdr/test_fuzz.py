@@ -67,7 +67,7 @@ def _replace(h5, name, data):
         d.attrs[k] = v
 
 
-PHYSICS = {  # what broke through before (issue 24), product by product
+PHYSICS = {  # what once read silently, product by product
     "GCRSO": (
         "MidTime 0",
         "MidTime -1",
@@ -389,7 +389,7 @@ def test_no_mutant_escapes_the_readers_and_few_are_silent(cases, scratch, per_pr
     should = counts["rejected"] + counts["silent"]
     assert sum(counts.values()) == sum(per_product.values())
     assert counts["silent"] <= SILENT_SHARE * should, outcomes["silent"]
-    # every mutation that broke through before issue 24 is refused now
+    # every mutation that once read silently is refused
     physics = [
         m for kind in ("harmless", "silent", "undetectable") for m in outcomes[kind] if m[2] == "physics"
     ]

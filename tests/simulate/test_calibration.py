@@ -1,5 +1,5 @@
 """A simulated CrIS-VIIRS calibration difference: the CrIS BT in the I5 band departs from the agreeing
-instruments' by the bias and gain injected (what the intercalibration of issue 27 must recover)."""
+instruments' by the bias and gain injected (what the intercalibration must recover)."""
 
 import dataclasses
 import datetime as dt
@@ -74,7 +74,7 @@ def _assess(root, name, cost):
 def test_a_calibration_bias_leaves_the_paper_cost_as_it_was(differing):
     """The paper's cost, STDEV(BT_VIIRS - BT_CrIS), does not see a constant: a 2 K bias in every channel
     moves no FOR by more than half its stated sigma (the band BT's shift is not quite constant, Planck
-    weighting over the band: measured up to 1.8 urad for sigmas of ~5). A gain it does see (issue 27)."""
+    weighting over the band: measured up to 1.8 urad for sigmas of ~5). A gain it does see."""
     agree, biased = (_assess(differing, name, Cost.STDEV) for name in ("agree", "biased"))
     for a, b in zip(agree.fors, biased.fors, strict=True):
         if a.reliable:

@@ -1,7 +1,7 @@
 """The lift decision on a flat-cloud day whose texture and footprint differ from the days the rule was
-chosen on: it declines the lift, so the day's offsets are those of ``parallax=False`` (issue 57 item 2).
+chosen on: it declines the lift, so the day's offsets are those of ``parallax=False``.
 Slow (~2 min: a sharp-edged day samples each CrIS cone at 4096 points); the held-back grid is
-docs/science.md "The lift decision on held-back days"."""
+studies/clouds-with-height.md "The lift decision on held-back days"."""
 
 import numpy as np
 import pytest
