@@ -21,6 +21,7 @@ from monitor.cli.registry import (
     satellites_of,
 )
 from monitor.cli.types import iso_day, nagios_range, whole
+from monitor.core.constants import SPEC_KM
 from monitor.core.satellites import SATELLITES
 
 
@@ -29,13 +30,19 @@ from monitor.core.satellites import SATELLITES
     "copy the shipped configs, Grafana and Prometheus files, EP files, the unit and docs into a directory",
     arg("dest", type=Path, help="target directory, e.g. /opt/crisgeo/share"),
     arg("--force", action="store_true", help="replace files that exist"),
+    arg(
+        "--config",
+        help="configuration file whose alerts.spec_km the Grafana dashboards' thresholds are written at "
+        "(default: the default specification)",
+    ),
 )
 def cmd_install_files(args: argparse.Namespace) -> int:
     """crisgeo install-files: copy the shipped files out."""
     from monitor.service.install import install_files, kept_files
 
+    spec_km = load(args).alerts.spec_km if args.config else SPEC_KM
     kept = [] if args.force else kept_files(args.dest)
-    for path in install_files(args.dest, args.force):
+    for path in install_files(args.dest, args.force, spec_km):
         print(f"wrote {path}")
     for path in kept:
         print(f"kept  {path} (exists; --force replaces it)")

@@ -39,7 +39,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     """crisgeo export: the results, or what each known change did, as NetCDF or CSV."""
     from alerts.effects import change_effects
     from monitor.history.changes import all_changes
-    from monitor.service.outputs.export import export, export_effects
+    from monitor.service.outputs.export import Method, export, export_effects
 
     cfg = load(args)
     sats = satellites_of(cfg, args.satellite)
@@ -60,7 +60,9 @@ def cmd_export(args: argparse.Namespace) -> int:
                 ]
                 path = export_effects(effects, sats[0], args.out, args.format, cfg.export)
             else:
-                path = export(store, sats[0], args.out, args.format, args.since, args.until, cfg.export)
+                path = export(
+                    store, sats[0], args.out, args.format, args.since, args.until, cfg.export, Method.of(cfg)
+                )
         except ImportError as exc:
             raise BadInput(
                 f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"

@@ -9,11 +9,17 @@ place in an installation; ``crisgeo install-files DEST`` copies them out.
 
 from __future__ import annotations
 
+import json
 import shutil
 from collections.abc import Iterator
 from importlib.abc import Traversable
 from importlib.resources import as_file, files
 from pathlib import Path
+
+from monitor.core.constants import SPEC_KM
+from monitor.service.outputs.dashboards import with_specification
+
+DASHBOARDS = ("configs", "grafana")  # the folder of the Grafana dashboards, rendered at the specification
 
 
 def shipped_root() -> Traversable:
@@ -31,10 +37,25 @@ def _walk(node: Traversable, rel: tuple[str, ...] = ()) -> Iterator[tuple[tuple[
             yield rel + (child.name,), child
 
 
-def install_files(dest: str | Path, force: bool = False) -> list[Path]:
-    """Copy every shipped file under *dest* (same tree: configs/, systemd/, docs/, README.md). An existing
-    file is left alone unless *force* (it may be an operator's edited configuration); returns the files
-    written."""
+def install_files(dest: str | Path, force: bool = False, spec_km: float = SPEC_KM) -> list[Path]:
+    """Copy every shipped file under *dest* (same tree: configs/, systemd/, docs/, README.md).
+
+    Parameters
+    ----------
+    dest : str or Path
+        The directory to copy into.
+    force : bool, optional
+        Replace files that exist; else an existing file is left alone (it may be an operator's edited
+        configuration).
+    spec_km : float, optional
+        The specification (km, ``alerts.spec_km``) the Grafana dashboards' thresholds are written at
+        (:func:`monitor.service.outputs.dashboards.with_specification`).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     dest = Path(dest)
     written = []
     for rel, node in _walk(shipped_root()):
@@ -42,8 +63,13 @@ def install_files(dest: str | Path, force: bool = False) -> list[Path]:
         if target.exists() and not force:
             continue
         target.parent.mkdir(parents=True, exist_ok=True)
-        with as_file(node) as src:
-            shutil.copyfile(src, target)
+        dashboard = rel[:-1] == DASHBOARDS and rel[-1].endswith(".json")
+        shipped = json.loads(node.read_text()) if dashboard else None
+        if shipped is not None and with_specification(shipped, spec_km) != shipped:
+            target.write_text(json.dumps(with_specification(shipped, spec_km), indent=1) + "\n")
+        else:  # as shipped, byte for byte
+            with as_file(node) as src:
+                shutil.copyfile(src, target)
         written.append(target)
     return written
 

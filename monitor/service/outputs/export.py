@@ -23,13 +23,15 @@ if TYPE_CHECKING:
 
 import datetime as dt
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from alerts.effects import ChangeEffect
+from monitor.config.model import Config
 from monitor.config.outputs import ExportConfig
-from monitor.core.constants import N_FOR
+from monitor.core.constants import DEFAULT_HALF_STEPS, N_FOR, SPEC_KM
 from monitor.core.result import RELIABILITY_FLAGS, ForOffset, measures
 from monitor.core.satellites import satellite as satellite_info
 from monitor.history.records import History
@@ -71,6 +73,33 @@ class ResultStore:
         self.close()
 
 
+@dataclass(frozen=True)
+class Method:
+    """What the export's metadata says of how the results were made, from the configuration.
+
+    Parameters
+    ----------
+    half_steps : int
+        Perturbations on each side of zero per direction (``assessment.half_steps``).
+    spec_km : float
+        The specification of the geolocation error on the ground, km (``alerts.spec_km``).
+    """
+
+    half_steps: int = DEFAULT_HALF_STEPS
+    spec_km: float = SPEC_KM
+
+    @classmethod
+    def of(cls, cfg: Config) -> Method:
+        """The grid and specification of the configuration *cfg*."""
+        return cls(cfg.assessment.half_steps, cfg.alerts.spec_km)
+
+    @property
+    def grid(self) -> str:
+        """The perturbation grid, ``21 x 21`` at the defaults."""
+        n = 2 * self.half_steps + 1
+        return f"{n} x {n}"
+
+
 def to_xarray(
     store: History,
     satellite: str,
@@ -78,12 +107,35 @@ def to_xarray(
     until: dt.date | None = None,
     publisher: ExportConfig | None = None,
     record: type = ForOffset,
+    method: Method | None = None,
 ) -> xr.Dataset:
     """The per-FOR results of *satellite* between *since* and *until* (inclusive) as an xarray Dataset, a
-    variable per measured field of *record* with the unit and meaning it declares; *publisher*, the
-    ``export`` section of the configuration, fills the ACDD publisher attributes."""
+    variable per measured field of *record* with the unit and meaning it declares.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name (``j01``).
+    since, until : datetime.date, optional
+        The first and last day (inclusive); None for the store's first or last.
+    publisher : ExportConfig, optional
+        The ``export`` section of the configuration: the ACDD publisher attributes.
+    record : type, optional
+        The per-FOR record whose measured fields become variables.
+    method : Method, optional
+        The configured grid and specification the metadata states (:meth:`Method.of`); the defaults when
+        None.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``time`` x ``scan_position``, CF-1.8 and ACDD-1.3 attributes.
+    """
     import xarray as xr
 
+    method = method or Method()
     series = store.series(satellite, since, until)
     bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int8])
     flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
@@ -137,14 +189,14 @@ def to_xarray(
             f"CrIS geolocation assessed against VIIRS I5, {satellite_info(satellite).name}",
             "Daily per-field-of-regard offsets of the CrIS line of sight (in-track alpha, cross-track beta, "
             "urad) and the geolocation errors on the ground (km), found by perturbing the CrIS line of sight "
-            "21 x 21 times per FOV, collocating VIIRS I5 pixels in each perturbed footprint and minimising "
-            "a cost of the CrIS minus VIIRS brightness temperature differences.",
+            f"{method.grid} times per FOV, collocating VIIRS I5 pixels in each perturbed footprint and "
+            "minimising a cost of the CrIS minus VIIRS brightness temperature differences.",
             f"from {store.path.name}",
         ),
         comment=(
             "One value per assessed UTC day and CrIS scan position; flags set mark values not to be trusted "
-            "(few samples, grid edge, flat cost, uncertain). The specification is 1.5 km in-track and "
-            "cross-track, each."
+            f"(few samples, grid edge, flat cost, uncertain). The specification is {method.spec_km:g} km "
+            "in-track and cross-track, each."
         ),
         acknowledgement=(
             "CrIS and VIIRS SDR and GEO granules of NOAA's JPSS, from the NOAA Open Data Dissemination "
@@ -314,13 +366,14 @@ def export(
     since: dt.date | None = None,
     until: dt.date | None = None,
     publisher: ExportConfig | None = None,
+    method: Method | None = None,
 ) -> Path:
     """Write the results of *satellite* to *out* as ``netcdf`` or ``csv`` (*fmt*; None: from the suffix of
     *out*, :data:`FORMATS`); returns the path. :class:`NothingToExport` (and no file) when the period holds
     no results, :class:`ExportFormatError` when the format and the file's name disagree; :class:`OSError`
     when *out* cannot be written."""
     out, fmt = _target(out, fmt)
-    ds = to_xarray(store, satellite, since, until, publisher)
+    ds = to_xarray(store, satellite, since, until, publisher, method=method)
     if ds.sizes["time"] == 0:
         period = f"{since or 'the beginning'} .. {until or 'the end'}"
         raise NothingToExport(f"no results of {satellite} in {period}: nothing written")
@@ -333,6 +386,7 @@ def export_effects(
     out: str | Path,
     fmt: str | None = None,
     publisher: ExportConfig | None = None,
+    method: Method | None = None,
 ) -> Path:
     """Write what each known change did (*effects*, :func:`alerts.effects.change_effects`) to *out* as
     ``netcdf`` or ``csv`` (:func:`effects_to_xarray`; CSV: a row per change and FOR); the errors of

@@ -259,3 +259,23 @@ def test_what_each_change_did_exports_as_cf_netcdf_and_csv(store_with_days, tmp_
     lines = csv.read_text().splitlines()
     assert len(lines) == 31 and lines[0].startswith("change,scan_position,")
     assert main(["export", "--changes", "--config", str(cfg), "--until", "2025-03-06", "--out", str(nc)]) == 2
+
+
+def test_the_metadata_states_the_configured_grid_and_specification(store_with_days, tmp_path):
+    from monitor.cli import main
+
+    cfg, _ = store_with_days
+    cfg.write_text(cfg.read_text() + "assessment: {half_steps: 8}\nalerts: {spec_km: 2.0}\n")
+    out = tmp_path / "j01.nc"
+    assert main(["export", "--config", str(cfg), "--satellite", "j01", "--out", str(out)]) == 0
+    ds = xr.open_dataset(out, engine="h5netcdf")
+    assert "17 x 17 times per FOV" in ds.attrs["summary"] and "21 x 21" not in ds.attrs["summary"]
+    assert "The specification is 2 km" in ds.attrs["comment"]
+
+
+def test_the_defaults_state_the_default_grid_and_specification(store_with_days):
+    from monitor.service.outputs.export import to_xarray
+
+    _, store = store_with_days
+    ds = to_xarray(store, "j01")
+    assert "21 x 21 times per FOV" in ds.attrs["summary"] and "is 1.5 km" in ds.attrs["comment"]
