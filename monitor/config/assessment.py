@@ -15,6 +15,7 @@ from monitor.core.constants import (
     DEFAULT_HALF_STEPS,
     DEFAULT_STEP_URAD,
     MAX_GRID_SPREAD_RAD,
+    PAPER_GRANULES,
     PROCESSING_CHANGE_URAD,
     URAD,
 )
@@ -33,7 +34,7 @@ class SceneConfig(Section):
         40, "CrIS granules of the day scored for inhomogeneity (spread over the day).", 1, 3000
     )
     keep: int = key(
-        14,
+        PAPER_GRANULES,
         "Granules of the first batch, the most informative per byte first, and the fewest of any later "
         "one; without target_sigma_urad the day's only batch (the paper uses 14).",
         1,

@@ -15,6 +15,8 @@ from monitor.core.constants import (
     CALIBRATION_BIN_K,
     CALIBRATION_CURVATURE_SPAN_K,
     CALIBRATION_REFERENCE_K,
+    DEFAULT_HALF_STEPS,
+    DEFAULT_STEP_URAD,
     N_FOR,
 )
 from monitor.core.result import FLAG_FLAT, AssessmentResult, DifferenceBin
@@ -62,7 +64,7 @@ def day_result(
         )
     cube = None
     if with_cube:
-        off = (np.arange(21) - 10) * 450.0
+        off = (np.arange(2 * DEFAULT_HALF_STEPS + 1) - DEFAULT_HALF_STEPS) * DEFAULT_STEP_URAD
         cube = 0.8 + 1e-7 * (
             (off[:, None] - d_alpha[:, None, None]) ** 2 + (off[None, :] - d_beta[:, None, None]) ** 2
         )

@@ -113,7 +113,8 @@ def test_sigint_while_simulating_stops_within_a_step_and_leaves_no_half_day(tmp_
             CRISGEO + ["run", "--config", str(cfg), "--date", DAY], stdout=fh, stderr=fh, cwd=ROOT
         )
     assert wait_for(lambda: "simulating 3 CrIS granules" in log.read_text(), 60), log.read_text()
-    time.sleep(2)  # into the simulation
+    # into the simulation: its first granule written
+    assert wait_for(lambda: any((tmp_path / "state").rglob("*.h5")), 60), log.read_text()
     t0 = time.time()
     p.send_signal(signal.SIGINT)
     p.wait(timeout=60)
