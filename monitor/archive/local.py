@@ -14,7 +14,7 @@ from monitor.archive import ListedFile, listed, on_day
 from monitor.config.source import CalibrationDifference, SourceConfig
 from monitor.sdr.products import CRIS_PRODUCTS
 
-LOG = logging.getLogger("monitor.sources.local")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 IN_USE_S = 600.0  # a simulated day listed this recently may still be read by a run
 
 

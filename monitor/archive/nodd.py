@@ -49,7 +49,7 @@ from monitor.core.vocabulary import ReadMode
 from monitor.sdr.granules import GranuleRef
 from monitor.sdr.products import CRIS_PRODUCTS, PRODUCTS
 
-LOG = logging.getLogger("monitor.sources.nodd")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 S3_NS = "{http://s3.amazonaws.com/doc/2006-03-01/}"
 MAX_LISTING_PAGE_BYTES = 8 << 20  # a page of 1000 keys is ~0.3 MB
 RETRYABLE = (429, 500, 502, 503, 504)

@@ -54,7 +54,7 @@ from monitor.sdr import (
 )
 from monitor.sdr.pairing import CasePlan, GranuleFiles, plan
 
-LOG = logging.getLogger("monitor.assess")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 
 
 StopCheck = Callable[[], bool] | None  # polled; True: stop

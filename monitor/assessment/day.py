@@ -34,7 +34,7 @@ from monitor.sdr.engpkt import load_library
 from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
 from monitor.sdr.products import CRIS_GEO
 
-LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 
 # what assesses a day's fetched granules batch by batch, from (satellite, config, workers): the assessment,
 # or a test's stand-in

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.collocation import collocate, render, swath
+from monitor.collocation import collocate, reach, render, swath
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import Kernel
 from monitor.geometry.inverse import FovGeometry, granule_geometry
@@ -129,7 +129,7 @@ def read_viirs(v: GranuleFiles, viirs_all: list[GranuleFiles], span_us: Span | N
     scans = slice(None)
     if span_us is not None:
         start_us = read_scan_start_us(v.geo)
-        first, stop, _ = swath.scans_between(start_us, *span_us).indices(len(start_us))
+        first, stop, _ = reach.scans_between(start_us, *span_us).indices(len(start_us))
         scans = slice(max(first - 1, 0), min(stop + 1, len(start_us)))
     before, after = neighbours(viirs_all, v)
     geo = read_file(v.geo, kinds=("viirs_geo",), scans=scans)[0]
@@ -234,7 +234,7 @@ def piece(
     if cache.lift_m_per_k:
         with stage(timings, "parallax"):
             # what the piece keeps, and a scan either side: a ray's stretches lie within ~1 km of its foot
-            scans, columns = swath.kept_pixels(
+            scans, columns = reach.kept_pixels(
                 geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m, reach_rad,
                 geo.start_time_us, run_span,
             )  # fmt: skip

@@ -29,7 +29,7 @@ from monitor.sdr import GranuleError, read_file
 from monitor.sdr.pairing import GranuleFiles, granule_files
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
 
-LOG = logging.getLogger("monitor.scenes")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 COVER_MARGIN = dt.timedelta(seconds=10)
 
 

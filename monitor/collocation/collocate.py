@@ -97,7 +97,7 @@ def view_reach_rad(
     radii_rad: tuple[float, ...] = TOP_HAT,
 ) -> float:
     """The farthest angle from the geocentric nadir (rad) that a perturbed cone of these FOVs reaches,
-    plus VIEW_MARGIN_RAD: the VIIRS columns beyond it need no preparation (:func:`swath.view_columns`).
+    plus VIEW_MARGIN_RAD: the VIIRS columns beyond it need no preparation (:func:`reach.view_columns`).
     NaN FOVs are ignored; pi when there is none."""
     los = los_ecef(sbf_to_ecef, alpha_rad, beta_rad)
     nadir = -np.asarray(sat_m, float) / np.linalg.norm(sat_m, axis=-1, keepdims=True)

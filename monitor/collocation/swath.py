@@ -18,9 +18,9 @@ Search blocks. Each prepared granule keeps, per 4 x 4 block of pixels (blocks ne
 a sphere holding its usable pixels, and a KD-tree of the block centres to find where a FOV lands.
 
 Columns and scans. VIIRS scans to 56 deg from nadir, CrIS's cones reach ~51 deg: the columns no cone can
-reach (~15 % of a granule) are not prepared when the caller gives the reach (:func:`view_columns`). Nor
+reach (~15 % of a granule) are not prepared when the caller gives the reach (:func:`reach.view_columns`). Nor
 are the scans observed long before or after every CrIS granule that uses the VIIRS granule, when the
-caller gives that time span (:func:`scans_between`): a CrIS granule (32 s) needs a third of one VIIRS
+caller gives that time span (:func:`reach.scans_between`): a CrIS granule (32 s) needs a third of one VIIRS
 granule (86 s), or parts of two.
 
 A granule is prepared once per run (about 10 million pixels): the per-pixel work is compiled (numba) and
@@ -42,11 +42,9 @@ from scipy.ndimage import minimum_filter1d
 from scipy.spatial import cKDTree
 
 from monitor.collocation.geodesy import ecef_m
+from monitor.collocation.reach import BLOCK_PX, kept_pixels
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
-from monitor.geometry import wgs84
-
-BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of VIIRS_DETECTORS)
 
 
 class BandTable(Protocol):
@@ -426,64 +424,6 @@ def _fill_nan(a: ArrayLike) -> np.ndarray:
     return np.interp(np.arange(len(a)), np.nonzero(ok)[0], a[ok]) if not ok.all() else a
 
 
-def view_columns(
-    lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray, sat_m: np.ndarray, view_rad: float
-) -> slice:
-    """The columns holding every pixel seen within *view_rad* of nadir, judged on the middle detector row
-    of every fourth scan and the last from that scan's spacecraft position *sat_m* (nscan, 3; ECEF m; NaN
-    ignored): a column's view angle changes little from scan to scan.
-
-    The angle is from the geocentric nadir; all columns when no pixel qualifies (nothing to judge by). The
-    slice starts on a block boundary, so that the search blocks, and the order in which the cone sums add
-    pixels, are those of the whole granule.
-    """
-    scans = np.unique(np.r_[np.arange(0, len(sat_m), 4), len(sat_m) - 1])
-    sat = np.asarray(sat_m, float)[scans]
-    mid = scans * VIIRS_DETECTORS + VIIRS_DETECTORS // 2
-    los = wgs84.geodetic_to_ecef(lat_rad[mid], lon_rad[mid], height_m[mid]) - sat[:, None, :]
-    nadir = -sat / np.linalg.norm(sat, axis=-1, keepdims=True)
-    with np.errstate(invalid="ignore"):
-        seen = np.sum(los * nadir[:, None, :], -1) >= np.cos(view_rad) * np.linalg.norm(los, axis=-1)
-    cols = np.flatnonzero(seen.any(axis=0))
-    return slice(int(cols[0]) // BLOCK_PX * BLOCK_PX, int(cols[-1]) + 1) if cols.size else slice(None)
-
-
-def scans_between(scan_start_us: ArrayLike, t0_us: float, t1_us: float) -> slice:
-    """The scans observed between IET t0_us and t1_us, from the scans' start times *scan_start_us* (IET
-    us; a scan lasts until the next starts, the last to the granule's end): all scans when those times are
-    not all set and increasing (nothing to judge by)."""
-    t = np.asarray(scan_start_us, np.int64)
-    if t.size == 0 or t[0] <= 0 or np.any(np.diff(t) <= 0):
-        return slice(None)
-    first = max(int(np.searchsorted(t, t0_us, side="right")) - 1, 0)
-    stop = int(np.searchsorted(t, t1_us, side="right"))
-    return slice(first, max(stop, first + 1))
-
-
-def kept_pixels(
-    lat_rad: np.ndarray,
-    lon_rad: np.ndarray,
-    height_m: np.ndarray,
-    sat_m: np.ndarray | None = None,
-    view_rad: float = math.inf,
-    scan_start_us: np.ndarray | None = None,
-    span_us: tuple[float, float] | None = None,
-) -> tuple[slice, slice]:
-    """The scans and the columns of a granule (rows of 32-detector scans) that :func:`swath_piece` keeps
-    (its arguments of those names): the scans observed within *span_us* (:func:`scans_between`), and the
-    columns seen within *view_rad* of nadir on those scans (:func:`view_columns`); all of either where there
-    is nothing to judge it by."""
-    scans = slice(None)
-    if scan_start_us is not None and span_us is not None:
-        scans = scans_between(scan_start_us, *span_us)
-    columns = slice(None)
-    if sat_m is not None and view_rad < math.pi / 2:
-        first, stop, _ = scans.indices(np.shape(lat_rad)[0] // VIIRS_DETECTORS)
-        r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
-        columns = view_columns(lat_rad[r], lon_rad[r], height_m[r], np.asarray(sat_m)[first:stop], view_rad)
-    return scans, columns
-
-
 def swath_piece(
     lat_rad: np.ndarray,
     lon_rad: np.ndarray,
@@ -508,9 +448,9 @@ def swath_piece(
     *before* and *after* are optional (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent
     scan, so that the scan overlap at the granule's first and last scan is counted as inside a continuous
     swath. Given *sat_m*, the spacecraft position of each scan (ECEF m), only the columns seen within
-    *view_rad* of nadir are prepared (:func:`view_columns`); given *span_us* (t0, t1) and the start time
+    *view_rad* of nadir are prepared (:func:`reach.view_columns`); given *span_us* (t0, t1) and the start time
     of each scan *scan_start_us* (IET us), only the scans observed between t0 and t1
-    (:func:`scans_between`), each with the same weights as in the whole granule (the scans next to those
+    (:func:`reach.scans_between`), each with the same weights as in the whole granule (the scans next to those
     kept are their halos).
     *seen_bt_k* (views, rows, cols), when given, is the BT a CrIS ray at each in-track SBF angle of
     *view_alpha_rad* (views,) sees along its way to each GEO point (clouds with height:

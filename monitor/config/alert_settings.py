@@ -18,7 +18,7 @@ from pydantic import (
 from monitor.config.keys import Address, EnvName, FilePath, KeyProblem, Section, Text, Url, key
 from monitor.core.constants import REFERENCE_ALTITUDE_M, SPEC_KM, URAD
 
-LOG = logging.getLogger("monitor.config")
+LOG = logging.getLogger(__name__)
 # the earlier jump rule's keys: what became of each
 RETIRED = {
     "min_jump_km": "read as practical_step_urad",

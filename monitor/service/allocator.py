@@ -17,7 +17,7 @@ import ctypes.util
 import logging
 from functools import lru_cache
 
-LOG = logging.getLogger("monitor.allocator")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 
 _M_TRIM_THRESHOLD = -1  # mallopt parameters (malloc.h)
 _M_MMAP_MAX = -4

@@ -44,7 +44,7 @@ from monitor.service.pipeline import RunOutcome, days_to_run, run_day
 from monitor.service.store.sqlite import Store
 from monitor.version import __version__
 
-LOG = logging.getLogger("monitor.service")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
 HEARTBEAT_S = 30.0  # the scheduler's heartbeat job runs this often
 STALL_S = 300.0  # ... and the scheduler counts as stalled when it has not run for this long

@@ -27,7 +27,7 @@ from typing import Any, Protocol
 from prometheus_client import CollectorRegistry
 from prometheus_client.exposition import choose_encoder
 
-LOG = logging.getLogger("monitor.endpoint")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 INDEX = (
     b"crisgeo-monitor\n"
     b"  /metrics   Prometheus metrics\n"

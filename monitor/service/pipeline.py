@@ -35,7 +35,7 @@ from monitor.service.outputs.timeseries import change_lines, day_lines, drain_ou
 from monitor.service.store.sqlite import Store
 from monitor.service.timetable import catch_up, no_data_horizon
 
-LOG = logging.getLogger("monitor.pipeline")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 
 
 @dataclass

@@ -32,7 +32,7 @@ from monitor.service.timetable import no_data_horizon
 if TYPE_CHECKING:
     from distributed import Client, LocalCluster
 
-LOG = logging.getLogger("monitor.reprocess")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 
 
 def day_task(cfg: Config, satellite: str, day: dt.date) -> DayWork:

@@ -62,7 +62,7 @@ def test_the_simulated_source_keeps_only_its_newest_days(tmp_path, monkeypatch):
     other = SimulatedSource(tmp_path / "own", SourceConfig(kind="simulated", retention_days=1))
     other.list_day("j01", dt.date(2024, 6, 2), ("GCRSO",))  # another run reads it now
     day2 = tmp_path / "own" / "j01" / "2024-06-02"
-    seen = day2.stat().st_mtime_ns + 10**9  # and its listing is later than this source's own, whatever the clock
+    seen = day2.stat().st_mtime_ns + 10**9  # its listing later than this source's own, whatever the clock
     os.utime(day2, ns=(seen, seen))
     mine.list_day("j01", dt.date(2024, 6, 3), ("GCRSO",))
     assert sorted(d.name for d in (tmp_path / "own" / "j01").iterdir()) == ["2024-06-02", "2024-06-03"]

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from monitor.assessment.inputs import SwathCache, offsets_rad, piece, reach_us
-from monitor.collocation import collocate, swath
+from monitor.collocation import collocate, reach, swath
 from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_DETECTORS
@@ -57,13 +57,13 @@ def test_view_columns_keep_every_pixel_seen_within_the_angle(granule):
     nscan = geo.lat_rad.shape[0] // VIIRS_DETECTORS
     rows = np.arange(nscan) * VIIRS_DETECTORS + VIIRS_DETECTORS // 2
     view = _view_deg(geo, rows)
-    kept = swath.view_columns(geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m, math.radians(40.0))
+    kept = reach.view_columns(geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m, math.radians(40.0))
     inside = np.zeros(view.shape[1], bool)
     inside[kept] = True
     assert 0 < kept.start and kept.stop < view.shape[1]  # some columns left out on both sides
     assert np.all(inside[np.nonzero(view < 39.9)[1]])  # every pixel well within the angle is kept
     assert np.nanmin(view[:, ~inside]) > 39.9  # and what is left out is beyond it
-    assert swath.view_columns(
+    assert reach.view_columns(
         geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m * np.nan, 0.7
     ) == slice(None)  # nothing to judge by: every column
 
@@ -90,18 +90,6 @@ def test_columns_no_cone_reaches_change_no_cone_sum(case_plan):
     np.testing.assert_array_equal(a.sums, b.sums)
     np.testing.assert_array_equal(a.weights, b.weights)
     assert np.isfinite(a.mean()).mean() > 0.9
-
-
-def test_scans_between_picks_the_scans_observed_in_a_span():
-    start = 1_000_000 + 1_786_000 * np.arange(10)  # IET us, one scan every 1.786 s
-    assert swath.scans_between(start, start[2] + 5, start[5]) == slice(2, 6)
-    assert swath.scans_between(start, start[2], start[5] - 1) == slice(2, 5)
-    assert swath.scans_between(start, 0, start[-1] + 10**9) == slice(0, 10)  # beyond both ends: all
-    assert swath.scans_between(start, 0, 1) == slice(0, 1)  # before the granule: its first scan at least
-    unusable = start.copy()
-    unusable[4] = -993  # a fill time: nothing to judge by
-    assert swath.scans_between(unusable, start[2], start[5]) == slice(None)
-    assert swath.scans_between(start[::-1], start[2], start[5]) == slice(None)
 
 
 def test_scans_no_cone_reaches_change_no_cone_sum(case_plan):

@@ -38,7 +38,7 @@ from monitor.history.changes import Change
 from monitor.service.store.outbox import QueuedLines
 from monitor.service.store.sqlite import Store
 
-LOG = logging.getLogger("monitor.store.timeseries")  # the name journal filters know, kept
+LOG = logging.getLogger(__name__)
 
 
 class PublishError(RuntimeError):
