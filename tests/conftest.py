@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import fcntl
 import json
+import logging
 import os
 import pickle
 from pathlib import Path
@@ -19,6 +20,23 @@ from monitor.simulate.case import simulate_case
 
 REAL_DIR = Path(__file__).parent / "data" / "real"
 EP_CONFIGS = Path(__file__).resolve().parent.parent / "configs" / "ep"
+
+
+@pytest.fixture(autouse=True)
+def _root_logging_restored():
+    """A command run in a test (``main``: :func:`monitor.service.logs.setup`) points the root logger at the
+    test's captured stderr; a server thread that logs after the test (aiosmtpd's ``mail.log`` as it stops)
+    would then write to a closed stream. The root logger's handlers and level are put back after each
+    test."""
+    root = logging.getLogger()
+    handlers, level = list(root.handlers), root.level
+    yield
+    for h in [h for h in root.handlers if h not in handlers]:
+        root.removeHandler(h)
+    for h in handlers:
+        if h not in root.handlers:
+            root.addHandler(h)
+    root.setLevel(level)
 
 
 @pytest.fixture(scope="session")
