@@ -66,23 +66,64 @@ SCAN_TIME_MARGIN_US = 16_000_000
 
 
 def reach_rad(offsets_rad: np.ndarray, radii_rad: tuple[float, ...] = TOP_HAT) -> float:
-    """The angle (rad) from a FOV's LOS within which one of its perturbed discs (*offsets_rad*, the
-    perturbation grid; *radii_rad*, the discs' half-angles) can hold a pixel."""
+    """The angle from a FOV's LOS within which one of its perturbed discs can hold a pixel.
+
+    Parameters
+    ----------
+    offsets_rad : numpy.ndarray
+        The perturbation grid (2n+1,), rad.
+    radii_rad : tuple of float
+        The discs' half-angles, rad, increasing.
+
+    Returns
+    -------
+    float
+        The angle, rad.
+    """
     return max(radii_rad) + float(np.abs(offsets_rad).max()) * math.sqrt(2.0) * 1.02
 
 
 def box_half_widths_rad(
     beta_rad: np.ndarray | float, offsets_rad: np.ndarray, radii_rad: tuple[float, ...] = TOP_HAT
 ) -> tuple[np.ndarray | float, float]:
-    """Half-widths (rad) in alpha and beta of the box about a FOV's (alpha, beta) that holds the union of its
-    perturbed discs: the grid's reach plus the largest disc (2 % wider; in alpha over cos beta, the SBF
-    alpha of a fixed angle growing with the cross-track angle)."""
+    """The half-widths in alpha and beta of the box about a FOV's LOS that holds all its perturbed discs.
+
+    The grid's reach plus the largest disc, 2 % wider; in alpha over cos beta, the SBF alpha of a fixed angle
+    growing with the cross-track angle.
+
+    Parameters
+    ----------
+    beta_rad : numpy.ndarray or float
+        The FOV's cross-track angle, rad.
+    offsets_rad : numpy.ndarray
+        The perturbation grid (2n+1,), rad.
+    radii_rad : tuple of float
+        The discs' half-angles, rad, increasing.
+
+    Returns
+    -------
+    alpha_half_rad, beta_half_rad : numpy.ndarray or float
+        The half-widths, rad.
+    """
     big, h_max = float(np.abs(offsets_rad).max()), max(radii_rad)
     return big + 1.02 * h_max / np.cos(beta_rad), big + 1.02 * h_max
 
 
 def los_ecef(sbf_to_ecef: np.ndarray, alpha_rad: np.ndarray, beta_rad: np.ndarray) -> np.ndarray:
-    """Unit LOS (F, 3) in ECEF of FOVs at SBF angles alpha_rad, beta_rad (F,) (equations 1-2)."""
+    """The unit LOS in ECEF of FOVs at spacecraft-body-frame angles (equations 1-2).
+
+    Parameters
+    ----------
+    sbf_to_ecef : numpy.ndarray
+        Each FOV's rotation from the spacecraft body frame to ECEF, shape (F, 3, 3).
+    alpha_rad, beta_rad : numpy.ndarray
+        Each FOV's in-track and cross-track LOS angles in the spacecraft body frame, rad, shape (F,).
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, ECEF, shape (F, 3).
+    """
     t = np.stack([np.tan(alpha_rad), np.tan(beta_rad), np.ones(np.shape(alpha_rad))], -1)
     los = np.einsum("fij,fj->fi", sbf_to_ecef, t)
     return los / np.linalg.norm(los, axis=-1, keepdims=True)
@@ -96,9 +137,29 @@ def view_reach_rad(
     offsets_rad: np.ndarray,
     radii_rad: tuple[float, ...] = TOP_HAT,
 ) -> float:
-    """The farthest angle from the geocentric nadir (rad) that a perturbed cone of these FOVs reaches,
-    plus VIEW_MARGIN_RAD: the VIIRS columns beyond it need no preparation (:func:`reach.view_columns`).
-    NaN FOVs are ignored; pi when there is none."""
+    """The farthest angle from the geocentric nadir that a perturbed cone of these FOVs reaches, plus a
+    margin.
+
+    The VIIRS columns beyond it need no preparation (:func:`reach.view_columns`).
+
+    Parameters
+    ----------
+    sat_m : numpy.ndarray
+        Each FOV's satellite position, ECEF, m, shape (F, 3).
+    sbf_to_ecef : numpy.ndarray
+        Each FOV's rotation from the spacecraft body frame to ECEF, shape (F, 3, 3).
+    alpha_rad, beta_rad : numpy.ndarray
+        Each FOV's in-track and cross-track LOS angles in the spacecraft body frame, rad, shape (F,).
+    offsets_rad : numpy.ndarray
+        The perturbation grid (2n+1,), rad.
+    radii_rad : tuple of float
+        The discs' half-angles, rad, increasing.
+
+    Returns
+    -------
+    float
+        The angle plus :data:`VIEW_MARGIN_RAD`, rad; pi when there is no FOV (NaN FOVs are ignored).
+    """
     los = los_ecef(sbf_to_ecef, alpha_rad, beta_rad)
     nadir = -np.asarray(sat_m, float) / np.linalg.norm(sat_m, axis=-1, keepdims=True)
     off = np.arccos(np.clip(np.sum(los * nadir, -1), -1.0, 1.0))
@@ -338,18 +399,45 @@ class ConeSums:
     rendered: ConeSums | None = None
 
     def mean(self, k: int = 0) -> np.ndarray:
-        """The weighted mean radiance (F, m, m) in disc k; NaN where it holds no pixel."""
+        """The weighted mean radiance in disc *k*.
+
+        Parameters
+        ----------
+        k : int
+            The disc, 0 the innermost.
+
+        Returns
+        -------
+        numpy.ndarray
+            Band radiance, mW/(m2 sr cm-1), shape (F, m, m); NaN where the disc holds no pixel.
+        """
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(self.weights[:, k] > 0, self.sums[:, k] / self.weights[:, k], np.nan)
 
     def coverage(self, k: int = -1) -> np.ndarray:
-        """The share (F, m, m) of disc k's solid angle that usable pixels cover (the outermost disc by
-        default)."""
+        """The share of disc *k*'s solid angle that usable pixels cover.
+
+        Parameters
+        ----------
+        k : int, optional
+            The disc; the outermost by default.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shares 0..1, shape (F, m, m).
+        """
         return self.weights[:, k] / self.solid_sr[k]
 
     def annulus_means(self) -> np.ndarray:
-        """The weighted mean radiance (F, K, m, m) in each annulus between consecutive discs (the first:
-        the innermost disc); NaN where one holds no pixel."""
+        """The weighted mean radiance in each annulus between consecutive discs (the first: the innermost
+        disc).
+
+        Returns
+        -------
+        numpy.ndarray
+            Band radiance, mW/(m2 sr cm-1), shape (F, K, m, m); NaN where an annulus holds no pixel.
+        """
         s = np.diff(self.sums, axis=1, prepend=0.0)
         w = np.diff(self.weights, axis=1, prepend=0.0)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -379,15 +467,38 @@ def cone_sums(
     fov_range_m: np.ndarray | None = None,
     fov_cos_zen: np.ndarray | None = None,
 ) -> ConeSums:
-    """Weighted VIIRS radiance sums in nested discs about every perturbed LOS of a batch of FOVs.
+    """Solid-angle weighted VIIRS radiance sums in nested discs about every perturbed LOS of a batch of FOVs.
 
-    sat_m (F, 3) and sbf_to_ecef (F, 3, 3) give each FOV's satellite position and SBF; alpha_rad,
-    beta_rad (F,) its LOS angles; offsets_rad (2n+1,) the perturbation grid; *radii_rad* the discs'
-    half-angles, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`). When the pieces are
+    A pixel belongs to a disc when the angle between (pixel - satellite) and the LOS is within its half-angle
+    (Wang et al. 2016): one quadratic inequality in tan(beta_j) per in-track turn. When the pieces are
     rendered for several in-track angles (clouds with height,
-    :attr:`monitor.collocation.swath.SwathPiece.rendered`), the same pass sums what each FOV sees of them
-    into :attr:`ConeSums.rendered`: the two views about its own alpha, weighted linearly (the nearest beyond
-    the ends).
+    :attr:`monitor.collocation.swath.SwathPiece.rendered`), the same pass sums what each FOV sees of them into
+    :attr:`ConeSums.rendered`: the two views about its own alpha, weighted linearly (the nearest beyond the
+    ends).
+
+    Parameters
+    ----------
+    swath : ViirsSwath
+        The prepared VIIRS granules the cones may reach.
+    sat_m : numpy.ndarray
+        Each FOV's satellite position, ECEF, m, shape (F, 3).
+    sbf_to_ecef : numpy.ndarray
+        Each FOV's rotation from the spacecraft body frame to ECEF, shape (F, 3, 3).
+    alpha_rad, beta_rad : numpy.ndarray
+        Each FOV's in-track and cross-track LOS angles in the spacecraft body frame, rad, shape (F,).
+    offsets_rad : numpy.ndarray
+        The perturbation grid (2n+1,), rad.
+    radii_rad : tuple of float
+        The discs' half-angles, rad, increasing (:data:`TOP_HAT`: the paper's cone; :data:`ANNULI`).
+    fov_range_m : numpy.ndarray, optional
+        Each FOV's range to the ground, m, for the search's reach.
+    fov_cos_zen : numpy.ndarray, optional
+        The cosine of each FOV's zenith angle, for the search's reach.
+
+    Returns
+    -------
+    ConeSums
+        The sums, weights and solid angles of every disc, and of the rendered views when the pieces hold them.
     """
     nf = len(alpha_rad)
     m = len(offsets_rad)
@@ -455,8 +566,15 @@ def _sums(acc: np.ndarray, solid: np.ndarray, radii_rad: tuple[float, ...]) -> C
 
 
 def warm_up() -> float:
-    """Compile the kernels (or load them from numba's cache) on a tiny synthetic granule, so that a timing
-    or the first granule does not pay for it; the seconds it took."""
+    """Compile the kernels, or load them from numba's cache, on a tiny synthetic granule.
+
+    A timing, or the first granule, then does not pay for it.
+
+    Returns
+    -------
+    float
+        The seconds it took.
+    """
     t0 = time.perf_counter()
     rows, cols = 2 * VIIRS_DETECTORS, 16
     r, c = np.meshgrid(np.arange(rows), np.arange(cols), indexing="ij")

@@ -44,8 +44,22 @@ ROTATION_RAD_S = 2.0 * math.pi / (VIIRS_SCAN_US * 1e-6)
 
 
 def reference_k(bt_k: np.ndarray, good: np.ndarray, half_px: int = REFERENCE_HALF_PX) -> np.ndarray:
-    """The clear-sky reference BT (K) around each pixel of *bt_k* (rows, cols): the warmest 3 x 3 mean
-    within +-*half_px* pixels (unusable pixels never set it; NaN where none is usable)."""
+    """The clear-sky reference BT around each pixel: the warmest 3 x 3 mean within +-*half_px* pixels.
+
+    Parameters
+    ----------
+    bt_k : numpy.ndarray
+        The pixels' I5 BT, K, shape (rows, cols).
+    good : numpy.ndarray
+        Where a pixel is usable; the others never set the reference.
+    half_px : int, optional
+        The reach, pixels each side.
+
+    Returns
+    -------
+    numpy.ndarray
+        BT, K, shape (rows, cols); NaN where no usable pixel is within reach.
+    """
     ok = good & np.isfinite(bt_k)
     filled = np.where(ok, bt_k, 0.0).astype(np.float32)
     count = uniform_filter(ok.astype(np.float32), 3, mode="nearest")
@@ -56,8 +70,24 @@ def reference_k(bt_k: np.ndarray, good: np.ndarray, half_px: int = REFERENCE_HAL
 
 
 def height_above_m(bt_k: np.ndarray, good: np.ndarray, reference_k: np.ndarray, m_per_k: float) -> np.ndarray:
-    """Each pixel's height (m) above its GEO point: *m_per_k* times how much colder than its clear-sky
-    *reference_k* (:func:`reference_k`) it is (0 where not *good*)."""
+    """Each pixel's height above its GEO point: *m_per_k* times how much colder than its clear sky it is.
+
+    Parameters
+    ----------
+    bt_k : numpy.ndarray
+        The pixels' I5 BT, K, shape (rows, cols).
+    good : numpy.ndarray
+        Where a pixel is usable.
+    reference_k : numpy.ndarray
+        The clear-sky reference BT (:func:`reference_k`), K.
+    m_per_k : float
+        The lift, m per K of BT below the reference.
+
+    Returns
+    -------
+    numpy.ndarray
+        Heights, m, shape (rows, cols); 0 where not *good*.
+    """
     cooling = np.nan_to_num(reference_k - bt_k, nan=0.0)
     return np.where(good, m_per_k * np.maximum(cooling, 0.0), 0.0).astype(np.float32)
 
@@ -73,13 +103,34 @@ def scan_points(
     vel: np.ndarray,
     point: np.ndarray,
 ) -> float:
-    """For the pixels of the scan starting at row *row0* where *mask* (32, cols) holds, write into *point*
-    (32, cols, 7) the GEO point in ECEF (m, :func:`monitor.collocation.geodesy.ecef_m`), the ellipsoid's
-    normal there and the scan angle (rad) seen from the scan's spacecraft position *sat* (3,) with
-    velocity *vel*; return whether the columns come in time order with the scan angle (1) or against it
-    (-1: the sign of the least-squares slope of the angle over the column; 1 where all lie in one column
-    or it is flat), 0 when no pixel is masked. A pixel is seen from the spacecraft at the scan's middle
-    plus the velocity times order x angle / ROTATION_RAD_S."""
+    """The GEO points, ellipsoid normals and scan angles of one scan's pixels, for the rendering.
+
+    A pixel is seen from the spacecraft at the scan's middle plus the velocity times order x angle /
+    :data:`ROTATION_RAD_S`.
+
+    Parameters
+    ----------
+    lat, lon, h : numpy.ndarray
+        The granule's GEO: latitude and longitude (rad), height (m), shape (rows, cols).
+    mask : numpy.ndarray
+        Which pixels of the scan to write, shape (32, cols).
+    row0 : int
+        The scan's first row.
+    sat : numpy.ndarray
+        The spacecraft's ECEF position at the scan's middle, m, shape (3,).
+    vel : numpy.ndarray
+        Its ECEF velocity, m/s, shape (3,).
+    point : numpy.ndarray
+        Written: per pixel the GEO point (ECEF, m), the ellipsoid's normal there and the scan angle (rad) seen
+        from the spacecraft, shape (32, cols, 7).
+
+    Returns
+    -------
+    float
+        1 when the columns come in time order with the scan angle, -1 against it (the sign of the
+        least-squares slope of the angle over the column; 1 where all lie in one column or it is flat), 0 when
+        no pixel is masked.
+    """
     sx, sy, sz = sat[0], sat[1], sat[2]
     vx, vy, vz = vel[0], vel[1], vel[2]
     norm = math.sqrt(sx * sx + sy * sy + sz * sz)

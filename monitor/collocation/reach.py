@@ -22,13 +22,26 @@ BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of 
 def view_columns(
     lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray, sat_m: np.ndarray, view_rad: float
 ) -> slice:
-    """The columns holding every pixel seen within *view_rad* of nadir, judged on the middle detector row
-    of every fourth scan and the last from that scan's spacecraft position *sat_m* (nscan, 3; ECEF m; NaN
-    ignored): a column's view angle changes little from scan to scan.
+    """The columns holding every pixel seen within *view_rad* of nadir.
 
-    The angle is from the geocentric nadir; all columns when no pixel qualifies (nothing to judge by). The
-    slice starts on a block boundary, so that the search blocks, and the order in which the cone sums add
-    pixels, are those of the whole granule.
+    Judged on the middle detector row of every fourth scan and the last, from that scan's spacecraft: a
+    column's view angle changes little from scan to scan. The slice starts on a block boundary, so that the
+    search blocks, and the order in which the cone sums add pixels, are those of the whole granule.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    sat_m : numpy.ndarray
+        Each scan's spacecraft position, ECEF, m, shape (nscan, 3); NaN ignored.
+    view_rad : float
+        The view angle from the geocentric nadir, rad.
+
+    Returns
+    -------
+    slice
+        The columns, starting on a search block's boundary; all when no pixel qualifies.
     """
     scans = np.unique(np.r_[np.arange(0, len(sat_m), 4), len(sat_m) - 1])
     sat = np.asarray(sat_m, float)[scans]
@@ -42,9 +55,20 @@ def view_columns(
 
 
 def scans_between(scan_start_us: ArrayLike, t0_us: float, t1_us: float) -> slice:
-    """The scans observed between IET t0_us and t1_us, from the scans' start times *scan_start_us* (IET
-    us; a scan lasts until the next starts, the last to the granule's end): all scans when those times are
-    not all set and increasing (nothing to judge by)."""
+    """The scans observed between two times.
+
+    Parameters
+    ----------
+    scan_start_us : array_like
+        Each scan's start time, IET us; a scan lasts until the next starts, the last to the granule's end.
+    t0_us, t1_us : float
+        The span, IET us.
+
+    Returns
+    -------
+    slice
+        The scans; all when the start times are not all set and increasing (nothing to judge by).
+    """
     t = np.asarray(scan_start_us, np.int64)
     if t.size == 0 or t[0] <= 0 or np.any(np.diff(t) <= 0):
         return slice(None)
@@ -62,10 +86,28 @@ def kept_pixels(
     scan_start_us: np.ndarray | None = None,
     span_us: tuple[float, float] | None = None,
 ) -> tuple[slice, slice]:
-    """The scans and the columns of a granule (rows of 32-detector scans) that :func:`swath_piece` keeps
-    (its arguments of those names): the scans observed within *span_us* (:func:`scans_between`), and the
-    columns seen within *view_rad* of nadir on those scans (:func:`view_columns`); all of either where there
-    is nothing to judge it by."""
+    """The scans and the columns of a granule that :func:`monitor.collocation.swath.swath_piece` keeps.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    sat_m : numpy.ndarray, optional
+        Each scan's spacecraft position, ECEF, m, shape (nscan, 3).
+    view_rad : float, optional
+        The view angle from nadir beyond which no cone reaches, rad.
+    scan_start_us : numpy.ndarray, optional
+        Each scan's start time, IET us.
+    span_us : tuple of float, optional
+        The span (t0, t1) the CrIS granules reach, IET us.
+
+    Returns
+    -------
+    scans, columns : slice
+        The scans observed within *span_us* (:func:`scans_between`) and the columns seen within *view_rad* on
+        them (:func:`view_columns`); all of either where there is nothing to judge it by.
+    """
     scans = slice(None)
     if scan_start_us is not None and span_us is not None:
         scans = scans_between(scan_start_us, *span_us)

@@ -96,13 +96,38 @@ def rendered_bt(
     scans: slice = slice(None),
     columns: slice = slice(None),
 ) -> np.ndarray:
-    """The BT (K, float32 (len(cris_alpha_rad), rows, cols)) that a CrIS ray at each in-track SBF angle
-    of *cris_alpha_rad* sees on its way to each GEO point of a VIIRS granule (rows of 32-detector scans,
-    GEO (lat_rad, lon_rad, height_m), BT *bt_k*, usable where *good*; NaN elsewhere), each pixel standing
-    *m_per_k* m per K colder than its clear-sky reference
-    (:func:`monitor.collocation.lift.height_above_m`): :func:`view_tangents`, then
-    :func:`render_height_field`, :data:`COLUMNS_PER_PASS` columns at a time. Only the pixels of *scans*
-    (step 1) and *columns* are rendered, NaN elsewhere; the clear-sky reference is the whole granule's."""
+    """The BT a CrIS ray at each in-track angle sees on its way to each GEO point of a VIIRS granule.
+
+    :func:`view_tangents`, then :func:`render_height_field`, :data:`COLUMNS_PER_PASS` columns at a time. The
+    clear-sky reference is the whole granule's.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    bt_k : numpy.ndarray
+        The pixels' I5 BT, K, shape (rows, cols).
+    good : numpy.ndarray
+        Where a pixel is usable.
+    sat_m, velocity_m_s : numpy.ndarray
+        Each scan's spacecraft position (m) and velocity (m/s) at its middle, ECEF, shape (nscan, 3).
+    cris_alpha_rad : numpy.ndarray
+        The CrIS views' in-track angles in the spacecraft body frame, rad, positive ahead.
+    m_per_k : float
+        The lift: each pixel stands this many m per K colder than its clear-sky reference
+        (:func:`monitor.collocation.lift.height_above_m`).
+    scans : slice, optional
+        The scans to render (step 1).
+    columns : slice, optional
+        The columns to render.
+
+    Returns
+    -------
+    numpy.ndarray
+        BT, K, float32, shape (len(cris_alpha_rad), rows, cols); NaN outside *scans* and *columns* and where
+        unusable.
+    """
     rows, cols = np.shape(bt_k)
     out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
     usable = np.asarray(good, bool) & np.isfinite(bt_k)
@@ -143,28 +168,42 @@ def view_tangents(
     cris_alpha_rad: np.ndarray,
     first_column: int = 0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per pixel of a VIIRS granule (rows of 32-detector scans; *good* where usable) the along-track
-    coordinate x of its GEO point (m, along the first scan's SBF x axis; NaN where unusable), the in-track
-    tangent b of its VIIRS ray, and per in-track SBF angle of *cris_alpha_rad* (rad, positive ahead) the
-    in-track tangent a of a CrIS ray at that angle to the same GEO point: the horizontal run along the
-    column per unit of height towards the spacecraft, positive along +x (:func:`render_height_field`).
+    """The along-track coordinate and in-track tangents of the VIIRS and CrIS rays to each pixel's GEO point.
 
-    The SBF during a scan is VIIRS's: it scans the SBF's y-z plane (:func:`_scan_normal`); the columns
-    run along its x axis on the ground. VIIRS sees the pixel from the spacecraft at the pixel's time
-    (scan *sat_m*, *velocity_m_s* (nscan, 3) ECEF at the scan's middle,
-    :func:`monitor.collocation.lift.scan_points`).
-    CrIS at angle alpha sees it from the point S' of the track where (P - S') . x_sbf =
-    tan(alpha) (P - S') . z_sbf, the SBF taken at S' (three steps: its nadir turns by the move over
-    R_earth + altitude). A difference of in-track angles between the two instruments is about
-    1 + range / R_earth times larger at the ground (the local vertical turns along the track too): 21.6 mrad
-    for an outer row at nadir.
+    The SBF during a scan is VIIRS's: it scans the SBF's y-z plane; the columns run along its x axis on the
+    ground. VIIRS sees the pixel from the spacecraft at the pixel's time
+    (:func:`monitor.collocation.lift.scan_points`). CrIS at angle alpha sees it from the point S' of the track
+    where (P - S') . x_sbf = tan(alpha) (P - S') . z_sbf, the SBF taken at S'. A difference of in-track angles
+    between the two instruments is about 1 + range / R_earth times larger at the ground (the local vertical
+    turns along the track too): 21.6 mrad for an outer row at nadir. The CrIS tangent is traced at every
+    :data:`TANGENT_STEP`-th column and at each run's ends, and linearly in scan angle between them, where it
+    varies smoothly.
 
-    a is traced at every :data:`TANGENT_STEP`-th column of the granule (*first_column* is the granule
-    column of the first given, so that a part is traced as in the whole) and at each run's ends, and
-    linearly in scan angle between them. On a simulated granule that moves a by 1e-7 at the median and
-    3.4e-6 at most (5 cm at 15 km; 728 of 43 million rendered BTs then change by more than 0.01 K, rays
-    that fall on the other side of an edge); tracing every pixel had taken 26 of a 14-granule day's 47 s
-    of rendering."""
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    good : numpy.ndarray
+        Where a pixel is usable.
+    sat_m, velocity_m_s : numpy.ndarray
+        Each scan's spacecraft position (m) and velocity (m/s) at its middle, ECEF, shape (nscan, 3).
+    cris_alpha_rad : numpy.ndarray
+        The CrIS views' in-track angles in the spacecraft body frame, rad, positive ahead.
+    first_column : int
+        The granule column of the first column given, so that a part is traced as in the whole.
+
+    Returns
+    -------
+    x_m : numpy.ndarray
+        Each GEO point's coordinate along the track, m, along the first scan's SBF x axis; NaN where
+        unusable; shape (rows, cols).
+    viirs_tan : numpy.ndarray
+        The in-track tangent of each pixel's VIIRS ray, shape (rows, cols).
+    cris_tan : numpy.ndarray
+        Per view, the in-track tangent of the CrIS ray to each GEO point: the horizontal run along the
+        column per unit of height towards the spacecraft, positive along +x; shape (views, rows, cols).
+    """
     rows, cols = np.shape(lat_rad)
     sat = np.ascontiguousarray(sat_m, np.float64)
     vel = np.ascontiguousarray(velocity_m_s, np.float64)
@@ -329,12 +368,29 @@ def render_height_field(
     cris_tan: np.ndarray,
     m_per_k: float,
 ) -> np.ndarray:
-    """What a CrIS ray at each in-track tangent of *cris_tan* (views, rows, cols) sees on its way to each
-    GEO point (float32 (views, rows, cols), K; NaN where x is, and in columns of fewer than 3 usable
-    pixels): the sweep of the module docstring over each column of the granule's pixels (rows, cols; *x_m*
-    their along-track GEO coordinate, NaN where unusable), seen by VIIRS at *height_m* along rays of
-    in-track tangent *viirs_tan*; walls are their stretch's BT plus their depth below its top over
-    *m_per_k* (m per K)."""
+    """What a CrIS ray at each in-track tangent sees on its way to each GEO point: the module's sweep.
+
+    Parameters
+    ----------
+    x_m : numpy.ndarray
+        Each GEO point's coordinate along the track, m, NaN where unusable, shape (rows, cols).
+    viirs_tan : numpy.ndarray
+        The in-track tangent of each pixel's VIIRS ray, shape (rows, cols).
+    height_m : numpy.ndarray
+        The height VIIRS saw each pixel at, m, shape (rows, cols).
+    bt_k : numpy.ndarray
+        The pixels' I5 BT, K, shape (rows, cols).
+    cris_tan : numpy.ndarray
+        The CrIS rays' in-track tangents, shape (views, rows, cols).
+    m_per_k : float
+        The height law, m per K: a wall is its stretch's BT plus its depth below the top over it.
+
+    Returns
+    -------
+    numpy.ndarray
+        BT, K, float32, shape (views, rows, cols); NaN where *x_m* is and in columns of fewer than 3 usable
+        pixels.
+    """
     seen = np.full(np.shape(cris_tan), np.nan)
     args = [np.ascontiguousarray(v, np.float64) for v in (x_m, viirs_tan, height_m, bt_k, cris_tan)]
     with KERNEL_LOCK:

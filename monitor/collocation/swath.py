@@ -52,7 +52,15 @@ class BandTable(Protocol):
 
     @property
     def radiance_table(self) -> tuple[float, float, np.ndarray]:
-        """(first BT K, BT step K, band radiance per BT)."""
+        """The band's Planck table.
+
+        Returns
+        -------
+        t_min_k, t_step_k : float
+            The table's first BT and its step, K.
+        table : numpy.ndarray
+            Band radiance per BT, mW/(m2 sr cm-1).
+        """
         ...
 
 
@@ -100,17 +108,46 @@ class SwathPiece:
 
     @property
     def shape(self) -> tuple[int, int]:
-        """(rows, columns) of the prepared piece."""
+        """The rows and columns of the prepared piece.
+
+        Returns
+        -------
+        tuple of int
+            (rows, cols).
+        """
         rows, cols = self.radiance.shape
         return rows, cols
 
     def covers(self, t0_us: float, t1_us: float) -> bool:
-        """Whether the piece holds every scan observed between IET t0_us and t1_us."""
+        """Whether the piece holds every scan observed between two times.
+
+        Parameters
+        ----------
+        t0_us, t1_us : float
+            The span, IET us.
+
+        Returns
+        -------
+        bool
+            True when every scan of the span is prepared.
+        """
         return self.span_us[0] <= t0_us and t1_us < self.span_us[1]
 
     def nearest(self, points_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(row, col) of the first pixel of the usable block whose centre lies nearest each ECEF point,
-        and that distance (m)."""
+        """The first pixel of the usable block whose centre lies nearest each point, and that distance.
+
+        Parameters
+        ----------
+        points_m : numpy.ndarray
+            ECEF points, m, shape (N, 3).
+
+        Returns
+        -------
+        row, col : numpy.ndarray
+            The pixel, shape (N,).
+        distance_m : numpy.ndarray
+            The distance to the block's centre, m.
+        """
         dist, idx = self.tree.query(points_m)
         return self.tree_rows[idx], self.tree_cols[idx], dist
 
@@ -440,22 +477,46 @@ def swath_piece(
     seen_bt_k: np.ndarray | None = None,
     view_alpha_rad: np.ndarray | None = None,
 ) -> SwathPiece:
-    """Prepare one VIIRS granule (rows of 32-detector scans) of geolocation and I5 BT for collocation.
+    """Prepare one VIIRS granule's geolocation and I5 BT for collocation.
 
-    Pixels are the 3-D points (lat_rad, lon_rad, height_m) (height above the ellipsoid; zeros for the
-    ellipsoid product). *band* (:class:`monitor.instrument.spectral.I5Band`) turns pixel BT into band
-    radiance.
-    *before* and *after* are optional (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent
-    scan, so that the scan overlap at the granule's first and last scan is counted as inside a continuous
-    swath. Given *sat_m*, the spacecraft position of each scan (ECEF m), only the columns seen within
-    *view_rad* of nadir are prepared (:func:`reach.view_columns`); given *span_us* (t0, t1) and the start time
-    of each scan *scan_start_us* (IET us), only the scans observed between t0 and t1
-    (:func:`reach.scans_between`), each with the same weights as in the whole granule (the scans next to those
-    kept are their halos).
-    *seen_bt_k* (views, rows, cols), when given, is the BT a CrIS ray at each in-track SBF angle of
-    *view_alpha_rad* (views,) sees along its way to each GEO point (clouds with height:
-    :func:`monitor.collocation.render.rendered_bt`): the piece then holds their radiance beside the
-    pixels' own (:attr:`SwathPiece.rendered`), for both collocations in one kernel pass.
+    Pixels are the 3-D points (lat, lon, height); their weight is the solid angle their footprint subtends
+    from CrIS, less the share a neighbouring scan also covers (docs/science.md, "Collocation").
+
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    bt_k : numpy.ndarray
+        The pixels' I5 BT, K, shape (rows, cols).
+    good : numpy.ndarray
+        Where a pixel is usable.
+    band : BandTable
+        The I5 band (:class:`monitor.instrument.spectral.I5Band`): pixel BT to band radiance.
+    before, after : tuple of numpy.ndarray, optional
+        (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent scan, so that the scan overlap at
+        the granule's first and last scan is counted as inside a continuous swath.
+    sat_m : numpy.ndarray, optional
+        Each scan's spacecraft position, ECEF, m, shape (nscan, 3): only the columns seen within *view_rad* of
+        nadir are then prepared (:func:`reach.view_columns`).
+    view_rad : float, optional
+        The view angle from nadir beyond which no cone reaches, rad.
+    scan_start_us : numpy.ndarray, optional
+        Each scan's start time, IET us.
+    span_us : tuple of float, optional
+        With *scan_start_us*, only the scans observed in (t0, t1), IET us, are prepared
+        (:func:`reach.scans_between`), each with the same weights as in the whole granule.
+    seen_bt_k : numpy.ndarray, optional
+        The BT a CrIS ray at each angle of *view_alpha_rad* sees on its way to each GEO point (clouds with
+        height: :func:`monitor.collocation.render.rendered_bt`), K, shape (views, rows, cols).
+    view_alpha_rad : numpy.ndarray, optional
+        The in-track SBF angles of *seen_bt_k*, rad, shape (views,).
+
+    Returns
+    -------
+    SwathPiece
+        The 3-D pixel points, their band radiance, solid-angle footprints and scan-overlap shares, and the
+        rendered views' radiance when given.
     """
     scans, kept = kept_pixels(lat_rad, lon_rad, height_m, sat_m, view_rad, scan_start_us, span_us)
     if scans != slice(None) and scan_start_us is not None:

@@ -90,7 +90,22 @@ class EngineeringPacket:
         version: str | None = None,
         provenance: dict | None = None,
     ) -> EngineeringPacket:
-        """A copy with the 2 x 30 scene-mirror angles replaced (the only angles the optimiser changes)."""
+        """A copy with the 2 x 30 scene-mirror angles replaced (the only angles the optimiser changes).
+
+        Parameters
+        ----------
+        crosstrack_roll_rad, intrack_pitch_rad : array_like
+            The scene mirror's angles per FOR, rad, shape (30,).
+        version : str, optional
+            The new packet's version; the packet's own when None.
+        provenance : dict, optional
+            What the new angles were derived from, recorded with the packet.
+
+        Returns
+        -------
+        EngineeringPacket
+            The new packet.
+        """
         return dataclasses.replace(
             self,
             ssm_crosstrack_roll_rad=np.asarray(crosstrack_roll_rad, float),
@@ -101,30 +116,85 @@ class EngineeringPacket:
 
 
 def attitude_matrix(roll_rad: ArrayLike, pitch_rad: ArrayLike, yaw_rad: ArrayLike) -> np.ndarray:
-    """T = R_x(roll) P_y(pitch) Y_z(yaw), equation (10): the mapping-angle transformation."""
+    """T = R_x(roll) P_y(pitch) Y_z(yaw), equation (10): the mapping-angle transformation.
+
+    Parameters
+    ----------
+    roll_rad, pitch_rad, yaw_rad : array_like
+        The angles, rad, broadcast together.
+
+    Returns
+    -------
+    numpy.ndarray
+        Rotations, shape (..., 3, 3).
+    """
     return rot_x(roll_rad) @ rot_y(pitch_rad) @ rot_z(yaw_rad)
 
 
 def fov_los_ioar(ep: EngineeringPacket) -> np.ndarray:
-    """Unit LOS (9, 3) of FOV 1..9 in the IOAR from the long-wave FOV offsets and the FOV-5 LOS offset."""
+    """The unit LOS of FOVs 1..9 in the IOAR from the long-wave FOV offsets and the FOV-5 LOS offset.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, shape (9, 3).
+    """
     yaw = -(ep.fov_crosstrack_offset_rad + ep.los_relative_yaw_rad)
     pitch = ep.fov_intrack_offset_rad + ep.los_relative_pitch_rad
     return np.einsum("fij,fjk,k->fi", rot_y(pitch), rot_z(yaw), np.array([1.0, 0.0, 0.0]))
 
 
 def ioar_to_ssmf(ep: EngineeringPacket) -> np.ndarray:
-    """P(theta_SSMF) Y(phi_SSMF), equation (14): IOAR vectors to the scene-mirror frame."""
+    """P(theta_SSMF) Y(phi_SSMF), equation (14): IOAR vectors to the scene-mirror frame.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    numpy.ndarray
+        The rotation, shape (3, 3).
+    """
     yaw, pitch = ep.ifr_boresight_to_ssmf_rad
     return rot_y(pitch) @ rot_z(yaw)
 
 
 def fov_los_ssmf(ep: EngineeringPacket) -> np.ndarray:
-    """Unit LOS (9, 3) of each FOV in the SSMF before the mirror, equation (14)."""
+    """The unit LOS of each FOV in the SSMF before the mirror, equation (14).
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, shape (9, 3).
+    """
     return fov_los_ioar(ep) @ ioar_to_ssmf(ep).T
 
 
 def mirror_normal(crosstrack_roll_rad: ArrayLike, intrack_pitch_rad: ArrayLike) -> np.ndarray:
-    """Unit scene-mirror normal (..., 3) in the SSMF, equation (15): P(pitch) R(roll) [-1, 0, 1]/sqrt(2)."""
+    """The unit scene-mirror normal in the SSMF, equation (15): P(pitch) R(roll) [-1, 0, 1]/sqrt(2).
+
+    Parameters
+    ----------
+    crosstrack_roll_rad, intrack_pitch_rad : array_like
+        The scene mirror's angles, rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit normals, shape (..., 3).
+    """
     return np.einsum(
         "...ij,...jk,k->...i",
         rot_y(np.asarray(intrack_pitch_rad, float)),
@@ -134,10 +204,20 @@ def mirror_normal(crosstrack_roll_rad: ArrayLike, intrack_pitch_rad: ArrayLike) 
 
 
 def ssm_angles_from_normal(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(crosstrack_roll_rad, intrack_pitch_rad) of a mirror normal: the exact inverse of equation (15).
+    """The scene-mirror angles of a mirror normal: the exact inverse of equation (15).
 
-    With v = R(roll) n0 = (-1, -sin roll, cos roll)/sqrt(2), n_y = -sin(roll)/sqrt(2) gives the roll,
-    and the pitch is the turn about y that takes (v_x, v_z) onto (n_x, n_z).
+    With v = R(roll) n0 = (-1, -sin roll, cos roll)/sqrt(2), n_y = -sin(roll)/sqrt(2) gives the roll, and the
+    pitch is the turn about y that takes (v_x, v_z) onto (n_x, n_z).
+
+    Parameters
+    ----------
+    normal : numpy.ndarray
+        Unit mirror normals in the SSMF, shape (..., 3).
+
+    Returns
+    -------
+    crosstrack_roll_rad, intrack_pitch_rad : numpy.ndarray
+        The angles, rad.
     """
     n = unit(normal)
     roll = np.arcsin(np.clip(-np.sqrt(2.0) * n[..., 1], -1.0, 1.0))
@@ -146,12 +226,36 @@ def ssm_angles_from_normal(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def reflect(los: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """LOS reflected on a mirror of unit *normal*, equation (16): l - 2 (l . n) n."""
+    """The LOS reflected on a mirror, equation (16): l - 2 (l . n) n.
+
+    Parameters
+    ----------
+    los : numpy.ndarray
+        Unit lines of sight, shape (..., 3).
+    normal : numpy.ndarray
+        The mirror's unit normal in the same frame, broadcast against *los*.
+
+    Returns
+    -------
+    numpy.ndarray
+        The reflected unit vectors, shape (..., 3).
+    """
     return los - 2.0 * np.sum(los * normal, axis=-1, keepdims=True) * normal
 
 
 def ssmf_to_ep_sbf(ep: EngineeringPacket) -> np.ndarray:
-    """T_SBF/SSMF = T_SBF/IAR T_IAR/SSMR T_SSMR/SSMF, equation (17), each T as in equation (10)."""
+    """T_SBF/SSMF = T_SBF/IAR T_IAR/SSMR T_SSMR/SSMF, equation (17), each T as in equation (10).
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    numpy.ndarray
+        The rotation, shape (3, 3).
+    """
     return (
         attitude_matrix(*ep.sbf_to_iar_rad)
         @ attitude_matrix(*ep.iar_to_ssmr_rad)
@@ -160,14 +264,35 @@ def ssmf_to_ep_sbf(ep: EngineeringPacket) -> np.ndarray:
 
 
 def ep_sbf_to_spacecraft(ep: EngineeringPacket) -> np.ndarray:
-    """The instrument mounting: EP SBF vectors to the attitude-defined spacecraft body frame."""
+    """The instrument mounting: EP SBF vectors to the attitude-defined spacecraft body frame.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    numpy.ndarray
+        The rotation, shape (3, 3).
+    """
     return attitude_matrix(*ep.sc_to_sbf_rad)
 
 
 def los_ep_sbf(ep: EngineeringPacket) -> np.ndarray:
-    """Unit LOS (30, 9, 3) of every FOR and FOV in the EP's SBF, equations (14)-(18).
+    """The unit LOS of every FOR and FOV in the EP's SBF, equations (14)-(18).
 
     The 3 x 3 pattern turns with the scan angle because every FOV is reflected on the same mirror.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, shape (30, 9, 3): every FOR and FOV.
     """
     n = mirror_normal(ep.ssm_crosstrack_roll_rad, ep.ssm_intrack_pitch_rad)  # (30, 3)
     reflected = reflect(fov_los_ssmf(ep)[None, :, :], n[:, None, :])  # (30, 9, 3)
@@ -175,18 +300,40 @@ def los_ep_sbf(ep: EngineeringPacket) -> np.ndarray:
 
 
 def los_spacecraft(ep: EngineeringPacket) -> np.ndarray:
-    """Unit LOS (30, 9, 3) in the spacecraft body frame of :mod:`monitor.geometry.frames`."""
+    """The unit LOS of every FOR and FOV in the spacecraft body frame of :mod:`monitor.geometry.frames`.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, shape (30, 9, 3): every FOR and FOV.
+    """
     return los_ep_sbf(ep) @ ep_sbf_to_spacecraft(ep).T
 
 
 def ssm_angles_for_los(
     ep: EngineeringPacket, target_los_spacecraft: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Scene-mirror angles (roll, pitch) (30,) that point FOV 5 of each FOR along *target_los_spacecraft*.
+    """The scene-mirror angles that point FOV 5 of each FOR along a target LOS, equations (22)-(23).
 
-    Equations (22)-(23): the target goes back to the SSMF, the mirror normal is the unit difference of
-    the reflected and incident LOS (its sign chosen to face the incident beam like the EP's own normal),
-    and equation (15) is inverted.
+    The target goes back to the SSMF, the mirror normal is the unit difference of the reflected and incident
+    LOS (its sign chosen to face the incident beam like the EP's own normal), and equation (15) is inverted.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+    target_los_spacecraft : numpy.ndarray
+        The wanted FOV-5 LOS of each FOR in the spacecraft body frame, shape (30, 3).
+
+    Returns
+    -------
+    crosstrack_roll_rad, intrack_pitch_rad : numpy.ndarray
+        The angles, rad, shape (30,).
     """
     target = unit(np.asarray(target_los_spacecraft, float))
     to_ssmf = (ep_sbf_to_spacecraft(ep) @ ssmf_to_ep_sbf(ep)).T
@@ -204,8 +351,20 @@ def corrected_ssm_angles(
     """New scene-mirror angles from assessed LOS offsets, equations (19)-(23).
 
     alpha'_k = alpha_k + d_alpha_k and beta'_k = beta_k + d_beta_k for the FOV-5 LOS of *ep* in the
-    spacecraft frame (equations 19-20); the corrected LOS is unit(tan alpha', tan beta', 1) (equation 21
-    in its consistent form) and the mirror angles follow from :func:`ssm_angles_for_los`.
+    spacecraft frame (equations 19-20); the corrected LOS is unit(tan alpha', tan beta', 1) (equation 21 in
+    its consistent form) and the mirror angles follow from :func:`ssm_angles_for_los`.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+    d_alpha_rad, d_beta_rad : array_like
+        The assessed in-track and cross-track offsets per FOR, rad, shape (30,).
+
+    Returns
+    -------
+    crosstrack_roll_rad, intrack_pitch_rad : numpy.ndarray
+        The corrected angles, rad, shape (30,).
     """
     alpha, beta = los_angles(los_spacecraft(ep)[:, FOV5])
     target = los_from_angles(alpha + np.asarray(d_alpha_rad, float), beta + np.asarray(d_beta_rad, float))
@@ -213,5 +372,16 @@ def corrected_ssm_angles(
 
 
 def fov5_angles(ep: EngineeringPacket) -> tuple[np.ndarray, np.ndarray]:
-    """(alpha_rad, beta_rad) (30,) of the FOV-5 LOS of each FOR in the spacecraft frame."""
+    """The in-track and cross-track angles of the FOV-5 LOS of each FOR in the spacecraft frame.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The engineering packet.
+
+    Returns
+    -------
+    alpha_rad, beta_rad : numpy.ndarray
+        Shape (30,), rad.
+    """
     return los_angles(los_spacecraft(ep)[:, FOV5])

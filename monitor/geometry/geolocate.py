@@ -42,10 +42,28 @@ def geolocate_fovs(
     sc_attitude_rad: np.ndarray,
     h_m: float | np.ndarray = 0.0,
 ) -> GroundView:
-    """Geolocate the LOS (30, 9, 3) (spacecraft body frame) of every scan.
+    """Geolocate the line of sight of every FOV of every scan (the forward path of section 2.4).
 
-    *for_time_us* (nscan, 30) IET; per scan *mid_time_us* (nscan,), *sc_position_m*, *sc_velocity_m_s*
-    (ECEF) and *sc_attitude_rad* (roll, pitch, yaw) (nscan, 3). FOR times <= 0 (fill) give NaN.
+    Parameters
+    ----------
+    los_spacecraft : numpy.ndarray
+        Each FOR's and FOV's LOS in the spacecraft body frame, shape (30, 9, 3).
+    for_time_us : numpy.ndarray
+        Each FOR's time, IET us, shape (nscan, 30); times <= 0 (fill) give NaN.
+    mid_time_us : numpy.ndarray
+        Each scan's middle time, IET us, shape (nscan,).
+    sc_position_m, sc_velocity_m_s : numpy.ndarray
+        The spacecraft's ECEF position (m) and velocity (m/s) at each scan's middle, shape (nscan, 3).
+    sc_attitude_rad : numpy.ndarray
+        Roll, pitch and yaw at each scan's middle, rad, shape (nscan, 3).
+    h_m : float or numpy.ndarray, optional
+        Height of the surface met above the ellipsoid, m (GCRSO: 0).
+
+    Returns
+    -------
+    GroundView
+        Latitude and longitude (rad), the satellite's zenith and azimuth (rad), range (m) and the ground
+        points (ECEF, m) of every FOV, shape (nscan, 30, 9).
     """
     t = np.asarray(for_time_us, np.int64)
     bad_time = t <= 0

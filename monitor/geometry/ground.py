@@ -10,10 +10,22 @@ from monitor.geometry.inverse import forward_geolocation
 
 
 def track_axes(ground_ecef_m: np.ndarray, velocity_ecef_m_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit (along_track, cross_track) horizontal vectors at ground points.
+    """Unit horizontal vectors along and across the ground track at ground points.
 
-    Along-track is the spacecraft ECEF velocity projected on the local horizontal; cross-track is
-    along x up, i.e. to the right of the flight direction.
+    Along-track is the spacecraft's ECEF velocity projected on the local horizontal; cross-track is along x
+    up, to the right of the flight direction.
+
+    Parameters
+    ----------
+    ground_ecef_m : numpy.ndarray
+        Ground points, ECEF, m, shape (..., 3).
+    velocity_ecef_m_s : numpy.ndarray
+        Spacecraft velocity, ECEF, m/s, shape (..., 3).
+
+    Returns
+    -------
+    along, cross : numpy.ndarray
+        Unit vectors in ECEF, shape (..., 3).
     """
     up = wgs84.geodetic_up(ground_ecef_m)
     v = np.asarray(velocity_ecef_m_s, float)
@@ -31,10 +43,28 @@ def offset_km(
     d_alpha_rad: ArrayLike,
     d_beta_rad: ArrayLike,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Ground displacement (in_track_km, cross_track_km) of turning a LOS by (d_alpha, d_beta) in the SBF.
+    """The ground displacement of turning a LOS by (d_alpha, d_beta) in the spacecraft body frame.
 
-    Both the original and the turned LOS are intersected with the WGS84 ellipsoid; the difference is
-    projected on the local along-track and cross-track directions at the original point.
+    Both the original and the turned LOS are intersected with the WGS84 ellipsoid; the difference is projected
+    on the local along-track and cross-track directions at the original point (:func:`track_axes`).
+
+    Parameters
+    ----------
+    sat_ecef_m : numpy.ndarray
+        Spacecraft position, ECEF, m, shape (..., 3).
+    sbf_to_ecef : numpy.ndarray
+        Rotation from the spacecraft body frame to ECEF, shape (..., 3, 3).
+    alpha_rad, beta_rad : array_like
+        The LOS's in-track and cross-track angles in the spacecraft body frame, rad.
+    velocity_ecef_m_s : numpy.ndarray
+        Spacecraft velocity, ECEF, m/s, shape (..., 3).
+    d_alpha_rad, d_beta_rad : array_like
+        The turn, rad.
+
+    Returns
+    -------
+    in_track_km, cross_track_km : numpy.ndarray
+        The displacement along the flight direction and to its right, km.
     """
     p0 = forward_geolocation(sat_ecef_m, sbf_to_ecef, frames.los_from_angles(alpha_rad, beta_rad))
     p1 = forward_geolocation(

@@ -41,10 +41,24 @@ class FovGeometry:
 def satellite_from_fov(
     lat_rad: ArrayLike, lon_rad: ArrayLike, zenith_rad: ArrayLike, azimuth_rad: ArrayLike, range_m: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Ground point (h = 0) and satellite position implied by a FOV's geometry, both ECEF metres.
+    """The ground point (h = 0) and the satellite position a FOV's geometry implies.
 
-    Steps 1-2 of section 2.2: the ENU unit vector toward the satellite from zenith/azimuth, rotated to
-    ECEF at the FOV's latitude/longitude, scaled by the satellite range.
+    Steps 1-2 of section 2.2: the ENU unit vector toward the satellite from zenith and azimuth, rotated to
+    ECEF at the FOV's latitude and longitude, scaled by the satellite range.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad : array_like
+        Geodetic latitude and longitude of each FOV's ground point, rad.
+    zenith_rad, azimuth_rad : array_like
+        The satellite's zenith and azimuth seen from the ground point, rad.
+    range_m : array_like
+        The range from the ground point to the satellite, m.
+
+    Returns
+    -------
+    ground_ecef_m, sat_ecef_m : numpy.ndarray
+        ECEF positions, m, shape (..., 3).
     """
     ground = wgs84.geodetic_to_ecef(lat_rad, lon_rad, 0.0)
     look = wgs84.look_vector_ecef(lat_rad, lon_rad, zenith_rad, azimuth_rad)
@@ -63,11 +77,33 @@ def inverse_geolocation(
     sc_velocity_m_s: np.ndarray,
     sc_attitude_rad: np.ndarray,
 ) -> FovGeometry:
-    """LOS of each FOV in the SBF from the GEO fields (section 2.2).
+    """The line of sight of each FOV in the spacecraft body frame from the GEO fields (section 2.2).
 
-    FOV fields are (nscan, nfor, nfov); *for_time_us* (nscan, nfor) IET; the per-scan ephemeris
-    (*mid_time_us* (nscan,), *sc_position_m*, *sc_velocity_m_s*, *sc_attitude_rad* (nscan, 3) roll,
-    pitch, yaw) is propagated (position, velocity) or interpolated (attitude) to each FOR time.
+    The per-scan ephemeris is propagated (position, velocity) or interpolated (attitude) to each FOR's time.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad : array_like
+        Geodetic latitude and longitude of each FOV's ground point, rad.
+    zenith_rad, azimuth_rad : array_like
+        The satellite's zenith and azimuth seen from the ground point, rad.
+    range_m : array_like
+        The range from the ground point to the satellite, m.
+        All of shape (nscan, nfor, nfov).
+    for_time_us : numpy.ndarray
+        Each FOR's time, IET us, shape (nscan, nfor).
+    mid_time_us : numpy.ndarray
+        Each scan's middle time, IET us, shape (nscan,).
+    sc_position_m, sc_velocity_m_s : numpy.ndarray
+        The spacecraft's ECEF position (m) and velocity (m/s) at each scan's middle, shape (nscan, 3).
+    sc_attitude_rad : numpy.ndarray
+        Roll, pitch and yaw at each scan's middle, rad, shape (nscan, 3).
+
+    Returns
+    -------
+    FovGeometry
+        Ground points, satellite positions, the LOS in ECEF and in the spacecraft body frame, the rotation
+        between them, and each FOV's alpha (in-track) and beta (cross-track), rad.
     """
     ground, sat = satellite_from_fov(lat_rad, lon_rad, zenith_rad, azimuth_rad, range_m)
     los_ecef = frames.unit(ground - sat)
@@ -85,9 +121,25 @@ def inverse_geolocation(
 def forward_geolocation(
     sat_ecef_m: np.ndarray, sbf_to_ecef: np.ndarray, los_sbf: np.ndarray, h_m: ArrayLike = 0.0
 ) -> np.ndarray:
-    """Ground point (ECEF metres) where an SBF line of sight from *sat_ecef_m* meets the ellipsoid.
+    """The ground point where a line of sight in the spacecraft body frame meets the ellipsoid.
 
-    The SBF -> OCS -> ECEF path of section 2.4; NaN where the LOS misses the Earth.
+    The SBF -> OCS -> ECEF path of section 2.4.
+
+    Parameters
+    ----------
+    sat_ecef_m : numpy.ndarray
+        Spacecraft position, ECEF, m, shape (..., 3).
+    sbf_to_ecef : numpy.ndarray
+        Rotation from the spacecraft body frame to ECEF, shape (..., 3, 3).
+    los_sbf : numpy.ndarray
+        Lines of sight in the spacecraft body frame, shape (..., 3).
+    h_m : array_like, optional
+        Height above the ellipsoid of the surface met, m.
+
+    Returns
+    -------
+    numpy.ndarray
+        ECEF points, m, shape (..., 3); NaN where the LOS misses the Earth.
     """
     los_ecef = np.einsum("...ij,...j->...i", sbf_to_ecef, los_sbf)
     t = wgs84.intersect_ellipsoid(sat_ecef_m, los_ecef, h_m)
@@ -123,9 +175,21 @@ class CrisGeoFields(Protocol):
 
 
 def granule_geometry(geo: CrisGeoFields) -> FovGeometry:
-    """The inverse geolocation of a CrIS GEO granule (:class:`monitor.sdr.CrisGeoGranule`): its fields in,
-    fill FOVs given harmless values (a ground point at 0, 0 and a range of 1000 km) so that the arrays stay
-    finite; mask the result with ``geo.valid``."""
+    """The inverse geolocation of a CrIS GEO granule (:class:`monitor.sdr.CrisGeoGranule`).
+
+    Fill FOVs are given harmless values (a ground point at 0, 0 and a range of 1000 km) so that the arrays
+    stay finite.
+
+    Parameters
+    ----------
+    geo : CrisGeoFields
+        The granule's GEO fields.
+
+    Returns
+    -------
+    FovGeometry
+        As :func:`inverse_geolocation`; mask it with ``geo.valid``.
+    """
     valid = geo.valid
     return inverse_geolocation(
         np.where(valid, geo.lat_rad, 0.0),

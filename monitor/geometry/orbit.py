@@ -15,7 +15,20 @@ _OMEGA = np.array([0.0, 0.0, OMEGA_EARTH_RAD_S])
 
 
 def acceleration_ecef(r_m: ArrayLike, v_m_s: ArrayLike) -> np.ndarray:
-    """Acceleration (m/s^2) in the rotating frame: gravity with J2, Coriolis and centrifugal terms."""
+    """The acceleration in the rotating Earth frame: gravity with J2, Coriolis and centrifugal terms.
+
+    Parameters
+    ----------
+    r_m : array_like
+        Positions, ECEF, m, shape (..., 3).
+    v_m_s : array_like
+        Velocities relative to the rotating Earth, ECEF, m/s, shape (..., 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        Accelerations, ECEF, m/s^2, shape (..., 3).
+    """
     r = np.asarray(r_m, float)
     rn = np.linalg.norm(r, axis=-1, keepdims=True)
     z2 = (r[..., 2:3] / rn) ** 2
@@ -30,7 +43,22 @@ def acceleration_ecef(r_m: ArrayLike, v_m_s: ArrayLike) -> np.ndarray:
 def propagate(
     r_m: ArrayLike, v_m_s: ArrayLike, dt_s: ArrayLike, steps: int = 8
 ) -> tuple[np.ndarray, np.ndarray]:
-    """ECEF state after *dt_s* seconds (broadcast per row), by *steps* RK4 steps of dt_s/steps each."""
+    """The ECEF state after *dt_s*, by fourth-order Runge-Kutta steps.
+
+    Parameters
+    ----------
+    r_m, v_m_s : array_like
+        The state: ECEF position (m) and velocity (m/s), shape (..., 3).
+    dt_s : array_like
+        Time to propagate, s, broadcast per row.
+    steps : int, optional
+        RK4 steps of dt_s / steps each.
+
+    Returns
+    -------
+    r_m, v_m_s : numpy.ndarray
+        The state after *dt_s*.
+    """
     r = np.array(r_m, float)
     v = np.array(v_m_s, float)
     h = (np.asarray(dt_s, float) / steps)[..., None]
@@ -50,9 +78,21 @@ def propagate(
 def state_at(
     times_us: ArrayLike, mid_times_us: ArrayLike, positions_m: ArrayLike, velocities_m_s: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Spacecraft ECEF state at each of *times_us* (IET microseconds), from the nearest scan's MidTime state.
+    """The spacecraft's ECEF state at each of *times_us*, propagated from the nearest scan's MidTime state.
 
-    *mid_times_us* (n,) with *positions_m*/*velocities_m_s* (n, 3); returns (r, v) shaped times + (3,).
+    Parameters
+    ----------
+    times_us : array_like
+        The times wanted, IET us.
+    mid_times_us : array_like
+        Each scan's middle time, IET us, shape (n,).
+    positions_m, velocities_m_s : array_like
+        The spacecraft's ECEF position (m) and velocity (m/s) at each scan's middle, shape (n, 3).
+
+    Returns
+    -------
+    r_m, v_m_s : numpy.ndarray
+        ECEF position (m) and velocity (m/s), shape ``times_us.shape + (3,)``.
     """
     t = np.asarray(times_us, np.int64)
     mid = np.asarray(mid_times_us, np.int64)
@@ -62,7 +102,22 @@ def state_at(
 
 
 def interpolate_per_scan(times_us: ArrayLike, mid_times_us: ArrayLike, values: ArrayLike) -> np.ndarray:
-    """Linear interpolation (extrapolation at the ends) of per-scan *values* (n, k) to *times_us*."""
+    """Per-scan values interpolated linearly to *times_us* (extrapolated at the ends).
+
+    Parameters
+    ----------
+    times_us : array_like
+        The times wanted, IET us.
+    mid_times_us : array_like
+        Each scan's middle time, IET us, shape (n,).
+    values : array_like
+        The per-scan values (an attitude: roll, pitch, yaw, rad), shape (n, k).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``times_us.shape + (k,)``, in the values' unit.
+    """
     t = np.asarray(times_us, np.int64).astype(float)
     mid = np.asarray(mid_times_us, np.int64).astype(float)
     vals = np.asarray(values, float)

@@ -19,7 +19,20 @@ J2 = 1.08262668e-3  # EGM96 second zonal harmonic
 
 
 def geodetic_to_ecef(lat_rad: ArrayLike, lon_rad: ArrayLike, h_m: ArrayLike = 0.0) -> np.ndarray:
-    """ECEF position (..., 3) in metres of geodetic *lat_rad*, *lon_rad* and ellipsoidal height *h_m*."""
+    """The ECEF position of geodetic coordinates.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad : array_like
+        Geodetic latitude and longitude, rad.
+    h_m : array_like, optional
+        Height above the WGS84 ellipsoid, m.
+
+    Returns
+    -------
+    numpy.ndarray
+        ECEF positions, m, shape (..., 3).
+    """
     lat, lon, h = np.broadcast_arrays(
         np.asarray(lat_rad, float), np.asarray(lon_rad, float), np.asarray(h_m, float)
     )
@@ -34,8 +47,20 @@ def geodetic_to_ecef(lat_rad: ArrayLike, lon_rad: ArrayLike, h_m: ArrayLike = 0.
 
 
 def ecef_to_geodetic(xyz_m: ArrayLike, iterations: int = 5) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Geodetic (lat_rad, lon_rad, h_m) of ECEF points (..., 3); Bowring's iteration, converged to < 1 mm
-    (5 iterations hold from the ground to orbit; 2 are enough within ~10 km of the ellipsoid)."""
+    """Geodetic coordinates of ECEF points, by Bowring's iteration converged to < 1 mm.
+
+    Parameters
+    ----------
+    xyz_m : array_like
+        ECEF points, m, shape (..., 3).
+    iterations : int, optional
+        Bowring's iterations: 5 hold from the ground to orbit, 2 within ~10 km of the ellipsoid.
+
+    Returns
+    -------
+    lat_rad, lon_rad, h_m : numpy.ndarray
+        Geodetic latitude and longitude (rad) and height above the ellipsoid (m).
+    """
     xyz = np.asarray(xyz_m, float)
     x, y, z = xyz[..., 0], xyz[..., 1], xyz[..., 2]
     lon = np.arctan2(y, x)
@@ -53,15 +78,38 @@ def ecef_to_geodetic(xyz_m: ArrayLike, iterations: int = 5) -> tuple[np.ndarray,
 
 
 def surface_to_geodetic(xyz_m: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    """Geodetic (lat_rad, lon_rad) of ECEF points on the ellipsoid (h = 0), where the normal's slope is
-    closed-form: tan(lat) = z / ((1 - e^2) p), p = sqrt(x^2 + y^2); no iteration."""
+    """Geodetic latitude and longitude of ECEF points on the ellipsoid (h = 0), closed-form.
+
+    tan(lat) = z / ((1 - e^2) p), p = sqrt(x^2 + y^2): no iteration.
+
+    Parameters
+    ----------
+    xyz_m : array_like
+        ECEF points on the ellipsoid, m, shape (..., 3).
+
+    Returns
+    -------
+    lat_rad, lon_rad : numpy.ndarray
+        Geodetic latitude and longitude, rad.
+    """
     xyz = np.asarray(xyz_m, float)
     x, y, z = xyz[..., 0], xyz[..., 1], xyz[..., 2]
     return np.arctan2(z, np.hypot(x, y) * (1.0 - E2)), np.arctan2(y, x)
 
 
 def enu_basis(lat_rad: ArrayLike, lon_rad: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Unit vectors east, north, up (each (..., 3), ECEF) at geodetic *lat_rad*, *lon_rad*."""
+    """Unit vectors east, north and up at geodetic coordinates.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad : array_like
+        Geodetic latitude and longitude, rad.
+
+    Returns
+    -------
+    east, north, up : numpy.ndarray
+        ECEF unit vectors, shape (..., 3).
+    """
     lat = np.asarray(lat_rad, float)
     lon = np.asarray(lon_rad, float)
     sl, cl, so, co = np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon)
@@ -74,10 +122,22 @@ def enu_basis(lat_rad: ArrayLike, lon_rad: ArrayLike) -> tuple[np.ndarray, np.nd
 def look_vector_ecef(
     lat_rad: ArrayLike, lon_rad: ArrayLike, zenith_rad: ArrayLike, azimuth_rad: ArrayLike
 ) -> np.ndarray:
-    """Unit vector (..., 3, ECEF) from a ground point toward the satellite.
+    """The unit vector from a ground point toward the satellite.
 
-    *zenith_rad* is the satellite zenith angle at the ground point and *azimuth_rad* its azimuth,
-    clockwise from north (the JPSS ``SatelliteZenithAngle``/``SatelliteAzimuthAngle`` convention).
+    Parameters
+    ----------
+    lat_rad, lon_rad : array_like
+        Geodetic latitude and longitude of the ground point, rad.
+    zenith_rad : array_like
+        The satellite's zenith angle at the ground point, rad.
+    azimuth_rad : array_like
+        Its azimuth, clockwise from north, rad (the JPSS ``SatelliteZenithAngle`` and
+        ``SatelliteAzimuthAngle`` convention).
+
+    Returns
+    -------
+    numpy.ndarray
+        ECEF unit vectors, shape (..., 3).
     """
     east, north, up = enu_basis(lat_rad, lon_rad)
     sz = np.sin(zenith_rad)[..., None]
@@ -91,7 +151,18 @@ def look_vector_ecef(
 def zenith_azimuth(
     ground_ecef_m: ArrayLike, sat_ecef_m: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Satellite (zenith_rad, azimuth_rad, range_m) seen from ECEF ground points on the ellipsoid."""
+    """The satellite's zenith angle, azimuth and range seen from ground points on the ellipsoid.
+
+    Parameters
+    ----------
+    ground_ecef_m, sat_ecef_m : array_like
+        Ground points and satellite positions, ECEF, m, shape (..., 3).
+
+    Returns
+    -------
+    zenith_rad, azimuth_rad, range_m : numpy.ndarray
+        Zenith angle and azimuth (clockwise from north), rad, and range, m.
+    """
     lat, lon, _ = ecef_to_geodetic(ground_ecef_m)
     east, north, up = enu_basis(lat, lon)
     d = np.asarray(sat_ecef_m) - np.asarray(ground_ecef_m)
@@ -103,10 +174,24 @@ def zenith_azimuth(
 
 
 def intersect_ellipsoid(origin_m: ArrayLike, direction: ArrayLike, h_m: ArrayLike = 0.0) -> np.ndarray:
-    """Distance along unit *direction* from ECEF *origin_m* to the first crossing of the ellipsoid.
+    """The distance along a ray from an ECEF origin to its first crossing of the ellipsoid.
 
-    The ellipsoid is WGS84 grown by *h_m* on both axes (exact for h_m = 0, the IDPS convention).
-    Returns NaN where the ray misses. Shapes broadcast over the leading axes; the last is 3.
+    The ellipsoid is WGS84 grown by *h_m* on both axes (exact for h_m = 0, the IDPS convention). Shapes
+    broadcast over the leading axes; the last is 3.
+
+    Parameters
+    ----------
+    origin_m : array_like
+        Ray origins, ECEF, m.
+    direction : array_like
+        Unit ray directions, ECEF.
+    h_m : array_like, optional
+        Height the ellipsoid is grown by, m.
+
+    Returns
+    -------
+    numpy.ndarray
+        Distances, m; NaN where the ray misses.
     """
     o = np.asarray(origin_m, float)
     d = np.asarray(direction, float)
@@ -123,6 +208,17 @@ def intersect_ellipsoid(origin_m: ArrayLike, direction: ArrayLike, h_m: ArrayLik
 
 
 def geodetic_up(xyz_m: ArrayLike) -> np.ndarray:
-    """Unit normal to the ellipsoid (..., 3) at (or below) ECEF points, i.e. geodetic up."""
+    """The unit normal to the ellipsoid at (or below) ECEF points: geodetic up.
+
+    Parameters
+    ----------
+    xyz_m : array_like
+        ECEF points, m, shape (..., 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        ECEF unit vectors, shape (..., 3).
+    """
     lat, lon, _ = ecef_to_geodetic(xyz_m)
     return enu_basis(lat, lon)[2]
