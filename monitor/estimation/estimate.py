@@ -96,7 +96,13 @@ class ForSamples:
 
     @property
     def footprint(self) -> bool:
-        """Whether the samples carry annuli, so that the response is fitted."""
+        """Whether the samples carry annuli, so that the response is fitted.
+
+        Returns
+        -------
+        bool
+            True with annuli.
+        """
         return self.annuli_rad is not None
 
 
@@ -181,8 +187,18 @@ def _stdev(d: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
 
 
 def calibration_regressors(cris: np.ndarray) -> np.ndarray:
-    """The regressors of the regression cost (N, 2): the CrIS BT and its square about its mean, so that a
-    CrIS-VIIRS difference bias + gain T + curvature T^2 is explained away."""
+    """The regressors of the regression cost: the CrIS BT and its square about its mean.
+
+    Parameters
+    ----------
+    cris : numpy.ndarray
+        The samples' CrIS BT, K, shape (N,).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N, 2), K and K^2: a CrIS-VIIRS difference bias + gain T + curvature T^2 is explained away.
+    """
     c = np.asarray(cris, float) - np.mean(cris)
     return np.stack([c, c * c], axis=1)
 
@@ -214,17 +230,45 @@ def _regression_stdev(d: np.ndarray, cris: np.ndarray, weights: np.ndarray | Non
 def cost_surface(
     d: np.ndarray, cris: np.ndarray, cost: Cost, weights: np.ndarray | None = None
 ) -> np.ndarray:
-    """The cost over the perturbation grid of one FOR's samples (:class:`~monitor.core.vocabulary.Cost`)."""
+    """The cost over the perturbation grid of one FOR's samples (:class:`~monitor.core.vocabulary.Cost`).
+
+    Parameters
+    ----------
+    d : numpy.ndarray
+        Each sample's VIIRS minus CrIS BT at every perturbation, K, shape (N, m, m).
+    cris : numpy.ndarray
+        The samples' CrIS BT, K, shape (N,).
+    cost : Cost
+        The cost (``assessment.cost``).
+    weights : numpy.ndarray, optional
+        Replicate weights of the samples, shape (B, N): one surface per replicate.
+
+    Returns
+    -------
+    numpy.ndarray
+        The cost, K, shape (m, m) or (B, m, m).
+    """
     return _stdev(d, weights) if cost == Cost.STDEV else _regression_stdev(d, cris, weights)
 
 
 def find_minimum(cost: np.ndarray, contrast: float = 0.03) -> tuple[float, float, list[str]]:
-    """Sub-step minimum (x_i, y_j in grid steps from the centre) of a cost surface, and its flags.
+    """The sub-step minimum of a cost surface by the quadratic through the 3 x 3 about the grid minimum (Wang
+    2013).
 
-    A quadratic surface through the 3x3 neighbourhood of the grid minimum gives the sub-step position
-    (Wang 2013). A minimum on the grid border is flagged ``edge`` and not refined; a surface that
-    rises less than *contrast* (relative) from its minimum to the grid border, or whose fit is not
-    convex, is flagged ``flat``.
+    Parameters
+    ----------
+    cost : numpy.ndarray
+        The cost surface, K, shape (m, m).
+    contrast : float
+        The relative rise from the minimum to the grid's border below which a surface is flagged ``flat``.
+
+    Returns
+    -------
+    x, y : float
+        The minimum, grid steps from the centre (in-track, cross-track).
+    flags : list of str
+        ``edge`` where the grid minimum is on the border (not refined); ``flat`` where the surface rises less
+        than *contrast* or its fit is not convex.
     """
     m = cost.shape[0]
     n = (m - 1) // 2
@@ -290,16 +334,37 @@ def response_weights(
     band: I5Band,
     weights: np.ndarray | None = None,
 ) -> np.ndarray:
-    """The annulus weights w (K,), sum 1, that minimise the residual variance w^T M w of the cost's
-    difference, BT(sum_k w_k A_k) - C, at the refined optimum *at* (module docstring), for a response that
-    does not grow outwards; *weights* (K,) are the current ones (None: the annuli's solid angles, a top hat
-    out to the last).
+    """The annulus weights, sum 1, that minimise the residual variance of the cost's difference at the
+    optimum.
 
-    The difference is linear in w about the current V = sum_k w_k A_k: BT(V) + s (A_k - V) - C for annulus
-    k, s = dBT/dL at V, so that M is the covariance of these over the samples, less what the cost's
-    calibration regressors explain (a Schur complement). In BT, as the cost is: a CrIS-VIIRS bias, gain or
-    curvature leaves the weights as they were, as it leaves the cost. The response stays monotone
-    (:func:`monitor.instrument.footprint.monotone_weights`)."""
+    The difference is linear in w about the current V = sum_k w_k A_k: BT(V) + s (A_k - V) - C for annulus k,
+    s = dBT/dL at V, so that M is the covariance of these over the samples, less what the cost's calibration
+    regressors explain (a Schur complement). In BT, as the cost is: a CrIS-VIIRS bias, gain or curvature
+    leaves the weights as they were. The response stays monotone
+    (:func:`monitor.instrument.footprint.monotone_weights`).
+
+    Parameters
+    ----------
+    annuli_rad : numpy.ndarray
+        The samples' VIIRS radiance means in each annulus at every perturbation, shape (N, K, m, m).
+    cris_k : numpy.ndarray
+        The samples' CrIS BT, K, shape (N,).
+    at : _Minimum
+        The refined optimum.
+    cost : Cost
+        The cost (``assessment.cost``).
+    radii_rad : tuple of float
+        The annuli's outer radii, rad.
+    band : I5Band
+        The satellite's I5 band (radiance to BT).
+    weights : numpy.ndarray, optional
+        The current weights (K,); None: the annuli's solid angles, a top hat out to the last.
+
+    Returns
+    -------
+    numpy.ndarray
+        The weights, shape (K,), of a response that does not grow outwards.
+    """
     a = np.stack(
         [
             refine.window_values(annuli_rad[:, k], at.i0, at.j0, at.dx, at.dy)
@@ -386,13 +451,40 @@ def _estimate(
 
 
 def fitted_response(s: ForSamples, cost: Cost, contrast: float = 0.03) -> np.ndarray | None:
-    """The annulus weights (K,) the FOR's samples find at their minimum (None: no annuli, too few samples or
-    no refined minimum)."""
+    """The annulus weights the FOR's samples find at their minimum.
+
+    Parameters
+    ----------
+    s : ForSamples
+        One FOR's samples.
+    cost : Cost
+        The cost (``assessment.cost``).
+    contrast : float
+        The relative rise from the minimum to the grid's border below which a surface is flagged ``flat``.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        The weights (K,); None without annuli, with too few samples or no refined minimum.
+    """
     return _estimate(s, cost, contrast)[1]
 
 
 def through(s: ForSamples, weights: np.ndarray) -> ForSamples:
-    """*s* with its surface the VIIRS - CrIS BT through the annulus *weights*, not the top-hat cone."""
+    """The samples with their surface the VIIRS minus CrIS BT through annulus weights, not the top-hat cone.
+
+    Parameters
+    ----------
+    s : ForSamples
+        One FOR's samples.
+    weights : numpy.ndarray
+        The annulus weights, shape (K,).
+
+    Returns
+    -------
+    ForSamples
+        The same samples.
+    """
     return replace(s, d_k=_with_footprint(s, weights))
 
 
@@ -403,8 +495,22 @@ def _flagged(at: _Minimum, flags: list[str], converged: bool) -> _Minimum:
 
 
 def rows_apart(s: ForSamples, cost: Cost, contrast: float = 0.03) -> tuple[float, float]:
-    """(x, y) steps from the rows behind to the rows ahead (:data:`FOV_ROWS`), each row's own minimum of
-    the surface *s* carries; (0, 0) where either has fewer than 3 samples or no clear minimum."""
+    """The steps from the FOV rows behind to the rows ahead, each row's own minimum of the surface.
+
+    Parameters
+    ----------
+    s : ForSamples
+        One FOR's samples.
+    cost : Cost
+        The cost (``assessment.cost``).
+    contrast : float
+        The relative rise from the minimum to the grid's border below which a surface is flagged ``flat``.
+
+    Returns
+    -------
+    tuple of float
+        (x, y), grid steps; (0, 0) where either row has fewer than 3 samples or no clear minimum.
+    """
     if s.fov is None:
         return 0.0, 0.0
     found = []
@@ -422,8 +528,21 @@ def rows_apart(s: ForSamples, cost: Cost, contrast: float = 0.03) -> tuple[float
 
 
 def aligned(s: ForSamples, apart: tuple[float, float]) -> ForSamples:
-    """*s* with the rows ahead's surfaces moved by -apart/2 and the rows behind's by +apart/2 (steps; linear
-    interpolation, held at the grid's edge), so that both rows meet at their common turn."""
+    """The samples with the outer rows moved to meet at their common turn.
+
+    Parameters
+    ----------
+    s : ForSamples
+        One FOR's samples.
+    apart : tuple of float
+        The rows' separation (:func:`rows_apart`), grid steps.
+
+    Returns
+    -------
+    ForSamples
+        The rows ahead's surfaces moved by -apart/2 and the rows behind's by +apart/2 (linear interpolation,
+        held at the grid's edge).
+    """
     if s.fov is None or apart == (0.0, 0.0):
         return s
     d, annuli = s.d_k.copy(), None if s.annuli_rad is None else s.annuli_rad.copy()
@@ -443,9 +562,27 @@ def estimate(
     uncertainty: bool = True,
     reach: int = reach_steps(DEFAULT_STEP_RAD),
 ) -> ForEstimate:
-    """Offsets, jackknife sigmas, flags, the intercalibration and (with annuli) the footprint of one FOR's
-    samples (module docstring), its rows aligned first (:func:`aligned`); the intercalibration weighs each
-    sample by how much its cone mean changes within *reach* steps of the optimum (:mod:`intercal`)."""
+    """Offsets, jackknife sigmas, flags, the intercalibration and the footprint of one FOR's samples.
+
+    Parameters
+    ----------
+    s : ForSamples
+        One FOR's samples.
+    cost : Cost
+        The cost (``assessment.cost``).
+    contrast : float
+        The relative rise from the minimum to the grid's border below which a surface is flagged ``flat``.
+    uncertainty : bool
+        Whether to compute the jackknife sigmas.
+    reach : int
+        The turns (grid steps) about the optimum within which the intercalibration reads each sample's
+        collocation spread (:mod:`monitor.estimation.intercal`).
+
+    Returns
+    -------
+    ForEstimate
+        The FOR's estimate, its rows aligned first (:func:`aligned`).
+    """
     start, apart = None, (0.0, 0.0)
     if s.fov is not None:
         # the rows apart on the surface through the response the unaligned rows find: the top-hat cone's

@@ -94,7 +94,18 @@ class Intercalibration:
     sigma_curvature_k: float
 
     def sigmas_scaled(self, factor: float) -> Intercalibration:
-        """The same fit with every sigma times *factor* (the jackknife's count of independent granules)."""
+        """The same fit with every sigma times a factor (the jackknife's count of independent granules).
+
+        Parameters
+        ----------
+        factor : float
+            The factor.
+
+        Returns
+        -------
+        Intercalibration
+            The scaled fit.
+        """
         return replace(
             self,
             sigma_bias_k=factor * self.sigma_bias_k,
@@ -104,7 +115,13 @@ class Intercalibration:
 
     @property
     def gain_undetermined(self) -> bool:
-        """A bias was fitted, but the scenes' temperatures could not determine a gain."""
+        """Whether a bias was fitted but the scenes' temperatures could not determine a gain.
+
+        Returns
+        -------
+        bool
+            True then.
+        """
         return math.isfinite(self.bias_k) and not math.isfinite(self.gain_pct)
 
 
@@ -112,15 +129,39 @@ NO_FIT = Intercalibration(*[np.nan] * 6)
 
 
 def reach_steps(step_rad: float) -> int:
-    """The turns (grid steps of *step_rad*) that cover ``REACH_RAD`` about the optimum."""
+    """The turns that cover ``REACH_RAD`` about the optimum.
+
+    Parameters
+    ----------
+    step_rad : float
+        The perturbation step, rad.
+
+    Returns
+    -------
+    int
+        Grid steps.
+    """
     return max(1, math.ceil(REACH_RAD / step_rad - 1e-9))
 
 
 def collocation_spread_k(d_k: np.ndarray, i0: int, j0: int, reach: int) -> np.ndarray:
-    """Per sample, the most the cone mean changes (K) over the turns within *reach* steps (a square,
-    clipped to the grid) of the optimum (*i0*, *j0*) of the surfaces *d_k* (N, m, m) of V - C: what the
-    collocation can put into V there (module docstring); infinite where a turn has no cone mean (the
-    sample then weighs nothing)."""
+    """Per sample, the most its cone mean changes over the turns within reach of the optimum.
+
+    Parameters
+    ----------
+    d_k : numpy.ndarray
+        The samples' V - C surfaces, K, shape (N, m, m).
+    i0, j0 : int
+        The optimum's grid indices.
+    reach : int
+        The turns each side, a square clipped to the grid (:func:`reach_steps`).
+
+    Returns
+    -------
+    numpy.ndarray
+        K, shape (N,): what the collocation can put into V there; infinite where a turn has no cone mean (the
+        sample then weighs nothing).
+    """
     m = d_k.shape[1]
     window = d_k[:, max(0, i0 - reach) : min(m, i0 + reach + 1), max(0, j0 - reach) : min(m, j0 + reach + 1)]
     spread = np.abs(window - d_k[:, i0, j0][:, None, None]).max(axis=(1, 2))
@@ -170,11 +211,30 @@ def fit_difference(
     counts: np.ndarray | None = None,
     terms: int = 3,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The law's first *terms* parameters (b_k, g, c_k) over the samples *cris_k*, *viirs_k* (N,) whose
-    collocation spreads are *spread_k* (N,), with the variance model's *scale* (sigma_0 in K, kappa): (p,)
-    and the covariance (p, p); with *counts* (B, N), e.g. jackknife replicates, one fit per row ((B, p),
-    (B, p, p)), and *viirs_k* may be (B, N): one V per row. The effective-variance weights, their slope
-    factor from a first fit."""
+    """The law's first parameters (b_k, g, c_k) fitted with effective-variance weights.
+
+    The weights' slope factor comes from a first fit.
+
+    Parameters
+    ----------
+    cris_k, viirs_k : numpy.ndarray
+        The samples' CrIS BT and VIIRS cone mean at the optimum, K, shape (N,).
+        *viirs_k* may be (B, N): one V per row.
+    spread_k : numpy.ndarray
+        The samples' collocation spreads (:func:`collocation_spread_k`), K, shape (N,).
+    scale : tuple of float
+        The variance model's sigma_0 (K) and kappa (:func:`variance_scale`).
+    counts : numpy.ndarray, optional
+        Replicate weights, shape (B, N): one fit per row.
+    terms : int
+        1 (the bias), 2 (and the gain) or 3 (and the curvature).
+
+    Returns
+    -------
+    params, covariance : numpy.ndarray
+        Shapes (p,) and (p, p), or (B, p) and (B, p, p); the bias in K, the gain as a fraction, the curvature
+        in K.
+    """
     one = counts is None
     w0 = np.ones((1, len(cris_k))) if one else np.asarray(counts, float)
     v = np.broadcast_to(np.asarray(viirs_k, float), w0.shape)
@@ -189,8 +249,22 @@ def fit_difference(
 def variance_scale(
     cris_k: np.ndarray, viirs_k: np.ndarray, spread_k: np.ndarray, terms: int = 3
 ) -> tuple[float, float]:
-    """(sigma_0 in K, kappa) of the variance model sigma_0^2 + kappa^2 s_n^2, by maximum likelihood of the
-    fit's residuals (the law's parameters profiled out); None-like (NaN, NaN) without degrees of freedom."""
+    """The variance model's scale, sigma_0^2 + kappa^2 s_n^2, by maximum likelihood of the fit's residuals.
+
+    Parameters
+    ----------
+    cris_k, viirs_k : numpy.ndarray
+        The samples' CrIS BT and VIIRS cone mean at the optimum, K, shape (N,).
+    spread_k : numpy.ndarray
+        The samples' collocation spreads, K, shape (N,).
+    terms : int
+        The law's parameters, profiled out.
+
+    Returns
+    -------
+    sigma_0_k, kappa : float
+        NaN without degrees of freedom.
+    """
     if len(cris_k) <= terms + 2:
         return math.nan, math.nan
     finite = np.isfinite(spread_k)
@@ -217,11 +291,25 @@ def intercalibrate(
     jackknife: Jackknife | None = None,
     viirs_boot_k: np.ndarray | None = None,
 ) -> Intercalibration:
-    """The bias, gain and curvature of one FOR's samples at its optimum, the samples' collocation spreads
-    *spread_k* (:func:`collocation_spread_k`) weighing them; sigmas from the *jackknife*'s replicates, each
-    fitted at its own optimum where *viirs_boot_k* (G, N) gives the V there. No fit (NaN) from fewer than
-    ``MIN_SAMPLES``; the gain and curvature NaN where their sigma (the jackknife's, else the fit's) exceeds
-    ``GAIN_RESOLUTION_PCT``."""
+    """The bias, gain and curvature of one FOR's samples at its optimum.
+
+    Parameters
+    ----------
+    cris_k, viirs_k : numpy.ndarray
+        The samples' CrIS BT and VIIRS cone mean at the optimum, K, shape (N,).
+    spread_k : numpy.ndarray
+        The samples' collocation spreads (:func:`collocation_spread_k`), K, shape (N,).
+    jackknife : Jackknife, optional
+        The replicates the sigmas come from.
+    viirs_boot_k : numpy.ndarray, optional
+        Each replicate's V at its own optimum, K, shape (G, N).
+
+    Returns
+    -------
+    Intercalibration
+        No fit (NaN) from fewer than ``MIN_SAMPLES``; the gain and curvature NaN where their sigma (the
+        jackknife's, else the fit's) exceeds ``GAIN_RESOLUTION_PCT``.
+    """
     c, v, s = (np.asarray(a, float) for a in (cris_k, viirs_k, spread_k))
     if len(c) < MIN_SAMPLES:
         return NO_FIT
@@ -244,8 +332,18 @@ def intercalibrate(
 
 
 def difference_bins(cris_k: np.ndarray, viirs_k: np.ndarray) -> list[DifferenceBin]:
-    """C - V against C in bins ``CALIBRATION_BIN_K`` wide on multiples of it (the paper's Figure 15); bins
-    without samples are left out."""
+    """C - V against C in bins ``CALIBRATION_BIN_K`` wide on multiples of it (the paper's Figure 15).
+
+    Parameters
+    ----------
+    cris_k, viirs_k : numpy.ndarray
+        The samples' CrIS BT and VIIRS cone mean at the optimum, K, shape (N,).
+
+    Returns
+    -------
+    list of DifferenceBin
+        The bins with samples.
+    """
     c = np.asarray(cris_k, float)
     d = c - np.asarray(viirs_k, float)
     ok = np.isfinite(c) & np.isfinite(d)

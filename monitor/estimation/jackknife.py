@@ -69,19 +69,55 @@ MAX_GROUPS = 20  # replicates at most: beyond this many granules each leaves out
 
 
 def t_factor(nu: float) -> float:
-    """The factor from a standard error with *nu* degrees of freedom to the sigma whose 2-sigma interval
-    covers as a normal's (module docstring); NaN for nu < 1."""
+    """The factor from a standard error to the sigma whose 2-sigma interval covers as a normal's.
+
+    Parameters
+    ----------
+    nu : float
+        The degrees of freedom.
+
+    Returns
+    -------
+    float
+        t_nu(Phi(2)) / 2; NaN for nu < 1.
+    """
     return float(stats.t.ppf(TWO_SIGMA, nu) / 2.0) if nu >= 1 else math.nan
 
 
 def effective_groups(groups: int, rho: float) -> float:
-    """G_eff of *groups* granules whose neighbours correlate by *rho* (module docstring)."""
+    """G_eff of granules whose neighbours correlate: G (1 - rho) / (1 + rho).
+
+    Parameters
+    ----------
+    groups : int
+        G, the granules (or runs of them) the replicates leave out.
+    rho : float
+        The lag-one correlation of consecutive granules' replicates.
+
+    Returns
+    -------
+    float
+        The effective number of independent granules.
+    """
     return groups * (1.0 - rho) / (1.0 + rho)
 
 
 def correlation_factor(groups: int, rho: float) -> float:
-    """What a lag-one correlation *rho* of consecutive granules does to a sigma from *groups* granules:
-    sqrt(G / G_eff) t(G_eff - 1) / t(G - 1); NaN where G_eff - 1 < 1."""
+    """What a lag-one correlation of consecutive granules does to a sigma: sqrt(G / G_eff) t(G_eff - 1) / t(G
+    - 1).
+
+    Parameters
+    ----------
+    groups : int
+        G, the granules (or runs of them) the replicates leave out.
+    rho : float
+        The lag-one correlation.
+
+    Returns
+    -------
+    float
+        The factor; NaN where G_eff - 1 < 1.
+    """
     if rho <= 0:
         return 1.0
     g_eff = effective_groups(groups, rho)
@@ -89,37 +125,80 @@ def correlation_factor(groups: int, rho: float) -> float:
 
 
 def follows_in_time(starts_s: Sequence[float]) -> np.ndarray:
-    """Per granule (in the order given, start times *starts_s* in seconds), whether it directly follows the
-    one before: it starts at most 1.5 CrIS granules after it (consecutive granules start 32 s apart)."""
+    """Per granule, whether it directly follows the one before.
+
+    Parameters
+    ----------
+    starts_s : sequence of float
+        The granules' start times, s, in the order given.
+
+    Returns
+    -------
+    numpy.ndarray
+        bool per granule: it starts at most 1.5 CrIS granules after the one before (consecutive granules start
+        32 s apart).
+    """
     s = np.asarray(starts_s, float)
     gap = np.diff(s, prepend=np.nan)
     return (gap > 0) & (gap <= 1.5 * CRIS_GRANULE_US * 1e-6)
 
 
 def jackknife_sigma(replicates: np.ndarray) -> float:
-    """The delete-one jackknife standard error from the G replicates' estimates: sqrt((G - 1)/G sum
-    (x_g - mean)^2)."""
+    """The delete-one jackknife standard error: sqrt((G - 1)/G sum (x_g - mean)^2).
+
+    Parameters
+    ----------
+    replicates : numpy.ndarray
+        The G replicates' estimates.
+
+    Returns
+    -------
+    float
+        The standard error, in the estimates' unit.
+    """
     g = len(replicates)
     return float(np.sqrt((g - 1) / g * np.sum((replicates - replicates.mean()) ** 2)))
 
 
 def granule_runs(granules: np.ndarray) -> list[np.ndarray]:
-    """The granules each replicate leaves out, from the granule of every sample *granules* (ids in time
-    order): each its own up to :data:`MAX_GROUPS` granules, else MAX_GROUPS runs of consecutive ones whose
-    lengths differ by at most one (module docstring)."""
+    """The granules each replicate leaves out.
+
+    Parameters
+    ----------
+    granules : numpy.ndarray
+        The granule of every sample (ids in time order).
+
+    Returns
+    -------
+    list of numpy.ndarray
+        Each granule on its own up to :data:`MAX_GROUPS` granules, else MAX_GROUPS runs of consecutive ones
+        whose lengths differ by at most one.
+    """
     ids = np.unique(granules)
     return np.array_split(ids, min(len(ids), MAX_GROUPS))
 
 
 def adjacent_correlation(replicates: Sequence[tuple[np.ndarray, np.ndarray]], follows: np.ndarray) -> float:
-    """The day's lag-one correlation of the replicates of consecutive granules (module docstring): each
-    series in *replicates* (pairs of the first and last granule each replicate leaves out (G, 2) and the
-    replicates (G, k), one column a series) on its own scale; per pair of replicates of which the second
-    leaves out the granule after the first's last, and that granule directly follows it in time
-    (*follows* (granules,)), the mean product over the series; rho their mean, corrected for the -1 / G
-    bias. The series of one day share their granules' scenes, so the pairs, not the products, are the
-    independent units: rho counts only where it exceeds twice its standard error over the pairs (0
-    otherwise, and where no granule follows another)."""
+    """The day's lag-one correlation of the replicates of consecutive granules.
+
+    Per pair of replicates of which the second leaves out the granule after the first's last, and that
+    granule directly follows it in time, the mean product over the series; rho their mean. The series of
+    one day share their granules' scenes, so the pairs, not the products, are the independent units.
+
+    Parameters
+    ----------
+    replicates : sequence of (numpy.ndarray, numpy.ndarray)
+        Per series, the first and last granule each replicate leaves out (G, 2) and the replicates (G, k), one
+        column a series, each on its own scale.
+    follows : numpy.ndarray
+        Per granule, whether it directly follows the one before (:func:`follows_in_time`).
+
+    Returns
+    -------
+    float
+        rho, corrected for the -1 / G bias; 0 unless it exceeds twice its standard error over the pairs, and
+        where no granule follows another.
+    """
     products: dict[int, list[float]] = {}
     lengths = []
     for spans, reps in replicates:
@@ -145,7 +224,20 @@ def adjacent_correlation(replicates: Sequence[tuple[np.ndarray, np.ndarray]], fo
 
 
 def uncertainty_note(granules: int, rho: float) -> str:
-    """What a result says of how its sigmas count its *granules*, consecutive ones correlated by *rho*."""
+    """What a result says of how its sigmas count its granules.
+
+    Parameters
+    ----------
+    granules : int
+        The day's granules.
+    rho : float
+        The lag-one correlation of consecutive granules counted.
+
+    Returns
+    -------
+    str
+        The note, for the result's ``notes``.
+    """
     if granules < MIN_GRANULES:
         return (
             f"sigmas: {granules} granule(s), the scans within them resampled (the scene-to-scene part unseen)"
@@ -173,10 +265,22 @@ class Jackknife:
 
     @classmethod
     def of(cls, granule: np.ndarray, scan: np.ndarray) -> Jackknife | None:
-        """The replicates of samples from granules *granule* (N,, ids in time order) and scans *scan* (N,)
-        within them: one per granule from :data:`MIN_GRANULES` granules (per run of consecutive granules
-        beyond :data:`MAX_GROUPS`, :func:`granule_runs`), else one per scan; None from fewer groups than
-        that."""
+        """The replicates of samples from granules and scans.
+
+        Parameters
+        ----------
+        granule : numpy.ndarray
+            Each sample's granule (ids in time order), shape (N,).
+        scan : numpy.ndarray
+            Each sample's scan within its granule, shape (N,).
+
+        Returns
+        -------
+        Jackknife or None
+            One replicate per granule from :data:`MIN_GRANULES` granules (per run of consecutive granules
+            beyond :data:`MAX_GROUPS`, :func:`granule_runs`), else one per scan; None from fewer groups than
+            that.
+        """
         granule, scan = np.asarray(granule), np.asarray(scan)
         if len(np.unique(granule)) >= MIN_GRANULES:
             runs = granule_runs(granule)
@@ -191,13 +295,29 @@ class Jackknife:
 
     @property
     def groups(self) -> int:
-        """G, the number of replicates."""
+        """G, the number of replicates.
+
+        Returns
+        -------
+        int
+            G.
+        """
         return len(self.counts)
 
     def sigma(self, replicates: np.ndarray) -> np.ndarray:
-        """The sigma of the statistic whose G *replicates* are along axis 0, its groups independent: the
-        jackknife's standard error times t_factor(G - 1) (module docstring); NaN replicates are left out, G
-        counting those that remain (NaN below MIN_GRANULES)."""
+        """The sigma of a statistic from its replicates, its groups independent.
+
+        Parameters
+        ----------
+        replicates : numpy.ndarray
+            The G replicates along axis 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            The jackknife's standard error times t_factor(G - 1), in the statistic's unit; NaN replicates are
+            left out, G counting those that remain (NaN below MIN_GRANULES).
+        """
         t = np.asarray(replicates, float)
         g = np.sum(np.isfinite(t), axis=0)
         factor = np.vectorize(t_factor, otypes=[float])(g - 1.0)

@@ -37,11 +37,25 @@ NAN4 = (np.nan,) * 4
 def floor_urad(
     cfg: AssessmentConfig, used: Kernel, cone_error_urad: tuple[float, float]
 ) -> tuple[float, float]:
-    """What the estimator itself leaves beside the jackknife's scatter (urad, in-track and cross-track), added
-    in quadrature: ``sigma_floor_urad`` where configured; else nothing where the kernel *used* is the
-    configured one, and for a cone's estimate where the footprint is configured the day's own measure of
-    the cone's error, *cone_error_urad* (the RMS of cone minus footprint over the FORs that fitted a
-    response; 0 where none did)."""
+    """What the estimator itself leaves beside the jackknife's scatter, added in quadrature.
+
+    Parameters
+    ----------
+    cfg : AssessmentConfig
+        The configuration: ``sigma_floor_urad`` and the kernel configured.
+    used : Kernel
+        The kernel the FOR's estimate used.
+    cone_error_urad : tuple of float
+        The day's own measure of the cone's error, in-track and cross-track, urad: the RMS of cone minus
+        footprint over the FORs that fitted a response (0 where none did).
+
+    Returns
+    -------
+    tuple of float
+        In-track and cross-track, urad: ``sigma_floor_urad`` where configured; else nothing where the kernel
+        used is the configured one, and *cone_error_urad* for a cone's estimate where the footprint is
+        configured.
+    """
     if cfg.sigma_floor_urad is not None:
         return cfg.sigma_floor_urad, cfg.sigma_floor_urad
     return (0.0, 0.0) if used == cfg.kernel else cone_error_urad
@@ -90,11 +104,38 @@ def for_offset(
     lift: tuple[float, float],
     flags: Iterable[str],
 ) -> ForOffset:
-    """The record of FOR *for_index* (1..30) from its parts: the *turn_urad* (alpha, beta) and its final
-    *sigma_urad*; *ground_km* (in-track, cross-track, their sigmas); *cost_k* (at the minimum, at no turn);
-    the intercalibration *cal*; *response_urad* (full width at 50 % and its sigma, at 10 % and its sigma);
-    *rows_urad* (rows ahead minus behind, alpha and beta, and their sigmas); *lift* (m/K, height km); its
-    *flags*. Non-finite parts stay NaN: nothing was measured there."""
+    """The record of one FOR from its parts; non-finite parts stay NaN (nothing was measured there).
+
+    Parameters
+    ----------
+    for_index : int
+        The FOR, 1..30.
+    n_samples : int
+        The FOVs in its cost.
+    turn_urad : tuple of float
+        The offsets (d_alpha, d_beta), urad, spacecraft body frame.
+    sigma_urad : tuple of float
+        Their final sigmas, urad.
+    ground_km : tuple of float
+        The in-track and cross-track errors on the ground and their sigmas, km.
+    cost_k : tuple of float
+        The cost at the minimum and at no turn, K.
+    cal : Intercalibration
+        The CrIS-VIIRS intercalibration at the optimum.
+    response_urad : sequence of float
+        The response's full width at 50 % and its sigma, at 10 % and its sigma, urad.
+    rows_urad : sequence of float
+        The FOV rows ahead minus behind, alpha and beta, and their sigmas, urad.
+    lift : tuple of float
+        The day's lift, m/K, and the height it gives the FOR's cold scenes, km.
+    flags : iterable of str
+        The FOR's flags.
+
+    Returns
+    -------
+    ForOffset
+        The record.
+    """
     it, ct, s_it, s_ct = ground_km
     return ForOffset(
         for_index=for_index,
@@ -149,16 +190,38 @@ def day_offsets(
     follows: np.ndarray | None = None,
     lift: DayLift = NO_LIFT,
 ) -> DayEstimate:
-    """Every FOR's estimate as a :class:`~monitor.core.result.ForOffset` (:func:`for_offset`): angles in urad
-    with the jackknife sigma (granules that directly follow one another, *follows* (granules,) bool, counted
-    as fewer by the day's correlation of their replicates: :mod:`monitor.estimation.jackknife`), the floor
-    and the day's *lift* spread in quadrature, flags, the intercalibration; in km where *km* (FOR index
-    0-based, turn in rad) gives the mean in-track and cross-track km of a turn and its Jacobian (km/rad),
-    NaN without. *per_for* may build each FOR's samples when indexed (a long day's are read from disk): each
-    is taken once, and dropped once estimated."""
+    """Every FOR's estimate of a day as a :class:`~monitor.core.result.ForOffset`.
+
+    Angles in urad with the jackknife sigma, the floor and the lift's spread in quadrature, flags and the
+    intercalibration.
+
+    Parameters
+    ----------
+    per_for : sequence of ForSamples
+        Each FOR's samples; may build them when indexed (a long day's are read from disk): each is taken once,
+        and dropped once estimated.
+    cfg : AssessmentConfig
+        The assessment's configuration.
+    step_urad : float
+        The perturbation step, urad.
+    km : callable, optional
+        Given a FOR (0-based) and a turn (rad), the mean in-track and cross-track km of it and its Jacobian
+        (km/rad); the km are NaN without.
+    follows : numpy.ndarray, optional
+        Per granule, whether it directly follows the one before: such granules count as fewer by the day's
+        correlation of their replicates (:mod:`monitor.estimation.jackknife`).
+    lift : DayLift, optional
+        The day's lift and the spread it adds to each FOR, in quadrature.
+
+    Returns
+    -------
+    DayEstimate
+        The 30 records, their cost surfaces, the CrIS - VIIRS difference in BT bins and the correlation the
+        sigmas count.
+    """
     reach = reach_steps(step_urad * URAD)
 
-    def one(k: int) -> tuple[ForEstimate | None, np.ndarray]:
+    def _one(k: int) -> tuple[ForEstimate | None, np.ndarray]:
         """FOR k's estimate (None with fewer than 3 samples) and its samples' CrIS BT."""
         s = per_for[k]
         return (
@@ -168,7 +231,7 @@ def day_offsets(
     # the FORs are independent: estimated on the assessment's threads (numpy and the compiled BT inversion
     # leave the interpreter's lock), each the same numbers as alone
     with ThreadPoolExecutor(max_workers=max(1, cfg.workers), thread_name_prefix="estimate") as pool:
-        estimates, cris = (list(x) for x in zip(*pool.map(one, range(len(per_for))), strict=True))
+        estimates, cris = (list(x) for x in zip(*pool.map(_one, range(len(per_for))), strict=True))
     m = next((e.cost.shape[0] for e in estimates if e is not None), 2 * cfg.half_steps + 1)
     cube = np.full((len(per_for), m, m), np.nan)
     series = [

@@ -73,8 +73,20 @@ signature): the assessment takes one as an argument, so that a study can thin or
 
 
 def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
-    """The samples of a FOR collocated at f times the probe's lift, from those at none (*s0*) and at the
-    probe's (*s1*): the same samples, in the same order."""
+    """The samples of a FOR collocated at f times the probe's lift, from those at none and at the probe's.
+
+    Parameters
+    ----------
+    s0, s1 : ForSamples
+        The FOR's samples at no lift and at the probe's, the same samples in the same order.
+    f : float
+        The fraction of the probe's lift.
+
+    Returns
+    -------
+    ForSamples
+        V0 + f (V1 - V0), the same samples in the same order.
+    """
     annuli = None
     if s0.annuli_rad is not None and s1.annuli_rad is not None:
         annuli = s0.annuli_rad + f * (s1.annuli_rad - s0.annuli_rad)
@@ -82,14 +94,25 @@ def blend(s0: ForSamples, s1: ForSamples, f: float) -> ForSamples:
 
 
 def matched_cone(a: ForSamples, b: ForSamples, cost: Cost) -> tuple[ForSamples, ForSamples]:
-    """A FOR's samples at no lift (*a*) and at the probe's (*b*), their surfaces through the paper's cone
-    scaled by the half-peak width the FOR's response reads against the nominal, where it has annuli
-    (elsewhere the cone's, as they came); kept compact for the day's search (float32 surfaces, no annuli:
-    a day of 100 granules holds 30 of them at once).
+    """A FOR's samples at no lift and at the probe's, through the paper's cone scaled to the FOR's response.
 
     The cone is scaled because the paper's cone wants a lift that is not there where the response is
     narrower than it, while the response's own weights read the lift of days with high clouds short
-    (studies/footprint.md)."""
+    (studies/footprint.md).
+
+    Parameters
+    ----------
+    a, b : ForSamples
+        The FOR's samples at no lift and at the probe's.
+    cost : Cost
+        The cost (``assessment.cost``).
+
+    Returns
+    -------
+    tuple of ForSamples
+        Their surfaces through the cone scaled by the half-peak width the FOR's response reads against the
+        nominal (the cone's where there are no annuli); float32, no annuli, for the day's search.
+    """
     w = fitted_response(a, cost)
     width = np.nan if w is None else widths_of_weights(a.radii_rad, w)[0.5]
     if np.isfinite(width):
@@ -106,17 +129,48 @@ def _compact(s: ForSamples) -> ForSamples:
 def day_cost(
     s0: list[ForSamples], s1: list[ForSamples], f: float, cost: Cost, without: np.ndarray | None = None
 ) -> float:
-    """The sum over the FORs and their FOV rows (:data:`ROWS`; the FOR where the samples do not say their
-    FOV), each with 3 samples or more, of their cost minimum (K) at fraction *f*; *without* granules
-    (ids) those ones' samples (a jackknife replicate)."""
+    """The sum over the FORs and their FOV rows of their cost minimum at a fraction of the probe's lift.
+
+    Parameters
+    ----------
+    s0, s1 : list of ForSamples
+        Each FOR's samples at no lift and at the probe's.
+    f : float
+        The fraction.
+    cost : Cost
+        The cost (``assessment.cost``).
+    without : numpy.ndarray, optional
+        Granules (ids) whose samples are left out (a jackknife replicate).
+
+    Returns
+    -------
+    float
+        K; rows with fewer than 3 samples are left out (the FOR where the samples do not say their FOV).
+    """
     return float(row_costs(s0, s1, f, cost, without).sum())
 
 
 def row_costs(
     s0: list[ForSamples], s1: list[ForSamples], f: float, cost: Cost, without: np.ndarray | None = None
 ) -> np.ndarray:
-    """:func:`day_cost` by row (:data:`ROWS`: ahead, centre, behind), (3,) K; a FOR whose samples do not say
-    their FOV counts in the centre."""
+    """:func:`day_cost` by FOV row (:data:`ROWS`: ahead, centre, behind).
+
+    Parameters
+    ----------
+    s0, s1 : list of ForSamples
+        Each FOR's samples at no lift and at the probe's.
+    f : float
+        The fraction.
+    cost : Cost
+        The cost (``assessment.cost``).
+    without : numpy.ndarray, optional
+        Granules (ids) left out.
+
+    Returns
+    -------
+    numpy.ndarray
+        K, shape (3,); a FOR whose samples do not say their FOV counts in the centre.
+    """
     total = np.zeros(len(ROWS))
     for a, b in zip(s0, s1, strict=True):
         keep = np.ones(len(a), bool) if without is None else ~np.isin(a.granule, without)
@@ -139,9 +193,24 @@ def day_fraction(
     without: np.ndarray | None = None,
     near: float | None = None,
 ) -> float:
-    """The fraction of the probe's lift at which the day's cost is least (module docstring): searched on
-    :data:`FRACTIONS`, or only on the three of their spacing about *near* (a jackknife replicate, about the
-    day's), and refined by the parabola through the least three."""
+    """The fraction of the probe's lift at which the day's cost is least.
+
+    Parameters
+    ----------
+    s0, s1 : list of ForSamples
+        Each FOR's samples at no lift and at the probe's.
+    cost : Cost
+        The cost (``assessment.cost``).
+    without : numpy.ndarray, optional
+        Granules (ids) left out.
+    near : float, optional
+        Search only the three of :data:`FRACTIONS`' spacing about it (a jackknife replicate, about the day's).
+
+    Returns
+    -------
+    float
+        The fraction, refined by the parabola through the least three of :data:`FRACTIONS`.
+    """
     step = FRACTIONS[1] - FRACTIONS[0]
     grid = FRACTIONS if near is None else near + step * np.array([-1.0, 0.0, 1.0])
     totals = np.array([day_cost(s0, s1, float(f), cost, without) for f in grid])
@@ -153,17 +222,46 @@ def day_fraction(
 
 
 def keeps(lift_m_per_k: float, gain: float, sigma_gain: float) -> bool:
-    """Whether the day keeps the lift its cost prefers (module docstring): *lift_m_per_k* is a height a
-    cloud could have and its *gain* in the day's cost (K) passes :data:`GAIN_SIGMAS` times *sigma_gain*."""
+    """Whether the day keeps the lift its cost prefers.
+
+    Parameters
+    ----------
+    lift_m_per_k : float
+        The lift, m per K.
+    gain : float
+        What it lowers the day's cost by, K.
+    sigma_gain : float
+        The gain's jackknife sigma, K.
+
+    Returns
+    -------
+    bool
+        The lift is a height a cloud could have (at least :data:`MIN_LIFT_M_PER_K`) and its gain passes
+        :data:`GAIN_SIGMAS` times its sigma.
+    """
     return lift_m_per_k >= MIN_LIFT_M_PER_K and gain > GAIN_SIGMAS * sigma_gain
 
 
 def day_lift(
     s0: list[ForSamples], s1: list[ForSamples], cost: Cost, probe_m_per_k: float
 ) -> tuple[float, float]:
-    """The day's fraction of the probe's lift (*probe_m_per_k*, what *s1* was collocated at) and its
-    jackknife sigma (module docstring): (0, the f declined) where :func:`keeps` declines it, or where it
-    cannot be judged (fewer than 3 granules: sigma NaN)."""
+    """The day's fraction of the probe's lift and its jackknife sigma.
+
+    Parameters
+    ----------
+    s0, s1 : list of ForSamples
+        Each FOR's samples at no lift and at the probe's.
+    cost : Cost
+        The cost (``assessment.cost``).
+    probe_m_per_k : float
+        The probe's lift, m per K (what *s1* was collocated at).
+
+    Returns
+    -------
+    f, sigma_f : float
+        (0, the f declined) where :func:`keeps` declines it; sigma NaN where it cannot be judged (fewer than 3
+        granules).
+    """
     f = day_fraction(s0, s1, cost)
     granules = np.unique(np.concatenate([a.granule for a in s0]))
     if len(granules) < 3:
@@ -184,8 +282,22 @@ def _lifted(d0: np.ndarray, d1: np.ndarray, f: float) -> np.ndarray:
 
 
 def sensitivity(s0: ForSamples, s1: ForSamples, f: float, cost: Cost) -> np.ndarray:
-    """d/df (steps per unit f) of the FOR's top-hat minimum (alpha, beta) and of its rows ahead minus
-    behind (alpha, beta): (4,), NaN where a minimum is missing."""
+    """The derivative with f of the FOR's top-hat minimum and of its rows ahead minus behind.
+
+    Parameters
+    ----------
+    s0, s1 : ForSamples
+        The FOR's samples at no lift and at the probe's.
+    f : float
+        The fraction about which to differentiate.
+    cost : Cost
+        The cost (``assessment.cost``).
+
+    Returns
+    -------
+    numpy.ndarray
+        Steps per unit f, (alpha, beta, rows alpha, rows beta); NaN where a minimum is missing.
+    """
     ends = []
     for df in (-SENSITIVITY_STEP, SENSITIVITY_STEP):
         d = _lifted(s0.d_k, s1.d_k, f + df)

@@ -32,8 +32,18 @@ ZOOMS = (0.25, 1.0 / 16.0, 1.0 / 64.0, 1.0 / 256.0, 1.0 / 1024.0)
 
 
 def keys_weights(x: ArrayLike) -> np.ndarray:
-    """Cubic convolution weights (..., 2 * HALF + 1) on window nodes -HALF..HALF for positions *x*
-    (grid steps from the window centre, |x| <= REACH)."""
+    """Cubic convolution weights on the window's nodes -HALF..HALF for sub-step positions.
+
+    Parameters
+    ----------
+    x : array_like
+        Positions, grid steps from the window centre, |x| <= REACH.
+
+    Returns
+    -------
+    numpy.ndarray
+        Weights, shape ``x.shape + (2 * HALF + 1,)``.
+    """
     x = np.asarray(x, float)
     base = np.floor(x)
     t = x - base
@@ -64,22 +74,49 @@ def _path_of_shapes(subscripts: str, shapes: tuple) -> list:
 
 
 def refinable(i0: int, j0: int, m: int) -> bool:
-    """Whether the window around grid minimum (i0, j0) lies inside an m x m grid."""
+    """Whether the window around a grid minimum lies inside the grid.
+
+    Parameters
+    ----------
+    i0, j0 : int
+        The grid minimum, the window's centre (in-track, cross-track indices).
+    m : int
+        The grid's size, 2n + 1.
+
+    Returns
+    -------
+    bool
+        True when the 7 x 7 window fits.
+    """
     return HALF <= i0 < m - HALF and HALF <= j0 < m - HALF
 
 
 def window_covariance(
     d: np.ndarray, i0: int, j0: int, counts: np.ndarray | None = None, cris: np.ndarray | None = None
 ) -> np.ndarray:
-    """Covariance (49 x 49) over samples of d (N, m, m) in the window around (i0, j0); with bootstrap
-    *counts* (B, N) one covariance per replicate (B, 49, 49).
+    """The covariance over samples of the BT differences in the window around a grid minimum.
 
-    With *cris* (N, R), the regressors of the regression cost
-    (:func:`monitor.assessment.assess.calibration_regressors`:
-    the CrIS BT and its square), the covariance of what of d they do not explain: the residual of
-    d_interp = w^T d regressed on X has variance w^T S_dd w - w^T S_dX S_XX^-1 S_Xd w
-    = w^T (S_dd - S_dX S_XX^-1 S_Xd) w, a quadratic form in the same weights with the matrix returned here
-    (the Schur complement of S_XX), as long as the regressors are fixed: they are the samples' own.
+    With *cris*, the covariance of what of d the regressors do not explain: the residual of d_interp = w^T d
+    regressed on X has variance w^T (S_dd - S_dX S_XX^-1 S_Xd) w, a quadratic form in the same weights with
+    the Schur complement of S_XX returned here, as long as the regressors are fixed (they are the samples'
+    own).
+
+    Parameters
+    ----------
+    d : numpy.ndarray
+        Each sample's VIIRS minus CrIS BT at every perturbation, K, shape (N, m, m).
+    i0, j0 : int
+        The grid minimum, the window's centre (in-track, cross-track indices).
+    counts : numpy.ndarray, optional
+        Replicate weights of the samples, shape (B, N): one covariance per replicate.
+    cris : numpy.ndarray, optional
+        The regression cost's regressors, shape (N, R) (the CrIS BT and its square,
+        :func:`monitor.assessment.assess.calibration_regressors`).
+
+    Returns
+    -------
+    numpy.ndarray
+        K^2, shape (49, 49), or (B, 49, 49) with *counts*.
     """
     x = d[:, i0 - HALF : i0 + HALF + 1, j0 - HALF : j0 + HALF + 1].reshape(len(d), -1)
     if cris is None:
@@ -91,9 +128,22 @@ def window_covariance(
 
 
 def window_values(d: np.ndarray, i0: int, j0: int, x: ArrayLike, y: ArrayLike) -> np.ndarray:
-    """The samples' d (N, m, m) interpolated at (x, y) grid steps from the window centre (i0, j0), with the
-    weights the minimum was found with: d_n(x, y) = w(x, y)^T d_n, (N,); with *x*, *y* (B,), one row per
-    position (B, N)."""
+    """The samples' BT differences interpolated at sub-step positions, with the weights of the minimum.
+
+    Parameters
+    ----------
+    d : numpy.ndarray
+        Each sample's VIIRS minus CrIS BT at every perturbation, K, shape (N, m, m).
+    i0, j0 : int
+        The grid minimum, the window's centre (in-track, cross-track indices).
+    x, y : array_like
+        Positions, grid steps from the window centre (scalars, or (B,) for one row per position).
+
+    Returns
+    -------
+    numpy.ndarray
+        d_n(x, y) = w(x, y)^T d_n, K, shape (N,) or (B, N).
+    """
     win = d[:, i0 - HALF : i0 + HALF + 1, j0 - HALF : j0 + HALF + 1]
     return np.einsum("nab,...a,...b->...n", win, keys_weights(x), keys_weights(y))
 
@@ -112,11 +162,20 @@ def _covariance(x: np.ndarray, counts: np.ndarray | None = None) -> np.ndarray:
 
 
 def refined_minimum(cov: np.ndarray) -> np.ndarray:
-    """Position (x, y) (2,) in grid steps from the window centre where w^T S w is least, for one covariance
-    (49, 49) or a stack (B, 49, 49); |x|, |y| <= REACH.
+    """The sub-step position where the quadratic form w^T S w is least.
 
-    The weights are separable, w = wx (x) wy, so on a grid of positions the quadratic form is contracted
-    over the x nodes first and then over the y nodes.
+    The weights are separable, w = wx (x) wy, so on a grid of positions the form is contracted over the x
+    nodes first and then over the y nodes; searched down to 1/1024 of a step.
+
+    Parameters
+    ----------
+    cov : numpy.ndarray
+        One window covariance (49, 49) or a stack (B, 49, 49), K^2.
+
+    Returns
+    -------
+    numpy.ndarray
+        (x, y) grid steps from the window centre, |x|, |y| <= REACH, shape (2,) or (B, 2).
     """
     s = np.asarray(cov, float)
     single = s.ndim == 2
