@@ -73,7 +73,13 @@ class RadialResponse:
 
     @property
     def reach_rad(self) -> float:
-        """The angle beyond which the response is 0."""
+        """The angle beyond which the response is 0.
+
+        Returns
+        -------
+        float
+            rad.
+        """
         v = np.asarray(self.response)
         last = int(np.flatnonzero(v > 0).max())
         return float(self.radius_rad[min(last + 1, len(v) - 1)])
@@ -83,8 +89,19 @@ class RadialResponse:
         return np.interp(np.abs(r_rad), self.radius_rad, self.response, right=0.0)
 
     def full_width_rad(self, level: float) -> float:
-        """The full width (rad) of the response at *level* of its peak: twice the largest radius where the
-        response is still at or above it."""
+        """The full width of the response at a level of its peak: twice the largest radius still at or above
+        it.
+
+        Parameters
+        ----------
+        level : float
+            The level, a fraction of the peak (0.5: the half-peak width).
+
+        Returns
+        -------
+        float
+            rad.
+        """
         r, v = np.asarray(self.radius_rad), np.asarray(self.response)
         below = np.flatnonzero(v < level)
         if below.size == 0:
@@ -96,16 +113,45 @@ class RadialResponse:
         return 2.0 * float(r[k - 1] + frac * (r[k] - r[k - 1]))
 
     def at(self, x_rad: np.ndarray, y_rad: np.ndarray, turn_rad: float = 0.0) -> np.ndarray:
-        """The response at angles (*x_rad* in-track, *y_rad* cross-track) from the LOS; *turn_rad*, the
-        field's rotation, changes nothing for a radially symmetric response."""
+        """The response at angles from the LOS.
+
+        Parameters
+        ----------
+        x_rad, y_rad : numpy.ndarray
+            Angles from the LOS, in-track and cross-track, rad.
+        turn_rad : float, optional
+            The field's rotation: nothing changes for a radially symmetric response.
+
+        Returns
+        -------
+        numpy.ndarray
+            Relative response, peak 1.
+        """
         return self(np.hypot(x_rad, y_rad))
 
     def stretched(self, scale: float) -> RadialResponse:
-        """The same profile *scale* times as wide."""
+        """The same profile *scale* times as wide.
+
+        Parameters
+        ----------
+        scale : float
+            The stretch.
+
+        Returns
+        -------
+        RadialResponse
+            The stretched profile.
+        """
         return RadialResponse(tuple(scale * np.asarray(self.radius_rad)), self.response)
 
     def within_spec(self) -> list[str]:
-        """What of the specification's table this response violates (empty: within it)."""
+        """What of the specification's table this response violates.
+
+        Returns
+        -------
+        list of str
+            One line per violated width; empty within the table.
+        """
         return _outside_spec(self.full_width_rad, "")
 
 
@@ -126,34 +172,86 @@ class EllipticalResponse:
 
     @property
     def reach_rad(self) -> float:
-        """The angle beyond which the response is 0 in every direction."""
+        """The angle beyond which the response is 0 in every direction.
+
+        Returns
+        -------
+        float
+            rad.
+        """
         return self.radial.reach_rad * max(self.scale_a, self.scale_b)
 
     def at(self, x_rad: np.ndarray, y_rad: np.ndarray, turn_rad: float = 0.0) -> np.ndarray:
-        """The response at angles (*x_rad* in-track, *y_rad* cross-track) from the LOS, the field turned by
-        *turn_rad* (CrIS's field turns with the scene mirror: by the FOR's scan angle)."""
+        """The response at angles from the LOS, the field turned.
+
+        Parameters
+        ----------
+        x_rad, y_rad : numpy.ndarray
+            Angles from the LOS, in-track and cross-track, rad.
+        turn_rad : float, optional
+            The field's rotation, rad (CrIS's field turns with the scene mirror: by the FOR's scan angle).
+
+        Returns
+        -------
+        numpy.ndarray
+            Relative response, peak 1.
+        """
         c, s = math.cos(self.angle_rad + turn_rad), math.sin(self.angle_rad + turn_rad)
         u, v = c * x_rad + s * y_rad, -s * x_rad + c * y_rad
         return self.radial(np.hypot(u / self.scale_a, v / self.scale_b))
 
     def azimuthal_mean(self) -> RadialResponse:
-        """The response averaged over directions at each angle from the LOS: what annuli about it see."""
+        """The response averaged over directions at each angle from the LOS: what annuli about it see.
+
+        Returns
+        -------
+        RadialResponse
+            The mean profile.
+        """
         r = np.linspace(0.0, self.reach_rad, 4 * KNOTS)
         phi = np.linspace(0.0, 2 * math.pi, 720, endpoint=False)
         v = self.at(r[:, None] * np.cos(phi), r[:, None] * np.sin(phi)).mean(axis=1)
         return RadialResponse(tuple(r), tuple(np.clip(v / v[0], 0.0, 1.0)))
 
     def full_width_rad(self, level: float) -> float:
-        """The full width (rad) of the azimuthal mean at *level* of its peak."""
+        """The full width of the azimuthal mean at a level of its peak.
+
+        Parameters
+        ----------
+        level : float
+            The level, a fraction of the peak (0.5: the half-peak width).
+
+        Returns
+        -------
+        float
+            rad.
+        """
         return self.azimuthal_mean().full_width_rad(level)
 
     def axis_widths_rad(self, level: float) -> tuple[float, float]:
-        """The full widths (rad) at *level* along axes a and b."""
+        """The full widths at a level along axes a and b.
+
+        Parameters
+        ----------
+        level : float
+            The level, a fraction of the peak (0.5: the half-peak width).
+
+        Returns
+        -------
+        width_a_rad, width_b_rad : float
+            rad.
+        """
         w = self.radial.full_width_rad(level)
         return w * self.scale_a, w * self.scale_b
 
     def within_spec(self) -> list[str]:
-        """What of the specification's table either axis violates (empty: within it)."""
+        """What of the specification's table either axis violates.
+
+        Returns
+        -------
+        list of str
+            One line per violated width and axis; empty within the table.
+        """
         return [
             *_outside_spec(lambda lv: self.axis_widths_rad(lv)[0], "along axis a "),
             *_outside_spec(lambda lv: self.axis_widths_rad(lv)[1], "along axis b "),
@@ -182,7 +280,20 @@ def _tabulated(profile: Callable[[np.ndarray], np.ndarray], reach_rad: float) ->
 
 
 def super_gaussian(order: float = 10.0, half_width_50_rad: float = HALF_WIDTH_50_RAD) -> RadialResponse:
-    """exp(-ln 2 (r / r50)^order), tabulated out to where it is below 0.1 %."""
+    """exp(-ln 2 (r / r50)^order), tabulated out to where it is below 0.1 %.
+
+    Parameters
+    ----------
+    order : float, optional
+        The exponent.
+    half_width_50_rad : float, optional
+        r50, the half width at half peak, rad.
+
+    Returns
+    -------
+    RadialResponse
+        The profile.
+    """
     reach = half_width_50_rad * (math.log(1000.0) / math.log(2.0)) ** (1.0 / order)
     return _tabulated(lambda r: np.exp(-math.log(2.0) * (r / half_width_50_rad) ** order), reach)
 
@@ -190,15 +301,38 @@ def super_gaussian(order: float = 10.0, half_width_50_rad: float = HALF_WIDTH_50
 def trapezoid(
     inner_rad: float = math.radians(0.391), outer_rad: float = math.radians(0.551)
 ) -> RadialResponse:
-    """1 out to *inner_rad*, linear to 0 at *outer_rad*."""
+    """1 out to *inner_rad*, linear to 0 at *outer_rad*.
+
+    Parameters
+    ----------
+    inner_rad, outer_rad : float, optional
+        The radii, rad.
+
+    Returns
+    -------
+    RadialResponse
+        The profile.
+    """
     return RadialResponse((0.0, inner_rad, outer_rad), (1.0, 1.0, 0.0))
 
 
 def blurred_top_hat(
     radius_rad: float = math.radians(0.4745), sigma_rad: float = math.radians(0.055)
 ) -> RadialResponse:
-    """A top hat of angular radius *radius_rad* convolved with a circular Gaussian of *sigma_rad*
-    (the exact 2-D profile, by the Rice integral on a radial grid), normalised to its peak."""
+    """A top hat convolved with a circular Gaussian, normalised to its peak.
+
+    Parameters
+    ----------
+    radius_rad : float, optional
+        The top hat's angular radius, rad.
+    sigma_rad : float, optional
+        The Gaussian's sigma, rad.
+
+    Returns
+    -------
+    RadialResponse
+        The exact 2-D profile, by the Rice integral on a radial grid.
+    """
     from scipy.special import i0e  # here: the CLI lists the shapes, and starts without scipy
 
     reach = radius_rad + 4.0 * sigma_rad
@@ -224,8 +358,19 @@ DEFAULT_SHAPE = "super-gaussian"
 
 
 def shape(spec: str) -> Response:
-    """The response *spec* names: a shape of :data:`SHAPES`, then optionally ``:S`` (stretched S times) or
-    ``:AxB@DEG`` (stretched A times along an axis DEG degrees from in-track, B times across it)."""
+    """The response a specification names.
+
+    Parameters
+    ----------
+    spec : str
+        A shape of :data:`SHAPES`, then optionally ``:S`` (stretched S times) or ``:AxB@DEG`` (stretched A
+        times along an axis DEG degrees from in-track, B times across it).
+
+    Returns
+    -------
+    RadialResponse or EllipticalResponse
+        The response; a ValueError names what is wrong with *spec*.
+    """
     name, _, stretch = spec.partition(":")
     if name not in SHAPES:
         raise ValueError(f"footprint {spec!r}: {name!r} is not one of {', '.join(SHAPES)}")
@@ -247,16 +392,28 @@ def shape(spec: str) -> Response:
 
 
 def monotone_weights(m: np.ndarray, radii_rad: tuple[float, ...]) -> np.ndarray:
-    """The annulus weights w (K,), sum 1, that minimise w^T M w (*m*, K x K, positive semi-definite) for a
-    response that does not grow outwards; *radii_rad* (K,) the annuli's outer radii (the first a disc).
+    """The annulus weights, sum 1, that minimise w^T M w for a response that does not grow outwards.
 
-    Neighbouring annuli see nearly the same scene, so M is nearly singular along differences of their
-    weights, and free weights swing from annulus to annulus. A CrIS response is a monotone profile (the
-    specification bounds it by widths that grow as the level falls), so the fit keeps it one: the response
-    in annulus k, w_k / a_k (a_k its solid angle, ~ r_k^2 - r_(k-1)^2), is a sum of non-negative steps
-    delta_l >= 0 for l >= k, w = B delta with B_kl = a_k [l >= k]. With Q = B^T M B = L L^T, the least
-    squares ||L^T delta||^2 + lambda^2 (1^T B delta - 1)^2 with delta >= 0 (non-negative least squares, lambda
-    large against Q) holds the sum to 1."""
+    Neighbouring annuli see nearly the same scene, so M is nearly singular along differences of their weights,
+    and free weights swing from annulus to annulus. A CrIS response is a monotone profile (the specification
+    bounds it by widths that grow as the level falls), so the fit keeps it one: the response in annulus k,
+    w_k / a_k (a_k its solid angle, ~ r_k^2 - r_(k-1)^2), is a sum of non-negative steps delta_l >= 0 for
+    l >= k, w = B delta with B_kl = a_k [l >= k]. With Q = B^T M B = L L^T, the least squares
+    ||L^T delta||^2 + lambda^2 (1^T B delta - 1)^2 with delta >= 0 (non-negative least squares, lambda large
+    against Q) holds the sum to 1.
+
+    Parameters
+    ----------
+    m : numpy.ndarray
+        M, positive semi-definite, shape (K, K).
+    radii_rad : tuple of float
+        The annuli's outer radii (the first a disc), rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        The weights, shape (K,).
+    """
     from scipy.optimize import nnls  # here: the CLI lists the shapes, and starts without scipy
 
     r_out = np.asarray(radii_rad, float)
@@ -275,22 +432,35 @@ def monotone_weights(m: np.ndarray, radii_rad: tuple[float, ...]) -> np.ndarray:
 
 
 def seen_weights(profiles: np.ndarray, rho_rad: np.ndarray, radii_rad: tuple[float, ...]) -> np.ndarray:
-    """The annulus weights (S, K) the response fit finds for each radial profile *profiles* (S, P) (values
-    at angles *rho_rad* (P,) from the LOS, evenly spaced from 0) on scenes of sharp edges.
+    """The annulus weights the response fit finds for radial profiles on scenes of sharp edges.
 
     The fit does not return each annulus' share of the response. It returns the weights whose annulus means
-    best reproduce the response-weighted mean over the day's scenes (:func:`monotone_weights`). For a scene
-    L with power spectrum P(kappa), isotropic, the mean of the residual's square is, by Parseval,
+    best reproduce the response-weighted mean over the day's scenes (:func:`monotone_weights`). For a scene L
+    with power spectrum P(kappa), isotropic, the mean of the residual's square is, by Parseval,
 
         E (sum_k w_k A_k - C)^2 = int P(kappa) (sum_k w_k a_k(kappa) - r(kappa))^2 2 pi kappa d kappa,
 
-    with a_k the Fourier transform of annulus k's uniform mean (a disc of radius R: 2 J1(kappa R) /
-    (kappa R); an annulus, the difference of its discs weighted by their areas) and r = int R J0(kappa rho)
-    rho d rho / int R rho d rho the response's. With sum w = 1 the residual is sum_k w_k (a_k - r), so M is
-    the integral of (a_k - r)(a_l - r) P. Scenes of sharp edges (clouds, coasts) have P ~ kappa^-3
+    with a_k the Fourier transform of annulus k's uniform mean (a disc of radius R: 2 J1(kappa R) / (kappa
+    R); an annulus, the difference of its discs weighted by their areas) and r = int R J0(kappa rho) rho d rho
+    / int R rho d rho the response's. With sum w = 1 the residual is sum_k w_k (a_k - r), so M is the integral
+    of (a_k - r)(a_l - r) P. Scenes of sharp edges (clouds, coasts) have P ~ kappa^-3
     (:data:`EDGE_SPECTRUM_EXPONENT`), out to the VIIRS I-band pixel's Nyquist frequency. Where the response
-    falls inside an annulus, its weights fall short of its share there: a 5 % narrower super-Gaussian has
-    weights whose mid-annulus profile reads 21 % too narrow, as the simulated fit does."""
+    falls inside an annulus, its weights fall short of its share there.
+
+    Parameters
+    ----------
+    profiles : numpy.ndarray
+        Radial profiles, shape (S, P).
+    rho_rad : numpy.ndarray
+        Their angles from the LOS, evenly spaced from 0, rad, shape (P,).
+    radii_rad : tuple of float
+        The annuli's outer radii, rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (S, K).
+    """
     from scipy.special import j0, j1  # here: the CLI lists the shapes, and starts without scipy
 
     kappa = np.geomspace(*KAPPA_RANGE, SPECTRUM_SAMPLES)
@@ -326,9 +496,20 @@ def _super_gaussians(radii_rad: tuple[float, ...]) -> tuple[np.ndarray, np.ndarr
 
 
 def top_hat_weights(radii_rad: tuple[float, ...], radius_rad: float) -> np.ndarray:
-    """The annulus weights (K,) of a top hat of angular radius *radius_rad*: each annulus' solid angle within
-    it, over the top hat's (the annuli's outer radii *radii_rad*, the first a disc; the last holds the rest
-    if the top hat reaches past it)."""
+    """The annulus weights of a top hat: each annulus' solid angle within it, over the top hat's.
+
+    Parameters
+    ----------
+    radii_rad : tuple of float
+        The annuli's outer radii (the first a disc), rad.
+    radius_rad : float, optional
+        The top hat's angular radius, rad; the last annulus holds the rest if it reaches past it.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (K,).
+    """
     r_out = np.asarray(radii_rad, float)
     r_in = np.concatenate([[0.0], r_out[:-1]])
     inside = np.clip(np.minimum(radius_rad, r_out) ** 2 - r_in**2, 0.0, None)
@@ -338,14 +519,28 @@ def top_hat_weights(radii_rad: tuple[float, ...], radius_rad: float) -> np.ndarr
 def widths_of_weights(
     radii_rad: tuple[float, ...], weights: np.ndarray, levels: tuple[float, ...] = (0.5, 0.1)
 ) -> dict[float, float]:
-    """Full widths (rad) at *levels* of the response that fitted annulus weights describe.
+    """The full widths of the response that fitted annulus weights describe.
 
-    *radii_rad* (K,) are the annuli's outer radii (the first annulus a disc), *weights* (K,) the fitted
-    weights. The response read is the super-Gaussian exp(-ln 2 (r / r50)^n) whose weights on scenes of
-    sharp edges (:func:`seen_weights`) are closest to *weights* in least squares, r50 within
-    :data:`READ_SCALES` of the nominal and n within :data:`READ_ORDERS`: the family spans the flat tops and
-    soft edges of every shape here, and reads their widths within ~1 % from their seen weights. NaN where
-    the weights are not a response, or where the closest lies on the edge of the scales."""
+    The response read is the super-Gaussian exp(-ln 2 (r / r50)^n) whose weights on scenes of sharp edges
+    (:func:`seen_weights`) are closest to *weights* in least squares, r50 within :data:`READ_SCALES` of the
+    nominal and n within :data:`READ_ORDERS`: the family spans the flat tops and soft edges of every shape
+    here.
+
+    Parameters
+    ----------
+    radii_rad : tuple of float
+        The annuli's outer radii (the first a disc), rad.
+    weights : numpy.ndarray
+        The fitted weights, shape (K,).
+    levels : tuple of float, optional
+        The levels, fractions of the peak.
+
+    Returns
+    -------
+    dict of float to float
+        Level to full width, rad; NaN where the weights are not a response, or where the closest lies on the
+        edge of the scales.
+    """
     from scipy.interpolate import RegularGridInterpolator
     from scipy.optimize import least_squares
 

@@ -70,13 +70,37 @@ def _interp_serial(x: np.ndarray, xp: np.ndarray, fp: np.ndarray, guess: np.ndar
 
 
 def planck_radiance(wavenumber_cm1: ArrayLike, t_k: ArrayLike) -> np.ndarray:
-    """Planck radiance mW/(m2 sr cm-1) at *wavenumber_cm1* for temperature *t_k* (broadcast)."""
+    """Planck radiance at a wavenumber and temperature.
+
+    Parameters
+    ----------
+    wavenumber_cm1 : array_like
+        cm-1.
+    t_k : array_like
+        Temperature, K, broadcast against the wavenumbers.
+
+    Returns
+    -------
+    numpy.ndarray
+        mW/(m2 sr cm-1).
+    """
     nu = np.asarray(wavenumber_cm1, float)
     return C1 * nu**3 / np.expm1(C2 * nu / np.asarray(t_k, float))
 
 
 def load_srf(satellite: str) -> tuple[np.ndarray, np.ndarray]:
-    """(wavenumber_cm1, response) of the VIIRS I5 band of *satellite* (npp, j01, j02), ascending."""
+    """The VIIRS I5 relative spectral response of a satellite.
+
+    Parameters
+    ----------
+    satellite : str
+        ``npp``, ``j01`` or ``j02`` (NOAA-21 uses NOAA-20's).
+
+    Returns
+    -------
+    wavenumber_cm1, response : numpy.ndarray
+        Ascending wavenumbers, cm-1, and the relative response.
+    """
     name = SRF_FILES.get(satellite)
     if name is None:
         raise DataError(
@@ -94,7 +118,18 @@ def _read_csv(text: str) -> np.ndarray:
 
 
 def apodize_hamming(radiance: ArrayLike) -> np.ndarray:
-    """Hamming apodization along the last (channel) axis; the end channels keep their value."""
+    """Hamming apodization along the last (channel) axis; the end channels keep their value.
+
+    Parameters
+    ----------
+    radiance : array_like
+        Spectra, channels last.
+
+    Returns
+    -------
+    numpy.ndarray
+        The apodized spectra, same unit and shape.
+    """
     r = np.asarray(radiance)
     out = r.copy()
     out[..., 1:-1] = HAMMING[0] * r[..., :-2] + HAMMING[1] * r[..., 1:-1] + HAMMING[2] * r[..., 2:]
@@ -102,7 +137,15 @@ def apodize_hamming(radiance: ArrayLike) -> np.ndarray:
 
 
 class I5Band:
-    """The VIIRS I5 band of one satellite sampled on the CrIS LW grid, with its band-Planck table."""
+    """The VIIRS I5 band of one satellite sampled on the CrIS LW grid, with its band-Planck table.
+
+    Parameters
+    ----------
+    satellite : str
+        ``npp``, ``j01`` or ``j02`` (its relative spectral response, :func:`load_srf`).
+    wavenumber_cm1 : array_like, optional
+        The grid the response is sampled on, cm-1; the CrIS LW channels by default.
+    """
 
     T_MIN_K, T_MAX_K, T_STEP_K = 150.0, 350.0, 0.02
 
@@ -120,22 +163,62 @@ class I5Band:
         self._guess = np.maximum(np.searchsorted(self._l, edges, "right") - 2, 0)
 
     def band_radiance(self, spectra: ArrayLike) -> np.ndarray:
-        """Band radiance mW/(m2 sr cm-1) of spectra on the CrIS LW grid (last axis channels)."""
+        """The band radiance of spectra on the CrIS LW grid.
+
+        Parameters
+        ----------
+        spectra : array_like
+            Spectral radiance, mW/(m2 sr cm-1), channels last.
+
+        Returns
+        -------
+        numpy.ndarray
+            Band radiance, mW/(m2 sr cm-1).
+        """
         return np.asarray(spectra) @ self.weights
 
     def cris_band_radiance(self, radiance_lw: ArrayLike) -> np.ndarray:
-        """Band radiance of unapodized CrIS LW spectra: Hamming apodization, then the SRF convolution."""
+        """The band radiance of unapodized CrIS LW spectra: Hamming apodization, then the SRF convolution.
+
+        Parameters
+        ----------
+        radiance_lw : array_like
+            CrIS LW spectral radiance, mW/(m2 sr cm-1), channels last.
+
+        Returns
+        -------
+        numpy.ndarray
+            Band radiance, mW/(m2 sr cm-1).
+        """
         return self.band_radiance(apodize_hamming(radiance_lw))
 
     @property
     def radiance_table(self) -> tuple[float, float, np.ndarray]:
-        """(first BT K, BT step K, band radiance per BT): the uniform table radiance_from_bt interpolates."""
+        """The uniform table :meth:`radiance_from_bt` interpolates.
+
+        Returns
+        -------
+        t_min_k, t_step_k : float
+            The first BT and the step, K.
+        table : numpy.ndarray
+            Band radiance per BT, mW/(m2 sr cm-1).
+        """
         return self.T_MIN_K, self.T_STEP_K, self._l
 
     def radiance_from_bt(self, bt_k: ArrayLike) -> np.ndarray:
-        """Band radiance of a band brightness temperature (K); NaN outside 150-350 K.
+        """The band radiance of a band brightness temperature.
 
         The table is uniform in temperature, so the interpolation is index arithmetic.
+
+        Parameters
+        ----------
+        bt_k : array_like
+            BT, K.
+
+        Returns
+        -------
+        numpy.ndarray
+            mW/(m2 sr cm-1); NaN outside 150-350 K.
         """
         x = (np.asarray(bt_k, np.float64) - self.T_MIN_K) / self.T_STEP_K
         with np.errstate(invalid="ignore"):
@@ -145,9 +228,21 @@ class I5Band:
         return np.where(ok, self._l[i] * (1 - w) + self._l[i + 1] * w, np.nan)
 
     def bt_from_radiance(self, radiance: ArrayLike) -> np.ndarray:
-        """Band brightness temperature (K) of a band radiance (float64, the shape of *radiance*); NaN outside
-        the table. The table is inverted by linear interpolation (np.interp's numbers, compiled and in
-        parallel: an assessment converts ten million cone means)."""
+        """The band brightness temperature of a band radiance.
+
+        The table is inverted by linear interpolation (np.interp's numbers, compiled and in parallel: an
+        assessment converts ten million cone means).
+
+        Parameters
+        ----------
+        radiance : array_like
+            Band radiance, mW/(m2 sr cm-1).
+
+        Returns
+        -------
+        numpy.ndarray
+            BT, K, float64, the shape of *radiance*; NaN outside the table.
+        """
         x = np.ravel(np.asarray(radiance, np.float64))
         shape = np.shape(radiance)
         out = np.empty(shape)
@@ -161,5 +256,16 @@ class I5Band:
 
 @lru_cache(maxsize=8)
 def i5_band(satellite: str) -> I5Band:
-    """The cached :class:`I5Band` of *satellite*."""
+    """The cached :class:`I5Band` of a satellite.
+
+    Parameters
+    ----------
+    satellite : str
+        ``npp``, ``j01`` or ``j02``.
+
+    Returns
+    -------
+    I5Band
+        The band.
+    """
     return I5Band(satellite)
