@@ -34,8 +34,20 @@ def __getattr__(name: str) -> Any:  # the public API, imported when first used (
 
 
 def open_store(path: str | os.PathLike, create: bool = False) -> ResultStore:
-    """The service's SQLite store at *path*, e.g. ``open_store(p).to_xarray("j01")`` in a notebook. A
-    missing store is an error (a typo must not start an empty history) unless *create*."""
+    """The service's SQLite store, for a notebook: ``open_store(p).to_xarray("j01")``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The store (``store.sqlite``; the demo's ``demo-state/crisgeo.sqlite``).
+    create : bool, optional
+        Make a new store; otherwise a missing one is an error (a typo must not start an empty history).
+
+    Returns
+    -------
+    ResultStore
+        The store; a context manager that closes it.
+    """
     from monitor.service.outputs.export import ResultStore
     from monitor.service.store.sqlite import Store
 

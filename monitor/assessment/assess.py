@@ -82,7 +82,18 @@ class GranuleSamples:
     rendered: GranuleSamples | None = None
 
     def kept_in(self, spool: Spool) -> GranuleSamples:
-        """These samples with their perturbed cones' arrays in *spool*, on disk (:mod:`spool`)."""
+        """These samples with their perturbed cones' arrays kept on disk.
+
+        Parameters
+        ----------
+        spool : Spool
+            Where to keep them (:mod:`monitor.assessment.spool`).
+
+        Returns
+        -------
+        GranuleSamples
+            The same samples, read back from disk when indexed.
+        """
         cones = self.bt_viirs_k if isinstance(self.bt_viirs_k, OnDisk) else spool.keep(self.bt_viirs_k)
         annuli = self.annuli_rad
         if isinstance(annuli, np.ndarray):
@@ -104,8 +115,32 @@ def collocate_granule(
 ) -> GranuleSamples:
     """Collocate every FOV of one CrIS granule for every perturbation with its VIIRS cover.
 
-    *inputs* is what :func:`read_inputs` read ahead (read here when None); *timings*, when a dict,
-    accumulates seconds per stage: read, geometry, spectral, collocation.
+    Parameters
+    ----------
+    cris : GranuleFiles
+        The CrIS granule's SDR and GEO files.
+    viirs : list of GranuleFiles
+        The VIIRS I5 SDR and GEO granules covering it.
+    cfg : AssessmentConfig
+        The assessment's configuration (grid, kernel).
+    band : I5Band
+        The satellite's I5 band.
+    cache : SwathCache
+        The prepared VIIRS granules, shared by the run's CrIS granules.
+    timings : dict, optional
+        Collects seconds per stage (read, geometry, parallax, spectral, collocation, cost).
+    viirs_all : list of GranuleFiles, optional
+        Every VIIRS granule of the run, for the neighbours' adjacent scans.
+    should_stop : callable, optional
+        Polled before each granule; True ends the batch with :class:`StopRequested`.
+    inputs : GranuleInputs, optional
+        What :func:`read_inputs` read ahead; read here when None.
+
+    Returns
+    -------
+    GranuleSamples
+        Per FOV the VIIRS BT of every perturbed cone (K) beside the CrIS BT, and the rendered collocation when
+        the cache holds a lift.
     """
     viirs_all = viirs_all or viirs
     if inputs is None:
@@ -222,8 +257,24 @@ def _ground_km(
 def for_samples(
     samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, band: I5Band | None = None
 ) -> ForSamples:
-    """The estimator's input for FOR k (0-based): every usable FOV of it over the granules (*band*, the
-    satellite's I5 band, for the footprint kernel)."""
+    """The estimator's input for one FOR: every usable FOV of it over the granules.
+
+    Parameters
+    ----------
+    samples : list of GranuleSamples
+        The collocated granules, in time order.
+    k : int
+        The FOR, 0-based.
+    cfg : AssessmentConfig
+        The assessment's configuration.
+    band : I5Band, optional
+        The satellite's I5 band, for the footprint kernel's annuli.
+
+    Returns
+    -------
+    ForSamples
+        The FOR's samples.
+    """
     m = len(offsets_rad(cfg))
     d, granule, scan, fov, annuli = [], [], [], [], []
     for g_i, s in enumerate(samples):
@@ -351,8 +402,18 @@ def _seconds(iso: str) -> float:
 
 
 def paired(samples: list[GranuleSamples]) -> tuple[list[GranuleSamples], list[GranuleSamples]]:
-    """The granules of both collocations, at the GEO points and rendered (each granule's
-    :attr:`GranuleSamples.rendered`), with the FOVs usable in both."""
+    """The granules of both collocations, at the GEO points and rendered, with the FOVs usable in both.
+
+    Parameters
+    ----------
+    samples : list of GranuleSamples
+        Granules collocated with their rendering (:attr:`GranuleSamples.rendered`).
+
+    Returns
+    -------
+    at_geo, rendered : list of GranuleSamples
+        The two collocations; a ValueError if a granule was not rendered.
+    """
     rendered = [s.rendered for s in samples if s.rendered is not None]
     if len(rendered) != len(samples):
         raise ValueError("paired: a granule was not collocated rendered")
@@ -379,8 +440,16 @@ def _cold_height_km(cris_k: np.ndarray, m_per_k: float) -> float:
 
 
 class PerFor(Sequence[ForSamples]):
-    """The 30 FORs' samples, each built when indexed (read from the day's spool, blended): one FOR of a
-    long day in memory at a time, not the day (:func:`~monitor.estimation.offsets.day_offsets`)."""
+    """The 30 FORs' samples, each built when indexed (read from the day's spool, blended).
+
+    One FOR of a long day is in memory at a time, not the day
+    (:func:`~monitor.estimation.offsets.day_offsets`).
+
+    Parameters
+    ----------
+    build : callable
+        Builds FOR k's (0-based) samples.
+    """
 
     def __init__(self, build: Callable[[int], ForSamples]) -> None:
         self._build = build
@@ -414,16 +483,45 @@ def collocate_run(
     lift_m_per_k: float = 0.0,
     renderer: render.Renderer = render.rendered_bt,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
-    """Collocate a time-ordered run of CrIS granules with the VIIRS pixels as GEO places them; with
-    *lift_m_per_k*, in the same pass, also with the pixels standing *lift_m_per_k* m per K above their GEO
-    points and rendered as each CrIS FOV row sees them (:mod:`monitor.collocation.render`; each sample's
-    :attr:`GranuleSamples.rendered`) by *renderer*; returns (samples, skipped)."""
+    """Collocate a time-ordered run of CrIS granules, and in the same pass their rendering at a lift.
+
+    Parameters
+    ----------
+    cris : list of GranuleFiles
+        The CrIS granules, in time order.
+    viirs : dict of str to list of GranuleFiles
+        Each CrIS granule's (by key) VIIRS granules.
+    viirs_all : list of GranuleFiles
+        Every VIIRS granule of the run.
+    satellite : str
+        The satellite's short name.
+    cfg : AssessmentConfig
+        The assessment's configuration.
+    progress : callable, optional
+        Called after each granule with its files.
+    should_stop : callable, optional
+        Polled before each granule; True ends the batch with :class:`StopRequested`.
+    timings : dict, optional
+        Collects seconds per stage (read, geometry, parallax, spectral, collocation, cost).
+    lift_m_per_k : float, optional
+        With a lift, the pixels also stand this many m per K above their GEO points, rendered as each CrIS
+        FOV row sees them (:mod:`monitor.collocation.render`).
+    renderer : Renderer, optional
+        What renders them (:func:`monitor.collocation.render.rendered_bt`).
+
+    Returns
+    -------
+    samples : list of GranuleSamples
+        The collocated granules.
+    skipped : list of (str, str)
+        The granules that failed, with their reasons.
+    """
     band = i5_band(satellite)
     cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k, renderer=renderer)
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
-    def read_ahead(i: int) -> cf.Future[GranuleInputs]:
+    def _read_ahead(i: int) -> cf.Future[GranuleInputs]:
         """Read granule i's inputs (and compute its CrIS geometry) in the background while granule i - 1
         is computed (h5py, numpy and the compiled kernels release the interpreter to each other)."""
         prepared = set(cache.pieces) | ({v.key for v in viirs[cris[i - 1].key]} if i else set())
@@ -432,7 +530,7 @@ def collocate_run(
         )
 
     with cf.ThreadPoolExecutor(1, thread_name_prefix="crisgeo-read") as pool:
-        ahead = read_ahead(0) if cris else None
+        ahead = _read_ahead(0) if cris else None
         for i, g in enumerate(cris):
             current, ahead = ahead, None
             if should_stop is not None and should_stop():
@@ -441,7 +539,7 @@ def collocate_run(
                 skipped.append((g.key, "not assessed: stop requested"))
                 continue
             if i + 1 < len(cris):
-                ahead = read_ahead(i + 1)
+                ahead = _read_ahead(i + 1)
             try:
                 samples.append(
                     collocate_granule(
@@ -473,11 +571,29 @@ def collocate_run(
 
 
 class DayAssessment:
-    """A day's assessment built batch by batch (:meth:`add`): each batch's CrIS granules collocated once
-    (as GEO places the pixels and, in the same pass, rendered, for the parallax), the estimate made over
-    every granule so far whenever asked (:meth:`result`), so that a day can stop at the precision it needs.
-    Each granule's perturbed cones are kept on disk (:mod:`~monitor.assessment.spool`) until :meth:`close`
-    (or the context's end): memory holds one granule's collocation and one FOR's estimate, not the day."""
+    """A day's assessment built batch by batch, so that a day can stop at the precision it needs.
+
+    Each batch's CrIS granules are collocated once (as GEO places the pixels and, in the same pass, rendered,
+    for the parallax) by :meth:`add`; the estimate over every granule so far is made whenever asked
+    (:meth:`result`). Each granule's perturbed cones are kept on disk (:mod:`~monitor.assessment.spool`) until
+    :meth:`close` (or the context's end): memory holds one granule's collocation and one FOR's estimate, not
+    the day.
+
+    Parameters
+    ----------
+    satellite : str
+        The satellite's short name (``npp``, ``j01``, ``j02``).
+    cfg : AssessmentConfig, optional
+        The assessment's configuration; the defaults when None.
+    workers : int, optional
+        Threads of the compiled VIIRS preparation and collocation.
+    probe_m_per_k : float, optional
+        With the parallax correction, the lift (m per K of I5 BT below the clear sky) of the second, rendered
+        collocation from which the day's lift is found (:mod:`monitor.estimation.parallax`).
+    renderer : Renderer, optional
+        What renders the VIIRS pixels as each CrIS FOV row sees them
+        (:func:`monitor.collocation.render.rendered_bt`).
+    """
 
     def __init__(
         self,
@@ -487,22 +603,6 @@ class DayAssessment:
         probe_m_per_k: float = PROBE_M_PER_K,
         renderer: render.Renderer = render.rendered_bt,
     ) -> None:
-        """
-        Parameters
-        ----------
-        satellite : str
-            The satellite's short name (``npp``, ``j01``, ``j02``).
-        cfg : AssessmentConfig, optional
-            The assessment's configuration; the defaults when None.
-        workers : int, optional
-            Threads of the compiled VIIRS preparation and collocation.
-        probe_m_per_k : float, optional
-            With the parallax correction, the lift (m per K of I5 BT below the clear sky) of the second,
-            rendered collocation from which the day's lift is found (:mod:`monitor.estimation.parallax`).
-        renderer : Renderer, optional
-            What renders the VIIRS pixels as each CrIS FOV row sees them
-            (:func:`monitor.collocation.render.rendered_bt`).
-        """
         self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
         self.probe_m_per_k, self.renderer = probe_m_per_k, renderer
         self.samples: list[GranuleSamples] = []
@@ -526,12 +626,22 @@ class DayAssessment:
         should_stop: StopCheck = None,
         timings: Timings = None,
     ) -> None:
-        """Collocate every CrIS granule of *case* (a granule that fails is skipped with its reason).
+        """Collocate every CrIS granule of a batch; a granule that fails is skipped with its reason.
 
-        *progress* is called after each granule; *should_stop* is polled before each (a stop request
-        ends the batch with :class:`StopRequested`); *timings*, a dict, collects seconds per stage.
-        *workers* (the constructor's) is the number of threads of the compiled VIIRS preparation and
-        collocation (granules go one after the other, each VIIRS granule prepared once per batch)."""
+        Granules go one after the other, each VIIRS granule prepared once per batch, on the constructor's
+        *workers* threads.
+
+        Parameters
+        ----------
+        case : CasePlan
+            The batch's paired granules.
+        progress : callable, optional
+            Called after each granule with its files.
+        should_stop : callable, optional
+            Polled before each granule; True ends the batch with :class:`StopRequested`.
+        timings : dict, optional
+            Collects seconds per stage (read, geometry, parallax, spectral, collocation, cost).
+        """
         cfg = self.cfg
         run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
         # with the parallax correction, also the pixels at the probe's height per K, rendered, in the same
@@ -547,8 +657,19 @@ class DayAssessment:
             raise StopRequested
 
     def result(self, timings: Timings = None) -> AssessmentResult:
-        """The estimate over every granule added, in time order. Fewer usable FOVs in all than
-        ``min_samples`` is an :class:`AssessmentError` naming the files."""
+        """The estimate over every granule added, in time order.
+
+        Parameters
+        ----------
+        timings : dict, optional
+            Collects seconds per stage (read, geometry, parallax, spectral, collocation, cost).
+
+        Returns
+        -------
+        AssessmentResult
+            The day's result; an :class:`AssessmentError` naming the files with fewer usable FOVs in all than
+            ``min_samples``.
+        """
         cfg, skipped = self.cfg, self.skipped
         usable = sum(int(s.usable.sum()) for s in self.samples)
         if usable < cfg.min_samples:
@@ -571,8 +692,29 @@ def assess_plan(
     timings: Timings = None,
     workers: int = 1,
 ) -> AssessmentResult:
-    """Assess every CrIS granule of *case* in one batch (:class:`DayAssessment`); granules that fail are
-    skipped with their reason, a stop request ends it with :class:`StopRequested`."""
+    """Assess every CrIS granule of a plan in one batch (:class:`DayAssessment`).
+
+    Parameters
+    ----------
+    case : CasePlan
+        The paired granules.
+    cfg : AssessmentConfig, optional
+        The assessment's configuration; the defaults when None.
+    progress : callable, optional
+        Called after each granule with its files.
+    should_stop : callable, optional
+        Polled before each granule; True ends the batch with :class:`StopRequested`.
+    timings : dict, optional
+        Collects seconds per stage (read, geometry, parallax, spectral, collocation, cost).
+    workers : int, optional
+        Threads of the compiled kernels.
+
+    Returns
+    -------
+    AssessmentResult
+        The result; granules that fail are skipped with their reason, a stop request ends it with
+        :class:`StopRequested`.
+    """
     with DayAssessment(case.satellite, cfg, workers) as day:
         day.add(case, progress, should_stop, timings)
         return day.result(timings)
@@ -584,5 +726,22 @@ def assess_paths(
     progress: Progress = None,
     workers: int = 1,
 ) -> AssessmentResult:
-    """Find, pair and assess the granules under *paths* (files or directories)."""
+    """Find, pair and assess the granules under paths.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        Granule files or directories (CrIS SDR and GEO, VIIRS I5 SDR and image GEO).
+    cfg : AssessmentConfig, optional
+        The assessment's configuration; the defaults when None.
+    progress : callable, optional
+        Called after each granule with its files.
+    workers : int, optional
+        Threads of the compiled kernels.
+
+    Returns
+    -------
+    AssessmentResult
+        Per-FOR offsets (urad, km), sigmas, flags and the day's lift.
+    """
     return assess_plan(plan(paths), cfg, progress, workers=workers)

@@ -23,12 +23,29 @@ from monitor.simulate.case import simulate_case
 
 
 def peak_rss_mb(who: int = resource.RUSAGE_SELF) -> float:
-    """Peak resident memory so far, MB (Linux ru_maxrss is in KB); RUSAGE_CHILDREN gives the largest child."""
+    """The peak resident memory so far.
+
+    Parameters
+    ----------
+    who : int, optional
+        ``resource.RUSAGE_SELF``, or ``RUSAGE_CHILDREN`` for the largest child.
+
+    Returns
+    -------
+    float
+        MB (Linux ru_maxrss is in KB).
+    """
     return resource.getrusage(who).ru_maxrss / 1024.0
 
 
 def reset_peak_rss() -> bool:
-    """Start this process's peak-memory count afresh (Linux: clear_refs 5 resets VmHWM and ru_maxrss)."""
+    """Start this process's peak-memory count afresh (Linux: clear_refs 5 resets VmHWM and ru_maxrss).
+
+    Returns
+    -------
+    bool
+        Whether it could.
+    """
     try:
         Path("/proc/self/clear_refs").write_text("5")
         return True
@@ -75,8 +92,20 @@ def _pyresample_reference(
 
 
 def run_bench(args: argparse.Namespace, cfg: AssessmentConfig) -> int:
-    """``crisgeo bench``: simulate (or take --data), warm the kernels, assess with *cfg* (on
-    ``cfg.workers`` threads), time each stage, print; exit status."""
+    """``crisgeo bench``: simulate (or take --data), warm the kernels, assess, time each stage, print.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The command's arguments (``--granules``, ``--data``, ``--pyresample``).
+    cfg : AssessmentConfig
+        The assessment's configuration, on ``cfg.workers`` threads.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     with tempfile.TemporaryDirectory() as tmp:
         data = Path(args.data) if args.data else Path(tmp)
         t0 = time.perf_counter()

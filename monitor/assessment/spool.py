@@ -41,7 +41,18 @@ class Spool:
         self._count = 0
 
     def keep(self, array: np.ndarray) -> OnDisk:
-        """*array* written to the spool; an :class:`AssessmentError` naming the file if the disk refuses."""
+        """An array written to the spool.
+
+        Parameters
+        ----------
+        array : numpy.ndarray
+            The array.
+
+        Returns
+        -------
+        OnDisk
+            It, on disk; an :class:`AssessmentError` naming the file if the disk refuses.
+        """
         path = Path(self._dir.name) / f"{self._count:06d}.npy"
         self._count += 1
         try:
