@@ -46,9 +46,17 @@ class NoRoom(OSError):
 
 
 def check_room(cfg: Config) -> None:
-    """:class:`NoRoom` naming the folder when the file system of ``state_dir`` (the store, the download
-    cache, simulated granules) has less than ``min_free_mb`` free: the day is not begun, and is redone
-    once there is room."""
+    """Refuse to begin a day when the state directory's file system has less room than a day needs.
+
+    Raises :class:`NoRoom` naming the folder when the file system of ``state_dir`` (the store, the download
+    cache, simulated granules) has less than ``min_free_mb`` free: the day is not begun, and is redone once
+    there is room.
+
+    Parameters
+    ----------
+    cfg : Config
+        The service's configuration.
+    """
     probe = next(p for p in (cfg.state_dir, *cfg.state_dir.parents) if p.exists())
     free_mb = shutil.disk_usage(probe).free / 2**20
     if free_mb < cfg.min_free_mb:
@@ -59,8 +67,19 @@ def check_room(cfg: Config) -> None:
 
 
 class ProgressLines:
-    """Progress of a long stage as log lines, for logs and the journal where no bar can be drawn: one
-    line at most every *every_s* seconds, and one at the end. Call it once per item done."""
+    """Progress of a long stage as log lines, for logs and the journal where no bar can be drawn.
+
+    One line at most every *every_s* seconds, and one at the end. Call it once per item done.
+
+    Parameters
+    ----------
+    what : str
+        What is counted (``assessed granules``).
+    total : int
+        The items there will be.
+    every_s : float, optional
+        Seconds between lines at most.
+    """
 
     def __init__(self, what: str, total: int, every_s: float = 30.0):
         self.what, self.total, self.every_s = what, total, every_s
@@ -76,10 +95,18 @@ class ProgressLines:
 
 
 class Heartbeat:
-    """A line every *every_s* seconds while a satellite-day is computed, naming what it is doing and how
-    long the day has taken: the stages without items to count (simulating the day's granules, the day's
-    estimate after its granules are collocated) are otherwise silent for a minute and more. A context
-    manager; :meth:`stage` names each stage (the log lines' ``stage`` field too)."""
+    """A line every *every_s* seconds while a satellite-day is computed, naming what it is doing.
+
+    The stages without items to count (simulating the day's granules, the day's estimate after its granules
+    are collocated) are otherwise silent for a minute and more. A context manager: the beat stops with it.
+
+    Parameters
+    ----------
+    label : str
+        The satellite-day the lines name (``j01 2026-11-21``).
+    every_s : float, optional
+        Seconds between lines.
+    """
 
     def __init__(self, label: str, every_s: float = 15.0) -> None:
         self.label, self.every_s = label, every_s
@@ -91,7 +118,15 @@ class Heartbeat:
         )
 
     def stage(self, name: str, doing: str) -> None:
-        """Enter the stage *name* (the lines' field), described as *doing* (the heartbeat's words)."""
+        """Enter a stage.
+
+        Parameters
+        ----------
+        name : str
+            The stage (the lines' field: list, fingerprint, select, fetch, assess, estimate).
+        doing : str
+            What the heartbeat's lines say it is doing.
+        """
         logcontext.stage(name)
         self.doing = doing
 
@@ -124,10 +159,27 @@ class RunCounts:
 def day_fingerprint(
     cfg: Config, source: Source, satellite: str, day: dt.date, listing: list[ListedFile]
 ) -> fpr.DayFingerprint | None:
-    """The LOS fingerprint (:func:`monitor.mapping.fingerprint.granule_print`) of a sample of the day's GEO
-    granules,
-    with the EPs of the library identified (:func:`monitor.mapping.fingerprint.fingerprint_day`); a granule
-    that cannot be fetched or read is logged and left out; None without any."""
+    """The LOS fingerprint of a sample of the day's GEO granules, with the EPs of the library identified.
+
+    Parameters
+    ----------
+    cfg : Config
+        The service's configuration.
+    source : Source
+        Where the day's granules come from.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+    listing : list of ListedFile
+        The day's listing.
+
+    Returns
+    -------
+    DayFingerprint or None
+        :func:`monitor.mapping.fingerprint.fingerprint_day` of the granules read; None without any (a granule
+        that cannot be fetched or read is logged and left out).
+    """
     geos = sorted(
         (f for f in listing if f.product in CRIS_GEO and f.parsed.start.date() == day),
         key=lambda f: f.parsed.start,
@@ -159,9 +211,26 @@ def fetch_plan(
     stop: Callable[[], bool] = lambda: False,
     progress: Callable[[], None] | None = None,
 ) -> CasePlan:
-    """The assessment plan of the chosen scenes: their CrIS files as selection read them (no second
-    reading, no second pairing) with the VIIRS granules covering them, each fetched and its metadata read
-    once; a VIIRS granule that cannot be fetched or read is skipped with its reason."""
+    """The assessment plan of the chosen scenes, each VIIRS granule fetched and read once.
+
+    Parameters
+    ----------
+    source : Source
+        Where the day's granules come from.
+    satellite : str
+        The satellite's short name.
+    chosen : list of Candidate
+        The scenes chosen, their CrIS files as selection read them.
+    stop : callable
+        Polled between granules; True ends the work.
+    progress : callable, optional
+        Called after each file fetched.
+
+    Returns
+    -------
+    CasePlan
+        The paired granules; a VIIRS granule that cannot be fetched or read is skipped with its reason.
+    """
     viirs: dict[str, GranuleFiles] = {}
     skipped: list[tuple[str, str]] = []
     for c in chosen:
@@ -206,10 +275,33 @@ def compute_day(
     progress: Callable[[object], None] | None = None,
     assessor: Assessor = DayAssessment,
 ) -> DayWork:
-    """List, fingerprint, select, fetch and assess (*assessor*: :class:`DayAssessment` unless a test gives
-    its stand-in) one satellite-day, touching no store. Never raises for a problem of the day's data or
-    source: it becomes the work's status and reason. Its log lines carry the satellite, day and stage (and
-    only its own: the context ends with it)."""
+    """List, fingerprint, select, fetch and assess one satellite-day, touching no store.
+
+    Its log lines carry the satellite, day and stage, and only its own: the context ends with it.
+
+    Parameters
+    ----------
+    cfg : Config
+        The service's configuration.
+    source : Source
+        Where the day's granules come from.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+    should_stop : callable, optional
+        Polled between steps; True ends the day as interrupted.
+    progress : callable, optional
+        Called after each granule assessed.
+    assessor : Assessor, optional
+        What assesses the batches: :class:`DayAssessment` unless a test gives its stand-in.
+
+    Returns
+    -------
+    DayWork
+        What the day produced, picklable for a reprocessing worker; a problem of the day's data or source
+        becomes its status and reason, never an exception.
+    """
     with (
         logcontext.context(satellite=satellite, day=day.isoformat()),
         Heartbeat(f"{satellite} {day}") as beat,
@@ -298,15 +390,49 @@ def assess_in_batches(
     assessor: Assessor,
     beat: Heartbeat,
 ) -> tuple[AssessmentResult, DayPrecision, list[SceneDecision]]:
-    """Fetch and assess the *ranked* candidates in batches until the day's sigma
-    (:meth:`AssessmentResult.day_sigma_urad`) reaches ``scenes.target_sigma_urad`` (without a target: one
-    batch of ``scenes.keep``), ``scenes.max_granules`` are assessed, the candidates are spent, or not even
-    ``scenes.keep`` more granules, each as costly in bytes and seconds as the costliest per granule so
-    far, fit in ``source.daily_budget_mb`` or ``schedule.run_budget_min`` (counted from *started*, the
-    run's ``perf_counter``). The first batch is ``scenes.keep``; each next one aims at the target
-    (:func:`monitor.assessment.scenes.next_batch`), as far as the budgets allow. Returns the estimate over
-    every batch, how far it went, and the candidates' decisions. *timings* gains the seconds of
-    ``fetch`` and ``assess`` (the granules collocated, then the day's estimate); *beat* hears each."""
+    """Fetch and assess the ranked candidates in batches until the day's sigma reaches its target or a budget
+    ends.
+
+    The day stops when its sigma (:meth:`AssessmentResult.day_sigma_urad`) reaches
+    ``scenes.target_sigma_urad`` (without a target: one batch of ``scenes.keep``), ``scenes.max_granules`` are
+    assessed, the candidates are spent, or not even ``scenes.keep`` more granules, each as costly as the
+    costliest so far, fit in ``source.daily_budget_mb`` or ``schedule.run_budget_min``. Each batch after the
+    first aims at the target (:func:`monitor.assessment.scenes.next_batch`).
+
+    Parameters
+    ----------
+    cfg : Config
+        The service's configuration.
+    source : Source
+        Where the day's granules come from.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+    ranked : list of Candidate
+        The candidates, the most informative per byte first.
+    started : float
+        The run's start, ``time.perf_counter()`` s, for ``schedule.run_budget_min``.
+    timings : dict
+        Gains the seconds of ``fetch`` and ``assess``.
+    stop : callable
+        Polled between granules; True ends the work.
+    progress : callable, optional
+        Called after each granule assessed.
+    assessor : Assessor
+        What assesses the batches.
+    beat : Heartbeat
+        Hears each stage.
+
+    Returns
+    -------
+    result : AssessmentResult
+        The estimate over every batch.
+    precision : DayPrecision
+        How far it went and why it stopped.
+    decisions : list of SceneDecision
+        Every candidate's decision.
+    """
     s = cfg.scenes
     a = cfg.assessment
     with assessor(satellite, a, a.workers) as estimate:  # its spool removed at the end

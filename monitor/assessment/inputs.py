@@ -45,13 +45,37 @@ KERNELS = {Kernel.TOP_HAT: collocate.TOP_HAT, Kernel.FOOTPRINT: collocate.ANNULI
 
 
 def offsets_rad(cfg: AssessmentConfig) -> np.ndarray:
-    """The perturbation angles (rad) of one axis of the grid, -half_steps..+half_steps steps."""
+    """The perturbation angles of one axis of the grid, -half_steps..+half_steps steps.
+
+    Parameters
+    ----------
+    cfg : AssessmentConfig
+        The grid (``half_steps``, ``step_urad``).
+
+    Returns
+    -------
+    numpy.ndarray
+        rad, shape (2n+1,).
+    """
     return perturbation_grid(cfg.half_steps, cfg.step_rad)
 
 
 @contextmanager
 def stage(timings: Timings, name: str) -> Iterator[None]:
-    """Add the wall time of the block to timings[name] (seconds) when *timings* is a dict."""
+    """Add the wall time of the block to ``timings[name]`` when *timings* is a dict.
+
+    Parameters
+    ----------
+    timings : dict or None
+        Seconds per stage.
+    name : str
+        The stage.
+
+    Returns
+    -------
+    iterator
+        A context manager's one value, None.
+    """
     t0 = time.perf_counter()
     try:
         yield
@@ -86,13 +110,37 @@ def _widen(span: Span | None, other: Span | None) -> Span | None:
 
 
 def reach_us(first_us: int, last_us: int) -> Span:
-    """The IET span (us) of the VIIRS scans that CrIS observations from first_us to last_us may reach."""
+    """The span of the VIIRS scans that CrIS observations may reach.
+
+    Parameters
+    ----------
+    first_us, last_us : int
+        The first and last CrIS observation, IET us.
+
+    Returns
+    -------
+    tuple of int
+        (t0, t1), IET us, with :data:`collocate.SCAN_TIME_MARGIN_US` either side.
+    """
     return (first_us - collocate.SCAN_TIME_MARGIN_US, last_us + collocate.SCAN_TIME_MARGIN_US)
 
 
 def scan_spans(cris: list[GranuleFiles], viirs: dict[str, list[GranuleFiles]]) -> dict[str, Span]:
-    """Per VIIRS granule key, the IET span (us) of the scans the CrIS granules *cris* using it need (by
-    their nominal bounds, :func:`reach_us`): so that each is prepared once per run."""
+    """Per VIIRS granule, the span of the scans the CrIS granules using it need, so that each is prepared
+    once.
+
+    Parameters
+    ----------
+    cris : list of GranuleFiles
+        The run's CrIS granules.
+    viirs : dict of str to list of GranuleFiles
+        Each CrIS granule's (by key) VIIRS granules.
+
+    Returns
+    -------
+    dict of str to tuple of int
+        VIIRS granule key to (t0, t1), IET us (by the CrIS granules' nominal bounds, :func:`reach_us`).
+    """
     spans: dict[str, tuple[int, int]] = {}
     for g in cris:
         need = reach_us(g.geo_meta.start_iet_us, g.geo_meta.end_iet_us)
@@ -123,9 +171,22 @@ class GranuleInputs:
 def read_viirs(v: GranuleFiles, viirs_all: list[GranuleFiles], span_us: Span | None = None) -> RawViirs:
     """A VIIRS granule's GEO and SDR, with the adjacent scans of its neighbours (for the scan overlap).
 
-    Given *span_us* (IET us), only what :func:`swath.swath_piece` uses of that span is read: the scans
-    observed in it and one scan either side (their halos), and a neighbour's adjacent scan only where the
-    span reaches the granule's edge. The other rows hold fill; read in place, their bytes never travel."""
+    Parameters
+    ----------
+    v : GranuleFiles
+        A VIIRS granule's SDR and GEO files.
+    viirs_all : list of GranuleFiles
+        Every VIIRS granule of the run.
+    span_us : tuple of int, optional
+        Read only what :func:`swath.swath_piece` uses of this span (IET us): the scans observed in it and one
+        scan either side, and a neighbour's adjacent scan only where the span reaches the granule's edge.
+
+    Returns
+    -------
+    RawViirs
+        The GEO, the SDR and the neighbours' adjacent scans; rows outside the span hold fill (read in place,
+        their bytes never travel).
+    """
     scans = slice(None)
     if span_us is not None:
         start_us = read_scan_start_us(v.geo)
@@ -157,9 +218,32 @@ def read_inputs(
     timings: Timings = None,
     spans: dict[str, Span] | None = None,
 ) -> GranuleInputs:
-    """Read what :func:`collocate_granule` needs of *cris*, except the VIIRS granules in *prepared*, and
-    compute what depends on the CrIS granule alone (its geometry and band BT). A VIIRS granule is read
-    over its scans of the run (*spans*, by key: :func:`scan_spans`) and of this granule's reach."""
+    """Read what :func:`collocate_granule` needs of a CrIS granule, and compute what depends on it alone.
+
+    Parameters
+    ----------
+    cris : GranuleFiles
+        The CrIS granule's SDR and GEO files.
+    viirs : list of GranuleFiles
+        The VIIRS granules covering it.
+    viirs_all : list of GranuleFiles
+        Every VIIRS granule of the run.
+    band : I5Band
+        The satellite's I5 band.
+    cfg : AssessmentConfig
+        The assessment's configuration.
+    prepared : iterable of str
+        VIIRS granule keys already prepared: not read again.
+    timings : dict, optional
+        Collects seconds per stage.
+    spans : dict of str to tuple of int, optional
+        The scans of the run per VIIRS granule (:func:`scan_spans`).
+
+    Returns
+    -------
+    GranuleInputs
+        The CrIS GEO and SDR, their geometry and band BT, the cones' reach and the raw VIIRS granules.
+    """
     with stage(timings, "read"):
         geo = next(
             g
@@ -215,10 +299,34 @@ def piece(
     raw: RawViirs | None = None,
     span_us: Span | None = None,
 ) -> swath.SwathPiece:
-    """The granule prepared out to at least *view_rad* from nadir, with its scans of the IET span
-    *span_us* (None: all): from the cache, or prepared out to view_rad + VIEW_MARGIN_RAD (so that the next
-    CrIS granule's slightly wider reach finds it ready) with the scans the whole run needs. With the
-    cache's lift, rendered for the in-track angles :data:`monitor.collocation.render.VIEW_ALPHA_RAD`."""
+    """A VIIRS granule prepared out to at least *view_rad* from nadir, from the cache or prepared now.
+
+    Parameters
+    ----------
+    v : GranuleFiles
+        A VIIRS granule's SDR and GEO files.
+    viirs_all : list of GranuleFiles
+        Every VIIRS granule of the run.
+    band : I5Band
+        The satellite's I5 band.
+    cache : SwathCache
+        The run's prepared granules.
+    view_rad : float
+        The view angle from nadir the cones reach, rad.
+    timings : dict, optional
+        Collects seconds per stage.
+    raw : RawViirs, optional
+        The granule as read ahead; read here when None.
+    span_us : tuple of int, optional
+        The IET span whose scans are needed (None: all).
+
+    Returns
+    -------
+    SwathPiece
+        Prepared out to view_rad + :data:`VIEW_MARGIN_RAD` (so that the next CrIS granule's slightly wider
+        reach finds it ready) with the scans the whole run needs; with the cache's lift, rendered for the
+        in-track angles :data:`monitor.collocation.render.VIEW_ALPHA_RAD`.
+    """
     cached = cache.pieces.get(v.key)
     if cached is not None and cached.view_rad >= view_rad and (span_us is None or cached.covers(*span_us)):
         return cached
@@ -266,9 +374,32 @@ def load_swath(
     raw: dict[str, RawViirs] | None = None,
     span_us: Span | None = None,
 ) -> swath.ViirsSwath:
-    """The prepared VIIRS granules covering one CrIS granule (each prepared once, kept in *cache*) out
-    to *view_rad* from nadir and over the IET span *span_us*, from the raw granules in *raw* (key ->
-    :func:`read_viirs`) or read here."""
+    """The prepared VIIRS granules covering one CrIS granule, each prepared once and kept in the cache.
+
+    Parameters
+    ----------
+    viirs : list of GranuleFiles
+        The VIIRS granules covering it.
+    viirs_all : list of GranuleFiles
+        Every VIIRS granule of the run.
+    band : I5Band
+        The satellite's I5 band.
+    cache : SwathCache
+        The run's prepared granules.
+    view_rad : float
+        The view angle from nadir the cones reach, rad.
+    timings : dict, optional
+        Collects seconds per stage.
+    raw : dict of str to RawViirs, optional
+        Granules read ahead, by key (:func:`read_viirs`).
+    span_us : tuple of int, optional
+        The IET span whose scans are needed.
+
+    Returns
+    -------
+    ViirsSwath
+        The pieces.
+    """
     raw = raw or {}
     # a time-ordered run never needs again a piece this granule does not: freed before the new ones are
     # prepared, it does not add to the peak
@@ -280,7 +411,22 @@ def load_swath(
 
 
 def cris_geometry(geo: CrisGeoGranule) -> tuple[FovGeometry, np.ndarray, dict]:
-    """Inverse geolocation of a CrIS GEO granule, with fill FOVs given harmless values and masked."""
+    """The inverse geolocation of a CrIS GEO granule, with fill FOVs given harmless values and masked.
+
+    Parameters
+    ----------
+    geo : CrisGeoGranule
+        The granule.
+
+    Returns
+    -------
+    geometry : FovGeometry
+        :func:`monitor.geometry.inverse.granule_geometry`.
+    valid : numpy.ndarray
+        Where a FOV is geolocated.
+    fill : dict
+        The FOV fields with fill replaced.
+    """
     valid = geo.valid
     fill = {
         k: np.where(valid, getattr(geo, k), 0.0) for k in ("lat_rad", "lon_rad", "zenith_rad", "azimuth_rad")

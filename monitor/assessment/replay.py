@@ -46,7 +46,17 @@ STEP_TOLERANCE = 1e-3  # relative: the turns must be one uniform step, the same 
 
 
 class ReplayError(DataError):
-    """A collocation file that does not hold what the layout says: FILE: FIELD: REASON."""
+    """A collocation file that does not hold what the layout says: FILE: FIELD: REASON.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    field : str
+        The array or attribute.
+    reason : str
+        What is wrong with it.
+    """
 
     def __init__(self, path: Path, field: str, reason: str):
         super().__init__(f"{path}: {field}: {reason}")
@@ -67,6 +77,13 @@ class Collocation:
 
     @property
     def half_steps(self) -> int:
+        """The grid's perturbations on each side of zero.
+
+        Returns
+        -------
+        int
+            n of the (2n+1) x (2n+1) square.
+        """
         return (self.v_bt_k.shape[-1] - 1) // 2
 
 
@@ -97,8 +114,18 @@ def _turns(path: Path, key: str, a: np.ndarray) -> float:
 
 
 def read_collocation(path: str | Path) -> Collocation:
-    """One reference-implementation ``.npz``, checked against :data:`LAYOUT`; :class:`ReplayError` names
-    the file, the field and what is wrong."""
+    """One reference-implementation ``.npz``, checked against :data:`LAYOUT`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    Collocation
+        Its square grid; a :class:`ReplayError` names the file, the field and what is wrong.
+    """
     path = Path(path)
     try:
         z = np.load(path, allow_pickle=False)
@@ -136,7 +163,20 @@ def read_collocation(path: str | Path) -> Collocation:
 
 
 def for_samples(granules: list[Collocation], k: int) -> ForSamples:
-    """The estimator's input for FOR k (0-based) over *granules*: every usable FOV (cone means only)."""
+    """The estimator's input for one FOR over the granules: every usable FOV (cone means only).
+
+    Parameters
+    ----------
+    granules : list of Collocation
+        The collocation files read.
+    k : int
+        The FOR, 0-based.
+
+    Returns
+    -------
+    ForSamples
+        The FOR's samples.
+    """
     d, cris, granule, scan, fov = [], [], [], [], []
     for g_i, g in enumerate(granules):
         use = g.usable[:, k]
@@ -153,8 +193,18 @@ def for_samples(granules: list[Collocation], k: int) -> ForSamples:
 
 
 def granule_info(g: Collocation) -> GranuleInfo:
-    """What the result records of one collocation file; its times (UTC, ISO 8601) from the granule's name
-    (empty for another name)."""
+    """What the result records of one collocation file.
+
+    Parameters
+    ----------
+    g : Collocation
+        The file read.
+
+    Returns
+    -------
+    GranuleInfo
+        Its times (UTC, ISO 8601) from the granule's name, empty for another name.
+    """
     n = g.usable.size
     name = parse_name(g.path.name.removesuffix(".npz"))
     return GranuleInfo(
@@ -170,7 +220,18 @@ def granule_info(g: Collocation) -> GranuleInfo:
 
 
 def notes(granules: list[Collocation]) -> list[str]:
-    """What the result says of how collocation files were read."""
+    """What the result says of how collocation files were read.
+
+    Parameters
+    ----------
+    granules : list of Collocation
+        The files read.
+
+    Returns
+    -------
+    list of str
+        The result's notes.
+    """
     grids = sorted({g.file_grid for g in granules})
     m = granules[0].v_bt_k.shape[-1]
     return [
@@ -200,9 +261,23 @@ def _start_s(path: Path) -> float:
 def assess_collocations(
     paths: Iterable[str | Path], cfg: AssessmentConfig, satellite: str = ""
 ) -> AssessmentResult:
-    """The estimator's result for the collocation files *paths* (one granule each; all on one grid): per-FOR
-    offsets in urad with jackknife sigmas, flags and the intercalibration; the km fields NaN. The files hold
-    top-hat cone means: the top-hat kernel's floor of the sigmas applies."""
+    """The estimator's result for the reference implementation's collocation files.
+
+    Parameters
+    ----------
+    paths : iterable of str or Path
+        The files, one granule each, all on one grid.
+    cfg : AssessmentConfig, optional
+        The assessment's configuration (the cost).
+    satellite : str, optional
+        The satellite's short name.
+
+    Returns
+    -------
+    AssessmentResult
+        Per-FOR offsets in urad with jackknife sigmas, flags (``top_hat``: cone means) and the
+        intercalibration; the km fields NaN (the files hold no geometry).
+    """
     granules = sorted((read_collocation(p) for p in paths), key=lambda g: (_start_s(g.path), g.path.name))
     if not granules:
         raise DataError("no collocation files given")

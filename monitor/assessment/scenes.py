@@ -57,7 +57,20 @@ def _pairs(
 
 
 def inhomogeneity_k(radiance_lw: np.ndarray, satellite: str) -> float:
-    """Mean over FORs of the standard deviation of the 9 FOV I5-equivalent BTs (K)."""
+    """The mean over FORs of the standard deviation of the 9 FOVs' I5-equivalent BT.
+
+    Parameters
+    ----------
+    radiance_lw : numpy.ndarray
+        The granule's CrIS LW spectra, mW/(m2 sr cm-1).
+    satellite : str
+        The satellite's short name (its I5 band).
+
+    Returns
+    -------
+    float
+        K.
+    """
     band = i5_band(satellite)
     bt = band.bt_from_radiance(band.cris_band_radiance(radiance_lw))
     return float(np.nanmean(np.nanstd(bt, axis=-1)))
@@ -66,9 +79,31 @@ def inhomogeneity_k(radiance_lw: np.ndarray, satellite: str) -> float:
 def rank_scenes(
     listing: list[ListedFile], source: Source, satellite: str, candidates: int, min_score_k: float
 ) -> tuple[list[Candidate], list[SceneDecision]]:
-    """(usable candidates, the most informative per byte first; the decisions of every other granule of
-    the listing, rejected or not considered, with the reason). Scoring reads each candidate's CrIS SDR and
-    GEO files (a few MB); no VIIRS byte is read before a candidate is assessed."""
+    """The usable candidates of a day's listing, the most informative per byte first.
+
+    Scoring reads each candidate's CrIS SDR and GEO files (a few MB); no VIIRS byte is read before a candidate
+    is assessed.
+
+    Parameters
+    ----------
+    listing : list of ListedFile
+        The day's listing.
+    source : Source
+        Where the CrIS files are read from.
+    satellite : str
+        The satellite's short name.
+    candidates : int
+        How many CrIS granules to score, spread over the day.
+    min_score_k : float
+        The least inhomogeneity a candidate must have, K.
+
+    Returns
+    -------
+    candidates : list of Candidate
+        The usable ones, ranked.
+    decisions : list of SceneDecision
+        Every other granule of the listing, rejected or not considered, with the reason.
+    """
     decisions: list[SceneDecision] = []
     cris, unpaired = _pairs(listing, CRIS_SDR, CRIS_GEO)
     for key in unpaired:
@@ -130,10 +165,23 @@ def rank_scenes(
 
 
 def bytes_of(c: Candidate, covering: Counter[str]) -> float:
-    """What assessing *c* costs in bytes, as listed: its CrIS SDR and GEO, and its share of each VIIRS pair
-    covering it, split among the *covering* candidates (per VIIRS granule key: a VIIRS granule that two
-    consecutive CrIS granules share costs each half, so at equal information per byte consecutive runs
-    come first)."""
+    """What assessing a candidate costs in bytes, as listed.
+
+    A VIIRS granule that two consecutive CrIS granules share costs each half, so at equal information per
+    byte consecutive runs come first.
+
+    Parameters
+    ----------
+    c : Candidate
+        The candidate.
+    covering : Counter of str
+        Per VIIRS granule key, how many candidates it covers.
+
+    Returns
+    -------
+    float
+        Its CrIS SDR and GEO and its share of each VIIRS pair covering it, bytes.
+    """
     own = (c.sdr.size or 0) + (c.geo.size or 0)
     return own + sum(
         ((vs.size or 0) + (vg.size or 0)) / covering[vg.parsed.granule_key] for vs, vg in c.viirs
@@ -141,12 +189,28 @@ def bytes_of(c: Candidate, covering: Counter[str]) -> float:
 
 
 def next_batch(taken: int, sigma_urad: float | None, target_urad: float, keep: int) -> int:
-    """How many granules the next batch takes, after *taken* have given the day's sigma *sigma_urad*
-    (None: not estimable yet) against *target_urad*: what 1 / sqrt(N) says the target needs,
-    taken * (sigma / target)^2 - taken, at least *keep* and at most *taken* (the day at most doubles).
-    The estimate is made again after each batch, and it grows with the day, so batches that grow with it
-    keep a long day's estimates linear in its granules; the ranking puts the most informative granules
-    first, so the sigma falls more slowly than 1 / sqrt(N) and the aim falls short rather than beyond."""
+    """How many granules the next batch takes.
+
+    The estimate is made again after each batch and grows with the day, so batches that grow with it keep a
+    long day's estimates linear in its granules; the ranking puts the most informative granules first, so the
+    sigma falls more slowly than 1 / sqrt(N) and the aim falls short rather than beyond.
+
+    Parameters
+    ----------
+    taken : int
+        The granules assessed so far.
+    sigma_urad : float or None
+        The day's sigma they give, urad (None: not estimable yet).
+    target_urad : float
+        ``scenes.target_sigma_urad``.
+    keep : int
+        ``scenes.keep``: the fewest of a batch.
+
+    Returns
+    -------
+    int
+        taken (sigma / target)^2 - taken, at least *keep* and at most *taken* (the day at most doubles).
+    """
     if sigma_urad is None or taken == 0:
         return keep
     needed = math.ceil(taken * (sigma_urad / target_urad) ** 2 - 1e-9) - taken
@@ -154,8 +218,22 @@ def next_batch(taken: int, sigma_urad: float | None, target_urad: float, keep: i
 
 
 def batch_decisions(ranked: list[Candidate], sizes: list[int], why_not: str) -> list[SceneDecision]:
-    """The decisions of the *ranked* candidates once a day has assessed its first ones in batches of
-    *sizes*: chosen with their rank and batch, the rest rejected for *why_not* (why the day stopped)."""
+    """The decisions of the ranked candidates once a day has assessed its first ones in batches.
+
+    Parameters
+    ----------
+    ranked : list of Candidate
+        The candidates, ranked.
+    sizes : list of int
+        The batches' sizes.
+    why_not : str
+        Why the day stopped: the reason of those not assessed.
+
+    Returns
+    -------
+    list of SceneDecision
+        Chosen with their rank and batch, the rest rejected.
+    """
     batch_of = np.repeat(np.arange(1, len(sizes) + 1), sizes)
     return [
         SceneDecision(
