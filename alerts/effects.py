@@ -83,18 +83,18 @@ class ChangeEffect:
     dof: int
 
     @property
-    def significant(self) -> np.ndarray:
+    def significant(self) -> np.ndarray:  # numpydoc ignore=RT01
         """(N_FOR, 2): where |move| exceeds ``z_limit`` sigmas."""
         with np.errstate(invalid="ignore"):
             return np.abs(self.move_urad) > self.z_limit * self.sigma_move_urad
 
     @property
-    def residual_urad(self) -> np.ndarray | None:
+    def residual_urad(self) -> np.ndarray | None:  # numpydoc ignore=RT01
         """Observed minus predicted move, (N_FOR, 2), where a prediction exists."""
         return None if self.predicted_urad is None else self.move_urad - self.predicted_urad
 
     @property
-    def p_value(self) -> float:
+    def p_value(self) -> float:  # numpydoc ignore=RT01
         """The chance of a chi2 this large were the prediction right (NaN: nothing predicted)."""
         return float(stats.chi2.sf(self.chi2, self.dof)) if self.dof else math.nan
 
@@ -165,7 +165,7 @@ class EffectRow:
     predicted_urad: float
 
     @property
-    def residual_urad(self) -> float:
+    def residual_urad(self) -> float:  # numpydoc ignore=RT01
         """Observed minus predicted move (NaN: nothing predicted)."""
         return self.move_urad - self.predicted_urad
 

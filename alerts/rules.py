@@ -87,7 +87,7 @@ class Finding:
     data: dict = field(default_factory=dict)
 
     @property
-    def fingerprint(self) -> str:
+    def fingerprint(self) -> str:  # numpydoc ignore=RT01
         """rule:satellite, and :group where there is one: the identity the alert state tracks."""
         return ":".join(p for p in (self.rule, self.satellite, self.group) if p)
 

@@ -38,7 +38,7 @@ class ListedFile:
     md5: str | None = None
 
     @property
-    def product(self) -> str:
+    def product(self) -> str:  # numpydoc ignore=RT01
         """The file's (first) product prefix, e.g. GCRSO."""
         return self.parsed.products[0]
 

@@ -93,7 +93,7 @@ class NoddSource:
         self.sleep = sleep
 
     @property
-    def http(self) -> BoundedSession:
+    def http(self) -> BoundedSession:  # numpydoc ignore=RT01
         """This thread's session. Read in place, granules are read by the assessment's read-ahead thread
         and its main thread at once, and a watchdog cuts every socket of its session: each thread's
         deadline must cut only its own requests."""

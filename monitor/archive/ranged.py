@@ -100,7 +100,7 @@ class RangedGranule:
     root: Path
 
     @property
-    def name(self) -> str:
+    def name(self) -> str:  # numpydoc ignore=RT01
         """The granule's file name."""
         return self.listed.name
 

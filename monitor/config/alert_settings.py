@@ -209,11 +209,11 @@ class AlertSettings(RuleSettings):
         return self
 
     @property
-    def links(self) -> Links:
+    def links(self) -> Links:  # numpydoc ignore=RT01
         """The report and dashboard the messages point to (the top-level keys)."""
         return self._links
 
     @property
-    def channels(self) -> list[str]:
+    def channels(self) -> list[str]:  # numpydoc ignore=RT01
         """The names of the configured channels."""
         return [n for n in ("log", "email", "slack") if getattr(self, n)]

@@ -134,7 +134,7 @@ class AssessmentConfig(Section):
     )
 
     @property
-    def step_rad(self) -> float:
+    def step_rad(self) -> float:  # numpydoc ignore=RT01
         """The perturbation step in radians."""
         return self.step_urad * URAD
 

@@ -84,17 +84,17 @@ class Config(Section):
         return self
 
     @property
-    def path(self) -> Path | None:
+    def path(self) -> Path | None:  # numpydoc ignore=RT01
         """The file the configuration was loaded from."""
         return self._file
 
     @property
-    def events_file(self) -> Path | None:
+    def events_file(self) -> Path | None:  # numpydoc ignore=RT01
         """The events calendar (``alerts.events_file``): attribution of jumps, annotations, the report."""
         return self.alerts.events_file
 
     @property
-    def cache_dir(self) -> Path:
+    def cache_dir(self) -> Path:  # numpydoc ignore=RT01
         """Where downloads are cached: ``state_dir/cache``."""
         return self.state_dir / "cache"
 

@@ -78,7 +78,7 @@ class StoreConfig(Section):
     )
 
     @property
-    def path(self) -> Path:
+    def path(self) -> Path:  # numpydoc ignore=RT01
         """The store's file (filled in by :class:`Config`)."""
         assert self.sqlite is not None, "store.sqlite is filled in when the configuration is loaded"
         return self.sqlite

@@ -43,12 +43,12 @@ class Key:
     field: FieldInfo
 
     @property
-    def required(self) -> bool:
+    def required(self) -> bool:  # numpydoc ignore=RT01
         """Whether the file must give it (where its section is given)."""
         return self.field.is_required()
 
     @property
-    def default(self) -> Any:
+    def default(self) -> Any:  # numpydoc ignore=RT01
         """The default the loader fills in (None: none)."""
         if self.required:
             return None
@@ -56,13 +56,13 @@ class Key:
         return None if isinstance(value, BaseModel) else value
 
     @property
-    def unit(self) -> str:
+    def unit(self) -> str:  # numpydoc ignore=RT01
         """The unit its name ends in."""
         leaf = self.name.rsplit(".", 1)[-1]
         return next((u for suffix, u in UNITS if leaf.endswith(suffix)), "")
 
     @property
-    def range(self) -> tuple[float | None, float | None] | None:
+    def range(self) -> tuple[float | None, float | None] | None:  # numpydoc ignore=RT01
         """(lo, hi), inclusive, for a bounded number."""
         lo, hi = key_range(self.field)
         return None if lo is None and hi is None else (lo, hi)

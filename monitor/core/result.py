@@ -39,7 +39,7 @@ class SpecBreach:
     spec_km: float
 
     @property
-    def beyond_doubt(self) -> bool:
+    def beyond_doubt(self) -> bool:  # numpydoc ignore=RT01
         """The breach holds beyond the uncertainty: |error| - 2 sigma is still beyond the specification."""
         return math.isfinite(self.sigma_km) and abs(self.error_km) - 2 * self.sigma_km > self.spec_km
 
@@ -100,7 +100,7 @@ class Measure:
     metric: tuple[Family, str] | None = None
 
     @property
-    def to_base_unit(self) -> float:
+    def to_base_unit(self) -> float:  # numpydoc ignore=RT01
         """The factor from the field's unit to the SI unit of ``/metrics``."""
         return TO_BASE_UNIT[self.unit]
 
@@ -223,22 +223,22 @@ class ForOffset:
     )  # fmt: skip
 
     @property
-    def d_alpha_pct_fov(self) -> float:
+    def d_alpha_pct_fov(self) -> float:  # numpydoc ignore=RT01
         """The in-track offset as a percentage of the FOV diameter."""
         return 100.0 * self.d_alpha_urad / FOV_DIAMETER_URAD
 
     @property
-    def d_beta_pct_fov(self) -> float:
+    def d_beta_pct_fov(self) -> float:  # numpydoc ignore=RT01
         """The cross-track offset as a percentage of the FOV diameter."""
         return 100.0 * self.d_beta_urad / FOV_DIAMETER_URAD
 
     @property
-    def reliable(self) -> bool:
+    def reliable(self) -> bool:  # numpydoc ignore=RT01
         """Whether no flag of RELIABILITY_FLAGS is set: the offset may be trusted and alerted on."""
         return not any(f in RELIABILITY_FLAGS for f in self.flags)
 
     @property
-    def worst_km(self) -> float:
+    def worst_km(self) -> float:  # numpydoc ignore=RT01
         """The larger of the in-track and cross-track errors on the ground, in magnitude (km): what the
         specification judges (:meth:`spec_breaches`); NaN when neither was measured. "Worst" on every
         surface is this; the total (their root sum of squares) is shown as the total, never judged."""

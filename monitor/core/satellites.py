@@ -47,7 +47,7 @@ class Satellite:
         return int((unix_s - self.launch_unix_s) // NODAL_PERIOD_S) + 1
 
     @property
-    def launch_day(self) -> dt.date:
+    def launch_day(self) -> dt.date:  # numpydoc ignore=RT01
         """The UTC day of the launch."""
         return dt.datetime.fromtimestamp(self.launch_unix_s, dt.timezone.utc).date()
 

@@ -35,7 +35,7 @@ class EventKind(StrEnum):
     CHANGE_VIIRS = "change:viirs"  # the same for VIIRS
 
     @property
-    def is_change(self) -> bool:
+    def is_change(self) -> bool:  # numpydoc ignore=RT01
         """Whether the event records a processing change (change:<instrument>)."""
         return self.value.startswith("change:")
 

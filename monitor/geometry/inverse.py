@@ -150,27 +150,27 @@ class CrisGeoFields(Protocol):
     """What :func:`granule_geometry` reads of a CrIS GEO granule (:class:`monitor.sdr.CrisGeoGranule`,
     a floor above): per FOV (scan, FOR, FOV) unless said."""
 
-    @property
+    @property  # numpydoc ignore=RT01
     def valid(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def lat_rad(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def lon_rad(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def zenith_rad(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def azimuth_rad(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def range_m(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def for_time_us(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def mid_time_us(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def sc_position_m(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def sc_velocity_m_s(self) -> np.ndarray: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def sc_attitude_rad(self) -> np.ndarray: ...
 
 

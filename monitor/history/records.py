@@ -30,19 +30,19 @@ from monitor.core.vocabulary import (
 class FindingRecord(Protocol):
     """What the alert ledger records of a rule's finding (:class:`alerts.rules.Finding`, a floor above)."""
 
-    @property
+    @property  # numpydoc ignore=RT01
     def fingerprint(self) -> str: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def rule(self) -> str: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def satellite(self) -> str: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def group(self) -> str: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def severity(self) -> str: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def summary(self) -> str: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def lines(self) -> list: ...
 
 

@@ -218,7 +218,7 @@ class ProcessingChange:
     d_beta_urad: np.ndarray
 
     @property
-    def largest_urad(self) -> float:
+    def largest_urad(self) -> float:  # numpydoc ignore=RT01
         """The largest change of any FOR in either direction."""
         return float(np.nanmax(np.abs(np.concatenate([self.d_alpha_urad, self.d_beta_urad]))))
 
@@ -276,7 +276,7 @@ class EpMatch:
     d_beta_urad: np.ndarray
 
     @property
-    def rms_urad(self) -> float:
+    def rms_urad(self) -> float:  # numpydoc ignore=RT01
         """RMS over FORs of the residual in both directions."""
         return float(np.sqrt(np.nanmean(np.concatenate([self.d_alpha_urad, self.d_beta_urad]) ** 2)))
 

@@ -34,12 +34,12 @@ class AngleRow:
     kept: str = ""
 
     @property
-    def d_roll_urad(self) -> float:
+    def d_roll_urad(self) -> float:  # numpydoc ignore=RT01
         """Change of the cross-track (roll) mirror angle, new minus old (urad)."""
         return self.new_roll_urad - self.old_roll_urad
 
     @property
-    def d_pitch_urad(self) -> float:
+    def d_pitch_urad(self) -> float:  # numpydoc ignore=RT01
         """Change of the in-track (pitch) mirror angle, new minus old (urad)."""
         return self.new_pitch_urad - self.old_pitch_urad
 
@@ -80,7 +80,7 @@ class Optimization:
     rows: list
 
     @property
-    def kept(self) -> list:
+    def kept(self) -> list:  # numpydoc ignore=RT01
         """The rows whose old angles were kept, with why (``kept`` names the reason)."""
         return [r for r in self.rows if r.kept]
 

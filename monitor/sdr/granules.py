@@ -21,7 +21,7 @@ class RemoteGranule(Protocol):
     key)."""
 
     @property
-    def name(self) -> str:
+    def name(self) -> str:  # numpydoc ignore=RT01
         """The granule's file name."""
         ...
 
@@ -87,7 +87,7 @@ class CrisGeoGranule:
     sc_attitude_rad: np.ndarray
 
     @property
-    def valid(self) -> np.ndarray:
+    def valid(self) -> np.ndarray:  # numpydoc ignore=RT01
         """FOVs whose every geometry field is present."""
         ok = np.ones(self.lat_rad.shape, bool)
         for a in (self.lat_rad, self.lon_rad, self.range_m, self.zenith_rad, self.azimuth_rad):
@@ -112,7 +112,7 @@ class CrisSdrGranule:
     qf1_scan: np.ndarray | None
 
     @property
-    def good(self) -> np.ndarray:
+    def good(self) -> np.ndarray:  # numpydoc ignore=RT01
         """FOVs with good LW SDR quality (``QF3 & 0b11 == 0``, Wang's rule) and finite spectra."""
         ok = (self.qf3[..., 0] & 0b11) == 0
         return ok & np.all(np.isfinite(self.radiance_lw), axis=-1)
@@ -127,7 +127,7 @@ class ViirsSdrGranule:
     qf1: np.ndarray
 
     @property
-    def good(self) -> np.ndarray:
+    def good(self) -> np.ndarray:  # numpydoc ignore=RT01
         """Pixels with a value and QF1 == 0 (Wang's rule)."""
         return np.isfinite(self.bt_k) & (self.qf1 == 0)
 

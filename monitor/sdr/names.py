@@ -35,7 +35,7 @@ class JpssName:
     domain: str
 
     @property
-    def granule_key(self) -> str:
+    def granule_key(self) -> str:  # numpydoc ignore=RT01
         """``plat_dYYYYMMDD_tHHMMSSS_eHHMMSSS_bNNNNN``: identical for an SDR and its GEO file."""
         return (
             f"{self.platform}_d{self.start:%Y%m%d}_t{self.start:%H%M%S}{self.start.microsecond // 100000}"

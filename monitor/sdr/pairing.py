@@ -50,12 +50,12 @@ class GranuleFiles:
     geo_meta: GranuleMeta
 
     @property
-    def start(self) -> dt.datetime:
+    def start(self) -> dt.datetime:  # numpydoc ignore=RT01
         """Start of the granule (UTC, from its GEO metadata)."""
         return self.geo_meta.start
 
     @property
-    def end(self) -> dt.datetime:
+    def end(self) -> dt.datetime:  # numpydoc ignore=RT01
         """End of the granule (UTC, from its GEO metadata)."""
         return self.geo_meta.end
 

@@ -81,7 +81,7 @@ class Product:
     fields: dict = field(default_factory=dict)
 
     @property
-    def data_group(self) -> str:
+    def data_group(self) -> str:  # numpydoc ignore=RT01
         """The HDF5 group that holds the product's arrays."""
         return f"All_Data/{self.collection}_All"
 

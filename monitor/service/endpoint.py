@@ -140,7 +140,7 @@ class Endpoint:
         self.thread = threading.Thread(target=self.server.serve_forever, name="http", daemon=True)
 
     @property
-    def address(self) -> str:
+    def address(self) -> str:  # numpydoc ignore=RT01
         """HOST:PORT actually listened on (port 0 resolved)."""
         host, port = self.server.server_address[:2]
         host = host.decode() if isinstance(host, bytes) else str(host)

@@ -55,7 +55,7 @@ class ReprocessSummary:
     wall_s: float = 0.0
 
     @property
-    def finished(self) -> int:
+    def finished(self) -> int:  # numpydoc ignore=RT01
         """Satellite-days processed and recorded by this call."""
         return sum(self.statuses.values())
 

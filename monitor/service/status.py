@@ -98,12 +98,12 @@ class SatelliteStatus:
     stale_since: dt.datetime | None = None  # no successful assessment since (UTC): past the stale limit
 
     @property
-    def beyond_spec(self) -> tuple[ForOffset, ...]:
+    def beyond_spec(self) -> tuple[ForOffset, ...]:  # numpydoc ignore=RT01
         """The latest day's FORs beyond the specification (the one rule of :mod:`monitor.core.result`)."""
         return tuple(f for f in self.fors if f.spec_breaches(self.spec_km))
 
     @property
-    def worst_km(self) -> float | None:
+    def worst_km(self) -> float | None:  # numpydoc ignore=RT01
         """The worst error of the latest day (:func:`monitor.core.result.worst_for`), km."""
         worst = worst_for(self.fors)
         return None if worst is None else worst.worst_km

@@ -94,7 +94,7 @@ class Method:
         return cls(cfg.assessment.half_steps, cfg.alerts.spec_km)
 
     @property
-    def grid(self) -> str:
+    def grid(self) -> str:  # numpydoc ignore=RT01
         """The perturbation grid, ``21 x 21`` at the defaults."""
         n = 2 * self.half_steps + 1
         return f"{n} x {n}"

@@ -78,11 +78,11 @@ disable_created_metrics()  # a counter's start time is not a series anyone graph
 class Counts(Protocol):
     """What the metrics read of a run's counts (:class:`monitor.assessment.day.RunCounts`)."""
 
-    @property
+    @property  # numpydoc ignore=RT01
     def downloaded(self) -> int: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def bytes(self) -> int: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def requests(self) -> int: ...
 
 
@@ -90,9 +90,9 @@ class Outcome(Protocol):
     """What the metrics read of a run (:class:`monitor.service.pipeline.RunOutcome`): its satellite and its
     counts. Typed so, the metrics and the pipeline (one floor) do not import each other."""
 
-    @property
+    @property  # numpydoc ignore=RT01
     def satellite(self) -> str: ...
-    @property
+    @property  # numpydoc ignore=RT01
     def counts(self) -> Counts: ...
 
 

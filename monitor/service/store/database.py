@@ -98,7 +98,7 @@ class Database:
 
     # -- schema
     @property
-    def schema_version(self) -> int:
+    def schema_version(self) -> int:  # numpydoc ignore=RT01
         """The schema version of the file (SQLite user_version)."""
         return self.db.execute("PRAGMA user_version").fetchone()[0]
 
