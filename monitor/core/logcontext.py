@@ -15,13 +15,30 @@ _context: contextvars.ContextVar[dict | None] = contextvars.ContextVar("crisgeo_
 
 
 def fields() -> dict:
-    """The fields of the block under way (empty outside one)."""
+    """The fields of the block under way.
+
+    Returns
+    -------
+    dict
+        Satellite, day, stage, run_id; empty outside a block.
+    """
     return _context.get() or {}
 
 
 @contextmanager
 def context(**new: object) -> Iterator[None]:
-    """Add *new* fields (satellite, day, stage, run_id) to every line logged inside the block."""
+    """Add fields to every line logged inside the block.
+
+    Parameters
+    ----------
+    **new : object
+        Fields: satellite, day, stage, run_id.
+
+    Returns
+    -------
+    iterator
+        A context manager's one value, None.
+    """
     token = _context.set({**fields(), **{k: v for k, v in new.items() if v is not None}})
     try:
         yield
@@ -30,8 +47,16 @@ def context(**new: object) -> Iterator[None]:
 
 
 def stage(name: str) -> None:
-    """Name the stage of the satellite-day under way; only inside :func:`context`, which ends it (outside
-    one the name would stay on every later line of the thread)."""
+    """Name the stage of the satellite-day under way.
+
+    Only inside :func:`context`, which ends it: outside one the name would stay on every later line of the
+    thread.
+
+    Parameters
+    ----------
+    name : str
+        The stage.
+    """
     if _context.get() is None:
         raise RuntimeError("logcontext.stage outside logcontext.context")
     _context.set({**fields(), "stage": name})

@@ -113,8 +113,28 @@ def measured(
     series: bool = True,
     metric: tuple[Family, str] | None = None,
 ) -> Any:
-    """Declare a measured field of :class:`ForOffset` (or of a record extending it): its unit, meaning and
-    outputs (:class:`Measure`); *default* MISSING: required."""
+    """Declare a measured field of :class:`ForOffset` (or of a record extending it).
+
+    Parameters
+    ----------
+    unit : str
+        Its unit as CF writes it (``urad``, ``km``, ``K``, ``1`` for a count).
+    meaning : str
+        What it is, for the export's long name and the tables.
+    default : object, optional
+        Its default; MISSING: required.
+    quality : bool, optional
+        Whether it tells the quality of a measurement (an uncertainty, a cost) rather than being one.
+    series : bool, optional
+        Whether the time series carries it.
+    metric : tuple of (Family, str), optional
+        The ``/metrics`` family that publishes it, and its label value there.
+
+    Returns
+    -------
+    dataclasses.Field
+        The field, its :class:`Measure` in its metadata.
+    """
     spec = {"unit": unit, "meaning": meaning, "quality": quality, "series": series, "metric": metric}
     return field(default=default, metadata={"measure": spec})
 
@@ -246,10 +266,23 @@ class ForOffset:
         return max(errors) if errors else math.nan
 
     def spec_breaches(self, spec_km: float) -> tuple[SpecBreach, ...]:
-        """The one definition of "out of spec": a reliable FOR whose in-track or cross-track error on the
-        ground exceeds *spec_km* in magnitude, each direction on its own (the specification is per
-        direction, as the paper plots it; the total is shown, never judged). Empty when within it, and
-        for an unreliable FOR (no trustworthy number to judge)."""
+        """The one definition of "out of spec".
+
+        A reliable FOR is out of spec when its in-track or cross-track error on the ground exceeds the
+        specification, each direction on its own (the specification is per direction, as the paper plots it;
+        the total is shown, never judged).
+
+        Parameters
+        ----------
+        spec_km : float
+            The specification, km (``alerts.spec_km``).
+
+        Returns
+        -------
+        tuple of SpecBreach
+            One per direction whose error on the ground exceeds *spec_km* in magnitude; empty when within it,
+            and for an unreliable FOR (no trustworthy number to judge).
+        """
         if not self.reliable:
             return ()
         return tuple(
@@ -262,6 +295,13 @@ class ForOffset:
         )
 
     def to_dict(self) -> dict:
+        """The record as JSON-ready values: ``for``, the measured fields, the derived % of FOV and ``flags``.
+
+        Returns
+        -------
+        dict
+            NaN where nothing was measured.
+        """
         d = asdict(self)
         d["for"] = d.pop("for_index")
         d["flags"] = list(self.flags)
@@ -271,16 +311,36 @@ class ForOffset:
 
     @classmethod
     def from_dict(cls, d: dict) -> "ForOffset":
-        """The record of :meth:`to_dict` (or of a stored row: ``for``, ``flags`` and the measured fields),
-        where None is what was not measured: NaN, or 0 for a count."""
+        """The record of :meth:`to_dict`, or of a stored row.
+
+        Parameters
+        ----------
+        d : dict
+            ``for``, ``flags`` and the measured fields; None is what was not measured (NaN, or 0 for a count).
+
+        Returns
+        -------
+        ForOffset
+            The record.
+        """
         kw = {k: d[k] for k in MEASURED_FIELDS if k in d}
         kw = {k: (v if v is not None else 0 if k in COUNT_FIELDS else float("nan")) for k, v in kw.items()}
         return cls(for_index=int(d["for"]), flags=tuple(d.get("flags", ())), **kw)
 
 
 def measures(record: type = ForOffset) -> tuple[Measure, ...]:
-    """The measured fields of *record* (:class:`ForOffset`, or a record extending it) in declaration order:
-    what the export, the tables, ``/metrics``, the time series and the store derive from."""
+    """The measured fields of a record in declaration order: what the outputs derive from.
+
+    Parameters
+    ----------
+    record : type, optional
+        :class:`ForOffset`, or a record extending it.
+
+    Returns
+    -------
+    tuple of Measure
+        The export, the tables, ``/metrics``, the time series and the store derive from these.
+    """
     hints = typing.get_type_hints(record)
     return tuple(
         Measure(f.name, hints[f.name], **f.metadata["measure"])
@@ -324,7 +384,18 @@ class GranuleInfo:
 
     @classmethod
     def from_dict(cls, d: dict) -> GranuleInfo:
-        """A granule of a result file."""
+        """A granule of a result file.
+
+        Parameters
+        ----------
+        d : dict
+            Its record in the result's JSON.
+
+        Returns
+        -------
+        GranuleInfo
+            The granule.
+        """
         return cls(**{k: d[k] for k in cls.__dataclass_fields__ if k in d})
 
 
@@ -353,9 +424,17 @@ class AssessmentResult:
     notes: list[str] = field(default_factory=list)  # how the inputs were read, where that is not granules
 
     def day_sigma_urad(self) -> float | None:
-        """The day's precision, the one number a precision target is held to: the median over FORs of the
-        jackknife sigma, in the worse direction (urad; None where no FOR has one). The sigmas already count
-        consecutive granules as fewer independent ones (:mod:`monitor.estimation.jackknife`)."""
+        """The day's precision, the one number a precision target is held to.
+
+        The sigmas already count consecutive granules as fewer independent ones
+        (:mod:`monitor.estimation.jackknife`).
+
+        Returns
+        -------
+        float or None
+            The median over FORs of the jackknife sigma in the worse direction, urad; None where no FOR has
+            one.
+        """
         medians = [
             float(np.median(v))
             for v in (
@@ -367,6 +446,18 @@ class AssessmentResult:
         return max(medians) if medians else None
 
     def to_dict(self, with_cube: bool = False) -> dict:
+        """The result as the JSON document ``crisgeo assess --out`` writes.
+
+        Parameters
+        ----------
+        with_cube : bool, optional
+            Include the 21 x 21 cost cube of every FOR (K).
+
+        Returns
+        -------
+        dict
+            The document.
+        """
         d = {
             "satellite": self.satellite,
             "start": self.start,
@@ -384,10 +475,34 @@ class AssessmentResult:
         return d
 
     def to_json(self, with_cube: bool = True) -> str:
+        """The result as JSON text (:meth:`to_dict`).
+
+        Parameters
+        ----------
+        with_cube : bool, optional
+            Include the cost cubes.
+
+        Returns
+        -------
+        str
+            The JSON.
+        """
         return json.dumps(self.to_dict(with_cube), indent=1)
 
     @classmethod
     def from_dict(cls, d: dict) -> "AssessmentResult":
+        """A result from its JSON document (:meth:`to_dict`).
+
+        Parameters
+        ----------
+        d : dict
+            The document.
+
+        Returns
+        -------
+        AssessmentResult
+            The result.
+        """
         cube = d.get("cost_cube_k")
         return cls(
             satellite=d["satellite"],
@@ -405,6 +520,18 @@ class AssessmentResult:
 
     @classmethod
     def from_json(cls, text: str) -> "AssessmentResult":
+        """A result from its JSON text (:meth:`to_json`).
+
+        Parameters
+        ----------
+        text : str
+            The JSON.
+
+        Returns
+        -------
+        AssessmentResult
+            The result.
+        """
         return cls.from_dict(json.loads(text))
 
 
@@ -434,25 +561,58 @@ class DayPrecision:
     mb_per_granule: float | None = None
 
     def text(self) -> str:
-        """One line: ``24 granules in 2 batches, sigma 61 urad (target 60): target reached``."""
+        """One line: ``24 granules in 2 batches, sigma 61 urad (target 60): target reached``.
+
+        Returns
+        -------
+        str
+            The line.
+        """
         sigma = "no sigma" if self.sigma_urad is None else f"sigma {self.sigma_urad:.0f} urad"
         target = "" if self.target_sigma_urad is None else f" (target {self.target_sigma_urad:g})"
         per = "" if self.mb_per_granule is None else f", {self.mb_per_granule:.0f} MB per granule"
         return f"{self.granules} granules in {self.batches} batch(es), {sigma}{target}{per}: {self.stop}"
 
     def to_dict(self) -> dict:
-        """The JSON of the run summary's ``precision``."""
+        """The JSON of the run summary's ``precision``.
+
+        Returns
+        -------
+        dict
+            Its fields.
+        """
         return {**asdict(self), "stop": str(self.stop)}
 
     @classmethod
     def from_summary(cls, summary: str | None) -> "DayPrecision | None":
-        """The precision a run's stored summary (JSON) records; None where it records none (runs before
-        the batches, days without results)."""
+        """The precision a run's stored summary records.
+
+        Parameters
+        ----------
+        summary : str or None
+            The run's summary, JSON.
+
+        Returns
+        -------
+        DayPrecision or None
+            None where it records none (days without results).
+        """
         body = json.loads(summary).get("precision") if summary else None
         return None if body is None else cls(**{**body, "stop": DayStop(body["stop"])})
 
 
 def worst_for(fors: Iterable[ForOffset]) -> ForOffset | None:
-    """The reliable FOR of *fors* with the largest :attr:`ForOffset.worst_km` (None: none measured)."""
+    """The reliable FOR with the largest :attr:`ForOffset.worst_km`.
+
+    Parameters
+    ----------
+    fors : iterable of ForOffset
+        A day's FORs.
+
+    Returns
+    -------
+    ForOffset or None
+        None when none was measured.
+    """
     ok = [f for f in fors if f.reliable and math.isfinite(f.worst_km)]
     return max(ok, key=lambda f: f.worst_km) if ok else None

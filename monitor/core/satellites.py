@@ -43,7 +43,18 @@ class Satellite:
     pct_mounting_urad: tuple[float, float, float] | None  # CrIS PCT mounting roll, pitch, yaw (LW-GEO)
 
     def orbit_number(self, unix_s: float) -> int:
-        """The orbit number IDPS gives a granule starting at *unix_s*: whole orbits since launch, plus one."""
+        """The orbit number IDPS gives a granule starting at a time: whole orbits since launch, plus one.
+
+        Parameters
+        ----------
+        unix_s : float
+            The granule's start, Unix s.
+
+        Returns
+        -------
+        int
+            The orbit number.
+        """
         return int((unix_s - self.launch_unix_s) // NODAL_PERIOD_S) + 1
 
     @property
@@ -52,7 +63,20 @@ class Satellite:
         return dt.datetime.fromtimestamp(self.launch_unix_s, dt.timezone.utc).date()
 
     def outside_mission(self, day: dt.date, today: dt.date) -> str | None:
-        """Why *day* can hold no data of this satellite (before its launch, after *today*), or None."""
+        """Why a day can hold no data of this satellite.
+
+        Parameters
+        ----------
+        day : datetime.date
+            The UTC day.
+        today : datetime.date
+            Today, UTC.
+
+        Returns
+        -------
+        str or None
+            Before its launch or after *today*; None within the mission.
+        """
         if day < self.launch_day:
             return f"before {self.name}'s launch on {self.launch_day}"
         if day > today:
@@ -79,7 +103,18 @@ NODAL_PERIOD_S = 101.5 * 60.0  # the shared orbit's period (Lin et al. 2016): th
 
 
 def satellite(short: str) -> Satellite:
-    """The satellite of a file-name platform (npp, j01, j02); ValueError naming the known ones."""
+    """The satellite of a file-name platform.
+
+    Parameters
+    ----------
+    short : str
+        ``npp``, ``j01`` or ``j02``.
+
+    Returns
+    -------
+    Satellite
+        Its row of the satellite table; a ValueError names the known ones.
+    """
     try:
         return SATELLITES[short]
     except KeyError:

@@ -30,17 +30,54 @@ class Column:
     align: str = ">"
 
     def text(self, row: Any) -> str:
-        """The row's value as text, unpadded."""
+        """A row's value as text, unpadded.
+
+        Parameters
+        ----------
+        row : object
+            The row (a record whose attribute, or function, gives the value).
+
+        Returns
+        -------
+        str
+            The value written with the column's format.
+        """
         get = attrgetter(self.value) if isinstance(self.value, str) else self.value
         return format(get(row), self.fmt)
 
     def pad(self, text: str) -> str:
-        """*text* aligned to the column's width."""
+        """Text aligned to the column's width.
+
+        Parameters
+        ----------
+        text : str
+            The text.
+
+        Returns
+        -------
+        str
+            Padded to the width, left or right as the column aligns.
+        """
         return f"{text:{self.align}{self.width}}"
 
 
 def text_table(rows: Iterable[Any], columns: Sequence[Column], indent: str = "") -> list[str]:
-    """A header line, a unit line when any column has a unit, and a line per row (trailing blanks cut)."""
+    """A table as text lines: a header, a unit line when any column has a unit, and a line per row.
+
+    Parameters
+    ----------
+    rows : iterable
+        The rows.
+    columns : sequence of Column
+        The columns.
+    indent : str, optional
+        Put before every line.
+
+    Returns
+    -------
+    list of str
+        The lines, trailing blanks cut.
+    """
     lines = [indent + " ".join(c.pad(c.header) for c in columns)]
     if any(c.unit for c in columns):
         lines.append(indent + " ".join(c.pad(c.unit) for c in columns))
@@ -53,7 +90,26 @@ def _flags(f: ForOffset) -> str:
 
 
 def field_column(header: str, name: str, fmt: str, width: int, record: type = ForOffset) -> Column:
-    """The column of the measured field *name* of *record*, its unit the declaration's (a count has none)."""
+    """The column of a measured field, its unit the declaration's (a count has none).
+
+    Parameters
+    ----------
+    header : str
+        The column's header.
+    name : str
+        The field.
+    fmt : str
+        Its format spec.
+    width : int
+        The column's width.
+    record : type, optional
+        The record declaring the field.
+
+    Returns
+    -------
+    Column
+        The column.
+    """
     unit = next(m.unit for m in measures(record) if m.name == name)
     return Column(header, name, fmt, width, "" if unit == "1" else unit)
 
@@ -87,5 +143,20 @@ REPORT = FULL[:5] + ("alpha_pct_fov", "beta_pct_fov") + FULL[5:-1] + ("rows_alph
 
 
 def for_table(fors: Iterable[ForOffset], columns: tuple[str, ...] = FULL, indent: str = "") -> list[str]:
-    """The per-FOR table of *columns* (:data:`FOR_COLUMNS`): header, units, a line per FOR."""
+    """The per-FOR table: header, units, a line per FOR.
+
+    Parameters
+    ----------
+    fors : iterable of ForOffset
+        The FORs.
+    columns : tuple of str, optional
+        Keys of :data:`FOR_COLUMNS`.
+    indent : str, optional
+        Put before every line.
+
+    Returns
+    -------
+    list of str
+        The lines.
+    """
     return text_table(fors, [FOR_COLUMNS[c] for c in columns], indent)
