@@ -47,7 +47,13 @@ ORDER = (
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser: the global options and one subparser per entry of :data:`COMMANDS`."""
+    """The argument parser: the global options and one subparser per entry of :data:`COMMANDS`.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser, its commands in :data:`ORDER`.
+    """
     p = Parser(
         prog="crisgeo",
         description=__doc__.replace("``", ""),
@@ -84,9 +90,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """The crisgeo command: parse, set up logging, run the subcommand; its exit status. Every error a
-    command lets through is mapped to its exit status here, in one line: bad input (2), another instance
-    (75), an unusable store or the machine's (1), an interruption (130)."""
+    """The crisgeo command: parse, set up logging, run the subcommand.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments; ``sys.argv[1:]`` when None.
+
+    Returns
+    -------
+    int
+        The exit status: every error a command lets through is mapped here, in one line: bad input (2),
+        another instance (75), an unusable store or the machine's (1), an interruption (130).
+    """
     from monitor.service.lock import AlreadyRunning
     from monitor.service.store.database import StoreError
 

@@ -42,7 +42,18 @@ RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices'
     arg("--channel", choices=("email", "slack", "alertmanager"), help="test: only this channel"),
 )
 def cmd_alerts(args: argparse.Namespace) -> int:
-    """crisgeo alerts: list, silence, unsilence, evaluate, test."""
+    """crisgeo alerts: list, silence, unsilence, evaluate, test.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from alerts.engine import alerts_view, evaluate_and_deliver
     from monitor.service.store.alert_state import AlertState, SilenceError
     from monitor.service.store.sqlite import Store
@@ -124,7 +135,18 @@ def cmd_alerts(args: argparse.Namespace) -> int:
     arg("--description", help="add: what changed"),
 )
 def cmd_events(args: argparse.Namespace) -> int:
-    """crisgeo events: list the known changes, measure what each did, or add one to the calendar."""
+    """crisgeo events: list the known changes, measure what each did, or add one to the calendar.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.history.changes import Change, add_to_calendar, listing
 
     cfg = load(args)

@@ -26,7 +26,18 @@ class PrintReference(argparse.Action):
 
 
 def cli_reference(parser: argparse.ArgumentParser) -> str:
-    """Every command with its usage and options, as Markdown (docs/cli.md is its output)."""
+    """Every command with its usage and options, as Markdown (docs/cli.md is its output).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The crisgeo parser.
+
+    Returns
+    -------
+    str
+        The Markdown.
+    """
 
     out = [
         "# The crisgeo command line",

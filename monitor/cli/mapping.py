@@ -53,7 +53,18 @@ def _residuals(args: argparse.Namespace) -> ResidualTable | OwnResiduals | None:
     arg("--table-json", help="also write the old/new angle table as JSON here"),
 )
 def cmd_optimize(args: argparse.Namespace) -> int:
-    """crisgeo optimize: new scene-mirror angles from an assessment."""
+    """crisgeo optimize: new scene-mirror angles from an assessment.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import json
 
     from monitor.core.result import AssessmentResult
@@ -87,7 +98,18 @@ def cmd_optimize(args: argparse.Namespace) -> int:
     *RESIDUAL_ARGS,
 )
 def cmd_regeolocate(args: argparse.Namespace) -> int:
-    """crisgeo regeolocate: GEO copies geolocated with another EP."""
+    """crisgeo regeolocate: GEO copies geolocated with another EP.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.mapping.regeolocate import regeolocate_file
 
     ep = ep_file(args.ep)
@@ -114,7 +136,18 @@ def cmd_regeolocate(args: argparse.Namespace) -> int:
     *RESIDUAL_ARGS,
 )
 def cmd_geolocate(args: argparse.Namespace) -> int:
-    """crisgeo geolocate: an EP's geolocation against the files' own, per FOR."""
+    """crisgeo geolocate: an EP's geolocation against the files' own, per FOR.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import json
 
     from monitor.mapping.regeolocate import compare_with_files
@@ -164,7 +197,18 @@ def cmd_geolocate(args: argparse.Namespace) -> int:
     arg("--ep", help="the EP the residual table is learned against (XML or YAML)"),
 )
 def cmd_fingerprint(args: argparse.Namespace) -> int:
-    """crisgeo fingerprint: the per-FOR LOS fingerprint of GEO files."""
+    """crisgeo fingerprint: the per-FOR LOS fingerprint of GEO files.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import json
 
     from monitor.mapping import fingerprint as fpr

@@ -37,7 +37,18 @@ from monitor.core.satellites import SATELLITES
     ),
 )
 def cmd_install_files(args: argparse.Namespace) -> int:
-    """crisgeo install-files: copy the shipped files out."""
+    """crisgeo install-files: copy the shipped files out.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.service.install import install_files, kept_files
 
     spec_km = load(args).alerts.spec_km if args.config else SPEC_KM
@@ -57,7 +68,18 @@ def cmd_install_files(args: argparse.Namespace) -> int:
     arg("--schema", action="store_true", help="print the JSON Schema of the file instead (for editors)"),
 )
 def cmd_check_config(args: argparse.Namespace) -> int:
-    """crisgeo check-config: validate and print the effective configuration, or the reference."""
+    """crisgeo check-config: validate and print the effective configuration, or the reference.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import yaml
 
     from monitor.config.file import effective, json_schema, secret_status
@@ -99,7 +121,18 @@ def _in_mission(sats: list[str], days: dict[str, dt.date | None]) -> None:
     arg("--date", type=iso_day, help="the UTC day to (re)assess, YYYY-MM-DD"),
 )
 def cmd_run(args: argparse.Namespace) -> int:
-    """crisgeo run: one run of the daily job, then exit."""
+    """crisgeo run: one run of the daily job, then exit.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.core.vocabulary import RunStatus
     from monitor.service.daemon import Service
 
@@ -145,7 +178,18 @@ def cmd_run(args: argparse.Namespace) -> int:
     arg("--force", action="store_true", help="redo the days already done"),
 )
 def cmd_reprocess(args: argparse.Namespace) -> int:
-    """crisgeo reprocess: a period on Dask; this process alone writes the store."""
+    """crisgeo reprocess: a period on Dask; this process alone writes the store.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.core.vocabulary import RunStatus
     from monitor.service.reprocess import run_reprocess
 
@@ -170,7 +214,18 @@ def cmd_reprocess(args: argparse.Namespace) -> int:
     ),
 )
 def cmd_daemon(args: argparse.Namespace) -> int:
-    """crisgeo daemon: the long-running service."""
+    """crisgeo daemon: the long-running service.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.service.daemon import Service
 
     cfg = load(args, writes=True)
@@ -219,7 +274,18 @@ def cmd_daemon(args: argparse.Namespace) -> int:
     arg("-t", "--timeout", type=float, default=30.0, help="UNKNOWN after this many seconds (default 30)"),
 )
 def cmd_status(args: argparse.Namespace) -> int:
-    """crisgeo status: the state of every satellite, as text or JSON, with Nagios exit codes."""
+    """crisgeo status: the state of every satellite, as text or JSON, with Nagios exit codes.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import json
     import signal
     from types import FrameType

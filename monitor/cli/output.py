@@ -11,8 +11,13 @@ from monitor.core.tables import for_table
 
 
 class PipedOutput:
-    """Standard output that a reader closing the pipe (``| head -1``) silences instead of ending the
-    command: the exit status stays the one computed (a Nagios check piped into head still says 2)."""
+    """Standard output that a closed pipe silences (``crisgeo status | head``): no traceback, no error.
+
+    Parameters
+    ----------
+    stream : TextIO
+        The stream written to.
+    """
 
     def __init__(self, stream: TextIO) -> None:
         self._stream = stream
@@ -46,7 +51,18 @@ class PipedOutput:
 
 
 def result_text(result: AssessmentResult) -> str:
-    """What ``crisgeo assess`` and ``crisgeo run`` print of an assessment."""
+    """What ``crisgeo assess`` and ``crisgeo run`` print of an assessment.
+
+    Parameters
+    ----------
+    result : AssessmentResult
+        The assessment.
+
+    Returns
+    -------
+    str
+        Its time span, the per-FOR table and its notes.
+    """
     who = f"{result.satellite} " if result.satellite else ""
     span = f"{result.start} .. {result.end}" if result.start else "time range unknown"
     lines = [f"{who}{span}, {len(result.granules)} granules"]

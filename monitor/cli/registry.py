@@ -50,7 +50,15 @@ class BadInput(Exception):
 
 
 class UsageError(Exception):
-    """A command line the parser refuses: the usage of the (sub)command and the message (:class:`Parser`)."""
+    """A command line the parser refuses: the usage of the (sub)command and the message (:class:`Parser`).
+
+    Parameters
+    ----------
+    usage : str
+        The usage text.
+    message : str
+        What is wrong.
+    """
 
     def __init__(self, usage: str, message: str) -> None:
         super().__init__(message)
@@ -62,12 +70,34 @@ class Parser(argparse.ArgumentParser):
     exit status is the command's convention (``status``: Nagios UNKNOWN), decided in one place, main."""
 
     def error(self, message: str) -> NoReturn:
+        """Raise :class:`UsageError` instead of exiting: main decides the exit status.
+
+        Parameters
+        ----------
+        message : str
+            argparse's message.
+        """
         raise UsageError(self.format_usage(), f"{self.prog}: error: {message}")
 
 
 def options(model: type[SectionT], flags: str, **values: Any) -> SectionT:
-    """The options of a command that are keys of a configuration section (*model*), checked by the same
-    model as the file: a problem is bad input naming the *flags* and the key."""
+    """The options of a command that are keys of a configuration section, checked by the same model as the
+    file.
+
+    Parameters
+    ----------
+    model : type
+        The section's model.
+    flags : str
+        The options, named in an error.
+    **values : object
+        The section's keys.
+
+    Returns
+    -------
+    AssessmentConfig or FingerprintConfig
+        The section; a problem is bad input naming the *flags* and the key.
+    """
     from monitor.config.file import section_of
     from monitor.config.keys import ConfigError
 
@@ -81,7 +111,20 @@ def options(model: type[SectionT], flags: str, **values: Any) -> SectionT:
 
 
 def arg(*names: str, **options: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
-    """One argument of a subcommand: the add_argument call, as data."""
+    """One argument of a subcommand: the add_argument call, as data.
+
+    Parameters
+    ----------
+    *names : str
+        Its names.
+    **options : object
+        add_argument's keywords.
+
+    Returns
+    -------
+    tuple
+        (names, options).
+    """
     return names, options
 
 
@@ -114,8 +157,19 @@ WORKERS = arg(
 
 
 def unset(argument: tuple[tuple[str, ...], dict[str, Any]]) -> tuple[tuple[str, ...], dict[str, Any]]:
-    """*argument* without a default (None when not given), for a command whose defaults come from a
-    configuration file: the help keeps saying what the default is."""
+    """An argument without a default (None when not given), for a command whose defaults come from a
+    configuration file.
+
+    Parameters
+    ----------
+    argument : tuple
+        The argument (:func:`arg`).
+
+    Returns
+    -------
+    tuple
+        The same, default None: the help keeps saying what the default is.
+    """
     names, opts = argument
     return names, {**opts, "default": None}
 
@@ -127,7 +181,22 @@ COMMANDS: dict[str, tuple[Handler, str, tuple]] = {}
 def command(
     name: str, help: str, *arguments: tuple[tuple[str, ...], dict[str, Any]]
 ) -> Callable[[Handler], Handler]:
-    """Register the decorated handler as subcommand *name* with its *arguments* (:func:`arg`)."""
+    """Register the decorated handler as a subcommand.
+
+    Parameters
+    ----------
+    name : str
+        The subcommand.
+    help : str
+        Its one line in ``crisgeo --help``.
+    *arguments : tuple
+        Its arguments (:func:`arg`).
+
+    Returns
+    -------
+    callable
+        The decorator.
+    """
 
     def register(handler: Handler) -> Handler:
         COMMANDS[name] = (handler, help, arguments)
@@ -137,7 +206,20 @@ def command(
 
 
 def load(args: argparse.Namespace, writes: bool = False) -> Config:
-    """The configuration of *args*; with *writes*, its state directory made (the commands that write)."""
+    """The configuration of a command's arguments.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (``--config``, else ``$CRISGEO_CONFIG``, else the default path).
+    writes : bool, optional
+        Make the state directory (the commands that write).
+
+    Returns
+    -------
+    Config
+        The configuration; a problem is bad input naming the file.
+    """
 
     from monitor.config.file import load_config, make_state_dir
     from monitor.config.keys import ConfigError
@@ -155,26 +237,70 @@ def load(args: argparse.Namespace, writes: bool = False) -> Config:
 
 
 def open_store(cfg: Config) -> Store:
-    """The configured store for a command that only reads: never created (a missing one is an error)."""
+    """The configured store for a command that only reads: never created.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+
+    Returns
+    -------
+    Store
+        The store; a missing one is an error.
+    """
     from monitor.service.store.sqlite import Store
 
     return Store(cfg.store.path, create=False)
 
 
 def period(since: dt.date | None, until: dt.date | None) -> None:
-    """Refuse (bad input) a period that ends before it starts."""
+    """Refuse (bad input) a period that ends before it starts.
+
+    Parameters
+    ----------
+    since, until : datetime.date or None
+        The period's first and last day.
+    """
     if since and until and since > until:
         raise BadInput(f"--since {since} is after --until {until}")
 
 
 def satellites_of(cfg: Config, satellite: str | None) -> list[str]:
-    """The configured satellites, or the one asked for (which must be configured)."""
+    """The configured satellites, or the one asked for (which must be configured).
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    satellite : str or None
+        The one asked for.
+
+    Returns
+    -------
+    list of str
+        The satellites.
+    """
     if satellite and satellite not in cfg.satellites:
         raise BadInput(f"satellite {satellite!r} is not in the configuration ({', '.join(cfg.satellites)})")
     return [satellite] if satellite else list(cfg.satellites)
 
 
 def ep_file(path: str | os.PathLike[str], satellite: str | None = None) -> EngineeringPacket:
+    """An engineering packet file, read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The EP (XML or YAML).
+    satellite : str, optional
+        The satellite it must be for.
+
+    Returns
+    -------
+    EngineeringPacket
+        The packet.
+    """
     from monitor.sdr.engpkt import load_ep
 
     return load_ep(path, satellite)

@@ -36,7 +36,18 @@ from monitor.core.satellites import SATELLITES
     arg("--until", type=iso_day, help="last day, YYYY-MM-DD"),
 )
 def cmd_export(args: argparse.Namespace) -> int:
-    """crisgeo export: the results, or what each known change did, as NetCDF or CSV."""
+    """crisgeo export: the results, or what each known change did, as NetCDF or CSV.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from alerts.effects import change_effects
     from monitor.history.changes import all_changes
     from monitor.service.outputs.export import Method, export, export_effects
@@ -85,7 +96,18 @@ def cmd_export(args: argparse.Namespace) -> int:
     arg("--until", type=iso_day, help="last day shown, YYYY-MM-DD"),
 )
 def cmd_report(args: argparse.Namespace) -> int:
-    """crisgeo report: write the HTML report."""
+    """crisgeo report: write the HTML report.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     import time
 
     from monitor.service.outputs.report.html import build_report, options_from_config

@@ -115,7 +115,18 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     ),
 )
 def cmd_simulate(args: argparse.Namespace) -> int:
-    """crisgeo simulate: write a simulated case."""
+    """crisgeo simulate: write a simulated case.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.simulate.case import simulate_case
 
     where = dict(
@@ -195,7 +206,18 @@ def _footprint(names: Sequence[str] | None) -> Response | tuple[Response, ...] |
     unset(WORKERS),
 )
 def cmd_assess(args: argparse.Namespace) -> int:
-    """crisgeo assess: assess the granules given; print the table, write the JSON."""
+    """crisgeo assess: assess the granules given; print the table, write the JSON.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.assessment.assess import assess_paths
 
     base = load(args).assessment if args.config else ASSESSMENT
@@ -243,7 +265,18 @@ def cmd_assess(args: argparse.Namespace) -> int:
     KERNEL,
 )
 def cmd_bench(args: argparse.Namespace) -> int:
-    """crisgeo bench: time each stage on a simulated case."""
+    """crisgeo bench: time each stage on a simulated case.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     from monitor.assessment.bench import run_bench
 
     cfg = options(AssessmentConfig, "--workers", cost=args.cost, kernel=args.kernel, workers=args.workers)

@@ -19,7 +19,18 @@ KERNEL_LOCK = threading.Lock()
 
 @contextmanager
 def parallel_threads(workers: int) -> Iterator[None]:
-    """Run the compiled kernels on *workers* threads (at most numba's pool) in this block."""
+    """Run the compiled kernels on a number of threads in this block.
+
+    Parameters
+    ----------
+    workers : int
+        Threads, at most numba's pool.
+
+    Returns
+    -------
+    iterator
+        A context manager's one value, None.
+    """
     previous = numba.get_num_threads()
     numba.set_num_threads(max(1, min(workers, numba.config.NUMBA_NUM_THREADS)))
     try:

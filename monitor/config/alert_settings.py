@@ -204,7 +204,18 @@ class AlertSettings(RuleSettings):
         return self
 
     def linked(self, links: Links) -> AlertSettings:
-        """These settings, pointing their messages at *links*."""
+        """These settings, pointing their messages at the report and dashboard.
+
+        Parameters
+        ----------
+        links : Links
+            The top-level ``report_dir``, ``report_url`` and ``dashboard_url``.
+
+        Returns
+        -------
+        AlertSettings
+            The same settings, linked.
+        """
         self._links = links
         return self
 

@@ -23,8 +23,18 @@ from monitor.core.vocabulary import SourceKind
 
 
 def load_config(path: str | Path) -> Config:
-    """Load and validate the YAML configuration at *path*; relative paths are relative to the file. Any
-    problem is a :class:`ConfigError` naming the key, in one line."""
+    """Load and validate the YAML configuration; relative paths are relative to the file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    Config
+        The configuration; any problem is a :class:`ConfigError` naming the key, in one line.
+    """
     path = Path(path)
     doc = read_yaml(path)
     if not isinstance(doc, dict):
@@ -39,8 +49,20 @@ def load_config(path: str | Path) -> Config:
 
 
 def section_of(name: str, **values: Any) -> BaseModel:
-    """The section *name* of the configuration from *values* alone (the command line's options), checked by
-    the same model as a file: any problem a :class:`ConfigError` naming the key (``name.key: PROBLEM``)."""
+    """A section of the configuration from values alone (the command line's options), checked as a file's.
+
+    Parameters
+    ----------
+    name : str
+        The section (``assessment``).
+    **values : object
+        Its keys.
+
+    Returns
+    -------
+    pydantic.BaseModel
+        The section; any problem a :class:`ConfigError` naming the key (``name.key: PROBLEM``).
+    """
     model = _section_type(Config.model_fields[name].annotation)
     try:
         return model.model_validate(values)
@@ -137,14 +159,33 @@ def _bounds(loc: list) -> tuple[float | None, float | None]:
 
 
 def key_range(field: Any) -> tuple[float | None, float | None]:
-    """The range lo..hi declared for a key (``key(..., lo, hi)``)."""
+    """The range declared for a key (``key(..., lo, hi)``).
+
+    Parameters
+    ----------
+    field : pydantic.fields.FieldInfo
+        The key's declaration.
+
+    Returns
+    -------
+    lo, hi : float or None
+        Inclusive bounds, in the unit its name ends in; None where unbounded.
+    """
     lo = next((m.ge for m in field.metadata if getattr(m, "ge", None) is not None), None)
     hi = next((m.le for m in field.metadata if getattr(m, "le", None) is not None), None)
     return lo, hi
 
 
 def make_state_dir(cfg: Config) -> None:
-    """Create the state directory (for the commands that write state); a ConfigError naming the key."""
+    """Create the state directory, for the commands that write state.
+
+    A ConfigError names the key when it cannot be made.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    """
     try:
         cfg.state_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -174,9 +215,19 @@ def _check_secrets(doc: Any, where: str = "") -> None:
 
 
 def effective(cfg: Config) -> dict:
-    """The configuration as loaded, defaults filled in, under the file's keys: written out as YAML it loads
-    back to the same configuration (``crisgeo check-config`` prints it). Secrets are never in it: the
-    ``*_env`` keys name variables (see :func:`secret_status`)."""
+    """The configuration as loaded, defaults filled in, under the file's keys.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+
+    Returns
+    -------
+    dict
+        Written out as YAML it loads back to the same configuration (``crisgeo check-config`` prints it).
+        Secrets are never in it: the ``*_env`` keys name variables (:func:`secret_status`).
+    """
     out = cfg.model_dump(mode="json", by_alias=True, exclude_none=True)
     if cfg.source.kind != SourceKind.LOCAL:
         out["source"].pop("path", None)
@@ -184,7 +235,18 @@ def effective(cfg: Config) -> dict:
 
 
 def secret_status(cfg: Config) -> list[tuple[str, str, bool]]:
-    """(KEY, VARIABLE, whether it is set) for every ``*_env`` key of the configuration."""
+    """Every ``*_env`` key of the configuration and whether its variable is set.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+
+    Returns
+    -------
+    list of (str, str, bool)
+        (KEY, VARIABLE, set).
+    """
     lines = []
 
     def walk(doc: Any, where: str) -> None:
@@ -202,7 +264,13 @@ def secret_status(cfg: Config) -> list[tuple[str, str, bool]]:
 
 
 def json_schema() -> str:
-    """The JSON Schema of the file (``docs/crisgeo-config.schema.json``; editors validate YAML with it)."""
+    """The JSON Schema of the file (``docs/crisgeo-config.schema.json``; editors validate YAML with it).
+
+    Returns
+    -------
+    str
+        The schema, JSON.
+    """
     schema = Config.model_json_schema(by_alias=True, mode="validation")
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "crisgeo-monitor configuration"
@@ -247,7 +315,18 @@ class _Loader(yaml.SafeLoader):
 
 
 def read_yaml(path: Path) -> Any:
-    """The YAML document at *path*: at most 1 MiB, safe types only, no anchors or aliases."""
+    """The YAML document in a file: at most 1 MiB, safe types only, no anchors or aliases.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+
+    Returns
+    -------
+    object
+        The document.
+    """
     try:
         with open(path, "rb") as fh:
             raw = fh.read(MAX_CONFIG_BYTES + 1)
@@ -266,7 +345,18 @@ def read_yaml(path: Path) -> Any:
 
 
 def yaml_problem(exc: yaml.YAMLError) -> str:
-    """A YAML error as one line: where (line, column) and what."""
+    """A YAML error as one line: where (line, column) and what.
+
+    Parameters
+    ----------
+    exc : yaml.YAMLError
+        The error.
+
+    Returns
+    -------
+    str
+        The line.
+    """
     mark = getattr(exc, "problem_mark", None)
     problem = " ".join(str(getattr(exc, "problem", None) or exc).split())[:200]
     where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""

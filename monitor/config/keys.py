@@ -28,7 +28,15 @@ class ConfigError(ValueError):
 
 
 class KeyProblem(ValueError):
-    """Raised by a section's own checks: the problem of *key* (relative to the section)."""
+    """Raised by a section's own checks: the problem of a key (relative to the section).
+
+    Parameters
+    ----------
+    key : str
+        The key.
+    problem : str
+        What is wrong.
+    """
 
     def __init__(self, key: str, problem: str):
         super().__init__(problem)
@@ -122,8 +130,24 @@ TimeOfDay = Annotated[
 
 
 def key(default: Any, meaning: str, lo: float | None = None, hi: float | None = None, **kw: Any) -> Any:
-    """A configuration key: its default (``...``: required; a section class: that section's defaults), its
-    meaning, its accepted range lo..hi (inclusive, in the unit its name ends in)."""
+    """A configuration key: its default, meaning and accepted range.
+
+    Parameters
+    ----------
+    default : object
+        Its default; ``...``: required; a section class: that section's defaults.
+    meaning : str
+        What it means (the reference and the JSON Schema's description).
+    lo, hi : float, optional
+        The accepted range, inclusive, in the unit its name ends in.
+    **kw : object
+        Passed to pydantic's ``Field``.
+
+    Returns
+    -------
+    pydantic.fields.FieldInfo
+        The declaration.
+    """
     if isinstance(default, type):
         return Field(default_factory=default, description=meaning, **kw)
     if isinstance(default, StrEnum):
@@ -138,7 +162,20 @@ class Section(BaseModel):
 
 
 def parse_listen(text: str) -> tuple[str, int]:
-    """``HOST:PORT`` (``[::1]:PORT`` for IPv6) as (host, port); ValueError naming the value otherwise."""
+    """``HOST:PORT`` (``[::1]:PORT`` for IPv6) as host and port.
+
+    Parameters
+    ----------
+    text : str
+        The address.
+
+    Returns
+    -------
+    host : str
+        The host.
+    port : int
+        The port; a ValueError names the value otherwise.
+    """
     host, sep, port = str(text).rpartition(":")
     host = host[1:-1] if host.startswith("[") and host.endswith("]") else host
     if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
@@ -147,7 +184,18 @@ def parse_listen(text: str) -> tuple[str, int]:
 
 
 def check_listen(text: str) -> str:
-    """``off`` or ``HOST:PORT`` (the daemon's HTTP endpoint)."""
+    """``off`` or ``HOST:PORT`` (the daemon's HTTP endpoint).
+
+    Parameters
+    ----------
+    text : str
+        The value.
+
+    Returns
+    -------
+    str
+        It, checked; a ValueError otherwise.
+    """
     if text != "off":
         try:
             parse_listen(text)
@@ -157,12 +205,34 @@ def check_listen(text: str) -> str:
 
 
 def env_secret(name: str | None) -> str | None:
-    """The value of the environment variable *name* (a ``*_env`` key's value), or None."""
+    """The value of the environment variable a ``*_env`` key names.
+
+    Parameters
+    ----------
+    name : str or None
+        The variable.
+
+    Returns
+    -------
+    str or None
+        Its value; None when unset or unnamed.
+    """
     return os.environ.get(name) if name else None
 
 
 def redact_url(url: str) -> str:
-    """*url* with any user:password and query string masked, for logs and messages."""
+    """A URL with any user:password and query string masked, for logs and messages.
+
+    Parameters
+    ----------
+    url : str
+        The URL.
+
+    Returns
+    -------
+    str
+        The masked URL.
+    """
     try:
         p = urlsplit(str(url))
     except ValueError:

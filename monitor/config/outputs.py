@@ -60,7 +60,18 @@ class PublishConfig(Section):
     timeout_s: float = key(30.0, "Timeout of one write.", 0.1, 600)
 
     def secret(self, name: str) -> str | None:
-        """The value of the environment variable named by the key *name* (e.g. token_env), or None."""
+        """The value of the environment variable a key names (e.g. ``token_env``).
+
+        Parameters
+        ----------
+        name : str
+            The key.
+
+        Returns
+        -------
+        str or None
+            Its value, or None.
+        """
         return env_secret(getattr(self, name))
 
 

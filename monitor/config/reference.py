@@ -76,7 +76,20 @@ def _sections(annotation: Any) -> list[type[BaseModel]]:
 
 
 def model_keys(model: type[BaseModel] = Config, prefix: str = "") -> list[Key]:
-    """Every key the loader accepts, sections and lists of mappings included, in declaration order."""
+    """Every key the loader accepts, sections and lists of mappings included, in declaration order.
+
+    Parameters
+    ----------
+    model : type of pydantic.BaseModel, optional
+        The section; the whole configuration by default.
+    prefix : str, optional
+        The section's dotted name.
+
+    Returns
+    -------
+    list of Key
+        The keys.
+    """
     keys = []
     for name, field in model.model_fields.items():
         dotted = prefix + (field.alias or name)
@@ -118,7 +131,13 @@ def _num(v: float | None) -> str:
 
 
 def reference() -> str:
-    """The reference as Markdown: one table, the keys in the order the model declares them."""
+    """The reference of every key as Markdown: one table, the keys in the order the model declares them.
+
+    Returns
+    -------
+    str
+        docs/configuration.md.
+    """
     lines = [
         "# Configuration reference",
         "",
