@@ -11,7 +11,9 @@ from monitor.core.tables import for_table
 
 
 class PipedOutput:
-    """Standard output that a closed pipe silences (``crisgeo status | head``): no traceback, no error.
+    """Standard output that a reader closing the pipe (``| head -1``) silences instead of ending the command.
+
+    The exit status stays the one computed: a Nagios check piped into head still says 2.
 
     Parameters
     ----------
