@@ -45,7 +45,24 @@ class ListedFile:
 
 def listed(name: str, size: int | None, location: str, md5: str | None = None) -> ListedFile | None:
     """A :class:`ListedFile` for a safe JPSS file name (a base name, so no dot segment can slip in), or
-    None for anything else (path parts, non-ASCII, odd names)."""
+    None for anything else (path parts, non-ASCII, odd names).
+
+    Parameters
+    ----------
+    name : str
+        The file's base name.
+    size : int or None
+        Its size, bytes.
+    location : str
+        Where it is (a path or a key).
+    md5 : str, optional
+        Its checksum as the archive lists it.
+
+    Returns
+    -------
+    ListedFile or None
+        None for anything but a safe JPSS file name.
+    """
     if not name.isascii() or "/" in name or "\\" in name or name.startswith("."):
         return None
     parsed = parse_name(name)
@@ -53,7 +70,20 @@ def listed(name: str, size: int | None, location: str, md5: str | None = None) -
 
 
 def on_day(f: ListedFile, day: dt.date) -> bool:
-    """Whether *f* starts on *day* (UTC)."""
+    """Whether *f* starts on *day* (UTC).
+
+    Parameters
+    ----------
+    f : ListedFile
+        A listed file.
+    day : datetime.date
+        The UTC day.
+
+    Returns
+    -------
+    bool
+        Whether the file starts on the day.
+    """
     return f.parsed.start.date() == day
 
 
@@ -66,11 +96,33 @@ class Source(Protocol):
 
     def start_day(self, should_stop: Callable[[], bool] | None = None) -> None:
         """Start a run: reset the run's budget and deadline, apply the cache retention; *should_stop*, the
-        run's stop request, is polled between the long steps of listing (a :class:`StopRequested`)."""
+        run's stop request, is polled between the long steps of listing (a :class:`StopRequested`).
+
+        Parameters
+        ----------
+        should_stop : callable, optional
+            The run's stop request, polled between the long steps.
+        """
 
     def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
-        """The granule files of *satellite* for *day* whose product is in *products*."""
+        """The granule files of *satellite* for *day* whose product is in *products*.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+        products : iterable of str
+            The product prefixes wanted (GCRSO, SCRIF, SVI05, GITCO, ...).
+        """
 
     def fetch(self, f: ListedFile) -> GranuleRef:
         """*f* to read: a local path holding it (downloaded if need be), or a granule read in place;
-        :class:`SourceError` on failure."""
+        :class:`SourceError` on failure.
+
+        Parameters
+        ----------
+        f : ListedFile
+            A listed file.
+        """

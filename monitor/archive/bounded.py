@@ -81,7 +81,18 @@ class BoundedSession:
     @contextmanager
     def guard(self, deadline: float) -> Iterator[None]:
         """Run the block under a watchdog: at ``time.monotonic() == deadline`` every socket of the
-        session is shut down, and whatever the block then raises becomes :class:`DeadlinePassed`."""
+        session is shut down, and whatever the block then raises becomes :class:`DeadlinePassed`.
+
+        Parameters
+        ----------
+        deadline : float
+            The ``time.monotonic()`` s at which every socket of the session is shut down.
+
+        Returns
+        -------
+        iterator
+            A context manager's one value, None.
+        """
         fired = threading.Event()
         timer = threading.Timer(max(0.0, deadline - time.monotonic()), self._cut, (fired,))
         timer.daemon = True
@@ -98,7 +109,20 @@ class BoundedSession:
             raise DeadlinePassed
 
     def get(self, url: str, **kwargs: Any) -> requests.Response:
-        """A plain GET on the session (call it under :meth:`guard`)."""
+        """A plain GET on the session (call it under :meth:`guard`).
+
+        Parameters
+        ----------
+        url : str
+            The URL.
+        **kwargs : object
+            ``requests``' keywords.
+
+        Returns
+        -------
+        requests.Response
+            The response.
+        """
         return self.session.get(url, allow_redirects=False, **kwargs)
 
 
@@ -107,6 +131,15 @@ class StallWatch:
 
     :meth:`stalled` is true once the transfer has run for at least *window_s* and the bytes of the
     last *window_s* seconds are fewer than ``min_rate_b_s * window_s``.
+
+    Parameters
+    ----------
+    min_rate_b_s : float
+        The least rate, bytes per s, over a window.
+    window_s : float
+        The window, s.
+    clock : callable, optional
+        The clock, s (``time.monotonic``).
     """
 
     def __init__(
@@ -120,7 +153,13 @@ class StallWatch:
         self._marks: collections.deque = collections.deque([(self.t0, 0)])
 
     def add(self, n: int) -> None:
-        """Count *n* bytes received now."""
+        """Count *n* bytes received now.
+
+        Parameters
+        ----------
+        n : int
+            Bytes received now.
+        """
         self.total += n
         now = self.clock()
         self._marks.append((now, self.total))
@@ -129,7 +168,13 @@ class StallWatch:
             self._marks.popleft()
 
     def stalled(self) -> bool:
-        """Fewer bytes than the minimum rate asks for over the last window."""
+        """Fewer bytes than the minimum rate asks for over the last window.
+
+        Returns
+        -------
+        bool
+            True when the rate over the last window is below the minimum.
+        """
         now = self.clock()
         if now - self.t0 < self.window_s:
             return False

@@ -11,7 +11,18 @@ from monitor.config.model import Config
 
 
 def make_source(cfg: Config) -> Source:
-    """The source named by the configuration's ``source.kind``."""
+    """The source named by the configuration's ``source.kind``.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+
+    Returns
+    -------
+    Source
+        A local, simulated or NODD source.
+    """
     kind = cfg.source.kind
     if kind == "local":
         assert cfg.source.path is not None, "the configuration requires a path for a local source"

@@ -19,7 +19,13 @@ IN_USE_S = 600.0  # a simulated day listed this recently may still be read by a 
 
 
 class LocalSource:
-    """Granule files anywhere below *root*; fetching returns the file itself (nothing is downloaded)."""
+    """Granule files anywhere below *root*; fetching returns the file itself (nothing is downloaded).
+
+    Parameters
+    ----------
+    root : str or Path
+        The tree's root: every ``*.h5`` below it is considered.
+    """
 
     spent_bytes = 0
     downloaded_files = 0
@@ -31,7 +37,22 @@ class LocalSource:
 
     def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
         """The granule files of *satellite* on *day* (and VIIRS of the days around it) whose product is in
-        *products*."""
+        *products*.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+        products : iterable of str
+            The product prefixes wanted (GCRSO, SCRIF, SVI05, GITCO, ...).
+
+        Returns
+        -------
+        list of ListedFile
+            The files.
+        """
         if not self.root.is_dir():
             raise FileNotFoundError(f"source.path {self.root}: no such directory")
         out = []
@@ -47,11 +68,28 @@ class LocalSource:
         return [f for f in out if on_day(f, day) or f.product not in CRIS_PRODUCTS]
 
     def fetch(self, f: ListedFile) -> Path:
-        """The file itself: a local tree needs no download."""
+        """The file itself: a local tree needs no download.
+
+        Parameters
+        ----------
+        f : ListedFile
+            A listed file.
+
+        Returns
+        -------
+        Path
+            The file.
+        """
         return Path(f.location)
 
     def start_day(self, should_stop: Callable[[], bool] | None = None) -> None:
-        """Nothing to reset for a local tree; the run's *should_stop* is kept for a simulation."""
+        """Nothing to reset for a local tree; the run's *should_stop* is kept for a simulation.
+
+        Parameters
+        ----------
+        should_stop : callable, optional
+            The run's stop request, polled between the long steps.
+        """
         self.should_stop = should_stop
 
 
@@ -60,7 +98,15 @@ class SimulatedSource(LocalSource):
     ``source.retention_days`` most recently listed days are kept, and any another run listed in the last
     :data:`IN_USE_S` (e.g. another reprocessing worker may still read it); a day this source listed itself,
     and nobody since, is done with once the next is listed: a catch-up of months would otherwise fill the
-    disk, ~0.36 GB a day of three granules."""
+    disk, ~0.36 GB a day of three granules.
+
+    Parameters
+    ----------
+    root : str or Path
+        Where the simulated days are written.
+    source_cfg : SourceConfig
+        The ``source`` section (granules, profile, seed, retention).
+    """
 
     def __init__(self, root: str | Path, source_cfg: SourceConfig) -> None:
         super().__init__(root)
@@ -70,7 +116,22 @@ class SimulatedSource(LocalSource):
     def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
         """Simulate the satellite-day once (into ``root/<satellite>/<day>``), then list it. A stop requested
         during the simulation ends it within a granule's step; a stop or a failure (a full disk) leaves no
-        half-simulated day."""
+        half-simulated day.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+        products : iterable of str
+            The product prefixes wanted (GCRSO, SCRIF, SVI05, GITCO, ...).
+
+        Returns
+        -------
+        list of ListedFile
+            The files.
+        """
         from monitor.simulate.case import simulate_case
 
         target = self.root / satellite / day.isoformat()

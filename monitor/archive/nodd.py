@@ -76,7 +76,17 @@ def _retry_after_s(value: str | None) -> float | None:
 
 
 class NoddSource:
-    """Granules of the NODD bucket of each satellite, cached under *cache_dir*."""
+    """Granules of the NODD bucket of each satellite, cached under *cache_dir*.
+
+    Parameters
+    ----------
+    cfg : SourceConfig
+        The ``source`` section (bucket endpoint, bounds, budget, read mode).
+    cache_dir : Path
+        The download and block cache.
+    sleep : callable, optional
+        How a retry waits, s (``time.sleep``).
+    """
 
     def __init__(
         self, cfg: SourceConfig, cache_dir: Path, sleep: Callable[[float], object] = time.sleep
@@ -117,7 +127,13 @@ class NoddSource:
     def start_day(self, should_stop: Callable[[], bool] | None = None) -> None:
         """Start a run: reset the day's budget and the run deadline, apply the cache retention (age, then
         size: the least recently used files go until the cache holds at most ``cache_max_mb``); the run's
-        *should_stop* is polled between listing pages."""
+        *should_stop* is polled between listing pages.
+
+        Parameters
+        ----------
+        should_stop : callable, optional
+            The run's stop request, polled between the long steps.
+        """
         self.should_stop = should_stop or (lambda: False)
         self.spent_bytes = 0
         self.downloaded_files = 0
@@ -251,7 +267,20 @@ class NoddSource:
         return body
 
     def list_prefix(self, satellite: str, prefix: str) -> list[ListedFile]:
-        """Every object under *prefix* (``folder/YYYY/MM/DD/name-prefix``), following continuation tokens."""
+        """Every object under *prefix* (``folder/YYYY/MM/DD/name-prefix``), following continuation tokens.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name (its bucket).
+        prefix : str
+            ``folder/YYYY/MM/DD/name-prefix``.
+
+        Returns
+        -------
+        list of ListedFile
+            The objects.
+        """
         out, token, seen = [], None, set()
         base = self._base(satellite)
         folder = prefix.rsplit("/", 1)[0] + "/"
@@ -301,7 +330,22 @@ class NoddSource:
         return f
 
     def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
-        """The day's files of *products* in the satellite's bucket (the newest creation per granule)."""
+        """The day's files of *products* in the satellite's bucket (the newest creation per granule).
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+        products : iterable of str
+            The product prefixes wanted (GCRSO, SCRIF, SVI05, GITCO, ...).
+
+        Returns
+        -------
+        list of ListedFile
+            The files.
+        """
         out = []
         for product in products:
             folder = PRODUCTS[product].collection  # the NODD folder is the collection name
@@ -321,7 +365,18 @@ class NoddSource:
     def fetch(self, f: ListedFile) -> GranuleRef:
         """*f* to read: with ``read: ranges`` a granule read in place through the block cache (nothing is
         fetched yet); with ``read: whole`` the cached copy, downloaded (bounded, checked against the
-        listing) if missing."""
+        listing) if missing.
+
+        Parameters
+        ----------
+        f : ListedFile
+            A listed file.
+
+        Returns
+        -------
+        GranuleRef
+            A granule read in place, or the cached file's path.
+        """
         if self.cfg.read == ReadMode.RANGES:
             return ranged.RangedGranule(f, self.read_range, self.cache_dir / RANGES_FOLDER)
         folder = self.cache_dir / f.product
@@ -429,7 +484,20 @@ class NoddSource:
         """Bytes *start* to *end* (exclusive) of *f*, in one HTTP range request under every bound of a
         download (the one retry layer, ``timeout_s`` for the headers, the stall window, the run deadline,
         the day's budget, redirects only on the endpoint's host): exactly those bytes of an object of the
-        listed size, or a :class:`SourceError` naming the key and the range."""
+        listed size, or a :class:`SourceError` naming the key and the range.
+
+        Parameters
+        ----------
+        f : ListedFile
+            A listed file.
+        start, end : int
+            The byte range, end exclusive.
+
+        Returns
+        -------
+        bytes
+            Exactly those bytes.
+        """
         what = f"{f.location} bytes {start}-{end - 1}"
         if self.spent_bytes + (end - start) > self.cfg.daily_budget_mb * 1e6:
             raise BudgetExceeded(

@@ -85,7 +85,13 @@ no_cyclic_gc = _CyclicGcPaused()
 
 
 def forget(path: Path) -> None:
-    """Remove a cached file and its block list (a download, or a granule read in place)."""
+    """Remove a cached file and its block list (a download, or a granule read in place).
+
+    Parameters
+    ----------
+    path : Path
+        The cached file.
+    """
     path.unlink(missing_ok=True)
     Path(f"{path}{BLOCK_LIST}").unlink(missing_ok=True)
 
@@ -108,7 +114,13 @@ class RangedGranule:
         return self.listed.location  # errors name the key
 
     def open(self) -> RangedReader:
-        """A file object over the granule's bytes, through the block cache."""
+        """A file object over the granule's bytes, through the block cache.
+
+        Returns
+        -------
+        RangedReader
+            The file object.
+        """
         return RangedReader(self)
 
 
@@ -116,7 +128,13 @@ class RangedReader(io.RawIOBase):
     """A seekable binary file over a remote granule; what is read is fetched through the block cache.
 
     A failed fetch leaves the reader failed: ``failure`` names the key, the range and the reason, every
-    further read raises, and nothing it fetched is recorded as held."""
+    further read raises, and nothing it fetched is recorded as held.
+
+    Parameters
+    ----------
+    granule : RangedGranule
+        The granule read.
+    """
 
     def __init__(self, granule: RangedGranule):
         super().__init__()

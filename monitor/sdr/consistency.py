@@ -88,7 +88,18 @@ RAW_ONE_COUNT_SHARE = 0.01
 
 
 def granule_id_time_us(granule_id: str) -> int | None:
-    """The IET (us) a granule ID stands for, or None if it is not ``<3 letters><12 digits>``."""
+    """The IET (us) a granule ID stands for, or None if it is not ``<3 letters><12 digits>``.
+
+    Parameters
+    ----------
+    granule_id : str
+        ``<3 letters><12 digits>``.
+
+    Returns
+    -------
+    int or None
+        The IET, us; None for another form.
+    """
     digits = granule_id[3:]
     if len(granule_id) != 15 or not digits.isascii() or not digits.isdigit():
         return None
@@ -103,7 +114,21 @@ def check_identity(
     file_orbit: int | None,
 ) -> None:
     """Granule ID, orbit number, text dates and scan count against the IET times (*name* is the
-    ``_Gran_k`` group; *text_times* the (start, end) parsed from the text attributes, or None)."""
+    ``_Gran_k`` group; *text_times* the (start, end) parsed from the text attributes, or None).
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    name : str
+        The ``_Gran_k`` group.
+    meta : GranuleMeta
+        The granule's metadata.
+    text_times : tuple of datetime, optional
+        (start, end) parsed from the text attributes.
+    file_orbit : int, optional
+        The orbit the file's name gives.
+    """
     sat = SATELLITES[meta.platform]
     if not meta.granule_id:
         raise GranuleError(path, f"{name}/N_Granule_ID", "missing: a granule without an ID cannot be paired")
@@ -142,7 +167,17 @@ def check_identity(
 
 
 def check_cris_span(path: GranuleRef, name: str, meta: GranuleMeta) -> None:
-    """A CrIS granule of n scans spans more than n - 1 and at most n scan periods."""
+    """A CrIS granule of n scans spans more than n - 1 and at most n scan periods.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    name : str
+        The ``_Gran_k`` group.
+    meta : GranuleMeta
+        The granule's metadata.
+    """
     span = meta.end_iet_us - meta.start_iet_us
     if not (meta.n_scans - 1) * CRIS_SCAN_US < span <= meta.n_scans * CRIS_SCAN_US:
         raise GranuleError(
@@ -159,7 +194,19 @@ def _scans_with_data(granule: Granule, key: str, rows_per_scan: int) -> np.ndarr
 
 
 def check_viirs_scan_count(path: GranuleRef, product: Product, granule: Granule, key: str) -> None:
-    """VIIRS arrays hold 48 scans: those past N_Number_Of_Scans are fill, the last counted one is not."""
+    """VIIRS arrays hold 48 scans: those past N_Number_Of_Scans are fill, the last counted one is not.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    key : str
+        The dataset checked.
+    """
     has = _scans_with_data(granule, key, product.rows_per_scan)
     n = granule.meta.n_scans
     name = f"{product.data_group}/{product.fields[key].dataset}"
@@ -170,7 +217,19 @@ def check_viirs_scan_count(path: GranuleRef, product: Product, granule: Granule,
 
 def check_scan_times(path: GranuleRef, product: Product, granule: GeoGranule, has_data: np.ndarray) -> None:
     """StartTime and MidTime of every scan with data: present, increasing by whole scan periods, MidTime
-    within a period after StartTime, inside the granule."""
+    within a period after StartTime, inside the granule.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    has_data : numpy.ndarray
+        Per scan, whether it holds data.
+    """
     period = SCAN_US[product.kind]
     meta = granule.meta
     lo, hi = meta.start_iet_us - 10_000_000, meta.end_iet_us + 10_000_000
@@ -206,7 +265,19 @@ def check_scan_times(path: GranuleRef, product: Product, granule: GeoGranule, ha
 
 
 def check_ephemeris(path: GranuleRef, product: Product, granule: GeoGranule, has_data: np.ndarray) -> None:
-    """Orbit radius and speed of the named satellite; attitude small, smooth and measured."""
+    """Orbit radius and speed of the named satellite; attitude small, smooth and measured.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    has_data : numpy.ndarray
+        Per scan, whether it holds data.
+    """
     sat = SATELLITES[granule.meta.platform]
     g = product.data_group
     radius_m = wgs84.A_M + sat.altitude_m  # the mean altitude is above the equatorial radius
@@ -252,7 +323,17 @@ def check_ephemeris(path: GranuleRef, product: Product, granule: GeoGranule, has
 
 
 def check_line_of_sight(path: GranuleRef, product: Product, granule: CrisGeoGranule) -> None:
-    """CrIS GEO: ground point + range along zenith/azimuth = the spacecraft at the FOR time."""
+    """CrIS GEO: ground point + range along zenith/azimuth = the spacecraft at the FOR time.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    """
     valid = granule.valid
     if not valid.any():
         return
@@ -289,7 +370,19 @@ def check_line_of_sight(path: GranuleRef, product: Product, granule: CrisGeoGran
 
 
 def check_nadir(path: GranuleRef, product: Product, granule: ViirsGeoGranule, has_data: np.ndarray) -> None:
-    """VIIRS GEO: the middle pixel of each scan lies below the spacecraft at the scan's MidTime."""
+    """VIIRS GEO: the middle pixel of each scan lies below the spacecraft at the scan's MidTime.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    has_data : numpy.ndarray
+        Per scan, whether it holds data.
+    """
     rows = product.rows_per_scan
     centre = granule.lat_rad.shape[1] // 2
     scans = np.flatnonzero(has_data & np.isfinite(granule.sc_position_m).all(axis=-1))
@@ -337,7 +430,17 @@ def check_pixel_steps(path: GranuleRef, product: Product, granule: GeoGranule) -
     """VIIRS GEO: neighbouring pixels of a row lie within PIXEL_STEP_KM of each other on the ground.
 
     A corrupt latitude or longitude (a flipped byte of a float) moves its pixel hundreds of km or more; no
-    other check sees one pixel among ten million. Pairs with a fill (unread scans included) are skipped."""
+    other check sees one pixel among ten million. Pairs with a fill (unread scans included) are skipped.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    """
     r, c, step = _first_leap(granule.lat_rad, granule.lon_rad, PIXEL_STEP_KM / (wgs84.A_M / 1e3))
     if r >= 0:
         raise GranuleError(
@@ -350,7 +453,17 @@ def check_pixel_steps(path: GranuleRef, product: Product, granule: GeoGranule) -
 
 def check_raw_counts(path: GranuleRef, name: str, raw: np.ndarray) -> None:
     """Scaled VIIRS BT (uint16): raw count 0 is the scaled minimum, which no scene fills, and no real scene
-    piles up on one count."""
+    piles up on one count.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    name : str
+        The dataset.
+    raw : numpy.ndarray
+        Its raw counts.
+    """
     counts = np.bincount(raw.ravel(), minlength=UINT16_FILL_MIN)[:UINT16_FILL_MIN]  # fills left out
     valid = int(counts.sum())
     if counts[0] > RAW_ZERO_SHARE * raw.size:
@@ -370,7 +483,17 @@ def check_raw_counts(path: GranuleRef, name: str, raw: np.ndarray) -> None:
 
 
 def check_spectra(path: GranuleRef, name: str, radiance: np.ndarray) -> None:
-    """CrIS: no FOV spectrum exactly zero in every channel."""
+    """CrIS: no FOV spectrum exactly zero in every channel.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    name : str
+        The dataset.
+    radiance : numpy.ndarray
+        The spectra, channels last.
+    """
     dead = np.all(radiance == 0, axis=-1)
     if dead.any():
         raise GranuleError(
@@ -379,7 +502,17 @@ def check_spectra(path: GranuleRef, name: str, radiance: np.ndarray) -> None:
 
 
 def check_relations(path: GranuleRef, product: Product, granule: Granule) -> None:
-    """The relations between fields a genuine granule obeys (:mod:`monitor.sdr.consistency`)."""
+    """The relations between fields a genuine granule obeys (:mod:`monitor.sdr.consistency`).
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    """
     key = MAIN_FIELD[product.kind]
     if isinstance(granule, CrisSdrGranule):
         check_spectra(path, f"{product.data_group}/{product.fields[key].dataset}", granule.radiance_lw)
@@ -400,7 +533,17 @@ def check_relations(path: GranuleRef, product: Product, granule: Granule) -> Non
 def check_for_times(path: GranuleRef, product: Product, granule: Granule) -> None:
     """CrIS FOR times increase and lie within the granule (10 s of margin: the IDPS granule bounds are
     nominal); the per-scan times of both GEO products are checked with the physics
-    (:func:`monitor.sdr.check_scan_times`)."""
+    (:func:`monitor.sdr.check_scan_times`).
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    product : Product
+        Its product's table.
+    granule : Granule
+        The granule read.
+    """
     t = getattr(granule, "for_time_us", None)
     name = f"{product.data_group}/FORTime"
     if t is None:  # VIIRS GEO: per-scan times only; SDR files: their times are their GEO's
@@ -453,7 +596,19 @@ def check_not_all_fill(path: GranuleRef, product: Product, granule: Granule) -> 
 def check_height(
     path: GranuleRef, name: str, lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray
 ) -> None:
-    """A terrain-corrected pixel needs its height: fill only where the pixel itself is fill."""
+    """A terrain-corrected pixel needs its height: fill only where the pixel itself is fill.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    name : str
+        The dataset.
+    lat_rad, lon_rad : numpy.ndarray
+        The pixels' latitude and longitude, rad (NaN: fill).
+    height_m : numpy.ndarray
+        Their height, m.
+    """
     located = np.isfinite(lat_rad) & np.isfinite(lon_rad)
     missing = located & ~np.isfinite(height_m)
     if missing.any():

@@ -53,7 +53,17 @@ PACKAGED = {s.short: s.ep_file for s in SATELLITES.values() if s.ep_file}
 
 
 class EngPktError(DataError):
-    """A malformed EP file; the message names the file, the field and the value."""
+    """A malformed EP file; the message names the file, the field and the value.
+
+    Parameters
+    ----------
+    path : object
+        The file.
+    field : str
+        The element.
+    problem : str
+        What is wrong.
+    """
 
     def __init__(self, path: object, field: str, problem: str) -> None:
         super().__init__(f"{path}: {field}: {problem}")
@@ -133,6 +143,18 @@ def load_ep(path: str | os.PathLike[str], satellite: str | None = None) -> Engin
     """Read an EP from a decoded EP XML file or a YAML file of the same content.
 
     *satellite* (npp, j01, j02) overrides the satellite found in the file (XML: by InstrumentId).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    satellite : str, optional
+        ``npp``, ``j01`` or ``j02``: overrides the satellite found in the file.
+
+    Returns
+    -------
+    EngineeringPacket
+        The packet; an :class:`EngPktError` names the file and element.
     """
     path = Path(path)
     try:
@@ -174,14 +196,36 @@ def load_ep(path: str | os.PathLike[str], satellite: str | None = None) -> Engin
 
 
 def packaged_ep(satellite: str) -> EngineeringPacket:
-    """The real EP shipped in the package for *satellite* (S-NPP V37, NOAA-20 V115)."""
+    """The real EP shipped in the package for *satellite* (S-NPP V37, NOAA-20 V115).
+
+    Parameters
+    ----------
+    satellite : str
+        ``npp`` or ``j01`` (``j02``: a stand-in).
+
+    Returns
+    -------
+    EngineeringPacket
+        The packet.
+    """
     if satellite not in PACKAGED:
         raise KeyError(f"no real engineering packet is shipped for {satellite!r} (have {sorted(PACKAGED)})")
     return load_ep(packaged_path(satellite))
 
 
 def packaged_path(satellite: str) -> Path:
-    """Where the real EP shipped for *satellite* lies in the installed package."""
+    """Where the real EP shipped for *satellite* lies in the installed package.
+
+    Parameters
+    ----------
+    satellite : str
+        The satellite's short name.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
     return Path(str(resources.files("monitor.data.ep") / PACKAGED[satellite]))
 
 
@@ -191,7 +235,18 @@ def _urad(values: ArrayLike) -> list[float | int]:
 
 
 def ep_to_yaml_doc(ep: EngineeringPacket) -> dict:
-    """The YAML document of *ep*: the EP element names, values in urad (the time-stamp bias in ms)."""
+    """The YAML document of *ep*: the EP element names, values in urad (the time-stamp bias in ms).
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The packet.
+
+    Returns
+    -------
+    dict
+        The document.
+    """
     doc = {
         "satellite": ep.satellite,
         "version": ep.version,
@@ -232,6 +287,20 @@ def save_ep(
     XML: the text of *like* with ActualCrosstrackAngleRoll and ActualIntrackAnglePitch replaced (whole
     microradians, as the EP stores them) and the provenance as a comment after the declaration; every
     other element is kept byte for byte.
+
+    Parameters
+    ----------
+    ep : EngineeringPacket
+        The packet.
+    out_path : str or os.PathLike
+        Where to write it.
+    like : str or os.PathLike, optional
+        The file whose format, and for XML whose text, it keeps.
+
+    Returns
+    -------
+    Path
+        The file written.
     """
     out = Path(out_path)
     if like is not None and Path(like).read_text().lstrip().startswith("<"):
@@ -261,6 +330,18 @@ def load_library(paths: Iterable[str | os.PathLike[str]]) -> tuple[dict[str, Eng
 
     With no paths the library is the real EPs shipped in the package; unreadable files are reported,
     not fatal.
+
+    Parameters
+    ----------
+    paths : iterable of str or os.PathLike
+        EP files or directories.
+
+    Returns
+    -------
+    library : dict of str to EngineeringPacket
+        By name.
+    problems : list of str
+        The files that could not be read, with why.
     """
     paths = list(paths)
     library = {} if paths else {PACKAGED[sat]: load_ep(packaged_path(sat)) for sat in PACKAGED}

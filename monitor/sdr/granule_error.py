@@ -4,7 +4,17 @@ from monitor.core.errors import DataError
 
 
 class GranuleError(DataError):
-    """A granule that cannot be used. ``str()`` reads ``FILE: FIELD: REASON``."""
+    """A granule that cannot be used. ``str()`` reads ``FILE: FIELD: REASON``.
+
+    Parameters
+    ----------
+    path : object
+        The file.
+    field : str
+        The dataset or attribute.
+    reason : str
+        What is wrong with it.
+    """
 
     def __init__(self, path: object, field: str, reason: str) -> None:
         self.path = str(path)

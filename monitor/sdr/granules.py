@@ -34,7 +34,18 @@ GranuleRef = Path | RemoteGranule  # a granule file: on local disk, or read in p
 
 
 def as_ref(path: str | os.PathLike | RemoteGranule) -> GranuleRef:
-    """A local path (str or PathLike) as a Path; a :class:`RemoteGranule` as it is."""
+    """A local path (str or PathLike) as a Path; a :class:`RemoteGranule` as it is.
+
+    Parameters
+    ----------
+    path : str or os.PathLike or GranuleRef
+        A file.
+
+    Returns
+    -------
+    GranuleRef
+        It, as the readers take it.
+    """
     return Path(path) if isinstance(path, (str, os.PathLike)) else path
 
 

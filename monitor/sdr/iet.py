@@ -56,7 +56,18 @@ _CHANGE_IET_US = _CHANGE_UNIX_US + _UNIX_MINUS_IET_EPOCH_US + _OFFSET_US
 
 
 def iet_to_unix_us(iet_us: ArrayLike) -> np.ndarray:
-    """UTC microseconds since 1970 (int64) of IET microseconds."""
+    """UTC microseconds since 1970 (int64) of IET microseconds.
+
+    Parameters
+    ----------
+    iet_us : array_like
+        IET, us since 1958-01-01 counting TAI seconds.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unix time, us.
+    """
     iet = np.asarray(iet_us, np.int64)
     k = np.searchsorted(_CHANGE_IET_US, iet, side="right") - 1
     if np.any(k < 0):
@@ -65,7 +76,18 @@ def iet_to_unix_us(iet_us: ArrayLike) -> np.ndarray:
 
 
 def unix_us_to_iet(unix_us: ArrayLike) -> np.ndarray:
-    """IET microseconds (int64) of UTC microseconds since 1970."""
+    """IET microseconds (int64) of UTC microseconds since 1970.
+
+    Parameters
+    ----------
+    unix_us : array_like
+        Unix time, us.
+
+    Returns
+    -------
+    numpy.ndarray
+        IET, us.
+    """
     u = np.asarray(unix_us, np.int64)
     k = np.searchsorted(_CHANGE_UNIX_US, u, side="right") - 1
     if np.any(k < 0):
@@ -74,11 +96,33 @@ def unix_us_to_iet(unix_us: ArrayLike) -> np.ndarray:
 
 
 def iet_to_datetime(iet_us: ArrayLike) -> dt.datetime:
-    """Timezone-aware UTC datetime of one IET value."""
+    """Timezone-aware UTC datetime of one IET value.
+
+    Parameters
+    ----------
+    iet_us : int
+        IET, us.
+
+    Returns
+    -------
+    datetime.datetime
+        UTC.
+    """
     return dt.datetime(1970, 1, 1, tzinfo=UTC) + dt.timedelta(microseconds=int(iet_to_unix_us(iet_us)))
 
 
 def datetime_to_iet(when: dt.datetime) -> int:
-    """IET microseconds of a timezone-aware datetime."""
+    """IET microseconds of a timezone-aware datetime.
+
+    Parameters
+    ----------
+    when : datetime.datetime
+        A UTC time.
+
+    Returns
+    -------
+    int
+        IET, us.
+    """
     delta = when.astimezone(UTC) - dt.datetime(1970, 1, 1, tzinfo=UTC)
     return int(unix_us_to_iet((delta.days * 86400 + delta.seconds) * 1_000_000 + delta.microseconds))

@@ -58,7 +58,18 @@ def _clock(date: dt.date, hhmmsst: str) -> dt.datetime:
 
 def parse_name(name: str) -> JpssName | None:
     """The parsed name, or None if *name* (a base name) is not a JPSS product file name (an impossible
-    date or time included)."""
+    date or time included).
+
+    Parameters
+    ----------
+    name : str
+        A file's base name.
+
+    Returns
+    -------
+    JpssName or None
+        Its fields; None for another name.
+    """
     m = _PATTERN.match(name)
     if not m:
         return None
@@ -92,7 +103,30 @@ def format_name(
     origin: str = "oebc",
     domain: str = "ops",
 ) -> str:
-    """A JPSS file name for the given fields (used by the simulator)."""
+    """A JPSS file name for the given fields (used by the simulator).
+
+    Parameters
+    ----------
+    products : sequence of str
+        The product prefixes.
+    platform : str
+        ``npp``, ``j01``, ``j02``.
+    start, end : datetime.datetime
+        The granule's span, UTC.
+    orbit : int
+        The orbit number.
+    created : datetime.datetime
+        The creation time, UTC.
+    origin : str, optional
+        The origin field.
+    domain : str, optional
+        The domain field.
+
+    Returns
+    -------
+    str
+        The file name.
+    """
 
     def clock(t: dt.datetime) -> str:
         return f"{t:%H%M%S}{t.microsecond // 100000}"

@@ -28,7 +28,20 @@ ByPrefix = defaultdict[str, dict[str, tuple[Path, GranuleMeta]]]  # product pref
 def neighbours(
     viirs_all: list[GranuleFiles], granule: GranuleFiles
 ) -> tuple[GranuleFiles | None, GranuleFiles | None]:
-    """The VIIRS granules just before and just after *granule* in a continuous swath (None if absent)."""
+    """The VIIRS granules just before and just after *granule* in a continuous swath (None if absent).
+
+    Parameters
+    ----------
+    viirs_all : list of GranuleFiles
+        The run's VIIRS granules.
+    granule : GranuleFiles
+        One of them.
+
+    Returns
+    -------
+    before, after : GranuleFiles or None
+        None where absent.
+    """
     before = next(
         (v for v in viirs_all if abs(v.end - granule.start) < CONTIGUOUS and v.key != granule.key), None
     )
@@ -76,7 +89,18 @@ class PlanError(DataError):
 
 
 def find_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
-    """Every ``*.h5`` file under *paths* (files or directories), sorted; missing paths raise PlanError."""
+    """Every ``*.h5`` file under *paths* (files or directories), sorted; missing paths raise PlanError.
+
+    Parameters
+    ----------
+    paths : iterable of str or os.PathLike
+        Files or directories.
+
+    Returns
+    -------
+    list of Path
+        The JPSS granule files found.
+    """
     out = []
     for p in map(Path, paths):
         if p.is_dir():
@@ -89,7 +113,18 @@ def find_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
 
 
 def plan(paths: Sequence[str | os.PathLike[str]]) -> CasePlan:
-    """Pair the granule files found under *paths* into a :class:`CasePlan`."""
+    """Pair the granule files found under *paths* into a :class:`CasePlan`.
+
+    Parameters
+    ----------
+    paths : sequence of str or os.PathLike
+        Files or directories.
+
+    Returns
+    -------
+    CasePlan
+        The CrIS granules in time order with the VIIRS granules covering each, and the files skipped.
+    """
     files = find_files(paths)
     if not files:
         raise PlanError(f"no .h5 files in {', '.join(map(str, paths))}")
@@ -132,7 +167,24 @@ def plan(paths: Sequence[str | os.PathLike[str]]) -> CasePlan:
 def assemble(satellite: str, cris: list, viirs: list, skipped: list) -> CasePlan:
     """The :class:`CasePlan` of paired CrIS and VIIRS granules (:class:`GranuleFiles`): each CrIS granule
     with the VIIRS granules covering it in time; one without cover joins *skipped* with the reason. The one
-    place the coverage rule lives, for ``crisgeo assess`` and the daily run alike."""
+    place the coverage rule lives, for ``crisgeo assess`` and the daily run alike.
+
+    Parameters
+    ----------
+    satellite : str
+        The satellite's short name.
+    cris : list of GranuleFiles
+        The CrIS granules.
+    viirs : list of GranuleFiles
+        The VIIRS granules.
+    skipped : list
+        Files left out, with why.
+
+    Returns
+    -------
+    CasePlan
+        The plan.
+    """
     viirs = sorted(viirs, key=lambda g: g.start)
     result = CasePlan(satellite, skipped=skipped, viirs_all=viirs)
     for g in sorted(cris, key=lambda g: g.start):
@@ -150,7 +202,22 @@ def granule_files(
 ) -> GranuleFiles:
     """The :class:`GranuleFiles` of one single-granule SDR file and its GEO file, reading the metadata not
     given (*sdr_meta*, e.g. from a granule already read). :class:`GranuleError` for a file holding other
-    than one granule of its product."""
+    than one granule of its product.
+
+    Parameters
+    ----------
+    key : str
+        The granule's key.
+    sdr, geo : GranuleRef
+        The SDR file and its GEO file.
+    sdr_meta : GranuleMeta, optional
+        The SDR's metadata when already read.
+
+    Returns
+    -------
+    GranuleFiles
+        The pair with its metadata.
+    """
     sdr, geo = as_ref(sdr), as_ref(geo)
     metas = []
     for path, known in ((sdr, sdr_meta), (geo, None)):
@@ -168,7 +235,18 @@ def granule_files(
 
 def partners_differ(sdr_meta: GranuleMeta, geo_meta: GranuleMeta) -> str | None:
     """Why an SDR granule and the GEO granule paired with it by name are not the same granule, or None:
-    IDPS gives both the same granule ID and the same beginning and end (docs/jpss-formats.md 1.1)."""
+    IDPS gives both the same granule ID and the same beginning and end (docs/jpss-formats.md 1.1).
+
+    Parameters
+    ----------
+    sdr_meta, geo_meta : GranuleMeta
+        The two files' metadata.
+
+    Returns
+    -------
+    str or None
+        How they differ; None when they are partners.
+    """
     if sdr_meta.granule_id != geo_meta.granule_id:
         return f"granule {sdr_meta.granule_id!r}, its GEO holds {geo_meta.granule_id!r}"
     if (

@@ -40,7 +40,18 @@ UINT16_FILL_MIN = 65528  # IDPS uint16 fills are 65528 ... 65535
 
 
 def is_float_fill(values: ArrayLike) -> np.ndarray:
-    """True where *values* hold one of the IDPS float fill codes (not merely a large negative number)."""
+    """True where *values* hold one of the IDPS float fill codes (not merely a large negative number).
+
+    Parameters
+    ----------
+    values : array_like
+        Float values.
+
+    Returns
+    -------
+    numpy.ndarray
+        bool, the shape of *values*.
+    """
     v = np.asarray(values)
     with np.errstate(invalid="ignore", over="ignore"):
         fill = np.asarray(v < -999.15)
@@ -178,7 +189,18 @@ PRODUCTS = {
 
 
 def prefixes(kind: str) -> tuple[str, ...]:
-    """The prefixes of the products of *kind* (cris_sdr, cris_geo, viirs_sdr, viirs_geo), preferred first."""
+    """The prefixes of the products of *kind* (cris_sdr, cris_geo, viirs_sdr, viirs_geo), preferred first.
+
+    Parameters
+    ----------
+    kind : str
+        A granule kind (``cris_geo``, ``viirs_sdr``, ...).
+
+    Returns
+    -------
+    tuple of str
+        Its products' prefixes.
+    """
     return tuple(p.prefix for p in PRODUCTS.values() if p.kind == kind)
 
 
@@ -189,5 +211,16 @@ CRIS_PRODUCTS = CRIS_SDR + CRIS_GEO
 
 
 def cris_lw_wavenumbers_cm1(nchan: int = CRIS_LW_CHANNELS) -> np.ndarray:
-    """Wavenumbers (cm-1) of the stored CrIS LW channels."""
+    """Wavenumbers (cm-1) of the stored CrIS LW channels.
+
+    Parameters
+    ----------
+    nchan : int, optional
+        The LW channels.
+
+    Returns
+    -------
+    numpy.ndarray
+        cm-1.
+    """
     return CRIS_LW_FIRST_CM1 + CRIS_LW_STEP_CM1 * np.arange(nchan)

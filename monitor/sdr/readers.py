@@ -377,7 +377,20 @@ def _check_name_time(path: GranuleRef, metas: Sequence[GranuleMeta]) -> None:
 
 
 def products_in(path: GranuleRef, h5: h5py.File) -> list[Product]:
-    """Products present in an open file, from the file name or, failing that, the groups."""
+    """Products present in an open file, from the file name or, failing that, the groups.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    h5 : h5py.File
+        It, open.
+
+    Returns
+    -------
+    list of Product
+        The supported products it holds.
+    """
     parsed = parse_name(path.name)
     if parsed is not None:
         unknown = [p for p in parsed.products if p not in PRODUCTS]
@@ -400,7 +413,22 @@ def read_file(
     checked against the product table; any problem is a :class:`GranuleError` naming file and field.
 
     *scans* (VIIRS, one granule per file) reads only the pixel rows of those scans; the other rows hold
-    fill, as scans without data do (only the bytes of the scans a CrIS granule can reach travel)."""
+    fill, as scans without data do (only the bytes of the scans a CrIS granule can reach travel).
+
+    Parameters
+    ----------
+    path : str or os.PathLike or GranuleRef
+        The file.
+    kinds : collection of str, optional
+        Only granules of these kinds.
+    scans : slice, optional
+        Only these scans (the others hold fill).
+
+    Returns
+    -------
+    list of Granule
+        The granules.
+    """
     path = as_ref(path)
     with _opened(path) as h5:
         platform = _platform(path, h5)
@@ -413,7 +441,18 @@ def read_file(
 
 
 def read_metadata(path: str | os.PathLike[str] | GranuleRef) -> list[GranuleMeta]:
-    """Granule metadata of every product in *path*, without reading the arrays."""
+    """Granule metadata of every product in *path*, without reading the arrays.
+
+    Parameters
+    ----------
+    path : str or os.PathLike or GranuleRef
+        The file.
+
+    Returns
+    -------
+    list of GranuleMeta
+        Per granule.
+    """
     path = as_ref(path)
     with _opened(path) as h5:
         platform = _platform(path, h5)
@@ -434,7 +473,20 @@ def read_metadata(path: str | os.PathLike[str] | GranuleRef) -> list[GranuleMeta
 
 def read_viirs_geo_scan(path: str | os.PathLike[str] | GranuleRef, scan: int) -> tuple[np.ndarray, ...]:
     """(lat_rad, lon_rad, height_m) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the
-    end); height_m is zero for the ellipsoid product."""
+    end); height_m is zero for the ellipsoid product.
+
+    Parameters
+    ----------
+    path : str or os.PathLike or GranuleRef
+        A VIIRS GEO file.
+    scan : int
+        The scan (negative from the end).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (lat_rad, lon_rad, height_m) of its rows.
+    """
     path = as_ref(path)
     with _opened(path) as h5:
         product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
@@ -465,7 +517,18 @@ def read_viirs_geo_scan(path: str | os.PathLike[str] | GranuleRef, scan: int) ->
 
 def read_scan_start_us(path: str | os.PathLike[str] | GranuleRef) -> np.ndarray:
     """The start time (IET us) of every scan of a VIIRS GEO file, read alone (a few hundred bytes):
-    enough to choose the scans a CrIS granule can reach before any pixel is read."""
+    enough to choose the scans a CrIS granule can reach before any pixel is read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike or GranuleRef
+        A VIIRS GEO file.
+
+    Returns
+    -------
+    numpy.ndarray
+        Each scan's StartTime, IET us.
+    """
     path = as_ref(path)
     with _opened(path) as h5:
         product = next((p for p in products_in(path, h5) if p.kind == "viirs_geo"), None)
