@@ -41,7 +41,13 @@ class Change:
     origin: str  # calendar, metadata, fingerprint
 
     def label(self) -> str:
-        """The change in a few words, for messages and plots."""
+        """The change in a few words, for messages and plots.
+
+        Returns
+        -------
+        str
+            The label.
+        """
         who = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS and VIIRS (common geolocation)"}[
             self.instrument
         ]
@@ -57,7 +63,18 @@ def _when(value: object) -> dt.datetime:
 
 
 def load_calendar(path: str | Path) -> list[Change]:
-    """Events of the calendar YAML at *path* (missing file: none). Errors name the entry and key."""
+    """Events of the calendar YAML at *path* (missing file: none). Errors name the entry and key.
+
+    Parameters
+    ----------
+    path : str or Path
+        The calendar YAML.
+
+    Returns
+    -------
+    list of Change
+        Its events; none for a missing file.
+    """
     path = Path(path)
     if not path.exists():
         return []
@@ -87,7 +104,15 @@ def load_calendar(path: str | Path) -> list[Change]:
 def add_to_calendar(path: str | Path, change: Change) -> None:
     """Append *change* to the calendar YAML at *path* (created if missing). The file is edited as a
     round trip (ruamel.yaml): its comments, order and quoting stay as the team wrote them. A change the
-    calendar already holds (same satellite, time, instrument and kind) is a ValueError naming it."""
+    calendar already holds (same satellite, time, instrument and kind) is a ValueError naming it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The calendar YAML.
+    change : Change
+        The change.
+    """
     from ruamel.yaml import YAML
 
     path = Path(path)
@@ -130,7 +155,20 @@ def _lut_kinds(names: Iterable[str]) -> dict[str, set[str]]:
 
 
 def metadata_changes(store: History, satellite: str) -> list[Change]:
-    """Changes of LUTs and SDR software between consecutive days of stored granule metadata."""
+    """Changes of LUTs and SDR software between consecutive days of stored granule metadata.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+
+    Returns
+    -------
+    list of Change
+        In time order.
+    """
     days: dict[str, dict[str, set[str]]] = {}
     for g in store.granules(satellite):
         d = days.setdefault(g.day, {"cris": set(), "viirs": set(), "cris_sw": set(), "viirs_sw": set()})
@@ -173,7 +211,20 @@ def metadata_changes(store: History, satellite: str) -> list[Change]:
 
 
 def stored_changes(store: History, satellite: str) -> list[Change]:
-    """Change events the service itself recorded (``events`` rows of kind ``change:<instrument>``)."""
+    """Change events the service itself recorded (``events`` rows of kind ``change:<instrument>``).
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+
+    Returns
+    -------
+    list of Change
+        In time order.
+    """
     out = []
     for e in store.events():
         if e.kind.is_change and e.satellite == satellite and "time" in e.detail:
@@ -192,7 +243,22 @@ def stored_changes(store: History, satellite: str) -> list[Change]:
 
 
 def all_changes(store: History, satellite: str, calendar_path: str | Path | None = None) -> list[Change]:
-    """Every known change of *satellite*, in time order: the calendar, the metadata, the recorded events."""
+    """Every known change of *satellite*, in time order: the calendar, the metadata, the recorded events.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    calendar_path : str or Path, optional
+        The events calendar.
+
+    Returns
+    -------
+    list of Change
+        In time order.
+    """
     cal = [c for c in load_calendar(calendar_path) if c.satellite == satellite] if calendar_path else []
     return sorted(
         cal + metadata_changes(store, satellite) + stored_changes(store, satellite), key=lambda c: c.time
@@ -205,7 +271,24 @@ def listing(
     """What ``crisgeo events list`` shows: the changes of satellite *only*, else of every satellite the
     calendar or the configuration (*configured*) names, in the satellite table's order, each in time
     order. Before the first run (*store* None) the calendar alone; after, the metadata and recorded events
-    too."""
+    too.
+
+    Parameters
+    ----------
+    calendar_path : str or Path
+        The events calendar.
+    configured : iterable of str
+        The configured satellites.
+    only : str or None
+        One satellite.
+    store : History or None
+        The store's records, for the changes found in the data.
+
+    Returns
+    -------
+    list of Change
+        In time order.
+    """
     calendar = load_calendar(calendar_path)
     known = {c.satellite for c in calendar} | set(configured)
     chosen = [only] if only else [s for s in SATELLITES if s in known]
@@ -215,7 +298,22 @@ def listing(
 
 
 def preceding_change(changes: list[Change], split_day: dt.date, window_days: int = 10) -> Change | None:
-    """The latest change at or before the end of *split_day* and no more than *window_days* before it."""
+    """The latest change at or before the end of *split_day* and no more than *window_days* before it.
+
+    Parameters
+    ----------
+    changes : list of Change
+        Known changes, in time order.
+    split_day : datetime.date
+        The day a step was found at.
+    window_days : int, optional
+        How far back a change may lie, days.
+
+    Returns
+    -------
+    Change or None
+        The change; None without one.
+    """
     end = _when(split_day) + dt.timedelta(days=1)
     start = end - dt.timedelta(days=window_days + 1)
     before = [c for c in changes if start <= c.time < end]

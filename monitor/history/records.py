@@ -53,7 +53,18 @@ class Row(Protocol):
 
 
 def iso(t: dt.datetime) -> str:
-    """*t* as an ISO 8601 UTC string, to the second."""
+    """*t* as an ISO 8601 UTC string, to the second.
+
+    Parameters
+    ----------
+    t : datetime.datetime
+        An aware time.
+
+    Returns
+    -------
+    str
+        ISO 8601, UTC, to the second.
+    """
     return t.astimezone(dt.timezone.utc).isoformat(timespec="seconds")
 
 
@@ -76,7 +87,18 @@ class Alert:
 
     @classmethod
     def from_row(cls, r: Row) -> "Alert":
-        """The Alert of a row of the store."""
+        """The Alert of a row of the store.
+
+        Parameters
+        ----------
+        r : sqlite3.Row
+            The row.
+
+        Returns
+        -------
+        Alert
+            The record.
+        """
         d = {k: r[k] for k in cls.__dataclass_fields__}
         d["lines"] = json.loads(r["lines"] or "[]")
         d["status"] = AlertStatus(d["status"])
@@ -97,7 +119,18 @@ class Silence:
 
     @classmethod
     def from_row(cls, r: Row) -> "Silence":
-        """The Silence of a row of the store."""
+        """The Silence of a row of the store.
+
+        Parameters
+        ----------
+        r : sqlite3.Row
+            The row.
+
+        Returns
+        -------
+        Silence
+            The record.
+        """
         return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
 
@@ -120,7 +153,18 @@ class Delivery:
 
     @classmethod
     def from_row(cls, r: Row) -> "Delivery":
-        """The Delivery of a row of the store."""
+        """The Delivery of a row of the store.
+
+        Parameters
+        ----------
+        r : sqlite3.Row
+            The row.
+
+        Returns
+        -------
+        Delivery
+            The record.
+        """
         d = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(
             **{
@@ -145,7 +189,18 @@ class Event:
 
     @classmethod
     def from_row(cls, r: Row) -> "Event":
-        """The event of an ``events`` row."""
+        """The event of an ``events`` row.
+
+        Parameters
+        ----------
+        r : sqlite3.Row
+            The row.
+
+        Returns
+        -------
+        Event
+            The record.
+        """
         try:
             detail = json.loads(r["detail"])
         except (TypeError, ValueError):
@@ -171,14 +226,36 @@ class Run:
 
     @classmethod
     def from_row(cls, r: Row) -> "Run":
-        """The Run of a row of the store."""
+        """The Run of a row of the store.
+
+        Parameters
+        ----------
+        r : sqlite3.Row
+            The row.
+
+        Returns
+        -------
+        Run
+            The record.
+        """
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, "status": RunStatus(row["status"])})
 
 
 def last_success(runs: Sequence[Run]) -> dt.datetime | None:
     """When the latest successful run (status ok) of *runs* (in order) finished, UTC; if none succeeded,
-    when the first began; None without runs. Empty days (no data at the source) are not a success."""
+    when the first began; None without runs. Empty days (no data at the source) are not a success.
+
+    Parameters
+    ----------
+    runs : sequence of Run
+        A satellite's runs, in order.
+
+    Returns
+    -------
+    datetime.datetime or None
+        UTC.
+    """
     if not runs:
         return None
     ok = [r for r in runs if r.status == RunStatus.OK]
@@ -201,7 +278,13 @@ class ForSeries:
         return len(self.days)
 
     def reliable(self) -> np.ndarray:
-        """(days, N_FOR): a stored FOR without any of the reliability flags."""
+        """(days, N_FOR): a stored FOR without any of the reliability flags.
+
+        Returns
+        -------
+        numpy.ndarray
+            bool per day and FOR: no reliability flag set.
+        """
         flagged = np.vectorize(lambda f: bool(set(f) & set(RELIABILITY_FLAGS)), otypes=[bool])(self.flags)
         return self.stored & ~flagged if self.flags.size else self.stored
 
@@ -233,7 +316,18 @@ class GranuleRow:
 
     @classmethod
     def from_row(cls, r: Row) -> "GranuleRow":
-        """The GranuleRow of a row of the store."""
+        """The GranuleRow of a row of the store.
+
+        Parameters
+        ----------
+        r : sqlite3.Row
+            The row.
+
+        Returns
+        -------
+        GranuleRow
+            The record.
+        """
         row = {k: r[k] for k in cls.__dataclass_fields__}
         return cls(**{**row, **{k: _json_list(row[k]) for k in ("viirs", "cris_aux", "viirs_aux")}})
 
@@ -252,7 +346,18 @@ class SelectionRow:
 
     @classmethod
     def from_row(cls, r: Row) -> "SelectionRow":
-        """The SelectionRow of a row of the store."""
+        """The SelectionRow of a row of the store.
+
+        Parameters
+        ----------
+        r : sqlite3.Row
+            The row.
+
+        Returns
+        -------
+        SelectionRow
+            The record.
+        """
         return cls(**{k: r[k] for k in cls.__dataclass_fields__})
 
 

@@ -93,7 +93,18 @@ class DayPrint:
 
 
 def granule_print(geo: CrisGeoGranule) -> GranulePrint:
-    """The fingerprint of one CrIS GEO granule (a :class:`monitor.sdr.CrisGeoGranule`)."""
+    """The fingerprint of one CrIS GEO granule (a :class:`monitor.sdr.CrisGeoGranule`).
+
+    Parameters
+    ----------
+    geo : CrisGeoGranule
+        The granule.
+
+    Returns
+    -------
+    GranulePrint
+        Per FOR the FOV-5 SBF angles' median and per-scan values, urad.
+    """
     valid = geo.valid
     fg = granule_geometry(geo)
     a = np.where(valid, fg.alpha_rad, np.nan) / URAD
@@ -112,7 +123,18 @@ def granule_print(geo: CrisGeoGranule) -> GranulePrint:
 
 
 def day_print(prints: list[GranulePrint]) -> DayPrint:
-    """Combine granule fingerprints: medians over granules, scatter over all scans."""
+    """Combine granule fingerprints: medians over granules, scatter over all scans.
+
+    Parameters
+    ----------
+    prints : list of GranulePrint
+        The granules' fingerprints, in time order.
+
+    Returns
+    -------
+    DayPrint
+        Per FOR the median alpha and beta and their scan-to-scan scatter, urad.
+    """
     sa = np.concatenate([p.scan_alpha_urad for p in prints])
     sb = np.concatenate([p.scan_beta_urad for p in prints])
     with np.errstate(all="ignore"):
@@ -133,7 +155,20 @@ K_SIGMA = 4.0
 def thresholds(
     sd_alpha_urad: np.ndarray, sd_beta_urad: np.ndarray, threshold_urad: float = PROCESSING_CHANGE_URAD
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Per-FOR step thresholds (urad): max(threshold, 4 x scan-to-scan scatter), per direction."""
+    """Per-FOR step thresholds (urad): max(threshold, 4 x scan-to-scan scatter), per direction.
+
+    Parameters
+    ----------
+    sd_alpha_urad, sd_beta_urad : numpy.ndarray
+        The scan-to-scan scatter per FOR, urad.
+    threshold_urad : float, optional
+        The least step of a processing change, urad (``fingerprint.threshold_urad``).
+
+    Returns
+    -------
+    alpha_urad, beta_urad : numpy.ndarray
+        The thresholds per FOR, urad.
+    """
     return (
         np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_alpha_urad)),
         np.maximum(threshold_urad, K_SIGMA * np.nan_to_num(sd_beta_urad)),
@@ -159,6 +194,20 @@ def compare_days(
     """(FORs changed, d_alpha_urad, d_beta_urad) between two daily fingerprints.
 
     Thresholds use the larger scatter of the two days: a step between days does not widen either.
+
+    Parameters
+    ----------
+    previous, current : DayPrint
+        The two days' prints.
+    threshold_urad : float, optional
+        The least step of a processing change, urad (``fingerprint.threshold_urad``).
+
+    Returns
+    -------
+    fors : list of int
+        The FORs changed (1-based).
+    d_alpha_urad, d_beta_urad : numpy.ndarray
+        The moves per FOR, urad.
     """
     return _changed_fors(
         previous.alpha_urad,
@@ -186,6 +235,22 @@ def change_within(
     thresholds come from the scatter of *reference* (the previous day) or, without one, of the whole
     day, so that the scene-mirror servo excursions of the noisy FORs do not pass for a change.
     Returns (index of the first changed granule, FORs changed, d_alpha_urad, d_beta_urad).
+
+    Parameters
+    ----------
+    prints : list of GranulePrint
+        The granules' fingerprints, in time order.
+    threshold_urad : float, optional
+        The least step of a processing change, urad (``fingerprint.threshold_urad``).
+    min_side : int, optional
+        The fewest granules on each side of a split.
+    reference : DayPrint, optional
+        The previous day's print.
+
+    Returns
+    -------
+    tuple or None
+        (index of the first changed granule, FORs changed, d_alpha_urad, d_beta_urad); None without a step.
     """
     ref = reference or day_print(prints)
     thr = thresholds(ref.sd_alpha_urad, ref.sd_beta_urad, threshold_urad)
@@ -223,7 +288,18 @@ class ProcessingChange:
         return float(np.nanmax(np.abs(np.concatenate([self.d_alpha_urad, self.d_beta_urad]))))
 
     def describe(self, matches: Sequence[EpMatch] = ()) -> str:
-        """One sentence for logs, events and messages; with the best-matching EP of *matches* if any."""
+        """One sentence for logs, events and messages; with the best-matching EP of *matches* if any.
+
+        Parameters
+        ----------
+        matches : sequence of EpMatch, optional
+            The EP matches; the best one is named.
+
+        Returns
+        -------
+        str
+            The sentence.
+        """
         text = (
             f"CrIS geolocation processing changed (LOS fingerprint): FOR {', '.join(map(str, self.fors))}, "
             f"up to {self.largest_urad:.0f} urad, from granule {self.granule}"
@@ -234,7 +310,13 @@ class ProcessingChange:
         return text
 
     def to_dict(self) -> dict:
-        """JSON-ready: time, granule, fors and the per-FOR changes rounded to 0.1 urad."""
+        """JSON-ready: time, granule, fors and the per-FOR changes rounded to 0.1 urad.
+
+        Returns
+        -------
+        dict
+            Its JSON.
+        """
         return {
             "time": self.time,
             "granule": self.granule,
@@ -251,7 +333,24 @@ def detect_change(
     day: dt.date | None = None,
 ) -> ProcessingChange | None:
     """The processing change of a day: a step within its time-ordered *prints* (from 4 granules), else a
-    step against *reference* (the previous day's print; dated 00:00 UTC of *day*), else None."""
+    step against *reference* (the previous day's print; dated 00:00 UTC of *day*), else None.
+
+    Parameters
+    ----------
+    prints : list of GranulePrint
+        The granules' fingerprints, in time order.
+    threshold_urad : float
+        The least step of a processing change, urad.
+    reference : DayPrint, optional
+        The previous day's print.
+    day : datetime.date, optional
+        The day, for a step against *reference* (dated 00:00 UTC).
+
+    Returns
+    -------
+    ProcessingChange or None
+        The change; None without one.
+    """
     if len(prints) >= 4:
         within = change_within(prints, threshold_urad, reference=reference)
         if within is not None:
@@ -298,6 +397,20 @@ def identify_ep(day: DayPrint, library: dict, satellite: str | None = None) -> l
     per-FOR medians. With *satellite*, EPs of other satellites are left out. On real NOAA-20 data the
     right EP leaves ~30 urad (the servo and in-track residuals of docs/jpss-formats.md 2.3); a wrong one,
     hundreds.
+
+    Parameters
+    ----------
+    day : DayPrint
+        The day's print.
+    library : dict of str to EngineeringPacket
+        The EPs to identify from, by name.
+    satellite : str, optional
+        Leave out the EPs of other satellites.
+
+    Returns
+    -------
+    list of EpMatch
+        Best first.
     """
     matches = []
     for name, ep in library.items():
@@ -346,7 +459,18 @@ PRINT_COLUMNS = (
 
 
 def format_matches(matches: list[EpMatch]) -> str:
-    """Ranked EP matches, with the best one's per-FOR residual."""
+    """Ranked EP matches, with the best one's per-FOR residual.
+
+    Parameters
+    ----------
+    matches : list of EpMatch
+        Ranked matches.
+
+    Returns
+    -------
+    str
+        The text.
+    """
     if not matches:
         return "no EP in the library to compare with"
     lines = ["EP identification (fingerprint - EP model, FOV 5):"]
@@ -361,7 +485,18 @@ def format_matches(matches: list[EpMatch]) -> str:
 
 
 def format_print(day: DayPrint) -> str:
-    """The per-FOR table printed by ``crisgeo fingerprint`` (SBF angles of FOV 5; sd: scan to scan)."""
+    """The per-FOR table printed by ``crisgeo fingerprint`` (SBF angles of FOV 5; sd: scan to scan).
+
+    Parameters
+    ----------
+    day : DayPrint
+        The day's print.
+
+    Returns
+    -------
+    str
+        The table.
+    """
     rows = [
         _ForRow(k + 1, day.alpha_urad[k], day.beta_urad[k], day.sd_alpha_urad[k], day.sd_beta_urad[k])
         for k in range(len(day.alpha_urad))
@@ -397,14 +532,44 @@ class DayFingerprint:
         self, threshold_urad: float, reference: DayPrint | None = None, day: dt.date | None = None
     ) -> DayVerdict:
         """The day's :class:`DayVerdict`: its print, its EP matches and the change found within the files
-        or against *reference*, the previous day's print (:func:`detect_change`)."""
+        or against *reference*, the previous day's print (:func:`detect_change`).
+
+        Parameters
+        ----------
+        threshold_urad : float
+            The least step of a processing change, urad.
+        reference : DayPrint, optional
+            The previous day's print.
+        day : datetime.date, optional
+            The day, for a step against *reference* (dated 00:00 UTC).
+
+        Returns
+        -------
+        DayVerdict
+            The verdict.
+        """
         change = detect_change(list(self.prints), threshold_urad, reference, day)
         return DayVerdict(self.day, list(self.matches), change)
 
 
 def fingerprint_day(prints: list[GranulePrint], library: dict, platform: str | None) -> DayFingerprint:
     """The :class:`DayFingerprint` of granule *prints*: the EPs of *library* matched against their day print
-    (those of *platform* only, when known)."""
+    (those of *platform* only, when known).
+
+    Parameters
+    ----------
+    prints : list of GranulePrint
+        The granules' fingerprints, in time order.
+    library : dict of str to EngineeringPacket
+        The EPs to identify from, by name.
+    platform : str or None
+        The satellite, when known.
+
+    Returns
+    -------
+    DayFingerprint
+        The day's print and matches.
+    """
     prints = sorted(prints, key=lambda p: p.start)
     today = day_print(prints)
     return DayFingerprint(tuple(prints), today, tuple(identify_ep(today, library, platform)))
@@ -420,7 +585,28 @@ def day_verdict(
 ) -> DayVerdict:
     """The fingerprint of a day from its granule *prints*: the day print, the EPs of *library* matched
     against it (those of *platform* only, when known), and the change (:func:`detect_change`). The daily
-    run and ``crisgeo fingerprint`` both come here."""
+    run and ``crisgeo fingerprint`` both come here.
+
+    Parameters
+    ----------
+    prints : list of GranulePrint
+        The granules' fingerprints, in time order.
+    library : dict of str to EngineeringPacket
+        The EPs to identify from, by name.
+    platform : str or None
+        The satellite, when known.
+    threshold_urad : float
+        The least step of a processing change, urad.
+    reference : DayPrint, optional
+        The previous day's print.
+    day : datetime.date, optional
+        The day, for a step against *reference* (dated 00:00 UTC).
+
+    Returns
+    -------
+    DayVerdict
+        The verdict.
+    """
     return fingerprint_day(prints, library, platform).verdict(threshold_urad, reference, day)
 
 
@@ -435,7 +621,13 @@ class FilesPrint:
     problems: list[str]
 
     def to_dict(self) -> dict:
-        """The JSON document of ``crisgeo fingerprint --json``."""
+        """The JSON document of ``crisgeo fingerprint --json``.
+
+        Returns
+        -------
+        dict
+            Its JSON (``crisgeo fingerprint --json``).
+        """
         doc = self.verdict.day.to_dict()
         doc["skipped"] = self.skipped
         c = self.verdict.change
@@ -452,7 +644,22 @@ def fingerprint_files(
 ) -> FilesPrint:
     """Fingerprint the CrIS GEO files under *paths*, rank the EPs of *ep_library* (files or directories;
     empty: the packaged real EPs) against it and look for a step within the files. A
-    :class:`~monitor.core.errors.DataError` when no file can be read."""
+    :class:`~monitor.core.errors.DataError` when no file can be read.
+
+    Parameters
+    ----------
+    paths : sequence of str or os.PathLike
+        CrIS GEO files or directories.
+    ep_library : iterable of str or os.PathLike, optional
+        EP files or directories; empty: the packaged real EPs.
+    threshold_urad : float, optional
+        The least step of a processing change, urad (``fingerprint.threshold_urad``).
+
+    Returns
+    -------
+    FilesPrint
+        The print, the EP matches, the step found and the files skipped.
+    """
     files = find_files(paths)
     prints, skipped = [], []
     for f in files:

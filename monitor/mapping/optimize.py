@@ -85,7 +85,13 @@ class Optimization:
         return [r for r in self.rows if r.kept]
 
     def table(self) -> str:
-        """The old/new angle table as fixed-width text (urad; :data:`ANGLE_COLUMNS`)."""
+        """The old/new angle table as fixed-width text (urad; :data:`ANGLE_COLUMNS`).
+
+        Returns
+        -------
+        list of dict
+            Per FOR the old and new scene-mirror angles, urad.
+        """
         lines = ["roll: ActualCrosstrackAngleRoll, pitch: ActualIntrackAnglePitch; d_alpha, d_beta: assessed"]
         lines += text_table(self.rows, ANGLE_COLUMNS)
         if self.kept:
@@ -108,6 +114,20 @@ def optimize(result: AssessmentResult, ep: EngineeringPacket, source: str = "") 
     """The EP with scene-mirror angles that cancel the offsets of *result*, assessed on data made with *ep*.
 
     Raises ValueError when the result is for another satellite than the EP or does not have 30 FORs.
+
+    Parameters
+    ----------
+    result : AssessmentResult
+        The assessment whose offsets are corrected.
+    ep : EngineeringPacket
+        The EP in force when the assessed data were made.
+    source : str, optional
+        What the result came from, recorded in the new EP's provenance.
+
+    Returns
+    -------
+    Optimization
+        The new EP and the angles' table.
     """
     if result.satellite != ep.satellite:
         raise DataError(

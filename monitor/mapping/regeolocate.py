@@ -45,7 +45,22 @@ def geolocate_granule(
     ep: EngineeringPacket, g: CrisGeoGranule, residuals: ResidualTable | OwnResiduals | None = None
 ) -> GroundView:
     """Geolocation of every FOV of *g* with the LOS of *ep* (turned by the per-FOR *residuals*, if given)
-    and the granule's own ephemeris and attitude."""
+    and the granule's own ephemeris and attitude.
+
+    Parameters
+    ----------
+    g : CrisGeoGranule
+        The granule.
+    ep : EngineeringPacket
+        The EP to geolocate with.
+    residuals : ResidualTable or OwnResiduals, optional
+        The per-FOR FOV-5 residuals applied to the EP model.
+
+    Returns
+    -------
+    GroundView
+        The geolocation.
+    """
     if g.meta.platform != ep.satellite:
         raise DataError(f"{g.meta.path}: granule of {g.meta.platform}, EP {ep.version} of {ep.satellite}")
     if residuals is not None and residuals.satellite != ep.satellite:
@@ -89,7 +104,22 @@ def compare_with_files(
     ep: EngineeringPacket, paths: Iterable[str | Path], residuals: ResidualTable | OwnResiduals | None = None
 ) -> list[ForDistance]:
     """Per-FOR statistics of the distance between *ep*'s geolocation (with *residuals*, if given) and the
-    files' latitude/longitude."""
+    files' latitude/longitude.
+
+    Parameters
+    ----------
+    paths : sequence of str or os.PathLike
+        CrIS GEO files.
+    ep : EngineeringPacket
+        The EP.
+    residuals : ResidualTable or OwnResiduals, optional
+        The per-FOR residuals.
+
+    Returns
+    -------
+    list of ForDistance
+        Per FOR the statistics of the distance from the files' own geolocation.
+    """
     per_for: list[list] = [[] for _ in range(N_FOR)]
     for path in paths:
         for g in _geo_granules(path):
@@ -120,7 +150,24 @@ def regeolocate_file(
     residuals: ResidualTable | OwnResiduals | None = None,
 ) -> Path:
     """Write a copy of the GEO file *path* into *out_dir* with its geolocation computed from *ep* (and the
-    per-FOR *residuals*, if given)."""
+    per-FOR *residuals*, if given).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A CrIS GEO file.
+    ep : EngineeringPacket
+        The EP.
+    out_dir : str or os.PathLike
+        Where the copy goes (never the input's directory).
+    residuals : ResidualTable or OwnResiduals, optional
+        The per-FOR residuals.
+
+    Returns
+    -------
+    Path
+        The copy.
+    """
     src = Path(path).resolve()
     dst_dir = Path(out_dir).resolve()
     if dst_dir == src.parent:

@@ -69,7 +69,18 @@ class ResidualTable:
     fov5_beta_urad: np.ndarray | None = None
 
     def apply(self, los_spacecraft: np.ndarray) -> np.ndarray:
-        """The LOS (30, 9, 3) (spacecraft frame) with every FOV of FOR k turned by the FOR's residual."""
+        """The LOS (30, 9, 3) (spacecraft frame) with every FOV of FOR k turned by the FOR's residual.
+
+        Parameters
+        ----------
+        los_spacecraft : numpy.ndarray
+            The EP model's LOS, spacecraft body frame, shape (30, 9, 3).
+
+        Returns
+        -------
+        numpy.ndarray
+            The LOS turned by the table's residuals, the same shape.
+        """
         alpha, beta = los_angles(los_spacecraft)
         return los_from_angles(
             alpha + self.d_alpha_urad[:, None] * URAD, beta + self.d_beta_urad[:, None] * URAD
@@ -77,7 +88,18 @@ class ResidualTable:
 
     def departure_urad(self, granule: CrisGeoGranule) -> tuple[np.ndarray, np.ndarray] | None:
         """Per FOR, the FOV-5 angles (in-track, cross-track; urad) *granule* shows minus those of the learning
-        granules (NaN where either was not measured); None for a table written without them."""
+        granules (NaN where either was not measured); None for a table written without them.
+
+        Parameters
+        ----------
+        granule : CrisGeoGranule
+            A granule the table is applied to.
+
+        Returns
+        -------
+        numpy.ndarray
+            Per FOR the departure of its FOV-5 angles from those the table was learned from, urad.
+        """
         if self.fov5_alpha_urad is None:
             return None
 
@@ -86,7 +108,18 @@ class ResidualTable:
 
     def table_for(self, granule: CrisGeoGranule) -> "ResidualTable":
         """The table to apply to *granule*: this one. Warns when the granule departs from the learning
-        granules by more than :data:`STALE_URAD` at some FOR, naming the FORs and the departures."""
+        granules by more than :data:`STALE_URAD` at some FOR, naming the FORs and the departures.
+
+        Parameters
+        ----------
+        granule : CrisGeoGranule
+            A granule.
+
+        Returns
+        -------
+        ResidualTable
+            The table to apply to it.
+        """
         departure = self.departure_urad(granule)
         if departure is not None:
             da, db = departure
@@ -107,7 +140,13 @@ class ResidualTable:
         return self
 
     def to_dict(self) -> dict:
-        """The table as the JSON document of the module docstring."""
+        """The table as the JSON document of the module docstring.
+
+        Returns
+        -------
+        dict
+            Its JSON.
+        """
         rows: list[dict[str, float | None]] = [
             {"for": k + 1, "d_alpha_urad": round(float(a), 3), "d_beta_urad": round(float(b), 3)}
             for k, (a, b) in enumerate(zip(self.d_alpha_urad, self.d_beta_urad, strict=True))
@@ -125,7 +164,18 @@ class ResidualTable:
         }
 
     def write(self, path: str | os.PathLike[str]) -> Path:
-        """Write the table as JSON to *path* (through a temporary name)."""
+        """Write the table as JSON to *path* (through a temporary name).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         path = Path(path)
         tmp = path.with_name(path.name + ".part")
         tmp.write_text(json.dumps(self.to_dict(), indent=1) + "\n")
@@ -135,7 +185,20 @@ class ResidualTable:
 
 def learn(day: DayPrint, ep: EngineeringPacket) -> ResidualTable:
     """The residual table of a fingerprint *day* (:class:`monitor.mapping.fingerprint.DayPrint`) against *ep*:
-    measured minus modelled FOV-5 angles per FOR. FORs the fingerprint could not measure get 0."""
+    measured minus modelled FOV-5 angles per FOR. FORs the fingerprint could not measure get 0.
+
+    Parameters
+    ----------
+    day : DayPrint
+        The day's fingerprint.
+    ep : EngineeringPacket
+        The EP the residuals are learned against.
+
+    Returns
+    -------
+    ResidualTable
+        The per-FOR FOV-5 residual.
+    """
     alpha, beta = fov5_angles(ep)
     return ResidualTable(
         ep.satellite,
@@ -168,7 +231,18 @@ class OwnResiduals:
 
 
 def load(path: str | os.PathLike[str]) -> ResidualTable:
-    """Read a residual table; :class:`ResidualError` naming file, field and value when it is unusable."""
+    """Read a residual table; :class:`ResidualError` naming file, field and value when it is unusable.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A residual table's JSON.
+
+    Returns
+    -------
+    ResidualTable
+        The table.
+    """
     path = Path(path)
     try:
         doc = json.loads(path.read_text())
