@@ -38,7 +38,13 @@ def _glibc() -> ctypes.CDLL | None:
 
 def reuse_freed_memory() -> bool:
     """Serve large allocations from the heap and keep what is freed for reuse (process-wide); whether
-    it was set (glibc only)."""
+    it was set (glibc only).
+
+    Returns
+    -------
+    bool
+        Whether it was set (glibc only).
+    """
     libc = _glibc()
     if libc is None:
         return False

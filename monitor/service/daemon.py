@@ -51,7 +51,18 @@ STALL_S = 300.0  # ... and the scheduler counts as stalled when it has not run f
 
 
 def sd_notify(message: str) -> bool:
-    """Send *message* (e.g. ``READY=1``) to systemd's notify socket; False when not under systemd."""
+    """Send *message* (e.g. ``READY=1``) to systemd's notify socket; False when not under systemd.
+
+    Parameters
+    ----------
+    message : str
+        ``READY=1``, ``STATUS=...``, ``WATCHDOG=1``, ``STOPPING=1``.
+
+    Returns
+    -------
+    bool
+        Whether it was sent (False outside systemd).
+    """
     addr = os.environ.get("NOTIFY_SOCKET")
     if not addr:
         return False
@@ -71,7 +82,15 @@ def sd_notify(message: str) -> bool:
 
 
 class Service:
-    """Runs satellite-days for a configuration; the daemon adds the scheduler and signals."""
+    """Runs satellite-days for a configuration; the daemon adds the scheduler and signals.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    progress : callable, optional
+        Called after each granule assessed.
+    """
 
     def __init__(self, cfg: Config, progress: Callable[[object], None] | None = None) -> None:
         self.cfg = cfg
@@ -84,12 +103,33 @@ class Service:
         self.metrics: ServiceMetrics | None = None  # while the daemon serves /metrics
 
     def store(self) -> Store:
-        """A new connection to the configured store (close it, or use it in ``with``)."""
+        """A new connection to the configured store (close it, or use it in ``with``).
+
+        Returns
+        -------
+        Store
+            A new connection.
+        """
         return Store(self.cfg.store.path)
 
     def run(self, satellite: str, day: dt.date, today: dt.date | None = None) -> RunOutcome:
         """Run one satellite-day (health-tracked) as of *today* (default: the date now, UTC), then evaluate
-        the alerts and regenerate the report."""
+        the alerts and regenerate the report.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+        today : datetime.date, optional
+            Today, UTC, for the no-data horizon.
+
+        Returns
+        -------
+        RunOutcome
+            The day's outcome, recorded.
+        """
         today = today or dt.datetime.now(UTC).date()
         try:
             with self.store() as store, logcontext.context(satellite=satellite, day=day.isoformat()):
@@ -123,7 +163,13 @@ class Service:
         self.check_alerts(store, report=not self.stop_event.is_set())  # stopping: the next run rewrites it
 
     def regenerate_report(self, store: Store) -> None:
-        """Rewrite the HTML report into ``report_dir``; a report problem never stops the service."""
+        """Rewrite the HTML report into ``report_dir``; a report problem never stops the service.
+
+        Parameters
+        ----------
+        store : Store
+            The service's store.
+        """
         if not self.cfg.report_dir:
             return
         from monitor.service.outputs.report.html import (  # matplotlib: when first needed
@@ -138,7 +184,15 @@ class Service:
 
     def check_alerts(self, store: Store | None = None, report: bool = False) -> None:
         """Evaluate the alert rules for every satellite and deliver the queue (regenerating the report in
-        between when *report*); a broken channel never stops the service."""
+        between when *report*); a broken channel never stops the service.
+
+        Parameters
+        ----------
+        store : Store, optional
+            The store; the service's own by default.
+        report : bool, optional
+            Regenerate the report after.
+        """
 
         own = store is None
         store = store or self.store()
@@ -159,7 +213,13 @@ class Service:
 
     def drain_outbox(self) -> dict:
         """Send the time-series points waiting in the outbox (after an outage they need not wait for the
-        next daily run); returns {target: (sent, left)}."""
+        next daily run); returns {target: (sent, left)}.
+
+        Returns
+        -------
+        dict
+            Per target, (sent, left).
+        """
 
         with self.store() as store:
             report = drain_outbox(store, self.cfg.store.publish)
@@ -181,7 +241,20 @@ class Service:
 
     def catch_up(self, satellite: str, today: dt.date | None = None) -> Iterator[RunOutcome]:
         """Run the days of the catch-up window that have no completed run, oldest first, yielding each
-        outcome as its day ends (the daemon keeps none: a 90-day catch-up holds no 90 results)."""
+        outcome as its day ends (the daemon keeps none: a 90-day catch-up holds no 90 results).
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        today : datetime.date, optional
+            Today, UTC.
+
+        Returns
+        -------
+        iterator of RunOutcome
+            Each missed day's outcome, oldest first.
+        """
         today = today or dt.datetime.now(UTC).date()
         with self.store() as store:
             days = days_to_run(store, satellite, self.cfg.schedule, today)
@@ -191,14 +264,33 @@ class Service:
             yield self.run(satellite, day, today)
 
     def daily_job(self, satellite: str) -> None:
-        """The scheduled job of *satellite*: the days of its catch-up window."""
+        """The scheduled job of *satellite*: the days of its catch-up window.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        """
         for _ in self.catch_up(satellite):
             pass
 
     def run_once(self, satellites: Iterable[str], day: dt.date | None = None) -> list[RunOutcome]:
         """``crisgeo run``: under the instance lock, recover what a killed process left, then per satellite
         the given *day* or the days of the catch-up window; the outcomes. :class:`AlreadyRunning` when the
-        daemon (or another run) holds the state directory."""
+        daemon (or another run) holds the state directory.
+
+        Parameters
+        ----------
+        satellites : iterable of str
+            The satellites.
+        day : datetime.date, optional
+            One day; else the missed days.
+
+        Returns
+        -------
+        list of RunOutcome
+            The outcomes.
+        """
         with InstanceLock(self.cfg.state_dir, "run"):
             self.recover()
             outcomes: list[RunOutcome] = []
@@ -211,7 +303,13 @@ class Service:
     # -- daemon
     def add_jobs(self, scheduler: BlockingScheduler) -> None:
         """The daemon's jobs: per satellite the daily run (catching up at start), the hourly alert
-        evaluation, and (with publishing) the outbox timer."""
+        evaluation, and (with publishing) the outbox timer.
+
+        Parameters
+        ----------
+        scheduler : BlockingScheduler
+            APScheduler's scheduler.
+        """
 
         sch = self.cfg.schedule
         now = dt.datetime.now(UTC)
@@ -240,7 +338,18 @@ class Service:
         scheduler.add_listener(self._job_event, EVENT_JOB_ERROR | EVENT_JOB_MISSED | EVENT_JOB_MAX_INSTANCES)
 
     def start_endpoint(self, listen: str) -> Endpoint | None:
-        """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing)."""
+        """Serve /metrics, /healthz and /report/ on *listen* (``HOST:PORT``; ``off``: nothing).
+
+        Parameters
+        ----------
+        listen : str
+            ``HOST:PORT``, or ``off``.
+
+        Returns
+        -------
+        Endpoint or None
+            The endpoint started; None for ``off``.
+        """
         if listen == "off":
             return None
 
@@ -251,7 +360,13 @@ class Service:
         return Endpoint(*parse_listen(listen), self.metrics, self.health, report).start()
 
     def daemon(self, listen: str | None = None) -> None:
-        """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``."""
+        """Run the scheduler until SIGTERM/SIGINT; *listen* overrides ``http.listen``.
+
+        Parameters
+        ----------
+        listen : str, optional
+            ``HOST:PORT`` overriding ``http.listen``.
+        """
         sch = self.cfg.schedule
         with InstanceLock(self.cfg.state_dir, "daemon"):
             endpoint = self.start_endpoint(listen or self.cfg.http.listen)

@@ -122,7 +122,21 @@ class _V6Server(ThreadingHTTPServer):
 class Endpoint:
     """Serves *metrics* (:class:`monitor.service.outputs.metrics.ServiceMetrics`), *health*
     (:class:`monitor.service.health.Health`) and the files under *report_dir* on (host, port); port 0 takes a
-    free one (see :attr:`address`)."""
+    free one (see :attr:`address`).
+
+    Parameters
+    ----------
+    host : str
+        The address to serve on.
+    port : int
+        The port; 0 takes a free one.
+    metrics : Registered
+        What ``/metrics`` serves.
+    health : HealthView
+        What ``/healthz`` serves.
+    report_dir : Path or None
+        The report's files, under ``/report/``.
+    """
 
     def __init__(
         self, host: str, port: int, metrics: Registered, health: HealthView, report_dir: Path | None
@@ -147,7 +161,13 @@ class Endpoint:
         return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
 
     def start(self) -> "Endpoint":
-        """Serve on a daemon thread."""
+        """Serve on a daemon thread.
+
+        Returns
+        -------
+        Endpoint
+            It, serving on a thread.
+        """
         self.thread.start()
         LOG.info("serving /metrics, /healthz and /report/ on http://%s/", self.address)
         return self

@@ -16,6 +16,13 @@ class Health:
     """Jobs in flight with their budgets, and the scheduler's last heartbeat (monotonic seconds).
 
     *stall_s*: the scheduler counts as stalled when its heartbeat job has not run for this long.
+
+    Parameters
+    ----------
+    stall_s : float
+        The scheduler counts as stalled when its heartbeat job has not run for this long, s.
+    clock : callable, optional
+        The clock, s (``time.monotonic``).
     """
 
     def __init__(self, stall_s: float, clock: Callable[[], float] = time.monotonic) -> None:
@@ -33,7 +40,20 @@ class Health:
 
     @contextmanager
     def job(self, name: str, budget_s: float) -> Iterator[None]:
-        """Track the block as job *name*, unhealthy once it runs longer than *budget_s*."""
+        """Track the block as job *name*, unhealthy once it runs longer than *budget_s*.
+
+        Parameters
+        ----------
+        name : str
+            The job.
+        budget_s : float
+            How long it may take, s.
+
+        Returns
+        -------
+        iterator
+            A context manager's one value, None.
+        """
         with self._lock:
             key = self._next
             self._next += 1
@@ -45,7 +65,13 @@ class Health:
                 del self._jobs[key]
 
     def problems(self) -> list[str]:
-        """What is wrong now, one sentence each; empty when healthy."""
+        """What is wrong now, one sentence each; empty when healthy.
+
+        Returns
+        -------
+        list of str
+            A stalled scheduler and jobs over their budget; empty when healthy.
+        """
         now = self.clock()
         with self._lock:
             jobs = list(self._jobs.values())
@@ -60,7 +86,13 @@ class Health:
         return out
 
     def running(self) -> list[dict]:
-        """The jobs in flight: name, seconds running, budget."""
+        """The jobs in flight: name, seconds running, budget.
+
+        Returns
+        -------
+        list of dict
+            The jobs in flight, their budgets and how long they have run.
+        """
         now = self.clock()
         with self._lock:
             return [

@@ -23,7 +23,13 @@ DASHBOARDS = ("configs", "grafana")  # the folder of the Grafana dashboards, ren
 
 
 def shipped_root() -> Traversable:
-    """The shipped files (an importlib.resources Traversable)."""
+    """The shipped files (an importlib.resources Traversable).
+
+    Returns
+    -------
+    importlib.abc.Traversable
+        ``monitor/shipped``.
+    """
     return files("monitor") / "shipped"
 
 
@@ -75,6 +81,17 @@ def install_files(dest: str | Path, force: bool = False, spec_km: float = SPEC_K
 
 
 def kept_files(dest: str | Path) -> list[Path]:
-    """The shipped files that already exist under *dest* (what :func:`install_files` leaves alone)."""
+    """The shipped files that already exist under *dest* (what :func:`install_files` leaves alone).
+
+    Parameters
+    ----------
+    dest : str or Path
+        The target directory.
+
+    Returns
+    -------
+    list of Path
+        The shipped files that already exist under it.
+    """
     dest = Path(dest)
     return [dest.joinpath(*rel) for rel, _ in _walk(shipped_root()) if dest.joinpath(*rel).exists()]

@@ -19,7 +19,15 @@ class AlreadyRunning(RuntimeError):
 
 
 class InstanceLock:
-    """An exclusive flock on ``state_dir/crisgeo.lock``, held for the life of the process."""
+    """An exclusive flock on ``state_dir/crisgeo.lock``, held for the life of the process.
+
+    Parameters
+    ----------
+    state_dir : Path
+        The state directory.
+    role : str
+        What holds it (``daemon``, ``run``, ``reprocess``), written into the lock file.
+    """
 
     def __init__(self, state_dir: Path, role: str):
         self.path = Path(state_dir) / "crisgeo.lock"
@@ -63,7 +71,20 @@ class InstanceLock:
 
 
 def holder(state_dir: Path, role: str) -> int | None:
-    """The pid of the process of *role* holding *state_dir*'s lock, None when none does."""
+    """The pid of the process of *role* holding *state_dir*'s lock, None when none does.
+
+    Parameters
+    ----------
+    state_dir : Path
+        The state directory.
+    role : str
+        The role asking.
+
+    Returns
+    -------
+    int or None
+        The pid of the process of *role* holding the lock; None when none does.
+    """
     path = Path(state_dir) / "crisgeo.lock"
     try:
         inode = path.stat().st_ino

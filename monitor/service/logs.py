@@ -29,7 +29,18 @@ QUIET_LIBRARIES = ("apscheduler", "urllib3", "distributed", "numba", "matplotlib
 
 
 def priority(levelno: int) -> int:
-    """The syslog priority of a logging level (levels in between take the next more severe one)."""
+    """The syslog priority of a logging level (levels in between take the next more severe one).
+
+    Parameters
+    ----------
+    levelno : int
+        A logging level.
+
+    Returns
+    -------
+    int
+        The syslog priority (levels in between take the next more severe one).
+    """
     return next((p for level, p in sorted(PRIORITY.items()) if levelno <= level), 2)
 
 
@@ -40,7 +51,18 @@ class JournalFormatter(logging.Formatter):
         super().__init__("%(levelname)s %(name)s: %(message)s")
 
     def format(self, record: logging.LogRecord) -> str:
-        """One line, its priority first; a traceback's lines follow on it, joined by `` | ``."""
+        """One line, its priority first; a traceback's lines follow on it, joined by `` | ``.
+
+        Parameters
+        ----------
+        record : logging.LogRecord
+            The record.
+
+        Returns
+        -------
+        str
+            ``<N>logger: message``, one journal entry.
+        """
         lines = [line for line in super().format(record).splitlines() if line.strip()]
         return f"<{priority(record.levelno)}>" + " | ".join(line.strip() for line in lines)
 
@@ -59,7 +81,18 @@ class JsonFormatter(logging.Formatter):
     context (satellite, day, stage, run_id) where there is one, and the exception."""
 
     def format(self, record: logging.LogRecord) -> str:
-        """One JSON object per record."""
+        """One JSON object per record.
+
+        Parameters
+        ----------
+        record : logging.LogRecord
+            The record.
+
+        Returns
+        -------
+        str
+            One JSON object.
+        """
         doc = {
             "time": dt.datetime.fromtimestamp(record.created, dt.timezone.utc).isoformat(
                 timespec="milliseconds"
@@ -77,7 +110,15 @@ class JsonFormatter(logging.Formatter):
 
 def setup(verbose: bool, log_format: str) -> None:
     """Log to stderr: JSON lines, journal lines (under systemd) or text with a timestamp; libraries at
-    WARNING unless *verbose*."""
+    WARNING unless *verbose*.
+
+    Parameters
+    ----------
+    verbose : bool
+        DEBUG rather than INFO, and libraries below WARNING.
+    log_format : str
+        ``text`` or ``json``.
+    """
     handler = logging.StreamHandler()
     if log_format == "json":
         handler.setFormatter(JsonFormatter())

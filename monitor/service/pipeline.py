@@ -53,7 +53,13 @@ class RunOutcome:
     precision: DayPrecision | None = None
 
     def summary(self) -> str:
-        """The one line a run leaves in the log."""
+        """The one line a run leaves in the log.
+
+        Returns
+        -------
+        str
+            The day's one summary line.
+        """
         c, t = self.counts, self.timings
         parts = [
             f"run {self.satellite} {self.day}: {self.status}" + (f" ({self.reason})" if self.reason else "")
@@ -80,7 +86,24 @@ class RunOutcome:
 def days_to_run(store: Store, satellite: str, schedule: ScheduleConfig, today: dt.date) -> list[dt.date]:
     """The days of the catch-up window (ending ``lag_days`` before *today*) without a completed run, oldest
     first. A day found empty (archive outage, late ingest) is tried again for ``no_data_retry_days`` after
-    it became due; then its empty listing is final."""
+    it became due; then its empty listing is final.
+
+    Parameters
+    ----------
+    store : Store
+        The service's store.
+    satellite : str
+        The satellite's short name.
+    schedule : ScheduleConfig
+        The ``schedule`` section.
+    today : datetime.date
+        Today, UTC.
+
+    Returns
+    -------
+    list of datetime.date
+        The days to run, oldest first.
+    """
     return catch_up(schedule, store.done_days(satellite, no_data_horizon(schedule, today)), today)
 
 
@@ -90,6 +113,24 @@ def record_fingerprint(
     """Compare the day's *fingerprint* with the previous day's print in the store, and store it.
 
     A step becomes a ``change:cris`` event (used for jump attribution and notified by the alerts).
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    store : Store
+        The service's store.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+    fingerprint : DayFingerprint
+        The day's fingerprint.
+
+    Returns
+    -------
+    dict
+        The verdict as the run's summary records it.
     """
     prev = store.fingerprint(satellite, day)
     reference = DayPrint.from_dict(prev[1]) if prev else None
@@ -112,7 +153,17 @@ def record_fingerprint(
 
 
 def publish_changes(cfg: Config, store: Store, satellite: str) -> None:
-    """Queue every known change of *satellite* for the time-series stores (dashboard annotations)."""
+    """Queue every known change of *satellite* for the time-series stores (dashboard annotations).
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    store : Store
+        The service's store.
+    satellite : str
+        The satellite's short name.
+    """
     if not cfg.store.publish:
         return
 
@@ -128,7 +179,26 @@ def publish_changes(cfg: Config, store: Store, satellite: str) -> None:
 def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.date) -> RunOutcome:
     """Write what :func:`compute_day` produced under the ledger row *run_id*: the fingerprint, then the
     day's results and their outbox lines in one transaction (ok), or the empty, failed or interrupted
-    run with its reason; then drain the outbox."""
+    run with its reason; then drain the outbox.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    store : Store
+        The service's store.
+    run_id : int
+        The ledger's run.
+    w : DayWork
+        What the day's computing produced.
+    today : datetime.date
+        Today, UTC (the no-data horizon).
+
+    Returns
+    -------
+    RunOutcome
+        The outcome.
+    """
     t1 = time.perf_counter()
     try:
         if w.fingerprint is not None:
@@ -176,7 +246,34 @@ def run_day(
 ) -> RunOutcome:
     """Process one satellite-day end to end (:func:`compute_day`, then :func:`record_day`) as of *today*
     (the no-data horizon); every outcome is recorded in the ledger, an unexpected exception too
-    (``failed`` with its type and message)."""
+    (``failed`` with its type and message).
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    store : Store
+        The service's store.
+    source : Source
+        Where the granules come from.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+    today : datetime.date
+        Today, UTC (the no-data horizon).
+    should_stop : callable, optional
+        Polled between steps.
+    progress : callable, optional
+        Called after each granule assessed.
+    assessor : Assessor, optional
+        What assesses the batches (:class:`DayAssessment`).
+
+    Returns
+    -------
+    RunOutcome
+        The outcome, recorded.
+    """
     run_id = store.begin_run(satellite, day)
     with logcontext.context(satellite=satellite, day=day.isoformat(), run_id=run_id):
         work = compute_day(cfg, source, satellite, day, should_stop, progress, assessor)

@@ -39,7 +39,22 @@ def day_task(cfg: Config, satellite: str, day: dt.date) -> DayWork:
     """One satellite-day on a worker: its own source (a NODD source shares ``cache_dir`` when that is on
     a shared file system), no store. The worker's allocator keeps freed memory for the next array, as in
     every crisgeo command (Dask starts its workers with MALLOC_TRIM_THRESHOLD_ = 64 KiB, which has the
-    kernel zero fresh pages for every large array: ~10 % of a day's time)."""
+    kernel zero fresh pages for every large array: ~10 % of a day's time).
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+
+    Returns
+    -------
+    DayWork
+        What the day produced, for the client to record.
+    """
     reuse_freed_memory()
     return compute_day(cfg, make_source(cfg), satellite, day)
 
@@ -60,7 +75,13 @@ class ReprocessSummary:
         return sum(self.statuses.values())
 
     def lines(self) -> list[str]:
-        """The summary printed at the end."""
+        """The summary printed at the end.
+
+        Returns
+        -------
+        list of str
+            Days per status, skipped, per hour, and left to do.
+        """
         rate = self.finished / (self.wall_s / 3600) if self.wall_s > 0 and self.finished else 0.0
         out = [
             f"satellite-days: {self.planned} in the period, {self.skipped_done} already done (skipped), "
@@ -74,7 +95,18 @@ class ReprocessSummary:
 
 
 def period_days(since: dt.date, until: dt.date) -> list[dt.date]:
-    """The days from *since* to *until*, both included."""
+    """The days from *since* to *until*, both included.
+
+    Parameters
+    ----------
+    since, until : datetime.date
+        The first and last day.
+
+    Returns
+    -------
+    list of datetime.date
+        Every day, inclusive.
+    """
     if until < since:
         raise ValueError(f"--until {until} is before --since {since}")
     return [since + dt.timedelta(days=k) for k in range((until - since).days + 1)]
@@ -113,6 +145,30 @@ def reprocess(
 
     *progress*, called with each recorded :class:`~monitor.service.pipeline.RunOutcome`; *stop*, an event that
     ends the call cleanly (queued and running days are cancelled and stay to do).
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    since, until : datetime.date
+        The period, inclusive.
+    satellites : list of str
+        The satellites.
+    scheduler : str, optional
+        A running Dask scheduler's address; else a local cluster.
+    workers : int, optional
+        Processes of the local cluster.
+    force : bool, optional
+        Redo the days already done.
+    progress : callable, optional
+        Called with each recorded outcome.
+    stop : threading.Event, optional
+        Ends the call cleanly: queued and running days are cancelled and stay to do.
+
+    Returns
+    -------
+    ReprocessSummary
+        What was done.
     """
     from distributed import wait
 
@@ -182,7 +238,28 @@ def run_reprocess(
     force: bool = False,
 ) -> ReprocessSummary:
     """``crisgeo reprocess``: :func:`reprocess` with SIGINT/SIGTERM as a clean stop and a progress bar on a
-    terminal (log lines otherwise)."""
+    terminal (log lines otherwise).
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    since, until : datetime.date
+        The period, inclusive.
+    satellites : list of str
+        The satellites.
+    scheduler : str, optional
+        A running Dask scheduler's address.
+    workers : int, optional
+        Processes of the local cluster.
+    force : bool, optional
+        Redo the days already done.
+
+    Returns
+    -------
+    ReprocessSummary
+        What was done.
+    """
     import sys
 
     stop = threading.Event()

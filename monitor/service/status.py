@@ -52,7 +52,20 @@ class Thresholds:
     stale_days: float = 2.0
 
     def state(self, worst_km: float | None, fors_beyond: int) -> NagiosState:
-        """The state these ranges give the worst error and the FORs beyond the specification."""
+        """The state these ranges give the worst error and the FORs beyond the specification.
+
+        Parameters
+        ----------
+        worst_km : float or None
+            The worst error, km.
+        fors_beyond : int
+            FORs beyond the specification.
+
+        Returns
+        -------
+        NagiosState
+            The state the thresholds give.
+        """
         checks = ((self.critical_km, worst_km, NagiosState.CRITICAL), (self.critical_fors, fors_beyond,
                   NagiosState.CRITICAL), (self.warning_km, worst_km, NagiosState.WARNING),
                   (self.warning_fors, fors_beyond, NagiosState.WARNING))  # fmt: skip
@@ -62,7 +75,18 @@ class Thresholds:
         return NagiosState.OK
 
     def text(self, limit: Range | None) -> str:
-        """A range as perfdata writes it (empty: none)."""
+        """A range as perfdata writes it (empty: none).
+
+        Parameters
+        ----------
+        limit : Range or None
+            A threshold.
+
+        Returns
+        -------
+        str
+            As perfdata writes it (empty: none).
+        """
         return "" if limit is None else str(limit)
 
 
@@ -77,7 +101,13 @@ class FiringAlert:
     silence: Silence | None = None
 
     def silenced_text(self) -> str:
-        """`` (silenced until ...: reason)``, or nothing."""
+        """`` (silenced until ...: reason)``, or nothing.
+
+        Returns
+        -------
+        str
+            Until when and why it is silenced.
+        """
         if self.silence is None:
             return ""
         why = f": {self.silence.reason}" if self.silence.reason else ""
@@ -110,7 +140,13 @@ class SatelliteStatus:
 
     def reasons(self) -> list[str]:
         """What makes the state, one phrase each: the failed last run, each alert firing (silences
-        named), or the latest day's standing when all is well."""
+        named), or the latest day's standing when all is well.
+
+        Returns
+        -------
+        list of str
+            Why its state is not OK.
+        """
         out = []
         if self.last_run is not None and self.last_run.status == RunStatus.FAILED:
             out.append(f"{self.satellite}: run of {self.last_run.day} failed: {self.last_run.reason or '?'}")
@@ -131,7 +167,18 @@ class SatelliteStatus:
 
     def perfdata(self, t: Thresholds) -> list[str]:
         """Nagios performance data: FORs beyond the specification and the worst error (km), with the
-        warning and critical ranges in force."""
+        warning and critical ranges in force.
+
+        Parameters
+        ----------
+        t : Thresholds
+            The thresholds.
+
+        Returns
+        -------
+        list of str
+            Nagios perfdata: FORs beyond the specification and the worst error.
+        """
         if self.latest_day is None:
             return []
         out = [
@@ -158,7 +205,13 @@ class Status:
     thresholds: Thresholds = Thresholds()
 
     def nagios_line(self) -> str:
-        """``STATE - reasons | perfdata``: the first line a Nagios plugin prints."""
+        """``STATE - reasons | perfdata``: the first line a Nagios plugin prints.
+
+        Returns
+        -------
+        str
+            The plugin's first line: state, reason, perfdata.
+        """
         reasons = [r for s in self.satellites for r in s.reasons()]
         t = self.thresholds
         reasons += [
@@ -180,7 +233,13 @@ class Status:
 
     def text(self) -> str:
         """What ``crisgeo status`` prints: the Nagios line first (state, reasons, perfdata), then per
-        satellite its last run, its alerts (silences named) and its latest FORs, the daemon, the outbox."""
+        satellite its last run, its alerts (silences named) and its latest FORs, the daemon, the outbox.
+
+        Returns
+        -------
+        str
+            The human-readable status.
+        """
         lines = [self.nagios_line()]
         for s in self.satellites:
             r = s.last_run
@@ -209,7 +268,13 @@ class Status:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        """The JSON of ``crisgeo status --json``."""
+        """The JSON of ``crisgeo status --json``.
+
+        Returns
+        -------
+        dict
+            ``crisgeo status --json``.
+        """
         return {
             "state": self.state.name,
             "exit": int(self.state),
@@ -250,7 +315,26 @@ def status_report(
     thresholds: Thresholds | None = None,
 ) -> Status:
     """The :class:`Status` of *satellites* (default: the configured ones) at *now*, the *thresholds*
-    (default: WARNING beyond the specification, stale after 2 days) over the alerts."""
+    (default: WARNING beyond the specification, stale after 2 days) over the alerts.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    store : Store
+        The service's store.
+    satellites : list of str, optional
+        The satellites; the configured ones by default.
+    now : datetime.datetime, optional
+        Now, UTC.
+    thresholds : Thresholds, optional
+        WARNING beyond the specification, stale after 2 days, by default.
+
+    Returns
+    -------
+    Status
+        The status.
+    """
     now = now or dt.datetime.now(dt.timezone.utc)
     t = thresholds or Thresholds(warning_km=Range(f"{cfg.alerts.spec_km:g}"))
     runs = {r.satellite: r for r in store.last_runs()}
