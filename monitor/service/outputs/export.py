@@ -51,7 +51,13 @@ FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
 
 class ResultStore:
     """The store as a notebook opens it (:func:`monitor.open_store`): its results as xarray, over the
-    SQLite store (``.store``); a context manager that closes it."""
+    SQLite store (``.store``); a context manager that closes it.
+
+    Parameters
+    ----------
+    store : Store
+        The SQLite store.
+    """
 
     def __init__(self, store: Store) -> None:
         self.store = store
@@ -59,7 +65,20 @@ class ResultStore:
     def to_xarray(
         self, satellite: str, since: dt.date | None = None, until: dt.date | None = None
     ) -> xr.Dataset:
-        """The per-FOR results of *satellite* as a CF-style xarray Dataset."""
+        """The per-FOR results of *satellite* as a CF-style xarray Dataset.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        since, until : datetime.date, optional
+            The first and last day, inclusive; None: open.
+
+        Returns
+        -------
+        xarray.Dataset
+            As :func:`to_xarray`.
+        """
         return to_xarray(self.store, satellite, since, until)
 
     def close(self) -> None:
@@ -77,7 +96,7 @@ class ResultStore:
 class Method:
     """What the export's metadata says of how the results were made, from the configuration.
 
-    Parameters
+    Attributes
     ----------
     half_steps : int
         Perturbations on each side of zero per direction (``assessment.half_steps``).
@@ -90,7 +109,18 @@ class Method:
 
     @classmethod
     def of(cls, cfg: Config) -> Method:
-        """The grid and specification of the configuration *cfg*."""
+        """The grid and specification of the configuration *cfg*.
+
+        Parameters
+        ----------
+        cfg : Config
+            The configuration.
+
+        Returns
+        -------
+        Method
+            Its grid and specification.
+        """
         return cls(cfg.assessment.half_steps, cfg.alerts.spec_km)
 
     @property
@@ -280,7 +310,22 @@ def effects_to_xarray(
     """What each known change did (:mod:`alerts.effects`) as an xarray Dataset: dimensions ``change`` (its
     day, its description) x ``scan_position``, a variable per quantity and direction (e.g.
     ``move_alpha_urad``), ``significant_alpha`` and ``significant_beta`` as 0/1 flags, and per change the
-    windows, the EPs and the chi-square of the prediction."""
+    windows, the EPs and the chi-square of the prediction.
+
+    Parameters
+    ----------
+    effects : sequence of ChangeEffect
+        What each known change did.
+    satellite : str
+        The satellite's short name.
+    publisher : ExportConfig, optional
+        The ``export`` section: the ACDD publisher attributes.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``change`` x ``scan_position``.
+    """
     import xarray as xr
 
     def per_direction(attr: str, c: int) -> np.ndarray:
@@ -371,7 +416,30 @@ def export(
     """Write the results of *satellite* to *out* as ``netcdf`` or ``csv`` (*fmt*; None: from the suffix of
     *out*, :data:`FORMATS`); returns the path. :class:`NothingToExport` (and no file) when the period holds
     no results, :class:`ExportFormatError` when the format and the file's name disagree; :class:`OSError`
-    when *out* cannot be written."""
+    when *out* cannot be written.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    out : str or Path
+        The file.
+    fmt : str, optional
+        ``netcdf`` or ``csv``; None: from the suffix of *out*.
+    since, until : datetime.date, optional
+        The first and last day, inclusive; None: open.
+    publisher : ExportConfig, optional
+        The ``export`` section: the ACDD publisher attributes.
+    method : Method, optional
+        The grid and specification the metadata states.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     out, fmt = _target(out, fmt)
     ds = to_xarray(store, satellite, since, until, publisher, method=method)
     if ds.sizes["time"] == 0:
@@ -386,11 +454,29 @@ def export_effects(
     out: str | Path,
     fmt: str | None = None,
     publisher: ExportConfig | None = None,
-    method: Method | None = None,
 ) -> Path:
     """Write what each known change did (*effects*, :func:`alerts.effects.change_effects`) to *out* as
     ``netcdf`` or ``csv`` (:func:`effects_to_xarray`; CSV: a row per change and FOR); the errors of
-    :func:`export`."""
+    :func:`export`.
+
+    Parameters
+    ----------
+    effects : sequence of ChangeEffect
+        What each known change did.
+    satellite : str
+        The satellite's short name.
+    out : str or Path
+        The file.
+    fmt : str, optional
+        ``netcdf`` or ``csv``; None: from the suffix of *out*.
+    publisher : ExportConfig, optional
+        The ``export`` section: the ACDD publisher attributes.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     out, fmt = _target(out, fmt)
     if not effects:
         raise NothingToExport(

@@ -268,7 +268,21 @@ def _gauge(family: Family) -> GaugeMetricFamily:
 
 
 class ServiceMetrics:
-    """The daemon's registry: the store's view at each scrape plus this process's run figures."""
+    """The daemon's registry: the store's view at each scrape plus this process's run figures.
+
+    Parameters
+    ----------
+    open_store : callable
+        Opens the store for a scrape.
+    satellites : iterable of str
+        The configured satellites.
+    health : Health
+        The daemon's jobs and scheduler heartbeat.
+    version : str
+        crisgeo's version (``crisgeo_build_info``).
+    spec_km : float
+        The specification, km (``alerts.spec_km``).
+    """
 
     def __init__(
         self,
@@ -311,7 +325,13 @@ class ServiceMetrics:
             self.requests.labels(sat)
 
     def record(self, outcome: Outcome) -> None:
-        """Take in a :class:`monitor.service.pipeline.RunOutcome`'s downloads."""
+        """Take in a :class:`monitor.service.pipeline.RunOutcome`'s downloads.
+
+        Parameters
+        ----------
+        outcome : Outcome
+            A run's outcome (:class:`monitor.service.pipeline.RunOutcome`).
+        """
         self.granules.labels(outcome.satellite).inc(outcome.counts.downloaded)
         self.bytes.labels(outcome.satellite).inc(outcome.counts.bytes)
         self.requests.labels(outcome.satellite).inc(outcome.counts.requests)

@@ -46,7 +46,24 @@ class PublishError(RuntimeError):
 
 
 def result_lines(measurement: str, satellite: str, day: dt.date, fors: Iterable[ForOffset]) -> list[str]:
-    """Line-protocol points of one day's per-FOR results."""
+    """Line-protocol points of one day's per-FOR results.
+
+    Parameters
+    ----------
+    measurement : str
+        The measurement (``cris_geolocation``).
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day (the points' time).
+    fors : iterable of ForOffset
+        The day's FORs.
+
+    Returns
+    -------
+    list of str
+        Line-protocol points, one per FOR.
+    """
     when = dt.datetime(day.year, day.month, day.day, tzinfo=dt.timezone.utc)
     lines = []
     for f in fors:
@@ -64,7 +81,24 @@ def day_lines(
     publish: Iterable[PublishConfig], satellite: str, day: dt.date, result: AssessmentResult
 ) -> list[QueuedLines]:
     """The lines of a day's *result* for each configured time-series store, queued with the day's results
-    (:meth:`monitor.service.store.sqlite.Store.save_day`)."""
+    (:meth:`monitor.service.store.sqlite.Store.save_day`).
+
+    Parameters
+    ----------
+    publish : iterable of PublishConfig
+        The configured time-series stores.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+    result : AssessmentResult
+        The day's result.
+
+    Returns
+    -------
+    list of QueuedLines
+        Per target, its lines.
+    """
     return [
         QueuedLines(target_name(p), result_lines(p.measurement, satellite, day, result.fors)) for p in publish
     ]
@@ -76,6 +110,18 @@ def change_lines(measurement: str, changes: Iterable[Change]) -> list[str]:
 
     Tags satellite, instrument, kind, origin; string field ``description``; time = the change time. The
     same change written again overwrites its point (same measurement, tags and time).
+
+    Parameters
+    ----------
+    measurement : str
+        The results' measurement.
+    changes : iterable of Change
+        Known changes.
+
+    Returns
+    -------
+    list of str
+        Line-protocol points.
     """
     lines = []
     for c in changes:
@@ -92,12 +138,29 @@ def change_lines(measurement: str, changes: Iterable[Change]) -> list[str]:
 
 
 def target_name(cfg: PublishConfig) -> str:
-    """Outbox target of a publisher (kind and URL; never a credential)."""
+    """Outbox target of a publisher (kind and URL; never a credential).
+
+    Parameters
+    ----------
+    cfg : PublishConfig
+        A publisher.
+
+    Returns
+    -------
+    str
+        Its kind and URL.
+    """
     return f"{cfg.kind}:{cfg.url}"
 
 
 class Influx2Writer:
-    """v2 write API through influxdb-client, synchronous so that every failure is seen."""
+    """v2 write API through influxdb-client, synchronous so that every failure is seen.
+
+    Parameters
+    ----------
+    cfg : PublishConfig
+        The publisher (``kind: influx2``).
+    """
 
     def __init__(self, cfg: PublishConfig):
         self.cfg = cfg
@@ -107,7 +170,13 @@ class Influx2Writer:
         self.api = self.client.write_api(write_options=SYNCHRONOUS)
 
     def write(self, lines: list[str]) -> None:
-        """Write line-protocol *lines*; raises on any failure (the outbox keeps them)."""
+        """Write line-protocol *lines*; raises on any failure (the outbox keeps them).
+
+        Parameters
+        ----------
+        lines : list of str
+            Line-protocol points.
+        """
         try:
             self.api.write(
                 bucket=self.cfg.bucket,
@@ -128,7 +197,13 @@ class Influx2Writer:
 
 
 class Influx1Writer:
-    """InfluxDB 1.x ``/write`` with line protocol; creates the database once if it is missing."""
+    """InfluxDB 1.x ``/write`` with line protocol; creates the database once if it is missing.
+
+    Parameters
+    ----------
+    cfg : PublishConfig
+        The publisher (``kind: influx1``).
+    """
 
     def __init__(self, cfg: PublishConfig):
         self.cfg = cfg
@@ -145,7 +220,13 @@ class Influx1Writer:
         )
 
     def write(self, lines: list[str]) -> None:
-        """POST line-protocol *lines* to /write; raises on any failure (the outbox keeps them)."""
+        """POST line-protocol *lines* to /write; raises on any failure (the outbox keeps them).
+
+        Parameters
+        ----------
+        lines : list of str
+            Line-protocol points.
+        """
         try:
             r = self._post(lines)
             if r.status_code == 404 and "database not found" in r.text:
@@ -173,7 +254,22 @@ WRITERS: dict[str, type[Influx2Writer] | type[Influx1Writer]] = {
 
 
 def drain_outbox(store: Store, publish_cfgs: list[PublishConfig], batch: int = 5000) -> dict:
-    """Send every queued point to its server; returns {target: (sent, left)}. Never raises for a server."""
+    """Send every queued point to its server; returns {target: (sent, left)}. Never raises for a server.
+
+    Parameters
+    ----------
+    store : Store
+        The store.
+    publish_cfgs : list of PublishConfig
+        The publishers.
+    batch : int, optional
+        Points per request.
+
+    Returns
+    -------
+    dict
+        {target: (sent, left)}.
+    """
     report = {}
     for cfg in publish_cfgs:
         target = target_name(cfg)

@@ -26,31 +26,75 @@ class Database(Protocol):
 
 
 class AlertState:
-    """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries."""
+    """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries.
+
+    Parameters
+    ----------
+    store : Database
+        The store.
+    """
 
     def __init__(self, store: Database):
         self.store = store
         self.db = store.db
 
     def get(self, fingerprint: str) -> Alert | None:
-        """The alert row of *fingerprint* (rule:satellite:group), or None."""
+        """The alert row of *fingerprint* (rule:satellite:group), or None.
+
+        Parameters
+        ----------
+        fingerprint : str
+            rule:satellite:group.
+
+        Returns
+        -------
+        Alert or None
+            The row.
+        """
         r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
         return Alert.from_row(r) if r else None
 
     def firing(self, satellite: str | None = None) -> list[Alert]:
-        """The alerts firing now (of *satellite*)."""
+        """The alerts firing now (of *satellite*).
+
+        Parameters
+        ----------
+        satellite : str, optional
+            Only this satellite.
+
+        Returns
+        -------
+        list of Alert
+            The alerts firing.
+        """
         q = "SELECT * FROM alert_state WHERE status=?" + (" AND satellite=?" if satellite else "")
         args = (AlertStatus.FIRING, satellite) if satellite else (AlertStatus.FIRING,)
         return [Alert.from_row(r) for r in self.db.execute(q, args)]
 
     def all(self) -> list[Alert]:
-        """Every alert, firing or resolved."""
+        """Every alert, firing or resolved.
+
+        Returns
+        -------
+        list of Alert
+            Every alert.
+        """
         q = "SELECT * FROM alert_state ORDER BY satellite, rule, grp"
         return [Alert.from_row(r) for r in self.db.execute(q)]
 
     def upsert(self, finding: FindingRecord, now: dt.datetime, notified: bool) -> None:
         """Record *finding* as firing (keeping its start while it fires); *notified* stamps the notification
-        time."""
+        time.
+
+        Parameters
+        ----------
+        finding : FindingRecord
+            What a rule found.
+        now : datetime.datetime
+            Now, UTC.
+        notified : bool
+            Stamp the notification time.
+        """
         prev = self.get(finding.fingerprint)
         started = prev.started if prev and prev.status == AlertStatus.FIRING else iso(now)
         last = iso(now) if notified else (prev.last_notified if prev else None)
@@ -72,7 +116,15 @@ class AlertState:
         )
 
     def resolve(self, fingerprint: str, now: dt.datetime) -> None:
-        """Mark an alert resolved at *now*."""
+        """Mark an alert resolved at *now*.
+
+        Parameters
+        ----------
+        fingerprint : str
+            rule:satellite:group.
+        now : datetime.datetime
+            Now, UTC.
+        """
         self.db.execute(
             "UPDATE alert_state SET status=?, resolved=? WHERE fingerprint=?",
             (AlertStatus.RESOLVED, iso(now), fingerprint),
@@ -83,7 +135,21 @@ class AlertState:
         self, rule: str | None, satellite: str | None, until: dt.datetime, reason: str, now: dt.datetime
     ) -> None:
         """Silence *rule* (None: all) of *satellite* (None: all) until *until*, with a reason; a silence
-        without a reason or ending before *now* is refused (:class:`SilenceError`)."""
+        without a reason or ending before *now* is refused (:class:`SilenceError`).
+
+        Parameters
+        ----------
+        rule : str or None
+            The rule; None: all.
+        satellite : str or None
+            The satellite; None: all.
+        until : datetime.datetime
+            When it ends, UTC.
+        reason : str
+            Why.
+        now : datetime.datetime
+            Now, UTC.
+        """
         if not reason.strip():
             raise SilenceError("alerts silence needs --expires and --reason")
         if until <= now:
@@ -96,7 +162,15 @@ class AlertState:
 
     def lift(self, silence_id: int, now: dt.datetime) -> None:
         """End the silence *silence_id* now (kept, as history); no such silence in force is a
-        :class:`SilenceError`."""
+        :class:`SilenceError`.
+
+        Parameters
+        ----------
+        silence_id : int
+            The silence.
+        now : datetime.datetime
+            Now, UTC.
+        """
         with self.store.transaction():
             cur = self.db.execute(
                 "UPDATE silences SET until=? WHERE id=? AND until > ?", (iso(now), silence_id, iso(now))
@@ -105,7 +179,22 @@ class AlertState:
             raise SilenceError(f"--id {silence_id}: no silence in force has that number")
 
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None:
-        """The silence in force for *rule* and *satellite* at *now*, or None."""
+        """The silence in force for *rule* and *satellite* at *now*, or None.
+
+        Parameters
+        ----------
+        rule : str
+            The rule.
+        satellite : str
+            The satellite's short name.
+        now : datetime.datetime
+            Now, UTC.
+
+        Returns
+        -------
+        Silence or None
+            The silence in force.
+        """
         r = self.db.execute(
             "SELECT * FROM silences WHERE until > ? AND (rule IS NULL OR rule=?) "
             "AND (satellite IS NULL OR satellite=?) ORDER BY until DESC",
@@ -114,7 +203,18 @@ class AlertState:
         return Silence.from_row(r) if r else None
 
     def silences(self, now: dt.datetime) -> list[Silence]:
-        """The silences in force at *now*."""
+        """The silences in force at *now*.
+
+        Parameters
+        ----------
+        now : datetime.datetime
+            Now, UTC.
+
+        Returns
+        -------
+        list of Silence
+            Those in force.
+        """
         return [
             Silence.from_row(r)
             for r in self.db.execute("SELECT * FROM silences WHERE until > ? ORDER BY until", (iso(now),))
@@ -122,7 +222,19 @@ class AlertState:
 
     # -- delivery queue
     def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime) -> None:
-        """Queue *message* (subject, text, ...) for delivery on *channel*."""
+        """Queue *message* (subject, text, ...) for delivery on *channel*.
+
+        Parameters
+        ----------
+        channel : str
+            ``email``, ``slack``, ``alertmanager``.
+        satellite : str
+            The satellite's short name.
+        message : dict
+            Subject, text, ...
+        now : datetime.datetime
+            Now, UTC.
+        """
         self.db.execute(
             "INSERT INTO deliveries (channel, satellite, subject, body, created, status, next_attempt) "
             "VALUES (?, ?, ?, ?, ?, ?, ?)",
@@ -139,7 +251,18 @@ class AlertState:
 
     def due(self, now: dt.datetime) -> list[Delivery]:
         """Deliveries to try now: pending ones whose time has come, and claims whose lease ran out (a
-        sender that died mid-send)."""
+        sender that died mid-send).
+
+        Parameters
+        ----------
+        now : datetime.datetime
+            Now, UTC.
+
+        Returns
+        -------
+        list of Delivery
+            Oldest first.
+        """
         return [
             Delivery.from_row(r)
             for r in self.db.execute(
@@ -152,6 +275,20 @@ class AlertState:
         """Take a due delivery for sending, atomically: False when another sender has it (no double send).
 
         The claim holds for *lease_s*; a sender that dies leaves it to be tried again after that.
+
+        Parameters
+        ----------
+        delivery_id : int
+            The delivery.
+        now : datetime.datetime
+            Now, UTC.
+        lease_s : float, optional
+            How long the claim holds, s.
+
+        Returns
+        -------
+        bool
+            Whether this sender has it.
         """
         with self.store.transaction():
             cur = self.db.execute(
@@ -169,7 +306,18 @@ class AlertState:
             return cur.rowcount == 1
 
     def deliveries(self, status: DeliveryStatus | None = None) -> list[Delivery]:
-        """The queued deliveries (with *status*: pending, sending, sent, failed), oldest first."""
+        """The queued deliveries (with *status*: pending, sending, sent, failed), oldest first.
+
+        Parameters
+        ----------
+        status : DeliveryStatus, optional
+            Only those in this state.
+
+        Returns
+        -------
+        list of Delivery
+            Oldest first.
+        """
         q = "SELECT * FROM deliveries" + (" WHERE status=?" if status else "") + " ORDER BY id"
         return [Delivery.from_row(r) for r in self.db.execute(q, (status,) if status else ())]
 
@@ -181,7 +329,21 @@ class AlertState:
         error: str | None = None,
         retry_after_s: float = 0.0,
     ) -> None:
-        """Record a delivery attempt's *status*; a retry waits *retry_after_s*."""
+        """Record a delivery attempt's *status*; a retry waits *retry_after_s*.
+
+        Parameters
+        ----------
+        delivery_id : int
+            The delivery.
+        status : DeliveryStatus
+            The attempt's outcome.
+        now : datetime.datetime
+            Now, UTC.
+        error : str, optional
+            What went wrong.
+        retry_after_s : float, optional
+            When to try again, s from now.
+        """
         with self.store.transaction():
             self.db.execute(
                 "UPDATE deliveries SET status=?, attempts=attempts+1, last_error=?, next_attempt=?, sent=? "

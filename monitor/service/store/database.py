@@ -19,7 +19,13 @@ UTC = dt.timezone.utc
 
 
 def utc_now() -> dt.datetime:
-    """The time now, UTC (the store's default clock)."""
+    """The time now, UTC (the store's default clock).
+
+    Returns
+    -------
+    datetime.datetime
+        Aware, UTC.
+    """
     return dt.datetime.now(UTC)
 
 
@@ -32,7 +38,17 @@ class Database:
 
     A store is created only where no file exists (built under a temporary name, then renamed into place);
     an existing file that is empty, corrupt or not a crisgeo store is refused with :class:`StoreError`,
-    never re-initialised: it holds the history and the alert state."""
+    never re-initialised: it holds the history and the alert state.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The SQLite file.
+    create : bool, optional
+        Make a new store where there is none; an existing file that is not a store is refused either way.
+    clock : callable, optional
+        The clock, aware UTC datetimes (:func:`utc_now`).
+    """
 
     def __init__(
         self, path: str | os.PathLike[str], create: bool = True, clock: Callable[[], dt.datetime] = utc_now
@@ -125,11 +141,23 @@ class Database:
 
     def transaction(self) -> _Transaction:
         """A context manager: BEGIN IMMEDIATE ... COMMIT, rolled back on an exception; a file system
-        without room is a :class:`StoreError` naming the file (the transaction rolled back whole)."""
+        without room is a :class:`StoreError` naming the file (the transaction rolled back whole).
+
+        Returns
+        -------
+        _Transaction
+            The context manager.
+        """
         return _Transaction(self.db, self.path)
 
     def alert_state(self) -> AlertState:
-        """The alert state, silences and delivery queue of this store."""
+        """The alert state, silences and delivery queue of this store.
+
+        Returns
+        -------
+        AlertState
+            Over this store.
+        """
         return AlertState(self)
 
 

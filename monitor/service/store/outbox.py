@@ -28,7 +28,17 @@ class Outbox:
 
     # -- outbox
     def queue_lines(self, target: str, satellite: str | None, lines: list) -> None:
-        """Queue points not tied to a day's results (e.g. change annotations)."""
+        """Queue points not tied to a day's results (e.g. change annotations).
+
+        Parameters
+        ----------
+        target : str
+            The time-series database (its name).
+        satellite : str or None
+            The satellite's short name; None: every one.
+        lines : list
+            Line-protocol points.
+        """
         with self.transaction():
             for line in lines:
                 self.db.execute(
@@ -37,7 +47,20 @@ class Outbox:
                 )
 
     def outbox(self, target: str, limit: int = 5000) -> list:
-        """Up to *limit* points waiting for *target*, oldest first."""
+        """Up to *limit* points waiting for *target*, oldest first.
+
+        Parameters
+        ----------
+        target : str
+            The time-series database.
+        limit : int, optional
+            At most this many.
+
+        Returns
+        -------
+        list
+            Dicts of ``id`` and ``line``.
+        """
         return [
             dict(r)
             for r in self.db.execute(
@@ -46,17 +69,42 @@ class Outbox:
         ]
 
     def outbox_size(self, target: str | None = None) -> int:
-        """The number of points waiting (for *target*)."""
+        """The number of points waiting (for *target*).
+
+        Parameters
+        ----------
+        target : str, optional
+            Only this target.
+
+        Returns
+        -------
+        int
+            Points waiting.
+        """
         q = "SELECT COUNT(*) FROM outbox" + (" WHERE target=?" if target else "")
         return self.db.execute(q, (target,) if target else ()).fetchone()[0]
 
     def outbox_delivered(self, ids: list) -> None:
-        """Remove delivered points."""
+        """Remove delivered points.
+
+        Parameters
+        ----------
+        ids : list
+            The points' ids.
+        """
         with self.transaction():
             self.db.executemany("DELETE FROM outbox WHERE id=?", [(i,) for i in ids])
 
     def outbox_failed(self, ids: list, error: str) -> None:
-        """Count a failed attempt and its error on the points."""
+        """Count a failed attempt and its error on the points.
+
+        Parameters
+        ----------
+        ids : list
+            The points' ids.
+        error : str
+            What went wrong.
+        """
         with self.transaction():
             self.db.executemany(
                 "UPDATE outbox SET attempts = attempts + 1, last_error=? WHERE id=?",
@@ -64,5 +112,11 @@ class Outbox:
             )
 
     def outbox_sizes(self) -> dict:
-        """{target: points waiting}."""
+        """{target: points waiting}.
+
+        Returns
+        -------
+        dict
+            {target: points waiting}.
+        """
         return dict(self.db.execute("SELECT target, COUNT(*) FROM outbox GROUP BY target").fetchall())

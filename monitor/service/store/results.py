@@ -60,7 +60,25 @@ class Results:
     ) -> None:
         """Replace the day's results, granules, scene *selection* and cube, queue its time-series lines
         (*queued*, derived by the outputs from *result*), close the run (its summary: reliable FORs, the
-        worst error, the *precision* reached), in one transaction."""
+        worst error, the *precision* reached), in one transaction.
+
+        Parameters
+        ----------
+        run_id : int
+            The run.
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+        result : AssessmentResult
+            The day's result.
+        selection : sequence of SceneDecision
+            The scene decisions.
+        queued : sequence of QueuedLines
+            Time-series lines per target.
+        precision : DayPrecision, optional
+            How far the day went.
+        """
         d = day.isoformat()
         with self.transaction():
             for table in ("results", "granules", "selection", "cost_cubes", "skipped", "difference_bins"):
@@ -149,7 +167,20 @@ class Results:
             )
 
     def day_result(self, satellite: str, day: dt.date) -> list[ForOffset]:
-        """The per-FOR offsets stored for *satellite* on *day*."""
+        """The per-FOR offsets stored for *satellite* on *day*.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+
+        Returns
+        -------
+        list of ForOffset
+            In FOR order.
+        """
         rows = self.db.execute(
             "SELECT * FROM results WHERE satellite=? AND day=? ORDER BY for_index",
             (satellite, day.isoformat()),
@@ -162,7 +193,20 @@ class Results:
         ]
 
     def difference_bins(self, satellite: str, day: dt.date) -> list[DifferenceBin]:
-        """CrIS minus VIIRS against the CrIS BT at the optimum on *satellite*'s *day* (Figure 15)."""
+        """CrIS minus VIIRS against the CrIS BT at the optimum on *satellite*'s *day* (Figure 15).
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+
+        Returns
+        -------
+        list of DifferenceBin
+            The bins.
+        """
         rows = self.db.execute(
             "SELECT low_k, n, mean_k, std_k FROM difference_bins WHERE satellite=? AND day=? ORDER BY low_k",
             (satellite, day.isoformat()),
@@ -175,12 +219,36 @@ class Results:
         ]
 
     def latest_day(self, satellite: str) -> dt.date | None:
-        """The latest day with results for *satellite*, or None."""
+        """The latest day with results for *satellite*, or None.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+
+        Returns
+        -------
+        datetime.date or None
+            The day.
+        """
         r = self.db.execute("SELECT MAX(day) FROM results WHERE satellite=?", (satellite,)).fetchone()[0]
         return dt.date.fromisoformat(r) if r else None
 
     def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> ForSeries:
-        """The per-FOR results of *satellite* from *since* to *until* (both included) as arrays."""
+        """The per-FOR results of *satellite* from *since* to *until* (both included) as arrays.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        since, until : datetime.date, optional
+            The period, inclusive; None: open.
+
+        Returns
+        -------
+        ForSeries
+            Days x FORs arrays of every measured field.
+        """
         q = "SELECT * FROM results WHERE satellite=?"
         args = [satellite]
         if since:
@@ -208,7 +276,20 @@ class Results:
         return ForSeries([dt.date.fromisoformat(d) for d in days], values, flags, stored)
 
     def granules(self, satellite: str, day: dt.date | None = None) -> list[GranuleRow]:
-        """The granules assessed for *satellite* (on *day*), with their metadata."""
+        """The granules assessed for *satellite* (on *day*), with their metadata.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date, optional
+            Only this day.
+
+        Returns
+        -------
+        list of GranuleRow
+            The granules.
+        """
         q = (
             "SELECT * FROM granules WHERE satellite=?"
             + (" AND day=?" if day else "")
@@ -218,7 +299,20 @@ class Results:
         return [GranuleRow.from_row(r) for r in self.db.execute(q, args)]
 
     def selection(self, satellite: str, day: dt.date) -> list[SelectionRow]:
-        """The scene-selection decisions of *satellite* on *day*."""
+        """The scene-selection decisions of *satellite* on *day*.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+
+        Returns
+        -------
+        list of SelectionRow
+            The decisions.
+        """
         return [
             SelectionRow.from_row(r)
             for r in self.db.execute(
@@ -227,7 +321,20 @@ class Results:
         ]
 
     def cost_cube(self, satellite: str, day: dt.date) -> tuple[np.ndarray, float] | None:
-        """(cube_k (30, 2n+1, 2n+1), step_urad) of the day's assessment, or None."""
+        """(cube_k (30, 2n+1, 2n+1), step_urad) of the day's assessment, or None.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+
+        Returns
+        -------
+        tuple or None
+            (cube_k, K, shape (30, 2n+1, 2n+1); step_urad).
+        """
         r = self.db.execute(
             "SELECT half_steps, step_urad, cube FROM cost_cubes WHERE satellite=? AND day=?",
             (satellite, day.isoformat()),
@@ -239,7 +346,17 @@ class Results:
 
     # -- fingerprints
     def save_fingerprint(self, satellite: str, day: dt.date, body: dict) -> None:
-        """Store the LOS fingerprint of *satellite* on *day* (replacing one computed before)."""
+        """Store the LOS fingerprint of *satellite* on *day* (replacing one computed before).
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+        body : dict
+            The fingerprint's JSON.
+        """
         with self.transaction():
             self.db.execute(
                 "INSERT OR REPLACE INTO fingerprints VALUES (?, ?, ?, ?)",
@@ -247,7 +364,20 @@ class Results:
             )
 
     def fingerprint(self, satellite: str, before: dt.date) -> tuple[dt.date, dict] | None:
-        """(day, body) of the latest fingerprint strictly before *before*, or None."""
+        """(day, body) of the latest fingerprint strictly before *before*, or None.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        before : datetime.date
+            Strictly before this day.
+
+        Returns
+        -------
+        tuple or None
+            (day, body).
+        """
         r = self.db.execute(
             "SELECT day, body FROM fingerprints WHERE satellite=? AND day < ? ORDER BY day DESC LIMIT 1",
             (satellite, before.isoformat()),

@@ -79,7 +79,20 @@ MIGRATIONS = [
 
 def result_columns(have: set[str], record: type = ForOffset) -> list[str]:
     """The statements adding to the results table a column for each measured field of *record* it lacks
-    (*have*: its columns), in declaration order: REAL, or INTEGER for a count."""
+    (*have*: its columns), in declaration order: REAL, or INTEGER for a count.
+
+    Parameters
+    ----------
+    have : set of str
+        The results table's columns.
+    record : type, optional
+        The per-FOR record.
+
+    Returns
+    -------
+    list of str
+        ``ALTER TABLE`` statements.
+    """
     return [
         f"ALTER TABLE results ADD COLUMN {m.name} {'INTEGER' if m.kind is int else 'REAL'}"
         for m in measures(record)

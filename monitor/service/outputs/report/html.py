@@ -82,7 +82,22 @@ def options_from_config(
     until: dt.date | None = None,
 ) -> ReportOptions:
     """Report options of a service configuration: the spec and windows of its alert rules, its events
-    calendar."""
+    calendar.
+
+    Parameters
+    ----------
+    cfg : Config
+        The configuration.
+    satellites : iterable of str, optional
+        The satellites; the configured ones by default.
+    since, until : datetime.date, optional
+        The first and last day, inclusive; None: open.
+
+    Returns
+    -------
+    ReportOptions
+        The options.
+    """
     return ReportOptions(
         spec_km=cfg.alerts.spec_km,
         rules=cfg.alerts,
@@ -210,7 +225,24 @@ def _precision(p: DayPrecision | None) -> str:
 
 
 def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions) -> dict:
-    """Write ``out/<satellite>/`` and return a summary for the index."""
+    """Write ``out/<satellite>/`` and return a summary for the index.
+
+    Parameters
+    ----------
+    store : Store
+        The store.
+    satellite : str
+        The satellite's short name.
+    out : Path
+        The report's directory.
+    opts : ReportOptions
+        The options.
+
+    Returns
+    -------
+    dict
+        The page's summary for the index.
+    """
     sat_dir = out / satellite
     sat_dir.mkdir(parents=True, exist_ok=True)
     name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
@@ -429,6 +461,20 @@ def build_report(store: Store, out_dir: str | os.PathLike[str], opts: ReportOpti
     """Write the report for *opts.satellites* into *out_dir*; returns the index path.
 
     Pages are written under temporary names and moved into place, so a reader never sees half a page.
+
+    Parameters
+    ----------
+    store : Store
+        The store.
+    out_dir : str or os.PathLike
+        The report's directory.
+    opts : ReportOptions
+        The options.
+
+    Returns
+    -------
+    Path
+        The index page.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -54,7 +54,28 @@ def latest_km(
     spec_km: float,
     title: str,
 ) -> Path:
-    """Per-FOR offsets on the ground with 1-sigma bars and the +-spec band (Wang et al. 2017 figure 8)."""
+    """Per-FOR offsets on the ground with 1-sigma bars and the +-spec band (Wang et al. 2017 figure 8).
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    in_track_km, cross_track_km : array_like
+        Per FOR, km.
+    sigma_in_km, sigma_cross_km : array_like
+        Their sigmas, km.
+    reliable : array_like
+        bool per FOR.
+    spec_km : float
+        The specification, km.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.6), sharey=True, constrained_layout=True)
     for ax, v, s, name in (
         (axes[0], in_track_km, sigma_in_km, "in-track"),
@@ -96,7 +117,24 @@ def latest_urad(
     sigma_beta_urad: np.ndarray,
     title: str,
 ) -> Path:
-    """Per-FOR LOS offset angles in urad with a % of FOV axis (Wang et al. 2017 figure 7)."""
+    """Per-FOR LOS offset angles in urad with a % of FOV axis (Wang et al. 2017 figure 7).
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    d_alpha_urad, d_beta_urad : numpy.ndarray
+        Per FOR, urad.
+    sigma_alpha_urad, sigma_beta_urad : numpy.ndarray
+        Their sigmas, urad.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.4), constrained_layout=True)
     for ax, v, s, name in (
         (axes[0], d_alpha_urad, sigma_alpha_urad, "in-track d_alpha"),
@@ -145,7 +183,28 @@ def heatmaps(
     changes: Marks,
     title: str,
 ) -> Path:
-    """FOR x day heat maps of in-track and cross-track km; *days* (n,) dates, arrays (n, 30), NaN gaps."""
+    """FOR x day heat maps of in-track and cross-track km; *days* (n,) dates, arrays (n, 30), NaN gaps.
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    days : sequence of datetime.date
+        The days, shape (n,).
+    in_track_km, cross_track_km : numpy.ndarray
+        Shape (n, 30), km, NaN gaps.
+    spec_km : float
+        The specification, km: the colour scale's reference.
+    changes : Marks
+        Known changes, drawn as lines.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
     days = [dt.datetime(d.year, d.month, d.day) for d in days]
     x0, x1 = (
         mdates.date2num(days[0] - dt.timedelta(hours=12)),
@@ -190,7 +249,32 @@ def trend_lines(
     alerts: Sequence[dt.datetime],
     title: str,
 ) -> Path:
-    """Chosen FORs over time with the spec band; change lines and alert markers (triangles)."""
+    """Chosen FORs over time with the spec band; change lines and alert markers (triangles).
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    days : sequence of datetime.date
+        The days, shape (n,).
+    fors : sequence of int
+        The FORs drawn, 1-based.
+    in_track_km, cross_track_km : numpy.ndarray
+        Shape (n, 30), km.
+    spec_km : float
+        The specification, km.
+    changes : Marks
+        Known changes, drawn as lines.
+    alerts : sequence of datetime.datetime
+        When alerts fired (triangles).
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
     days = [dt.datetime(d.year, d.month, d.day) for d in days]
     fig, axes = plt.subplots(2, 1, figsize=(11, 5.6), sharex=True, constrained_layout=True)
     for ax, v, name in ((axes[0], in_track_km, "in-track"), (axes[1], cross_track_km, "cross-track")):
@@ -230,6 +314,26 @@ def cost_contour(
     """Cost surface G of one FOR over the 21 x 21 offsets with its minimum marked (figure 5c).
 
     *cube_k* (2n+1, 2n+1): index i in-track, j cross-track; axes in urad.
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    cube_k : numpy.ndarray
+        The cost, K, shape (2n+1, 2n+1).
+    for_index : int
+        The FOR, 1-based.
+    step_urad : float
+        The grid's step, urad.
+    d_alpha_urad, d_beta_urad : float
+        The minimum, urad.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
     """
     n = (cube_k.shape[0] - 1) // 2
     offsets = np.arange(-n, n + 1) * step_urad
@@ -260,7 +364,28 @@ def calibration_bins(
     title: str,
 ) -> Path:
     """CrIS minus VIIRS I5 BT against the CrIS BT in bins *width_k* wide at the optimum, with the bins'
-    standard deviation and sample count (Wang et al. 2017 figure 15)."""
+    standard deviation and sample count (Wang et al. 2017 figure 15).
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    low_k : array_like
+        Each bin's lower edge, K.
+    n : array_like
+        Samples per bin.
+    mean_k, std_k : array_like
+        CrIS minus VIIRS per bin and its standard deviation, K.
+    width_k : float
+        The bins' width, K.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
     low_k, n, mean_k, std_k = (np.asarray(a, float) for a in (low_k, n, mean_k, std_k))
     centre = low_k + width_k / 2
     fig, ax = plt.subplots(figsize=(7.5, 3.8), constrained_layout=True)
@@ -284,7 +409,28 @@ def calibration_trend(
     title: str,
 ) -> Path:
     """The daily CrIS-VIIRS bias at the reference temperature and the gain difference (median over the
-    reliable FORs, the band between their quartiles), with the known changes."""
+    reliable FORs, the band between their quartiles), with the known changes.
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    days : sequence of datetime.date
+        The days, shape (n,).
+    bias_k : numpy.ndarray
+        Per day and FOR, K.
+    gain_pct : numpy.ndarray
+        Per day and FOR, per cent.
+    changes : Marks
+        Known changes, drawn as lines.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
     days = [dt.datetime(d.year, d.month, d.day) for d in days]
     fig, axes = plt.subplots(2, 1, figsize=(11, 5.0), sharex=True, constrained_layout=True)
     for ax, v, label in ((axes[0], bias_k, "bias at 280 K (K)"), (axes[1], gain_pct, "gain (%)")):
