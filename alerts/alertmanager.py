@@ -30,12 +30,38 @@ UTC = dt.timezone.utc
 
 
 def timestamp(t: dt.datetime) -> str:
-    """*t* as Alertmanager's API writes times: RFC 3339 in UTC, to the second."""
+    """*t* as Alertmanager's API writes times: RFC 3339 in UTC, to the second.
+
+    Parameters
+    ----------
+    t : datetime.datetime
+        An aware time.
+
+    Returns
+    -------
+    str
+        RFC 3339, UTC, to the second.
+    """
     return t.astimezone(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
 
 
 def alertmanager_alerts(store: History, settings: AlertSettings, now: dt.datetime) -> list[dict]:
-    """The Alertmanager API v2 alert objects of the service's current state (see the module docstring)."""
+    """The Alertmanager API v2 alert objects of the service's current state (see the module docstring).
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    settings : AlertSettings
+        The ``alerts`` section.
+    now : datetime.datetime
+        Now, UTC.
+
+    Returns
+    -------
+    list of dict
+        The alert objects.
+    """
     am = settings.alertmanager
     if am is None:
         return []
@@ -81,7 +107,22 @@ def alertmanager_alerts(store: History, settings: AlertSettings, now: dt.datetim
 
 def post_state(store: History, settings: AlertSettings, now: dt.datetime | None = None) -> int | None:
     """Post the alert state to Alertmanager; the number of alerts posted, or None when the post failed
-    (logged: the next evaluation posts the state again). Never raises."""
+    (logged: the next evaluation posts the state again). Never raises.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    settings : AlertSettings
+        The ``alerts`` section.
+    now : datetime.datetime, optional
+        Now, UTC; the clock's by default.
+
+    Returns
+    -------
+    int or None
+        The alerts posted; None when the post failed.
+    """
     if settings.alertmanager is None:
         return None
     now = now or dt.datetime.now(UTC)

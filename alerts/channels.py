@@ -26,7 +26,15 @@ LOG = logging.getLogger(__name__)
 
 
 class Transient(Exception):
-    """Try again later (server down, rate limited, 5xx)."""
+    """Try again later (server down, rate limited, 5xx).
+
+    Parameters
+    ----------
+    message : str
+        What went wrong.
+    retry_after_s : float, optional
+        When to try again, s.
+    """
 
     def __init__(self, message: str, retry_after_s: float = 300.0) -> None:
         super().__init__(message)
@@ -38,7 +46,13 @@ class Permanent(Exception):
 
 
 class LogChannel:
-    """Appends each message to a file (a channel that cannot fail)."""
+    """Appends each message to a file (a channel that cannot fail).
+
+    Parameters
+    ----------
+    path : Path
+        The log file (``alerts.log``).
+    """
 
     name = "log"
 
@@ -46,7 +60,13 @@ class LogChannel:
         self.path = Path(path)
 
     def send(self, msg: dict) -> None:
-        """Append *message* to the log file."""
+        """Append *message* to the log file.
+
+        Parameters
+        ----------
+        msg : dict
+            The message (subject, text, ...).
+        """
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with open(self.path, "a") as fh:
             fh.write(
@@ -56,7 +76,13 @@ class LogChannel:
 
 
 class EmailChannel:
-    """SMTP with STARTTLS and a verified certificate; the trend plot attached."""
+    """SMTP with STARTTLS and a verified certificate; the trend plot attached.
+
+    Parameters
+    ----------
+    settings : EmailSettings
+        The ``alerts.email`` section.
+    """
 
     name = "email"
 
@@ -64,7 +90,13 @@ class EmailChannel:
         self.s = settings
 
     def send(self, msg: dict) -> None:
-        """Send *message* as a multipart e-mail; raises on failure (the queue retries)."""
+        """Send *message* as a multipart e-mail; raises on failure (the queue retries).
+
+        Parameters
+        ----------
+        msg : dict
+            The message.
+        """
         s = self.s
         m = EmailMessage()
         m["Subject"] = msg["subject"]
@@ -100,7 +132,15 @@ class EmailChannel:
 
 class SlackChannel:
     """Slack incoming webhook: 200 ``ok`` is success; 429 honours Retry-After; 5xx is retried; 4xx is
-    permanent."""
+    permanent.
+
+    Parameters
+    ----------
+    settings : SlackSettings
+        The ``alerts.slack`` section.
+    sleep : callable, optional
+        How a rate-limited retry waits, s.
+    """
 
     name = "slack"
 
@@ -109,7 +149,13 @@ class SlackChannel:
         self.sleep = sleep
 
     def send(self, msg: dict) -> None:
-        """Post *message* to the webhook; raises on failure (the queue retries)."""
+        """Post *message* to the webhook; raises on failure (the queue retries).
+
+        Parameters
+        ----------
+        msg : dict
+            The message.
+        """
         url = env_secret(self.s.webhook_env)
         if not url:
             raise Permanent(f"Slack webhook: environment variable {self.s.webhook_env} is not set")
@@ -151,7 +197,18 @@ class SlackChannel:
 
 
 def make_channels(settings: AlertSettings) -> dict:
-    """The channels the settings configure, by name."""
+    """The channels the settings configure, by name.
+
+    Parameters
+    ----------
+    settings : AlertSettings
+        The ``alerts`` section.
+
+    Returns
+    -------
+    dict
+        {name: channel}.
+    """
     out: dict[str, LogChannel | EmailChannel | SlackChannel] = {}
     if settings.log:
         out["log"] = LogChannel(settings.log)

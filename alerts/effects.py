@@ -99,7 +99,13 @@ class ChangeEffect:
         return float(stats.chi2.sf(self.chi2, self.dof)) if self.dof else math.nan
 
     def title(self) -> str:
-        """The day, its changes, and the windows."""
+        """The day, its changes, and the windows.
+
+        Returns
+        -------
+        str
+            The title.
+        """
         span = lambda w: f"{w[0]}..{w[1]}" if w else "no day"  # noqa: E731
         return (
             f"{self.day}: "
@@ -108,7 +114,13 @@ class ChangeEffect:
         )
 
     def summary(self) -> str:
-        """One line: the common move per direction, the significant FOR-directions, the prediction's fit."""
+        """One line: the common move per direction, the significant FOR-directions, the prediction's fit.
+
+        Returns
+        -------
+        str
+            The line.
+        """
         common = ", ".join(
             f"{d} {m:+.1f} +- {s:.1f} urad"
             for d, m, s in zip(DIRECTIONS, self.common_move_urad, self.sigma_common_move_urad, strict=True)
@@ -125,7 +137,13 @@ class ChangeEffect:
         return text
 
     def rows(self) -> list[EffectRow]:
-        """A row per FOR and direction measured, for tables."""
+        """A row per FOR and direction measured, for tables.
+
+        Returns
+        -------
+        list of EffectRow
+            The rows.
+        """
         pred = self.predicted_urad
         return [
             EffectRow(
@@ -189,7 +207,18 @@ EFFECT_COLUMNS = (
 
 def effect_text(effect: ChangeEffect) -> list[str]:
     """The effect as the command line prints it: its title, its summary, and the table (no prediction
-    columns where nothing is predicted)."""
+    columns where nothing is predicted).
+
+    Parameters
+    ----------
+    effect : ChangeEffect
+        What a change did.
+
+    Returns
+    -------
+    list of str
+        The lines.
+    """
     columns = EFFECT_COLUMNS if effect.predicted_urad is not None else EFFECT_COLUMNS[:-2]
     return [effect.title(), "  " + effect.summary(), *text_table(effect.rows(), columns, "  ")]
 
@@ -198,7 +227,24 @@ def change_effects(
     store: History, satellite: str, changes: list[Change], s: RuleSettings
 ) -> list[ChangeEffect]:
     """The :class:`ChangeEffect` of every day holding known *changes* of *satellite* (time order), measured
-    on the stored offsets; days with no assessed day on either side are left out."""
+    on the stored offsets; days with no assessed day on either side are left out.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    changes : list of Change
+        Known changes, in time order.
+    s : RuleSettings
+        The rules' parameters.
+
+    Returns
+    -------
+    list of ChangeEffect
+        In time order.
+    """
     days, y, sig = watched_series(store, satellite, GEOLOCATION)
     if not days:
         return []

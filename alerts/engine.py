@@ -37,7 +37,24 @@ UTC = dt.timezone.utc
 
 
 def findings_for(store: History, satellite: str, settings: AlertSettings, now: dt.datetime) -> list:
-    """Every rule's findings for *satellite* at *now*."""
+    """Every rule's findings for *satellite* at *now*.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    settings : AlertSettings
+        The ``alerts`` section.
+    now : datetime.datetime
+        Now, UTC.
+
+    Returns
+    -------
+    list of Finding
+        The findings.
+    """
     s = settings
     out = [
         f
@@ -68,7 +85,24 @@ def _trend(store: History, satellite: str, days: int = 7) -> list[str]:
 
 
 def build_message(store: History, satellite: str, items: list, settings: AlertSettings) -> dict:
-    """One message for a satellite: every alert that started, repeats or resolved, with evidence."""
+    """One message for a satellite: every alert that started, repeats or resolved, with evidence.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    items : list
+        The alerts that started, repeat or resolved, with their notices.
+    settings : AlertSettings
+        The ``alerts`` section.
+
+    Returns
+    -------
+    dict
+        The message: subject, text, ...
+    """
     counts: dict[str, int] = {}
     for kind, _ in items:
         counts[kind] = counts.get(kind, 0) + 1
@@ -130,7 +164,24 @@ def _slack_escape(s: str) -> str:
 def evaluate(
     store: History, settings: AlertSettings, satellites: Iterable[str], now: dt.datetime | None = None
 ) -> list:
-    """Update alert state from the rules and queue the messages; returns [(satellite, message)] queued."""
+    """Update alert state from the rules and queue the messages; returns [(satellite, message)] queued.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    settings : AlertSettings
+        The ``alerts`` section.
+    satellites : iterable of str
+        The satellites.
+    now : datetime.datetime, optional
+        Now, UTC; the clock's by default.
+
+    Returns
+    -------
+    list
+        (satellite, message) queued.
+    """
     now = now or dt.datetime.now(UTC)
     state = store.alert_state()
     repeat = dt.timedelta(hours=settings.repeat_hours)
@@ -199,7 +250,13 @@ class DeliveryCounts:
     held: tuple[str, ...] = ()  # alerts firing that were not sent again: notified within repeat_hours
 
     def text(self) -> str:
-        """``queued 1, sent 3, to retry 0, failed 0``, and the alerts held back by the repeat interval."""
+        """``queued 1, sent 3, to retry 0, failed 0``, and the alerts held back by the repeat interval.
+
+        Returns
+        -------
+        str
+            The line.
+        """
         line = f"queued {self.queued}, sent {self.sent}, to retry {self.retry}, failed {self.failed}"
         if self.held:
             line += "; not sent again within the repeat interval (alerts.repeat_hours): " + "; ".join(
@@ -211,7 +268,24 @@ class DeliveryCounts:
 def deliver(
     store: History, settings: AlertSettings, now: dt.datetime | None = None, channels: dict | None = None
 ) -> DeliveryCounts:
-    """Try every due delivery once; the counts by outcome. Never raises for a channel."""
+    """Try every due delivery once; the counts by outcome. Never raises for a channel.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    settings : AlertSettings
+        The ``alerts`` section.
+    now : datetime.datetime, optional
+        Now, UTC; the clock's by default.
+    channels : dict, optional
+        {name: channel}; those the settings configure by default.
+
+    Returns
+    -------
+    DeliveryCounts
+        The counts by outcome.
+    """
     now = now or dt.datetime.now(UTC)
     state = store.alert_state()
     channels = channels if channels is not None else make_channels(settings)
@@ -244,7 +318,24 @@ def deliver(
 def evaluate_and_deliver(
     store: History, settings: AlertSettings, satellites: Iterable[str], now: dt.datetime | None = None
 ) -> DeliveryCounts:
-    """Evaluate the rules, queue, deliver; the counts (queued, sent, to retry, failed)."""
+    """Evaluate the rules, queue, deliver; the counts (queued, sent, to retry, failed).
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    settings : AlertSettings
+        The ``alerts`` section.
+    satellites : iterable of str
+        The satellites.
+    now : datetime.datetime, optional
+        Now, UTC; the clock's by default.
+
+    Returns
+    -------
+    DeliveryCounts
+        The counts.
+    """
     now = now or dt.datetime.now(UTC)
     queued = evaluate(store, settings, satellites, now)
     counts = deliver(store, settings, now)
@@ -256,7 +347,22 @@ def evaluate_and_deliver(
 
 def held_back(store: History, settings: AlertSettings, now: dt.datetime) -> tuple[str, ...]:
     """The alerts firing, sent before *now* and not silenced, that the repeat interval keeps from being sent
-    again at *now*: each as ``id (sent T, again from T')``."""
+    again at *now*: each as ``id (sent T, again from T')``.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    settings : AlertSettings
+        The ``alerts`` section.
+    now : datetime.datetime
+        Now, UTC.
+
+    Returns
+    -------
+    tuple of str
+        ``id (sent T, again from T')`` each.
+    """
     state = store.alert_state()
     repeat = dt.timedelta(hours=settings.repeat_hours)
     out = []
@@ -304,7 +410,13 @@ class AlertsView:
     pending_deliveries: int
 
     def to_dict(self) -> dict:
-        """The JSON of ``crisgeo alerts list --json``."""
+        """The JSON of ``crisgeo alerts list --json``.
+
+        Returns
+        -------
+        dict
+            The JSON.
+        """
         return {
             "alerts": [a.to_dict() for a in self.alerts],
             "silences": [
@@ -315,7 +427,13 @@ class AlertsView:
         }
 
     def text(self) -> str:
-        """The text of ``crisgeo alerts list``: the alerts' table, the silences, the deliveries waiting."""
+        """The text of ``crisgeo alerts list``: the alerts' table, the silences, the deliveries waiting.
+
+        Returns
+        -------
+        str
+            The text.
+        """
         if not (self.alerts or self.pending_deliveries or self.silences):
             return "no alerts"
         lines = text_table(self.alerts, ALERT_COLUMNS) if self.alerts else []
@@ -339,7 +457,20 @@ ALERT_COLUMNS = (
 
 
 def alerts_view(store: History, now: dt.datetime) -> AlertsView:
-    """The :class:`AlertsView` of the store at *now*."""
+    """The :class:`AlertsView` of the store at *now*.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    now : datetime.datetime
+        Now, UTC.
+
+    Returns
+    -------
+    AlertsView
+        The view.
+    """
     state = store.alert_state()
     shown = []
     for r in state.all():

@@ -35,18 +35,48 @@ class ProbeOutcome:
     reason: str = ""
 
     def text(self) -> str:
-        """``email: delivered`` or ``slack: not delivered: <reason>``."""
+        """``email: delivered`` or ``slack: not delivered: <reason>``.
+
+        Returns
+        -------
+        str
+            The line.
+        """
         return f"{self.channel}: " + ("delivered" if self.delivered else f"not delivered: {self.reason}")
 
 
 def configured(settings: AlertSettings) -> list[str]:
-    """The channels of *settings* a test message can go through, in :data:`PROBED` order."""
+    """The channels of *settings* a test message can go through, in :data:`PROBED` order.
+
+    Parameters
+    ----------
+    settings : AlertSettings
+        The ``alerts`` section.
+
+    Returns
+    -------
+    list of str
+        The channels.
+    """
     have = set(make_channels(settings)) | ({"alertmanager"} if settings.alertmanager else set())
     return [c for c in PROBED if c in have]
 
 
 def probe_message(now: dt.datetime, prefix: str) -> dict:
-    """The message: marked TEST in its subject and first line, saying that nothing is wrong."""
+    """The message: marked TEST in its subject and first line, saying that nothing is wrong.
+
+    Parameters
+    ----------
+    now : datetime.datetime
+        Now, UTC.
+    prefix : str
+        The subject's prefix (``alerts.subject_prefix``).
+
+    Returns
+    -------
+    dict
+        The message.
+    """
     host = socket.gethostname()
     subject = f"{prefix} TEST notification from {host}: no action needed"
     text = (
@@ -66,7 +96,22 @@ def probe(
     settings: AlertSettings, only: str | None = None, now: dt.datetime | None = None
 ) -> list[ProbeOutcome]:
     """Send the test message through every configured channel of :data:`PROBED`, or *only* that one; the
-    outcome per channel. ValueError when *only* is not configured."""
+    outcome per channel. ValueError when *only* is not configured.
+
+    Parameters
+    ----------
+    settings : AlertSettings
+        The ``alerts`` section.
+    only : str, optional
+        Only this channel.
+    now : datetime.datetime, optional
+        Now, UTC; the clock's by default.
+
+    Returns
+    -------
+    list of ProbeOutcome
+        Per channel.
+    """
     now = now or dt.datetime.now(dt.timezone.utc)
     names = configured(settings)
     if only is not None:

@@ -37,7 +37,18 @@ class Watched:
     digits: int  # decimals its sizes are shown with
 
     def rules(self, s: RuleSettings) -> StepRules:
-        """The step detector's parameters for this quantity under the settings *s*."""
+        """The step detector's parameters for this quantity under the settings *s*.
+
+        Parameters
+        ----------
+        s : RuleSettings
+            The rules' parameters.
+
+        Returns
+        -------
+        StepRules
+            The parameters.
+        """
         return StepRules(
             rate_per_year=s.false_detections_per_year,
             rate_at_change=s.false_detection_at_change,
@@ -98,6 +109,20 @@ def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | N
 
     Critical when every breach of a FOR holds beyond the uncertainty (|error| - 2 sigma > spec), warning
     otherwise.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    s : RuleSettings
+        The rules' parameters.
+
+    Returns
+    -------
+    Finding or None
+        None within the specification.
     """
     day = store.latest_day(satellite)
     if day is None:
@@ -128,7 +153,24 @@ def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | N
 
 def watched_series(store: History, satellite: str, watched: Watched) -> tuple[list, np.ndarray, np.ndarray]:
     """The days, values and sigmas (days, N_FOR, directions) of the *watched* quantity, NaN where a FOR is
-    not stored or flagged unreliable."""
+    not stored or flagged unreliable.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    watched : Watched
+        The quantity.
+
+    Returns
+    -------
+    days : list of datetime.date
+        The assessed days.
+    values, sigmas : numpy.ndarray
+        Shape (days, N_FOR, directions).
+    """
     series = store.series(satellite)
     reliable = series.reliable()[..., None]
     y = np.stack([series.values[f] for f in watched.fields], axis=-1)
@@ -146,7 +188,26 @@ def jump_findings(
     """A finding per step of the *watched* quantity (the LOS offsets, or the CrIS-VIIRS bias:
     :data:`CALIBRATION`) whose split lies in the baseline's length before the latest day
     (:func:`alerts.steps.detect`), named after the known change it follows; a warning when it reaches the
-    practical size, else recorded (severity info)."""
+    practical size, else recorded (severity info).
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    changes : list of Change
+        Known changes.
+    s : RuleSettings
+        The rules' parameters.
+    watched : Watched, optional
+        The quantity; the LOS offsets by default.
+
+    Returns
+    -------
+    list of Finding
+        One per step.
+    """
     days, y, sig = watched_series(store, satellite, watched)
     if not np.isfinite(y).any():  # nothing measured (e.g. no intercalibration)
         return []
@@ -212,7 +273,24 @@ def jump_findings(
 
 
 def stale_finding(store: History, satellite: str, s: RuleSettings, now: dt.datetime) -> Finding | None:
-    """No successful assessment for longer than the limit (counted from the first run if none succeeded)."""
+    """No successful assessment for longer than the limit (counted from the first run if none succeeded).
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    s : RuleSettings
+        The rules' parameters.
+    now : datetime.datetime
+        Now, UTC.
+
+    Returns
+    -------
+    Finding or None
+        None when fresh.
+    """
     runs = store.runs(satellite)
     since = last_success(runs)
     if since is None:
@@ -236,7 +314,20 @@ def stale_finding(store: History, satellite: str, s: RuleSettings, now: dt.datet
 
 
 def failure_finding(store: History, satellite: str) -> Finding | None:
-    """The latest run failed, or the scheduler reported a failed or missed job since the last good run."""
+    """The latest run failed, or the scheduler reported a failed or missed job since the last good run.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+
+    Returns
+    -------
+    Finding or None
+        None when the latest run is good.
+    """
     runs = store.runs(satellite)
     last_ok = max((r.id for r in runs if r.status in DONE), default=0)
     failed = [r for r in runs if r.id > last_ok and r.status == RunStatus.FAILED]
@@ -265,7 +356,24 @@ def failure_finding(store: History, satellite: str) -> Finding | None:
 def processing_change_findings(
     store: History, satellite: str, s: RuleSettings, today: dt.date
 ) -> list[Finding]:
-    """CrIS geolocation processing changes found by the LOS fingerprint in the last ``active_days``."""
+    """CrIS geolocation processing changes found by the LOS fingerprint in the last ``active_days``.
+
+    Parameters
+    ----------
+    store : History
+        The store's records.
+    satellite : str
+        The satellite's short name.
+    s : RuleSettings
+        The rules' parameters.
+    today : datetime.date
+        Today, UTC.
+
+    Returns
+    -------
+    list of Finding
+        One per change.
+    """
     out = []
     for e in store.events(EventKind.CHANGE_CRIS):
         if e.satellite != satellite:

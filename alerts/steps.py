@@ -133,7 +133,22 @@ def fit_noise(ordinal: np.ndarray, y: np.ndarray, s: np.ndarray) -> Noise | None
     """The :class:`Noise` of the days *ordinal* (T,), values *y* and sigmas *s* (T, N_FOR, C), from the
     differences of consecutive calendar days scaled by their sigmas: their variance is
     lambda^2 (1 - phi), their lag-one correlation -(1 - phi) / 2, and the variance of their mean over the
-    FORs of a day lambda^2 (1 - phi) (rho + (1 - rho) / K). None with fewer than MIN_HISTORY_DAYS pairs."""
+    FORs of a day lambda^2 (1 - phi) (rho + (1 - rho) / K). None with fewer than MIN_HISTORY_DAYS pairs.
+
+    Parameters
+    ----------
+    ordinal : numpy.ndarray
+        The days' ordinals, shape (T,).
+    y : numpy.ndarray
+        The values (urad, or K for the bias), shape (T, N_FOR, C).
+    s : numpy.ndarray
+        Their sigmas, same shape.
+
+    Returns
+    -------
+    Noise or None
+        None with fewer than MIN_HISTORY_DAYS pairs.
+    """
     consecutive = np.flatnonzero(np.diff(ordinal) == 1) + 1
     if len(consecutive) < MIN_HISTORY_DAYS:
         return None
@@ -162,7 +177,22 @@ def pooled(d: np.ndarray, sigma: np.ndarray, shared: float | np.ndarray) -> tupl
     per-FOR differences *d* (..., N_FOR) with sigmas *sigma* correlated by *shared* between FORs (NaN: not
     measured). With a = 1 / sigma, f = rho / (1 - rho + n rho) over the n FORs measured and x the group's
     indicator, x^T S^-1 d = (sum_G a^2 d - f sum_G a sum a d) / (1 - rho), x^T S^-1 x likewise (the
-    exchangeable correlation's inverse, Sherman-Morrison). Returns (estimate, sigma), (..., groups)."""
+    exchangeable correlation's inverse, Sherman-Morrison). Returns (estimate, sigma), (..., groups).
+
+    Parameters
+    ----------
+    d : numpy.ndarray
+        Per-FOR differences, shape (..., N_FOR); NaN: not measured.
+    sigma : numpy.ndarray
+        Their sigmas.
+    shared : float or numpy.ndarray
+        Their correlation between FORs.
+
+    Returns
+    -------
+    step, sigma : numpy.ndarray
+        Per group.
+    """
     rho = np.asarray(shared, float)
     a = np.where(np.isfinite(d) & np.isfinite(sigma) & (sigma > 0), 1.0 / np.where(sigma > 0, sigma, 1), 0.0)
     dz = np.where(a > 0, d, 0.0)
@@ -197,7 +227,18 @@ FIT_DRAWS = 50  # simulated fits per threshold: the fitted noise's own error
 
 def fit_days_bucket(n: int) -> int:
     """The length of :data:`FIT_DAYS` a fit of *n* days is judged as: the next shorter one (its noise is
-    known no better than that), a year for longer fits."""
+    known no better than that), a year for longer fits.
+
+    Parameters
+    ----------
+    n : int
+        Days fitted.
+
+    Returns
+    -------
+    int
+        The bucket's length, days.
+    """
     return max([b for b in FIT_DAYS if b <= n], default=FIT_DAYS[0])
 
 
@@ -238,7 +279,32 @@ def threshold(
     draws are split among :data:`FIT_DRAWS` fits of simulated histories (:func:`_simulated_fits`); each
     scales a split's contrast by its fit's sigma (lambda_f sqrt(c^T Phi_f c) against the true
     sqrt(c^T Phi c)) and pools with its fit's rho. A fit's error thus raises the threshold as much as it
-    raises the rate of false detections: most in a history's first weeks, little after a year."""
+    raises the rate of false detections: most in a history's first weeks, little after a year.
+
+    Parameters
+    ----------
+    probability : float
+        The family's false-detection probability on one day.
+    shared : float
+        The FORs' correlation.
+    lag1 : float
+        The days' lag-one correlation.
+    baseline : int
+        The baseline's length, days.
+    discovery : int
+        The splits tested: the last *discovery* days.
+    known : bool
+        A known change's test rather than the blind one.
+    directions : int
+        The directions tested.
+    fit_days : int
+        The days the noise was fitted on (:func:`fit_days_bucket`).
+
+    Returns
+    -------
+    float
+        The |z| threshold.
+    """
     if known:  # baseline days, the change's day, then the days after it
         rows = [np.r_[_contrast(baseline, j), np.zeros(discovery - j)] for j in range(1, discovery + 1)]
         ordinal = np.r_[np.arange(baseline), baseline + 1 + np.arange(discovery)]
@@ -361,7 +427,26 @@ def detect(
     """The steps of the series *y* with sigmas *s* (assessed days *days*, ascending; (T, N_FOR, C), NaN
     where nothing reliable was measured) that the daily evaluations up to the last day would have found,
     given the known changes' days *change_days*, whose split lies in the last ``baseline_days`` days (see
-    the module docstring)."""
+    the module docstring).
+
+    Parameters
+    ----------
+    days : list of datetime.date
+        The assessed days, ascending.
+    y : numpy.ndarray
+        The values, shape (T, N_FOR, C); NaN where nothing reliable was measured.
+    s : numpy.ndarray
+        Their sigmas.
+    change_days : list of datetime.date
+        The known changes' days.
+    rules : StepRules
+        The detector's parameters.
+
+    Returns
+    -------
+    list of Step
+        The steps found.
+    """
     if len(days) < MIN_HISTORY_DAYS:
         return []
     ordinal = np.array([d.toordinal() for d in days])
@@ -370,7 +455,7 @@ def detect(
     b, k = rules.baseline_days, rules.discovery_days
     fits: dict[int, _Fit | None] = {}
 
-    def fitted(split: int) -> _Fit | None:
+    def _fitted(split: int) -> _Fit | None:
         """The fit a test of *split* uses: the days before the refit date on or before its baseline
         (REFIT_DAYS apart, on fixed dates), or early in a history every day before it. It depends on the
         split alone, so every evaluation decides a split alike: once, not anew each day."""
@@ -400,7 +485,7 @@ def detect(
                 seen.append(t)
         usable = [
             np.count_nonzero((ordinal >= w.pre_from) & (ordinal < w.pre_to)) >= rules.min_baseline_days
-            and fitted(w.pre_to) is not None
+            and _fitted(w.pre_to) is not None
             for w in windows
         ]
         windows = [w for w, ok in zip(windows, usable, strict=True) if ok]
@@ -410,9 +495,9 @@ def detect(
         z, g, c, limit = (np.zeros(len(windows)) for _ in range(4))
         by_fit: dict[int, list[int]] = {}
         for i, w in enumerate(windows):
-            by_fit.setdefault(id(fitted(w.pre_to)), []).append(i)
+            by_fit.setdefault(id(_fitted(w.pre_to)), []).append(i)
         for members in by_fit.values():
-            f = fitted(windows[members[0]].pre_to)
+            f = _fitted(windows[members[0]].pre_to)
             assert f is not None
             zz, gg, cc, _, _ = _peaks(ordinal, y, f.sigma, [windows[i] for i in members], f.noise)
             z[members], g[members], c[members] = zz, gg, cc
@@ -433,7 +518,7 @@ def detect(
         replay = [t for t in replay if t > day]
     out = []
     for i, (w, *_) in enumerate(accepted):
-        f = fitted(w.pre_to)
+        f = _fitted(w.pre_to)
         if w.post_from > last - b and f is not None:
             out.append(_step(ordinal, y, f.sigma, f.noise, changes, rules, accepted, i))
     return out
@@ -476,7 +561,24 @@ def floored_noise(
 ) -> tuple[Noise, np.ndarray] | None:
     """The :class:`Noise` fitted on the *days* (a mask) and the sigmas it applies to: a day's sigma is not
     believed below half the FOR's usual one there (a day whose sigmas are too small cannot page). None
-    when the noise cannot be fitted (:func:`fit_noise`)."""
+    when the noise cannot be fitted (:func:`fit_noise`).
+
+    Parameters
+    ----------
+    ordinal : numpy.ndarray
+        The days' ordinals, shape (T,).
+    y : numpy.ndarray
+        The values (urad, or K for the bias), shape (T, N_FOR, C).
+    s : numpy.ndarray
+        Their sigmas, same shape.
+    days : numpy.ndarray
+        bool: the days fitted.
+
+    Returns
+    -------
+    tuple or None
+        (Noise, the floored sigmas); None when the noise cannot be fitted.
+    """
     with np.errstate(all="ignore"):
         typical = np.nanmedian(np.where(days[:, None, None], s, np.nan), axis=0)
     sigma = np.fmax(s, 0.5 * typical)
@@ -489,7 +591,26 @@ def window_mean(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per FOR and direction the inverse-variance mean of the days *first*..*last* (ordinals, both
     included) and its sigma, lambda * sqrt(F(n) / W) (W the summed inverse variances, F the AR(1) factor
-    of the mean of n days: :func:`_ar1_factor`); NaN where no day was measured."""
+    of the mean of n days: :func:`_ar1_factor`); NaN where no day was measured.
+
+    Parameters
+    ----------
+    ordinal : numpy.ndarray
+        The days' ordinals, shape (T,).
+    y : numpy.ndarray
+        The values (urad, or K for the bias), shape (T, N_FOR, C).
+    s : numpy.ndarray
+        Their sigmas, same shape.
+    first, last : int
+        The window's ordinals, both included.
+    noise : Noise
+        The fitted noise.
+
+    Returns
+    -------
+    mean, sigma : numpy.ndarray
+        Per FOR and direction; NaN where no day was measured.
+    """
     days = (ordinal >= first) & (ordinal <= last)
     ok = days[:, None, None] & np.isfinite(y) & np.isfinite(s) & (s > 0)
     w = np.where(ok, 1.0 / np.where(ok, s, 1.0) ** 2, 0.0)
@@ -510,7 +631,26 @@ def move(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per FOR and direction the mean of the days *after* minus that of the days *before* (ordinal ranges,
     both ends included) and its sigma, as the jump rule measures a step (:func:`_differences`: the two
-    windows' correlation through the days' included)."""
+    windows' correlation through the days' included).
+
+    Parameters
+    ----------
+    ordinal : numpy.ndarray
+        The days' ordinals, shape (T,).
+    y : numpy.ndarray
+        The values (urad, or K for the bias), shape (T, N_FOR, C).
+    s : numpy.ndarray
+        Their sigmas, same shape.
+    before, after : tuple of int
+        The two windows' ordinal ranges, both ends included.
+    noise : Noise
+        The fitted noise.
+
+    Returns
+    -------
+    move, sigma : numpy.ndarray
+        Per FOR and direction.
+    """
     d, sig = _differences(ordinal, y, s, [_Window(before[0], before[1] + 1, after[0], after[1])], noise)
     return d[0], sig[0]
 

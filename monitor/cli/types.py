@@ -20,7 +20,18 @@ def iso_time(text: str) -> dt.datetime:
 
 
 def until(text: str) -> dt.datetime:
-    """An end: ISO 8601 (UTC unless it says), or a duration from now, ``12h`` or ``7d``."""
+    """An end: ISO 8601 (UTC unless it says), or a duration from now, ``12h`` or ``7d``.
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    datetime.datetime
+        Aware, UTC; an argparse error otherwise.
+    """
     m = re.fullmatch(r"(\d{1,4})([hd])", text.strip())
     if m:
         hours = int(m[1]) * (24 if m[2] == "d" else 1)
@@ -39,7 +50,18 @@ def iso_day(text: str) -> dt.date:
 
 
 def whole(least: int) -> Callable[[str], int]:
-    """The argparse type of a whole number of at least *least* (a count of granules or processes, a seed)."""
+    """The argparse type of a whole number of at least *least* (a count of granules or processes, a seed).
+
+    Parameters
+    ----------
+    least : int
+        The least value.
+
+    Returns
+    -------
+    callable
+        The type.
+    """
 
     def parse(text: str) -> int:
         try:
@@ -54,7 +76,18 @@ def whole(least: int) -> Callable[[str], int]:
 
 
 def longitude(text: str) -> float:
-    """A longitude in degrees, -180..180."""
+    """A longitude in degrees, -180..180.
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    float
+        deg.
+    """
     try:
         lon = float(text)
     except ValueError:
@@ -66,7 +99,18 @@ def longitude(text: str) -> float:
 
 def nagios_range(text: str) -> Range:
     """A monitoring-plugins threshold range: ``10`` (alert outside 0..10), ``10:`` (below 10), ``~:10``
-    (above 10), ``10:20`` (outside), ``@10:20`` (inside)."""
+    (above 10), ``10:20`` (outside), ``@10:20`` (inside).
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    Range
+        The range.
+    """
     try:
         return Range(text)
     except ValueError:
