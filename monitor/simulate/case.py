@@ -149,16 +149,44 @@ class SimulationSpec:
     cloud_emissivity: float = 1.0
 
     def compressed(self, instrument: str) -> bool:
-        """Whether the datasets of *instrument* (CrIS, VIIRS) are written gzip-compressed."""
+        """Whether the datasets of *instrument* (CrIS, VIIRS) are written gzip-compressed.
+
+        Parameters
+        ----------
+        instrument : str
+            ``cris`` or ``viirs``.
+
+        Returns
+        -------
+        bool
+            Whether its datasets are gzip-compressed.
+        """
         return self.layout == "gzip" if self.layout is not None else instrument == "CrIS"
 
     @property
     def calibrated(self) -> bool:
-        """Whether CrIS and VIIRS agree radiometrically (no calibration difference)."""
+        """Whether CrIS and VIIRS agree radiometrically (no calibration difference).
+
+        Returns
+        -------
+        bool
+            True with no calibration difference.
+        """
         return self.cris_bias_k == 0.0 and self.cris_gain == 0.0 and self.cris_nonlinear_k == 0.0
 
     def cris_bt_k(self, bt_k: np.ndarray) -> np.ndarray:
-        """The BT CrIS reports for a scene of true brightness temperature *bt_k* (K)."""
+        """The BT CrIS reports for a scene of true brightness temperature *bt_k* (K).
+
+        Parameters
+        ----------
+        bt_k : numpy.ndarray
+            True brightness temperature, K.
+
+        Returns
+        -------
+        numpy.ndarray
+            K.
+        """
         x = bt_k - CALIBRATION_REFERENCE_K
         return (
             bt_k
@@ -201,7 +229,18 @@ class SimulationSpec:
 def ep_offsets_urad(
     true_ep: EngineeringPacket, ground_ep: EngineeringPacket
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Per-FOR (d_alpha, d_beta) (urad) of FOV 5 from the ground-processing LOS to the true one."""
+    """Per-FOR (d_alpha, d_beta) (urad) of FOV 5 from the ground-processing LOS to the true one.
+
+    Parameters
+    ----------
+    true_ep, ground_ep : EngineeringPacket
+        The EP the radiances are made with, and the ground processing's.
+
+    Returns
+    -------
+    d_alpha_urad, d_beta_urad : numpy.ndarray
+        Shape (30,).
+    """
     a_true, b_true = fov5_angles(true_ep)
     a_geo, b_geo = fov5_angles(ground_ep)
     return (a_true - a_geo) / URAD, (b_true - b_geo) / URAD
@@ -256,7 +295,20 @@ def law_m_per_k(satellite: str, clouds: str) -> float | None:
     lift reads the band BT's: through the simulator's atmosphere the window shrinks a BT contrast to
     0.79-0.84 of the temperatures' (colder tops more), so a lapse law of G K/km implies about 1230 / G
     m/K, not 1000 / G. The slope through the origin, by least squares, of the height over the BT cooling
-    over the scene's tops (:data:`LAW_TOPS_K`) above its sea surface (:data:`LAW_AIR_K`)."""
+    over the scene's tops (:data:`LAW_TOPS_K`) above its sea surface (:data:`LAW_AIR_K`).
+
+    Parameters
+    ----------
+    satellite : str
+        The satellite's short name (its I5 band).
+    clouds : str
+        The law (``ground``, ``lapse:G``, ``tropical``).
+
+    Returns
+    -------
+    float or None
+        m per K of band BT; None for clouds on the ground.
+    """
     law = CloudHeights.parse(clouds)
     if law.flat:
         return None
@@ -271,7 +323,13 @@ def law_m_per_k(satellite: str, clouds: str) -> float | None:
 
 
 class Simulator:
-    """Builds the orbit, attitude and scene of a case and writes its granules."""
+    """Builds the orbit, attitude and scene of a case and writes its granules.
+
+    Parameters
+    ----------
+    spec : SimulationSpec
+        The case.
+    """
 
     def __init__(self, spec: SimulationSpec):
         self.spec = spec
@@ -323,20 +381,57 @@ class Simulator:
         return Wind((float(axis[0]), float(axis[1]), float(axis[2])), self.spec.wind_in_track_m_s, self.t0)
 
     def attitude_rad(self, unix_s: ArrayLike) -> np.ndarray:
-        """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift."""
+        """Spacecraft roll, pitch, yaw (rad): small constants plus a slow drift.
+
+        Parameters
+        ----------
+        unix_s : array_like
+            UTC seconds since 1970.
+
+        Returns
+        -------
+        numpy.ndarray
+            Roll, pitch, yaw, rad, shape t + (3,).
+        """
         t = np.asarray(unix_s, float) - self.t0
         base = np.asarray(self.spec.attitude_arcsec, float)
         drift = 0.1 * np.stack([np.sin(t / 600.0), np.cos(t / 900.0), np.sin(t / 700.0)], -1)
         return (base + drift) * frames.ARCSEC_RAD
 
     def state(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Satellite position (m) and velocity (m/s) in ECEF and the SBF-to-ECEF matrix at unix times."""
+        """Satellite position (m) and velocity (m/s) in ECEF and the SBF-to-ECEF matrix at unix times.
+
+        Parameters
+        ----------
+        unix_s : array_like
+            UTC seconds since 1970.
+
+        Returns
+        -------
+        position_m, velocity_m_s : numpy.ndarray
+            ECEF, shape t + (3,).
+        sbf_to_ecef : numpy.ndarray
+            Shape t + (3, 3).
+        """
         r, v = self.orbit.state_ecef(unix_s)
         return r, v, frames.sbf_to_ecef(r, v, self.attitude_rad(unix_s))
 
     # ------------------------------------------------------------------ CrIS
     def cris_granule(self, k: int, out: Path) -> list[str]:
-        """Write CrIS granule *k* (SDR and GEO files) into *out*; the names of the files written."""
+        """Write CrIS granule *k* (SDR and GEO files) into *out*; the names of the files written.
+
+        Parameters
+        ----------
+        k : int
+            The granule, 0-based.
+        out : Path
+            The case's directory.
+
+        Returns
+        -------
+        list of str
+            The files written.
+        """
         spec = self.spec
         g0 = self.t0 + k * CRIS_GRANULE_S
         scan_start = g0 + np.arange(4) * CRIS_SCAN_US * 1e-6
@@ -443,7 +538,20 @@ class Simulator:
 
     def surface(self, origin: np.ndarray, los: np.ndarray) -> Point:
         """Where each ray meets the scene: geodetic (lat_rad, lon_rad, h_m), on the terrain if there is
-        one."""
+        one.
+
+        Parameters
+        ----------
+        origin : numpy.ndarray
+            Ray origins, ECEF, m.
+        los : numpy.ndarray
+            Unit ray directions, ECEF.
+
+        Returns
+        -------
+        lat_rad, lon_rad, h_m : numpy.ndarray
+            Geodetic.
+        """
         if not self.spec.terrain:
             pts = origin + wgs84.intersect_ellipsoid(origin, los)[..., None] * los
             lat, lon = wgs84.surface_to_geodetic(pts)
@@ -452,7 +560,24 @@ class Simulator:
 
     def met(self, origin: np.ndarray, los: np.ndarray, unix_s: ArrayLike, ground: Point) -> Point:
         """Where each ray at *unix_s* meets the first cloud or terrain, the clouds where the wind has them
-        then: geodetic (lat_rad, lon_rad, h_m); with clouds on the ground, *ground* (:meth:`surface`)."""
+        then: geodetic (lat_rad, lon_rad, h_m); with clouds on the ground, *ground* (:meth:`surface`).
+
+        Parameters
+        ----------
+        origin : numpy.ndarray
+            Ray origins, ECEF, m.
+        los : numpy.ndarray
+            Unit ray directions, ECEF.
+        unix_s : array_like
+            UTC seconds since 1970.
+        ground : tuple of numpy.ndarray
+            Where the rays meet the ground (:meth:`surface`).
+
+        Returns
+        -------
+        lat_rad, lon_rad, h_m : numpy.ndarray
+            Geodetic.
+        """
         if self.scene.clouds.flat:
             return ground
         return self.scene.intersect(origin, los, unix_s=unix_s)[1:]
@@ -464,7 +589,24 @@ class Simulator:
         what it meets (:meth:`met`; the scene's temperature is a function of its latitude, longitude and
         the terrain's height there), and where that is a thin cloud (above :data:`CIRRUS_BASE_M`, of
         emissivity below 1) also the ground behind it (:meth:`surface`, or *ground* if already known).
-        Radiances add with these weights; temperatures must not (the radiance is not linear in them)."""
+        Radiances add with these weights; temperatures must not (the radiance is not linear in them).
+
+        Parameters
+        ----------
+        origin : numpy.ndarray
+            Ray origins, ECEF, m.
+        los : numpy.ndarray
+            Unit ray directions, ECEF.
+        unix_s : array_like
+            UTC seconds since 1970.
+        ground : tuple of numpy.ndarray, optional
+            Where the rays meet the ground.
+
+        Returns
+        -------
+        temperature_k, weight : numpy.ndarray
+            Shape (n, ...) both.
+        """
         ground = ground or self.surface(origin, los)
         lat, lon, hit_m = self.met(origin, los, unix_s, ground)
         terrain_m = hit_m if self.scene.clouds.flat else self.scene.height_m(lat, lon)
@@ -553,7 +695,24 @@ class Simulator:
         self, g0: float, out: Path, scans_per_chunk: int = 6, should_stop: Callable[[], bool] | None = None
     ) -> list[str]:
         """Write the VIIRS I5 granule starting at unix time *g0* (SDR and GEO files) into *out*, a few
-        scans at a time (*should_stop* polled between them); the names of the files written."""
+        scans at a time (*should_stop* polled between them); the names of the files written.
+
+        Parameters
+        ----------
+        g0 : float
+            The granule's start, Unix s.
+        out : Path
+            The case's directory.
+        scans_per_chunk : int, optional
+            Scans simulated at a time.
+        should_stop : callable, optional
+            Polled between chunks.
+
+        Returns
+        -------
+        list of str
+            The files written.
+        """
         spec = self.spec
         theta, col_dt = ins.viirs_column_geometry()
         a_det = ins.viirs_detector_angles_rad()
@@ -709,7 +868,13 @@ class Simulator:
         }
 
     def viirs_granule_starts(self) -> np.ndarray:
-        """Start times (unix s) of the VIIRS granules that cover the CrIS granules with margin."""
+        """Start times (unix s) of the VIIRS granules that cover the CrIS granules with margin.
+
+        Returns
+        -------
+        numpy.ndarray
+            Unix s.
+        """
         first = self.t0 - 5.0
         last = self.t0 + self.spec.granules * CRIS_GRANULE_S + 5.0
         ref = self.t0 - self.spec.viirs_lead_s
@@ -729,7 +894,26 @@ def simulate_case(
     *spec*, or a :class:`SimulationSpec` of *parameters* (its fields: a name it does not declare is a
     TypeError). *viirs* False: the CrIS granules alone. *should_stop*, polled between granules and between
     a VIIRS granule's scans, ends the simulation with :class:`StopRequested` (what was written stays: the
-    caller decides)."""
+    caller decides).
+
+    Parameters
+    ----------
+    out_dir : str or os.PathLike
+        The case's directory.
+    spec : SimulationSpec, optional
+        The case; else one of *parameters*.
+    viirs : bool, optional
+        Also the VIIRS granules.
+    should_stop : callable, optional
+        Polled between granules and scans; True ends it with :class:`StopRequested`.
+    **parameters : object
+        :class:`SimulationSpec`'s fields.
+
+    Returns
+    -------
+    dict
+        The truth document (``truth.json``).
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     spec = spec or SimulationSpec(**parameters)

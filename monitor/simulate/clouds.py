@@ -39,7 +39,18 @@ class CloudHeights:
 
     @classmethod
     def parse(cls, text: str) -> CloudHeights:
-        """The law written as ``ground``, ``lapse:6.5`` (K/km, > 0) or ``tropical``."""
+        """The law written as ``ground``, ``lapse:6.5`` (K/km, > 0) or ``tropical``.
+
+        Parameters
+        ----------
+        text : str
+            The law.
+
+        Returns
+        -------
+        CloudHeights
+            The law; a ValueError names what is wrong.
+        """
         name, _, value = text.partition(":")
         if name in ("ground", "tropical") and not value:
             return cls(name)
@@ -57,12 +68,24 @@ class CloudHeights:
 
     @property
     def flat(self) -> bool:
-        """Whether every cloud lies on the ground."""
+        """Whether every cloud lies on the ground.
+
+        Returns
+        -------
+        bool
+            True on the ground.
+        """
         return self.law == "ground"
 
     def knots(self) -> tuple[np.ndarray, np.ndarray]:
         """The law as knots of a piecewise-linear function: (cooling below the surface air K, increasing;
-        height m), held at its ends beyond them (on the ground when warmer, at the ceiling when colder)."""
+        height m), held at its ends beyond them (on the ground when warmer, at the ceiling when colder).
+
+        Returns
+        -------
+        cooling_k, height_m : numpy.ndarray
+            The knots.
+        """
         if self.law == "ground":
             return np.array([0.0, 1.0]), np.zeros(2)
         if self.law == "lapse":
@@ -71,7 +94,20 @@ class CloudHeights:
         return cooling, np.minimum(np.arange(len(TROPICAL_K)) * 1000.0, CEILING_M)
 
     def top_height_m(self, top_k: ArrayLike, air_k: ArrayLike) -> np.ndarray:
-        """Height (m above sea level) of cloud tops at *top_k* (K) over surface air at *air_k* (K)."""
+        """Height (m above sea level) of cloud tops at *top_k* (K) over surface air at *air_k* (K).
+
+        Parameters
+        ----------
+        top_k : array_like
+            Cloud-top temperature, K.
+        air_k : array_like
+            Surface air temperature, K.
+
+        Returns
+        -------
+        numpy.ndarray
+            m above sea level.
+        """
         cooling_k = np.asarray(air_k, float) - np.asarray(top_k, float)
         return np.interp(cooling_k, *self.knots()).astype(np.float32)
 

@@ -33,7 +33,18 @@ def _enu(lat_rad: np.ndarray, lon_rad: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def sun_direction_ecef(unix_s: ArrayLike) -> np.ndarray:
     """Unit vector (ECEF) toward the Sun at unix time(s) *unix_s*: declination from the day of the year,
-    subsolar longitude from UTC (no equation of time; ~1 deg, enough for a dataset nobody reads here)."""
+    subsolar longitude from UTC (no equation of time; ~1 deg, enough for a dataset nobody reads here).
+
+    Parameters
+    ----------
+    unix_s : array_like
+        UTC seconds since 1970.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, ECEF.
+    """
     t = np.asarray(unix_s, float)
     day = (t / 86400.0) % 365.2422
     decl = np.radians(-23.44) * np.cos(2 * np.pi * (day + 10.0) / 365.2422)
@@ -49,7 +60,24 @@ def view_angles(
     direction: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Zenith and azimuth (deg, azimuth from north, -180..180) at each pixel toward a point (a position,
-    m, ECEF; with *direction*, a unit direction), and the distance (m) to a position."""
+    m, ECEF; with *direction*, a unit direction), and the distance (m) to a position.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad : array_like
+        Geodetic latitude and longitude, rad.
+    h_m : array_like
+        Height, m.
+    toward_ecef_m : numpy.ndarray
+        A position (m, ECEF), or with *direction* a unit direction.
+    direction : bool, optional
+        *toward_ecef_m* is a direction.
+
+    Returns
+    -------
+    zenith_deg, azimuth_deg, range_m : numpy.ndarray
+        Azimuth from north, -180..180.
+    """
     p = wgs84.geodetic_to_ecef(lat_rad, lon_rad, h_m)
     d = toward_ecef_m if direction else toward_ecef_m - p
     dist = np.linalg.norm(d, axis=-1)
@@ -67,7 +95,26 @@ def viirs_geo_extra(
     scan_unix_s: np.ndarray,
     rows_per_scan: int,
 ) -> dict:
-    """GITCO's pixel angles, range and per-scan solar angles and modes (1536 x 6400 float32 each)."""
+    """GITCO's pixel angles, range and per-scan solar angles and modes (1536 x 6400 float32 each).
+
+    Parameters
+    ----------
+    lat_deg, lon_deg : numpy.ndarray
+        The pixels' position, deg.
+    h_m : numpy.ndarray
+        Their height, m.
+    sc_position_m : numpy.ndarray
+        Each scan's spacecraft position, ECEF, m.
+    scan_unix_s : numpy.ndarray
+        Each scan's time, Unix s.
+    rows_per_scan : int
+        32.
+
+    Returns
+    -------
+    dict
+        Dataset name to array.
+    """
     shape = lat_deg.shape
     out = {
         k: np.full(shape, F32_FILL, np.float32)
@@ -112,7 +159,20 @@ def viirs_geo_extra(
 
 
 def viirs_sdr_extra(nscan: int, rows_per_scan: int) -> dict:
-    """SVI05's per-scan and per-granule quality and packet counts."""
+    """SVI05's per-scan and per-granule quality and packet counts.
+
+    Parameters
+    ----------
+    nscan : int
+        Scans.
+    rows_per_scan : int
+        32.
+
+    Returns
+    -------
+    dict
+        Dataset name to array.
+    """
     return {
         "QF3_SCAN_RDR": np.zeros(nscan, np.uint8),
         "QF4_SCAN_SDR": np.zeros(nscan * rows_per_scan, np.uint8),
@@ -128,7 +188,20 @@ def viirs_sdr_extra(nscan: int, rows_per_scan: int) -> dict:
 
 def cris_sdr_extra(spectra: dict, rng: np.random.Generator) -> dict:
     """SCRIF's imaginary spectra (noise, the shape of the real ones), NEdN and engineering datasets;
-    *spectra* maps band (LW, MW, SW) to its ES_Real array (nscan, 30, 9, nchan)."""
+    *spectra* maps band (LW, MW, SW) to its ES_Real array (nscan, 30, 9, nchan).
+
+    Parameters
+    ----------
+    spectra : dict
+        Band (LW, MW, SW) to its ES_Real array (nscan, 30, 9, nchan).
+    rng : numpy.random.Generator
+        The noise's generator.
+
+    Returns
+    -------
+    dict
+        Dataset name to array.
+    """
     out: dict = {}
     nscan = next(iter(spectra.values())).shape[0]
     for band, real in spectra.items():

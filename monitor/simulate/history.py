@@ -33,7 +33,26 @@ def day_result(
     satellite: str, day: dt.date, rng: np.random.Generator, step_urad: float = 0.0, with_cube: bool = True
 ) -> AssessmentResult:
     """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR
-    21-30."""
+    21-30.
+
+    Parameters
+    ----------
+    satellite : str
+        The satellite.
+    day : datetime.date
+        The day.
+    rng : numpy.random.Generator
+        The noise's generator.
+    step_urad : float, optional
+        Added cross-track at FOR 21-30, urad.
+    with_cube : bool, optional
+        With a cost cube.
+
+    Returns
+    -------
+    AssessmentResult
+        The result.
+    """
     d_alpha, d_beta = paper_profile()
     d_alpha = 0.3 * d_alpha + rng.normal(0, 15, N_FOR)
     d_beta = 0.3 * d_beta + rng.normal(0, 15, N_FOR) + np.where(np.arange(N_FOR) >= 20, step_urad, 0.0)
@@ -97,7 +116,32 @@ def fill_store(
     seed: int = 0,
     cubes: str = "last",
 ) -> list[dt.date]:
-    """Write *days* daily results per satellite from *first*; cost cubes on every day or only the last."""
+    """Write *days* daily results per satellite from *first*; cost cubes on every day or only the last.
+
+    Parameters
+    ----------
+    store : Store
+        The store written.
+    satellites : list of str
+        The satellites.
+    first : datetime.date
+        The first day.
+    days : int
+        Days per satellite.
+    step_day : int, optional
+        From this day on, the step.
+    step_urad : float, optional
+        The step, urad.
+    seed : int, optional
+        The noise's seed.
+    cubes : str, optional
+        ``all`` or ``last``.
+
+    Returns
+    -------
+    list of datetime.date
+        The days written.
+    """
     rng = np.random.default_rng(seed)
     out = [first + dt.timedelta(days=i) for i in range(days)]
     for sat in satellites:

@@ -22,19 +22,54 @@ MISSION = {s.short: s.mission for s in SATELLITES.values()}
 
 
 def text_attr(value: str) -> np.ndarray:
-    """An IDPS string attribute: a (1, 1) fixed-length byte array with room for a terminator."""
+    """An IDPS string attribute: a (1, 1) fixed-length byte array with room for a terminator.
+
+    Parameters
+    ----------
+    value : str
+        The text.
+
+    Returns
+    -------
+    numpy.ndarray
+        The attribute.
+    """
     b = value.encode("ascii")
     return np.array([[b]], dtype=f"S{len(b) + 1}")
 
 
 def texts_attr(values: Sequence[str]) -> np.ndarray:
-    """An IDPS list-of-strings attribute: (n, 1) fixed-length bytes."""
+    """An IDPS list-of-strings attribute: (n, 1) fixed-length bytes.
+
+    Parameters
+    ----------
+    values : sequence of str
+        The texts.
+
+    Returns
+    -------
+    numpy.ndarray
+        The attribute.
+    """
     bs = [v.encode("ascii") for v in values] or [b""]
     return np.array([[b] for b in bs], dtype=f"S{max(len(b) for b in bs) + 1}")
 
 
 def number_attr(value: float, dtype: DTypeLike) -> np.ndarray:
-    """A numeric HDF5 attribute shaped (1, 1), as IDPS writes them."""
+    """A numeric HDF5 attribute shaped (1, 1), as IDPS writes them.
+
+    Parameters
+    ----------
+    value : float
+        The number.
+    dtype : numpy dtype-like
+        Its type.
+
+    Returns
+    -------
+    numpy.ndarray
+        The attribute.
+    """
     return np.array([[value]], dtype=dtype)
 
 
@@ -47,7 +82,20 @@ def _attr(value: object) -> np.ndarray:
 
 
 def date_time_attrs(prefix: str, when: dt.datetime) -> dict:
-    """The IDPS pair ``{prefix}_Date`` (YYYYMMDD) and ``{prefix}_Time`` (HHMMSS.ffffffZ) for *when*."""
+    """The IDPS pair ``{prefix}_Date`` (YYYYMMDD) and ``{prefix}_Time`` (HHMMSS.ffffffZ) for *when*.
+
+    Parameters
+    ----------
+    prefix : str
+        ``Beginning``, ``Ending``, ...
+    when : datetime.datetime
+        The time, UTC.
+
+    Returns
+    -------
+    dict
+        The two attributes.
+    """
     return {f"{prefix}_Date": when.strftime("%Y%m%d"), f"{prefix}_Time": when.strftime("%H%M%S.%fZ")}
 
 
@@ -68,7 +116,19 @@ class ProductData:
 def write_file(
     path: str | os.PathLike[str], platform: str, created: dt.datetime, products: list[ProductData]
 ) -> None:
-    """Write *products* (one or more, for combined files) into the IDPS HDF5 file *path*."""
+    """Write *products* (one or more, for combined files) into the IDPS HDF5 file *path*.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    platform : str
+        ``npp``, ``j01``, ``j02``.
+    created : datetime.datetime
+        The creation time, UTC.
+    products : list of ProductData
+        The products' data.
+    """
     with h5py.File(path, "w", userblock_size=USERBLOCK) as f:
         f.attrs["Distributor"] = text_attr("noa-")
         f.attrs["Mission_Name"] = text_attr(MISSION[platform])

@@ -17,6 +17,11 @@ def paper_profile() -> tuple[np.ndarray, np.ndarray]:
 
     Cross-track ~0 for FOR 1-10, growing to +1750 urad at FOR 30; in-track a yaw-like ramp from
     +5.1 % of the FOV at FOR 1 to -3 % at FOR 30.
+
+    Returns
+    -------
+    d_alpha_urad, d_beta_urad : numpy.ndarray
+        Shape (30,).
     """
     k = np.arange(1, N_FOR + 1)
     d_beta = 1750.0 * np.clip((k - 10) / 20.0, 0.0, None) ** 2
@@ -29,13 +34,29 @@ def paper_ssm_error_urad() -> tuple[np.ndarray, np.ndarray]:
 
     The cross-track roll grows to 1000 urad at FOR 30 (the ~1000 urad end-of-scan changes of section 4),
     the in-track pitch follows a yaw-like ramp from +250 urad at FOR 1 to -250 urad at FOR 30.
+
+    Returns
+    -------
+    d_crosstrack_roll_urad, d_intrack_pitch_urad : numpy.ndarray
+        Shape (30,).
     """
     k = np.arange(1, N_FOR + 1)
     return -1000.0 * np.clip((k - 10) / 20.0, 0.0, None) ** 2, 250.0 * (15.5 - k) / 14.5
 
 
 def random_profile(seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """A smooth random profile within about +-1500 urad (low-order polynomials in scan position)."""
+    """A smooth random profile within about +-1500 urad (low-order polynomials in scan position).
+
+    Parameters
+    ----------
+    seed : int
+        The generator's seed.
+
+    Returns
+    -------
+    d_alpha_urad, d_beta_urad : numpy.ndarray
+        Shape (30,).
+    """
     rng = np.random.default_rng(seed + 7919)
     x = np.linspace(-1.0, 1.0, N_FOR)
     basis = np.stack([np.ones_like(x), x, x**2, x**3])
@@ -49,6 +70,18 @@ def load_profile(name: str, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
 
     A file holds ``fors: [{for: 1, d_alpha_urad: .., d_beta_urad: ..}, ...]`` (the truth.json and
     result.json layout) or two 30-element lists ``d_alpha_urad`` and ``d_beta_urad``.
+
+    Parameters
+    ----------
+    name : str
+        ``paper``, ``random``, ``zero`` or a file.
+    seed : int, optional
+        For ``random``.
+
+    Returns
+    -------
+    d_alpha_urad, d_beta_urad : numpy.ndarray
+        Shape (30,).
     """
     if name == "paper":
         return paper_profile()

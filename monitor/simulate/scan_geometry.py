@@ -33,12 +33,24 @@ VIIRS_EARTH_VIEW_S = 0.556  # the 112 deg Earth-view sector of the 1.7864 s rota
 
 
 def cris_scan_angles_rad() -> np.ndarray:
-    """Scan angle of FOR 1..30 (rad), -48.33 deg to +48.33 deg."""
+    """Scan angle of FOR 1..30 (rad), -48.33 deg to +48.33 deg.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (30,), rad.
+    """
     return (np.arange(N_FOR) - (N_FOR - 1) / 2) * CRIS_FOR_STEP_RAD
 
 
 def cris_fov_offsets_rad() -> tuple[np.ndarray, np.ndarray]:
-    """(in_track, cross_track) offsets (rad) of FOV 1..9 at nadir: FOV 7-9 ahead, FOV 1, 4, 7 on the left."""
+    """(in_track, cross_track) offsets (rad) of FOV 1..9 at nadir: FOV 7-9 ahead, FOV 1, 4, 7 on the left.
+
+    Returns
+    -------
+    in_track_rad, cross_track_rad : numpy.ndarray
+        Shape (9,).
+    """
     f = np.arange(N_FOV)
     return (f // 3 - 1) * FOV_SPACING_RAD, (f % 3 - 1) * FOV_SPACING_RAD
 
@@ -47,6 +59,16 @@ def cris_los_sbf(d_alpha_rad: ArrayLike | None = None, d_beta_rad: ArrayLike | N
     """Nominal CrIS LOS (30, 9, 3) in the SBF, optionally turned per FOR by (d_alpha, d_beta) (30,) rad.
 
     The 3x3 pattern turns with the scan angle (the scene mirror rotates about the optical axis).
+
+    Parameters
+    ----------
+    d_alpha_rad, d_beta_rad : array_like, optional
+        Per FOR turns, rad, shape (30,).
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, shape (30, 9, 3).
     """
     theta = cris_scan_angles_rad()
     da, dc = cris_fov_offsets_rad()
@@ -67,14 +89,33 @@ def cris_los_sbf(d_alpha_rad: ArrayLike | None = None, d_beta_rad: ArrayLike | N
 
 def turned(los_sbf: np.ndarray, d_alpha_rad: ArrayLike, d_beta_rad: ArrayLike) -> np.ndarray:
     """Unit LOS (..., 3) in the SBF turned by (d_alpha, d_beta) rad (broadcast over ``los_sbf[..., 0]``):
-    alpha = atan(x/z) in-track and beta = atan(y/z) cross-track (equations 1-2) grow by them."""
+    alpha = atan(x/z) in-track and beta = atan(y/z) cross-track (equations 1-2) grow by them.
+
+    Parameters
+    ----------
+    los_sbf : numpy.ndarray
+        Unit LOS, shape (..., 3).
+    d_alpha_rad, d_beta_rad : array_like
+        The turns, rad.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vectors, shape (..., 3).
+    """
     alpha = np.arctan2(los_sbf[..., 0], los_sbf[..., 2]) + d_alpha_rad
     beta = np.arctan2(los_sbf[..., 1], los_sbf[..., 2]) + d_beta_rad
     return unit(np.stack([np.tan(alpha), np.tan(beta), np.ones_like(alpha)], axis=-1))
 
 
 def viirs_column_geometry() -> tuple[np.ndarray, np.ndarray]:
-    """Scan angle (rad) and time within the Earth view (s) of each of the 6400 I-band columns."""
+    """Scan angle (rad) and time within the Earth view (s) of each of the 6400 I-band columns.
+
+    Returns
+    -------
+    scan_angle_rad, time_s : numpy.ndarray
+        Shape (6400,).
+    """
     agg = np.repeat(VIIRS_ZONE_AGGREGATION, VIIRS_ZONE_COLUMNS)
     native_end = np.cumsum(agg)
     centre = native_end - agg / 2.0
@@ -83,7 +124,13 @@ def viirs_column_geometry() -> tuple[np.ndarray, np.ndarray]:
 
 
 def viirs_bowtie_deleted() -> np.ndarray:
-    """(32, 6400) mask of on-board bow-tie deleted I-band pixels (docs/jpss-formats.md 3)."""
+    """(32, 6400) mask of on-board bow-tie deleted I-band pixels (docs/jpss-formats.md 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        bool, shape (32, 6400).
+    """
     mask = np.zeros((VIIRS_DETECTORS, VIIRS_COLUMNS), bool)
     for rows, n in (((0, 1, 30, 31), 2016), ((2, 3, 28, 29), 1280)):
         for r in rows:
@@ -93,5 +140,11 @@ def viirs_bowtie_deleted() -> np.ndarray:
 
 
 def viirs_detector_angles_rad() -> np.ndarray:
-    """In-track angle (rad) of the 32 detectors; detector 0 looks furthest back."""
+    """In-track angle (rad) of the 32 detectors; detector 0 looks furthest back.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (32,), rad.
+    """
     return (np.arange(VIIRS_DETECTORS) - (VIIRS_DETECTORS - 1) / 2) * VIIRS_DETECTOR_RAD

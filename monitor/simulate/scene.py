@@ -296,7 +296,18 @@ class Wind:
 
     def turn_back(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(cos, sin) of the angle that turns a point at *unix_s* back to where its clouds were at the
-        reference time."""
+        reference time.
+
+        Parameters
+        ----------
+        unix_s : array_like
+            UTC seconds since 1970.
+
+        Returns
+        -------
+        cos, sin : numpy.ndarray
+            The angle's.
+        """
         angle = -self.speed_m_s / (EARTH_RADIUS_KM * 1e3) * (np.asarray(unix_s, float) - self.reference_s)
         return np.cos(angle), np.sin(angle)
 
@@ -312,6 +323,25 @@ class Scene:
     cloud tops at the height their temperature implies (``top_m``, the surface a line of sight meets
     first). *edges* (:data:`EDGES`) how sharply the clouds' cover ends; *wind* carries the clouds (not the
     land) over the ground.
+
+    Parameters
+    ----------
+    seed : int, optional
+        The scene's seed.
+    cloud_fraction : float, optional
+        The cloud cover.
+    land_fraction : float, optional
+        The land's share.
+    terrain : bool, optional
+        1-4 km ranges and plateaus on land.
+    night : bool, optional
+        Land colder than the sea.
+    clouds : CloudHeights, optional
+        The cloud-top law.
+    edges : str, optional
+        ``soft`` or ``sharp`` (:data:`EDGES`).
+    wind : Wind, optional
+        What carries the clouds.
     """
 
     def __init__(
@@ -362,14 +392,31 @@ class Scene:
         return float(np.max(np.hypot(gx, gy)))
 
     def height_m(self, lat_rad: ArrayLike, lon_rad: ArrayLike) -> np.ndarray:
-        """Terrain height (m) above the ellipsoid at geodetic *lat_rad*, *lon_rad*; float32."""
+        """Terrain height (m) above the ellipsoid at geodetic *lat_rad*, *lon_rad*; float32.
+
+        Parameters
+        ----------
+        lat_rad, lon_rad : array_like
+            Geodetic latitude and longitude, rad.
+
+        Returns
+        -------
+        numpy.ndarray
+            m, float32.
+        """
         if not self.terrain:
             return np.zeros(np.shape(lat_rad), np.float32)
         return self._height(*np.moveaxis(self.shape(_unit_vectors(lat_rad, lon_rad)), -1, 0))
 
     @property
     def ceiling_m(self) -> float:
-        """The highest the scene's surface (terrain or cloud) stands (m)."""
+        """The highest the scene's surface (terrain or cloud) stands (m).
+
+        Returns
+        -------
+        float
+            m.
+        """
         return MAX_HEIGHT_M if self.clouds.flat else max(MAX_HEIGHT_M, CEILING_M)
 
     def _compiled(self, clouds: bool) -> tuple:
@@ -390,7 +437,20 @@ class Scene:
 
     def top_m(self, lat_rad: ArrayLike, lon_rad: ArrayLike, unix_s: ArrayLike = 0.0) -> np.ndarray:
         """Height (m) of the surface a line of sight meets at geodetic *lat_rad*, *lon_rad* at *unix_s*: the
-        terrain, or a cloud's top or side standing on it (cover x the top's height above the terrain)."""
+        terrain, or a cloud's top or side standing on it (cover x the top's height above the terrain).
+
+        Parameters
+        ----------
+        lat_rad, lon_rad : array_like
+            Geodetic latitude and longitude, rad.
+        unix_s : array_like
+            UTC seconds since 1970.
+
+        Returns
+        -------
+        numpy.ndarray
+            m.
+        """
         x, y, z = (np.ascontiguousarray(c, np.float64).ravel() for c in _unit_vectors(lat_rad, lon_rad))
         out = np.empty(x.size)
         _surface_points(x, y, z, self._turn_back(unix_s, np.shape(lat_rad)), *self._compiled(True), out)
@@ -403,7 +463,24 @@ class Scene:
         terrain, and with *clouds* the clouds standing on it where the wind has them at *unix_s*,
         broadcast to the rays), and that point's geodetic (lat_rad, lon_rad, h_m); NaN where the ray
         misses the Earth. Terrain alone is met once: one bracket; clouds are bracketed by marching
-        (:mod:`monitor.simulate.terrain`)."""
+        (:mod:`monitor.simulate.terrain`).
+
+        Parameters
+        ----------
+        origin_m : numpy.ndarray
+            Ray origins, ECEF, m.
+        los : numpy.ndarray
+            Unit directions, ECEF, shape (..., 3).
+        clouds : bool, optional
+            Meet the clouds too.
+        unix_s : array_like, optional
+            When, UTC s (where the wind has the clouds).
+
+        Returns
+        -------
+        distance_m, lat_rad, lon_rad, h_m : numpy.ndarray
+            NaN where the ray misses.
+        """
         tall = clouds and not self.clouds.flat
         cos_turn, sin_turn = self._turn_back(unix_s, np.shape(los)[:-1])
         return terrain.first_crossing(
@@ -434,7 +511,24 @@ class Scene:
     ) -> np.ndarray:
         """Emitting temperature (K) at geodetic *lat_rad*, *lon_rad* and terrain height *height_m*, the
         clouds where the wind has them at *unix_s*; not *cloudy*: the ground's, as if no cloud were
-        there."""
+        there.
+
+        Parameters
+        ----------
+        lat_rad, lon_rad : array_like
+            Geodetic latitude and longitude, rad.
+        height_m : array_like, optional
+            Terrain height, m.
+        unix_s : array_like, optional
+            When, UTC s.
+        cloudy : bool, optional
+            False: the ground's, as if no cloud were there.
+
+        Returns
+        -------
+        numpy.ndarray
+            K.
+        """
         xyz = _unit_vectors(lat_rad, lon_rad)
         land = self.shape(xyz)[..., 0]
         h = np.zeros(np.shape(lat_rad), np.float32) if height_m is None else np.asarray(height_m, np.float32)
@@ -460,7 +554,18 @@ def _locked(kernel: Callable[..., None], *args: Any) -> None:
 
 
 def transmittance(wavenumber_cm1: ArrayLike) -> np.ndarray:
-    """A simple clear-sky transmittance: a moist window with CO2 below 760 cm-1 and ozone near 1040 cm-1."""
+    """A simple clear-sky transmittance: a moist window with CO2 below 760 cm-1 and ozone near 1040 cm-1.
+
+    Parameters
+    ----------
+    wavenumber_cm1 : array_like
+        cm-1.
+
+    Returns
+    -------
+    numpy.ndarray
+        0..1.
+    """
     nu = np.asarray(wavenumber_cm1, float)
     k = 0.12 + 0.25 * ((nu - 900.0) / 150.0) ** 2
     k += 4.0 / (1.0 + np.exp((nu - 740.0) / 8.0))
@@ -470,6 +575,19 @@ def transmittance(wavenumber_cm1: ArrayLike) -> np.ndarray:
 
 
 def spectra(wavenumber_cm1: ArrayLike, mean_planck: ArrayLike) -> np.ndarray:
-    """Top-of-atmosphere spectra from the cone-mean surface Planck radiance (..., nchan)."""
+    """Top-of-atmosphere spectra from the cone-mean surface Planck radiance (..., nchan).
+
+    Parameters
+    ----------
+    wavenumber_cm1 : array_like
+        cm-1.
+    mean_planck : array_like
+        Cone-mean surface Planck radiance, mW/(m2 sr cm-1).
+
+    Returns
+    -------
+    numpy.ndarray
+        mW/(m2 sr cm-1), shape (..., nchan).
+    """
     tau = transmittance(wavenumber_cm1)
     return tau * mean_planck + (1.0 - tau) * planck_radiance(wavenumber_cm1, T_ATM_K)

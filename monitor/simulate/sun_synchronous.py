@@ -23,21 +23,57 @@ DAY_S = 86400.0
 
 
 def earth_rotation_angle(unix_s: ArrayLike) -> np.ndarray:
-    """Earth rotation angle (rad) at UTC seconds since 1970 (UT1 taken as UTC; IERS 2010 eq. 5.15)."""
+    """Earth rotation angle (rad) at UTC seconds since 1970 (UT1 taken as UTC; IERS 2010 eq. 5.15).
+
+    Parameters
+    ----------
+    unix_s : array_like
+        UTC seconds since 1970.
+
+    Returns
+    -------
+    numpy.ndarray
+        rad.
+    """
     d = (np.asarray(unix_s, float) - J2000_UNIX_S) / DAY_S
     return 2 * np.pi * ((0.7790572732640 + 0.00273781191135448 * d + d) % 1.0)
 
 
 def mean_sun_right_ascension(unix_s: ArrayLike) -> np.ndarray:
     """Right ascension (rad) of the mean Sun: its mean longitude 280.460 + 0.9856474 deg/day from J2000
-    (the equation of time, < 4.5 deg, is left out: a sun-synchronous node follows the mean Sun)."""
+    (the equation of time, < 4.5 deg, is left out: a sun-synchronous node follows the mean Sun).
+
+    Parameters
+    ----------
+    unix_s : array_like
+        UTC seconds since 1970.
+
+    Returns
+    -------
+    numpy.ndarray
+        rad.
+    """
     d = (np.asarray(unix_s, float) - J2000_UNIX_S) / DAY_S
     return np.radians((280.460 + 0.9856474 * d) % 360.0)
 
 
 class CircularOrbit:
     """Circular orbit of *altitude_m* and *inclination_deg*: argument of latitude *u0_rad* (default -14 deg)
-    and right ascension of the ascending node *raan_rad* at *t0_unix_s* (UTC seconds since 1970)."""
+    and right ascension of the ascending node *raan_rad* at *t0_unix_s* (UTC seconds since 1970).
+
+    Parameters
+    ----------
+    t0_unix_s : float
+        The epoch, UTC s.
+    altitude_m : float
+        m.
+    inclination_deg : float
+        deg.
+    u0_rad : float, optional
+        Argument of latitude at the epoch, rad.
+    raan_rad : float, optional
+        Right ascension of the ascending node, rad.
+    """
 
     def __init__(
         self,
@@ -64,7 +100,26 @@ class CircularOrbit:
         inclination_deg: float = 98.74,
     ) -> CircularOrbit:
         """The orbit whose sub-satellite point at *t0_unix_s* is at longitude *lon0_deg*, argument of
-        latitude *u0_deg*."""
+        latitude *u0_deg*.
+
+        Parameters
+        ----------
+        t0_unix_s : float
+            The epoch, UTC s.
+        lon0_deg : float
+            The sub-point's longitude, deg.
+        u0_deg : float, optional
+            Argument of latitude, deg.
+        altitude_m : float, optional
+            m.
+        inclination_deg : float, optional
+            deg.
+
+        Returns
+        -------
+        CircularOrbit
+            The orbit.
+        """
         orbit = cls(t0_unix_s, altitude_m, inclination_deg, np.radians(u0_deg), 0.0)
         x, y, _ = orbit._orbit_plane(orbit.u0, 0.0)
         orbit.raan = np.radians(lon0_deg) + earth_rotation_angle(orbit.t0) - np.arctan2(y, x)
@@ -73,7 +128,20 @@ class CircularOrbit:
     @classmethod
     def of(cls, sat: Satellite, t0_unix_s: float) -> CircularOrbit:
         """The satellite's own orbit at *t0_unix_s*: node from the local time of the ascending node,
-        argument of latitude from the phase."""
+        argument of latitude from the phase.
+
+        Parameters
+        ----------
+        sat : Satellite
+            The satellite.
+        t0_unix_s : float
+            The epoch, UTC s.
+
+        Returns
+        -------
+        CircularOrbit
+            Its orbit.
+        """
         orbit = cls(t0_unix_s, sat.altitude_m, sat.inclination_deg)
         orbit.u0 = float(_argument_of_latitude(sat, t0_unix_s))
         orbit.raan = float(_node_right_ascension(sat, t0_unix_s))
@@ -86,14 +154,36 @@ class CircularOrbit:
         return np.stack([co * cu - so * su * ci, so * cu + co * su * ci, su * si])
 
     def state_eci(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """ECI position (m) and velocity (m/s), shapes t + (3,)."""
+        """ECI position (m) and velocity (m/s), shapes t + (3,).
+
+        Parameters
+        ----------
+        unix_s : array_like
+            UTC seconds since 1970.
+
+        Returns
+        -------
+        position_m, velocity_m_s : numpy.ndarray
+            ECI, shape t + (3,).
+        """
         u = self.u0 + self.n * (np.asarray(unix_s, float) - self.t0)
         r = self.a * np.moveaxis(self._orbit_plane(u, self.raan), 0, -1)
         du = np.moveaxis(self._orbit_plane(u + np.pi / 2, self.raan), 0, -1)
         return r, self.a * self.n * du
 
     def state_ecef(self, unix_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """ECEF position (m) and velocity (m/s) at UTC seconds since 1970."""
+        """ECEF position (m) and velocity (m/s) at UTC seconds since 1970.
+
+        Parameters
+        ----------
+        unix_s : array_like
+            UTC seconds since 1970.
+
+        Returns
+        -------
+        position_m, velocity_m_s : numpy.ndarray
+            ECEF, shape t + (3,).
+        """
         r, v = self.state_eci(unix_s)
         theta = earth_rotation_angle(unix_s)
         c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
@@ -137,7 +227,30 @@ def find_pass(
     """UTC seconds of the satellite's sub-point crossing *lat_deg* (geocentric, northbound when
     *ascending*) after *after_unix_s*; with *lon_deg*, the crossing nearest that longitude within
     *days* (16: the JPSS repeat cycle, so every longitude comes within ~1 deg). ValueError if the
-    latitude is beyond the orbit's reach."""
+    latitude is beyond the orbit's reach.
+
+    Parameters
+    ----------
+    sat : Satellite
+        The satellite.
+    after_unix_s : float
+        UTC s.
+    lat_deg : float
+        Geocentric latitude, deg.
+    ascending : bool, optional
+        Northbound.
+    lon_deg : float, optional
+        The crossing nearest this longitude, deg.
+    days : int, optional
+        Searched within these days.
+    step_s : float, optional
+        The search's step, s.
+
+    Returns
+    -------
+    float
+        UTC s.
+    """
     if abs(np.sin(np.radians(lat_deg))) >= np.sin(np.radians(180.0 - sat.inclination_deg)):
         raise DataError(f"latitude {lat_deg} deg is beyond the reach of the {sat.name} orbit")
     t = after_unix_s + np.arange(0.0, (days if lon_deg is not None else 1) * DAY_S, step_s)

@@ -50,7 +50,24 @@ class RayGeometry(NamedTuple):
 
 def ray_geometry(o: np.ndarray, d: np.ndarray, t_floor: np.ndarray, top_m: float) -> RayGeometry:
     """The :class:`RayGeometry` of rays from ECEF *o* (R, 3) along unit *d* (R, 3) that meet the ellipsoid
-    at *t_floor* (R,), from the shell at *top_m* (m above the ellipsoid) down."""
+    at *t_floor* (R,), from the shell at *top_m* (m above the ellipsoid) down.
+
+    Parameters
+    ----------
+    o : numpy.ndarray
+        Ray origins, ECEF, m, shape (R, 3).
+    d : numpy.ndarray
+        Unit directions, shape (R, 3).
+    t_floor : numpy.ndarray
+        Where they meet the ellipsoid, m, shape (R,).
+    top_m : float
+        The shell's height above the ellipsoid, m.
+
+    Returns
+    -------
+    RayGeometry
+        The rays from the shell down.
+    """
     t_top = wgs84.intersect_ellipsoid(o, d, top_m)
     ts = (t_top, 0.5 * (t_top + t_floor), t_floor)
     geo = [wgs84.ecef_to_geodetic(o + t[:, None] * d, NEAR_SURFACE_ITERATIONS) for t in ts]
@@ -94,7 +111,28 @@ def first_crossing(
     Earth. *march(rays, steps, index, out)* finds each ray's crossing (*index*: the rays' places among
     those given, flattened) in *steps* equal steps from the shell down
     (steps of at most *step_m* of ground distance; inf: one bracket). Given *floor_height(lat_rad,
-    lon_rad)*, the surface is met once: a ray whose ellipsoid point has no surface above it ends there."""
+    lon_rad)*, the surface is met once: a ray whose ellipsoid point has no surface above it ends there.
+
+    Parameters
+    ----------
+    origin_m : numpy.ndarray
+        Ray origins, ECEF, m.
+    los : numpy.ndarray
+        Unit directions, shape (..., 3).
+    top_m : float
+        The surface's highest point, m.
+    step_m : float
+        The march's step of ground distance, m (inf: one bracket).
+    march : March
+        Finds each ray's crossing.
+    floor_height : callable, optional
+        The surface below which a ray has crossed, m, of (lat_rad, lon_rad).
+
+    Returns
+    -------
+    distance_m, lat_rad, lon_rad, h_m : numpy.ndarray
+        NaN where the ray misses the Earth.
+    """
     o = np.ascontiguousarray(np.broadcast_to(np.asarray(origin_m, float), np.shape(los)).reshape(-1, 3))
     d = np.ascontiguousarray(np.asarray(los, float).reshape(-1, 3))
     shape = np.shape(los)[:-1]
