@@ -16,14 +16,14 @@ For the day *x* that holds one or more known changes (calendar, granule metadata
   change (no move at all) shows a significant FOR-direction somewhere with probability
   ``alerts.false_detection_at_change`` (Sidak over the FOR-directions measured). The move common to all
   FORs, per direction, is the generalised least-squares estimate the rule pools with
-  (:func:`alerts.steps.pooled`).
+  (:func:`alerts.noise.pooled`).
 * **predicted**: where the LOS fingerprints on either side of the change each name an EP (the best match of
   the EP library within :data:`EP_MATCH_URAD`) and the two differ, the move the new EP's mapping angles
   predict. The offset is the turn to add to the GEO's line of sight (the export's ``sign_convention``), so
   turning the GEO's FOV-5 line of sight by delta moves the offset by -delta. The EP model's angles are the
   fingerprint's minus the match's residual (:func:`monitor.mapping.fingerprint.identify_ep`). **chi2**
   weighs observed - predicted with the moves' covariance: exchangeable within a direction (the fitted shared
-  part rho; Sherman-Morrison, as :func:`alerts.steps.pooled`), so per direction
+  part rho; Sherman-Morrison, as :func:`alerts.noise.pooled`), so per direction
   (sum z^2 - f (sum z)^2) / (1 - rho), f = rho / (1 - rho + n rho), n the FORs measured; its degrees of
   freedom are the FOR-directions measured.
 """
@@ -38,8 +38,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from alerts.noise import GROUPS, Noise, pooled
 from alerts.rules import GEOLOCATION, watched_series
-from alerts.steps import GROUPS, Noise, floored_noise, move, pooled, window_mean
+from alerts.steps import floored_noise, move, window_mean
 from monitor.config.alert_settings import RuleSettings
 from monitor.core.constants import N_FOR
 from monitor.core.tables import Column, text_table

@@ -8,7 +8,7 @@ urad; or the CrIS-VIIRS bias, in K) is its level plus an error
 s the reported sigma, lambda_c the scale of the real scatter to the reported one, rho_c the share of the
 error variance that the FORs of one day have in common (their scenes are shared), g and h unit AR(1)
 series over calendar days with lag-one correlation phi. The three are fitted from the history, never
-assumed (:func:`fit_noise`): from first differences of consecutive days, so a step costs one outlier,
+assumed (:func:`alerts.noise.fit_noise`): from first differences of consecutive days, so a step costs one outlier,
 with medians, so outliers cost nothing. lambda checks the reported sigmas against the day-to-day scatter:
 sigmas too small make lambda > 1, so such days cannot page; honest ones give lambda ~ 1.
 
@@ -17,7 +17,7 @@ of the days [tau, T] with that of the baseline before tau (at most ``baseline_da
 accepted step): D_k with variance V_k = lambda^2 u^T Phi u (u the contrast times the sigmas, Phi the
 AR(1) correlation of the days). For a group G of FORs (all 30, the three tens, every 3 adjacent, each
 alone) the step common to G is its generalised least-squares estimate under the exchangeable correlation
-rho of the D_k (:func:`pooled`): the FORs outside G then measure the shared part of the error, so a step
+rho of the D_k (:func:`alerts.noise.pooled`): the FORs outside G then measure the shared part of the error, so a step
 of a few FORs is seen through it. z = estimate / sigma.
 
 **The thresholds** come from false-detection rates (:func:`threshold`): on each day the blind test tries
@@ -51,18 +51,19 @@ from functools import lru_cache
 
 import numpy as np
 
+from alerts.noise import (
+    GROUPS,
+    MEMBERS,
+    MIN_HISTORY_DAYS,
+    Noise,
+    ar1_correlation,
+    fit_noise,
+    pooled,
+    step_contrast,
+)
 from monitor.core.constants import N_FOR
 
-# the groups of FORs pooled: all, the three tens, every 3 adjacent, each alone; (name, 0-based indices)
-GROUPS: tuple[tuple[str, tuple[int, ...]], ...] = (
-    (("FOR 1-30", tuple(range(N_FOR))),)
-    + tuple((f"FOR {i + 1}-{i + 10}", tuple(range(i, i + 10))) for i in range(0, N_FOR, 10))
-    + tuple((f"FOR {i + 1}-{i + 3}", (i, i + 1, i + 2)) for i in range(N_FOR - 2))
-    + tuple((f"FOR {i + 1}", (i,)) for i in range(N_FOR))
-)
-MEMBERS = np.array([[k in idx for k in range(N_FOR)] for _, idx in GROUPS], float)  # (groups, N_FOR)
 NULL_DRAWS = 200_000  # simulated days per threshold: ~550 beyond it at 1/365
-MIN_HISTORY_DAYS = 20  # assessed days the noise is fitted from before anything is tested
 REFIT_DAYS = 28  # the noise is fitted anew every four weeks (detect)
 REFIT_EPOCH = dt.date(2000, 1, 3).toordinal()  # a Monday: the refits' dates
 # the thresholds are simulated for this share of the configured rates: the rates are bounds ("at most"),
@@ -88,16 +89,6 @@ class StepRules:
 
 
 @dataclass(frozen=True)
-class Noise:
-    """The history's error, per direction: *scale* (real scatter over the reported sigma), *shared* (the
-    share of the variance common to the FORs of a day), and *lag1* (the day-to-day correlation)."""
-
-    scale: np.ndarray
-    shared: np.ndarray
-    lag1: float
-
-
-@dataclass(frozen=True)
 class Step:
     """A step found: its *split* (the first day at the new level; for a known change, the change's day),
     the known change's index in the changes given (None: none within ``attribution_days``), the day it
@@ -116,108 +107,6 @@ class Step:
     size: np.ndarray  # (N_FOR, directions)
     sigma: np.ndarray
     paged: bool
-
-
-def _robust_var(x: np.ndarray) -> float:
-    """The variance of a normal sample of zero mean, its values winsorised at 3.5 times the scale their
-    median absolute value gives: nearly as precise as the plain variance (the rule's thresholds pay for
-    the fit's error), while an outlier costs at most 12 / n of it."""
-    x = x[np.isfinite(x)]
-    if x.size < 5:
-        return math.nan
-    clip = 3.5 * 1.4826 * float(np.median(np.abs(x)))
-    return float(np.mean(np.minimum(x**2, clip**2)))
-
-
-def fit_noise(ordinal: np.ndarray, y: np.ndarray, s: np.ndarray) -> Noise | None:
-    """The :class:`Noise` of the days *ordinal* (T,), values *y* and sigmas *s* (T, N_FOR, C), from the
-    differences of consecutive calendar days scaled by their sigmas: their variance is
-    lambda^2 (1 - phi), their lag-one correlation -(1 - phi) / 2, and the variance of their mean over the
-    FORs of a day lambda^2 (1 - phi) (rho + (1 - rho) / K). None with fewer than MIN_HISTORY_DAYS pairs.
-
-    Parameters
-    ----------
-    ordinal : numpy.ndarray
-        The days' ordinals, shape (T,).
-    y : numpy.ndarray
-        The values (urad, or K for the bias), shape (T, N_FOR, C).
-    s : numpy.ndarray
-        Their sigmas, same shape.
-
-    Returns
-    -------
-    Noise or None
-        None with fewer than MIN_HISTORY_DAYS pairs.
-    """
-    consecutive = np.flatnonzero(np.diff(ordinal) == 1) + 1
-    if len(consecutive) < MIN_HISTORY_DAYS:
-        return None
-    d = (y[consecutive] - y[consecutive - 1]) / np.hypot(s[consecutive], s[consecutive - 1])
-    var1 = np.array([_robust_var(d[..., c]) for c in range(d.shape[-1])])  # lambda^2 (1 - phi)
-    if not np.all(np.isfinite(var1)) or np.any(var1 <= 0):
-        return None
-    u = np.clip(d / np.sqrt(var1), -5.0, 5.0)  # a step is one outlier of the differences: clipped
-    follows = np.flatnonzero(np.diff(consecutive) == 1) + 1  # difference pairs on consecutive days
-    a, b = u[follows], u[follows - 1]
-    ok = np.isfinite(a) & np.isfinite(b)
-    norm = math.sqrt(np.sum(a[ok] ** 2) * np.sum(b[ok] ** 2)) if ok.any() else 0.0
-    corr = float(np.sum(a[ok] * b[ok]) / norm) if norm > 0 else 0.0
-    lag1 = float(np.clip(1.0 + 2.0 * corr, 0.0, 0.9))
-    k = np.sum(np.isfinite(u), axis=1)  # FORs per day and direction
-    with np.errstate(all="ignore"):
-        mean = np.nansum(u, axis=1) / k
-    ratio = np.array([_robust_var(mean[:, c]) for c in range(u.shape[-1])])
-    kc = np.maximum(np.median(k, axis=0), 2)
-    shared = np.clip((ratio - 1.0 / kc) / (1.0 - 1.0 / kc), 0.0, 0.95)
-    return Noise(np.sqrt(var1 / (1.0 - lag1)), shared, lag1)
-
-
-def pooled(d: np.ndarray, sigma: np.ndarray, shared: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per group (:data:`GROUPS`) the generalised least-squares step common to its FORs and its sigma, from
-    per-FOR differences *d* (..., N_FOR) with sigmas *sigma* correlated by *shared* between FORs (NaN: not
-    measured). With a = 1 / sigma, f = rho / (1 - rho + n rho) over the n FORs measured and x the group's
-    indicator, x^T S^-1 d = (sum_G a^2 d - f sum_G a sum a d) / (1 - rho), x^T S^-1 x likewise (the
-    exchangeable correlation's inverse, Sherman-Morrison). Returns (estimate, sigma), (..., groups).
-
-    Parameters
-    ----------
-    d : numpy.ndarray
-        Per-FOR differences, shape (..., N_FOR); NaN: not measured.
-    sigma : numpy.ndarray
-        Their sigmas.
-    shared : float or numpy.ndarray
-        Their correlation between FORs.
-
-    Returns
-    -------
-    step, sigma : numpy.ndarray
-        Per group.
-    """
-    rho = np.asarray(shared, float)
-    a = np.where(np.isfinite(d) & np.isfinite(sigma) & (sigma > 0), 1.0 / np.where(sigma > 0, sigma, 1), 0.0)
-    dz = np.where(a > 0, d, 0.0)
-    n = np.sum(a > 0, axis=-1, keepdims=True)
-    f = rho / (1.0 - rho + n * rho)
-    total = np.sum(a * dz, axis=-1, keepdims=True)
-    a_g = a @ MEMBERS.T
-    num = ((a**2 * dz) @ MEMBERS.T - f * a_g * total) / (1.0 - rho)
-    den = ((a**2) @ MEMBERS.T - f * a_g**2) / (1.0 - rho)
-    measured = (a > 0).astype(float) @ MEMBERS.T >= np.maximum(1.0, 0.5 * MEMBERS.sum(axis=1))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        est = np.where(measured & (den > 0), num / den, np.nan)
-        sig = np.where(measured & (den > 0), 1.0 / np.sqrt(den), np.nan)
-    return est, sig
-
-
-def _ar1(ordinal: np.ndarray, lag1: float) -> np.ndarray:
-    """The AR(1) correlation of days *ordinal*: lag1 ** |days apart|."""
-    apart = np.abs(ordinal[:, None] - ordinal[None, :]).astype(float)
-    return lag1**apart if lag1 > 0 else (apart == 0).astype(float)
-
-
-def _contrast(n_pre: int, n_post: int) -> np.ndarray:
-    """Uniform weights: +1/n_post on the post days, -1/n_pre on the baseline's."""
-    return np.r_[np.full(n_pre, -1.0 / n_pre), np.full(n_post, 1.0 / n_post)]
 
 
 # the fits' lengths (days) thresholds are simulated for
@@ -243,7 +132,7 @@ def fit_days_bucket(n: int) -> int:
 
 
 def _simulated_fits(shared: float, lag1: float, fit_days: int, directions: int) -> list[Noise]:
-    """:data:`FIT_DRAWS` noises :func:`fit_noise` fits on *fit_days* days in a row of unit sigmas whose
+    """:data:`FIT_DRAWS` noises :func:`alerts.noise.fit_noise` fits on *fit_days* days in a row of unit sigmas whose
     true noise is scale 1, *shared* and *lag1* (a fixed seed): the spread of what the rule would believe."""
     rng = np.random.default_rng(20261128)
     out = []
@@ -306,7 +195,7 @@ def threshold(
         The |z| threshold.
     """
     if known:  # baseline days, the change's day, then the days after it
-        rows = [np.r_[_contrast(baseline, j), np.zeros(discovery - j)] for j in range(1, discovery + 1)]
+        rows = [np.r_[step_contrast(baseline, j), np.zeros(discovery - j)] for j in range(1, discovery + 1)]
         ordinal = np.r_[np.arange(baseline), baseline + 1 + np.arange(discovery)]
     else:  # a baseline of its own before each split, the splits' post days ending on the last day
         span = baseline + discovery
@@ -318,7 +207,7 @@ def threshold(
             rows.append(c)
         ordinal = np.arange(span)
     c = np.array(rows)
-    cov = c @ _ar1(ordinal, lag1) @ c.T
+    cov = c @ ar1_correlation(ordinal, lag1) @ c.T
     chol = np.linalg.cholesky(cov + 1e-12 * np.eye(len(cov))).astype(np.float32)  # the contrasts' truth
     n_g = MEMBERS.sum(axis=1).astype(np.float32)
     members = MEMBERS.T.astype(np.float32)
@@ -326,7 +215,8 @@ def threshold(
     peaks = []
     fits = _simulated_fits(shared, lag1, fit_days, directions)
     for fit, chunk in zip(fits, np.array_split(np.arange(NULL_DRAWS), len(fits)), strict=True):
-        believed = fit.scale * np.sqrt(np.einsum("ij,jk,ik->i", c, _ar1(ordinal, fit.lag1), c))[:, None]
+        days = ar1_correlation(ordinal, fit.lag1)
+        believed = fit.scale * np.sqrt(np.einsum("ij,jk,ik->i", c, days, c))[:, None]
         shape = (len(rows), len(chunk), directions)
         g = rng.standard_normal((*shape, 1), dtype=np.float32)
         h = rng.standard_normal((*shape, N_FOR), dtype=np.float32)
@@ -561,7 +451,7 @@ def floored_noise(
 ) -> tuple[Noise, np.ndarray] | None:
     """The :class:`Noise` fitted on the *days* (a mask) and the sigmas it applies to: a day's sigma is not
     believed below half the FOR's usual one there (a day whose sigmas are too small cannot page). None
-    when the noise cannot be fitted (:func:`fit_noise`).
+    when the noise cannot be fitted (:func:`alerts.noise.fit_noise`).
 
     Parameters
     ----------

@@ -10,7 +10,7 @@ import json
 from pathlib import Path
 
 from monitor.assessment import DayAssessment
-from monitor.assessment.assess import GranuleSamples
+from monitor.assessment.estimates import GranuleSamples
 from monitor.collocation import render
 from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import cost_and_offsets
+from monitor.assessment.estimates import cost_and_offsets
 from monitor.assessment.replay import assess_collocations, read_collocation
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR, URAD

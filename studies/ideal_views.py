@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import emit
-from monitor.assessment.assess import cost_and_offsets, paired
+from monitor.assessment.estimates import cost_and_offsets, paired
 from monitor.collocation import render
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig

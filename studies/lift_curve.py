@@ -20,7 +20,7 @@ import json
 from pathlib import Path
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import for_samples, paired
+from monitor.assessment.estimates import for_samples, paired
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
 from monitor.estimation import parallax

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.provenance import commit, emit
-from monitor.assessment.assess import cost_and_offsets, for_samples, paired
+from monitor.assessment.estimates import cost_and_offsets, for_samples, paired
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR

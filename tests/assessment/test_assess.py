@@ -65,7 +65,8 @@ def test_result_fields_and_km(cases):
 
 
 def test_too_few_samples_are_flagged(cases):
-    from monitor.assessment.assess import collocate_run, cost_and_offsets
+    from monitor.assessment.assess import collocate_run
+    from monitor.assessment.estimates import cost_and_offsets
     from monitor.sdr.pairing import plan
 
     out, _, _ = cases.get("paper", 1)
@@ -125,7 +126,8 @@ def test_a_day_assessed_in_batches_is_the_day_assessed_at_once(cases, case_plan)
     day keeps its cones on disk, reads them back exactly, and removes them when closed."""
     from dataclasses import replace
 
-    from monitor.assessment.assess import DayAssessment, cost_and_offsets
+    from monitor.assessment.assess import DayAssessment
+    from monitor.assessment.estimates import cost_and_offsets
     from monitor.assessment.spool import OnDisk
 
     _, _, at_once = cases.get()

@@ -9,7 +9,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from monitor.assessment.assess import DayAssessment, cost_and_offsets
+from monitor.assessment.assess import DayAssessment
+from monitor.assessment.estimates import cost_and_offsets
 from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case

@@ -1,0 +1,307 @@
+"""The day's estimate from its collocated granules: per FOR the samples over the granules, the day's lift
+chosen by the cost (:mod:`monitor.estimation.parallax`), the offsets and their sigmas
+(:mod:`monitor.estimation.offsets`), and the offsets on the ground in km (Wang et al. 2017, section 2.4).
+
+:class:`GranuleSamples` is what :mod:`monitor.assessment.assess` collocates of one CrIS granule.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import overload
+
+import numpy as np
+
+from monitor.assessment.inputs import KERNELS, offsets_rad
+from monitor.assessment.spool import OnDisk, Spool
+from monitor.collocation.lift import PROBE_M_PER_K
+from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import N_FOR
+from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
+from monitor.estimation import parallax
+from monitor.estimation.estimate import ForSamples
+from monitor.estimation.jackknife import follows_in_time, uncertainty_note
+from monitor.estimation.offsets import DayLift, day_offsets
+from monitor.estimation.parallax import Blend
+from monitor.geometry.ground import offset_km
+from monitor.instrument.spectral import I5Band, i5_band
+
+
+@dataclass
+class GranuleSamples:
+    """Collocated samples of one CrIS granule: per FOV the VIIRS BT of every perturbed cone."""
+
+    key: str
+    info: GranuleInfo
+    bt_viirs_k: np.ndarray | OnDisk  # (nscan, 30, 9, m, m) through the top-hat cone
+    bt_cris_k: np.ndarray  # (nscan, 30, 9)
+    usable: np.ndarray  # (nscan, 30, 9)
+    sat_m: np.ndarray  # FOV-5 geometry per (nscan, 30) for the km conversion
+    sbf_to_ecef: np.ndarray
+    alpha_rad: np.ndarray
+    beta_rad: np.ndarray
+    velocity_m_s: np.ndarray
+    annuli_rad: np.ndarray | OnDisk | None = None  # (nscan, 30, 9, K, m, m) radiance per annulus (footprint)
+    # the same granule with the VIIRS pixels standing at a height, rendered as each FOV row sees them
+    rendered: GranuleSamples | None = None
+
+    def kept_in(self, spool: Spool) -> GranuleSamples:
+        """These samples with their perturbed cones' arrays kept on disk.
+
+        Parameters
+        ----------
+        spool : Spool
+            Where to keep them (:mod:`monitor.assessment.spool`).
+
+        Returns
+        -------
+        GranuleSamples
+            The same samples, read back from disk when indexed.
+        """
+        cones = self.bt_viirs_k if isinstance(self.bt_viirs_k, OnDisk) else spool.keep(self.bt_viirs_k)
+        annuli = self.annuli_rad
+        if isinstance(annuli, np.ndarray):
+            annuli = spool.keep(annuli)
+        rendered = None if self.rendered is None else self.rendered.kept_in(spool)
+        return replace(self, bt_viirs_k=cones, annuli_rad=annuli, rendered=rendered)
+
+
+def _ground_km(
+    samples: list[GranuleSamples], k: int, d_alpha: float, d_beta: float
+) -> tuple[float, float, np.ndarray]:
+    """Mean in-track/cross-track km of a turn (rad) at FOR k over the FOV-5 views used, and the Jacobian."""
+    sel = [
+        (s.sat_m[:, k], s.sbf_to_ecef[:, k], s.alpha_rad[:, k], s.beta_rad[:, k], s.velocity_m_s[:, k])
+        for s in samples
+        if np.any(s.usable[:, k])
+    ]
+    if not sel:
+        return np.nan, np.nan, np.full((2, 2), np.nan)
+    sat, mat, a, b, v = (np.concatenate(x) for x in zip(*sel, strict=True))
+    if not np.isfinite(d_alpha + d_beta):
+        return np.nan, np.nan, np.full((2, 2), np.nan)
+    it, ct = offset_km(sat, mat, a, b, v, d_alpha, d_beta)
+    eps = 1e-4
+    ja = offset_km(sat, mat, a, b, v, eps, 0.0)
+    jb = offset_km(sat, mat, a, b, v, 0.0, eps)
+    jac = np.array([[np.mean(ja[0]), np.mean(jb[0])], [np.mean(ja[1]), np.mean(jb[1])]]) / eps
+    return float(np.mean(it)), float(np.mean(ct)), jac
+
+
+def for_samples(
+    samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, band: I5Band | None = None
+) -> ForSamples:
+    """The estimator's input for one FOR: every usable FOV of it over the granules.
+
+    Parameters
+    ----------
+    samples : list of GranuleSamples
+        The collocated granules, in time order.
+    k : int
+        The FOR, 0-based.
+    cfg : AssessmentConfig
+        The assessment's configuration.
+    band : I5Band, optional
+        The satellite's I5 band, for the footprint kernel's annuli.
+
+    Returns
+    -------
+    ForSamples
+        The FOR's samples.
+    """
+    m = len(offsets_rad(cfg))
+    d, granule, scan, fov, annuli = [], [], [], [], []
+    for g_i, s in enumerate(samples):
+        use = s.usable[:, k]  # (nscan, 9)
+        d.append((s.bt_viirs_k[:, k][use] - s.bt_cris_k[:, k][use][:, None, None]).astype(np.float64))
+        scans, fovs = np.nonzero(use)  # the scan and FOV of each sample
+        granule.append(np.full(scans.size, g_i))
+        scan.append(scans)
+        fov.append(fovs)
+        if s.annuli_rad is not None:
+            annuli.append(s.annuli_rad[:, k][use])
+    footprint = len(KERNELS[cfg.kernel]) > 1
+    return ForSamples(
+        np.concatenate(d) if d else np.empty((0, m, m)),
+        _cris_k(samples, k),
+        np.concatenate(granule) if granule else np.empty(0, int),
+        np.concatenate(scan) if scan else np.empty(0, int),
+        np.concatenate(annuli) if footprint and annuli else None,
+        KERNELS[cfg.kernel] if footprint else (),
+        band,
+        np.concatenate(fov) if fov else np.empty(0, int),
+    )
+
+
+def cost_and_offsets(
+    samples: list[GranuleSamples],
+    cfg: AssessmentConfig,
+    skipped: Sequence[tuple[str, str]] | None = None,
+    satellite: str = "",
+    probe_m_per_k: float = PROBE_M_PER_K,
+    blend: Blend = parallax.blend,
+) -> AssessmentResult:
+    """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*.
+
+    When *cfg* asks for the parallax correction and every granule was also collocated with the VIIRS
+    pixels standing at the probe's height (:attr:`GranuleSamples.rendered`: rendered as each FOV row sees
+    them, :mod:`monitor.collocation.render`), the day's lift is chosen by the cost
+    (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it.
+
+    Parameters
+    ----------
+    samples : list of GranuleSamples
+        The collocated granules, in time order.
+    cfg : AssessmentConfig
+        The assessment's configuration (grid, kernel, cost, parallax, uncertainty).
+    skipped : sequence of (str, str), optional
+        Granules left out and why, carried into the result.
+    satellite : str, optional
+        The satellite's short name (``j01``); by default the first granule's platform.
+    probe_m_per_k : float, optional
+        The lift (m per K of I5 BT) the rendered collocation was made at.
+    blend : callable, optional
+        How a FOR's two collocations are combined at the day's fraction of the probe
+        (:func:`monitor.estimation.parallax.blend`).
+
+    Returns
+    -------
+    AssessmentResult
+        Per-FOR offsets (urad, km), sigmas, flags and the day's lift.
+    """
+    band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
+    per_for: Sequence[ForSamples] = PerFor(lambda k: for_samples(samples, k, cfg, band))
+    m_per_k = np.nan
+    spread = np.zeros((N_FOR, 4))  # the sigma (steps) the day's lift adds: FOR alpha, beta; rows alpha, beta
+    rendered = bool(samples) and all(s.rendered is not None for s in samples)
+    pairs = paired(samples) if cfg.parallax and rendered else None
+    if pairs is not None:
+        s0, s1 = pairs
+        cones0, cones1 = zip(
+            *(
+                parallax.matched_cone(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), cfg.cost)
+                for k in range(N_FOR)
+            ),
+            strict=True,
+        )
+        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost, probe_m_per_k)
+        if cfg.uncertainty and np.isfinite(sigma_f):
+            spread = np.array(
+                [
+                    np.abs(parallax.sensitivity(a, b, f, cfg.cost)) * sigma_f if len(a) >= 3 else np.zeros(4)
+                    for a, b in zip(cones0, cones1, strict=True)
+                ]
+            )
+        per_for = PerFor(
+            lambda k: blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
+        )
+        m_per_k = f * probe_m_per_k
+    used = samples if pairs is None else pairs[0]
+    lift = DayLift(
+        m_per_k,
+        np.nan_to_num(spread) * cfg.step_urad,
+        np.array([_cold_height_km(_cris_k(used, k), m_per_k) for k in range(N_FOR)]),
+    )
+    day = day_offsets(
+        per_for,
+        cfg,
+        cfg.step_urad,
+        lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
+        follows_in_time([_seconds(s.info.start) for s in samples]),
+        lift,
+    )
+    starts = [s.info.start for s in samples]
+    ends = [s.info.end for s in samples]
+    return AssessmentResult(
+        satellite=satellite,
+        start=min(starts) if starts else "",
+        end=max(ends) if ends else "",
+        fors=day.fors,
+        granules=[s.info for s in samples],
+        skipped=[Skipped(str(a), str(b)) for a, b in (skipped or [])],
+        half_steps=cfg.half_steps,
+        step_urad=cfg.step_urad,
+        cost_cube_k=day.cost_cube_k,
+        difference_bins=day.difference_bins,
+        notes=[uncertainty_note(len(samples), day.correlation)],
+    )
+
+
+def _seconds(iso: str) -> float:
+    """Seconds since the epoch of an ISO time (NaN where there is none: then no granule follows another)."""
+    try:
+        return dt.datetime.fromisoformat(iso).timestamp()
+    except ValueError:
+        return np.nan
+
+
+def paired(samples: list[GranuleSamples]) -> tuple[list[GranuleSamples], list[GranuleSamples]]:
+    """The granules of both collocations, at the GEO points and rendered, with the FOVs usable in both.
+
+    Parameters
+    ----------
+    samples : list of GranuleSamples
+        Granules collocated with their rendering (:attr:`GranuleSamples.rendered`).
+
+    Returns
+    -------
+    at_geo, rendered : list of GranuleSamples
+        The two collocations; a ValueError if a granule was not rendered.
+    """
+    rendered = [s.rendered for s in samples if s.rendered is not None]
+    if len(rendered) != len(samples):
+        raise ValueError("paired: a granule was not collocated rendered")
+    both = [s.usable & r.usable for s, r in zip(samples, rendered, strict=True)]
+    return (
+        [replace(s, usable=u, rendered=None) for s, u in zip(samples, both, strict=True)],
+        [replace(r, usable=u) for r, u in zip(rendered, both, strict=True)],
+    )
+
+
+def _cris_k(samples: list[GranuleSamples], k: int) -> np.ndarray:
+    """The CrIS BT (K) of FOR k's usable FOVs over the granules, in order (the samples' cris_k)."""
+    return np.concatenate([s.bt_cris_k[:, k][s.usable[:, k]] for s in samples] or [np.empty(0)]).astype(
+        np.float64
+    )
+
+
+def _cold_height_km(cris_k: np.ndarray, m_per_k: float) -> float:
+    """The height (km) the correction puts a FOR's cold scenes at: *m_per_k* times its CrIS BT's 95th
+    minus 5th percentile (NaN without samples or correction)."""
+    if len(cris_k) < 3 or not np.isfinite(m_per_k):
+        return np.nan
+    return float(m_per_k * np.subtract(*np.percentile(cris_k, [95, 5])) / 1000.0)
+
+
+class PerFor(Sequence[ForSamples]):
+    """The 30 FORs' samples, each built when indexed (read from the day's spool, blended).
+
+    One FOR of a long day is in memory at a time, not the day
+    (:func:`~monitor.estimation.offsets.day_offsets`).
+
+    Parameters
+    ----------
+    build : callable
+        Builds FOR k's (0-based) samples.
+    """
+
+    def __init__(self, build: Callable[[int], ForSamples]) -> None:
+        self._build = build
+
+    def __len__(self) -> int:
+        return N_FOR
+
+    @overload
+    def __getitem__(self, k: int) -> ForSamples: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> list[ForSamples]: ...
+
+    def __getitem__(self, k: int | slice) -> ForSamples | list[ForSamples]:
+        if isinstance(k, slice):
+            return [self._build(i) for i in range(N_FOR)[k]]
+        if not -N_FOR <= k < N_FOR:
+            raise IndexError(k)
+        return self._build(k % N_FOR)
