@@ -8,17 +8,17 @@ urad; or the CrIS-VIIRS bias, in K) is its level plus an error
 s the reported sigma, lambda_c the scale of the real scatter to the reported one, rho_c the share of the
 error variance that the FORs of one day have in common (their scenes are shared), g and h unit AR(1)
 series over calendar days with lag-one correlation phi. The three are fitted from the history, never
-assumed (:func:`alerts.noise.fit_noise`): from first differences of consecutive days, so a step costs one outlier,
-with medians, so outliers cost nothing. lambda checks the reported sigmas against the day-to-day scatter:
-sigmas too small make lambda > 1, so such days cannot page; honest ones give lambda ~ 1.
+assumed (:func:`alerts.noise.fit_noise`): from first differences of consecutive days, so a step costs one
+outlier, with medians, so outliers cost nothing. lambda checks the reported sigmas against the day-to-day
+scatter: sigmas too small make lambda > 1, so such days cannot page; honest ones give lambda ~ 1.
 
 **The test.** A step at day tau seen on day T compares, per FOR and direction, the inverse-variance mean
 of the days [tau, T] with that of the baseline before tau (at most ``baseline_days``, after the last
 accepted step): D_k with variance V_k = lambda^2 u^T Phi u (u the contrast times the sigmas, Phi the
 AR(1) correlation of the days). For a group G of FORs (all 30, the three tens, every 3 adjacent, each
 alone) the step common to G is its generalised least-squares estimate under the exchangeable correlation
-rho of the D_k (:func:`alerts.noise.pooled`): the FORs outside G then measure the shared part of the error, so a step
-of a few FORs is seen through it. z = estimate / sigma.
+rho of the D_k (:func:`alerts.noise.pooled`): the FORs outside G then measure the shared part of the error, so
+a step of a few FORs is seen through it. z = estimate / sigma.
 
 **The thresholds** come from false-detection rates (:func:`threshold`): on each day the blind test tries
 the splits T, T-1, T-2 (a step is found within three days) for every group and both directions; the
@@ -132,7 +132,8 @@ def fit_days_bucket(n: int) -> int:
 
 
 def _simulated_fits(shared: float, lag1: float, fit_days: int, directions: int) -> list[Noise]:
-    """:data:`FIT_DRAWS` noises :func:`alerts.noise.fit_noise` fits on *fit_days* days in a row of unit sigmas whose
+    """:data:`FIT_DRAWS` noises :func:`alerts.noise.fit_noise` fits on *fit_days* days in a row of unit sigmas
+    whose
     true noise is scale 1, *shared* and *lag1* (a fixed seed): the spread of what the rule would believe."""
     rng = np.random.default_rng(20261128)
     out = []
