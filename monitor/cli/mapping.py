@@ -15,7 +15,8 @@ from monitor.core.errors import DataError
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
     from monitor.geometry.ep_model import EngineeringPacket
-    from monitor.mapping.fingerprint import DayPrint, EpMatch
+    from monitor.mapping.fingerprint import DayPrint
+    from monitor.mapping.identify import EpMatch
     from monitor.mapping.residuals import OwnResiduals, ResidualTable
 
 RESIDUAL_ARGS = (
@@ -212,6 +213,7 @@ def cmd_fingerprint(args: argparse.Namespace) -> int:
     import json
 
     from monitor.mapping import fingerprint as fpr
+    from monitor.mapping import identify
 
     f = options(
         FingerprintConfig,
@@ -223,7 +225,7 @@ def cmd_fingerprint(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(fp.to_dict(), indent=1))
     else:
-        print(fpr.format_print(fp.verdict.day))
+        print(identify.format_print(fp.verdict.day))
         for s in fp.skipped:
             print(f"skipped {s}")
         c = fp.verdict.change
@@ -232,7 +234,7 @@ def cmd_fingerprint(args: argparse.Namespace) -> int:
             if c is None
             else f"step from granule {c.granule} at FOR {', '.join(map(str, c.fors))}"
         )
-        print(fpr.format_matches(fp.verdict.matches))
+        print(identify.format_matches(fp.verdict.matches))
         for p in fp.problems:
             print(f"EP library: {p}")
     if args.write_residuals:
