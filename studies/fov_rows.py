@@ -32,7 +32,8 @@ from monitor.assessment.replay import assess_collocations, read_collocation
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR, URAD
 from monitor.core.result import AssessmentResult
-from monitor.estimation.estimate import FOV_ROWS, find_minimum
+from monitor.estimation.cost import find_minimum
+from monitor.estimation.estimate import FOV_ROWS
 from monitor.simulate.case import simulate_case
 from studies.collocated import collocated
 

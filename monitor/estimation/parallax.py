@@ -49,11 +49,10 @@ import numpy as np
 
 from monitor.core.constants import FOV_HALF_ANGLE_RAD
 from monitor.core.vocabulary import Cost
+from monitor.estimation.cost import cost_surface, find_minimum
 from monitor.estimation.estimate import (
     FOV_ROWS,
     ForSamples,
-    cost_surface,
-    find_minimum,
     fitted_response,
     through,
 )

@@ -111,7 +111,7 @@ def window_covariance(
         Replicate weights of the samples, shape (B, N): one covariance per replicate.
     cris : numpy.ndarray, optional
         The regression cost's regressors, shape (N, R) (the CrIS BT and its square,
-        :func:`monitor.assessment.assess.calibration_regressors`).
+        :func:`monitor.estimation.cost.calibration_regressors`).
 
     Returns
     -------

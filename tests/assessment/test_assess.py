@@ -3,7 +3,7 @@ import pytest
 
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import FLAG_EDGE, FLAG_FEW_SAMPLES, FLAG_FLAT, FLAG_UNCERTAIN, AssessmentResult
-from monitor.estimation.estimate import find_minimum
+from monitor.estimation.cost import find_minimum
 from tests.conftest import truth_arrays
 from tests.invoke import run_crisgeo
 

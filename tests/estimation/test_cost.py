@@ -7,7 +7,8 @@ import pytest
 from monitor.core.constants import DEFAULT_STEP_URAD
 from monitor.core.vocabulary import Cost
 from monitor.estimation import refine
-from monitor.estimation.estimate import ForSamples, calibration_regressors, cost_surface, estimate
+from monitor.estimation.cost import calibration_regressors, cost_surface
+from monitor.estimation.estimate import ForSamples, estimate
 
 
 def _samples(rng, n=300, m=21):
