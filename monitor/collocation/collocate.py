@@ -22,7 +22,7 @@ testing its pixels.
 Compiled. The search, the interval test and the accumulation run in one numba kernel, in parallel over
 FOVs; each FOV accumulates its own (2n+1) x (2n+2) difference array, so threads never share a sum. Its
 entries are complex, weight x radiance + i weight: the two sums a pixel adds to are one 16-byte
-read-modify-write at each end of its run, not two (~5 % of the kernel's time).
+read-modify-write at each end of its run, not two.
 The j run of an interval [t_lo, t_hi] is found by comparing with the FOV's tan B_j (no arctangent), for
 all rows in one loop of selects, not branches (the accumulation, a scatter, is a loop of its own). The
 kernel uses numba's numpy error model (a division by zero gives inf or NaN, which it tests for).
@@ -48,9 +48,8 @@ from monitor.instrument.spectral import PARALLEL_FROM, i5_band
 # annuli between nested discs let the estimator fit the CrIS spatial response (monitor.estimation.estimate):
 # CrIS sees a smooth, radially symmetric response, 70 % of peak at 0.437 deg from the LOS and 3 % at 0.619 deg
 # at most (Wang slides, table 3, monitor.instrument.footprint), so the annuli reach past the cone to 0.64 deg.
-# Four discs: the kernel's work grows with their number, and three (no edge inside the cone) miss the
-# response's fall
-# from 0.42 to 0.48 deg (6-granule smooth cases: 11-12 urad RMS against 3-4 with four; six gave 3-3.5).
+# Four discs: the kernel's work grows with their number, and three (no edge inside the cone) would miss
+# the response's fall from 0.42 to 0.48 deg (studies/footprint.md).
 TOP_HAT = (FOV_HALF_ANGLE_RAD,)
 ANNULI = (math.radians(0.42), FOV_HALF_ANGLE_RAD, math.radians(0.56), math.radians(0.64))
 # The kernel's threads take FOVs in chunks of this many as they come free (FOVs differ in pixel count, and
@@ -566,9 +565,8 @@ def _sums(acc: np.ndarray, solid: np.ndarray, radii_rad: tuple[float, ...]) -> C
 
 
 def warm_up() -> float:
-    """Compile the kernels, or load them from numba's cache, on a tiny synthetic granule.
-
-    A timing, or the first granule, then does not pay for it.
+    """Compile the kernels, or load them from numba's cache, on a tiny synthetic granule: a timing, or the
+    first granule, then does not pay for it.
 
     Returns
     -------

@@ -15,18 +15,11 @@ covers counts half). The sum of the weights inside a cone over the cone's solid 
 1 when VIIRS fills it.
 
 Search blocks. Each prepared granule keeps, per 4 x 4 block of pixels (blocks never straddle two scans),
-a sphere holding its usable pixels, and a KD-tree of the block centres to find where a FOV lands.
+a sphere holding its usable pixels, and a KD-tree of the block centres to find where a FOV lands. Only the
+columns and scans a CrIS granule can reach are prepared (:mod:`monitor.collocation.reach`).
 
-Columns and scans. VIIRS scans to 56 deg from nadir, CrIS's cones reach ~51 deg: the columns no cone can
-reach (~15 % of a granule) are not prepared when the caller gives the reach (:func:`reach.view_columns`). Nor
-are the scans observed long before or after every CrIS granule that uses the VIIRS granule, when the
-caller gives that time span (:func:`reach.scans_between`): a CrIS granule (32 s) needs a third of one VIIRS
-granule (86 s), or parts of two.
-
-A granule is prepared once per run (about 10 million pixels): the per-pixel work is compiled (numba) and
-runs scan by scan in parallel; only the one-scan statistics and the KD-tree are numpy/scipy. The kernels
-use numba's numpy error model: a division by zero gives inf or NaN, which they test for, instead of a
-Python exception check in every loop that keeps the compiler from vectorising it (~8 % of the time).
+A granule is prepared once per run (about 10 million pixels), compiled (numba) and scan by scan in
+parallel, with numba's numpy error model (a division by zero gives inf or NaN, which the kernels test for).
 """
 
 from __future__ import annotations
@@ -479,9 +472,6 @@ def swath_piece(
 ) -> SwathPiece:
     """Prepare one VIIRS granule's geolocation and I5 BT for collocation.
 
-    Pixels are the 3-D points (lat, lon, height); their weight is the solid angle their footprint subtends
-    from CrIS, less the share a neighbouring scan also covers (docs/science.md, "Collocation").
-
     Parameters
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
@@ -515,7 +505,7 @@ def swath_piece(
     Returns
     -------
     SwathPiece
-        The 3-D pixel points, their band radiance, solid-angle footprints and scan-overlap shares, and the
+        The 3-D pixel points, their band radiance and solid-angle weights (module docstring), and the
         rendered views' radiance when given.
     """
     scans, kept = kept_pixels(lat_rad, lon_rad, height_m, sat_m, view_rad, scan_start_us, span_us)

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from monitor.core.result import NAN, Family, ForOffset, measured, measures
+from monitor.core.measures import Family, measured
+from monitor.core.result import NAN, ForOffset, measures
 from monitor.core.tables import field_column, text_table
 from monitor.history.records import ForSeries
 from monitor.service.outputs.metrics import _StoreCollector

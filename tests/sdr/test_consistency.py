@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from monitor.sdr import GranuleError
-from monitor.sdr.consistency import check_pixel_steps
+from monitor.sdr.geolocation import check_pixel_steps
 from monitor.sdr.products import PRODUCTS
 
 STEP_RAD = 0.4 / 6371.0  # 400 m, an I-band pixel

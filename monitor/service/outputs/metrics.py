@@ -67,7 +67,8 @@ from prometheus_client.core import CounterMetricFamily, GaugeMetricFamily
 from prometheus_client.metrics_core import Metric
 
 from monitor.core.constants import URAD
-from monitor.core.result import DayPrecision, Family, ForOffset, measures
+from monitor.core.measures import Family
+from monitor.core.result import DayPrecision, ForOffset, measures
 from monitor.core.vocabulary import DayStop, RunStatus
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
