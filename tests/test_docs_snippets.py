@@ -46,7 +46,7 @@ def test_the_documented_silence_is_in_the_future_and_parses():
     text = (ROOT / "docs" / "operations.md").read_text()
     (example,) = re.findall(r"`(crisgeo alerts silence [^`]+)`", text)
     args = build_parser().parse_args(shlex.split(example)[1:])
-    assert args.until > dt.datetime.now(dt.timezone.utc) + dt.timedelta(days=6)
+    assert args.expires > dt.datetime.now(dt.timezone.utc) + dt.timedelta(days=6)
 
 
 def test_the_docs_link_only_to_files_that_exist():

@@ -153,7 +153,7 @@ def test_assess_options_are_checked_by_the_configuration_model(tmp_path, capsys,
         (["reprocess", "--since", "2024-06-01", "--processes", "0"], "argument --processes: 0: at least 1"),
         (
             ["reprocess", "--since", "2024-06-01", "--processes", "two"],
-            "argument --workers: not a whole number",
+            "argument --processes: not a whole number",
         ),
         (["simulate", "--out", "{tmp}/x", "--seed", "-1"], "argument --seed: -1: at least 0"),
         (
