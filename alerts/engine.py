@@ -19,6 +19,7 @@ from alerts.alertmanager import post_state
 from alerts.channels import Permanent, Transient, make_channels
 from alerts.rules import (
     CALIBRATION,
+    GEOLOCATION,
     Finding,
     failure_finding,
     jump_findings,
@@ -26,6 +27,7 @@ from alerts.rules import (
     spec_finding,
     stale_finding,
 )
+from alerts.steps import replay_reach
 from monitor.config.alert_settings import AlertSettings
 from monitor.core.tables import Column, text_table
 from monitor.core.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
@@ -67,7 +69,9 @@ def findings_for(store: History, satellite: str, settings: AlertSettings, now: d
     ]
     latest = store.latest_day(satellite)
     if latest is not None:
-        changes = all_changes(store, satellite, settings.events_file)
+        # the changes the jump rule's replay can meet (alerts.steps.replay_reach), however long the history
+        reach = dt.timedelta(replay_reach(GEOLOCATION.rules(s)) + 1)
+        changes = all_changes(store, satellite, settings.events_file, since=latest - reach)
         out += jump_findings(store, satellite, changes, s)
         out += jump_findings(store, satellite, changes, s, CALIBRATION)
     out += processing_change_findings(store, satellite, s, latest or now.date())
@@ -75,7 +79,11 @@ def findings_for(store: History, satellite: str, settings: AlertSettings, now: d
 
 
 def _trend(store: History, satellite: str, days: int = 7) -> list[str]:
-    series = store.series(satellite)
+    latest = store.latest_day(satellite)
+    if latest is None:
+        return []
+    # the last *days* assessed days, looked for over ten times as many calendar days
+    series = store.series(satellite, since=latest - dt.timedelta(10 * days), fields=("total_km",))
     total = series.values["total_km"]
     lines = []
     for i in [i for i in range(len(series)) if np.isfinite(total[i]).any()][-days:]:

@@ -12,8 +12,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alerts.steps import StepRules, detect
+from alerts.noise import MIN_HISTORY_DAYS
+from alerts.steps import FittedNoise, StepRules, detect, fitted_before, replay_reach
 from monitor.config.alert_settings import RuleSettings
+from monitor.core.constants import N_FOR
 from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 from monitor.history.changes import Change
 from monitor.history.records import History, last_success
@@ -151,9 +153,15 @@ def spec_finding(store: History, satellite: str, s: RuleSettings) -> Finding | N
     )
 
 
-def watched_series(store: History, satellite: str, watched: Watched) -> tuple[list, np.ndarray, np.ndarray]:
-    """The days, values and sigmas (days, N_FOR, directions) of the *watched* quantity, NaN where a FOR is
-    not stored or flagged unreliable.
+def watched_series(
+    store: History,
+    satellite: str,
+    watched: Watched,
+    since: dt.date | None = None,
+    until: dt.date | None = None,
+) -> tuple[list, np.ndarray, np.ndarray]:
+    """The days, values and sigmas (days, N_FOR, directions) of the *watched* quantity from *since* to
+    *until*, NaN where a FOR is not stored or flagged unreliable.
 
     Parameters
     ----------
@@ -163,6 +171,8 @@ def watched_series(store: History, satellite: str, watched: Watched) -> tuple[li
         The satellite's short name.
     watched : Watched
         The quantity.
+    since, until : datetime.date, optional
+        The period, inclusive; None: open.
 
     Returns
     -------
@@ -171,11 +181,53 @@ def watched_series(store: History, satellite: str, watched: Watched) -> tuple[li
     values, sigmas : numpy.ndarray
         Shape (days, N_FOR, directions).
     """
-    series = store.series(satellite)
+    series = store.series(satellite, since, until, fields=watched.fields + watched.sigmas)
     reliable = series.reliable()[..., None]
+    shape = (len(series), N_FOR, len(watched.fields))
+    if not len(series):
+        return [], np.full(shape, np.nan), np.full(shape, np.nan)
     y = np.stack([series.values[f] for f in watched.fields], axis=-1)
     sig = np.stack([series.values[f] for f in watched.sigmas], axis=-1)
     return series.days, np.where(reliable, y, np.nan), np.where(reliable, sig, np.nan)
+
+
+# the noise fit's method (alerts/noise.py, alerts/steps.py): a fit kept by another method is fitted anew
+FIT_METHOD = 1
+
+
+@dataclass(frozen=True)
+class KeptFits:
+    """The noise of the *watched* quantity on every day before a date, as the store keeps it per refit
+    date (:func:`alerts.steps.detect`'s *fits*): fitted from the store's days once, then read back, so a
+    daily evaluation reads its replay window, not the whole history."""
+
+    store: History
+    satellite: str
+    watched: Watched
+
+    def __call__(self, before: int) -> FittedNoise:
+        """The fit of every day before the ordinal *before*.
+
+        Parameters
+        ----------
+        before : int
+            The first day's ordinal not fitted.
+
+        Returns
+        -------
+        FittedNoise
+            The fit.
+        """
+        day = dt.date.fromordinal(before)
+        kept = self.store.noise_fit(self.satellite, self.watched.rule, day)
+        if kept is not None and kept.get("method") == FIT_METHOD:
+            return FittedNoise.from_dict(kept)
+        days, y, sig = watched_series(self.store, self.satellite, self.watched, until=day - dt.timedelta(1))
+        fitted = fitted_before(np.array([d.toordinal() for d in days], int), y, sig, before)
+        self.store.keep_noise_fit(
+            self.satellite, self.watched.rule, day, {**fitted.to_dict(), "method": FIT_METHOD}
+        )
+        return fitted
 
 
 def jump_findings(
@@ -208,10 +260,16 @@ def jump_findings(
     list of Finding
         One per step.
     """
-    days, y, sig = watched_series(store, satellite, watched)
+    latest = store.latest_day(satellite)
+    if latest is None:
+        return []
+    rules = watched.rules(s)
+    days, y, sig = watched_series(store, satellite, watched, since=latest - dt.timedelta(replay_reach(rules)))
+    if len(days) < MIN_HISTORY_DAYS:  # a young or sparse history: all of it (its noise cannot be kept yet)
+        days, y, sig = watched_series(store, satellite, watched)
     if not np.isfinite(y).any():  # nothing measured (e.g. no intercalibration)
         return []
-    found = detect(days, y, sig, [c.time.date() for c in changes], watched.rules(s))
+    found = detect(days, y, sig, [c.time.date() for c in changes], rules, KeptFits(store, satellite, watched))
     u, practical, n = watched.unit, watched.rules(s).practical, watched.digits
     out = []
     for step in found:
@@ -291,7 +349,7 @@ def stale_finding(store: History, satellite: str, s: RuleSettings, now: dt.datet
     Finding or None
         None when fresh.
     """
-    runs = store.runs(satellite)
+    runs = store.runs_since_success(satellite)
     since = last_success(runs)
     if since is None:
         return None
@@ -328,7 +386,7 @@ def failure_finding(store: History, satellite: str) -> Finding | None:
     Finding or None
         None when the latest run is good.
     """
-    runs = store.runs(satellite)
+    runs = store.runs_since_success(satellite)  # a failure since the last good run is among them
     last_ok = max((r.id for r in runs if r.status in DONE), default=0)
     failed = [r for r in runs if r.id > last_ok and r.status == RunStatus.FAILED]
     last_ok_time = next((r.finished for r in runs if r.id == last_ok), "")

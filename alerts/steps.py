@@ -46,6 +46,8 @@ from __future__ import annotations
 
 import datetime as dt
 import math
+import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -107,6 +109,101 @@ class Step:
     size: np.ndarray  # (N_FOR, directions)
     sigma: np.ndarray
     paged: bool
+
+
+@dataclass(frozen=True)
+class FittedNoise:
+    """The noise fitted on every assessed day before a date: how many days there were, the :class:`Noise`
+    (None: too few to fit), and each FOR's usual sigma there (N_FOR, C), below half of which a day's sigma
+    is not believed (a day whose sigmas are too small cannot page)."""
+
+    days: int
+    noise: Noise | None
+    typical: np.ndarray
+
+    def to_dict(self) -> dict:
+        """The fit as JSON-serialisable values (what the store keeps).
+
+        Returns
+        -------
+        dict
+            ``days``, ``typical`` and, when fitted, ``scale``, ``shared`` and ``lag1``.
+        """
+        out: dict = {"days": self.days, "typical": self.typical.tolist()}
+        if self.noise is not None:
+            out |= {
+                "scale": self.noise.scale.tolist(),
+                "shared": self.noise.shared.tolist(),
+                "lag1": self.noise.lag1,
+            }
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict) -> FittedNoise:
+        """The fit *d* as :meth:`to_dict` wrote it.
+
+        Parameters
+        ----------
+        d : dict
+            The fit's values.
+
+        Returns
+        -------
+        FittedNoise
+            The fit.
+        """
+        noise = (
+            Noise(np.array(d["scale"], float), np.array(d["shared"], float), float(d["lag1"]))
+            if "scale" in d
+            else None
+        )
+        return cls(int(d["days"]), noise, np.array(d["typical"], float))
+
+
+# the noise of every day before an ordinal (see detect): computed from the series given, or kept by the store
+FitSource = Callable[[int], FittedNoise]
+
+
+def fitted_before(ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, before: int) -> FittedNoise:
+    """The :class:`FittedNoise` of the days of the series before the ordinal *before*.
+
+    Parameters
+    ----------
+    ordinal : numpy.ndarray
+        The days' ordinals, shape (T,).
+    y : numpy.ndarray
+        The values (urad, or K for the bias), shape (T, N_FOR, C).
+    s : numpy.ndarray
+        Their sigmas, same shape.
+    before : int
+        The first ordinal not fitted.
+
+    Returns
+    -------
+    FittedNoise
+        The fit.
+    """
+    days = ordinal < before
+    typical = _typical(s, days)
+    return FittedNoise(int(np.count_nonzero(days)), _floored_fit(ordinal, y, s, days, typical), typical)
+
+
+def replay_reach(rules: StepRules) -> int:
+    """The calendar days before the last one that :func:`detect` reads: the replay's ``2 * baseline_days``,
+    the discovery days before its first split, and a baseline (moved to a known change up to
+    ``attribution_days`` earlier) before those. Older days enter only through the noise fits.
+
+    Parameters
+    ----------
+    rules : StepRules
+        The detector's parameters.
+
+    Returns
+    -------
+    int
+        Days.
+    """
+    return 3 * rules.baseline_days + rules.discovery_days + rules.attribution_days
 
 
 # the fits' lengths (days) thresholds are simulated for
@@ -314,11 +411,13 @@ def detect(
     s: np.ndarray,
     change_days: list[dt.date],
     rules: StepRules,
+    fits: FitSource | None = None,
 ) -> list[Step]:
     """The steps of the series *y* with sigmas *s* (assessed days *days*, ascending; (T, N_FOR, C), NaN
     where nothing reliable was measured) that the daily evaluations up to the last day would have found,
     given the known changes' days *change_days*, whose split lies in the last ``baseline_days`` days (see
-    the module docstring).
+    the module docstring). The series need hold no more than the last :func:`replay_reach` days when
+    *fits* gives the noise of the days before.
 
     Parameters
     ----------
@@ -332,6 +431,9 @@ def detect(
         The known changes' days.
     rules : StepRules
         The detector's parameters.
+    fits : callable, optional
+        The :class:`FittedNoise` of every day before an ordinal (the store's kept fits); by default
+        fitted from the series given (:func:`fitted_before`), which must then hold the whole history.
 
     Returns
     -------
@@ -344,18 +446,25 @@ def detect(
     last = int(ordinal[-1])
     start = last - 2 * rules.baseline_days + 1  # the replay's first day
     b, k = rules.baseline_days, rules.discovery_days
-    fits: dict[int, _Fit | None] = {}
+    source: FitSource = fits or (lambda before: fitted_before(ordinal, y, s, before))
+    noises: dict[int, FittedNoise] = {}
+    judged: dict[int, _Fit | None] = {}
+
+    def _noise(before: int) -> FittedNoise:
+        if before not in noises:
+            noises[before] = source(before)
+        return noises[before]
 
     def _fitted(split: int) -> _Fit | None:
         """The fit a test of *split* uses: the days before the refit date on or before its baseline
         (REFIT_DAYS apart, on fixed dates), or early in a history every day before it. It depends on the
         split alone, so every evaluation decides a split alike: once, not anew each day."""
         anchor = split - b - (split - b - REFIT_EPOCH) % REFIT_DAYS
-        if np.count_nonzero(ordinal < anchor) < MIN_HISTORY_DAYS:
+        if _noise(anchor).days < MIN_HISTORY_DAYS:
             anchor = split
-        if anchor not in fits:
-            fits[anchor] = _fit(ordinal, y, s, ordinal < anchor, rules)
-        return fits[anchor]
+        if anchor not in judged:
+            judged[anchor] = _fit(y, s, _noise(anchor), rules)
+        return judged[anchor]
 
     changes = sorted({c.toordinal() for c in change_days})
     replay = [int(t) for t in ordinal[ordinal >= start]]
@@ -426,25 +535,36 @@ class _Fit:
     at_change: float
 
 
-def _fit(
-    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, days: np.ndarray, rules: StepRules
-) -> _Fit | None:
-    """The :class:`_Fit` of the *days* (a mask): a day's sigma is not believed below half the FOR's usual
-    one there (a day whose sigmas are too small cannot page); None when the noise cannot be fitted."""
-    fitted = floored_noise(ordinal, y, s, days)
-    if fitted is None:
+def _fit(y: np.ndarray, s: np.ndarray, fitted: FittedNoise, rules: StepRules) -> _Fit | None:
+    """The :class:`_Fit` of the noise *fitted* for the series *y*, *s*: its sigmas floored at half their
+    FOR's usual one; None when the noise could not be fitted."""
+    if fitted.noise is None:
         return None
-    noise, sigma = fitted
+    noise = fitted.noise
     rho = round(float(np.max(noise.shared)) * 20) / 20  # the thresholds on a grid of 0.05
     phi = round(noise.lag1 * 20) / 20
     b, k, c = rules.baseline_days, rules.discovery_days, y.shape[-1]
-    n = fit_days_bucket(int(np.count_nonzero(days)))
+    n = fit_days_bucket(fitted.days)
     return _Fit(
         noise,
-        sigma,
+        np.fmax(s, 0.5 * fitted.typical),
         threshold(RATE_MARGIN * rules.rate_per_year / 365.0, rho, phi, b, k, False, c, n),
         threshold(RATE_MARGIN * rules.rate_at_change, rho, phi, b, k, True, c, n),
     )
+
+
+def _typical(s: np.ndarray, days: np.ndarray) -> np.ndarray:
+    """Each FOR's and direction's median sigma over the *days* (a mask); NaN where none was measured."""
+    with warnings.catch_warnings():  # a FOR never measured there: NaN, as meant
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmedian(np.where(days[:, None, None], s, np.nan), axis=0)
+
+
+def _floored_fit(
+    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, days: np.ndarray, typical: np.ndarray
+) -> Noise | None:
+    """:func:`alerts.noise.fit_noise` on the *days*, their sigmas floored at half the *typical* ones."""
+    return fit_noise(ordinal[days], y[days], np.fmax(s, 0.5 * typical)[days])
 
 
 def floored_noise(
@@ -470,11 +590,9 @@ def floored_noise(
     tuple or None
         (Noise, the floored sigmas); None when the noise cannot be fitted.
     """
-    with np.errstate(all="ignore"):
-        typical = np.nanmedian(np.where(days[:, None, None], s, np.nan), axis=0)
-    sigma = np.fmax(s, 0.5 * typical)
-    noise = fit_noise(ordinal[days], y[days], sigma[days])
-    return None if noise is None else (noise, sigma)
+    typical = _typical(s, days)
+    noise = _floored_fit(ordinal, y, s, days, typical)
+    return None if noise is None else (noise, np.fmax(s, 0.5 * typical))
 
 
 def window_mean(

@@ -194,9 +194,7 @@ def cost_and_offsets(
                     for a, b in zip(cones0, cones1, strict=True)
                 ]
             )
-        per_for = PerFor(
-            lambda k: blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
-        )
+        per_for = PerFor(lambda k: blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f))
         m_per_k = f * probe_m_per_k
     used = samples if pairs is None else pairs[0]
     lift = DayLift(

@@ -154,8 +154,9 @@ def _lut_kinds(names: Iterable[str]) -> dict[str, set[str]]:
     return out
 
 
-def metadata_changes(store: History, satellite: str) -> list[Change]:
-    """Changes of LUTs and SDR software between consecutive days of stored granule metadata.
+def metadata_changes(store: History, satellite: str, since: dt.date | None = None) -> list[Change]:
+    """Changes of LUTs and SDR software between consecutive days of stored granule metadata (the days
+    from *since* on: the changes after its first day).
 
     Parameters
     ----------
@@ -163,6 +164,8 @@ def metadata_changes(store: History, satellite: str) -> list[Change]:
         The store's records.
     satellite : str
         The satellite's short name.
+    since : datetime.date, optional
+        The first day read; None: every day.
 
     Returns
     -------
@@ -170,7 +173,7 @@ def metadata_changes(store: History, satellite: str) -> list[Change]:
         In time order.
     """
     days: dict[str, dict[str, set[str]]] = {}
-    for g in store.granules(satellite):
+    for g in store.granules(satellite, since=since):
         d = days.setdefault(g.day, {"cris": set(), "viirs": set(), "cris_sw": set(), "viirs_sw": set()})
         d["cris"].update(g.cris_aux)
         d["viirs"].update(g.viirs_aux)
@@ -242,8 +245,11 @@ def stored_changes(store: History, satellite: str) -> list[Change]:
     return out
 
 
-def all_changes(store: History, satellite: str, calendar_path: str | Path | None = None) -> list[Change]:
-    """Every known change of *satellite*, in time order: the calendar, the metadata, the recorded events.
+def all_changes(
+    store: History, satellite: str, calendar_path: str | Path | None = None, since: dt.date | None = None
+) -> list[Change]:
+    """Every known change of *satellite*, in time order: the calendar, the metadata, the recorded events
+    (when *since* is given, those after that day: the metadata is read from that day on).
 
     Parameters
     ----------
@@ -253,6 +259,8 @@ def all_changes(store: History, satellite: str, calendar_path: str | Path | None
         The satellite's short name.
     calendar_path : str or Path, optional
         The events calendar.
+    since : datetime.date, optional
+        Only the changes after this day; None: all.
 
     Returns
     -------
@@ -260,9 +268,10 @@ def all_changes(store: History, satellite: str, calendar_path: str | Path | None
         In time order.
     """
     cal = [c for c in load_calendar(calendar_path) if c.satellite == satellite] if calendar_path else []
-    return sorted(
-        cal + metadata_changes(store, satellite) + stored_changes(store, satellite), key=lambda c: c.time
-    )
+    found = cal + metadata_changes(store, satellite, since) + stored_changes(store, satellite)
+    if since is not None:
+        found = [c for c in found if c.time.date() > since]
+    return sorted(found, key=lambda c: c.time)
 
 
 def listing(

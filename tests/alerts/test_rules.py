@@ -8,7 +8,14 @@ from alerts.engine import findings_for
 from alerts.rules import CALIBRATION, GEOLOCATION, failure_finding, jump_findings, spec_finding, stale_finding
 from monitor.config.alert_settings import AlertSettings, RuleSettings
 from monitor.core.result import AssessmentResult, ForOffset, GranuleInfo
-from monitor.history.changes import Change, add_to_calendar, load_calendar, metadata_changes, preceding_change
+from monitor.history.changes import (
+    Change,
+    add_to_calendar,
+    all_changes,
+    load_calendar,
+    metadata_changes,
+    preceding_change,
+)
 from monitor.service.store.sqlite import Store
 
 DAY = dt.date(2024, 6, 1)
@@ -85,6 +92,13 @@ def test_metadata_changes_name_the_instrument(tmp_path):
     assert len(changes) == 1  # the engineering-packet backup AUX changes every run and is ignored
     assert changes[0].instrument == "viirs" and "2042" in changes[0].description
     assert changes[0].time.date() == DAY + dt.timedelta(days=2)
+    # from a day on, as the daily evaluation reads them: the changes after that day, the calendar's too
+    (tmp_path / "events.yaml").write_text(
+        f"events:\n  - {{satellite: j01, time: '{DAY}T12:00:00Z', instrument: cris, kind: ep_upload}}\n"
+    )
+    assert all_changes(s, "j01", tmp_path / "events.yaml", since=DAY + dt.timedelta(days=1)) == changes
+    assert all_changes(s, "j01", tmp_path / "events.yaml", since=DAY + dt.timedelta(days=2)) == []
+    assert len(all_changes(s, "j01", tmp_path / "events.yaml")) == 2
 
 
 def test_a_bias_jump_after_a_viirs_lut_change_is_a_calibration_jump_attributed_to_viirs(tmp_path):
@@ -194,3 +208,32 @@ def test_a_step_at_an_ep_upload_is_paged_once_naming_it_and_a_small_one_only_rec
     (recorded,) = [a for a in small.alert_state().all() if a.rule == "jump" and a.grp == str(upload)]
     assert recorded.severity == "info" and recorded.status == "firing"
     assert all(a.severity == "info" for a in small.alert_state().all())  # recorded, nothing sent
+
+
+def test_the_jump_rule_reads_its_kept_noise_and_fits_anew_once_an_earlier_day_is_stored_again(tmp_path):
+    """A year with a cross-track step ten days before its end: the first evaluation keeps a noise fit per
+    refit date it uses; the next one reads them back (a kept fit made 100 times too wide hides the step);
+    storing an earlier day again, as a reprocessing does, drops the fits after that day, and the step is
+    found again as a store filled once finds it."""
+    from monitor.simulate.history import day_result, fill_store
+
+    days = fill_store(Store(tmp_path / "fresh.sqlite"), ["j01"], DAY, 365, step_day=355, step_urad=60.0)
+    store = Store(tmp_path / "fresh.sqlite")
+    settings, now = AlertSettings(), dt.datetime.combine(days[-1], dt.time(6), UTC) + dt.timedelta(days=1)
+    first = [f.fingerprint for f in findings_for(store, "j01", settings, now)]
+    assert first == [f"jump:j01:{days[355]}"]
+    kept = store.db.execute("SELECT before, body FROM noise_fits WHERE quantity='jump'").fetchall()
+    assert kept and all(dt.date.fromisoformat(r["before"]) <= days[-1] for r in kept)
+    with store.transaction():
+        store.db.execute(
+            "UPDATE noise_fits SET body=json_replace(body, '$.scale', json_array(100.0, 100.0)) "
+            "WHERE quantity='jump'"
+        )
+    assert [f.fingerprint for f in findings_for(store, "j01", settings, now)] == []  # read back, not refitted
+    again = days[200]
+    store.save_day(
+        store.begin_run("j01", again), "j01", again, day_result("j01", again, np.random.default_rng(1))
+    )
+    left = store.db.execute("SELECT before FROM noise_fits WHERE quantity='jump'").fetchall()
+    assert all(dt.date.fromisoformat(r["before"]) <= again for r in left)
+    assert [f.fingerprint for f in findings_for(store, "j01", settings, now)] == first

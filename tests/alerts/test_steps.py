@@ -178,3 +178,59 @@ def test_the_retired_keys_are_read_with_a_warning(caplog):
     assert r.practical_step_urad == pytest.approx(300.1, abs=0.1)
     assert "alerts.min_jump_km (0.25 km) is read as alerts.practical_step_urad 300" in caplog.text
     assert "alerts.jump_z is no longer used" in caplog.text
+
+
+def test_the_replay_window_with_the_kept_fits_finds_what_the_whole_history_finds():
+    """Two years with a step at a known change and one blind step near the end: detect on the last
+    replay_reach days, given the fits of the whole history before each refit date (as the store keeps
+    them), finds the same steps, sizes and sigmas as detect on the whole history, asking for each fit once."""
+    rng = np.random.default_rng(12)
+    n = 730
+    y = 120.0 * _noise(rng, n, 1.0, 0.3, 0.2)
+    s = np.full_like(y, 120.0)
+    s[:, 5] = 200.0  # a FOR with its own usual sigma: the floor comes from the kept fit
+    y[n - 15 :, :, 0] += 300.0
+    y[n - 5 :, 20:23, 1] += 600.0
+    days = _days(n)
+    change = [days[100], days[n - 15]]
+    ordinal = np.array([d.toordinal() for d in days])
+    asked = []
+
+    def kept(before):
+        asked.append(before)
+        return steps.fitted_before(ordinal, y, s, before)
+
+    start = ordinal[-1] - steps.replay_reach(RULES)
+    window = ordinal >= start
+    whole = steps.detect(days, y, s, change, RULES)
+    part = steps.detect(
+        [d for d, w in zip(days, window, strict=True) if w], y[window], s[window], change, RULES, kept
+    )
+    assert len(whole) == 2 and {x.change for x in whole} == {1, None}
+    assert [(x.split, x.change, x.seen, x.group, x.direction) for x in part] == [
+        (x.split, x.change, x.seen, x.group, x.direction) for x in whole
+    ]
+    for a, b in zip(part, whole, strict=True):
+        assert a.z == pytest.approx(b.z, rel=1e-9) and a.pooled == pytest.approx(b.pooled, rel=1e-9)
+        np.testing.assert_allclose(a.sigma, b.sigma, rtol=1e-9)
+    # refit dates on or before the splits' baselines, each asked once
+    assert len(asked) == len(set(asked)) and max(asked) <= ordinal[-1] - RULES.baseline_days
+
+
+def test_a_fit_survives_its_round_trip_through_json():
+    """What the store keeps (FittedNoise.to_dict, as JSON) is the fit itself, NaN sigmas included."""
+    import json
+
+    rng = np.random.default_rng(13)
+    y = 50.0 * _noise(rng, 60)
+    s = np.full_like(y, 50.0)
+    s[:, 3, 0] = np.nan  # a FOR never measured: no usual sigma
+    fitted = steps.fitted_before(np.arange(60), y, s, 40)
+    back = steps.FittedNoise.from_dict(json.loads(json.dumps(fitted.to_dict())))
+    assert back.days == 40 and np.isnan(back.typical[3, 0])
+    np.testing.assert_array_equal(back.typical, fitted.typical)
+    np.testing.assert_array_equal(back.noise.scale, fitted.noise.scale)
+    np.testing.assert_array_equal(back.noise.shared, fitted.noise.shared)
+    assert back.noise.lag1 == fitted.noise.lag1
+    young = steps.fitted_before(np.arange(60), y, s, 10)  # too few days: counted, not fitted
+    assert young.noise is None and steps.FittedNoise.from_dict(young.to_dict()).noise is None

@@ -41,7 +41,11 @@ def _check_recovery(result, truth, rms_max=60.0, abs_max=150.0, min_reliable=20)
             assert FLAG_UNCERTAIN in f.flags and max(f.sigma_alpha_urad, f.sigma_beta_urad) > 250
 
 
-@pytest.mark.parametrize("profile,seed", [("paper", 1), ("random", 2), ("zero", 3), ("paper", 4)])
+@pytest.mark.parametrize(
+    "profile,seed",
+    [("paper", 1), ("random", 2)]
+    + [pytest.param(*c, marks=pytest.mark.slow) for c in (("zero", 3), ("paper", 4))],
+)
 def test_recovers_injected_offsets_on_reduced_cases(cases, profile, seed):
     """Two-granule cases (72 samples per FOR); the 14- and 6-granule acceptance runs are in benchmarks/."""
     _, truth, result = cases.get(profile, seed)

@@ -57,8 +57,10 @@ def test_the_ten_real_granules_give_offsets_and_say_what_they_lack():
     assert -0.25 < np.median(bias) < -0.05 and np.all(np.abs(bias - np.median(bias)) < 0.1)
 
 
-def test_split_halves_agree_within_their_jackknife_sigmas():
-    """Honest sigmas on real radiances: 5 granules against the other 5, twenty random splits; the halves'
+@pytest.mark.parametrize("splits", [6, pytest.param(20, marks=pytest.mark.slow)])
+def test_split_halves_agree_within_their_jackknife_sigmas(splits):
+    """Honest sigmas on real radiances: 5 granules against the other 5, random splits (twenty with
+    ``-m slow``, six by default); the halves'
     offsets differ by more than 2 combined sigmas for at most 12 % of FOR-directions, and the rms of the
     normalised difference lies between 0.75 and 1.3 (the scan bootstrap it replaces: 13-15 %, 1.36-1.41).
     The FOV rows (ahead minus behind) likewise: within 2 combined sigmas for at least 85 %. The
@@ -67,7 +69,7 @@ def test_split_halves_agree_within_their_jackknife_sigmas():
     cfg = AssessmentConfig()
     rng = np.random.default_rng(42)
     z, z_rows, z_bias, apart_k = [], [], [], []
-    for _ in range(20):
+    for _ in range(splits):
         p = rng.permutation(len(REAL))
         a, b = (assess_collocations([REAL[i] for i in half], cfg).fors for half in (p[:5], p[5:]))
         apart_k.append(np.median([f.bias_k for f in a]) - np.median([f.bias_k for f in b]))

@@ -17,10 +17,9 @@ def _check(rep):
     assert rep.first.fors[29].d_beta_urad > 1000
 
 
-def test_closed_loop_four_granules(tmp_path, error_ep, nominal_ep):
-    _check(run_closed_loop(tmp_path, error_ep, nominal_ep, granules=4, seed=2))
-
-
-@pytest.mark.slow
-def test_closed_loop_paper_size(tmp_path, error_ep, nominal_ep):
-    _check(run_closed_loop(tmp_path, error_ep, nominal_ep, granules=14, seed=1))
+@pytest.mark.parametrize(
+    "granules,seed",
+    [(2, 2), pytest.param(4, 2, marks=pytest.mark.slow), pytest.param(14, 1, marks=pytest.mark.slow)],
+)
+def test_closed_loop(tmp_path, error_ep, nominal_ep, granules, seed):
+    _check(run_closed_loop(tmp_path, error_ep, nominal_ep, granules=granules, seed=seed))

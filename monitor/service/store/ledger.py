@@ -252,6 +252,26 @@ class RunLedger:
         q = "SELECT * FROM runs" + (" WHERE satellite=?" if satellite else "") + " ORDER BY id"
         return [Run.from_row(r) for r in self.db.execute(q, (satellite,) if satellite else ())]
 
+    def runs_since_success(self, satellite: str) -> list[Run]:
+        """The runs of *satellite* from its latest successful one (status ok) on, oldest first; all of them
+        when none succeeded. What the stale and failure rules read, however long the history.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+
+        Returns
+        -------
+        list of Run
+            Oldest first.
+        """
+        q = (
+            "SELECT * FROM runs WHERE satellite=? AND id >= "
+            "COALESCE((SELECT MAX(id) FROM runs WHERE satellite=? AND status=?), 0) ORDER BY id"
+        )
+        return [Run.from_row(r) for r in self.db.execute(q, (satellite, satellite, RunStatus.OK))]
+
     # -- events (failures, misses: the alerting layer reads them)
     def add_event(self, kind: "EventKind", satellite: str | None, detail: dict) -> None:
         """Record an event; *detail* is stored as JSON.

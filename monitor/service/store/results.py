@@ -83,6 +83,8 @@ class Results:
         with self.transaction():
             for table in ("results", "granules", "selection", "cost_cubes", "skipped", "difference_bins"):
                 self.db.execute(f"DELETE FROM {table} WHERE satellite=? AND day=?", (satellite, d))
+            # the noise fitted on days that include this one is fitted anew when next needed
+            self.db.execute("DELETE FROM noise_fits WHERE satellite=? AND before > ?", (satellite, d))
             for f in result.fors:
                 self.db.execute(
                     f"INSERT INTO results (satellite, day, for_index, run_id, {', '.join(RESULT_FIELDS)}, "
@@ -234,7 +236,13 @@ class Results:
         r = self.db.execute("SELECT MAX(day) FROM results WHERE satellite=?", (satellite,)).fetchone()[0]
         return dt.date.fromisoformat(r) if r else None
 
-    def series(self, satellite: str, since: dt.date | None = None, until: dt.date | None = None) -> ForSeries:
+    def series(
+        self,
+        satellite: str,
+        since: dt.date | None = None,
+        until: dt.date | None = None,
+        fields: Sequence[str] | None = None,
+    ) -> ForSeries:
         """The per-FOR results of *satellite* from *since* to *until* (both included) as arrays.
 
         Parameters
@@ -243,13 +251,19 @@ class Results:
             The satellite's short name.
         since, until : datetime.date, optional
             The period, inclusive; None: open.
+        fields : sequence of str, optional
+            The measured fields read (:data:`RESULT_FIELDS`); all by default.
 
         Returns
         -------
         ForSeries
-            Days x FORs arrays of every measured field.
+            Days x FORs arrays of the fields read, with the flags.
         """
-        q = "SELECT * FROM results WHERE satellite=?"
+        read = list(RESULT_FIELDS) if fields is None else [k for k in RESULT_FIELDS if k in set(fields)]
+        unknown = sorted(set(fields or ()) - set(RESULT_FIELDS))
+        if unknown:
+            raise ValueError(f"series: no measured field {', '.join(unknown)}")
+        q = f"SELECT day, for_index, flags, {', '.join(read)} FROM results WHERE satellite=?"
         args = [satellite]
         if since:
             q += " AND day >= ?"
@@ -261,8 +275,9 @@ class Results:
         days = sorted({r["day"] for r in rows})
         index = {d: i for i, d in enumerate(days)}
         shape = (len(days), N_FOR)
-        values = {k: np.full(shape, np.nan) for k in RESULT_FIELDS if k != "n_samples"}
-        values["n_samples"] = np.zeros(shape, np.int64)
+        values = {k: np.full(shape, np.nan) for k in read if k != "n_samples"}
+        if "n_samples" in read:
+            values["n_samples"] = np.zeros(shape, np.int64)
         flags = np.empty(shape, object)
         flags.fill(())
         stored = np.zeros(shape, bool)
@@ -275,8 +290,55 @@ class Results:
             stored[at] = True
         return ForSeries([dt.date.fromisoformat(d) for d in days], values, flags, stored)
 
-    def granules(self, satellite: str, day: dt.date | None = None) -> list[GranuleRow]:
-        """The granules assessed for *satellite* (on *day*), with their metadata.
+    def noise_fit(self, satellite: str, quantity: str, before: dt.date) -> dict | None:
+        """The jump rule's noise of *quantity* fitted on every day of *satellite* before *before*, as kept
+        (:meth:`keep_noise_fit`); None when none is kept, or a day before *before* was stored since.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        quantity : str
+            The quantity watched (its rule's name).
+        before : datetime.date
+            The fit covers the days before this one.
+
+        Returns
+        -------
+        dict or None
+            The fit as kept.
+        """
+        r = self.db.execute(
+            "SELECT body FROM noise_fits WHERE satellite=? AND quantity=? AND before=?",
+            (satellite, quantity, before.isoformat()),
+        ).fetchone()
+        return json.loads(r["body"]) if r else None
+
+    def keep_noise_fit(self, satellite: str, quantity: str, before: dt.date, body: dict) -> None:
+        """Keep the noise of *quantity* fitted on every day of *satellite* before *before*; storing a day
+        before *before* drops it (:meth:`save_day`).
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        quantity : str
+            The quantity watched (its rule's name).
+        before : datetime.date
+            The fit covers the days before this one.
+        body : dict
+            The fit, JSON-serialisable.
+        """
+        with self.transaction():
+            self.db.execute(
+                "INSERT OR REPLACE INTO noise_fits VALUES (?, ?, ?, ?)",
+                (satellite, quantity, before.isoformat(), json.dumps(body)),
+            )
+
+    def granules(
+        self, satellite: str, day: dt.date | None = None, since: dt.date | None = None
+    ) -> list[GranuleRow]:
+        """The granules assessed for *satellite* (on *day*, or from *since* on), with their metadata.
 
         Parameters
         ----------
@@ -284,19 +346,20 @@ class Results:
             The satellite's short name.
         day : datetime.date, optional
             Only this day.
+        since : datetime.date, optional
+            Only the days from this one on.
 
         Returns
         -------
         list of GranuleRow
             The granules.
         """
-        q = (
-            "SELECT * FROM granules WHERE satellite=?"
-            + (" AND day=?" if day else "")
-            + " ORDER BY day, start"
-        )
-        args = (satellite, day.isoformat()) if day else (satellite,)
-        return [GranuleRow.from_row(r) for r in self.db.execute(q, args)]
+        q, args = "SELECT * FROM granules WHERE satellite=?", [satellite]
+        for cond, value in ((" AND day=?", day), (" AND day>=?", since)):
+            if value is not None:
+                q += cond
+                args.append(value.isoformat())
+        return [GranuleRow.from_row(r) for r in self.db.execute(q + " ORDER BY day, start", args)]
 
     def selection(self, satellite: str, day: dt.date) -> list[SelectionRow]:
         """The scene-selection decisions of *satellite* on *day*.

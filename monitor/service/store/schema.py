@@ -74,6 +74,13 @@ MIGRATIONS = [
     """
     UPDATE alert_state SET fingerprint = rtrim(fingerprint, ':') WHERE fingerprint LIKE '%:';
     """,
+    # 7: the jump rule's noise, fitted on every day before a refit date (alerts/steps.py) and kept, so that
+    # a daily evaluation reads its replay window only; storing a day before a fit's date drops the fit
+    """
+    CREATE TABLE noise_fits (
+        satellite TEXT NOT NULL, quantity TEXT NOT NULL, before TEXT NOT NULL, body TEXT NOT NULL,
+        PRIMARY KEY (satellite, quantity, before));
+    """,
 ]
 
 

@@ -176,3 +176,44 @@ def test_cli_reports_a_corrupt_store_in_one_line(tmp_path):
     assert "crisgeo.sqlite: not a usable crisgeo store" in r.stderr
     r = run_crisgeo("status", "--config", cfg)
     assert r.returncode == 3 and r.stdout.startswith("UNKNOWN - ")  # status speaks Nagios, on stdout
+
+
+def test_what_the_rules_read_of_a_long_history_is_bounded_by_what_they_ask(tmp_path):
+    """What the alert rules read of a long history: the runs from the latest success on (all of them when
+    none succeeded), the fields and the period of the series asked for, the granules from a day on."""
+    from monitor.core.vocabulary import RunStatus
+    from monitor.simulate.history import fill_store
+
+    s = Store(tmp_path / "r.sqlite")
+    failed = s.begin_run("npp", DAY)
+    s.finish_run(failed, RunStatus.FAILED, "no data yet")
+    assert [r.id for r in s.runs_since_success("npp")] == [failed]  # none succeeded: every run
+    days = fill_store(s, ["j01"], DAY, 40)
+    late = s.begin_run("j01", days[-1] + dt.timedelta(days=1))
+    s.finish_run(late, RunStatus.FAILED, "disk full")
+    runs = s.runs("j01")
+    assert s.runs_since_success("j01") == runs[-2:]  # the last ok one, then the failure
+    part = s.series("j01", since=days[30], fields=("d_beta_urad", "sigma_beta_urad"))
+    whole = s.series("j01")
+    assert part.days == days[30:] and set(part.values) == {"d_beta_urad", "sigma_beta_urad"}
+    np.testing.assert_array_equal(part.values["d_beta_urad"], whole.values["d_beta_urad"][30:])
+    assert (part.flags == whole.flags[30:]).all() and (part.reliable() == whole.reliable()[30:]).all()
+    with pytest.raises(ValueError, match="no measured field d_gamma_urad"):
+        s.series("j01", fields=("d_gamma_urad",))
+
+
+def test_a_kept_noise_fit_is_dropped_when_a_day_it_covers_is_stored_again(tmp_path):
+    from monitor.simulate.history import day_result, fill_store
+
+    s = Store(tmp_path / "n.sqlite")
+    days = fill_store(s, ["j01", "npp"], DAY, 10)
+    for before in (days[3], days[8]):
+        s.keep_noise_fit("j01", "jump", before, {"days": 3})
+    s.keep_noise_fit("npp", "jump", days[8], {"days": 8})
+    assert s.noise_fit("j01", "jump", days[8]) == {"days": 3} and s.noise_fit("j01", "jump", days[5]) is None
+    s.save_day(
+        s.begin_run("j01", days[5]), "j01", days[5], day_result("j01", days[5], np.random.default_rng(2))
+    )
+    assert s.noise_fit("j01", "jump", days[3]) == {"days": 3}  # fitted before the day: kept
+    assert s.noise_fit("j01", "jump", days[8]) is None  # it covered the day: fitted anew when next needed
+    assert s.noise_fit("npp", "jump", days[8]) == {"days": 8}  # another satellite's
