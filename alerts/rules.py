@@ -195,15 +195,17 @@ def watched_series(
 FIT_METHOD = 1
 
 
-@dataclass(frozen=True)
+@dataclass
 class KeptFits:
     """The noise of the *watched* quantity on every day before a date, as the store keeps it per refit
     date (:func:`alerts.steps.detect`'s *fits*): fitted from the store's days once, then read back, so a
-    daily evaluation reads its replay window, not the whole history."""
+    daily evaluation reads its replay window, not the whole history. The fits not kept are fitted from one
+    read of the history, however many are missing."""
 
     store: History
     satellite: str
     watched: Watched
+    _history: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (ordinals, values, sigmas)
 
     def __call__(self, before: int) -> FittedNoise:
         """The fit of every day before the ordinal *before*.
@@ -222,8 +224,10 @@ class KeptFits:
         kept = self.store.noise_fit(self.satellite, self.watched.rule, day)
         if kept is not None and kept.get("method") == FIT_METHOD:
             return FittedNoise.from_dict(kept)
-        days, y, sig = watched_series(self.store, self.satellite, self.watched, until=day - dt.timedelta(1))
-        fitted = fitted_before(np.array([d.toordinal() for d in days], int), y, sig, before)
+        if self._history is None:
+            days, y, sig = watched_series(self.store, self.satellite, self.watched)
+            self._history = (np.array([d.toordinal() for d in days], int), y, sig)
+        fitted = fitted_before(*self._history, before)
         self.store.keep_noise_fit(
             self.satellite, self.watched.rule, day, {**fitted.to_dict(), "method": FIT_METHOD}
         )

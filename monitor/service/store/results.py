@@ -272,22 +272,25 @@ class Results:
             q += " AND day <= ?"
             args.append(until.isoformat())
         rows = self.db.execute(q + " ORDER BY day, for_index", args).fetchall()
-        days = sorted({r["day"] for r in rows})
+        columns = list(zip(*rows, strict=True)) if rows else [()] * (3 + len(read))
+        days = sorted(set(columns[0]))
         index = {d: i for i, d in enumerate(days)}
+        at = (np.array([index[d] for d in columns[0]], int), np.array(columns[1], int) - 1)
         shape = (len(days), N_FOR)
-        values = {k: np.full(shape, np.nan) for k in read if k != "n_samples"}
-        if "n_samples" in read:
-            values["n_samples"] = np.zeros(shape, np.int64)
+        values: dict[str, np.ndarray] = {}
+        for name, column in zip(read, columns[3:], strict=True):
+            values[name] = np.full(shape, np.nan)
+            values[name][at] = np.array(column, float)  # NULL (None) is NaN
+        if "n_samples" in values:  # a count: 0 where nothing is stored
+            values["n_samples"] = np.nan_to_num(values["n_samples"]).astype(np.int64)
         flags = np.empty(shape, object)
         flags.fill(())
+        parsed: dict[str | None, tuple] = {}  # a day's flags repeat: each text parsed once
+        for text in set(columns[2]):
+            parsed[text] = tuple(json.loads(text or "[]"))
+        flags[at] = np.fromiter((parsed[t] for t in columns[2]), object, count=len(rows))
         stored = np.zeros(shape, bool)
-        for r in rows:
-            at = (index[r["day"]], r["for_index"] - 1)
-            for k in values:
-                if r[k] is not None:
-                    values[k][at] = r[k]
-            flags[at] = tuple(json.loads(r["flags"] or "[]"))
-            stored[at] = True
+        stored[at] = True
         return ForSeries([dt.date.fromisoformat(d) for d in days], values, flags, stored)
 
     def noise_fit(self, satellite: str, quantity: str, before: dt.date) -> dict | None:
