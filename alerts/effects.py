@@ -38,9 +38,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from alerts.noise import GROUPS, Noise, pooled
+from alerts.noise import GROUPS, Noise, floored_noise, pooled
 from alerts.rules import GEOLOCATION, watched_series
-from alerts.steps import floored_noise, move, window_mean
+from alerts.steps import move, window_mean
 from monitor.config.alert_settings import RuleSettings
 from monitor.core.constants import N_FOR
 from monitor.core.tables import Column, text_table

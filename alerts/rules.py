@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alerts.noise import MIN_HISTORY_DAYS
-from alerts.steps import FittedNoise, StepRules, detect, fitted_before, replay_reach
+from alerts.noise import MIN_HISTORY_DAYS, FittedNoise, fitted_before
+from alerts.steps import StepRules, detect, replay_reach
 from monitor.config.alert_settings import RuleSettings
 from monitor.core.constants import N_FOR
 from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity

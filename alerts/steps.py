@@ -46,8 +46,6 @@ from __future__ import annotations
 
 import datetime as dt
 import math
-import warnings
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -57,9 +55,12 @@ from alerts.noise import (
     GROUPS,
     MEMBERS,
     MIN_HISTORY_DAYS,
+    FitSource,
+    FittedNoise,
     Noise,
     ar1_correlation,
     fit_noise,
+    fitted_before,
     pooled,
     step_contrast,
 )
@@ -109,83 +110,6 @@ class Step:
     size: np.ndarray  # (N_FOR, directions)
     sigma: np.ndarray
     paged: bool
-
-
-@dataclass(frozen=True)
-class FittedNoise:
-    """The noise fitted on every assessed day before a date: how many days there were, the :class:`Noise`
-    (None: too few to fit), and each FOR's usual sigma there (N_FOR, C), below half of which a day's sigma
-    is not believed (a day whose sigmas are too small cannot page)."""
-
-    days: int
-    noise: Noise | None
-    typical: np.ndarray
-
-    def to_dict(self) -> dict:
-        """The fit as JSON-serialisable values (what the store keeps).
-
-        Returns
-        -------
-        dict
-            ``days``, ``typical`` and, when fitted, ``scale``, ``shared`` and ``lag1``.
-        """
-        out: dict = {"days": self.days, "typical": self.typical.tolist()}
-        if self.noise is not None:
-            out |= {
-                "scale": self.noise.scale.tolist(),
-                "shared": self.noise.shared.tolist(),
-                "lag1": self.noise.lag1,
-            }
-        return out
-
-    @classmethod
-    def from_dict(cls, d: dict) -> FittedNoise:
-        """The fit *d* as :meth:`to_dict` wrote it.
-
-        Parameters
-        ----------
-        d : dict
-            The fit's values.
-
-        Returns
-        -------
-        FittedNoise
-            The fit.
-        """
-        noise = (
-            Noise(np.array(d["scale"], float), np.array(d["shared"], float), float(d["lag1"]))
-            if "scale" in d
-            else None
-        )
-        return cls(int(d["days"]), noise, np.array(d["typical"], float))
-
-
-# the noise of every day before an ordinal (see detect): computed from the series given, or kept by the store
-FitSource = Callable[[int], FittedNoise]
-
-
-def fitted_before(ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, before: int) -> FittedNoise:
-    """The :class:`FittedNoise` of the days of the series before the ordinal *before*.
-
-    Parameters
-    ----------
-    ordinal : numpy.ndarray
-        The days' ordinals, shape (T,).
-    y : numpy.ndarray
-        The values (urad, or K for the bias), shape (T, N_FOR, C).
-    s : numpy.ndarray
-        Their sigmas, same shape.
-    before : int
-        The first ordinal not fitted.
-
-    Returns
-    -------
-    FittedNoise
-        The fit.
-    """
-    days = ordinal < before
-    typical = _typical(s, days)
-    return FittedNoise(int(np.count_nonzero(days)), _floored_fit(ordinal, y, s, days, typical), typical)
 
 
 def replay_reach(rules: StepRules) -> int:
@@ -551,48 +475,6 @@ def _fit(y: np.ndarray, s: np.ndarray, fitted: FittedNoise, rules: StepRules) ->
         threshold(RATE_MARGIN * rules.rate_per_year / 365.0, rho, phi, b, k, False, c, n),
         threshold(RATE_MARGIN * rules.rate_at_change, rho, phi, b, k, True, c, n),
     )
-
-
-def _typical(s: np.ndarray, days: np.ndarray) -> np.ndarray:
-    """Each FOR's and direction's median sigma over the *days* (a mask); NaN where none was measured."""
-    with warnings.catch_warnings():  # a FOR never measured there: NaN, as meant
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return np.nanmedian(np.where(days[:, None, None], s, np.nan), axis=0)
-
-
-def _floored_fit(
-    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, days: np.ndarray, typical: np.ndarray
-) -> Noise | None:
-    """:func:`alerts.noise.fit_noise` on the *days*, their sigmas floored at half the *typical* ones."""
-    return fit_noise(ordinal[days], y[days], np.fmax(s, 0.5 * typical)[days])
-
-
-def floored_noise(
-    ordinal: np.ndarray, y: np.ndarray, s: np.ndarray, days: np.ndarray
-) -> tuple[Noise, np.ndarray] | None:
-    """The :class:`Noise` fitted on the *days* (a mask) and the sigmas it applies to: a day's sigma is not
-    believed below half the FOR's usual one there (a day whose sigmas are too small cannot page). None
-    when the noise cannot be fitted (:func:`alerts.noise.fit_noise`).
-
-    Parameters
-    ----------
-    ordinal : numpy.ndarray
-        The days' ordinals, shape (T,).
-    y : numpy.ndarray
-        The values (urad, or K for the bias), shape (T, N_FOR, C).
-    s : numpy.ndarray
-        Their sigmas, same shape.
-    days : numpy.ndarray
-        bool: the days fitted.
-
-    Returns
-    -------
-    tuple or None
-        (Noise, the floored sigmas); None when the noise cannot be fitted.
-    """
-    typical = _typical(s, days)
-    noise = _floored_fit(ordinal, y, s, days, typical)
-    return None if noise is None else (noise, np.fmax(s, 0.5 * typical))
 
 
 def window_mean(

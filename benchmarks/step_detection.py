@@ -97,8 +97,8 @@ def history(case: Case, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarra
 
 class MemoryHistory:
     """The :class:`monitor.history.records.History` the rules read, over arrays, as of day *today* (an
-    index): the store's series and latest day; no runs, events or granules (the rules that read those
-    find nothing)."""
+    index): the store's series, latest day and noise fits; no runs, events or granules (the rules that read
+    those find nothing)."""
 
     def __init__(
         self, y: np.ndarray, s: np.ndarray, bias: tuple[np.ndarray, np.ndarray] | None = None
@@ -106,6 +106,7 @@ class MemoryHistory:
         self.y, self.s, self.today = y, s, 0
         self.bias = bias  # (bias, sigma) (DAYS, N_FOR) K, or none
         self.days = [START + dt.timedelta(days=i) for i in range(len(y))]
+        self.fits: dict[tuple[str, str, dt.date], dict] = {}  # the noise fits the store would keep
 
     def latest_day(self, satellite: str) -> dt.date:
         return self.days[self.today]
@@ -113,26 +114,44 @@ class MemoryHistory:
     def day_result(self, satellite: str, day: dt.date) -> list[ForOffset]:
         return []
 
-    def series(self, satellite: str, since: object = None, until: object = None) -> ForSeries:
+    def series(
+        self,
+        satellite: str,
+        since: dt.date | None = None,
+        until: dt.date | None = None,
+        fields: object = None,
+    ) -> ForSeries:
         n = self.today + 1
-        nan = np.full((n, N_FOR), np.nan)
+        a = 0 if since is None else max(0, (since - START).days)
+        if until is not None:
+            n = min(n, (until - START).days + 1)
+        nan = np.full((max(n - a, 0), N_FOR), np.nan)
         values = {
-            "d_alpha_urad": self.y[:n, :, 0],
-            "d_beta_urad": self.y[:n, :, 1],
-            "sigma_alpha_urad": self.s[:n, :, 0],
-            "sigma_beta_urad": self.s[:n, :, 1],
-            "bias_k": nan if self.bias is None else self.bias[0][:n],
-            "sigma_bias_k": nan if self.bias is None else self.bias[1][:n],
+            "d_alpha_urad": self.y[a:n, :, 0],
+            "d_beta_urad": self.y[a:n, :, 1],
+            "sigma_alpha_urad": self.s[a:n, :, 0],
+            "sigma_beta_urad": self.s[a:n, :, 1],
+            "bias_k": nan if self.bias is None else self.bias[0][a:n],
+            "sigma_bias_k": nan if self.bias is None else self.bias[1][a:n],
         }
-        return ForSeries(self.days[:n], values, np.empty(0), np.ones((n, N_FOR), bool))
+        return ForSeries(self.days[a:n], values, np.empty(0), np.ones((max(n - a, 0), N_FOR), bool))
+
+    def noise_fit(self, satellite: str, quantity: str, before: dt.date) -> dict | None:
+        return self.fits.get((satellite, quantity, before))
+
+    def keep_noise_fit(self, satellite: str, quantity: str, before: dt.date, body: dict) -> None:
+        self.fits[(satellite, quantity, before)] = body  # the days never change: a fit stays valid
 
     def runs(self, satellite: str | None = None) -> list:
+        return []
+
+    def runs_since_success(self, satellite: str) -> list:
         return []
 
     def events(self, kind: object = None) -> list:
         return []
 
-    def granules(self, satellite: str, day: object = None) -> list:
+    def granules(self, satellite: str, day: object = None, since: object = None) -> list:
         return []
 
 

@@ -7,7 +7,7 @@ import logging
 import numpy as np
 import pytest
 
-from alerts import steps
+from alerts import noise, steps
 from monitor.config.alert_settings import RuleSettings
 from monitor.core.constants import N_FOR
 
@@ -198,7 +198,7 @@ def test_the_replay_window_with_the_kept_fits_finds_what_the_whole_history_finds
 
     def kept(before):
         asked.append(before)
-        return steps.fitted_before(ordinal, y, s, before)
+        return noise.fitted_before(ordinal, y, s, before)
 
     start = ordinal[-1] - steps.replay_reach(RULES)
     window = ordinal >= start
@@ -225,12 +225,12 @@ def test_a_fit_survives_its_round_trip_through_json():
     y = 50.0 * _noise(rng, 60)
     s = np.full_like(y, 50.0)
     s[:, 3, 0] = np.nan  # a FOR never measured: no usual sigma
-    fitted = steps.fitted_before(np.arange(60), y, s, 40)
-    back = steps.FittedNoise.from_dict(json.loads(json.dumps(fitted.to_dict())))
+    fitted = noise.fitted_before(np.arange(60), y, s, 40)
+    back = noise.FittedNoise.from_dict(json.loads(json.dumps(fitted.to_dict())))
     assert back.days == 40 and np.isnan(back.typical[3, 0])
     np.testing.assert_array_equal(back.typical, fitted.typical)
     np.testing.assert_array_equal(back.noise.scale, fitted.noise.scale)
     np.testing.assert_array_equal(back.noise.shared, fitted.noise.shared)
     assert back.noise.lag1 == fitted.noise.lag1
-    young = steps.fitted_before(np.arange(60), y, s, 10)  # too few days: counted, not fitted
-    assert young.noise is None and steps.FittedNoise.from_dict(young.to_dict()).noise is None
+    young = noise.fitted_before(np.arange(60), y, s, 10)  # too few days: counted, not fitted
+    assert young.noise is None and noise.FittedNoise.from_dict(young.to_dict()).noise is None
