@@ -269,7 +269,7 @@ def jump_findings(
         return []
     rules = watched.rules(s)
     days, y, sig = watched_series(store, satellite, watched, since=latest - dt.timedelta(replay_reach(rules)))
-    if len(days) < MIN_HISTORY_DAYS:  # a young or sparse history: all of it (its noise cannot be kept yet)
+    if len(days) < MIN_HISTORY_DAYS:  # a young or sparse history: all of it, as detect then needs
         days, y, sig = watched_series(store, satellite, watched)
     if not np.isfinite(y).any():  # nothing measured (e.g. no intercalibration)
         return []
