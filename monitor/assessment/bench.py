@@ -1,8 +1,10 @@
-"""``crisgeo bench``: wall time of each stage of an assessment on a simulated case, FOVs/s, peak memory."""
+"""``crisgeo bench``: wall time of each stage of an assessment on a simulated case, FOVs/s, the CPU and the
+bytes read per CrIS granule, peak memory."""
 
 from __future__ import annotations
 
 import argparse
+import json
 import resource
 import tempfile
 import time
@@ -53,6 +55,24 @@ def reset_peak_rss() -> bool:
         return False
 
 
+def bytes_read() -> int | None:
+    """The bytes this process has read through system calls so far (Linux ``/proc/self/io`` rchar: files
+    read from the page cache count too, as they cost the reads).
+
+    Returns
+    -------
+    int or None
+        Bytes; None where the system does not count them.
+    """
+    try:
+        for line in Path("/proc/self/io").read_text().splitlines():
+            if line.startswith("rchar:"):
+                return int(line.split()[1])
+    except (OSError, ValueError):
+        pass
+    return None
+
+
 def _pyresample_reference(
     case: CasePlan, cfg: AssessmentConfig, max_granules: int = 1
 ) -> tuple[float, int] | None:
@@ -91,6 +111,12 @@ def _pyresample_reference(
     return time.perf_counter() - t0, int(valid.sum())
 
 
+def _clouds(data: Path) -> str:
+    """The simulated case's clouds, as its truth document names them."""
+    heights = json.loads((data / "truth.json").read_text()).get("cloud_heights", "ground")
+    return "flat clouds" if heights == "ground" else f"clouds with height {heights}"
+
+
 def run_bench(args: argparse.Namespace, cfg: AssessmentConfig) -> int:
     """``crisgeo bench``: simulate (or take --data), warm the kernels, assess, time each stage, print.
 
@@ -111,19 +137,20 @@ def run_bench(args: argparse.Namespace, cfg: AssessmentConfig) -> int:
         t0 = time.perf_counter()
         simulated = not (data / "truth.json").exists()
         if simulated:
-            simulate_case(data, granules=args.granules, profile="paper", seed=1)
+            simulate_case(data, granules=args.granules, profile="paper", seed=1, cloud_heights=args.clouds)
         t_sim = time.perf_counter() - t0
         t_jit = warm_up()  # numba compiles once (cached on disk); a run pays it once, not per granule
         sim_counted = simulated and not reset_peak_rss()  # the simulation's memory is not the assessment's
         timings = {}
-        t0 = time.perf_counter()
+        read0, cpu0, t0 = bytes_read(), time.process_time(), time.perf_counter()
         case = plan([data])
         timings["read"] = time.perf_counter() - t0
         result = assess_plan(case, cfg, timings=timings, workers=cfg.workers)
-        wall = time.perf_counter() - t0
+        wall, cpu, read1 = time.perf_counter() - t0, time.process_time() - cpu0, bytes_read()
+        n_cris = len(result.granules)
         n_fov = sum(gr.n_fovs for gr in result.granules)
         print(
-            f"case: {len(result.granules)} CrIS granules, {n_fov} FOVs x {len(offsets_rad(cfg)) ** 2} "
+            f"case: {n_cris} CrIS granules ({_clouds(data)}), {n_fov} FOVs x {len(offsets_rad(cfg)) ** 2} "
             f"perturbations, cost {cfg.cost}, kernel {cfg.kernel} (simulation {t_sim:.1f} s and kernel "
             f"compile/load {t_jit:.1f} s, not counted)"
         )
@@ -132,6 +159,10 @@ def run_bench(args: argparse.Namespace, cfg: AssessmentConfig) -> int:
             print(f"  {stage:<12} {t:8.2f} s  {n_fov / t if t else float('inf'):10.0f} FOVs/s")
         print(f"  {'total':<12} {wall:8.2f} s  {n_fov / wall:10.0f} FOVs/s")
         print("(the next granule is read in a thread while one is computed: the stages add up to more)")
+        print(f"CPU: {cpu:.1f} CPU-s, {cpu / n_cris:.2f} CPU-s per CrIS granule ({cfg.workers} threads)")
+        if read0 is not None and read1 is not None:
+            mb = (read1 - read0) / 1e6
+            print(f"read: {mb:.0f} MB, {mb / n_cris:.1f} MB per CrIS granule")
         print(f"peak memory: {peak_rss_mb():.0f} MB ({cfg.workers} threads in one process)")
         if sim_counted:
             print("(the main process's peak includes the simulation: this system cannot reset the count)")

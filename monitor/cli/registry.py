@@ -148,6 +148,15 @@ COST = arg(
 )
 
 
+CLOUDS = arg(
+    "--clouds",
+    default="ground",
+    metavar="LAW",
+    help="cloud tops at the height their temperature implies: lapse:G (K/km, e.g. lapse:6.5) or "
+    "tropical (a profile that is not linear); default ground (flat clouds, no parallax)",
+)
+
+
 WORKERS = arg(
     "--workers",
     type=int,

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 from monitor.cli.output import result_text
 from monitor.cli.registry import (
     ASSESSMENT,
+    CLOUDS,
     COST,
     EXIT_OK,
     KERNEL,
@@ -51,13 +52,7 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     arg("--true-ep", help="EP file (XML or YAML) the radiances are made with (with --ground-ep)"),
     arg("--ground-ep", help="EP file the GEO files are made with (the ground processing's EP)"),
     arg("--terrain", action="store_true", help="1-4 km ranges and plateaus over 40 %% land"),
-    arg(
-        "--clouds",
-        default="ground",
-        metavar="LAW",
-        help="cloud tops at the height their temperature implies: lapse:G (K/km, e.g. lapse:6.5) or "
-        "tropical (a profile that is not linear); default ground (flat clouds, no parallax)",
-    ),
+    CLOUDS,
     arg(
         "--cloud-edges",
         default="soft",
@@ -251,7 +246,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
 
 @command(
     "bench",
-    "time each stage on a simulated case; print FOVs/s and peak memory",
+    "time each stage on a simulated case; print FOVs/s, CPU and bytes read per granule, peak memory",
     arg(
         "--granules",
         type=whole(1),
@@ -259,6 +254,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
         help=f"consecutive CrIS granules of the simulated case (default {PAPER_GRANULES})",
     ),
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
+    CLOUDS,
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
     WORKERS,
     COST,

@@ -92,7 +92,14 @@ def test_bench_prints_every_stage_and_the_assessment_memory():
     run = run_crisgeo("bench", "--granules", "1", "--workers", "1", "--kernel", "top-hat")
     assert run.returncode == 0, run.stderr
     out = run.stdout
-    assert "case: 1 CrIS granules, 1080 FOVs x 441 perturbations, cost regression, kernel top-hat" in out
+    assert (
+        "case: 1 CrIS granules (flat clouds), 1080 FOVs x 441 perturbations, cost regression, kernel top-hat"
+        in out
+    )
+    cpu = float(re.search(r"^CPU: [0-9.]+ CPU-s, ([0-9.]+) CPU-s per CrIS granule", out, re.M).group(1))
+    assert 0.5 < cpu < 200
+    mb = float(re.search(r"^read: [0-9]+ MB, ([0-9.]+) MB per CrIS granule", out, re.M).group(1))
+    assert 20 < mb < 2000  # one CrIS granule, its GEO and the VIIRS granules it reaches
     for stage in ("read", "geometry", "spectral", "collocation", "cost", "total"):
         secs, rate = re.search(rf"^  {stage} +([0-9.]+) s +([0-9.]+|inf) FOVs/s", out, re.M).groups()
         assert float(secs) > 0 or stage in ("spectral", "cost")
