@@ -17,14 +17,24 @@ views. One JSON row. Rows before 2026-11-28 11:30 also hold the two-dimensional 
 was then ("render") and the sweep measured here before it replaced that ("sweep", "sweep_linear"; nearest
 and linear tops).
 
+For each angle it also prints the renderer's cross-track shift, in VIIRS columns, in each sixth of the
+scan ("cross_track_columns"): the renderer is given each pixel's hit point (ECEF, where VIIRS's ray met
+the scene) as its field, so what it renders at a GEO point is where it takes that point's value from;
+that minus the truth's hit point, along the scan's direction at the GEO point (its next column), over the
+rays whose truth meets a cloud above 1 km: median, 16th and 84th percentiles, and the count. A top's BT
+taken from a pixel a column aside reads +-1 here.
+
 With ``--reaches 40,100`` the views are also rendered from the heights the assessment would give the
 pixels (:func:`monitor.collocation.lift.height_above_m` at the law, the clear-sky reference the warmest
 3 x 3 mean within each reach), the fields "reference_40px" ...; the row's "heights" holds their bias and
 RMS (m) against the true heights over the tops above 6 km and over the pixels that see the ground
 (docs/science.md, "The clear-sky reference").
 
+With ``--across`` the renderer takes each ray's BT at its own position across the track
+(:func:`monitor.collocation.render.view_tangents_across`); the row says which ("across").
+
     .venv/bin/python -m studies.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
-        [--scans 8] [--reaches 40,100] [--rows FILE]
+        [--scans 8] [--reaches 40,100] [--across] [--rows FILE]
 
 The scene is VIIRS's first granule of a one-granule case, from its 11th scan on; no noise. The walls and
 the reference's heights take the case's law in band BT (:func:`monitor.simulate.case.law_m_per_k`; rows
@@ -50,6 +60,9 @@ from monitor.simulate.case import T_BINS_K, SimulationSpec, Simulator, law_m_per
 ALPHA_RAD = np.array([19.1e-3, 0.0, -19.1e-3])  # the rows ahead, the centre, the rows behind
 DISC_M = 7000.0
 EDGE_DETECTORS = np.r_[0:8, 24:32]
+SIXTHS = 6  # the scan's parts the cross-track shift is stated in
+CLOUD_M = 1000.0  # the truth's rays that meet something higher than this count in the shift
+WALLS_AS_STRETCHES = 1e30  # m per K: a wall renders as its stretch's own field (no depth term)
 
 
 def _band_bt(sim: Simulator, temp_k: np.ndarray) -> np.ndarray:
@@ -86,7 +99,54 @@ def _height_errors(height_m: np.ndarray, true_m: np.ndarray) -> dict:
     return out
 
 
-def measure(clouds: str, edges: str, seed: int, scans: int, reaches_px: tuple[int, ...] = ()) -> dict:
+def _shift_columns(
+    x: np.ndarray,
+    b: np.ndarray,
+    a: np.ndarray,
+    height: np.ndarray,
+    good: np.ndarray,
+    hit_p: np.ndarray,
+    geo_p: np.ndarray,
+    across: render.Across | None,
+) -> np.ndarray:
+    """Per view, the cross-track distance, in columns, from the truth's hit point to the point the renderer
+    takes each GEO point's value from (NaN where it takes none or the next column is unusable).
+
+    Parameters
+    ----------
+    x, b, a, height : numpy.ndarray
+        :func:`render.view_tangents`'s along-track coordinate and tangents and the pixels' heights (m).
+    good : numpy.ndarray
+        Where a pixel is usable, shape (rows, cols).
+    hit_p : numpy.ndarray
+        Where VIIRS's ray of each pixel met the scene, ECEF, m, shape (rows, cols, 3).
+    geo_p : numpy.ndarray
+        Each pixel's GEO point, ECEF, m, shape (rows, cols, 3).
+    across : render.Across or None
+        Where the rays lie across the track, when the renderer takes it.
+
+    Returns
+    -------
+    numpy.ndarray
+        The rendered hit point minus the truth's along the scan, columns, shape (views, rows, cols) before
+        the truth is subtracted: the caller takes the truth per view.
+    """
+    centre = np.nanmean(geo_p[good], axis=0)  # float32 renders: keep the field's values small
+    rendered = np.stack(
+        [
+            render.render_height_field(
+                np.where(good, x, np.nan), b, height, hit_p[..., k] - centre[k], a, WALLS_AS_STRETCHES, across
+            ).astype(np.float64)
+            for k in range(3)
+        ],
+        -1,
+    )
+    return rendered + centre
+
+
+def measure(
+    clouds: str, edges: str, seed: int, scans: int, reaches_px: tuple[int, ...] = (), across: bool = False
+) -> dict:
     """The row (module docstring)."""
     sim = Simulator(SimulationSpec(granules=1, seed=seed, cloud_heights=clouds, cloud_edges=edges))
     theta, col_dt = ins.viirs_column_geometry()
@@ -100,20 +160,22 @@ def measure(clouds: str, edges: str, seed: int, scans: int, reaches_px: tuple[in
     origin = np.broadcast_to(r[:, None], los.shape)
     lat, lon, _ = sim.surface(origin, los)
     t3 = np.broadcast_to(pixel_s[:, None, :], lat.shape)
-    _, hit_lat, hit_lon, hit_m = sim.scene.intersect(origin, los, unix_s=t3)
+    hit_dist, hit_lat, hit_lon, hit_m = sim.scene.intersect(origin, los, unix_s=t3)
     temp = sim.scene.temperature_k(hit_lat, hit_lon, sim.scene.height_m(hit_lat, hit_lon), t3)
     shape = (scans * VIIRS_DETECTORS, VIIRS_COLUMNS)
+    hit_p = (origin + hit_dist[..., None] * los).reshape(*shape, 3)
     lat, lon, hit_m, times = (np.asarray(v).reshape(shape) for v in (lat, lon, hit_m, t3))
     bt = _band_bt(sim, temp).reshape(shape)
     good = ~np.tile(ins.viirs_bowtie_deleted(), (scans, 1)) & np.isfinite(lat)
     sat, vel = sim.orbit.state_ecef(scan_start + ins.VIIRS_EARTH_VIEW_S / 2)
-    x, b, a = render.view_tangents(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
+    x, b, a, traced = render.view_tangents_across(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
+    sideways = traced if across else None
     m_per_k = law_m_per_k(sim.spec.satellite, clouds)  # the law, in metres per kelvin of band BT
     if m_per_k is None:
         raise ValueError(f"clouds {clouds!r}: nothing stands above the ground to render")
     t0 = time.perf_counter()
     height = np.where(good, np.nan_to_num(hit_m), 0.0)
-    rendered = render.render_height_field(np.where(good, x, np.nan), b, height, bt, a, m_per_k)
+    rendered = render.render_height_field(np.where(good, x, np.nan), b, height, bt, a, m_per_k, sideways)
     render_s = time.perf_counter() - t0
     by_reach = {}  # rendered from the heights the clear-sky reference gives at each reach, at the law
     heights = {}
@@ -122,21 +184,39 @@ def measure(clouds: str, edges: str, seed: int, scans: int, reaches_px: tuple[in
         h = lift.height_above_m(bt.astype(np.float32), good, ref, m_per_k)
         heights[f"reference_{reach}px"] = _height_errors(h[good], height[good])
         by_reach[f"reference_{reach}px"] = render.render_height_field(
-            np.where(good, x, np.nan), b, h, bt, a, m_per_k
+            np.where(good, x, np.nan), b, h, bt, a, m_per_k, sideways
         )
-    p = wgs84.geodetic_to_ecef(lat[good], lon[good], np.zeros(int(good.sum())))
+    geo_p = wgs84.geodetic_to_ecef(lat, lon, np.zeros(shape))
+    source = _shift_columns(x, b, a, height, good, hit_p, geo_p, sideways)
+    next_column = np.roll(geo_p, -1, axis=1) - geo_p  # the scan's way at the GEO point
+    next_column[:, -1] = np.nan
+    across_good = good & np.roll(good, -1, axis=1)
+    sixth = np.broadcast_to((np.arange(shape[1]) * SIXTHS // shape[1])[None, :], shape)[good]
+    p = geo_p[good]
     centres = p[np.random.default_rng(1).choice(len(p), 400, replace=False)]
     discs = cKDTree(p).query_ball_point(centres, DISC_M)
     detector = np.broadcast_to((np.arange(shape[0]) % VIIRS_DETECTORS)[:, None], shape)[good]
     edge = np.isin(detector, EDGE_DETECTORS)
     row: dict = {"commit": commit(), "clouds": clouds, "edges": edges, "seed": seed, "scans": scans}
+    row["across"] = across
     row |= {"m_per_k": m_per_k, "render_s": render_s} | ({"heights": heights} if heights else {})
     for j, alpha in enumerate(ALPHA_RAD):
         t_view = _view_time(sim, p, times[good], alpha)
         r_view, _, _ = sim.state(t_view)
-        _, v_lat, v_lon, _ = sim.scene.intersect(r_view, frames.unit(p - r_view), unix_s=t_view)
-        truth = _band_bt(sim, sim.scene.temperature_k(v_lat, v_lon, sim.scene.height_m(v_lat, v_lon), t_view))
-        out = {}
+        _, v_lat, v_lon, v_hit = sim.scene.intersect(r_view, frames.unit(p - r_view), unix_s=t_view)
+        v_h = sim.scene.height_m(v_lat, v_lon)
+        truth = _band_bt(sim, sim.scene.temperature_k(v_lat, v_lon, v_h, t_view))
+        e = next_column[good]
+        cols = np.einsum("nk,nk->n", source[j][good] - wgs84.geodetic_to_ecef(v_lat, v_lon, v_hit), e)
+        cols = cols / np.einsum("nk,nk->n", e, e)
+        counted = across_good[good] & (v_hit > CLOUD_M) & np.isfinite(cols)
+        shift = []
+        for part in range(SIXTHS):
+            c = cols[counted & (sixth == part)]
+            q = np.percentile(c, [50, 16, 84]) if len(c) else np.full(3, np.nan)
+            shift.append({"median": round(float(q[0]), 4), "p16": round(float(q[1]), 3),
+                          "p84": round(float(q[2]), 3), "n": int(len(c))})  # fmt: skip
+        out: dict = {}
         fields = {"render": rendered[j][good].astype(float), "geo": bt[good]}
         fields |= {name: v[j][good].astype(float) for name, v in by_reach.items()}
         for name, field in fields.items():
@@ -150,6 +230,7 @@ def measure(clouds: str, edges: str, seed: int, scans: int, reaches_px: tuple[in
                 "off_5k_scan_middle": float(np.mean(off[~edge])),
                 "nan": float(np.mean(~np.isfinite(field))),
             }
+        out["cross_track_columns"] = shift
         row[f"alpha_{alpha * 1e3:+.1f}_mrad"] = out
     return row
 
@@ -165,6 +246,7 @@ def main() -> int:
         default="",
         help="comma-separated reaches (pixels) of the clear-sky reference to render from as well",
     )
+    p.add_argument("--across", action="store_true", help="take each ray's BT at its own cross-track position")
     p.add_argument("--rows", help="append the JSON row here")
     args = p.parse_args()
     if args.clouds == "ground":
@@ -173,7 +255,7 @@ def main() -> int:
         reaches = tuple(int(v) for v in args.reaches.split(",") if v)
     except ValueError:
         p.error(f"--reaches {args.reaches!r}: not comma-separated whole numbers of pixels")
-    emit(measure(args.clouds, args.edges, args.seed, args.scans, reaches), args.rows)
+    emit(measure(args.clouds, args.edges, args.seed, args.scans, reaches, args.across), args.rows)
     return 0
 
 

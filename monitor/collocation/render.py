@@ -42,6 +42,7 @@ argument); ``studies/render_truth.py`` measures this one against the simulator's
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Protocol
 
 import numba
@@ -95,11 +96,14 @@ def rendered_bt(
     m_per_k: float,
     scans: slice = slice(None),
     columns: slice = slice(None),
+    across: bool = False,
 ) -> np.ndarray:
     """The BT a CrIS ray at each in-track angle sees on its way to each GEO point of a VIIRS granule.
 
     :func:`view_tangents`, then :func:`render_height_field`, :data:`COLUMNS_PER_PASS` columns at a time. The
-    clear-sky reference is the whole granule's.
+    clear-sky reference is the whole granule's. With *across*, each ray takes its BT at its own position
+    across the track (:func:`view_tangents_across`; a pass then renders a column more either side, so that
+    its edge columns have their neighbours).
 
     Parameters
     ----------
@@ -121,6 +125,8 @@ def rendered_bt(
         The scans to render (step 1).
     columns : slice, optional
         The columns to render.
+    across : bool, optional
+        Take each ray's BT at its own position across the track.
 
     Returns
     -------
@@ -136,25 +142,35 @@ def rendered_bt(
     first, stop, _ = scans.indices(rows // VIIRS_DETECTORS)
     r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
     c_first, c_stop, _ = columns.indices(cols)
+    halo = 1 if across else 0
     for c0 in range(c_first, c_stop, COLUMNS_PER_PASS):
         part = slice(c0, min(c0 + COLUMNS_PER_PASS, c_stop))
-        # traced from the node at or before the part to the node at or after it: a part as in the whole
-        lo, hi = c0 - c0 % TANGENT_STEP, min(-(-(part.stop - 1) // TANGENT_STEP) * TANGENT_STEP + 1, cols)
+        drawn = slice(max(c0 - halo, 0), min(part.stop + halo, cols))  # the part and its halo
+        # traced from the node at or before them to the node at or after: a part as in the whole
+        lo = drawn.start - drawn.start % TANGENT_STEP
+        hi = min(-(-(drawn.stop - 1) // TANGENT_STEP) * TANGENT_STEP + 1, cols)
         traced = slice(lo, hi)
-        x, b, a = view_tangents(
-            lat_rad[r, traced], lon_rad[r, traced], height_m[r, traced], usable[r, traced], sat_m[first:stop],
-            velocity_m_s[first:stop], cris_alpha_rad, lo,
-        )  # fmt: skip
-        inner = slice(c0 - lo, part.stop - lo)
-        ok = usable[r, part]
-        out[:, r, part] = render_height_field(
+        geo = (lat_rad[r, traced], lon_rad[r, traced], height_m[r, traced], usable[r, traced])
+        orbit = (sat_m[first:stop], velocity_m_s[first:stop], cris_alpha_rad, lo)
+        inner = slice(drawn.start - lo, drawn.stop - lo)
+        sideways = None
+        if across:
+            x, b, a, w = view_tangents_across(*geo, *orbit)
+            cut = (w.geo_m[:, inner], w.unit[:, inner], w.viirs_tan[:, inner], w.cris_tan[:, :, inner])
+            sideways = Across(*cut)
+        else:
+            x, b, a = view_tangents(*geo, *orbit)
+        ok = usable[r, drawn]
+        seen = render_height_field(
             np.where(ok, x[:, inner], np.nan),
             b[:, inner],
-            height[r, part],
-            bt_k[r, part],
+            height[r, drawn],
+            bt_k[r, drawn],
             a[:, :, inner],
             m_per_k,
+            sideways,
         )
+        out[:, r, part] = seen[:, :, part.start - drawn.start : part.stop - drawn.start]
     return out
 
 
@@ -204,17 +220,117 @@ def view_tangents(
         Per view, the in-track tangent of the CrIS ray to each GEO point: the horizontal run along the
         column per unit of height towards the spacecraft, positive along +x; shape (views, rows, cols).
     """
+    x, b, a, _ = _traced(
+        lat_rad, lon_rad, height_m, good, sat_m, velocity_m_s, cris_alpha_rad, first_column, False
+    )
+    return x, b, a
+
+
+@dataclass(frozen=True)
+class Across:
+    """Where a granule's rays lie across the track: what lets a ray take its value at its own cross-track
+    position (:func:`view_tangents_across`).
+
+    Attributes
+    ----------
+    geo_m : numpy.ndarray
+        Each pixel's GEO point, ECEF, m, shape (rows, cols, 3); NaN where unusable.
+    unit : numpy.ndarray
+        The horizontal unit vector across the track at each GEO point (the local vertical cross the
+        column's way), ECEF, shape (rows, cols, 3).
+    viirs_tan : numpy.ndarray
+        The cross-track tangent of each pixel's VIIRS ray: its run along *unit* per metre of height towards
+        the spacecraft, shape (rows, cols).
+    cris_tan : numpy.ndarray
+        Per view, the same of the CrIS ray to each GEO point, shape (views, rows, cols).
+    """
+
+    geo_m: np.ndarray
+    unit: np.ndarray
+    viirs_tan: np.ndarray
+    cris_tan: np.ndarray
+
+
+def view_tangents_across(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    good: np.ndarray,
+    sat_m: np.ndarray,
+    velocity_m_s: np.ndarray,
+    cris_alpha_rad: np.ndarray,
+    first_column: int = 0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, Across]:
+    """:func:`view_tangents`, and where the rays lie across the track.
+
+    A CrIS ray meets a GEO point from where the spacecraft is seconds before or after VIIRS saw it, and
+    the Earth has turned under the track meanwhile, so at a height it lies a little across the track from
+    VIIRS's ray to the same point; pixels of other scans and detectors at one column index lie across
+    the track from it too (the Earth's turn between scans, the bow-tie's smile).
+
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    good : numpy.ndarray
+        Where a pixel is usable.
+    sat_m, velocity_m_s : numpy.ndarray
+        Each scan's spacecraft position (m) and velocity (m/s) at its middle, ECEF, shape (nscan, 3).
+    cris_alpha_rad : numpy.ndarray
+        The CrIS views' in-track angles in the spacecraft body frame, rad, positive ahead.
+    first_column : int
+        The granule column of the first column given, so that a part is traced as in the whole.
+
+    Returns
+    -------
+    x_m, viirs_tan, cris_tan : numpy.ndarray
+        As :func:`view_tangents`.
+    across : Across
+        The GEO points, the across-track directions and both instruments' cross-track tangents; the CrIS
+        tangent traced and interpolated as the in-track one.
+    """
+    x, b, a, across = _traced(
+        lat_rad, lon_rad, height_m, good, sat_m, velocity_m_s, cris_alpha_rad, first_column, True
+    )
+    assert across is not None
+    return x, b, a, across
+
+
+def _traced(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    good: np.ndarray,
+    sat_m: np.ndarray,
+    velocity_m_s: np.ndarray,
+    cris_alpha_rad: np.ndarray,
+    first_column: int,
+    with_across: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, Across | None]:
+    """:func:`_tangents` into new arrays (NaN where not written); the :class:`Across` with *with_across*."""
     rows, cols = np.shape(lat_rad)
+    views = len(cris_alpha_rad)
     sat = np.ascontiguousarray(sat_m, np.float64)
     vel = np.ascontiguousarray(velocity_m_s, np.float64)
     x = np.full((rows, cols), np.nan)
     b = np.full((rows, cols), np.nan, np.float32)
-    a = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
+    a = np.full((views, rows, cols), np.nan, np.float32)
+    n = rows if with_across else 0
+    across = Across(
+        np.full((n, cols, 3), np.nan),
+        np.full((n, cols, 3), np.nan),
+        np.full((n, cols), np.nan, np.float32),
+        np.full((views, n, cols), np.nan, np.float32),
+    )
     geo = [np.ascontiguousarray(v, np.float64) for v in (lat_rad, lon_rad, height_m)]
     tan_alpha = np.tan(np.asarray(cris_alpha_rad, np.float64))
     with KERNEL_LOCK:
-        _tangents(*geo, np.ascontiguousarray(good, np.bool_), sat, vel, tan_alpha, first_column, x, b, a)
-    return x, b, a
+        _tangents(
+            *geo, np.ascontiguousarray(good, np.bool_), sat, vel, tan_alpha, first_column, x, b, a,
+            across.geo_m, across.unit, across.viirs_tan, across.cris_tan,
+        )  # fmt: skip
+    return x, b, a, across if with_across else None
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -261,10 +377,16 @@ def _tangents(
     x: np.ndarray,
     b: np.ndarray,
     a: np.ndarray,
+    geo: np.ndarray,
+    across: np.ndarray,
+    b_across: np.ndarray,
+    a_across: np.ndarray,
 ) -> None:
     """Fill *x*, *b* and *a* (:func:`view_tangents`), one scan a task; x along the first scan's
-    SBF x."""
+    SBF x. When *geo* has rows, also *geo*, *across*, *b_across* and *a_across*
+    (:func:`view_tangents_across`)."""
     cols = lat.shape[1]
+    with_across = geo.shape[0] > 0
     axis0 = np.full(3, np.nan)
     for k in range(lat.shape[0] // VIIRS_DETECTORS):  # the first scan with an SBF: x's axis
         if np.all(np.isfinite(sat[k])) and np.all(np.isfinite(vel[k])):
@@ -307,26 +429,39 @@ def _tangents(
                 t0, t1, t2 = xs0 - xu * u0, xs1 - xu * u1, xs2 - xu * u2
                 norm = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
                 t0, t1, t2 = t0 / norm, t1 / norm, t2 / norm
+                w0, w1, w2 = u1 * t2 - u2 * t1, u2 * t0 - u0 * t2, u0 * t1 - u1 * t0  # across: u x t
                 x[row0 + i, c] = p0 * axis0[0] + p1 * axis0[1] + p2 * axis0[2]
                 when = order * q[6] / ROTATION_RAD_S
                 d0, d1, d2 = s0 + v0 * when - p0, s1 + v1 * when - p1, s2 + v2 * when - p2  # to VIIRS then
-                b[row0 + i, c] = (d0 * t0 + d1 * t1 + d2 * t2) / (d0 * u0 + d1 * u1 + d2 * u2)
+                d_up = d0 * u0 + d1 * u1 + d2 * u2
+                b[row0 + i, c] = (d0 * t0 + d1 * t1 + d2 * t2) / d_up
+                if with_across:
+                    geo[row0 + i, c, 0], geo[row0 + i, c, 1], geo[row0 + i, c, 2] = p0, p1, p2
+                    across[row0 + i, c, 0], across[row0 + i, c, 1], across[row0 + i, c, 2] = w0, w1, w2
+                    b_across[row0 + i, c] = (d0 * w0 + d1 * w1 + d2 * w2) / d_up
                 ends = last < 0 or c == cols - 1 or not rows[i, c + 1]  # a run of usable pixels
                 node = ends or (first_column + c) % TANGENT_STEP == 0
                 if not node:
                     continue
                 for j in range(tan_alpha.shape[0]):
-                    a[j, row0 + i, c] = _cris_tangent(p0, p1, p2, d0, d1, d2, t0, t1, t2, u0, u1, u2,
-                                                      xs0, xs1, xs2, v0, v1, v2, tan_alpha[j])  # fmt: skip
+                    a_in, a_out = _cris_tangent(p0, p1, p2, d0, d1, d2, t0, t1, t2, u0, u1, u2, xs0, xs1,
+                                                xs2, v0, v1, v2, tan_alpha[j], w0, w1, w2)  # fmt: skip
+                    a[j, row0 + i, c] = a_in
+                    if with_across:
+                        a_across[j, row0 + i, c] = a_out
                 # the columns since the last node, linearly in scan angle between the two
                 if last >= 0 and c - last > 1:
-                    w0 = point[i, last, 6]
-                    span = q[6] - w0
+                    angle0 = point[i, last, 6]
+                    span = q[6] - angle0
                     for m in range(last + 1, c):
                         if rows[i, m]:
-                            w = (point[i, m, 6] - w0) / span if span != 0.0 else 0.0
+                            w = (point[i, m, 6] - angle0) / span if span != 0.0 else 0.0
                             for j in range(tan_alpha.shape[0]):
                                 a[j, row0 + i, m] = (1.0 - w) * a[j, row0 + i, last] + w * a[j, row0 + i, c]
+                                if with_across:
+                                    a_across[j, row0 + i, m] = (1.0 - w) * a_across[j, row0 + i, last] + (
+                                        w * a_across[j, row0 + i, c]
+                                    )
                 last = c
 
 
@@ -334,11 +469,12 @@ def _tangents(
 def _cris_tangent(
     p0: float, p1: float, p2: float, d0: float, d1: float, d2: float, t0: float, t1: float, t2: float,
     u0: float, u1: float, u2: float, xs0: float, xs1: float, xs2: float, v0: float, v1: float, v2: float,
-    tan_alpha: float,
-) -> float:  # fmt: skip
+    tan_alpha: float, w0: float, w1: float, w2: float,
+) -> tuple[float, float]:  # fmt: skip
     """The in-track tangent a of the CrIS ray at SBF angle tan(alpha) to the GEO point p (m, ECEF; its
     local vertical u, the column's way t on the horizontal; d from p to VIIRS at the pixel's time; xs the
-    scan's SBF x; v the velocity): :func:`view_tangents`."""
+    scan's SBF x; v the velocity): :func:`view_tangents`; and its tangent along the horizontal across the
+    track w (:func:`view_tangents_across`)."""
     r0, r1, r2 = d0, d1, d2
     for _ in range(3):  # the SBF turns with the spacecraft's move: 11 % of it, then 1 %
         z0, z1, z2 = p0 + r0, p1 + r1, p2 + r2
@@ -357,7 +493,8 @@ def _cris_tangent(
         vx, vz = v0 * x0 + v1 * x1 + v2 * x2, v0 * z0 + v1 * z1 + v2 * z2
         dt = (-rx + tan_alpha * rz) / (vx - tan_alpha * vz)
         r0, r1, r2 = r0 + dt * v0, r1 + dt * v1, r2 + dt * v2
-    return (r0 * t0 + r1 * t1 + r2 * t2) / (r0 * u0 + r1 * u1 + r2 * u2)
+    up = r0 * u0 + r1 * u1 + r2 * u2
+    return (r0 * t0 + r1 * t1 + r2 * t2) / up, (r0 * w0 + r1 * w1 + r2 * w2) / up
 
 
 def render_height_field(
@@ -367,8 +504,13 @@ def render_height_field(
     bt_k: np.ndarray,
     cris_tan: np.ndarray,
     m_per_k: float,
+    across: Across | None = None,
 ) -> np.ndarray:
     """What a CrIS ray at each in-track tangent sees on its way to each GEO point: the module's sweep.
+
+    With *across*, a ray takes the BT of what it meets at its own position across the track: from the
+    pixel's row, linearly between its column and the next one on the side the ray lies (the pixel's own
+    where that one is unusable or outside the arrays given).
 
     Parameters
     ----------
@@ -384,6 +526,8 @@ def render_height_field(
         The CrIS rays' in-track tangents, shape (views, rows, cols).
     m_per_k : float
         The height law, m per K: a wall is its stretch's BT plus its depth below the top over it.
+    across : Across, optional
+        Where the rays lie across the track (:func:`view_tangents_across`), the same pixels.
 
     Returns
     -------
@@ -393,9 +537,54 @@ def render_height_field(
     """
     seen = np.full(np.shape(cris_tan), np.nan)
     args = [np.ascontiguousarray(v, np.float64) for v in (x_m, viirs_tan, height_m, bt_k, cris_tan)]
+    if across is None:
+        none = np.zeros((0, 0, 3))
+        sideways = [none, none, np.zeros((0, 0)), np.zeros((0, 0, 0))]
+    else:
+        sideways = [
+            np.ascontiguousarray(v, np.float64)
+            for v in (across.geo_m, across.unit, across.viirs_tan, across.cris_tan)
+        ]
     with KERNEL_LOCK:
-        _sweep(*args, float(m_per_k), seen)
+        _sweep(*args, float(m_per_k), *sideways, seen)
     return seen.astype(np.float32)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _across_bt(
+    bt: np.ndarray,
+    x: np.ndarray,
+    geo: np.ndarray,
+    unit: np.ndarray,
+    b_across: np.ndarray,
+    a_across: np.ndarray,
+    v: int,
+    r0: int,
+    r: int,
+    c: int,
+    z: float,
+) -> float:
+    """The BT of pixel (r, c) at view v's ray to GEO point (r0, c) where it meets height z: the ray lies
+    z (a - b) plus the two GEO points' distance across the track from that pixel's ray (both along the
+    horizontal across at r0), taken between column c and its neighbour on that side
+    (:func:`render_height_field`)."""
+    own = bt[r, c]
+    w0, w1, w2 = unit[r0, c, 0], unit[r0, c, 1], unit[r0, c, 2]
+    apart = (geo[r, c, 0] - geo[r0, c, 0]) * w0 + (geo[r, c, 1] - geo[r0, c, 1]) * w1
+    apart += (geo[r, c, 2] - geo[r0, c, 2]) * w2
+    off = z * (a_across[v, r0, c] - b_across[r, c]) - apart
+    if not math.isfinite(off) or off == 0.0:
+        return own
+    for step in (1, -1):
+        n = c + step
+        if n < 0 or n >= x.shape[1] or not math.isfinite(x[r, n]):
+            continue
+        spacing = (geo[r, n, 0] - geo[r, c, 0]) * w0 + (geo[r, n, 1] - geo[r, c, 1]) * w1
+        spacing += (geo[r, n, 2] - geo[r, c, 2]) * w2
+        share = off / spacing
+        if share > 0.0:
+            return own + min(share, 1.0) * (bt[r, n] - own)
+    return own
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
@@ -406,16 +595,22 @@ def _sweep(
     bt: np.ndarray,
     a: np.ndarray,
     m_per_k: float,
+    geo: np.ndarray,
+    unit: np.ndarray,
+    b_across: np.ndarray,
+    a_across: np.ndarray,
     out: np.ndarray,
 ) -> None:
-    """Fill *out* (:func:`render_height_field`), one column a task: the column's hits p sorted along the
-    track, then per ray the stretches within its reach tested for where it meets them, the highest
-    meeting kept. The reach: a GEO spacing behind the ray's foot (the stretch it stands on), and ahead,
-    towards the spacecraft, a spacing plus the run along the ray of the column's highest pixel, or of the
-    highest within NEAR_HITS hits of its own in the sorted order when that reach stays among them: a
-    stretch farther than its own height's run is met below ground. It is found by stepping from the
-    foot's own hit, not by bisection: a few steps, where a search of 1536 hits takes eleven."""
+    """Fill *out* (:func:`render_height_field`; across the track where *geo* has rows), one column a task:
+    the column's hits p sorted along the track, then per ray the stretches within its reach tested for
+    where it meets them, the highest meeting kept. The reach: a GEO spacing behind the ray's foot (the
+    stretch it stands on), and ahead, towards the spacecraft, a spacing plus the run along the ray of the
+    column's highest pixel, or of the highest within NEAR_HITS hits of its own in the sorted order when
+    that reach stays among them: a stretch farther than its own height's run is met below ground. It is
+    found by stepping from the foot's own hit, not by bisection: a few steps, where a search of 1536 hits
+    takes eleven."""
     rows, cols = x.shape
+    sideways = geo.shape[0] > 0
     for c in numba.prange(cols):
         idx = np.array([r for r in range(rows) if math.isfinite(x[r, c])], np.int64)
         n = len(idx)
@@ -457,8 +652,11 @@ def _sweep(
                 if best < 0:
                     continue
                 top = h[rs[best], c]
+                met = bt[rs[best], c]
+                if sideways:
+                    met = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z)
                 if top - best_z > TOP_M:  # a wall: the air's temperature at its depth
-                    out[v, r0, c] = bt[rs[best], c] + (top - best_z) / m_per_k
+                    out[v, r0, c] = met + (top - best_z) / m_per_k
                     continue
                 at = s0 + best_z * av  # a top: the two hits about where the ray meets it, linearly
                 k = best  # the last hit before it (a step from the stretch's own)
@@ -468,9 +666,13 @@ def _sweep(
                     k += 1
                 if 0 <= k < n - 1 and ps[k + 1] > ps[k]:
                     w = (at - ps[k]) / (ps[k + 1] - ps[k])
-                    out[v, r0, c] = (1 - w) * bt[rs[k], c] + w * bt[rs[k + 1], c]
+                    before, after = bt[rs[k], c], bt[rs[k + 1], c]
+                    if sideways:
+                        before = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[k], c, best_z)
+                        after = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[k + 1], c, best_z)
+                    out[v, r0, c] = (1 - w) * before + w * after
                 else:
-                    out[v, r0, c] = bt[rs[best], c]
+                    out[v, r0, c] = met
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -4,7 +4,14 @@ ray march through the column the pixels were drawn from, the view tangents again
 import numpy as np
 import pytest
 
-from monitor.collocation.render import TANGENT_STEP, render_height_field, rendered_bt, view_tangents
+from monitor.collocation.render import (
+    TANGENT_STEP,
+    Across,
+    render_height_field,
+    rendered_bt,
+    view_tangents,
+    view_tangents_across,
+)
 from monitor.geometry import wgs84
 from tests.collocation.test_lift import scan_geometry
 
@@ -205,3 +212,97 @@ def test_a_rays_reach_leaves_out_no_stretch_it_could_meet(steep):
     a = np.stack([np.full(n, -steep), np.full(n, steep)])
     got = render_height_field(x[:, None], b[:, None], h[:, None], bt[:, None], a[:, :, None], M_PER_K)
     np.testing.assert_allclose(got[..., 0], _every_stretch(x, b, h, bt, a, M_PER_K), rtol=0, atol=1e-4)
+
+
+def _deck(rows=12, cols=10, height_m=10e3, shift_m=None):
+    """A flat grid under an opaque deck *height_m* high: GEO points 375 m apart along the track (x) and
+    across it (y, the columns' way), each row shifted across by *shift_m* (rows,); the BT rises 0.5 K per
+    column's width across the track, so a value taken a fraction of a column aside reads half that."""
+    shift = np.zeros(rows) if shift_m is None else shift_m
+    r, c = np.meshgrid(np.arange(rows), np.arange(cols), indexing="ij")
+    geo = np.stack([r * PIXEL_M, c * PIXEL_M + shift[:, None], np.zeros(r.shape)], -1).astype(float)
+    unit = np.broadcast_to([0.0, 1.0, 0.0], geo.shape).copy()
+    bt = 250.0 + 0.5 * geo[..., 1] / PIXEL_M
+    return geo, unit, bt, np.full(r.shape, height_m)
+
+
+def test_a_ray_takes_its_value_at_its_own_place_across_the_track():
+    """Under a deck 10 km high, a CrIS ray tilted 0.01 more across the track than VIIRS's meets it 100 m
+    (0.27 columns) aside: it reads the BT there, between its column and the next on that side; at the
+    grid's last column, with no neighbour, the pixel's own. Without the cross-track data, its own."""
+    geo, unit, bt, height = _deck()
+    rows, cols = bt.shape
+    x, b = geo[..., 0], np.zeros(bt.shape)
+    a = np.zeros((2, rows, cols))  # both views climb straight up in-track: each ray meets its own top
+    tilt = np.array([0.01, -0.01])
+    across = Across(geo, unit, np.zeros(bt.shape), np.broadcast_to(tilt[:, None, None], a.shape).copy())
+    seen = render_height_field(x, b, height, bt, a, M_PER_K, across)
+    inner = slice(1, cols - 1)
+    np.testing.assert_allclose(
+        seen[:, 2:-2, inner], (bt + 0.5 * tilt[:, None, None] * 10e3 / PIXEL_M)[:, 2:-2, inner], atol=1e-4
+    )
+    assert np.allclose(seen[0, 2:-2, -1], bt[2:-2, -1]) and np.allclose(seen[1, 2:-2, 0], bt[2:-2, 0])
+    plain = render_height_field(x, b, height, bt, a, M_PER_K)
+    assert np.allclose(plain[:, 2:-2], bt[2:-2].astype(np.float32))
+
+
+def test_a_top_met_in_another_row_is_read_at_the_rays_own_place_across():
+    """Rows shifted across the track by up to 150 m (pixels of other scans and detectors at one column
+    index): a ray climbing 375 m ahead per 10 km meets the next row's top, and reads it where the ray is,
+    at its own row's place across the track, not the next row's."""
+    shift = np.random.default_rng(3).uniform(-150.0, 150.0, 12)
+    geo, unit, bt, height = _deck(shift_m=shift)
+    rows, cols = bt.shape
+    a = np.full((1, rows, cols), PIXEL_M / 10e3)
+    across = Across(geo, unit, np.zeros(bt.shape), np.zeros(a.shape))
+    seen = render_height_field(geo[..., 0], np.zeros(bt.shape), height, bt, a, M_PER_K, across)[0]
+    plain = render_height_field(geo[..., 0], np.zeros(bt.shape), height, bt, a, M_PER_K)[0]
+    inner = (slice(2, rows - 2), slice(1, cols - 1))
+    np.testing.assert_allclose(seen[inner], bt[inner], atol=1e-3)  # the ray's own place across
+    np.testing.assert_allclose(plain[inner], np.roll(bt, -1, axis=0)[inner], atol=1e-3)  # the next row's
+
+
+def test_the_cross_track_tangents_follow_the_lines_of_sight():
+    """The across direction is horizontal and square to the column's way; VIIRS's cross-track tangent is
+    the run along it per metre of height up its line of sight; a CrIS row at a detector's own in-track
+    angle sees that pixel along VIIRS's line, across the track too; the in-track results are
+    :func:`view_tangents`'s."""
+    lat, lon, h, origin, sat, v = scan_geometry()
+    good = np.ones(lat.shape, bool)
+    c, i = 200, 3
+    own = np.arctan(np.tan((i - 15.5) * 4.5e-4) / np.cos(np.linspace(-0.9, 0.9, 400)[c]))
+    alphas = np.array([own, 0.0191, -0.0191])
+    first = TANGENT_STEP - c % TANGENT_STEP
+    x, b, a, across = view_tangents_across(lat, lon, h, good, sat[None], v[None], alphas, first_column=first)
+    plain = view_tangents(lat, lon, h, good, sat[None], v[None], alphas, first)
+    for mine, theirs in zip((x, b, a), plain, strict=True):
+        np.testing.assert_array_equal(mine, theirs)
+    ground = wgs84.geodetic_to_ecef(lat, lon, h)
+    np.testing.assert_allclose(across.geo_m, ground, atol=1e-6)
+    up = wgs84.geodetic_up(ground)
+    assert np.abs(np.sum(across.unit * up, -1)).max() < 1e-9
+    look = origin - ground
+    run = np.sum(look * across.unit, -1) / np.sum(look * up, -1)
+    assert np.abs(run - across.viirs_tan).max() < 1e-5
+    assert across.cris_tan[0, i, c] == pytest.approx(across.viirs_tan[i, c], abs=1e-6)
+
+
+def test_across_the_track_flat_scenes_and_parts_render_as_before():
+    """With the cross-track position taken: a flat scene is left as it is; a part renders as in the whole
+    (its edge columns drawn with their neighbours)."""
+    lat, lon, h, _, sat, v = scan_geometry()
+    good = np.ones(lat.shape, bool)
+    alphas = np.array([-0.0191, 0.0, 0.0191])
+    flat = rendered_bt(lat, lon, h, np.full(lat.shape, 280.0, np.float32), good, sat[None], v[None], alphas,
+                       M_PER_K, across=True)  # fmt: skip
+    assert np.all(flat == 280.0)
+    bt = np.full(lat.shape, 295.0, np.float32)
+    bt[10:21] = 230.0 + 20.0 * (np.arange(lat.shape[1]) % 2)  # the band's BT alternates across the track
+    whole = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, across=True)
+    part = rendered_bt(
+        lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, columns=slice(100, 300), across=True
+    )
+    assert np.all(np.isnan(part[:, :, :100])) and np.all(np.isnan(part[:, :, 300:]))
+    np.testing.assert_allclose(part[:, :, 100:300], whole[:, :, 100:300], atol=0.01)
+    plain = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K)
+    assert np.nanmax(np.abs(whole - plain)) > 0.01  # the cross-track position moves some rays' values
