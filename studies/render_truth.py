@@ -31,7 +31,7 @@ RMS (m) against the true heights over the tops above 6 km and over the pixels th
 (docs/science.md, "The clear-sky reference").
 
 With ``--across`` the renderer takes each ray's BT at its own position across the track
-(:func:`monitor.collocation.render.view_tangents_across`); the row says which ("across").
+(:func:`monitor.collocation.views.view_tangents_across`); the row says which ("across").
 
     .venv/bin/python -m studies.render_truth [--clouds lapse:6.5] [--edges sharp] [--seed 11]
         [--scans 8] [--reaches 40,100] [--across] [--rows FILE]
@@ -51,7 +51,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from benchmarks.provenance import commit, emit
-from monitor.collocation import lift, render
+from monitor.collocation import lift, render, views
 from monitor.core.constants import VIIRS_COLUMNS, VIIRS_DETECTORS
 from monitor.geometry import frames, wgs84
 from monitor.simulate import scan_geometry as ins
@@ -107,7 +107,7 @@ def _shift_columns(
     good: np.ndarray,
     hit_p: np.ndarray,
     geo_p: np.ndarray,
-    across: render.Across | None,
+    across: views.Across | None,
 ) -> np.ndarray:
     """Per view, the cross-track distance, in columns, from the truth's hit point to the point the renderer
     takes each GEO point's value from (NaN where it takes none or the next column is unusable).
@@ -115,14 +115,14 @@ def _shift_columns(
     Parameters
     ----------
     x, b, a, height : numpy.ndarray
-        :func:`render.view_tangents`'s along-track coordinate and tangents and the pixels' heights (m).
+        :func:`views.view_tangents`'s along-track coordinate and tangents and the pixels' heights (m).
     good : numpy.ndarray
         Where a pixel is usable, shape (rows, cols).
     hit_p : numpy.ndarray
         Where VIIRS's ray of each pixel met the scene, ECEF, m, shape (rows, cols, 3).
     geo_p : numpy.ndarray
         Each pixel's GEO point, ECEF, m, shape (rows, cols, 3).
-    across : render.Across or None
+    across : views.Across or None
         Where the rays lie across the track, when the renderer takes it.
 
     Returns
@@ -168,7 +168,7 @@ def measure(
     bt = _band_bt(sim, temp).reshape(shape)
     good = ~np.tile(ins.viirs_bowtie_deleted(), (scans, 1)) & np.isfinite(lat)
     sat, vel = sim.orbit.state_ecef(scan_start + ins.VIIRS_EARTH_VIEW_S / 2)
-    x, b, a, traced = render.view_tangents_across(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
+    x, b, a, traced = views.view_tangents_across(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
     sideways = traced if across else None
     m_per_k = law_m_per_k(sim.spec.satellite, clouds)  # the law, in metres per kelvin of band BT
     if m_per_k is None:
