@@ -13,7 +13,7 @@ themselves leave (each FOV's one in-track angle, views 20 mrad apart blended lin
 the noise and the day's scenes: the part of the error that better heights, walls or reference cannot
 remove.
 
-    .venv/bin/python -m studies.ideal_views CASE_DIR... [--workers 2] [--across] [--rows FILE]
+    .venv/bin/python -m studies.ideal_views CASE_DIR... [--workers 2] [--across] [--no-ideal] [--rows FILE]
 
 A case directory is one ``crisgeo simulate`` wrote, with truth.json; its scene is simulated again from
 the truth's parameters (the seed gives the same scene). One JSON row per case: the errors as the service
@@ -22,7 +22,8 @@ assesses it ("default") and from the ideal views ("ideal"), with the bounds' fie
 VIIRS's own BT| over the rendered pixels (a check that the scene is the case's: VIIRS's own view is within
 7 mrad of the centre's, so most pixels differ by the noise alone). With ``--across`` the row also holds the
 errors as the service assesses the case when each ray takes its BT at its own place across the track
-("across": :func:`monitor.collocation.render.rendered_bt` with ``across=True``).
+("across": :func:`monitor.collocation.render.rendered_bt` with ``across=True``); with ``--no-ideal``
+it holds the service's assessments alone (no "ideal", no tracing).
 """
 
 from __future__ import annotations
@@ -121,32 +122,29 @@ class IdealViews:
         return out
 
 
-def measure(case: Path, workers: int, across: bool = False) -> dict:
-    """The row of one case (module docstring)."""
+def measure(case: Path, workers: int, across: bool = False, ideal_views: bool = True) -> dict:
+    """The row of one case (module docstring); without *ideal_views*, the service's assessments alone."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
     plain = cfg.model_copy(update={"parallax": False})
     samples = collocated(case, cfg, workers, PROBE_M_PER_K)
     default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
-    ideal = IdealViews(simulator_of(truth))
-    again = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=ideal)  # the truth for the rendering
-    at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
-    diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
-    sideways: dict = {}
+    row = {**case_fields(case, truth), "granules": truth["granules"], "default": _scores(default, truth)}
+    if ideal_views:
+        ideal = IdealViews(simulator_of(truth))
+        again = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=ideal)  # the truth for the rendering
+        at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
+        diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
+        row["ideal"] = _scores(at, truth)
     if across:
         renderer = functools.partial(render.rendered_bt, across=True)
         both = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=renderer)
-        sideways["across"] = _scores(cost_and_offsets(both, cfg, satellite=truth["satellite"]), truth)
-    return {
-        **case_fields(case, truth),
-        "granules": truth["granules"],
-        "default": _scores(default, truth),
-        "ideal": _scores(at, truth),
-        **sideways,
-        "centre_view_k": [round(float(np.nanmedian(diff)), 2), round(float(np.nanpercentile(diff, 99)), 2)],
-        "pixels_traced": ideal.pixels,
-        "trace_s": round(ideal.trace_s),
-    }
+        row["across"] = _scores(cost_and_offsets(both, cfg, satellite=truth["satellite"]), truth)
+    if ideal_views:
+        centre = (np.nanmedian(diff), np.nanpercentile(diff, 99))
+        row["centre_view_k"] = [round(float(v), 2) for v in centre]
+        row["pixels_traced"], row["trace_s"] = ideal.pixels, round(ideal.trace_s)
+    return row
 
 
 def main() -> None:
@@ -154,10 +152,11 @@ def main() -> None:
     p.add_argument("cases", nargs="+", type=Path)
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--across", action="store_true", help="also assess with the cross-track rendering")
+    p.add_argument("--no-ideal", action="store_true", help="the service's assessments alone, no ideal views")
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()
     for case in args.cases:
-        emit(measure(case, args.workers, args.across), args.rows)
+        emit(measure(case, args.workers, args.across, not args.no_ideal), args.rows)
 
 
 if __name__ == "__main__":
