@@ -109,8 +109,8 @@ def _shift_columns(
     geo_p: np.ndarray,
     across: views.Across | None,
 ) -> np.ndarray:
-    """Per view, the cross-track distance, in columns, from the truth's hit point to the point the renderer
-    takes each GEO point's value from (NaN where it takes none or the next column is unusable).
+    """Per view, the point the renderer takes each GEO point's value from: each pixel's hit point rendered
+    as a field (NaN where it takes none).
 
     Parameters
     ----------
@@ -128,8 +128,8 @@ def _shift_columns(
     Returns
     -------
     numpy.ndarray
-        The rendered hit point minus the truth's along the scan, columns, shape (views, rows, cols) before
-        the truth is subtracted: the caller takes the truth per view.
+        ECEF, m, shape (views, rows, cols, 3); the caller measures it against the truth's hit point
+        along the scan, per view.
     """
     centre = np.nanmean(geo_p[good], axis=0)  # float32 renders: keep the field's values small
     rendered = np.stack(
