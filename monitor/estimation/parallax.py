@@ -208,7 +208,8 @@ def day_fraction(
     Returns
     -------
     float
-        The fraction, refined by the parabola through the least three of :data:`FRACTIONS`.
+        The fraction, refined by the parabola through the least three of :data:`FRACTIONS`; its vertex is kept
+        between the outer two.
     """
     step = FRACTIONS[1] - FRACTIONS[0]
     grid = FRACTIONS if near is None else near + step * np.array([-1.0, 0.0, 1.0])
@@ -216,8 +217,10 @@ def day_fraction(
     i = int(np.clip(np.argmin(totals), 1, len(grid) - 2))
     y0, y1, y2 = totals[i - 1 : i + 2]
     curvature = y0 - 2 * y1 + y2
-    best = grid[i] + (0.5 * (y0 - y2) / curvature * step if curvature > 0 else 0.0)
-    return float(np.clip(best, FRACTIONS[0], FRACTIONS[-1]))
+    # The vertex stays between the parabola's outer points: beyond them it is an extrapolation, and where a
+    # replicate's curve is flat about its least point it would throw f anywhere.
+    shift = float(np.clip(0.5 * (y0 - y2) / curvature, -1.0, 1.0)) if curvature > 0 else 0.0
+    return float(np.clip(grid[i] + shift * step, FRACTIONS[0], FRACTIONS[-1]))
 
 
 def keeps(lift_m_per_k: float, gain: float, sigma_gain: float) -> bool:

@@ -56,6 +56,17 @@ def test_the_search_finds_the_fraction_the_samples_agree_at(true_f):
     assert f == pytest.approx(true_f, abs=0.05) and 0 < sigma < 0.1
 
 
+def test_a_replicate_searched_about_another_fraction_stays_within_its_bracket():
+    """A replicate's search about *near* keeps the parabola's vertex between the outer two of its three
+    points, though the samples agree best far outside them."""
+    fors = [pair(1.8, 0.5, seed=k) for k in range(6)]
+    s0, s1 = [a for a, _ in fors], [b for _, b in fors]
+    step = 0.25
+    found = day_fraction(s0, s1, Cost.STDEV, near=0.5)
+    assert found == pytest.approx(0.5 + step)
+    assert day_fraction(s0, s1, Cost.STDEV, near=1.75) == pytest.approx(1.8, abs=0.05)  # bracketed: the vertex
+
+
 def test_a_lift_that_gains_nothing_significant_is_declined_and_its_size_is_the_sigma():
     fors = [pair(0.6, 0.01, seed=k) for k in range(6)]  # a shallow preference for a cloud's lift
     s0, s1 = [a for a, _ in fors], [b for _, b in fors]
