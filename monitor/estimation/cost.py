@@ -93,6 +93,23 @@ def cost_surface(
     return _stdev(d, weights) if cost == Cost.STDEV else _regression_stdev(d, cris, weights)
 
 
+# The quadratic a + b x + c y + d x^2 + e x y + f y^2 fitted by least squares to a 3 x 3 neighbourhood
+# (steps -1, 0, 1): its coefficients are this matrix times the nine values, row by row
+_X, _Y = (g.ravel() for g in np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.0, 1.0], indexing="ij"))
+_QUADRATIC_FIT = np.linalg.pinv(np.stack([np.ones(9), _X, _Y, _X**2, _X * _Y, _Y**2], 1))
+
+
+def _vertex(cost: np.ndarray, i0: int, j0: int) -> tuple[float, float, float] | None:
+    """The vertex (steps from (i0, j0), each within +-1) and value of the quadratic fitted to the 3 x 3
+    about an interior grid point; None where the fit is not convex."""
+    c = _QUADRATIC_FIT @ cost[i0 - 1 : i0 + 2, j0 - 1 : j0 + 2].ravel()
+    hess = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
+    if np.linalg.det(hess) <= 0 or hess[0, 0] <= 0:
+        return None
+    dx, dy = (float(v) for v in np.clip(np.linalg.solve(hess, -c[1:3]), -1, 1))
+    return dx, dy, float(c[0] + c[1] * dx + c[2] * dy + c[3] * dx * dx + c[4] * dx * dy + c[5] * dy * dy)
+
+
 def find_minimum(cost: np.ndarray, contrast: float = 0.03) -> tuple[float, float, list[str]]:
     """The sub-step minimum of a cost surface by the quadratic through the 3 x 3 about the grid minimum (Wang
     2013).
@@ -123,12 +140,32 @@ def find_minimum(cost: np.ndarray, contrast: float = 0.03) -> tuple[float, float
         flags.append(FLAG_FLAT)
     if i0 in (0, m - 1) or j0 in (0, m - 1):
         return float(i0 - n), float(j0 - n), flags + [FLAG_EDGE]
-    x, y = np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.0, 1.0], indexing="ij")
-    a = np.stack([np.ones(9), x.ravel(), y.ravel(), x.ravel() ** 2, x.ravel() * y.ravel(), y.ravel() ** 2], 1)
-    c = np.linalg.lstsq(a, cost[i0 - 1 : i0 + 2, j0 - 1 : j0 + 2].ravel(), rcond=None)[0]
-    hess = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
-    if np.linalg.det(hess) <= 0 or hess[0, 0] <= 0:
+    vertex = _vertex(cost, int(i0), int(j0))
+    if vertex is None:
         return float(i0 - n), float(j0 - n), sorted(set(flags + [FLAG_FLAT]))
-    dx, dy = np.linalg.solve(hess, -c[1:3])
-    dx, dy = float(np.clip(dx, -1, 1)), float(np.clip(dy, -1, 1))
-    return i0 - n + dx, j0 - n + dy, flags
+    return i0 - n + vertex[0], j0 - n + vertex[1], flags
+
+
+def minimum_value(cost: np.ndarray) -> float:
+    """The cost at the sub-step minimum of :func:`find_minimum`: the fitted quadratic's value at its vertex.
+
+    The grid minimum is the value at the grid point nearest the minimum, so as the minimum moves between
+    points it rises and falls by up to the surface's curvature over half a step; this value does not. The
+    day's lift is searched on a sum of such minima (:mod:`monitor.estimation.parallax`).
+
+    Parameters
+    ----------
+    cost : numpy.ndarray
+        The cost surface, K, shape (m, m); NaN where a perturbation has no value.
+
+    Returns
+    -------
+    float
+        K; the grid minimum where it lies on the border, the fit is not convex or the surface has NaN.
+    """
+    m = cost.shape[0]
+    if not np.all(np.isfinite(cost)):
+        return float(np.nanmin(cost))
+    i0, j0 = np.unravel_index(np.argmin(cost), cost.shape)
+    vertex = None if i0 in (0, m - 1) or j0 in (0, m - 1) else _vertex(cost, int(i0), int(j0))
+    return float(cost[i0, j0]) if vertex is None else vertex[2]

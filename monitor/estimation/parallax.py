@@ -13,7 +13,9 @@ the probe kappa1 (V1), and for a fraction f
 is the collocation at kappa = f kappa1 to first order (a lift moves a pixel by a small part of a cone; a cone
 mean moves linearly with the pixels that cross its edge). The day's f is where the sum over the FORs, and over
 each FOR's three FOV rows (:data:`ROWS`), of their own cost minimum (the configured cost, through the paper's
-cone scaled to the width the FOR's response reads, :func:`matched_cone`) is least: a wrong scale leaves each
+cone scaled to the width the FOR's response reads, :func:`matched_cone`; the value at the sub-step minimum,
+:func:`monitor.estimation.cost.minimum_value`: a grid minimum rises and falls as a row's turn moves between
+grid points, and would pull f to where the rows' turns lie on the grid) is least: a wrong scale leaves each
 cloud edge turned by an amount that grows with its height, which no single turn of a row can undo. Each row
 has its own turn because an error of the EP's FOV positions turns the rows apart, the same for every scene, as
 the parallax of one cloud height does: one turn for the whole FOR would take a lift for it (a case whose rows
@@ -49,7 +51,7 @@ import numpy as np
 
 from monitor.core.constants import FOV_HALF_ANGLE_RAD
 from monitor.core.vocabulary import Cost
-from monitor.estimation.cost import cost_surface, find_minimum
+from monitor.estimation.cost import cost_surface, find_minimum, minimum_value
 from monitor.estimation.estimate import (
     FOV_ROWS,
     ForSamples,
@@ -181,7 +183,7 @@ def row_costs(
         for r, sel in groups:
             if sel.sum() >= 3:
                 d = _lifted(a.d_k[sel], b.d_k[sel], f)
-                total[r] += float(np.nanmin(cost_surface(d, a.cris_k[sel], cost)))
+                total[r] += minimum_value(cost_surface(d, a.cris_k[sel], cost))
     return total
 
 

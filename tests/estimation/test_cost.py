@@ -7,7 +7,7 @@ import pytest
 from monitor.core.constants import DEFAULT_STEP_URAD
 from monitor.core.vocabulary import Cost
 from monitor.estimation import refine
-from monitor.estimation.cost import calibration_regressors, cost_surface
+from monitor.estimation.cost import calibration_regressors, cost_surface, find_minimum, minimum_value
 from monitor.estimation.estimate import ForSamples, estimate
 
 
@@ -89,3 +89,35 @@ def test_a_calibration_difference_leaves_the_offsets_and_sigmas_and_is_recovered
     cal = differ.intercalibration
     assert cal.bias_k == pytest.approx(1.5, abs=0.05) and cal.gain_pct == pytest.approx(3.0, abs=0.2)
     assert 0 < cal.sigma_bias_k < 0.05 and 0 < cal.sigma_gain_pct < 0.1
+
+
+def _bowl(centre, m=21):
+    """A quadratic cost surface, K, least (1.0 K) at *centre* (steps from the grid's centre, in-track and
+    cross-track), its axes turned from the grid's."""
+    x, y = (np.mgrid[:m, :m] - m // 2).astype(float)
+    dx, dy = x - centre[0], y - centre[1]
+    return 1.0 + 0.05 * dx**2 + 0.02 * dx * dy + 0.03 * dy**2
+
+
+@pytest.mark.parametrize("centre", [(0.0, 0.0), (0.49, -0.3), (0.51, 0.2), (-3.7, 6.45)])
+def test_the_minimum_value_is_the_surfaces_least_between_grid_points(centre):
+    surface = _bowl(centre)
+    x, y, flags = find_minimum(surface)
+    assert (x, y) == pytest.approx(centre, abs=1e-9) and not flags
+    assert minimum_value(surface) == pytest.approx(1.0, abs=1e-12)
+    assert minimum_value(surface) < surface.min() or centre == (0.0, 0.0)
+
+
+def test_the_minimum_value_does_not_rise_and_fall_as_the_minimum_moves_between_grid_points():
+    centres = np.linspace(-1.0, 1.0, 41)
+    values = [minimum_value(_bowl((c, 0.3 * c))) for c in centres]
+    grid = [float(_bowl((c, 0.3 * c)).min()) for c in centres]
+    assert np.ptp(values) < 1e-9 and np.ptp(grid) > 0.01
+
+
+def test_the_minimum_value_is_the_grid_minimum_on_the_border_or_with_gaps():
+    surface = _bowl((12.0, 0.0))  # beyond the grid: its minimum on the border
+    assert minimum_value(surface) == surface.min()
+    gapped = _bowl((0.3, 0.0))
+    gapped[5, 5] = np.nan
+    assert minimum_value(gapped) == np.nanmin(gapped)

@@ -3,6 +3,7 @@ and its sigma."""
 
 import numpy as np
 import pytest
+from scipy.ndimage import gaussian_filter
 
 from monitor.core.vocabulary import Cost
 from monitor.estimation.estimate import ForSamples
@@ -27,11 +28,13 @@ M = 21
 def pair(true_f, depth, n=180, granules=6, seed=0):
     """Two collocations of one FOR (at no lift and at the probe's) whose samples agree best at *true_f*
     of the probe: each sample's VIIRS-CrIS difference is a bowl about the centre plus a pattern of its own
-    scaled by (f - true_f), and noise."""
+    scaled by (f - true_f), and noise. The pattern is smooth over the grid, as a real one is: neighbouring
+    perturbed cones share most of their pixels."""
     rng = np.random.default_rng(seed)
     y, x = np.mgrid[:M, :M] - M // 2
     bowl = 0.02 * (x**2 + y**2)
-    pattern = depth * rng.normal(size=(n, M, M))
+    pattern = gaussian_filter(rng.normal(size=(n, M, M)), (0, 2.0, 2.0))
+    pattern *= depth / pattern.std()
     base = bowl * rng.uniform(0.5, 1.5, (n, 1, 1)) + rng.normal(0, 0.05, (n, 1, 1))
     cris = rng.uniform(230, 300, n)
     granule = np.repeat(np.arange(granules), n // granules)
