@@ -17,7 +17,8 @@ remove.
 
 A case directory is one ``crisgeo simulate`` wrote, with truth.json; its scene is simulated again from
 the truth's parameters (the seed gives the same scene). One JSON row per case: the errors as the service
-assesses it ("default") and from the ideal views ("ideal"), with the bounds' fields of
+assesses it ("default"), with ``parallax=False`` ("no_parallax", the same collocation at no lift) and
+from the ideal views ("ideal"), with the bounds' fields of
 ``studies.lift_decision``; "centre_view_k" is the median and 99th percentile of |ideal centre view -
 VIIRS's own BT| over the rendered pixels (a check that the scene is the case's: VIIRS's own view is within
 7 mrad of the centre's, so most pixels differ by the noise alone). With ``--across`` the row also holds the
@@ -130,6 +131,7 @@ def measure(case: Path, workers: int, across: bool = False, ideal_views: bool = 
     samples = collocated(case, cfg, workers, PROBE_M_PER_K)
     default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
     row = {**case_fields(case, truth), "granules": truth["granules"], "default": _scores(default, truth)}
+    row["no_parallax"] = _scores(cost_and_offsets(paired(samples)[0], plain, satellite=truth["satellite"]), truth)
     if ideal_views:
         ideal = IdealViews(simulator_of(truth))
         again = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=ideal)  # the truth for the rendering
