@@ -13,7 +13,7 @@ themselves leave (each FOV's one in-track angle, views 20 mrad apart blended lin
 the noise and the day's scenes: the part of the error that better heights, walls or reference cannot
 remove.
 
-    .venv/bin/python -m studies.ideal_views CASE_DIR... [--workers 2] [--across] [--no-ideal] [--rows FILE]
+    .venv/bin/python -m studies.ideal_views CASE_DIR... [--workers 2] [--sweep] [--no-ideal] [--rows FILE]
 
 A case directory is one ``crisgeo simulate`` wrote, with truth.json; its scene is simulated again from
 the truth's parameters (the seed gives the same scene). One JSON row per case: the errors as the service
@@ -21,10 +21,10 @@ assesses it ("default"), with ``parallax=False`` ("no_parallax", the same colloc
 from the ideal views ("ideal"), with the bounds' fields of
 ``studies.lift_decision``; "centre_view_k" is the median and 99th percentile of |ideal centre view -
 VIIRS's own BT| over the rendered pixels (a check that the scene is the case's: VIIRS's own view is within
-7 mrad of the centre's, so most pixels differ by the noise alone). With ``--across`` the row also holds the
-errors as the service assesses the case when each ray takes its BT at its own place across the track
-("across": :func:`monitor.collocation.render.rendered_bt` with ``across=True``); with ``--no-ideal``
-it holds the service's assessments alone (no "ideal", no tracing).
+7 mrad of the centre's, so most pixels differ by the noise alone). With ``--sweep`` the row also holds the
+errors as the service assesses the case when each ray takes the BT of the pixel its column's sweep meets,
+not of its own place across the track ("sweep": :func:`monitor.collocation.render.rendered_bt` with
+``across=False``); with ``--no-ideal`` it holds the service's assessments alone (no "ideal", no tracing).
 """
 
 from __future__ import annotations
@@ -123,7 +123,7 @@ class IdealViews:
         return out
 
 
-def measure(case: Path, workers: int, across: bool = False, ideal_views: bool = True) -> dict:
+def measure(case: Path, workers: int, sweep: bool = False, ideal_views: bool = True) -> dict:
     """The row of one case (module docstring); without *ideal_views*, the service's assessments alone."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
@@ -138,10 +138,10 @@ def measure(case: Path, workers: int, across: bool = False, ideal_views: bool = 
         at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
         diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
         row["ideal"] = _scores(at, truth)
-    if across:
-        renderer = functools.partial(render.rendered_bt, across=True)
+    if sweep:
+        renderer = functools.partial(render.rendered_bt, across=False)
         both = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=renderer)
-        row["across"] = _scores(cost_and_offsets(both, cfg, satellite=truth["satellite"]), truth)
+        row["sweep"] = _scores(cost_and_offsets(both, cfg, satellite=truth["satellite"]), truth)
     if ideal_views:
         centre = (np.nanmedian(diff), np.nanpercentile(diff, 99))
         row["centre_view_k"] = [round(float(v), 2) for v in centre]
@@ -153,12 +153,12 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("cases", nargs="+", type=Path)
     p.add_argument("--workers", type=int, default=2)
-    p.add_argument("--across", action="store_true", help="also assess with the cross-track rendering")
+    p.add_argument("--sweep", action="store_true", help="also assess with the sweep alone (across=False)")
     p.add_argument("--no-ideal", action="store_true", help="the service's assessments alone, no ideal views")
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()
     for case in args.cases:
-        emit(measure(case, args.workers, args.across, not args.no_ideal), args.rows)
+        emit(measure(case, args.workers, args.sweep, not args.no_ideal), args.rows)
 
 
 if __name__ == "__main__":

@@ -33,11 +33,11 @@ Pixels hidden behind a higher one drop out (the ray meets the higher first), and
 come in. Which stretch a ray meets is found in its column alone: the sweep is one dimension per column.
 One column index of two scans is not one line on the ground (the Earth turns 1-2 columns under the track
 between scans, and the bow-tie's smile puts a scan's outer detectors a few hundredths of a column further
-out), and a CrIS ray is tilted across the track against VIIRS's, so where scans overlap a top's BT comes
-from a pixel aside: a cross-track error docs/science.md states among the known limitations. With the rays'
-places across the track (``across``: :func:`monitor.collocation.views.view_tangents_across`) a ray takes
-what it meets at its own place instead, between the met pixel's column and its neighbour. A granule's
-first and last rows are rendered without the next granule's pixels.
+out), and a CrIS ray is tilted across the track against VIIRS's. So a ray takes the BT of what it meets at
+its own place across the track (:func:`monitor.collocation.views.view_tangents_across`), linearly between
+the met pixel's column and its neighbour on the side the ray lies; without that (``across=False``) it takes
+the met pixel's own, and where scans overlap a top's BT comes from a pixel a column or two aside. A
+granule's first and last rows are rendered without the next granule's pixels.
 
 A study can put another rendering in this one's place (:class:`Renderer`: the assessment takes it as an
 argument); ``studies/render_truth.py`` measures this one against the simulator's own views.
@@ -97,13 +97,13 @@ def rendered_bt(
     m_per_k: float,
     scans: slice = slice(None),
     columns: slice = slice(None),
-    across: bool = False,
+    across: bool = True,
 ) -> np.ndarray:
     """The BT a CrIS ray at each in-track angle sees on its way to each GEO point of a VIIRS granule.
 
     :func:`~monitor.collocation.views.view_tangents`, then :func:`render_height_field`,
     :data:`COLUMNS_PER_PASS` columns at a time. The clear-sky reference is the whole granule's. With
-    *across*, each ray takes its BT at its own position across the track
+    *across* (the default), each ray takes its BT at its own position across the track
     (:func:`~monitor.collocation.views.view_tangents_across`; a pass then renders a column more either
     side, so that its edge columns have their neighbours).
 
@@ -128,7 +128,7 @@ def rendered_bt(
     columns : slice, optional
         The columns to render.
     across : bool, optional
-        Take each ray's BT at its own position across the track.
+        Take each ray's BT at its own position across the track (False: the met pixel's, the sweep alone).
 
     Returns
     -------
