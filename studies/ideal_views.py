@@ -131,7 +131,9 @@ def measure(case: Path, workers: int, sweep: bool = False, ideal_views: bool = T
     samples = collocated(case, cfg, workers, PROBE_M_PER_K)
     default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
     row = {**case_fields(case, truth), "granules": truth["granules"], "default": _scores(default, truth)}
-    row["no_parallax"] = _scores(cost_and_offsets(paired(samples)[0], plain, satellite=truth["satellite"]), truth)
+    row["no_parallax"] = _scores(
+        cost_and_offsets(paired(samples)[0], plain, satellite=truth["satellite"]), truth
+    )
     if ideal_views:
         ideal = IdealViews(simulator_of(truth))
         again = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=ideal)  # the truth for the rendering

@@ -128,7 +128,12 @@ def _compact(s: ForSamples) -> ForSamples:
 
 
 def day_cost(
-    s0: list[ForSamples], s1: list[ForSamples], f: float, cost: Cost, without: np.ndarray | None = None
+    s0: list[ForSamples],
+    s1: list[ForSamples],
+    f: float,
+    cost: Cost,
+    without: np.ndarray | None = None,
+    minimum: Callable[[np.ndarray], float] = minimum_value,
 ) -> float:
     """The sum over the FORs and their FOV rows of their cost minimum at a fraction of the probe's lift.
 
@@ -142,17 +147,24 @@ def day_cost(
         The cost (``assessment.cost``).
     without : numpy.ndarray, optional
         Granules (ids) whose samples are left out (a jackknife replicate).
+    minimum : callable, optional
+        A row's cost minimum from its surface, K (a study may give ``numpy.nanmin``, the grid's).
 
     Returns
     -------
     float
         K; rows with fewer than 3 samples are left out (the FOR where the samples do not say their FOV).
     """
-    return float(row_costs(s0, s1, f, cost, without).sum())
+    return float(row_costs(s0, s1, f, cost, without, minimum).sum())
 
 
 def row_costs(
-    s0: list[ForSamples], s1: list[ForSamples], f: float, cost: Cost, without: np.ndarray | None = None
+    s0: list[ForSamples],
+    s1: list[ForSamples],
+    f: float,
+    cost: Cost,
+    without: np.ndarray | None = None,
+    minimum: Callable[[np.ndarray], float] = minimum_value,
 ) -> np.ndarray:
     """:func:`day_cost` by FOV row (:data:`ROWS`: ahead, centre, behind).
 
@@ -166,6 +178,8 @@ def row_costs(
         The cost (``assessment.cost``).
     without : numpy.ndarray, optional
         Granules (ids) left out.
+    minimum : callable, optional
+        A row's cost minimum from its surface, K (:func:`monitor.estimation.cost.minimum_value`).
 
     Returns
     -------
@@ -183,7 +197,7 @@ def row_costs(
         for r, sel in groups:
             if sel.sum() >= 3:
                 d = _lifted(a.d_k[sel], b.d_k[sel], f)
-                total[r] += minimum_value(cost_surface(d, a.cris_k[sel], cost))
+                total[r] += float(minimum(cost_surface(d, a.cris_k[sel], cost)))
     return total
 
 
