@@ -35,7 +35,14 @@ from monitor.instrument.spectral import i5_band
 from studies.collocated import collocated
 
 FINE = np.linspace(parallax.FRACTIONS[0], parallax.FRACTIONS[-1], 2 * len(parallax.FRACTIONS) - 1)
-MINIMA = {"grid": np.nanmin, "sub-step": minimum_value}
+
+
+def grid_minimum(cost_k: np.ndarray) -> float:
+    """The surface's least grid value, K."""
+    return float(np.nanmin(cost_k))
+
+
+MINIMA = {"grid": grid_minimum, "sub-step": minimum_value}
 
 
 def least(curve_k: np.ndarray) -> float:
