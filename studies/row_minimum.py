@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.provenance import emit
+from benchmarks.provenance import commit, emit
 from monitor.assessment.estimates import for_samples, paired
 from monitor.collocation import render
 from monitor.collocation.lift import PROBE_M_PER_K
@@ -74,7 +74,8 @@ def measure(case: Path, workers: int, sweep: bool) -> list[dict]:
             curve = np.array([parallax.day_cost(s0, s1, float(f), cfg.cost, minimum=minimum) for f in FINE])
             f = least(curve)
             rows.append({
-                "case": case.name, "clouds": truth.get("cloud_heights"), "granules": truth["granules"],
+                "commit": commit(), "case": case.name, "clouds": truth.get("cloud_heights"),
+                "granules": truth["granules"],
                 "fov_rows_alpha_urad": truth.get("fov_rows_alpha_urad", 0.0), "rendering": name,
                 "minimum": label, "f": round(f, 3), "lift_m_per_k": round(f * PROBE_M_PER_K, 1),
                 "law_m_per_k": truth.get("law_m_per_k"),
