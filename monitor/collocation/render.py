@@ -333,9 +333,9 @@ def _sweep(
                     continue
                 top = h[rs[best], c]
                 met = bt[rs[best], c]
-                if sideways:
-                    met = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z)
                 if top - best_z > TOP_M:  # a wall: the air's temperature at its depth
+                    if sideways:
+                        met = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z)
                     out[v, r0, c] = met + (top - best_z) / m_per_k
                     continue
                 at = s0 + best_z * av  # a top: the two hits about where the ray meets it, linearly
@@ -351,6 +351,8 @@ def _sweep(
                         before = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[k], c, best_z)
                         after = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[k + 1], c, best_z)
                     out[v, r0, c] = (1 - w) * before + w * after
+                elif sideways:
+                    out[v, r0, c] = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z)
                 else:
                     out[v, r0, c] = met
 
