@@ -352,7 +352,9 @@ def _sweep(
                         after = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[k + 1], c, best_z)
                     out[v, r0, c] = (1 - w) * before + w * after
                 elif sideways:
-                    out[v, r0, c] = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z)
+                    out[v, r0, c] = _across_bt(
+                        bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z
+                    )
                 else:
                     out[v, r0, c] = met
 

@@ -67,7 +67,7 @@ def test_a_replicate_searched_about_another_fraction_stays_within_its_bracket():
     step = 0.25
     found = day_fraction(s0, s1, Cost.STDEV, near=0.5)
     assert found == pytest.approx(0.5 + step)
-    assert day_fraction(s0, s1, Cost.STDEV, near=1.75) == pytest.approx(1.8, abs=0.05)  # bracketed: the vertex
+    assert day_fraction(s0, s1, Cost.STDEV, near=1.75) == pytest.approx(1.8, abs=0.05)  # bracketed
 
 
 def test_a_lift_that_gains_nothing_significant_is_declined_and_its_size_is_the_sigma():
