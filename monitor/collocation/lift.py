@@ -30,7 +30,6 @@ import math
 
 import numba
 import numpy as np
-from scipy.ndimage import maximum_filter, uniform_filter
 
 from monitor.collocation.geodesy import ecef_m
 from monitor.core.constants import VIIRS_SCAN_US
@@ -46,6 +45,10 @@ ROTATION_RAD_S = 2.0 * math.pi / (VIIRS_SCAN_US * 1e-6)
 def reference_k(bt_k: np.ndarray, good: np.ndarray, half_px: int = REFERENCE_HALF_PX) -> np.ndarray:
     """The clear-sky reference BT around each pixel: the warmest 3 x 3 mean within +-*half_px* pixels.
 
+    A 3 x 3 mean counts the usable pixels among the nine (the edge pixel standing in for those beyond the
+    array) and is kept where at least five are; the warmest is taken over a square, a row pass and a
+    column pass (van Herk 1992; Gil and Werman 1993: three comparisons a pixel, whatever the reach).
+
     Parameters
     ----------
     bt_k : numpy.ndarray
@@ -58,15 +61,101 @@ def reference_k(bt_k: np.ndarray, good: np.ndarray, half_px: int = REFERENCE_HAL
     Returns
     -------
     numpy.ndarray
-        BT, K, shape (rows, cols); NaN where no usable pixel is within reach.
+        BT, K, float32, shape (rows, cols); NaN where no usable pixel is within reach.
     """
-    ok = good & np.isfinite(bt_k)
-    filled = np.where(ok, bt_k, 0.0).astype(np.float32)
-    count = uniform_filter(ok.astype(np.float32), 3, mode="nearest")
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.where(count > 0.5, uniform_filter(filled, 3, mode="nearest") / count, -np.inf)
-    ref = maximum_filter(mean, size=2 * half_px + 1, mode="nearest")
-    return np.where(np.isfinite(ref), ref, np.nan).astype(np.float32)
+    bt = np.asarray(bt_k, np.float32)
+    ok = np.asarray(good, np.bool_)
+    out = np.empty(bt.shape, np.float32)
+    if bt.size:
+        _warmest_mean(bt, ok, int(half_px), out)
+    return out
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _warmest_mean(bt: np.ndarray, good: np.ndarray, half: int, out: np.ndarray) -> None:
+    """Fill *out* with :func:`reference_k`: the 3 x 3 means (a row pass of sums, then a column pass), then
+    the warmest within +-*half* along each row and then along each column."""
+    rows, cols = bt.shape
+    row_sum = np.empty((rows, cols), np.float32)
+    row_n = np.empty((rows, cols), np.int8)
+    for i in range(rows):
+        for j in range(cols):
+            s, n = 0.0, 0
+            for k in (max(j - 1, 0), j, min(j + 1, cols - 1)):  # the edge pixel repeated
+                v = bt[i, k]
+                if good[i, k] and math.isfinite(v):
+                    s += v
+                    n += 1
+            row_sum[i, j], row_n[i, j] = s, n
+    mean = np.empty((rows, cols), np.float32)
+    for i in range(rows):
+        above, below = max(i - 1, 0), min(i + 1, rows - 1)
+        for j in range(cols):
+            n = np.int64(row_n[above, j]) + row_n[i, j] + row_n[below, j]
+            s = np.float64(row_sum[above, j]) + row_sum[i, j] + row_sum[below, j]
+            mean[i, j] = s / n if n >= 5 else -np.inf  # more than half of the nine
+    along = np.empty((rows, cols), np.float32)
+    for i in range(rows):
+        running_max(mean[i], half, along[i])
+    _running_max_down(along, half, mean)  # the rows' maxima, now down the columns, into the means' place
+    for i in range(rows):
+        for j in range(cols):
+            out[i, j] = mean[i, j] if mean[i, j] > -np.inf else np.nan
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def running_max(line: np.ndarray, half: int, out: np.ndarray) -> None:
+    """The largest of *line* within +-*half* of each place (the window cut at the ends): blocks of 2 half
+    + 1, each with its running maximum from its start (*ahead*) and from its end (*behind*); a whole
+    window is the end of one block and the start of the next, or one block."""
+    n = line.shape[0]
+    width = 2 * half + 1
+    ahead = np.empty(n, line.dtype)
+    behind = np.empty(n, line.dtype)
+    for start in range(0, n, width):
+        stop = min(start + width, n)
+        ahead[start] = line[start]
+        for i in range(start + 1, stop):
+            ahead[i] = max(ahead[i - 1], line[i])
+        behind[stop - 1] = line[stop - 1]
+        for i in range(stop - 2, start - 1, -1):
+            behind[i] = max(behind[i + 1], line[i])
+    for i in range(n):
+        lo, hi = i - half, i + half
+        if lo <= 0:  # cut at the start: the first block's start part
+            out[i] = ahead[min(hi, n - 1)]
+        elif hi >= n - 1 and lo // width == (n - 1) // width:  # cut at the end, within the last block
+            out[i] = behind[lo]
+        else:
+            out[i] = max(behind[lo], ahead[min(hi, n - 1)])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _running_max_down(grid: np.ndarray, half: int, out: np.ndarray) -> None:
+    """:func:`running_max` down each column of *grid*, a row at a time (the rows are contiguous)."""
+    rows, cols = grid.shape
+    width = 2 * half + 1
+    ahead = np.empty((rows, cols), grid.dtype)
+    behind = np.empty((rows, cols), grid.dtype)
+    for start in range(0, rows, width):
+        stop = min(start + width, rows)
+        ahead[start] = grid[start]
+        for i in range(start + 1, stop):
+            for j in range(cols):
+                ahead[i, j] = max(ahead[i - 1, j], grid[i, j])
+        behind[stop - 1] = grid[stop - 1]
+        for i in range(stop - 2, start - 1, -1):
+            for j in range(cols):
+                behind[i, j] = max(behind[i + 1, j], grid[i, j])
+    for i in range(rows):
+        lo, hi = i - half, min(i + half, rows - 1)
+        if lo <= 0:
+            out[i] = ahead[hi]
+        elif hi == rows - 1 and lo // width == (rows - 1) // width:
+            out[i] = behind[lo]
+        else:
+            for j in range(cols):
+                out[i, j] = max(behind[lo, j], ahead[hi, j])
 
 
 def height_above_m(bt_k: np.ndarray, good: np.ndarray, reference_k: np.ndarray, m_per_k: float) -> np.ndarray:
@@ -86,10 +175,24 @@ def height_above_m(bt_k: np.ndarray, good: np.ndarray, reference_k: np.ndarray, 
     Returns
     -------
     numpy.ndarray
-        Heights, m, shape (rows, cols); 0 where not *good*.
+        Heights, m, float32, shape (rows, cols); 0 where not *good* or the reference is NaN.
     """
-    cooling = np.nan_to_num(reference_k - bt_k, nan=0.0)
-    return np.where(good, m_per_k * np.maximum(cooling, 0.0), 0.0).astype(np.float32)
+    out = np.empty(np.shape(bt_k), np.float32)
+    _heights(
+        np.asarray(bt_k, np.float32), np.asarray(good, np.bool_), np.asarray(reference_k, np.float32),
+        float(m_per_k), out,
+    )  # fmt: skip
+    return out
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _heights(bt: np.ndarray, good: np.ndarray, ref: np.ndarray, m_per_k: float, out: np.ndarray) -> None:
+    """Fill *out* with :func:`height_above_m`."""
+    for i in range(bt.shape[0]):
+        for j in range(bt.shape[1]):
+            cooling = ref[i, j] - bt[i, j]
+            ok = good[i, j] and math.isfinite(cooling)
+            out[i, j] = m_per_k * max(cooling, 0.0) if ok else 0.0
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

@@ -51,7 +51,7 @@ from typing import Protocol
 import numba
 import numpy as np
 
-from monitor.collocation.lift import height_above_m, reference_k
+from monitor.collocation.lift import height_above_m, reference_k, running_max
 from monitor.collocation.views import TANGENT_STEP, Across, view_tangents, view_tangents_across
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
@@ -154,23 +154,19 @@ def rendered_bt(
         traced = slice(lo, hi)
         geo = (lat_rad[r, traced], lon_rad[r, traced], height_m[r, traced], usable[r, traced])
         orbit = (sat_m[first:stop], velocity_m_s[first:stop], cris_alpha_rad, lo)
-        inner = slice(drawn.start - lo, drawn.stop - lo)
-        sideways = None
         if across:
-            x, b, a, w = view_tangents_across(*geo, *orbit)
-            cut = (w.geo_m[:, inner], w.unit[:, inner], w.viirs_tan[:, inner], w.cris_tan[:, :, inner])
-            sideways = Across(*cut)
+            x, b, a, sideways = view_tangents_across(*geo, *orbit)
         else:
-            x, b, a = view_tangents(*geo, *orbit)
-        ok = usable[r, drawn]
+            (x, b, a), sideways = view_tangents(*geo, *orbit), None
         seen = render_height_field(
-            np.where(ok, x[:, inner], np.nan),
-            b[:, inner],
-            height[r, drawn],
-            bt_k[r, drawn],
-            a[:, :, inner],
+            np.where(usable[r, traced], x, np.nan),
+            b,
+            height[r, traced],
+            bt_k[r, traced],
+            a,
             m_per_k,
             sideways,
+            slice(drawn.start - lo, drawn.stop - lo),
         )
         out[:, r, part] = seen[:, :, part.start - drawn.start : part.stop - drawn.start]
     return out
@@ -184,12 +180,13 @@ def render_height_field(
     cris_tan: np.ndarray,
     m_per_k: float,
     across: Across | None = None,
+    columns: slice = slice(None),
 ) -> np.ndarray:
     """What a CrIS ray at each in-track tangent sees on its way to each GEO point: the module's sweep.
 
     With *across*, a ray takes the BT of what it meets at its own position across the track: from the
     pixel's row, linearly between its column and the next one on the side the ray lies (the pixel's own
-    where that one is unusable or outside the arrays given).
+    where that one is unusable or outside *columns*).
 
     Parameters
     ----------
@@ -208,26 +205,29 @@ def render_height_field(
     across : Across, optional
         Where the rays lie across the track (:func:`~monitor.collocation.views.view_tangents_across`), the
         same pixels.
+    columns : slice, optional
+        The columns rendered (step 1); the others are not read.
 
     Returns
     -------
     numpy.ndarray
-        BT, K, float32, shape (views, rows, cols); NaN where *x_m* is and in columns of fewer than 3 usable
-        pixels.
+        BT, K, float32, shape (views, rows, len(columns)); NaN where *x_m* is and in columns of fewer than 3
+        usable pixels.
     """
-    seen = np.full(np.shape(cris_tan), np.nan)
-    args = [np.ascontiguousarray(v, np.float64) for v in (x_m, viirs_tan, height_m, bt_k, cris_tan)]
+    c_lo, c_hi, _ = columns.indices(np.shape(x_m)[1])
+    seen = np.full((np.shape(cris_tan)[0], np.shape(x_m)[0], max(c_hi - c_lo, 0)), np.nan, np.float32)
+    # one type for each argument, so that one compiled sweep serves every caller
+    x = np.ascontiguousarray(x_m, np.float64)
+    fields = [np.ascontiguousarray(v, np.float32) for v in (viirs_tan, height_m, bt_k, cris_tan)]
     if across is None:
         none = np.zeros((0, 0, 3))
-        sideways = [none, none, np.zeros((0, 0)), np.zeros((0, 0, 0))]
+        sideways = [none, none, np.zeros((0, 0), np.float32), np.zeros((0, 0, 0), np.float32)]
     else:
-        sideways = [
-            np.ascontiguousarray(v, np.float64)
-            for v in (across.geo_m, across.unit, across.viirs_tan, across.cris_tan)
-        ]
+        sideways = [np.ascontiguousarray(v, np.float64) for v in (across.geo_m, across.unit)]
+        sideways += [np.ascontiguousarray(v, np.float32) for v in (across.viirs_tan, across.cris_tan)]
     with KERNEL_LOCK:
-        _sweep(*args, float(m_per_k), *sideways, seen)
-    return seen.astype(np.float32)
+        _sweep(x, *fields, float(m_per_k), *sideways, c_lo, c_hi, seen)
+    return seen
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -243,21 +243,23 @@ def _across_bt(
     r: int,
     c: int,
     z: float,
+    c_lo: int,
+    c_hi: int,
 ) -> float:
     """The BT of pixel (r, c) at view v's ray to GEO point (r0, c) where it meets height z: the ray lies
     z (a - b) plus the two GEO points' distance across the track from that pixel's ray (both along the
-    horizontal across at r0), taken between column c and its neighbour on that side
+    horizontal across at r0), taken between column c and its neighbour on that side within [c_lo, c_hi)
     (:func:`render_height_field`)."""
     own = bt[r, c]
     w0, w1, w2 = unit[r0, c, 0], unit[r0, c, 1], unit[r0, c, 2]
     apart = (geo[r, c, 0] - geo[r0, c, 0]) * w0 + (geo[r, c, 1] - geo[r0, c, 1]) * w1
     apart += (geo[r, c, 2] - geo[r0, c, 2]) * w2
-    off = z * (a_across[v, r0, c] - b_across[r, c]) - apart
+    off = z * (np.float64(a_across[v, r0, c]) - b_across[r, c]) - apart
     if not math.isfinite(off) or off == 0.0:
         return own
     for step in (1, -1):
         n = c + step
-        if n < 0 or n >= x.shape[1] or not math.isfinite(x[r, n]):
+        if n < c_lo or n >= c_hi or not math.isfinite(x[r, n]):
             continue
         spacing = (geo[r, n, 0] - geo[r, c, 0]) * w0 + (geo[r, n, 1] - geo[r, c, 1]) * w1
         spacing += (geo[r, n, 2] - geo[r, c, 2]) * w2
@@ -279,9 +281,12 @@ def _sweep(
     unit: np.ndarray,
     b_across: np.ndarray,
     a_across: np.ndarray,
+    c_lo: int,
+    c_hi: int,
     out: np.ndarray,
 ) -> None:
-    """Fill *out* (:func:`render_height_field`; across the track where *geo* has rows), one column a task:
+    """Fill *out* (:func:`render_height_field`: columns c_lo to c_hi; across the track where *geo* has
+    rows), one column a task:
     the column's hits p sorted along the track, then per ray the stretches within its reach tested for
     where it meets them, the highest meeting kept. The reach: a GEO spacing behind the ray's foot (the
     stretch it stands on), and ahead, towards the spacecraft, a spacing plus the run along the ray of the
@@ -289,28 +294,26 @@ def _sweep(
     that reach stays among them: a stretch farther than its own height's run is met below ground. It is
     found by stepping from the foot's own hit, not by bisection: a few steps, where a search of 1536 hits
     takes eleven."""
-    rows, cols = x.shape
+    rows = x.shape[0]
     sideways = geo.shape[0] > 0
-    for c in numba.prange(cols):
+    for c in numba.prange(c_lo, c_hi):
         idx = np.array([r for r in range(rows) if math.isfinite(x[r, c])], np.int64)
         n = len(idx)
         if n < 3:
             continue
-        hit = np.array([x[r, c] + h[r, c] * b[r, c] for r in idx])
+        hit = np.array([x[r, c] + np.float64(h[r, c]) * b[r, c] for r in idx])
         order = np.argsort(hit)
         ps, rs = hit[order], idx[order]
         place = np.empty(rows, np.int64)  # each row's place in the sorted hits
         for j in range(n):
             place[rs[j]] = j
         spacing = np.median(np.diff(np.sort(np.array([x[r, c] for r in idx]))))
-        h_max = max([h[r, c] for r in idx])
-        near_max = np.zeros(n)
-        for j in range(n):
-            for k in range(max(j - NEAR_HITS, 0), min(j + NEAR_HITS + 1, n)):
-                near_max[j] = max(near_max[j], h[rs[k], c])
+        h_max = max([np.float64(h[r, c]) for r in idx])
+        near_max = np.empty(n)
+        running_max(np.array([h[r, c] for r in rs], np.float64), NEAR_HITS, near_max)
         for v in range(a.shape[0]):
             for r0 in idx:
-                s0, av = x[r0, c], a[v, r0, c]
+                s0, av = x[r0, c], np.float64(a[v, r0, c])
                 own = place[r0]
                 lo, hi = _reach(ps, own, s0, av, spacing, h_max)
                 if lo >= own - NEAR_HITS and hi <= own + NEAR_HITS + 1:  # within what near_max bounds
@@ -335,8 +338,10 @@ def _sweep(
                 met = bt[rs[best], c]
                 if top - best_z > TOP_M:  # a wall: the air's temperature at its depth
                     if sideways:
-                        met = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z)
-                    out[v, r0, c] = met + (top - best_z) / m_per_k
+                        met = _across_bt(
+                            bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z, c_lo, c_hi
+                        )
+                    out[v, r0, c - c_lo] = met + (top - best_z) / m_per_k
                     continue
                 at = s0 + best_z * av  # a top: the two hits about where the ray meets it, linearly
                 k = best  # the last hit before it (a step from the stretch's own)
@@ -348,15 +353,19 @@ def _sweep(
                     w = (at - ps[k]) / (ps[k + 1] - ps[k])
                     before, after = bt[rs[k], c], bt[rs[k + 1], c]
                     if sideways:
-                        before = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[k], c, best_z)
-                        after = _across_bt(bt, x, geo, unit, b_across, a_across, v, r0, rs[k + 1], c, best_z)
-                    out[v, r0, c] = (1 - w) * before + w * after
+                        before = _across_bt(
+                            bt, x, geo, unit, b_across, a_across, v, r0, rs[k], c, best_z, c_lo, c_hi
+                        )
+                        after = _across_bt(
+                            bt, x, geo, unit, b_across, a_across, v, r0, rs[k + 1], c, best_z, c_lo, c_hi
+                        )
+                    out[v, r0, c - c_lo] = (1 - w) * before + w * after
                 elif sideways:
-                    out[v, r0, c] = _across_bt(
-                        bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z
+                    out[v, r0, c - c_lo] = _across_bt(
+                        bt, x, geo, unit, b_across, a_across, v, r0, rs[best], c, best_z, c_lo, c_hi
                     )
                 else:
-                    out[v, r0, c] = met
+                    out[v, r0, c - c_lo] = met
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -3,6 +3,7 @@ what is drawn from them."""
 
 import numpy as np
 import pytest
+from scipy.ndimage import maximum_filter, uniform_filter
 
 from monitor.collocation.lift import REFERENCE_HALF_PX, ROTATION_RAD_S, height_above_m, reference_k
 from monitor.core.constants import VIIRS_DETECTORS
@@ -33,6 +34,27 @@ def test_the_reference_is_the_clear_sky_around_and_never_a_bad_pixel():
     wide = np.full((40, 4 * REFERENCE_HALF_PX), 230.0, np.float32)
     wide[:, :5] = 295.0
     assert reference_k(wide, np.ones(wide.shape, bool))[0, -1] == pytest.approx(230.0)
+
+
+@pytest.mark.parametrize(("shape", "half_px"), [((96, 300), 100), ((70, 45), 100), ((64, 500), 7), ((5, 3), 1)])
+def test_the_reference_is_the_warmest_3x3_mean_within_reach_to_the_pixel_edges(shape, half_px):
+    """Against the definition written with scipy's filters: the 3 x 3 mean of the usable pixels (the edge
+    repeated) where more than half of the nine are usable, then the warmest over the square."""
+    rng = np.random.default_rng(sum(shape) + half_px)
+    bt = (280 + 20 * rng.standard_normal(shape)).astype(np.float32)
+    good = rng.random(shape) > 0.3
+    bt[rng.random(shape) < 0.02] = np.nan
+    ok = good & np.isfinite(bt)
+    count = uniform_filter(ok.astype(np.float64), 3, mode="nearest")
+    total = uniform_filter(np.where(ok, bt, 0.0).astype(np.float64), 3, mode="nearest")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(count > 0.5, total / count, -np.inf)
+    expected = maximum_filter(mean, size=2 * half_px + 1, mode="nearest")
+    expected[~np.isfinite(expected)] = np.nan
+    got = reference_k(bt, good, half_px)
+    assert got.dtype == np.float32
+    assert np.array_equal(np.isnan(got), np.isnan(expected))
+    assert np.nanmax(np.abs(got - expected)) < 1e-4
 
 
 def test_a_deck_tens_of_km_wide_stands_at_its_height_in_its_middle():
