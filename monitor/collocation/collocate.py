@@ -288,6 +288,8 @@ def _accumulate(
         guess_scale = (m - 1) / (tan_b[f, m - 1] - tan_b[f, 0]) if m > 1 else 0.0
         t_lo = np.empty(m)
         t_hi = np.empty(m)
+        b1_row = np.empty(m)
+        c2_row = np.empty(m)
         j_first = np.empty(m, np.int64)
         j_after = np.empty(m, np.int64)
         sx, sy, sz = sat[f, 0], sat[f, 1], sat[f, 2]
@@ -336,14 +338,17 @@ def _accumulate(
                                 view_value += w_next * (np.float64(seen_next[r, c]) - view_value)
                             if math.isfinite(view_value):
                                 wr = complex(weight * view_value, weight)
+                        for i in range(m):  # per row i, what every disc's interval shares
+                            ci = ta[i] * dx + dz
+                            b1_row[i] = ci * dy
+                            c2_row[i] = ci * ci
                         for k in range(nk):
                             a2 = dy * dy - ring_g2[k]
                             inv_a2 = 1.0 / a2
                             for i in range(m):  # the interval of t = tan B per row i
                                 # (c + dy t)^2 >= g2 (K + t^2), c = dx tan A_i + dz: a2 t^2 + 2 b1 t + e >= 0
-                                ci = ta[i] * dx + dz
-                                b1 = ci * dy
-                                disc = b1 * b1 - a2 * (ci * ci - g2k[k, i])
+                                b1 = b1_row[i]
+                                disc = b1 * b1 - a2 * (c2_row[i] - g2k[k, i])
                                 sq = math.sqrt(max(disc, 0.0))
                                 t_lo[i] = (sq - b1) * inv_a2 if disc >= 0.0 else np.inf
                                 t_hi[i] = -(b1 + sq) * inv_a2 if disc >= 0.0 else -np.inf

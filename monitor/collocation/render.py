@@ -137,13 +137,17 @@ def rendered_bt(
         unusable.
     """
     rows, cols = np.shape(bt_k)
-    out = np.full((len(cris_alpha_rad), rows, cols), np.nan, np.float32)
+    out = np.empty((len(cris_alpha_rad), rows, cols), np.float32)
     usable = np.asarray(good, bool) & np.isfinite(bt_k)
     reference = reference_k(bt_k, usable)  # over the whole granule: it looks 100 pixels around
     height = height_above_m(bt_k, usable, reference, m_per_k)
     first, stop, _ = scans.indices(rows // VIIRS_DETECTORS)
     r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
     c_first, c_stop, _ = columns.indices(cols)
+    c_stop = max(c_stop, c_first)
+    # what the passes do not write: the passes write every pixel of r and [c_first, c_stop)
+    out[:, : r.start], out[:, r.stop :] = np.nan, np.nan
+    out[:, r, :c_first], out[:, r, c_stop:] = np.nan, np.nan
     halo = 1 if across else 0
     for c0 in range(c_first, c_stop, COLUMNS_PER_PASS):
         part = slice(c0, min(c0 + COLUMNS_PER_PASS, c_stop))
@@ -297,20 +301,34 @@ def _sweep(
     rows = x.shape[0]
     sideways = geo.shape[0] > 0
     for c in numba.prange(c_lo, c_hi):
-        idx = np.array([r for r in range(rows) if math.isfinite(x[r, c])], np.int64)
-        n = len(idx)
+        usable = np.empty(rows, np.int64)
+        n = 0
+        for r in range(rows):
+            if math.isfinite(x[r, c]):
+                usable[n] = r
+                n += 1
         if n < 3:
             continue
-        hit = np.array([x[r, c] + np.float64(h[r, c]) * b[r, c] for r in idx])
+        idx = usable[:n]
+        hit, foot = np.empty(n), np.empty(n)
+        h_max = -np.inf
+        for q in range(n):
+            r = idx[q]
+            hit[q] = x[r, c] + np.float64(h[r, c]) * b[r, c]
+            foot[q] = x[r, c]
+            h_max = max(h_max, np.float64(h[r, c]))
         order = np.argsort(hit)
         ps, rs = hit[order], idx[order]
         place = np.empty(rows, np.int64)  # each row's place in the sorted hits
+        sorted_h = np.empty(n)
         for j in range(n):
             place[rs[j]] = j
-        spacing = np.median(np.diff(np.sort(np.array([x[r, c] for r in idx]))))
-        h_max = max([np.float64(h[r, c]) for r in idx])
+            sorted_h[j] = h[rs[j], c]
+        spacing = np.median(np.diff(np.sort(foot)))
         near_max = np.empty(n)
-        running_max(np.array([h[r, c] for r in rs], np.float64), NEAR_HITS, near_max)
+        running_max(sorted_h, NEAR_HITS, near_max)
+        for j in range(n):
+            near_max[j] = max(near_max[j], 0.0)  # no lower than the ground
         for v in range(a.shape[0]):
             for r0 in idx:
                 s0, av = x[r0, c], np.float64(a[v, r0, c])
