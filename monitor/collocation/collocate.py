@@ -242,12 +242,15 @@ def _accumulate(
     half_brows: np.ndarray,
     half_bcols: np.ndarray,
     ring_g2: np.ndarray,
+    cos_whole: np.ndarray,
     order: np.ndarray,
     rendered: np.ndarray,
     view: np.ndarray,
     view_w: np.ndarray,
     acc: np.ndarray,
     acc_rendered: np.ndarray,
+    whole: np.ndarray,
+    whole_rendered: np.ndarray,
 ) -> None:
     """Add the pixels of one prepared granule to each FOV's cone sums (difference arrays along j).
 
@@ -255,12 +258,14 @@ def _accumulate(
     which a pixel can lie in some cone, tan A_i and tan B_j (m), the tangent box (4,) of the cones' union, and
     the search window of blocks (centre block_row/col +- half_brows/bcols; negative: none). *ring_g2* is cos^2
     h of each disc, largest first. FOVs are taken in *order*, in chunks of FOVS_PER_TASK.
+    A pixel within the angle whose cosine is *cos_whole* (per disc) of the LOS lies in every cone of that
+    disc: its weights go to *whole* (F, discs), every perturbation's share, instead of 2m runs' ends.
     acc (F, discs, m, m + 1) complex receives, per disc, runs of weight x radiance (rows, cols) (real) and
     weight (imaginary): +w at the first j, -w after the last. The discs are nested: where a row's interval of
     a disc is empty, so are those of the smaller discs. When *acc_rendered* has FOVs, it receives the same
     runs of what FOV f sees of the pixel rendered (:mod:`monitor.collocation.render`): (1 - view_w[f])
-    times view view[f] of *rendered* (views, rows, cols) plus view_w[f] times the next; the cone test,
-    the costly part, is made once for both.
+    times view view[f] of *rendered* (views, rows, cols) plus view_w[f] times the next (and
+    *whole_rendered*); the cone test, the costly part, is made once for both.
     """
     ncol = radiance.shape[1]
     with_rendered = acc_rendered.shape[0] > 0
@@ -274,6 +279,8 @@ def _accumulate(
         ta = tan_a[f]
         out = acc[f]
         out_rendered = acc_rendered[f if with_rendered else 0]
+        all_in = whole[f]
+        all_in_rendered = whole_rendered[f if with_rendered else 0]
         seen = rendered[view[f]]
         w_next = view_w[f]
         seen_next = rendered[min(view[f] + 1, rendered.shape[0] - 1)]
@@ -330,6 +337,7 @@ def _accumulate(
                         a_dot = area[r, c, 0] * px + area[r, c, 1] * py + area[r, c, 2] * pz
                         weight = abs(a_dot) / (dist2 * dist)  # steradians seen from CrIS
                         dx, dy, dz = dx / dist, dy / dist, dz / dist
+                        near = (px * lx + py * ly + pz * lz) / dist  # the cosine of its angle from the LOS
                         wz = complex(weight * value, weight)
                         wr = 0j
                         if with_rendered:
@@ -343,6 +351,11 @@ def _accumulate(
                             b1_row[i] = ci * dy
                             c2_row[i] = ci * ci
                         for k in range(nk):
+                            if near >= cos_whole[k]:  # within every cone of disc k
+                                all_in[k] += wz
+                                if with_rendered:
+                                    all_in_rendered[k] += wr
+                                continue
                             a2 = dy * dy - ring_g2[k]
                             inv_a2 = 1.0 / a2
                             for i in range(m):  # the interval of t = tan B per row i
@@ -369,9 +382,12 @@ def _accumulate(
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _finish(acc: np.ndarray, solid: np.ndarray, sums: np.ndarray, weights: np.ndarray) -> None:
-    """Each FOV's disc sums from its difference arrays acc (F, discs, m, m + 1) complex: the running sums
-    along j give weight x radiance (real, into *sums*) and weight (imaginary, into *weights*); a weight
+def _finish(
+    acc: np.ndarray, whole: np.ndarray, solid: np.ndarray, sums: np.ndarray, weights: np.ndarray
+) -> None:
+    """Each FOV's disc sums from its difference arrays acc (F, discs, m, m + 1) complex and what every
+    perturbation holds, *whole* (F, discs): the running sums along j from that give weight x radiance
+    (real, into *sums*) and weight (imaginary, into *weights*); a weight
     below 1e-9 of the disc's *solid* angle (discs,) is what rounding leaves of the runs that passed an empty
     disc (~1e-16 of the row's weight; one pixel weighs ~1e-3 of a cone's solid angle) and is set to 0."""
     nk = acc.shape[1]
@@ -379,8 +395,8 @@ def _finish(acc: np.ndarray, solid: np.ndarray, sums: np.ndarray, weights: np.nd
     for f in numba.prange(acc.shape[0]):
         for k in range(nk):
             for i in range(m):
-                s = 0.0
-                w = 0.0
+                s = whole[f, k].real
+                w = whole[f, k].imag
                 for j in range(m):
                     s += acc[f, k, i, j].real
                     w += acc[f, k, i, j].imag
@@ -530,10 +546,17 @@ def cone_sums(
     tan_b = np.tan(offsets_rad[None, :] + beta_rad[:, None])
     ring_g2 = np.cos(np.asarray(radii_rad[::-1], np.float64)) ** 2  # the kernel takes the largest first
     acc = np.zeros((nf, len(radii_rad), m, m + 1), np.complex128)
+    whole = np.zeros((nf, len(radii_rad)), np.complex128)
+    # a pixel this close to the LOS lies in every perturbed cone of a disc: the grid's reach (as the
+    # search's) from the disc's edge; 2 where the grid reaches farther than the disc
+    spread = rho - max(radii_rad)
+    edge = np.asarray(radii_rad[::-1], np.float64) - spread
+    cos_whole = np.where(edge > 0, np.cos(edge), 2.0)
     rendered_pieces = sum(p.rendered is not None for p in swath.pieces)
     if rendered_pieces not in (0, len(swath.pieces)):
         raise ValueError("the pieces of a swath are all rendered or none")
     acc_rendered = np.zeros((nf if rendered_pieces else 0, *acc.shape[1:]), np.complex128)
+    whole_rendered = np.zeros((len(acc_rendered), len(radii_rad)), np.complex128)
     unrendered = np.zeros((1, 1, 1), np.float32), np.zeros(nf, np.int64), np.zeros(nf)  # views, view, weight
     # FOVs interleaved by thread count: each thread's first share is spread over the granule (the scans
     # that a VIIRS granule reaches are a contiguous part of it)
@@ -551,21 +574,22 @@ def cone_sums(
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
                 sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
-                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, order, rendered, view,
-                view_w, acc, acc_rendered,
+                np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, cos_whole, order,
+                rendered, view, view_w, acc, acc_rendered, whole, whole_rendered,
             )  # fmt: skip
     solid = 2 * np.pi * (1 - np.cos(np.asarray(radii_rad[::-1], np.float64)))
-    rendered_sums = _sums(acc_rendered, solid, radii_rad) if len(acc_rendered) else None
-    return replace(_sums(acc, solid, radii_rad), rendered=rendered_sums)
+    rendered_sums = _sums(acc_rendered, whole_rendered, solid, radii_rad) if len(acc_rendered) else None
+    return replace(_sums(acc, whole, solid, radii_rad), rendered=rendered_sums)
 
 
-def _sums(acc: np.ndarray, solid: np.ndarray, radii_rad: tuple[float, ...]) -> ConeSums:
-    """The cone sums of difference arrays *acc* (F, discs largest first, m, m + 1), *solid* the discs'
-    solid angles in that order (:func:`_finish`)."""
+def _sums(acc: np.ndarray, whole: np.ndarray, solid: np.ndarray, radii_rad: tuple[float, ...]) -> ConeSums:
+    """The cone sums of difference arrays *acc* (F, discs largest first, m, m + 1) and every
+    perturbation's share *whole* (F, discs), *solid* the discs' solid angles in that order
+    (:func:`_finish`)."""
     nf, nk, m = acc.shape[0], acc.shape[1], acc.shape[2]
     sums, weights = np.empty((nf, nk, m, m)), np.empty((nf, nk, m, m))
     with KERNEL_LOCK:
-        _finish(acc, solid, sums, weights)
+        _finish(acc, whole, solid, sums, weights)
     return ConeSums(tuple(radii_rad), sums[:, ::-1], weights[:, ::-1], solid[::-1])
 
 

@@ -205,6 +205,20 @@ def test_kernel_equals_brute_force_on_random_pixels(lat0, lon0, seed, alpha, bet
             np.testing.assert_allclose(cones.coverage(k)[0], bc, rtol=1e-9, atol=1e-12)
 
 
+def test_pixels_within_every_cone_of_a_disc_count_in_each():
+    """A grid fine against the disc: most pixels lie within every perturbed cone and are added to all of
+    them at once; the sums are the brute force's."""
+    viirs, sat, sbf = _synthetic(10.0, 20.0, 6)
+    offsets = perturbation_grid(5, 40e-6)  # the grid reaches 0.3 mrad, the discs 3-8.4 mrad
+    for radii in (collocate.TOP_HAT, (0.003, 0.006)):
+        cones = collocate.cone_sums(viirs, sat[None], sbf[None], np.zeros(1), np.zeros(1), offsets, radii)
+        for k, half_angle in enumerate(radii):
+            bm, bc = _brute(viirs, sat, sbf, 0.0, 0.0, offsets, half_angle)
+            assert np.isfinite(bm).all()
+            np.testing.assert_allclose(cones.mean(k)[0], bm, rtol=1e-9)
+            np.testing.assert_allclose(cones.coverage(k)[0], bc, rtol=1e-9, atol=1e-12)
+
+
 def test_threads_give_identical_sums(scene):
     """Each FOV accumulates its own sums: 1 or 2 threads give the same bits, and cones on two pieces too."""
     fg, viirs = scene
