@@ -36,7 +36,9 @@ def test_the_reference_is_the_clear_sky_around_and_never_a_bad_pixel():
     assert reference_k(wide, np.ones(wide.shape, bool))[0, -1] == pytest.approx(230.0)
 
 
-@pytest.mark.parametrize(("shape", "half_px"), [((96, 300), 100), ((70, 45), 100), ((64, 500), 7), ((5, 3), 1)])
+@pytest.mark.parametrize(
+    ("shape", "half_px"), [((96, 300), 100), ((70, 45), 100), ((64, 500), 7), ((5, 3), 1)]
+)
 def test_the_reference_is_the_warmest_3x3_mean_within_reach_to_the_pixel_edges(shape, half_px):
     """Against the definition written with scipy's filters: the 3 x 3 mean of the usable pixels (the edge
     repeated) where more than half of the nine are usable, then the warmest over the square."""
