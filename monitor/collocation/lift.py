@@ -105,9 +105,20 @@ def _warmest_mean(bt: np.ndarray, good: np.ndarray, half: int, out: np.ndarray) 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def running_max(line: np.ndarray, half: int, out: np.ndarray) -> None:
-    """The largest of *line* within +-*half* of each place (the window cut at the ends): blocks of 2 half
-    + 1, each with its running maximum from its start (*ahead*) and from its end (*behind*); a whole
-    window is the end of one block and the start of the next, or one block."""
+    """The largest of *line* within +-*half* of each place (the window cut at the ends).
+
+    Blocks of 2 half + 1, each with its running maximum from its start and from its end; a whole window is
+    the end of one block and the start of the next, or one block (van Herk 1992; Gil and Werman 1993).
+
+    Parameters
+    ----------
+    line : numpy.ndarray
+        The values, shape (n,).
+    half : int
+        The window's reach each side, places.
+    out : numpy.ndarray
+        Written: the maxima, shape (n,).
+    """
     n = line.shape[0]
     width = 2 * half + 1
     ahead = np.empty(n, line.dtype)
