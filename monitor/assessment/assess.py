@@ -155,7 +155,7 @@ def _collocate_fors(
     should_stop: StopCheck = None,
 ) -> collocate.ConeSums:
     """The cone sums of every FOV of the granule (in one call of the parallel kernel), and of what each
-    sees rendered when the pieces are (:attr:`monitor.collocation.collocate.ConeSums.rendered`)."""
+    sees rendered when the pieces are (:attr:`monitor.collocation.sums.ConeSums.rendered`)."""
     if should_stop is not None and should_stop():
         raise StopRequested
     return collocate.cone_sums(

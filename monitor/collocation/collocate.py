@@ -32,12 +32,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numba
 import numpy as np
 
 from monitor.collocation import render
+from monitor.collocation.sums import ConeSums, cone_sums_of
 from monitor.collocation.swath import BLOCK_PX, SwathPiece, ViirsSwath, swath_piece
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, MAX_GRID_SPREAD_RAD, VIIRS_DETECTORS
@@ -381,89 +382,6 @@ def _accumulate(
                                 break
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def _finish(
-    acc: np.ndarray, whole: np.ndarray, solid: np.ndarray, sums: np.ndarray, weights: np.ndarray
-) -> None:
-    """Each FOV's disc sums from its difference arrays acc (F, discs, m, m + 1) complex and what every
-    perturbation holds, *whole* (F, discs): the running sums along j from that give weight x radiance
-    (real, into *sums*) and weight (imaginary, into *weights*); a weight
-    below 1e-9 of the disc's *solid* angle (discs,) is what rounding leaves of the runs that passed an empty
-    disc (~1e-16 of the row's weight; one pixel weighs ~1e-3 of a cone's solid angle) and is set to 0."""
-    nk = acc.shape[1]
-    m = sums.shape[2]
-    for f in numba.prange(acc.shape[0]):
-        for k in range(nk):
-            for i in range(m):
-                s = whole[f, k].real
-                w = whole[f, k].imag
-                for j in range(m):
-                    s += acc[f, k, i, j].real
-                    w += acc[f, k, i, j].imag
-                    occupied = w > 1e-9 * solid[k]
-                    sums[f, k, i, j] = s if occupied else 0.0
-                    weights[f, k, i, j] = w if occupied else 0.0
-
-
-@dataclass(frozen=True)
-class ConeSums:
-    """Solid-angle weighted VIIRS sums in nested discs about every perturbed LOS of a batch of F FOVs:
-    *sums* (F, K, m, m) weight x radiance and *weights* (F, K, m, m) weight (sr) of disc k (radius
-    ``radii_rad[k]``, increasing), *solid_sr* (K,) each disc's solid angle; *rendered*, when the pixels
-    were rendered as each FOV row sees them standing at a height, the same discs' sums of that radiance."""
-
-    radii_rad: tuple[float, ...]
-    sums: np.ndarray
-    weights: np.ndarray
-    solid_sr: np.ndarray
-    rendered: ConeSums | None = None
-
-    def mean(self, k: int = 0) -> np.ndarray:
-        """The weighted mean radiance in disc *k*.
-
-        Parameters
-        ----------
-        k : int
-            The disc, 0 the innermost.
-
-        Returns
-        -------
-        numpy.ndarray
-            Band radiance, mW/(m2 sr cm-1), shape (F, m, m); NaN where the disc holds no pixel.
-        """
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(self.weights[:, k] > 0, self.sums[:, k] / self.weights[:, k], np.nan)
-
-    def coverage(self, k: int = -1) -> np.ndarray:
-        """The share of disc *k*'s solid angle that usable pixels cover.
-
-        Parameters
-        ----------
-        k : int, optional
-            The disc; the outermost by default.
-
-        Returns
-        -------
-        numpy.ndarray
-            Shares 0..1, shape (F, m, m).
-        """
-        return self.weights[:, k] / self.solid_sr[k]
-
-    def annulus_means(self) -> np.ndarray:
-        """The weighted mean radiance in each annulus between consecutive discs (the first: the innermost
-        disc).
-
-        Returns
-        -------
-        numpy.ndarray
-            Band radiance, mW/(m2 sr cm-1), shape (F, K, m, m); NaN where an annulus holds no pixel.
-        """
-        s = np.diff(self.sums, axis=1, prepend=0.0)
-        w = np.diff(self.weights, axis=1, prepend=0.0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(w > 0, s / w, np.nan).astype(np.float32)
-
-
 def _views(view_alpha_rad: np.ndarray, alpha_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per FOV (in-track SBF angle *alpha_rad*) the view at or below its angle among *view_alpha_rad*
     (increasing) and the linear weight of the next one (0 beyond the ends: the nearest view alone)."""
@@ -578,19 +496,10 @@ def cone_sums(
                 rendered, view, view_w, acc, acc_rendered, whole, whole_rendered,
             )  # fmt: skip
     solid = 2 * np.pi * (1 - np.cos(np.asarray(radii_rad[::-1], np.float64)))
-    rendered_sums = _sums(acc_rendered, whole_rendered, solid, radii_rad) if len(acc_rendered) else None
-    return replace(_sums(acc, whole, solid, radii_rad), rendered=rendered_sums)
-
-
-def _sums(acc: np.ndarray, whole: np.ndarray, solid: np.ndarray, radii_rad: tuple[float, ...]) -> ConeSums:
-    """The cone sums of difference arrays *acc* (F, discs largest first, m, m + 1) and every
-    perturbation's share *whole* (F, discs), *solid* the discs' solid angles in that order
-    (:func:`_finish`)."""
-    nf, nk, m = acc.shape[0], acc.shape[1], acc.shape[2]
-    sums, weights = np.empty((nf, nk, m, m)), np.empty((nf, nk, m, m))
-    with KERNEL_LOCK:
-        _finish(acc, whole, solid, sums, weights)
-    return ConeSums(tuple(radii_rad), sums[:, ::-1], weights[:, ::-1], solid[::-1])
+    rendered_sums = None
+    if len(acc_rendered):
+        rendered_sums = cone_sums_of(acc_rendered, whole_rendered, solid, radii_rad)
+    return replace(cone_sums_of(acc, whole, solid, radii_rad), rendered=rendered_sums)
 
 
 def warm_up() -> float:
