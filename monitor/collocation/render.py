@@ -35,8 +35,10 @@ One column index of two scans is not one line on the ground (the Earth turns 1-2
 between scans, and the bow-tie's smile puts a scan's outer detectors a few hundredths of a column further
 out), and a CrIS ray is tilted across the track against VIIRS's. So a ray takes the BT of what it meets at
 its own place across the track (:func:`monitor.collocation.views.view_tangents_across`), linearly between
-the met pixel's column and its neighbour on the side the ray lies; without that (``across=False``) it takes
-the met pixel's own, and where scans overlap a top's BT comes from a pixel a column or two aside. A
+the two columns of the met pixel's row about that place, up to :data:`ACROSS_COLUMNS` columns aside (a pixel
+of the next or the last scan at one column index lies about two columns aside where the scans overlap);
+without that (``across=False``) it takes the met pixel's own, and where scans overlap a top's BT comes from
+a pixel a column or two aside. A
 granule's first and last rows are rendered without the next granule's pixels.
 
 A study can put another rendering in this one's place (:class:`Renderer`: the assessment takes it as an
@@ -62,6 +64,9 @@ COLUMNS_PER_PASS = 512  # columns rendered at a time: the tangents of five views
 VIEW_ALPHA_RAD = np.linspace(-0.04, 0.04, 5)
 TOP_M = 1.0  # a ray that meets a stretch more than this below its top met its wall
 NEAR_HITS = 16  # a ray's reach is bounded by the highest pixel within this many hits of its own
+# A ray's place across the track is looked up this many columns either side of the pixel it meets, at most:
+# between two scans the Earth turns ~2 columns under the track, the bow-tie's smile adds hundredths
+ACROSS_COLUMNS = 3
 
 
 class Renderer(Protocol):
@@ -104,8 +109,8 @@ def rendered_bt(
     :func:`~monitor.collocation.views.view_tangents`, then :func:`render_height_field`,
     :data:`COLUMNS_PER_PASS` columns at a time. The clear-sky reference is the whole granule's. With
     *across* (the default), each ray takes its BT at its own position across the track
-    (:func:`~monitor.collocation.views.view_tangents_across`; a pass then renders a column more either
-    side, so that its edge columns have their neighbours).
+    (:func:`~monitor.collocation.views.view_tangents_across`; a pass then renders :data:`ACROSS_COLUMNS`
+    columns more either side, so that its edge columns have their neighbours).
 
     Parameters
     ----------
@@ -148,7 +153,7 @@ def rendered_bt(
     # what the passes do not write: the passes write every pixel of r and [c_first, c_stop)
     out[:, : r.start], out[:, r.stop :] = np.nan, np.nan
     out[:, r, :c_first], out[:, r, c_stop:] = np.nan, np.nan
-    halo = 1 if across else 0
+    halo = ACROSS_COLUMNS if across else 0
     for c0 in range(c_first, c_stop, COLUMNS_PER_PASS):
         part = slice(c0, min(c0 + COLUMNS_PER_PASS, c_stop))
         drawn = slice(max(c0 - halo, 0), min(part.stop + halo, cols))  # the part and its halo
@@ -189,8 +194,8 @@ def render_height_field(
     """What a CrIS ray at each in-track tangent sees on its way to each GEO point: the module's sweep.
 
     With *across*, a ray takes the BT of what it meets at its own position across the track: from the
-    pixel's row, linearly between its column and the next one on the side the ray lies (the pixel's own
-    where that one is unusable or outside *columns*).
+    pixel's row, linearly between the two columns about that place, up to :data:`ACROSS_COLUMNS` aside
+    (the last usable column within *columns* where the row ends or a pixel is unusable before it).
 
     Parameters
     ----------
@@ -252,8 +257,9 @@ def _across_bt(
 ) -> float:
     """The BT of pixel (r, c) at view v's ray to GEO point (r0, c) where it meets height z: the ray lies
     z (a - b) plus the two GEO points' distance across the track from that pixel's ray (both along the
-    horizontal across at r0), taken between column c and its neighbour on that side within [c_lo, c_hi)
-    (:func:`render_height_field`)."""
+    horizontal across at r0), taken linearly between the two columns of row r about that place, within
+    :data:`ACROSS_COLUMNS` of c and [c_lo, c_hi); the farthest usable column on that side where the place
+    lies beyond them (:func:`render_height_field`)."""
     own = bt[r, c]
     w0, w1, w2 = unit[r0, c, 0], unit[r0, c, 1], unit[r0, c, 2]
     apart = (geo[r, c, 0] - geo[r0, c, 0]) * w0 + (geo[r, c, 1] - geo[r0, c, 1]) * w1
@@ -262,14 +268,21 @@ def _across_bt(
     if not math.isfinite(off) or off == 0.0:
         return own
     for step in (1, -1):
-        n = c + step
-        if n < c_lo or n >= c_hi or not math.isfinite(x[r, n]):
-            continue
-        spacing = (geo[r, n, 0] - geo[r, c, 0]) * w0 + (geo[r, n, 1] - geo[r, c, 1]) * w1
-        spacing += (geo[r, n, 2] - geo[r, c, 2]) * w2
-        share = off / spacing
-        if share > 0.0:
-            return own + min(share, 1.0) * (bt[r, n] - own)
+        before, at = own, 0.0  # the last column passed on this side: its BT, its distance across from c
+        for k in range(1, ACROSS_COLUMNS + 1):
+            n = c + k * step
+            if n < c_lo or n >= c_hi or not math.isfinite(x[r, n]):
+                break
+            spacing = (geo[r, n, 0] - geo[r, c, 0]) * w0 + (geo[r, n, 1] - geo[r, c, 1]) * w1
+            spacing += (geo[r, n, 2] - geo[r, c, 2]) * w2
+            share = (off - at) / (spacing - at)
+            if not share > 0.0:  # on the other side of c (k = 1), or the columns fold back
+                break
+            if share <= 1.0:
+                return before + share * (bt[r, n] - before)
+            before, at = bt[r, n], spacing
+        if at != 0.0:  # beyond the columns reached on this side
+            return before
     return own
 
 

@@ -225,6 +225,21 @@ def test_a_top_met_in_another_row_is_read_at_the_rays_own_place_across():
     np.testing.assert_allclose(plain[inner], np.roll(bt, -1, axis=0)[inner], atol=1e-3)  # the next row's
 
 
+def test_a_top_met_in_another_scan_two_columns_aside_is_read_at_the_rays_own_place():
+    """Rows alternately 1.8 columns across the track from each other (one column index of two scans where
+    they overlap: the Earth turns ~2 columns under the track between them): a ray that meets the next
+    row's top reads it between that row's columns about its own place, on either side, not a column
+    short of it."""
+    shift = np.where(np.arange(12) % 2 == 1, 1.8 * PIXEL_M, 0.0)
+    geo, unit, bt, height = _deck(shift_m=shift)
+    rows, cols = bt.shape
+    a = np.full((1, rows, cols), PIXEL_M / 10e3)
+    across = Across(geo, unit, np.zeros(bt.shape), np.zeros(a.shape))
+    seen = render_height_field(geo[..., 0], np.zeros(bt.shape), height, bt, a, M_PER_K, across)[0]
+    inner = (slice(2, rows - 2), slice(2, cols - 2))
+    np.testing.assert_allclose(seen[inner], bt[inner], atol=1e-3)
+
+
 def test_across_the_track_flat_scenes_and_parts_render_as_before():
     """With the cross-track position taken: a flat scene is left as it is; a part renders as in the whole
     (its edge columns drawn with their neighbours)."""
