@@ -8,7 +8,8 @@ the day's estimate makes of the case against its truth, as the default configura
 with ``parallax=False`` (from the same collocation): per direction the FOR offsets' RMS and worst error,
 the share of FOR-directions within 2 sigma, the rms of error / sigma over them ("rms_z"), the median
 sigma, the mean cross-track error of FORs 1-10 and 21-30 ("ends_beta_urad": the pattern a rendering
-common to every granule bends into them), and the rows' median error, share within 2
+common to every granule bends into them) and each FOR's cross-track error and sigma ("beta_error_urad",
+"beta_sigma_urad", FOR 1 first), and the rows' median error, share within 2
 sigma and median sigma (the bounds of benchmarks.acceptance). With ``--at-lift`` as well, a second
 pass: the case collocated again with the pixels rendered at the lift the default kept, and assessed
 from that rendering alone (``parallax=False`` on it: f held at 1, no lift sigma), the row's
@@ -143,6 +144,8 @@ def _scores(result: AssessmentResult, truth: dict) -> dict:
         "within_2_sigma": round(float(np.mean(np.abs(err) <= 2 * sigma)), 2),
         "rms_z": round(float(np.sqrt(np.nanmean((err / sigma) ** 2))), 2),
         "ends_beta_urad": [round(float(np.nanmean(err[s, 1])), 1) for s in (slice(0, 10), slice(20, 30))],
+        "beta_error_urad": err[:, 1].round(1).tolist(),
+        "beta_sigma_urad": sigma[:, 1].round(1).tolist(),
         "median_sigma_urad": np.nanmedian(sigma, axis=0).round(1).tolist(),
         "rows_median_error_urad": round(float(np.nanmedian(rows)), 1),
         "rows_within_2_sigma": round(float(np.mean(np.abs(rows) <= 2 * rows_sigma)), 2),

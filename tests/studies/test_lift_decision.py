@@ -24,7 +24,7 @@ def test_a_flat_day_of_sharp_edges_seen_through_a_smooth_footprint_declines_the_
     row = decision(tmp_path, workers=2, offsets=True)
     assert row["law_m_per_k"] is None and row["kept_m_per_k"] == 0.0, row
     assert row["default"]["lift_m_per_k"] == 0.0 and np.isnan(row["no_parallax"]["lift_m_per_k"])
-    same = ("rms_urad", "worst_urad", "rows_median_error_urad")
+    same = ("rms_urad", "worst_urad", "rows_median_error_urad", "beta_error_urad")
     assert all(row["default"][k] == row["no_parallax"][k] for k in same), row
 
 
