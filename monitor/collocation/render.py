@@ -47,6 +47,7 @@ argument); ``studies/render_truth.py`` measures this one against the simulator's
 
 from __future__ import annotations
 
+import enum
 import math
 from typing import Protocol
 
@@ -67,6 +68,18 @@ NEAR_HITS = 16  # a ray's reach is bounded by the highest pixel within this many
 # A ray's place across the track is looked up this many columns either side of the pixel it meets, at most:
 # between two scans the Earth turns ~2 columns under the track, the bow-tie's smile adds hundredths
 ACROSS_COLUMNS = 3
+
+
+class Met(enum.IntEnum):
+    """What a ray met (the *met* output of :func:`rendered_bt`): its own pixel's top, the top of another
+    pixel of its scan or of another scan (at one column index, where scans overlap), or a wall; NOTHING where
+    no ray was rendered."""
+
+    OWN_TOP = 0
+    SCAN_TOP = 1
+    OTHER_SCAN_TOP = 2
+    WALL = 3
+    NOTHING = 255
 
 
 class Renderer(Protocol):
@@ -103,6 +116,7 @@ def rendered_bt(
     scans: slice = slice(None),
     columns: slice = slice(None),
     across: bool = True,
+    met: np.ndarray | None = None,
 ) -> np.ndarray:
     """The BT a CrIS ray at each in-track angle sees on its way to each GEO point of a VIIRS granule.
 
@@ -134,6 +148,9 @@ def rendered_bt(
         The columns to render.
     across : bool, optional
         Take each ray's BT at its own position across the track (False: the met pixel's, the sweep alone).
+    met : numpy.ndarray, optional
+        Filled with what each ray met (:class:`Met`), uint8, the output's shape: a study's view of the
+        rendering.
 
     Returns
     -------
@@ -153,6 +170,8 @@ def rendered_bt(
     # what the passes do not write: the passes write every pixel of r and [c_first, c_stop)
     out[:, : r.start], out[:, r.stop :] = np.nan, np.nan
     out[:, r, :c_first], out[:, r, c_stop:] = np.nan, np.nan
+    if met is not None:
+        met[...] = Met.NOTHING
     halo = ACROSS_COLUMNS if across else 0
     for c0 in range(c_first, c_stop, COLUMNS_PER_PASS):
         part = slice(c0, min(c0 + COLUMNS_PER_PASS, c_stop))
@@ -167,6 +186,8 @@ def rendered_bt(
             x, b, a, sideways = view_tangents_across(*geo, *orbit)
         else:
             (x, b, a), sideways = view_tangents(*geo, *orbit), None
+        shape = (len(cris_alpha_rad), r.stop - r.start, drawn.stop - drawn.start)
+        kind = None if met is None else np.empty(shape, np.uint8)
         seen = render_height_field(
             np.where(usable[r, traced], x, np.nan),
             b,
@@ -176,8 +197,12 @@ def rendered_bt(
             m_per_k,
             sideways,
             slice(drawn.start - lo, drawn.stop - lo),
+            kind,
         )
-        out[:, r, part] = seen[:, :, part.start - drawn.start : part.stop - drawn.start]
+        inner = slice(part.start - drawn.start, part.stop - drawn.start)
+        out[:, r, part] = seen[:, :, inner]
+        if met is not None and kind is not None:
+            met[:, r, part] = kind[:, :, inner]
     return out
 
 
@@ -190,6 +215,7 @@ def render_height_field(
     m_per_k: float,
     across: Across | None = None,
     columns: slice = slice(None),
+    met: np.ndarray | None = None,
 ) -> np.ndarray:
     """What a CrIS ray at each in-track tangent sees on its way to each GEO point: the module's sweep.
 
@@ -216,6 +242,8 @@ def render_height_field(
         same pixels.
     columns : slice, optional
         The columns rendered (step 1); the others are not read.
+    met : numpy.ndarray, optional
+        Filled with what each ray met (:class:`Met`), uint8, the output's shape.
 
     Returns
     -------
@@ -225,6 +253,7 @@ def render_height_field(
     """
     c_lo, c_hi, _ = columns.indices(np.shape(x_m)[1])
     seen = np.full((np.shape(cris_tan)[0], np.shape(x_m)[0], max(c_hi - c_lo, 0)), np.nan, np.float32)
+    kind = np.full(seen.shape if met is not None else (0, 0, 0), Met.NOTHING, np.uint8)
     # one type for each argument, so that one compiled sweep serves every caller
     x = np.ascontiguousarray(x_m, np.float64)
     fields = [np.ascontiguousarray(v, np.float32) for v in (viirs_tan, height_m, bt_k, cris_tan)]
@@ -235,7 +264,9 @@ def render_height_field(
         sideways = [np.ascontiguousarray(v, np.float64) for v in (across.geo_m, across.unit)]
         sideways += [np.ascontiguousarray(v, np.float32) for v in (across.viirs_tan, across.cris_tan)]
     with KERNEL_LOCK:
-        _sweep(x, *fields, float(m_per_k), *sideways, c_lo, c_hi, seen)
+        _sweep(x, *fields, float(m_per_k), *sideways, c_lo, c_hi, seen, kind)
+    if met is not None:
+        met[...] = kind
     return seen
 
 
@@ -301,9 +332,10 @@ def _sweep(
     c_lo: int,
     c_hi: int,
     out: np.ndarray,
+    kind: np.ndarray,
 ) -> None:
     """Fill *out* (:func:`render_height_field`: columns c_lo to c_hi; across the track where *geo* has
-    rows), one column a task:
+    rows; and *kind* with what each ray met, :class:`Met`, where it has rows), one column a task:
     the column's hits p sorted along the track, then per ray the stretches within its reach tested for
     where it meets them, the highest meeting kept. The reach: a GEO spacing behind the ray's foot (the
     stretch it stands on), and ahead, towards the spacecraft, a spacing plus the run along the ray of the
@@ -313,6 +345,7 @@ def _sweep(
     takes eleven."""
     rows = x.shape[0]
     sideways = geo.shape[0] > 0
+    told = kind.shape[0] > 0
     for c in numba.prange(c_lo, c_hi):
         usable = np.empty(rows, np.int64)
         n = 0
@@ -367,6 +400,15 @@ def _sweep(
                     continue
                 top = h[rs[best], c]
                 met = bt[rs[best], c]
+                if told:
+                    if top - best_z > TOP_M:
+                        kind[v, r0, c - c_lo] = Met.WALL
+                    elif rs[best] == r0:
+                        kind[v, r0, c - c_lo] = Met.OWN_TOP
+                    elif rs[best] // VIIRS_DETECTORS == r0 // VIIRS_DETECTORS:
+                        kind[v, r0, c - c_lo] = Met.SCAN_TOP
+                    else:
+                        kind[v, r0, c - c_lo] = Met.OTHER_SCAN_TOP
                 if top - best_z > TOP_M:  # a wall: the air's temperature at its depth
                     if sideways:
                         met = _across_bt(

@@ -4,7 +4,7 @@ ray march through the column the pixels were drawn from, and each ray at its own
 import numpy as np
 import pytest
 
-from monitor.collocation.render import render_height_field, rendered_bt
+from monitor.collocation.render import Met, render_height_field, rendered_bt
 from monitor.collocation.views import Across, view_tangents
 from tests.collocation.test_lift import scan_geometry
 
@@ -259,3 +259,43 @@ def test_across_the_track_flat_scenes_and_parts_render_as_before():
     np.testing.assert_allclose(part[:, :, 100:300], whole[:, :, 100:300], atol=0.01)
     plain = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, across=False)
     assert np.nanmax(np.abs(whole - plain)) > 0.01  # the cross-track position moves some rays' values
+
+
+def test_what_each_ray_met_is_told():
+    """Under a deck 10 km high, rays climbing 375 m ahead per 10 km meet the next row's top: of their own
+    scan, or of the next scan for a scan's last row. Over flat ground with one pixel standing 10 km high,
+    the ray one row behind it meets its wall halfway up (5 km, the wall's BT the top's plus 5 km of air),
+    the others their own pixel; what is told does not change what is rendered."""
+    geo, unit, bt, height = _deck(rows=40, cols=4)
+    a = np.full((1, *bt.shape), PIXEL_M / 10e3)
+    met = np.empty(a.shape, np.uint8)
+    args = (geo[..., 0], np.zeros(bt.shape), height, bt, a, M_PER_K)
+    seen = render_height_field(*args, met=met)
+    np.testing.assert_array_equal(seen, render_height_field(*args))
+    assert np.all(met[0, 1:31] == Met.SCAN_TOP) and np.all(met[0, 31] == Met.OTHER_SCAN_TOP)
+    assert np.all(met[0, 32:39] == Met.SCAN_TOP)
+    tower = np.zeros(bt.shape)
+    tower[20] = 10e3
+    bt = np.where(tower > 0, 300.0 - 10e3 / M_PER_K, 300.0)
+    seen = render_height_field(geo[..., 0], np.zeros(bt.shape), tower, bt, a, M_PER_K, met=met)
+    assert np.all(met[0, 20] == Met.WALL) and np.all(met[0, 19] == Met.SCAN_TOP)
+    assert np.all(met[0, 1:19] == Met.OWN_TOP) and np.all(met[0, 21:39] == Met.OWN_TOP)
+    np.testing.assert_allclose(seen[0, 20], 300.0 - 5e3 / M_PER_K, atol=1e-3)
+
+
+def test_a_granule_tells_what_its_rays_met():
+    """Through :func:`rendered_bt`: every rendered ray is told, the rest NOTHING; a flat granule's rays all
+    meet their own pixel, and a cloud band's edge shows the rows ahead and behind its walls."""
+    lat, lon, h, _, sat, v = scan_geometry()
+    good = np.ones(lat.shape, bool)
+    alphas = np.array([-0.0191, 0.0, 0.0191])
+    met = np.empty((3, *lat.shape), np.uint8)
+    flat = np.full(lat.shape, 280.0, np.float32)
+    orbit = (sat[None], v[None], alphas, M_PER_K)
+    rendered_bt(lat, lon, h, flat, good, *orbit, columns=slice(100, 300), met=met)
+    assert np.all(met[:, :, 100:300] == Met.OWN_TOP) and np.all(met[:, :, :100] == Met.NOTHING)
+    bt = np.full(lat.shape, 295.0, np.float32)
+    bt[10:21] = 230.0
+    seen = rendered_bt(lat, lon, h, bt, good, *orbit, met=met)
+    np.testing.assert_array_equal(seen, rendered_bt(lat, lon, h, bt, good, *orbit))
+    assert np.any(met[0] == Met.WALL) and np.any(met[2] == Met.WALL) and not np.any(met[1] == Met.WALL)
