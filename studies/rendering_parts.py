@@ -34,6 +34,7 @@ import argparse
 import hashlib
 import json
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -146,21 +147,20 @@ def shifts(cache: Path) -> dict[str, list[list[float]]]:
     return {name: np.round(acc[..., 0] / acc[..., 1], 3).tolist() for name, acc in sums.items()}
 
 
-def measure(case: Path, lift_m_per_k: float, cache: Path, parts: list[str], workers: int) -> list[dict]:
-    """One row per part of *case* assessed at *lift_m_per_k* (module docstring)."""
+def measure(case: Path, lift_m_per_k: float, cache: Path, parts: list[str], workers: int) -> Iterator[dict]:
+    """One row per part of *case* assessed at *lift_m_per_k* (module docstring), as each is assessed."""
     truth = json.loads((case / "truth.json").read_text())
     cfg = AssessmentConfig(workers=workers)
     plain = cfg.model_copy(update={"parallax": False})
     renderer = Parts(truth, cache)
-    rows = []
+    for part in parts:  # a typo fails before the first trace
+        selected(part, np.zeros((len(render.VIEW_ALPHA_RAD), VIIRS_DETECTORS, 6), np.uint8))
     for part in parts:
-        selected(part, np.zeros((1, 1, 1), np.uint8))  # a typo fails before the first trace
         renderer.part = part
         samples = collocated(case, cfg, workers, lift_m_per_k, renderer=renderer)
         result = cost_and_offsets(paired(samples)[1], plain, satellite=truth["satellite"])
-        rows.append({**case_fields(case, truth), "granules": truth["granules"], "lift_m_per_k": lift_m_per_k,
-                     "part": part, "scores": _scores(result, truth)})  # fmt: skip
-    return rows
+        yield {**case_fields(case, truth), "granules": truth["granules"], "lift_m_per_k": lift_m_per_k,
+               "part": part, "scores": _scores(result, truth)}  # fmt: skip
 
 
 def main() -> None:
