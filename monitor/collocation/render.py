@@ -189,7 +189,7 @@ def rendered_bt(
         shape = (len(cris_alpha_rad), r.stop - r.start, drawn.stop - drawn.start)
         kind = None if met is None else np.empty(shape, np.uint8)
         seen = render_height_field(
-            np.where(usable[r, traced], x, np.nan),
+            x,  # NaN where unusable: traced with usable as the pixels' good
             b,
             height[r, traced],
             bt_k[r, traced],

@@ -159,20 +159,22 @@ def _traced(
     first_column: int,
     with_across: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Across | None]:
-    """:func:`_tangents` into new arrays (NaN where not written); the :class:`Across` with *with_across*."""
+    """:func:`_tangents` into new arrays (NaN where no tangent is traced); the :class:`Across` with
+    *with_across*."""
     rows, cols = np.shape(lat_rad)
     views = len(cris_alpha_rad)
     sat = np.ascontiguousarray(sat_m, np.float64)
     vel = np.ascontiguousarray(velocity_m_s, np.float64)
-    x = np.full((rows, cols), np.nan)
-    b = np.full((rows, cols), np.nan, np.float32)
-    a = np.full((views, rows, cols), np.nan, np.float32)
+    # the kernel writes every element (NaN where it traces none), each scan on the thread that traces it
+    x = np.empty((rows, cols))
+    b = np.empty((rows, cols), np.float32)
+    a = np.empty((views, rows, cols), np.float32)
     n = rows if with_across else 0
     across = Across(
-        np.full((n, cols, 3), np.nan),
-        np.full((n, cols, 3), np.nan),
-        np.full((n, cols), np.nan, np.float32),
-        np.full((views, n, cols), np.nan, np.float32),
+        np.empty((n, cols, 3)),
+        np.empty((n, cols, 3)),
+        np.empty((n, cols), np.float32),
+        np.empty((views, n, cols), np.float32),
     )
     geo = [np.ascontiguousarray(v, np.float64) for v in (lat_rad, lon_rad, height_m)]
     tan_alpha = np.tan(np.asarray(cris_alpha_rad, np.float64))
@@ -235,9 +237,13 @@ def _tangents(
 ) -> None:
     """Fill *x*, *b* and *a* (:func:`view_tangents`), one scan a task; x along the first scan's
     SBF x. When *geo* has rows, also *geo*, *across*, *b_across* and *a_across*
-    (:func:`view_tangents_across`)."""
+    (:func:`view_tangents_across`). Every element is written: NaN where no tangent is traced."""
     cols = lat.shape[1]
     with_across = geo.shape[0] > 0
+    nscan = lat.shape[0] // VIIRS_DETECTORS
+    for k in numba.prange(nscan):  # NaN first, each scan by its own thread
+        _unset(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS, x, b, a, geo, across, b_across, a_across)
+    _unset(nscan * VIIRS_DETECTORS, lat.shape[0], x, b, a, geo, across, b_across, a_across)  # a part scan
     axis0 = np.full(3, np.nan)
     for k in range(lat.shape[0] // VIIRS_DETECTORS):  # the first scan with an SBF: x's axis
         if np.all(np.isfinite(sat[k])) and np.all(np.isfinite(vel[k])):
@@ -314,6 +320,30 @@ def _tangents(
                                         w * a_across[j, row0 + i, c]
                                     )
                 last = c
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _unset(
+    row0: int,
+    row1: int,
+    x: np.ndarray,
+    b: np.ndarray,
+    a: np.ndarray,
+    geo: np.ndarray,
+    across: np.ndarray,
+    b_across: np.ndarray,
+    a_across: np.ndarray,
+) -> None:
+    """NaN in every output of :func:`_tangents` in rows *row0* to *row1* (excluded)."""
+    rows = slice(row0, row1)
+    x[rows] = np.nan
+    b[rows] = np.nan
+    a[:, rows] = np.nan
+    if geo.shape[0] > 0:
+        geo[rows] = np.nan
+        across[rows] = np.nan
+        b_across[rows] = np.nan
+        a_across[:, rows] = np.nan
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -47,7 +47,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.ndimage import shift as shift_grid
 
 from monitor.core.constants import DEFAULT_STEP_RAD
 from monitor.core.result import (
@@ -430,11 +429,43 @@ def aligned(s: ForSamples, apart: tuple[float, float]) -> ForSamples:
     d, annuli = s.d_k.copy(), None if s.annuli_rad is None else s.annuli_rad.copy()
     for fovs, sign in zip(FOV_ROWS, (1.0, -1.0), strict=True):
         sel = np.isin(s.fov, fovs)
-        move = (0.0, -sign * 0.5 * apart[0], -sign * 0.5 * apart[1])  # out(t) = in(t + apart/2) ahead
-        d[sel] = shift_grid(s.d_k[sel], move, order=1, mode="nearest")
+        move = (-sign * 0.5 * apart[0], -sign * 0.5 * apart[1])  # out(t) = in(t + apart/2) ahead
+        d[sel] = shifted(s.d_k[sel], move)
         if annuli is not None and s.annuli_rad is not None:
-            annuli[sel] = shift_grid(s.annuli_rad[sel], (0.0, *move), order=1, mode="nearest")
+            annuli[sel] = shifted(s.annuli_rad[sel], move)
     return replace(s, d_k=d, annuli_rad=annuli)
+
+
+def _shifted_along(a: np.ndarray, move: float, axis: int) -> np.ndarray:
+    """*a* moved by *move* steps along *axis*: out[i] = a(i - move), linear between nodes, the edge value
+    beyond them."""
+    n = a.shape[axis]
+    x = np.clip(np.arange(n) - move, 0, n - 1)
+    lo = np.minimum(np.floor(x).astype(int), n - 2) if n > 1 else np.zeros(n, int)
+    t = (x - lo).reshape((-1,) + (1,) * (a.ndim - axis % a.ndim - 1))
+    hi = np.minimum(lo + 1, n - 1)
+    below, above = np.take(a, lo, axis=axis), np.take(a, hi, axis=axis)
+    return below + t * (above - below)
+
+
+def shifted(a: np.ndarray, move: tuple[float, float]) -> np.ndarray:
+    """Surfaces moved across the grid, held at its edge.
+
+    Parameters
+    ----------
+    a : numpy.ndarray
+        Values on the perturbation grid in the last two axes, shape (..., m, m).
+    move : tuple of float
+        The move along the two grid axes (in-track, cross-track), grid steps: out(i, j) = a(i - move[0],
+        j - move[1]), bilinear between grid points, the edge value beyond the grid.
+
+    Returns
+    -------
+    numpy.ndarray
+        The moved values, the shape and type of *a*.
+    """
+    out = _shifted_along(_shifted_along(a, move[0], -2), move[1], -1)
+    return out.astype(a.dtype, copy=False)
 
 
 def estimate(

@@ -62,3 +62,26 @@ def test_the_cross_track_tangents_follow_the_lines_of_sight():
     run = np.sum(look * across.unit, -1) / np.sum(look * up, -1)
     assert np.abs(run - across.viirs_tan).max() < 1e-5
     assert across.cris_tan[0, i, c] == pytest.approx(across.viirs_tan[i, c], abs=1e-6)
+
+
+def test_what_is_not_traced_is_nan_in_every_output():
+    """Unusable pixels, a scan without its spacecraft position and the rows of a part scan get no tangent:
+    NaN in every output, whatever the arrays held before; the usable pixels of the scan with an orbit are
+    traced as when it is alone."""
+    lat, lon, h, _, sat, v = scan_geometry(cols=64)
+    good = np.ones(lat.shape, bool)
+    good[5, 10:20] = False
+    two = [np.concatenate([f, f]) for f in (lat, lon, h)]
+    rows = len(lat)
+    part = [np.concatenate([f, f[:7]]) for f in two]  # two scans and 7 rows of a third
+    usable = np.concatenate([good, good, good[:7]])
+    orbit = np.stack([sat, np.full(3, np.nan)]), np.stack([v, v])  # the second scan has no position
+    alphas = np.array([0.0191, -0.0191])
+    x, b, a, across = view_tangents_across(*part, usable, *orbit, alphas)
+    alone = view_tangents_across(lat, lon, h, good, sat[None], v[None], alphas)
+    for mine, theirs in zip((x, b, a), alone[:3], strict=True):
+        np.testing.assert_array_equal(mine[..., :rows, :], theirs)
+    fields = (x, b, a[0], a[1], across.geo_m, across.unit, across.viirs_tan, across.cris_tan[0])
+    for f in fields:
+        assert np.isnan(f[5, 10:20]).all() and np.isfinite(f[5, :10]).all()
+        assert np.isnan(f[rows:]).all()  # the scan without position and the part scan

@@ -2,9 +2,10 @@
 
 import numpy as np
 import pytest
+from scipy.ndimage import shift as scipy_shift
 
 from monitor.core.vocabulary import Cost
-from monitor.estimation.estimate import ForSamples, aligned, estimate, rows_apart
+from monitor.estimation.estimate import ForSamples, aligned, estimate, rows_apart, shifted
 
 M = 21
 
@@ -41,3 +42,16 @@ def test_the_for_offset_is_the_rows_common_turn_and_the_rows_keep_their_differen
     s = rows_split(0.6)
     blurred = estimate(ForSamples(s.d_k, s.cris_k, s.granule, s.scan), Cost.REGRESSION)  # one turn for all
     assert blurred.x - 1.3 > 0.1  # pulled towards the sharper row ahead: what the alignment prevents
+
+
+@pytest.mark.parametrize("move", [(0.3, -1.7), (-2.5, 0.0), (4.2, 3.9), (25.0, -30.0)])
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_surfaces_move_as_scipy_moves_them(move, dtype):
+    """A row's move is bilinear on the grid and holds the edge value beyond it: scipy.ndimage's linear
+    shift in "nearest" mode, to rounding, in the surfaces' own type (also past the grid's edge)."""
+    a = np.random.default_rng(1).normal(size=(5, 4, M, M)).astype(dtype)
+    moved = shifted(a, move)
+    assert moved.dtype == dtype
+    np.testing.assert_allclose(
+        moved, scipy_shift(a, (0, 0, *move), order=1, mode="nearest"), atol=4 * np.finfo(dtype).eps
+    )
