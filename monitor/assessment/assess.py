@@ -23,6 +23,7 @@ from monitor.assessment.estimates import GranuleSamples, cost_and_offsets
 from monitor.assessment.inputs import (
     KERNELS,
     GranuleInputs,
+    PieceVariant,
     SwathCache,
     Timings,
     load_swath,
@@ -198,6 +199,7 @@ def collocate_run(
     timings: Timings = None,
     lift_m_per_k: float = 0.0,
     renderer: render.Renderer = render.rendered_bt,
+    piece_variant: PieceVariant | None = None,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
     """Collocate a time-ordered run of CrIS granules, and in the same pass their rendering at a lift.
 
@@ -224,6 +226,9 @@ def collocate_run(
         FOV row sees them (:mod:`monitor.collocation.render`).
     renderer : Renderer, optional
         What renders them (:func:`monitor.collocation.render.rendered_bt`).
+    piece_variant : callable, optional
+        A study's change to each VIIRS granule as it is prepared
+        (:class:`~monitor.assessment.inputs.SwathCache`); None: the pieces as prepared.
 
     Returns
     -------
@@ -233,7 +238,8 @@ def collocate_run(
         The granules that failed, with their reasons.
     """
     band = i5_band(satellite)
-    cache = SwathCache(spans=scan_spans(cris, viirs), lift_m_per_k=lift_m_per_k, renderer=renderer)
+    spans = scan_spans(cris, viirs)
+    cache = SwathCache(spans=spans, lift_m_per_k=lift_m_per_k, renderer=renderer, piece_variant=piece_variant)
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
@@ -309,6 +315,8 @@ class DayAssessment:
     renderer : Renderer, optional
         What renders the VIIRS pixels as each CrIS FOV row sees them
         (:func:`monitor.collocation.render.rendered_bt`).
+    piece_variant : callable, optional
+        A study's change to each VIIRS granule as it is prepared; None (the service): none.
     """
 
     def __init__(
@@ -318,9 +326,10 @@ class DayAssessment:
         workers: int = 1,
         probe_m_per_k: float = PROBE_M_PER_K,
         renderer: render.Renderer = render.rendered_bt,
+        piece_variant: PieceVariant | None = None,
     ) -> None:
         self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
-        self.probe_m_per_k, self.renderer = probe_m_per_k, renderer
+        self.probe_m_per_k, self.renderer, self.piece_variant = probe_m_per_k, renderer, piece_variant
         self.samples: list[GranuleSamples] = []
         self.skipped: list[tuple[str, str]] = []
         self._spool = Spool()
@@ -365,7 +374,7 @@ class DayAssessment:
         lift_m_per_k = self.probe_m_per_k if cfg.parallax else 0.0
         with parallel_threads(self.workers):
             samples, skipped = collocate_run(
-                *run, progress, should_stop, timings, lift_m_per_k, self.renderer
+                *run, progress, should_stop, timings, lift_m_per_k, self.renderer, self.piece_variant
             )
         self.skipped += list(case.skipped) + skipped
         self.samples += [s.kept_in(self._spool) for s in samples]

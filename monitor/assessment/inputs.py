@@ -5,7 +5,7 @@ included) and prepared once per run as swath pieces (:mod:`monitor.collocation.s
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -84,6 +84,9 @@ def stage(timings: Timings, name: str) -> Iterator[None]:
             timings[name] = timings.get(name, 0.0) + time.perf_counter() - t0
 
 
+PieceVariant = Callable[[swath.SwathPiece], swath.SwathPiece]  # a study's change to a prepared piece
+
+
 @dataclass
 class SwathCache:
     """Prepared VIIRS granules (swath pieces) by key; the few most recent are kept. *spans* holds, by key,
@@ -91,7 +94,8 @@ class SwathCache:
     *lift_m_per_k* (m per K colder than the clear-sky reference: :mod:`monitor.collocation.lift`), every
     piece holds what each CrIS FOV row sees of its pixels standing at that height
     (*renderer*, :func:`monitor.collocation.render.rendered_bt` unless a study gives another); with 0, the
-    pixels' own radiance."""
+    pixels' own radiance. *piece_variant*, None in the service, is a study's change to each piece as it
+    is prepared (the pixels the cone kernel sees)."""
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
@@ -100,6 +104,7 @@ class SwathCache:
     spans: dict = field(default_factory=dict)
     lift_m_per_k: float = 0.0
     renderer: render.Renderer = render.rendered_bt
+    piece_variant: PieceVariant | None = None
 
 
 def _widen(span: Span | None, other: Span | None) -> Span | None:
@@ -358,6 +363,8 @@ def piece(
             sat_m=geo.sc_position_m, view_rad=reach_rad, scan_start_us=geo.start_time_us, span_us=run_span,
             seen_bt_k=seen, view_alpha_rad=render.VIEW_ALPHA_RAD,
         )  # fmt: skip
+    if cache.piece_variant is not None:
+        piece = cache.piece_variant(piece)
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))
     cache.pieces[v.key] = piece
