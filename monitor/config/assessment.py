@@ -47,7 +47,8 @@ class SceneConfig(Section):
         "are assessed until it is reached, max_granules are assessed, the candidates are spent, or keep "
         "more granules would pass source.daily_budget_mb or schedule.run_budget_min; after the first "
         "(keep), each takes what 1/sqrt(N) says the target needs, at least keep and at most the day so "
-        "far. None: one batch.",
+        "far. None: one batch. What a day at a target costs, and which budget ends it first: "
+        "docs/operations.md.",
         1.0,
         10000.0,
     )
