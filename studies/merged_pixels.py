@@ -32,7 +32,7 @@ from monitor.collocation.collocate import warm_up
 from monitor.collocation.swath import SwathPiece
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult
-from monitor.instrument.spectral import I5Band, i5_band
+from monitor.instrument.spectral import BandModel, i5_band
 from monitor.sdr.pairing import plan
 from studies.lift_decision import _scores, case_fields
 
@@ -46,7 +46,7 @@ def _quads(a: np.ndarray) -> np.ndarray:
     return np.swapaxes(q, -3, -2).reshape(*lead, r2 // 2, c2 // 2, 4)
 
 
-def _bt_k(radiance: np.ndarray, band: I5Band) -> np.ndarray:
+def _bt_k(radiance: np.ndarray, band: BandModel) -> np.ndarray:
     """The BT of band radiances, NaN where the radiance is."""
     bt = band.bt_from_radiance(np.nan_to_num(radiance, nan=1.0).ravel()).reshape(radiance.shape)
     return np.where(np.isfinite(radiance), bt, np.nan)
@@ -67,11 +67,11 @@ class Merged:
     ----------
     tolerance_k : float
         The widest BT range (K) of a quad merged, in its radiance and every rendered view.
-    band : I5Band
+    band : BandModel
         The satellite's I5 band.
     """
 
-    def __init__(self, tolerance_k: float, band: I5Band) -> None:
+    def __init__(self, tolerance_k: float, band: BandModel) -> None:
         self.tolerance_k, self.band = tolerance_k, band
         self.merged = self.quads = 0
 

@@ -78,10 +78,12 @@ class CaseCache:
         self.root.mkdir(exist_ok=True)
         self.cases = {}
 
-    def get(self, profile="paper", seed=1, granules=2, satellite="j01", clouds="ground"):
-        key = (profile, seed, granules, satellite, clouds)
+    def get(self, profile="paper", seed=1, granules=2, satellite="j01", clouds="ground", bands=("I5",)):
+        """(directory, truth, result) of a case; with bands beyond I5 the result is None (not assessed)."""
+        key = (profile, seed, granules, satellite, clouds, tuple(bands))
         if key not in self.cases:
-            name = f"case_{profile}_{seed}_{granules}_{satellite}_{clouds}"
+            tag = "" if tuple(bands) == ("I5",) else "_" + "-".join(bands)
+            name = f"case_{profile}_{seed}_{granules}_{satellite}_{clouds}{tag}"
             out, made = self.root / name, self.root / f"{name}.pickle"
             with open(self.root / f"{name}.lock", "w") as lock:
                 fcntl.flock(lock, fcntl.LOCK_EX)
@@ -93,8 +95,9 @@ class CaseCache:
                         profile=profile,
                         seed=seed,
                         cloud_heights=clouds,
+                        viirs_bands=tuple(bands),
                     )
-                    result = assess_paths([out], AssessmentConfig())
+                    result = assess_paths([out], AssessmentConfig()) if not tag else None
                     made.with_suffix(".part").write_bytes(pickle.dumps((truth, result)))
                     made.with_suffix(".part").rename(made)
             self.cases[key] = (out, *pickle.loads(made.read_bytes()))

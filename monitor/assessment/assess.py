@@ -42,7 +42,7 @@ from monitor.core.errors import AssessmentError, StopRequested
 from monitor.core.result import AssessmentResult, GranuleInfo
 from monitor.geometry.ep_model import FOV5
 from monitor.geometry.inverse import FovGeometry
-from monitor.instrument.spectral import I5Band, i5_band
+from monitor.instrument.spectral import BandModel, i5_band
 from monitor.sdr import (
     CrisGeoGranule,
     GranuleError,
@@ -62,7 +62,7 @@ def collocate_granule(
     cris: GranuleFiles,
     viirs: list[GranuleFiles],
     cfg: AssessmentConfig,
-    band: I5Band,
+    band: BandModel,
     cache: SwathCache,
     timings: Timings = None,
     viirs_all: list[GranuleFiles] | None = None,
@@ -79,7 +79,7 @@ def collocate_granule(
         The VIIRS I5 SDR and GEO granules covering it.
     cfg : AssessmentConfig
         The assessment's configuration (grid, kernel).
-    band : I5Band
+    band : BandModel
         The satellite's I5 band.
     cache : SwathCache
         The prepared VIIRS granules, shared by the run's CrIS granules.
@@ -152,7 +152,7 @@ def _collocate_fors(
     valid: np.ndarray,
     fill: dict,
     cfg: AssessmentConfig,
-    band: I5Band,
+    band: BandModel,
     should_stop: StopCheck = None,
 ) -> collocate.ConeSums:
     """The cone sums of every FOV of the granule (in one call of the parallel kernel), and of what each
@@ -173,7 +173,7 @@ def _collocate_fors(
 
 
 def _per_fov(
-    cones: collocate.ConeSums, fg: FovGeometry, cfg: AssessmentConfig, band: I5Band
+    cones: collocate.ConeSums, fg: FovGeometry, cfg: AssessmentConfig, band: BandModel
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """VIIRS BT (nscan, 30, 9, m, m) of every perturbed cone, the worst coverage per FOV (of the outermost
     disc), and with the footprint kernel the radiance per annulus (nscan, 30, 9, K, m, m), else None."""

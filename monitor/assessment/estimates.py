@@ -26,7 +26,7 @@ from monitor.estimation.jackknife import follows_in_time, uncertainty_note
 from monitor.estimation.offsets import DayLift, day_offsets
 from monitor.estimation.parallax import Blend
 from monitor.geometry.ground import offset_km
-from monitor.instrument.spectral import I5Band, i5_band
+from monitor.instrument.spectral import BandModel, i5_band
 
 
 @dataclass
@@ -91,7 +91,7 @@ def _ground_km(
 
 
 def for_samples(
-    samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, band: I5Band | None = None
+    samples: list[GranuleSamples], k: int, cfg: AssessmentConfig, band: BandModel | None = None
 ) -> ForSamples:
     """The estimator's input for one FOR: every usable FOV of it over the granules.
 
@@ -103,7 +103,7 @@ def for_samples(
         The FOR, 0-based.
     cfg : AssessmentConfig
         The assessment's configuration.
-    band : I5Band, optional
+    band : BandModel, optional
         The satellite's I5 band, for the footprint kernel's annuli.
 
     Returns

@@ -16,7 +16,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.vocabulary import Kernel
 from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
-from monitor.instrument.spectral import I5Band
+from monitor.instrument.spectral import BandModel
 from monitor.sdr import (
     CrisGeoGranule,
     CrisSdrGranule,
@@ -217,7 +217,7 @@ def read_inputs(
     cris: GranuleFiles,
     viirs: list[GranuleFiles],
     viirs_all: list[GranuleFiles],
-    band: I5Band,
+    band: BandModel,
     cfg: AssessmentConfig,
     prepared: Iterable[str] = (),
     timings: Timings = None,
@@ -233,7 +233,7 @@ def read_inputs(
         The VIIRS granules covering it.
     viirs_all : list of GranuleFiles
         Every VIIRS granule of the run.
-    band : I5Band
+    band : BandModel
         The satellite's I5 band.
     cfg : AssessmentConfig
         The assessment's configuration.
@@ -297,7 +297,7 @@ def _run_span(spans: dict[str, Span], key: str, span_us: Span | None) -> Span | 
 def piece(
     v: GranuleFiles,
     viirs_all: list[GranuleFiles],
-    band: I5Band,
+    band: BandModel,
     cache: SwathCache,
     view_rad: float,
     timings: Timings = None,
@@ -312,7 +312,7 @@ def piece(
         A VIIRS granule's SDR and GEO files.
     viirs_all : list of GranuleFiles
         Every VIIRS granule of the run.
-    band : I5Band
+    band : BandModel
         The satellite's I5 band.
     cache : SwathCache
         The run's prepared granules.
@@ -374,7 +374,7 @@ def piece(
 def load_swath(
     viirs: list[GranuleFiles],
     viirs_all: list[GranuleFiles],
-    band: I5Band,
+    band: BandModel,
     cache: SwathCache,
     view_rad: float,
     timings: Timings = None,
@@ -389,7 +389,7 @@ def load_swath(
         The VIIRS granules covering it.
     viirs_all : list of GranuleFiles
         Every VIIRS granule of the run.
-    band : I5Band
+    band : BandModel
         The satellite's I5 band.
     cache : SwathCache
         The run's prepared granules.

@@ -1,7 +1,7 @@
 """The ``crisgeo`` command line.
 
 The daily job and the service come first (run, daemon, status, check-config, alerts, events, report,
-export, reprocess, install-files), the science tools after (assess, simulate, fingerprint, geolocate,
+export, reprocess, install-files), the science tools after (assess, map, simulate, fingerprint, geolocate,
 regeolocate, optimize, bench).
 
 Exit status: 0 success; 1 failure (a run failed, the store is unusable, the disk is full); 2 bad input (one
@@ -42,7 +42,7 @@ from monitor.version import __version__
 ORDER = (
     "run", "daemon", "status", "check-config", "alerts", "events", "report", "export", "reprocess",
     "install-files",
-    "assess", "simulate", "fingerprint", "geolocate", "regeolocate", "optimize", "bench",
+    "assess", "map", "simulate", "fingerprint", "geolocate", "regeolocate", "optimize", "bench",
 )  # fmt: skip
 
 

@@ -23,8 +23,9 @@ from monitor.cli.registry import (
     options,
     unset,
 )
-from monitor.cli.types import iso_time, longitude, whole
+from monitor.cli.types import band_list, band_values_k, iso_time, longitude, whole
 from monitor.config.assessment import AssessmentConfig
+from monitor.core.bands import BANDS
 from monitor.core.constants import N_FOV, PAPER_GRANULES
 from monitor.core.satellites import SATELLITES
 from monitor.instrument.footprint import SHAPES as FOOTPRINTS
@@ -108,6 +109,21 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
         "blurred:0.95) or unequally by :AxB@DEG (axis a DEG deg from in-track): one shape for all FOVs, "
         "or nine (FOV 1..9); default the paper's top-hat cone",
     ),
+    arg(
+        "--bands",
+        type=band_list,
+        default=("I5",),
+        metavar="BANDS",
+        help="the VIIRS bands written, comma-separated, of I5, M13, M15, M16 (default I5, the assessment's)",
+    ),
+    arg(
+        "--viirs-band-bias-k",
+        type=band_values_k,
+        default={},
+        metavar="BAND=K,...",
+        help="a VIIRS calibration difference per band: K added to VIIRS's BT there (CrIS minus VIIRS reads "
+        "minus it), e.g. M15=0.15",
+    ),
 )
 def cmd_simulate(args: argparse.Namespace) -> int:
     """crisgeo simulate: write a simulated case.
@@ -136,6 +152,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         fov_rows_alpha_urad=args.fov_rows_urad,
         wind_in_track_m_s=args.wind,
         cloud_emissivity=args.cloud_emissivity,
+        viirs_bands=args.bands,
+        viirs_band_bias_k=args.viirs_band_bias_k,
     )
     if (args.true_ep is None) != (args.ground_ep is None):
         raise BadInput("--true-ep and --ground-ep go together")
@@ -152,7 +170,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {truth['profile']}"
     print(
         f"wrote {len(truth['files'])} files and truth.json to {args.out} "
-        f"({args.satellite}, {args.granules} CrIS granules, {error}, seed {truth['seed']})"
+        f"({args.satellite}, {args.granules} CrIS granules, VIIRS {', '.join(args.bands)}, {error}, "
+        f"seed {truth['seed']})"
     )
     return EXIT_OK
 
@@ -256,6 +275,12 @@ def cmd_assess(args: argparse.Namespace) -> int:
     arg("--data", help="case directory to reuse or create (default: a temporary directory)"),
     CLOUDS,
     arg("--pyresample", action="store_true", help="also time pyresample's radius search as a reference"),
+    arg(
+        "--map",
+        action="store_true",
+        help="also map the case onto every VIIRS band (simulated with I5, M13, M15, M16) and print the "
+        "mapping's CPU per band, the reading apart",
+    ),
     WORKERS,
     COST,
     KERNEL,
@@ -277,3 +302,57 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     cfg = options(AssessmentConfig, "--workers", cost=args.cost, kernel=args.kernel, workers=args.workers)
     return run_bench(args, cfg)
+
+
+@command(
+    "map",
+    "map every CrIS FOV onto VIIRS I5, M13, M15, M16: the VIIRS scene in each FOV and CrIS in each band",
+    arg(
+        "paths", nargs="+", metavar="PATH", help="granule files or directories (CrIS SDR+GEO, VIIRS SDR+GEO)"
+    ),
+    arg("--out", required=True, metavar="FILE.nc", help="the mapping file (NetCDF, CF-1.8/ACDD-1.3)"),
+    arg(
+        "--bands",
+        type=band_list,
+        default=tuple(BANDS),
+        metavar="BANDS",
+        help="the VIIRS bands, comma-separated (default I5,M13,M15,M16)",
+    ),
+    arg(
+        "--offsets",
+        metavar="RESULT.json",
+        help="an assessment result (crisgeo assess --out): each FOV placed on the assessed geolocation, "
+        "weighted by the day's fitted response; default the operational geolocation, the nominal response",
+    ),
+)
+def cmd_map(args: argparse.Namespace) -> int:
+    """crisgeo map: map CrIS FOVs onto VIIRS bands; write the NetCDF file.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`monitor.cli.build_parser`).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
+    from monitor.core.result import AssessmentResult
+    from monitor.matchup import map_granules
+
+    offsets = None
+    if args.offsets:
+        try:
+            offsets = AssessmentResult.from_json(Path(args.offsets).read_text())
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise BadInput(f"{args.offsets}: not an assessment result ({exc})") from None
+    matchup, cost = map_granules(args.paths, args.bands, offsets)
+    matchup.write(args.out)
+    for note in matchup.notes:
+        print(f"skipped {note}")
+    print(
+        f"wrote {args.out}: {matchup.scans} CrIS scans x 30 x 9 FOVs on VIIRS {', '.join(matchup.bands)}, "
+        f"{matchup.geolocation} geolocation, {matchup.response} response"
+    )
+    return EXIT_OK

@@ -117,3 +117,55 @@ def nagios_range(text: str) -> Range:
         raise argparse.ArgumentTypeError(
             f"not a threshold range (10, 10:, ~:10, 10:20, @10:20): {text!r}"
         ) from None
+
+
+def band_list(text: str) -> tuple[str, ...]:
+    """VIIRS bands, comma-separated: ``I5,M15,M16,M13`` (any order and case).
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    tuple of str
+        The bands in the band table's order; an argparse error otherwise.
+    """
+    from monitor.core.bands import parse_bands
+    from monitor.core.errors import DataError
+
+    try:
+        return parse_bands(text)
+    except DataError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def band_values_k(text: str) -> dict[str, float]:
+    """A value in K per VIIRS band: ``M15=0.15,M16=-0.1``.
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    dict
+        Band to K; an argparse error otherwise.
+    """
+    out: dict[str, float] = {}
+    for item in filter(None, (t.strip() for t in text.split(","))):
+        band, eq, value = item.partition("=")
+        try:
+            (name,) = band_list(band)
+            out[name] = float(value)
+        except (ValueError, argparse.ArgumentTypeError):
+            raise argparse.ArgumentTypeError(
+                f"{item!r} is not BAND=K (a band of I5, M13, M15, M16 and a number of kelvin)"
+            ) from None
+        if not eq or not -10.0 <= out[name] <= 10.0:
+            raise argparse.ArgumentTypeError(f"{item!r}: the value must be a number of kelvin within +-10")
+    if not out:
+        raise argparse.ArgumentTypeError(f"{text!r}: no BAND=K given")
+    return out

@@ -41,7 +41,7 @@ from monitor.core.constants import VIIRS_DETECTORS
 
 
 class BandTable(Protocol):
-    """The I5 band's Planck table (:class:`monitor.instrument.spectral.I5Band`, a neighbour on this floor)."""
+    """The I5 band's Planck table (:class:`monitor.instrument.spectral.BandModel`, a neighbour here)."""
 
     @property
     def radiance_table(self) -> tuple[float, float, np.ndarray]:
@@ -482,7 +482,7 @@ def swath_piece(
     good : numpy.ndarray
         Where a pixel is usable.
     band : BandTable
-        The I5 band (:class:`monitor.instrument.spectral.I5Band`): pixel BT to band radiance.
+        The I5 band (:class:`monitor.instrument.spectral.BandModel`): pixel BT to band radiance.
     before, after : tuple of numpy.ndarray, optional
         (lat_rad, lon_rad, height_m) of the neighbouring granules' adjacent scan, so that the scan overlap at
         the granule's first and last scan is counted as inside a continuous swath.

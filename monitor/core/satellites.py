@@ -37,7 +37,7 @@ class Satellite:
     phase_deg: float  # mean argument of latitude ahead of S-NPP
     launch_unix_s: float  # launch, UTC seconds since 1970
     mission: str  # HDF5 Mission_Name of its granules
-    srf_file: str  # VIIRS I5 spectral response, monitor/data/srf (NOAA-21 has none public: NOAA-20's)
+    srf_platform: str  # whose VIIRS spectral responses, monitor/data/srf (NOAA-21 has none public: NOAA-20's)
     ep_file: str | None  # the real CrIS engineering packet shipped, monitor/data/ep
     cris_instrument_id: int | None  # InstrumentId of its CrIS in EP XML files
     pct_mounting_urad: tuple[float, float, float] | None  # CrIS PCT mounting roll, pitch, yaw (LW-GEO)
@@ -89,13 +89,13 @@ SNPP_EP, NOAA20_EP = "SNPP_side1_V37_EngPkt.xml", "JPSS1_side1_V115_EngPkt.xml" 
 # fmt: off
 SATELLITES = {s.short: s for s in (
     # short, IDPS, name, bucket, altitude_m, inclination_deg, ltan_h, phase_deg, launch_unix_s,
-    #   mission, srf_file, ep_file, cris_instrument_id, pct_mounting_urad
+    #   mission, srf_platform, ep_file, cris_instrument_id, pct_mounting_urad
     Satellite("npp", "NPP", "S-NPP", "noaa-nesdis-snpp-pds", 838.8e3, 98.67, 13.5, 0.0, 1319795281.0,
-              "NPP", "npp_viirs_i05_srf.csv", SNPP_EP, 1, (-518.45683, -77.760702, 46.109524)),
+              "NPP", "npp", SNPP_EP, 1, (-518.45683, -77.760702, 46.109524)),
     Satellite("j01", "J01", "NOAA-20", "noaa-nesdis-n20-pds", 833.0e3, 98.7, 13.5, -90.0, 1510998456.0,
-              "S-NPP/JPSS", "n20_viirs_i05_srf.csv", NOAA20_EP, 4, (-145.84994, 267.42417, 594.61832)),
+              "S-NPP/JPSS", "n20", NOAA20_EP, 4, (-145.84994, 267.42417, 594.61832)),
     Satellite("j02", "J02", "NOAA-21", "noaa-nesdis-n21-pds", 833.0e3, 98.8, 13.5, 90.0, 1668073765.0,
-              "S-NPP/JPSS", "n20_viirs_i05_srf.csv", None, None, None),
+              "S-NPP/JPSS", "n20", None, None, None),
 )}
 # fmt: on
 PHASE_EPOCH_UNIX_S = 1704067200.0  # 2024-01-01T00:00:00Z

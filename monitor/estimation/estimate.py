@@ -66,7 +66,7 @@ from monitor.estimation.intercal import (
 )
 from monitor.estimation.jackknife import Jackknife
 from monitor.instrument.footprint import monotone_weights, widths_of_weights
-from monitor.instrument.spectral import I5Band
+from monitor.instrument.spectral import BandModel
 
 FOOTPRINT_ITERATIONS = 40  # alternations of the response fit and the refined minimum in a window, at most
 FOOTPRINT_WINDOWS = 3  # windows the alternation may move through as the grid minimum moves, at most
@@ -88,7 +88,7 @@ class ForSamples:
     scan: np.ndarray
     annuli_rad: np.ndarray | None = None
     radii_rad: tuple[float, ...] = ()
-    band: I5Band | None = field(default=None, repr=False)
+    band: BandModel | None = field(default=None, repr=False)
     fov: np.ndarray | None = None  # (N,) the FOV (0..8) of each sample, for the rows (FOV_ROWS)
 
     def __len__(self) -> int:
@@ -212,7 +212,7 @@ def response_weights(
     at: _Minimum,
     cost: Cost,
     radii_rad: tuple[float, ...],
-    band: I5Band,
+    band: BandModel,
     weights: np.ndarray | None = None,
 ) -> np.ndarray:
     """The annulus weights, sum 1, that minimise the residual variance of the cost's difference at the
@@ -236,7 +236,7 @@ def response_weights(
         The cost (``assessment.cost``).
     radii_rad : tuple of float
         The annuli's outer radii, rad.
-    band : I5Band
+    band : BandModel
         The satellite's I5 band (radiance to BT).
     weights : numpy.ndarray, optional
         The current weights (K,); None: the annuli's solid angles, a top hat out to the last.

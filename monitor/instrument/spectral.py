@@ -1,10 +1,12 @@
-"""Spectral matching of CrIS to VIIRS I5: SRF convolution and band-Planck brightness temperature.
+"""Spectral matching of CrIS to a VIIRS band (I5, M13, M15, M16): SRF convolution and band-Planck BT.
 
 CrIS radiance R(nu) in mW/(m2 sr cm-1) is apodized (Hamming 0.23/0.54/0.23, as Wang's code does),
-integrated with the I5 response S(nu): L = sum R S / sum S, and turned into a brightness temperature
-with the band-integrated Planck function of the same response, inverted through a fine table. The
-same band model turns a VIIRS pixel BT into band radiance, so both sides are averaged in radiance.
-Responses: ``monitor/data/srf`` (NOAA/NG release; NOAA-21 has none public, NOAA-20's is used).
+integrated with the band's response S(nu) sampled on the CrIS grid of the CrIS band that holds it (LW for
+I5, M15 and M16; SW for M13): L = sum R S / sum S, and turned into a brightness temperature with the
+band-integrated Planck function of the same response, inverted through a fine table. The response is cut
+to the CrIS band (what lies outside it is not measured by CrIS). The same band model turns a VIIRS pixel
+BT into band radiance, so both sides are averaged in radiance. Responses: ``monitor/data/srf`` (NOAA/NG
+release; NOAA-21 has none public, NOAA-20's are used).
 """
 
 from __future__ import annotations
@@ -18,13 +20,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from monitor.compiled.threads import KERNEL_LOCK
+from monitor.core.bands import BANDS
 from monitor.core.errors import DataError
 from monitor.core.satellites import SATELLITES
-from monitor.sdr.products import cris_lw_wavenumbers_cm1
+from monitor.sdr.products import cris_lw_wavenumbers_cm1, cris_sw_wavenumbers_cm1
 
 C1 = 1.191042972e-5  # 2hc^2, mW/(m2 sr cm-4)
 C2 = 1.4387769  # hc/k, cm K
-SRF_FILES = {s.short: s.srf_file for s in SATELLITES.values()}
 HAMMING = (0.23, 0.54, 0.23)
 GUESS_BINS = 4096  # the inverse table's index is guessed from a uniform grid of radiance
 PARALLEL_FROM = 1 << 16  # values converted at once from which the parallel kernel is worth its lock
@@ -88,24 +90,46 @@ def planck_radiance(wavenumber_cm1: ArrayLike, t_k: ArrayLike) -> np.ndarray:
     return C1 * nu**3 / np.expm1(C2 * nu / np.asarray(t_k, float))
 
 
-def load_srf(satellite: str) -> tuple[np.ndarray, np.ndarray]:
-    """The VIIRS I5 relative spectral response of a satellite.
+def srf_file(satellite: str, band: str = "I5") -> str:
+    """The file of a satellite's VIIRS band response in ``monitor/data/srf``.
 
     Parameters
     ----------
     satellite : str
         ``npp``, ``j01`` or ``j02`` (NOAA-21 uses NOAA-20's).
+    band : str, optional
+        I5, M13, M15 or M16.
+
+    Returns
+    -------
+    str
+        The file name.
+    """
+    if satellite not in SATELLITES:
+        raise DataError(
+            f"no {band} spectral response for satellite {satellite!r} (known: {', '.join(SATELLITES)})"
+        )
+    if band not in BANDS:
+        raise DataError(f"no spectral response for band {band!r} (known: {', '.join(BANDS)})")
+    return f"{SATELLITES[satellite].srf_platform}_viirs_{BANDS[band].srf_tag}_srf.csv"
+
+
+def load_srf(satellite: str, band: str = "I5") -> tuple[np.ndarray, np.ndarray]:
+    """The VIIRS relative spectral response of a satellite's band.
+
+    Parameters
+    ----------
+    satellite : str
+        ``npp``, ``j01`` or ``j02`` (NOAA-21 uses NOAA-20's).
+    band : str, optional
+        I5, M13, M15 or M16.
 
     Returns
     -------
     wavenumber_cm1, response : numpy.ndarray
         Ascending wavenumbers, cm-1, and the relative response.
     """
-    name = SRF_FILES.get(satellite)
-    if name is None:
-        raise DataError(
-            f"no I5 spectral response for satellite {satellite!r} (known: {', '.join(SRF_FILES)})"
-        )
+    name = srf_file(satellite, band)
     text = resources.files("monitor.data.srf").joinpath(name).read_text()
     data = _read_csv(text)
     order = np.argsort(data[:, 0])
@@ -136,25 +160,29 @@ def apodize_hamming(radiance: ArrayLike) -> np.ndarray:
     return out
 
 
-class I5Band:
-    """The VIIRS I5 band of one satellite sampled on the CrIS LW grid, with its band-Planck table.
+class BandModel:
+    """A VIIRS band of one satellite sampled on a CrIS grid, with its band-Planck table.
 
     Parameters
     ----------
     satellite : str
         ``npp``, ``j01`` or ``j02`` (its relative spectral response, :func:`load_srf`).
     wavenumber_cm1 : array_like, optional
-        The grid the response is sampled on, cm-1; the CrIS LW channels by default.
+        The grid the response is sampled on, cm-1; by default the channels of the CrIS band that holds the
+        VIIRS band (LW; SW in full spectral resolution for M13).
+    band : str, optional
+        I5, M13, M15 or M16.
     """
 
     T_MIN_K, T_MAX_K, T_STEP_K = 150.0, 350.0, 0.02
 
-    def __init__(self, satellite: str, wavenumber_cm1: ArrayLike | None = None) -> None:
+    def __init__(self, satellite: str, wavenumber_cm1: ArrayLike | None = None, band: str = "I5") -> None:
         self.satellite = satellite
-        self.wavenumber_cm1 = (
-            cris_lw_wavenumbers_cm1() if wavenumber_cm1 is None else np.asarray(wavenumber_cm1)
-        )
-        nu, s = load_srf(satellite)
+        self.band = band
+        self.cris_band = BANDS[band].cris_band if band in BANDS else "LW"
+        default = cris_sw_wavenumbers_cm1 if self.cris_band == "SW" else cris_lw_wavenumbers_cm1
+        self.wavenumber_cm1 = default() if wavenumber_cm1 is None else np.asarray(wavenumber_cm1)
+        nu, s = load_srf(satellite, band)
         self.response = np.interp(self.wavenumber_cm1, nu, s, left=0.0, right=0.0)
         self.weights = self.response / self.response.sum()
         self._t = np.arange(self.T_MIN_K, self.T_MAX_K + self.T_STEP_K / 2, self.T_STEP_K)
@@ -177,20 +205,21 @@ class I5Band:
         """
         return np.asarray(spectra) @ self.weights
 
-    def cris_band_radiance(self, radiance_lw: ArrayLike) -> np.ndarray:
-        """The band radiance of unapodized CrIS LW spectra: Hamming apodization, then the SRF convolution.
+    def cris_band_radiance(self, radiance: ArrayLike) -> np.ndarray:
+        """The band radiance of unapodized CrIS spectra on :attr:`wavenumber_cm1`: Hamming apodization,
+        then the SRF convolution.
 
         Parameters
         ----------
-        radiance_lw : array_like
-            CrIS LW spectral radiance, mW/(m2 sr cm-1), channels last.
+        radiance : array_like
+            CrIS spectral radiance (LW, or SW for M13), mW/(m2 sr cm-1), channels last.
 
         Returns
         -------
         numpy.ndarray
             Band radiance, mW/(m2 sr cm-1).
         """
-        return self.band_radiance(apodize_hamming(radiance_lw))
+        return self.band_radiance(apodize_hamming(radiance))
 
     @property
     def radiance_table(self) -> tuple[float, float, np.ndarray]:
@@ -254,9 +283,31 @@ class I5Band:
         return out if shape else out[()]
 
 
-@lru_cache(maxsize=8)
-def i5_band(satellite: str) -> I5Band:
-    """The cached :class:`I5Band` of a satellite.
+@lru_cache(maxsize=32)
+def band_model(
+    satellite: str, band: str = "I5", wavenumber_cm1: tuple[float, ...] | None = None
+) -> BandModel:
+    """The cached :class:`BandModel` of a satellite's band.
+
+    Parameters
+    ----------
+    satellite : str
+        ``npp``, ``j01`` or ``j02``.
+    band : str, optional
+        I5, M13, M15 or M16.
+    wavenumber_cm1 : tuple of float, optional
+        The CrIS grid, cm-1 (a tuple: it is a cache key); the band's CrIS band in full resolution by default.
+
+    Returns
+    -------
+    BandModel
+        The band.
+    """
+    return BandModel(satellite, None if wavenumber_cm1 is None else np.asarray(wavenumber_cm1), band)
+
+
+def i5_band(satellite: str) -> BandModel:
+    """The cached I5 :class:`BandModel` of a satellite (the assessment's band).
 
     Parameters
     ----------
@@ -265,7 +316,7 @@ def i5_band(satellite: str) -> I5Band:
 
     Returns
     -------
-    I5Band
+    BandModel
         The band.
     """
-    return I5Band(satellite)
+    return band_model(satellite, "I5")

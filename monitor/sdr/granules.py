@@ -1,4 +1,4 @@
-"""What a reader gives: one typed object per granule (CrIS GEO and SDR, VIIRS I5 SDR and I-band GEO), its
+"""What a reader gives: one typed object per granule (CrIS GEO and SDR, a VIIRS band's SDR and GEO), its
 identity and provenance (:class:`GranuleMeta`), and the two places a granule file may lie
 (:data:`GranuleRef`: a local path, or a :class:`RemoteGranule` read in place)."""
 
@@ -114,13 +114,16 @@ class CrisGeoGranule:
 
 @dataclass
 class CrisSdrGranule:
-    """CrIS long-wave radiances (nscan, 30, 9, nchan) in mW/(m2 sr cm-1) and their quality."""
+    """CrIS long-wave radiances (nscan, 30, 9, nchan) in mW/(m2 sr cm-1) and their quality; the short-wave
+    ones where the file has them (VIIRS M13 lies in the SW band)."""
 
     meta: GranuleMeta
     wavenumber_cm1: np.ndarray
     radiance_lw: np.ndarray
     qf3: np.ndarray
     qf1_scan: np.ndarray | None
+    radiance_sw: np.ndarray | None = None
+    wavenumber_sw_cm1: np.ndarray | None = None
 
     @property
     def good(self) -> np.ndarray:  # numpydoc ignore=RT01
@@ -131,7 +134,8 @@ class CrisSdrGranule:
 
 @dataclass
 class ViirsSdrGranule:
-    """VIIRS I5 brightness temperature (rows, 6400) in K, NaN where filled (bow-tie deletion included)."""
+    """A VIIRS band's brightness temperature (rows, columns) in K, NaN where filled (bow-tie deletion
+    included); the band is its product's (``meta.product``: SVI05, SVM15, ...)."""
 
     meta: GranuleMeta
     bt_k: np.ndarray
@@ -145,11 +149,11 @@ class ViirsSdrGranule:
 
 @dataclass
 class ViirsGeoGranule:
-    """VIIRS I-band geolocation (rows, 6400) and per-scan spacecraft state.
+    """VIIRS geolocation of an I- or M-band grid (rows, columns) and per-scan spacecraft state.
 
-    Each pixel is the 3-D point (lat_rad, lon_rad, height_m): GITCO gives the terrain height where the
-    pixel's line of sight meets the terrain, GIMGO (ellipsoid geolocation) has no Height and its pixels
-    are at h = 0 (``height_m`` zeros).
+    Each pixel is the 3-D point (lat_rad, lon_rad, height_m): GITCO and GMTCO give the terrain height where
+    the pixel's line of sight meets the terrain, GIMGO and GMODO (ellipsoid geolocation) have no Height and
+    their pixels are at h = 0 (``height_m`` zeros).
     """
 
     meta: GranuleMeta

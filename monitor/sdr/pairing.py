@@ -1,4 +1,5 @@
-"""Find granule files, pair CrIS SDR with GEO, and attach the VIIRS I5 granules that cover each CrIS granule.
+"""Find granule files, pair CrIS SDR with GEO, and attach the VIIRS I5 granules that cover each CrIS granule;
+the other VIIRS bands (M13, M15, M16 with their M-band GEO) paired where asked for.
 
 Pairing is by file name (``plat_d_t_e_b``, which an SDR and its GEO share) and, for VIIRS coverage,
 by time. Files that cannot be used are returned with their reason, never dropped silently.
@@ -17,7 +18,7 @@ from monitor.core.errors import DataError
 from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import GranuleMeta, GranuleRef, as_ref
 from monitor.sdr.names import parse_name
-from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR
+from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR, prefixes
 from monitor.sdr.readers import read_metadata
 
 COVER_MARGIN = dt.timedelta(seconds=10)
@@ -82,6 +83,28 @@ class CasePlan:
     viirs: dict[str, list[GranuleFiles]] = field(default_factory=dict)  # by cris key, time-ordered
     viirs_all: list[GranuleFiles] = field(default_factory=list)  # every paired VIIRS granule, time-ordered
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (path or key, reason)
+    bands: dict[str, list[GranuleFiles]] = field(default_factory=dict)  # other VIIRS bands, time-ordered
+    cris_all: list[GranuleFiles] = field(default_factory=list)  # every paired CrIS granule, I5 cover or not
+
+    def cover(self, granule: GranuleFiles, band: str) -> list[GranuleFiles]:
+        """The granules of a VIIRS band that cover a CrIS granule in time (the rule of :func:`assemble`).
+
+        Parameters
+        ----------
+        granule : GranuleFiles
+            A CrIS granule.
+        band : str
+            I5, or a band of :attr:`bands`.
+
+        Returns
+        -------
+        list of GranuleFiles
+            Time-ordered.
+        """
+        pool = self.viirs_all if band == "I5" else self.bands.get(band, [])
+        return [
+            v for v in pool if v.start <= granule.end + COVER_MARGIN and v.end >= granule.start - COVER_MARGIN
+        ]
 
 
 class PlanError(DataError):
@@ -112,13 +135,15 @@ def find_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
     return sorted(set(out))
 
 
-def plan(paths: Sequence[str | os.PathLike[str]]) -> CasePlan:
+def plan(paths: Sequence[str | os.PathLike[str]], bands: Sequence[str] = ("I5",)) -> CasePlan:
     """Pair the granule files found under *paths* into a :class:`CasePlan`.
 
     Parameters
     ----------
     paths : sequence of str or os.PathLike
         Files or directories.
+    bands : sequence of str, optional
+        The VIIRS bands wanted besides I5 (M13, M15, M16) are paired with their GEO into ``bands``.
 
     Returns
     -------
@@ -161,7 +186,13 @@ def plan(paths: Sequence[str | os.PathLike[str]]) -> CasePlan:
     satellite = next(iter(platforms))
     cris = _pair(by_prefix, CRIS_SDR, CRIS_GEO, skipped)
     viirs = _pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped)
-    return assemble(satellite, cris, viirs, skipped)
+    result = assemble(satellite, cris, viirs, skipped)
+    result.cris_all = sorted(cris, key=lambda g: g.start)
+    for band in bands:
+        if band != "I5":
+            paired = _pair(by_prefix, prefixes("viirs_sdr", band), prefixes("viirs_geo", band), skipped)
+            result.bands[band] = sorted(paired, key=lambda g: g.start)
+    return result
 
 
 def assemble(satellite: str, cris: list, viirs: list, skipped: list) -> CasePlan:

@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.core.constants import N_FOR, N_FOV, VIIRS_COLUMNS, VIIRS_DETECTORS, VIIRS_SCANS
+from monitor.core.bands import BANDS, GRIDS, ViirsGrid
+from monitor.core.constants import N_FOR, N_FOV, VIIRS_SCANS
 
 DEG = np.pi / 180.0
 ARCSEC = np.pi / (180.0 * 3600.0)
@@ -76,13 +77,15 @@ class Field:
     norm: tuple | None = None
 
 
-DTYPES = {"float": "f", "scaled": "u", "time": "i", "flags": "u"}  # numpy kind of each field kind
 IET_LIMITS_US = (1.6e15, 2.8e15)  # IET of 2008 ... 2046: a time outside is not a JPSS observation time
 
 
 @dataclass(frozen=True)
 class Product:
-    """One JPSS product: file-name prefix, HDF5 collection, reader kind and its fields (a Field by name)."""
+    """One JPSS product: file-name prefix, HDF5 collection, reader kind and its fields (a Field by name).
+
+    A VIIRS product also names its grid (``resolution``, I or M) and, an SDR, its band (I5, M13, ...).
+    """
 
     prefix: str
     collection: str
@@ -90,6 +93,8 @@ class Product:
     rows_per_scan: int = 1
     scans_reserved: int | None = None  # VIIRS arrays always hold 48 scans per granule
     fields: dict = field(default_factory=dict)
+    resolution: str | None = None
+    band: str | None = None
 
     @property
     def data_group(self) -> str:  # numpydoc ignore=RT01
@@ -118,96 +123,154 @@ CRIS_GEO_FIELDS = {
     "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC, dims=(3,), limits=(-3600.0, 3600.0)),
 }
 
-CRIS_SDR_FIELDS = {
-    "radiance_lw": Field(
-        "ES_RealLW", dims=FOV + (CRIS_LW_CHANNELS,), limits=(-200.0, 500.0)
-    ),  # mW/(m2 sr cm-1)
-    "qf3": Field("QF3_CRISSDR", kind="flags", dims=FOV + (3,)),
-    "qf1_scan": Field("QF1_SCAN_CRISSDR", kind="flags", required=False),
-}
+# CrIS short-wave grid (VIIRS M13 lies in it): 2155-2550 cm-1 with 2 guard channels each end, 0.625 cm-1
+# apart in full spectral resolution (637 stored), 2.5 cm-1 in normal (163 stored)
+CRIS_SW_FIRST_CM1 = 2155.0
+CRIS_SW_STEP_CM1 = {"SCRIF": 0.625, "SCRIS": 2.5}
+CRIS_SW_CHANNELS = {"SCRIF": 637, "SCRIS": 163}
 
-VIIRS_SDR_FIELDS = {
-    "bt_k": Field(
-        "BrightnessTemperature",
-        per="row",
-        kind="scaled",
-        factors="BrightnessTemperatureFactors",
-        dims=(VIIRS_COLUMNS,),
-        limits=(120.0, 380.0),
-    ),
-    "qf1": Field("QF1_VIIRSIBANDSDR", per="row", kind="flags", dims=(VIIRS_COLUMNS,)),
-}
 
-VIIRS_GEO_FIELDS = {
-    "lat_rad": Field("Latitude", per="row", to_si=DEG, dims=(VIIRS_COLUMNS,), limits=(-90.0, 90.0)),
-    "lon_rad": Field("Longitude", per="row", to_si=DEG, dims=(VIIRS_COLUMNS,), limits=(-180.0, 180.0)),
-    "start_time_us": Field("StartTime", kind="time", limits=IET_LIMITS_US),
-    "mid_time_us": Field("MidTime", kind="time", limits=IET_LIMITS_US),
-    "sc_position_m": Field("SCPosition", dims=(3,), norm=(6.8e6, 7.8e6)),
-    "sc_velocity_m_s": Field("SCVelocity", dims=(3,), norm=(6.0e3, 8.5e3)),
-    "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC, dims=(3,), limits=(-3600.0, 3600.0)),
-}
+def _cris_sdr_fields(prefix: str) -> dict:
+    """The CrIS SDR fields of a product: the LW spectra, the SW spectra (optional: only M13 needs them)."""
+    return {
+        "radiance_lw": Field(
+            "ES_RealLW", dims=FOV + (CRIS_LW_CHANNELS,), limits=(-200.0, 500.0)
+        ),  # mW/(m2 sr cm-1)
+        "radiance_sw": Field(
+            "ES_RealSW", dims=FOV + (CRIS_SW_CHANNELS[prefix],), limits=(-20.0, 20.0), required=False
+        ),  # mW/(m2 sr cm-1)
+        "qf3": Field("QF3_CRISSDR", kind="flags", dims=FOV + (3,)),
+        "qf1_scan": Field("QF1_SCAN_CRISSDR", kind="flags", required=False),
+    }
 
-# Terrain-corrected geolocation: Latitude/Longitude/Height is the 3-D point where the pixel's line of sight
-# meets the terrain (docs/jpss-formats.md 1.8); the ellipsoid product (GIMGO) puts its pixels at h = 0.
-VIIRS_TC_GEO_FIELDS = {**VIIRS_GEO_FIELDS, "height_m": Field("Height", per="row", dims=(VIIRS_COLUMNS,))}
+
+def _viirs_sdr_fields(band: str) -> dict:
+    """A VIIRS band's SDR fields: its brightness temperature (uint16 and factors, or float32) and quality."""
+    b = BANDS[band]
+    cols = (b.grid.columns,)
+    bt = (
+        Field("BrightnessTemperature", per="row", kind="scaled", factors="BrightnessTemperatureFactors")
+        if b.bt_scaled
+        else Field("BrightnessTemperature", per="row")
+    )
+    return {
+        "bt_k": Field(bt.dataset, bt.per, bt.kind, factors=bt.factors, dims=cols, limits=(120.0, 380.0)),
+        "qf1": Field(b.quality_dataset, per="row", kind="flags", dims=cols),
+    }
+
+
+def _viirs_geo_fields(grid: ViirsGrid, terrain: bool) -> dict:
+    """A VIIRS grid's GEO fields. Terrain-corrected geolocation: Latitude/Longitude/Height is the 3-D point
+    where the pixel's line of sight meets the terrain (docs/jpss-formats.md 1.8); the ellipsoid product
+    (GIMGO, GMODO) puts its pixels at h = 0."""
+    cols = (grid.columns,)
+    fields = {
+        "lat_rad": Field("Latitude", per="row", to_si=DEG, dims=cols, limits=(-90.0, 90.0)),
+        "lon_rad": Field("Longitude", per="row", to_si=DEG, dims=cols, limits=(-180.0, 180.0)),
+        "start_time_us": Field("StartTime", kind="time", limits=IET_LIMITS_US),
+        "mid_time_us": Field("MidTime", kind="time", limits=IET_LIMITS_US),
+        "sc_position_m": Field("SCPosition", dims=(3,), norm=(6.8e6, 7.8e6)),
+        "sc_velocity_m_s": Field("SCVelocity", dims=(3,), norm=(6.0e3, 8.5e3)),
+        "sc_attitude_rad": Field("SCAttitude", to_si=ARCSEC, dims=(3,), limits=(-3600.0, 3600.0)),
+    }
+    if terrain:
+        fields["height_m"] = Field("Height", per="row", dims=cols)
+    return fields
+
+
+def _viirs_products() -> tuple[Product, ...]:
+    """Per band its SDR product, per grid its GEO products (terrain corrected first), from the band table."""
+    out = [
+        Product(
+            b.sdr_prefix,
+            b.sdr_collection,
+            "viirs_sdr",
+            rows_per_scan=b.grid.detectors,
+            scans_reserved=VIIRS_SCANS,
+            fields=_viirs_sdr_fields(b.name),
+            resolution=b.resolution,
+            band=b.name,
+        )
+        for b in BANDS.values()
+    ]
+    for g in GRIDS.values():
+        for k, (prefix, collection) in enumerate(zip(g.geo_prefixes, g.geo_collections, strict=True)):
+            out.append(
+                Product(
+                    prefix,
+                    collection,
+                    "viirs_geo",
+                    rows_per_scan=g.detectors,
+                    scans_reserved=VIIRS_SCANS,
+                    fields=_viirs_geo_fields(g, terrain=k == 0),
+                    resolution=g.resolution,
+                )
+            )
+    return tuple(out)
+
 
 # The product table. Within a kind the first listed is preferred (full spectral resolution; terrain-corrected
 # geolocation, the only one NOAA's archive carries). The collection is also the product's NODD folder.
 PRODUCTS = {
     p.prefix: p
     for p in (
-        Product("SCRIF", "CrIS-FS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
-        Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=CRIS_SDR_FIELDS),
+        Product("SCRIF", "CrIS-FS-SDR", "cris_sdr", fields=_cris_sdr_fields("SCRIF")),
+        Product("SCRIS", "CrIS-SDR", "cris_sdr", fields=_cris_sdr_fields("SCRIS")),
         Product("GCRSO", "CrIS-SDR-GEO", "cris_geo", fields=CRIS_GEO_FIELDS),
-        Product(
-            "SVI05",
-            "VIIRS-I5-SDR",
-            "viirs_sdr",
-            rows_per_scan=VIIRS_DETECTORS,
-            scans_reserved=VIIRS_SCANS,
-            fields=VIIRS_SDR_FIELDS,
-        ),
-        Product(
-            "GITCO",
-            "VIIRS-IMG-GEO-TC",
-            "viirs_geo",
-            rows_per_scan=VIIRS_DETECTORS,
-            scans_reserved=VIIRS_SCANS,
-            fields=VIIRS_TC_GEO_FIELDS,
-        ),
-        Product(
-            "GIMGO",
-            "VIIRS-IMG-GEO",
-            "viirs_geo",
-            rows_per_scan=VIIRS_DETECTORS,
-            scans_reserved=VIIRS_SCANS,
-            fields=VIIRS_GEO_FIELDS,
-        ),
+        *_viirs_products(),
     )
 }
 
 
-def prefixes(kind: str) -> tuple[str, ...]:
-    """The prefixes of the products of *kind* (cris_sdr, cris_geo, viirs_sdr, viirs_geo), preferred first.
+def prefixes(kind: str, band: str | None = None) -> tuple[str, ...]:
+    """The prefixes of the products of *kind* (cris_sdr, cris_geo, viirs_sdr, viirs_geo), preferred first;
+    for VIIRS, those of one band (its SDR) or of the band's grid (its GEO).
 
     Parameters
     ----------
     kind : str
         A granule kind (``cris_geo``, ``viirs_sdr``, ...).
+    band : str, optional
+        A VIIRS band (I5, M13, M15, M16).
 
     Returns
     -------
     tuple of str
         Its products' prefixes.
     """
-    return tuple(p.prefix for p in PRODUCTS.values() if p.kind == kind)
+    if band is None:
+        return tuple(p.prefix for p in PRODUCTS.values() if p.kind == kind)
+    b = BANDS[band]
+    return tuple(
+        p.prefix
+        for p in PRODUCTS.values()
+        if p.kind == kind and p.resolution == b.resolution and p.band in (None, band)
+    )
 
 
-CRIS_SDR, CRIS_GEO, VIIRS_SDR, VIIRS_GEO = (
-    prefixes(k) for k in ("cris_sdr", "cris_geo", "viirs_sdr", "viirs_geo")
-)
+CRIS_SDR, CRIS_GEO = prefixes("cris_sdr"), prefixes("cris_geo")
+# the assessment's VIIRS products: I5 and the I-band geolocation
+VIIRS_SDR, VIIRS_GEO = prefixes("viirs_sdr", "I5"), prefixes("viirs_geo", "I5")
 CRIS_PRODUCTS = CRIS_SDR + CRIS_GEO
+
+
+def cris_sw_wavenumbers_cm1(nchan: int = CRIS_SW_CHANNELS["SCRIF"]) -> np.ndarray:
+    """Wavenumbers (cm-1) of the stored CrIS SW channels: full spectral resolution (637) or normal (163).
+
+    Parameters
+    ----------
+    nchan : int, optional
+        The SW channels stored.
+
+    Returns
+    -------
+    numpy.ndarray
+        cm-1.
+    """
+    step = next((CRIS_SW_STEP_CM1[p] for p, n in CRIS_SW_CHANNELS.items() if n == nchan), None)
+    if step is None:
+        raise ValueError(f"{nchan} SW channels: not one of {sorted(CRIS_SW_CHANNELS.values())}")
+    return CRIS_SW_FIRST_CM1 - 2 * step + step * np.arange(nchan)
 
 
 def cris_lw_wavenumbers_cm1(nchan: int = CRIS_LW_CHANNELS) -> np.ndarray:

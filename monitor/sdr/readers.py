@@ -36,6 +36,7 @@ from monitor.sdr.products import (
     Field,
     Product,
     cris_lw_wavenumbers_cm1,
+    cris_sw_wavenumbers_cm1,
     is_float_fill,
 )
 
@@ -285,6 +286,8 @@ def _product_granules(
         radiance = kwargs.get("radiance_lw")
         if product.kind == "cris_sdr" and radiance is not None:  # a required field: never None here
             kwargs["wavenumber_cm1"] = cris_lw_wavenumbers_cm1(radiance.shape[-1])
+            if kwargs.get("radiance_sw") is not None:
+                kwargs["wavenumber_sw_cm1"] = cris_sw_wavenumbers_cm1(kwargs["radiance_sw"].shape[-1])
         granule = _GRANULE_TYPES[product.kind](meta=meta, **kwargs)
         consistency.check_not_all_fill(path, product, granule)
         consistency.check_for_times(path, product, granule)

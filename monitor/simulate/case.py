@@ -1,4 +1,5 @@
-"""Simulate a case: CrIS SCRIF + GCRSO and VIIRS SVI05 + GITCO granules with an injected LOS error.
+"""Simulate a case: CrIS SCRIF + GCRSO and VIIRS SVI05 + GITCO granules with an injected LOS error, and
+the M-band granules (SVM13, SVM15, SVM16 + GMTCO) where asked for.
 
 Where the case lies on the Earth is a pass of the satellite's own orbit (:data:`PASSES`: tropics by day
 on an ascending pass, by night on a descending one, 60-81 deg N or S; optionally nearest a longitude, e.g.
@@ -14,6 +15,13 @@ response ends. An elliptical field turns with the scene mirror, by the FOR's sca
 VIIRS granules share the spacecraft's state, attitude and scene at every instant; the file layouts are data
 (:mod:`monitor.simulate.jpss_h5`, :mod:`monitor.simulate.complete`), the scene and terrain modules of their
 own.
+
+Four bands (``SimulationSpec.viirs_bands``): every VIIRS band is the band's response applied to the same
+top-of-atmosphere spectra CrIS sees (:func:`monitor.simulate.scene.spectra`), at its own grid's geometry
+(:data:`monitor.core.bands.GRIDS`: 16 M-band detectors, 3200 aggregated columns, their bow-tie deletion
+and column times). So CrIS convolved with any band's response agrees with VIIRS in that band but for the
+noise, the response's cut to the CrIS band and a per-band calibration difference one injects
+(``viirs_band_bias_k``). The CrIS SW spectra are simulated like the LW ones (VIIRS M13 lies in them).
 
 Clouds with height (``SimulationSpec.cloud_heights``, :mod:`monitor.simulate.clouds`): both instruments'
 rays meet the first cloud they pass, its top or its side, and see its temperature there; GEO stays where
@@ -37,6 +45,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from monitor.core.bands import BANDS, GRIDS, ViirsGrid
 from monitor.core.constants import (
     CALIBRATION_CURVATURE_SPAN_K,
     CALIBRATION_REFERENCE_K,
@@ -47,8 +56,6 @@ from monitor.core.constants import (
     N_FOV,
     PAPER_GRANULES,
     URAD,
-    VIIRS_COLUMNS,
-    VIIRS_DETECTORS,
     VIIRS_SCANS,
 )
 from monitor.core.errors import DataError, StopRequested
@@ -56,11 +63,11 @@ from monitor.core.satellites import satellite as satellite_info
 from monitor.geometry import frames, wgs84
 from monitor.geometry.ep_model import EngineeringPacket, fov5_angles, los_spacecraft
 from monitor.instrument.footprint import EllipticalResponse, RadialResponse, Response
-from monitor.instrument.spectral import C1, C2, I5Band, i5_band, planck_radiance
+from monitor.instrument.spectral import C1, C2, BandModel, band_model, i5_band, planck_radiance
 from monitor.sdr import iet
 from monitor.sdr.consistency import GRANULE_ID_EPOCH_IET_US
 from monitor.sdr.names import format_name
-from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1
+from monitor.sdr.products import PRODUCTS, cris_lw_wavenumbers_cm1, cris_sw_wavenumbers_cm1
 from monitor.simulate import CIRRUS_BASE_M, complete
 from monitor.simulate import scan_geometry as ins
 from monitor.simulate.clouds import CloudHeights
@@ -81,7 +88,7 @@ T_BINS_K = np.arange(150.0, 350.0001, 0.05)
 # surface from 55 deg to the equator (289-301 K): where law_m_per_k measures a law's lift
 LAW_TOPS_K = np.linspace(227.0, 263.0, 13)
 LAW_AIR_K = np.linspace(289.0, 301.0, 5)
-BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS I5 BT = DN * scale + offset
+BT_SCALE, BT_OFFSET = 0.003, 150.0  # VIIRS BT = DN * scale + offset (every band but M13, float32)
 RAD_SCALE, RAD_OFFSET = 0.0002, 0.0
 OBPT_U16, OBPT_F32 = 65533, -999.7
 
@@ -147,6 +154,13 @@ class SimulationSpec:
     wind_in_track_m_s: float = 0.0
     # the emissivity of the clouds above CIRRUS_BASE_M (thin cirrus): below 1 the ground shows through
     cloud_emissivity: float = 1.0
+    # the VIIRS bands written (monitor.core.bands.BANDS); I5 is the assessment's
+    viirs_bands: tuple[str, ...] = ("I5",)
+    # a VIIRS calibration difference per band: K added to VIIRS's BT in that band (CrIS minus VIIRS reads
+    # minus it)
+    viirs_band_bias_k: dict = field(default_factory=dict)
+    # the CrIS short-wave noise per channel, mW/(m2 sr cm-1)
+    cris_noise_sw: float = 0.004
 
     def compressed(self, instrument: str) -> bool:
         """Whether the datasets of *instrument* (CrIS, VIIRS) are written gzip-compressed.
@@ -209,6 +223,15 @@ class SimulationSpec:
         CloudHeights.parse(self.cloud_heights)  # a law it does not know is a DataError now, not mid-case
         if self.cloud_edges not in EDGES:
             raise DataError(f"cloud edges {self.cloud_edges!r}: not one of {', '.join(EDGES)}")
+        unknown = [b for b in (*self.viirs_bands, *self.viirs_band_bias_k) if b not in BANDS]
+        if unknown or not self.viirs_bands:
+            raise DataError(
+                f"VIIRS band(s) {', '.join(unknown) or '(none)'}: each must be one of {', '.join(BANDS)}"
+            )
+        if not all(
+            math.isfinite(float(v)) and abs(float(v)) <= 10.0 for v in self.viirs_band_bias_k.values()
+        ):
+            raise DataError(f"VIIRS band bias {self.viirs_band_bias_k}: each must be a finite K within +-10")
         if not 0.0 < self.cloud_emissivity <= 1.0:
             raise DataError(f"cloud emissivity {self.cloud_emissivity!r}: not in (0, 1]")
         if not math.isfinite(self.wind_in_track_m_s):
@@ -280,7 +303,7 @@ def _sunflower_disk(n: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([x, -x]), np.concatenate([y, -y])
 
 
-def _band_table(band: I5Band, nu: np.ndarray, planck_table: np.ndarray) -> np.ndarray:
+def _band_table(band: BandModel, nu: np.ndarray, planck_table: np.ndarray) -> np.ndarray:
     """VIIRS band radiance of a pixel whose emitting temperature is each of T_BINS_K, seen through the
     simulator's atmosphere (:func:`monitor.simulate.scene.transmittance`, emitting at T_ATM_K)."""
     tau = transmittance(nu)
@@ -363,6 +386,16 @@ class Simulator:
         self.nu = cris_lw_wavenumbers_cm1()
         self.planck_table = planck_radiance(self.nu[None, :], T_BINS_K[:, None])
         self.band_table = _band_table(self.band, self.nu, self.planck_table)
+        self.nu_sw = cris_sw_wavenumbers_cm1()
+        self.planck_table_sw = planck_radiance(self.nu_sw[None, :], T_BINS_K[:, None])
+        self.band_tables = {
+            b: _band_table(
+                band_model(spec.satellite, b),
+                self.nu_sw if BANDS[b].cris_band == "SW" else self.nu,
+                self.planck_table_sw if BANDS[b].cris_band == "SW" else self.planck_table,
+            )
+            for b in spec.viirs_bands
+        }
         self.rng = rng
         if spec.true_ep is not None and spec.ground_ep is not None:
             self.los_true, self.los_geo = los_spacecraft(spec.true_ep), los_spacecraft(spec.ground_ep)
@@ -446,8 +479,10 @@ class Simulator:
         zen, az, rng_m = wgs84.zenith_azimuth(ground, sat)
         height = self.scene.height_m(lat, lon)  # reported only: GCRSO points are on the ellipsoid
         if spec.cris_sdr:
-            radiance = self._cris_spectra(sat, true_ecef, m[..., :, 0], for_unix)
+            radiance, sw = self._cris_spectra(sat, true_ecef, m[..., :, 0], for_unix)
             radiance += self.rng.normal(0.0, spec.cris_noise, radiance.shape)
+            # the SW noise from a generator of its own: the LW and VIIRS draws stay those of an LW-only case
+            sw += np.random.default_rng([spec.seed, 13, k]).normal(0.0, spec.cris_noise_sw, sw.shape)
 
         for_iet = _iet_us(for_unix)
         start_iet = for_iet[:, 0]
@@ -492,7 +527,7 @@ class Simulator:
         if spec.cris_sdr:
             t_mean = self.band.bt_from_radiance(self.band.band_radiance(radiance))
             mw = planck_radiance(1208.75 + 0.625 * np.arange(869), t_mean[..., None]).astype(np.float32)
-            sw = planck_radiance(2153.75 + 0.625 * np.arange(637), t_mean[..., None]).astype(np.float32)
+            sw = sw.astype(np.float32)
             products.append(
                 (
                     "SCRIF",
@@ -653,11 +688,11 @@ class Simulator:
 
     def _cris_spectra(
         self, sat: np.ndarray, los_ecef: np.ndarray, in_track_ecef: np.ndarray, for_unix: np.ndarray
-    ) -> np.ndarray:
-        """LW spectra (nscan, 30, 9, 717) averaged over each true FOV on the scene (the top-hat cone, or
-        weighted by the spatial response out to its reach) as it is at each FOR's time *for_unix* (nscan,
-        30), not the VIIRS grid; *in_track_ecef* (nscan, 30, 3), the SBF x axis, orients an elliptical
-        response."""
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """LW spectra (nscan, 30, 9, 717) and SW spectra (nscan, 30, 9, 637) averaged over each true FOV on
+        the scene (the top-hat cone, or weighted by the spatial response out to its reach) as it is at each
+        FOR's time *for_unix* (nscan, 30), not the VIIRS grid; *in_track_ecef* (nscan, 30, 3), the SBF x
+        axis, orients an elliptical response."""
         x, y = self._fov_disk
         n = len(x)
         helper = np.where(np.abs(los_ecef[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
@@ -683,19 +718,28 @@ class Simulator:
             wp = w * np.broadcast_to(part, temp.shape).reshape(-1, n)
             hist += np.bincount(rows + b0.ravel(), (wp * (1 - w1)).ravel(), hist.size)
             hist += np.bincount(rows + b0.ravel() + 1, (wp * w1).ravel(), hist.size)
-        mean_planck = hist.reshape(nfov, -1) @ self.planck_table / w.sum(axis=1, keepdims=True)
-        radiance = spectra(self.nu, mean_planck)
-        if not self.spec.calibrated:  # each channel's BT as CrIS would report it
-            bt_k = C2 * self.nu / np.log1p(C1 * self.nu**3 / radiance)
-            radiance = planck_radiance(self.nu, self.spec.cris_bt_k(bt_k))
-        return radiance.reshape(sat.shape[:-1] + (len(self.nu),))
+        out = []
+        for nu, table in ((self.nu, self.planck_table), (self.nu_sw, self.planck_table_sw)):
+            mean_planck = hist.reshape(nfov, -1) @ table / w.sum(axis=1, keepdims=True)
+            radiance = spectra(nu, mean_planck)
+            if not self.spec.calibrated:  # each channel's BT as CrIS would report it
+                bt_k = C2 * nu / np.log1p(C1 * nu**3 / radiance)
+                radiance = planck_radiance(nu, self.spec.cris_bt_k(bt_k))
+            out.append(radiance.reshape(sat.shape[:-1] + (len(nu),)))
+        return out[0], out[1]
 
     # ------------------------------------------------------------------ VIIRS
     def viirs_granule(
-        self, g0: float, out: Path, scans_per_chunk: int = 6, should_stop: Callable[[], bool] | None = None
+        self,
+        g0: float,
+        out: Path,
+        scans_per_chunk: int = 6,
+        should_stop: Callable[[], bool] | None = None,
+        grid: ViirsGrid = GRIDS["I"],
     ) -> list[str]:
-        """Write the VIIRS I5 granule starting at unix time *g0* (SDR and GEO files) into *out*, a few
-        scans at a time (*should_stop* polled between them); the names of the files written.
+        """Write the VIIRS granule of one grid starting at unix time *g0* into *out*: its GEO file and the SDR
+        file of each band of :attr:`SimulationSpec.viirs_bands` on the grid, a few scans at a time
+        (*should_stop* polled between them); the names of the files written.
 
         Parameters
         ----------
@@ -707,6 +751,8 @@ class Simulator:
             Scans simulated at a time.
         should_stop : callable, optional
             Polled between chunks.
+        grid : ViirsGrid, optional
+            The I-band grid (I5, the default) or the M-band grid (M13, M15, M16).
 
         Returns
         -------
@@ -714,44 +760,45 @@ class Simulator:
             The files written.
         """
         spec = self.spec
-        theta, col_dt = ins.viirs_column_geometry()
-        a_det = ins.viirs_detector_angles_rad()
+        bands = [b for b in spec.viirs_bands if BANDS[b].resolution == grid.resolution]
+        if not bands:
+            return []
+        theta, col_dt = ins.viirs_column_geometry(grid)
+        a_det = ins.viirs_detector_angles_rad(grid)
         local = frames.unit(np.stack([np.tan(a_det), np.zeros_like(a_det), np.ones_like(a_det)], -1))
-        los_sbf = np.einsum("cij,dj->dci", frames.rot_x(-theta), local)  # (32, 6400, 3)
-        deleted = ins.viirs_bowtie_deleted()
-        nrow = VIIRS_SCANS * VIIRS_DETECTORS
-        lat_out = np.empty((nrow, VIIRS_COLUMNS), np.float32)
+        los_sbf = np.einsum("cij,dj->dci", frames.rot_x(-theta), local)  # (detectors, columns, 3)
+        deleted = ins.viirs_bowtie_deleted(grid)
+        nrow, ncol = VIIRS_SCANS * grid.detectors, grid.columns
+        lat_out = np.empty((nrow, ncol), np.float32)
         lon_out = np.empty_like(lat_out)
         h_out = np.empty_like(lat_out)
-        bt_dn = np.empty((nrow, VIIRS_COLUMNS), np.uint16)
-        rad_dn = np.empty_like(bt_dn)
+        bt_out = {b: np.empty((nrow, ncol), np.float64) for b in bands}
         scan_start = g0 + np.arange(VIIRS_SCANS) * ins.VIIRS_SCAN_S
-        cwv = float(np.sum(self.band.weights * self.nu))
+        # the I5 noise comes from the case's generator, as in a one-band case; each other band has its own
+        rngs = {
+            b: self.rng if b == "I5" else np.random.default_rng([spec.seed, list(BANDS).index(b), round(g0)])
+            for b in bands
+        }
         for s0 in range(0, VIIRS_SCANS, scans_per_chunk):
             if should_stop is not None and should_stop():
                 raise StopRequested
             ss = slice(s0, s0 + scans_per_chunk)
             tt = scan_start[ss, None] + col_dt[None, :]
-            r, _, m = self.state(tt)  # (n, 6400, 3), (n, 6400, 3, 3)
+            r, _, m = self.state(tt)  # (n, columns, 3), (n, columns, 3, 3)
             los = np.einsum("scij,dcj->sdci", m, los_sbf)
             origin = np.broadcast_to(r[:, None], los.shape)
             lat, lon, h = self.surface(origin, los)
             temps, parts = self.seen(origin, los, tt[:, None, :], (lat, lon, h))
-            lrad = sum(p * np.interp(t, T_BINS_K, self.band_table) for t, p in zip(temps, parts, strict=True))
-            bt = self.band.bt_from_radiance(lrad) + self.rng.normal(0, spec.viirs_noise_k, lat.shape)
-            rows = slice(s0 * VIIRS_DETECTORS, (s0 + lat.shape[0]) * VIIRS_DETECTORS)
-            lat_out[rows] = np.degrees(lat).reshape(-1, VIIRS_COLUMNS)
-            lon_out[rows] = np.degrees(lon).reshape(-1, VIIRS_COLUMNS)
-            h_out[rows] = h.reshape(-1, VIIRS_COLUMNS)
-            bt_dn[rows] = np.clip(np.round((bt - BT_OFFSET) / BT_SCALE), 0, 65527).reshape(-1, VIIRS_COLUMNS)
-            # W/(m2 sr um) from mW/(m2 sr cm-1): L_lambda = L_nu * nu^2 / 1e4 / 1e3
-            lam = self.band.radiance_from_bt(bt) * cwv**2 * 1e-7
-            rad_dn[rows] = np.clip(np.round((lam - RAD_OFFSET) / RAD_SCALE), 0, 65527).reshape(
-                -1, VIIRS_COLUMNS
-            )
+            rows = slice(s0 * grid.detectors, (s0 + lat.shape[0]) * grid.detectors)
+            for b in bands:
+                model, table = band_model(spec.satellite, b), self.band_tables[b]
+                lrad = sum(p * np.interp(t, T_BINS_K, table) for t, p in zip(temps, parts, strict=True))
+                bt = model.bt_from_radiance(lrad) + rngs[b].normal(0, spec.viirs_noise_k, lat.shape)
+                bt_out[b][rows] = (bt + float(spec.viirs_band_bias_k.get(b, 0.0))).reshape(-1, ncol)
+            lat_out[rows] = np.degrees(lat).reshape(-1, ncol)
+            lon_out[rows] = np.degrees(lon).reshape(-1, ncol)
+            h_out[rows] = h.reshape(-1, ncol)
         mask = np.tile(deleted, (VIIRS_SCANS, 1))
-        bt_dn[mask] = OBPT_U16
-        rad_dn[mask] = OBPT_U16
         lat_out[mask] = OBPT_F32
         lon_out[mask] = OBPT_F32
         h_out[mask] = OBPT_F32
@@ -764,6 +811,7 @@ class Simulator:
         end = g0 + VIIRS_GRANULE_S
         gid = _granule_id(spec.satellite, int(start_iet[0]))
         valid = ~mask
+        geo_prefix = grid.geo_prefixes[0]
         attrs = self._granule_attrs(
             g0,
             end,
@@ -775,7 +823,7 @@ class Simulator:
             np.radians(lat_out[valid][::97]),
             np.radians(lon_out[valid][::97]),
             spec.aux["viirs"],
-            "VIIRS-IMG-GEO-TC",
+            PRODUCTS[geo_prefix].collection,
         )
         per_scan = {
             "StartTime": start_iet,
@@ -793,27 +841,16 @@ class Simulator:
             "QF2_VIIRSSDRGEO": np.zeros(lat_out.shape, np.uint8),
             **per_scan,
         }
-        sdr = {
-            "BrightnessTemperature": bt_dn,
-            "BrightnessTemperatureFactors": np.array([BT_SCALE, BT_OFFSET], np.float32),
-            "Radiance": rad_dn,
-            "RadianceFactors": np.array([RAD_SCALE, RAD_OFFSET], np.float32),
-            "QF1_VIIRSIBANDSDR": np.zeros(bt_dn.shape, np.uint8),
-            "QF2_SCAN_SDR": np.zeros(VIIRS_SCANS, np.uint8),
-            "NumberOfScans": np.array([VIIRS_SCANS], np.int32),
-        }
         if spec.complete:
-            geo |= complete.viirs_geo_extra(lat_out, lon_out, h_out, r_mid, scan_start, VIIRS_DETECTORS)
-            sdr |= complete.viirs_sdr_extra(VIIRS_SCANS, VIIRS_DETECTORS)
+            geo |= complete.viirs_geo_extra(lat_out, lon_out, h_out, r_mid, scan_start, grid.detectors)
+        files = [(geo_prefix, geo, "GEO", "N/A")]
+        for b in bands:
+            files.append((BANDS[b].sdr_prefix, self._viirs_sdr_data(b, bt_out[b], mask), "SDR", b))
         names = []
-        for prefix, data, tag in (("GITCO", geo, "GEO"), ("SVI05", sdr, "SDR")):
+        for prefix, data, tag, band_id in files:
             product = PRODUCTS[prefix]
-            created = _utc(end + 1700 + (3 if prefix == "GITCO" else 0))
-            a = dict(
-                attrs,
-                N_Reference_ID=f"{product.collection}:{gid}:A1",
-                Band_ID="I5" if tag == "SDR" else "N/A",
-            )
+            created = _utc(end + 1700 + (3 if tag == "GEO" else 0))
+            a = dict(attrs, N_Reference_ID=f"{product.collection}:{gid}:A1", Band_ID=band_id)
             name = format_name(
                 [prefix], spec.satellite, _utc(g0), _utc(end), attrs["N_Beginning_Orbit_Number"], created
             )
@@ -825,6 +862,37 @@ class Simulator:
             )
             names.append(name)
         return names
+
+    def _viirs_sdr_data(self, band: str, bt_k: np.ndarray, deleted: np.ndarray) -> dict:
+        """A band's SDR datasets from its pixels' BT (K): BT and radiance as IDPS stores them (uint16 and
+        factors; float32 for M13), bow-tie deleted pixels filled (OBPT)."""
+        b, model = BANDS[band], band_model(self.spec.satellite, band)
+        cwv = float(np.sum(model.weights * model.wavenumber_cm1))
+        # W/(m2 sr um) from mW/(m2 sr cm-1): L_lambda = L_nu * nu^2 / 1e4 / 1e3
+        lam = model.radiance_from_bt(bt_k) * cwv**2 * 1e-7
+        if b.bt_scaled:
+            bt = np.clip(np.round((bt_k - BT_OFFSET) / BT_SCALE), 0, 65527).astype(np.uint16)
+            rad = np.clip(np.round((lam - RAD_OFFSET) / RAD_SCALE), 0, 65527).astype(np.uint16)
+            bt[deleted], rad[deleted] = OBPT_U16, OBPT_U16
+            values = {
+                "BrightnessTemperature": bt,
+                "BrightnessTemperatureFactors": np.array([BT_SCALE, BT_OFFSET], np.float32),
+                "Radiance": rad,
+                "RadianceFactors": np.array([RAD_SCALE, RAD_OFFSET], np.float32),
+            }
+        else:
+            bt32, rad32 = bt_k.astype(np.float32), np.nan_to_num(lam, nan=OBPT_F32).astype(np.float32)
+            bt32[deleted], rad32[deleted] = OBPT_F32, OBPT_F32
+            values = {"BrightnessTemperature": bt32, "Radiance": rad32}
+        data = {
+            **values,
+            b.quality_dataset: np.zeros(bt_k.shape, np.uint8),
+            "QF2_SCAN_SDR": np.zeros(VIIRS_SCANS, np.uint8),
+            "NumberOfScans": np.array([VIIRS_SCANS], np.int32),
+        }
+        if self.spec.complete:
+            data |= complete.viirs_sdr_extra(VIIRS_SCANS, b.grid.detectors)
+        return data
 
     def _granule_attrs(
         self,
@@ -926,7 +994,8 @@ def simulate_case(
         files += sim.cris_granule(k, out)
     if viirs:
         for g0 in sim.viirs_granule_starts():
-            files += sim.viirs_granule(float(g0), out, should_stop=stop)
+            for grid in GRIDS.values():
+                files += sim.viirs_granule(float(g0), out, should_stop=stop, grid=grid)
     truth = {
         "satellite": spec.satellite,
         "profile": spec.profile,
@@ -945,6 +1014,8 @@ def simulate_case(
         "fov_rows_alpha_urad": spec.fov_rows_alpha_urad,
         "wind_in_track_m_s": spec.wind_in_track_m_s,
         "cloud_emissivity": spec.cloud_emissivity,
+        "viirs_bands": list(spec.viirs_bands),
+        "viirs_band_bias_k": {b: float(spec.viirs_band_bias_k.get(b, 0.0)) for b in spec.viirs_bands},
         "cris_calibration": {
             "bias_k": spec.cris_bias_k,
             "gain": spec.cris_gain,

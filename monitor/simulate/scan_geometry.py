@@ -1,4 +1,5 @@
-"""Nominal scan geometry of CrIS and VIIRS I-band as lines of sight in the spacecraft body frame (SBF).
+"""Nominal scan geometry of CrIS and VIIRS (I- and M-band grids) as lines of sight in the spacecraft body
+frame (SBF).
 
 SBF axes: x along track, y to the right of track, z toward nadir. A scan angle theta turns the
 boresight about x so that the cross-track angle beta = atan(y/z) equals theta (FOR 1 on the left).
@@ -9,15 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from monitor.core.constants import (
-    DEFAULT_STEP_RAD,
-    FOV_SPACING_RAD,
-    N_FOR,
-    N_FOV,
-    VIIRS_COLUMNS,
-    VIIRS_DETECTORS,
-    VIIRS_SCAN_US,
-)
+from monitor.core.bands import GRIDS, ZONE_AGGREGATION, ViirsGrid
+from monitor.core.constants import FOV_SPACING_RAD, N_FOR, N_FOV, VIIRS_SCAN_US
 from monitor.geometry.frames import rot_x, unit
 
 CRIS_FOR_STEP_RAD = np.radians(3.3333)
@@ -25,10 +19,7 @@ CRIS_FOR_DT_US = 200_000
 CRIS_MID_OFFSET_US = 2_899_989
 
 VIIRS_SCAN_S = VIIRS_SCAN_US * 1e-6
-VIIRS_ZONE_COLUMNS = (1280, 736, 2368, 736, 1280)  # aggregation zones, output columns (VcstGeoParameters.h)
-VIIRS_ZONE_AGGREGATION = (1, 2, 3, 2, 1)
-VIIRS_NATIVE_RAD = 155.2e-6  # along-scan native sample; 12608 samples span +-56 deg
-VIIRS_DETECTOR_RAD = DEFAULT_STEP_RAD  # one I-band pixel seen from 833 km
+I_GRID = GRIDS["I"]
 VIIRS_EARTH_VIEW_S = 0.556  # the 112 deg Earth-view sector of the 1.7864 s rotation
 
 
@@ -108,43 +99,59 @@ def turned(los_sbf: np.ndarray, d_alpha_rad: ArrayLike, d_beta_rad: ArrayLike) -
     return unit(np.stack([np.tan(alpha), np.tan(beta), np.ones_like(alpha)], axis=-1))
 
 
-def viirs_column_geometry() -> tuple[np.ndarray, np.ndarray]:
-    """Scan angle (rad) and time within the Earth view (s) of each of the 6400 I-band columns.
+def viirs_column_geometry(grid: ViirsGrid = I_GRID) -> tuple[np.ndarray, np.ndarray]:
+    """Scan angle (rad) and time within the Earth view (s) of each output column of a grid (6400 I-band,
+    3200 M-band): the centre of the native samples it aggregates.
+
+    Parameters
+    ----------
+    grid : ViirsGrid, optional
+        The I-band grid (default) or the M-band grid.
 
     Returns
     -------
     scan_angle_rad, time_s : numpy.ndarray
-        Shape (6400,).
+        Shape (columns,).
     """
-    agg = np.repeat(VIIRS_ZONE_AGGREGATION, VIIRS_ZONE_COLUMNS)
+    agg = np.repeat(ZONE_AGGREGATION, grid.zone_columns)
     native_end = np.cumsum(agg)
     centre = native_end - agg / 2.0
     total = native_end[-1]
-    return (centre - total / 2.0) * VIIRS_NATIVE_RAD, centre / total * VIIRS_EARTH_VIEW_S
+    return (centre - total / 2.0) * grid.native_rad, centre / total * VIIRS_EARTH_VIEW_S
 
 
-def viirs_bowtie_deleted() -> np.ndarray:
-    """(32, 6400) mask of on-board bow-tie deleted I-band pixels (docs/jpss-formats.md 3).
+def viirs_bowtie_deleted(grid: ViirsGrid = I_GRID) -> np.ndarray:
+    """(detectors, columns) mask of a grid's on-board bow-tie deleted pixels (docs/jpss-formats.md 3).
+
+    Parameters
+    ----------
+    grid : ViirsGrid, optional
+        The I-band grid (default) or the M-band grid.
 
     Returns
     -------
     numpy.ndarray
-        bool, shape (32, 6400).
+        bool, shape (detectors, columns).
     """
-    mask = np.zeros((VIIRS_DETECTORS, VIIRS_COLUMNS), bool)
-    for rows, n in (((0, 1, 30, 31), 2016), ((2, 3, 28, 29), 1280)):
+    mask = np.zeros((grid.detectors, grid.columns), bool)
+    for rows, n in grid.bowtie:
         for r in rows:
             mask[r, :n] = True
             mask[r, -n:] = True
     return mask
 
 
-def viirs_detector_angles_rad() -> np.ndarray:
-    """In-track angle (rad) of the 32 detectors; detector 0 looks furthest back.
+def viirs_detector_angles_rad(grid: ViirsGrid = I_GRID) -> np.ndarray:
+    """In-track angle (rad) of a grid's detectors (32 I-band, 16 M-band); detector 0 looks furthest back.
+
+    Parameters
+    ----------
+    grid : ViirsGrid, optional
+        The I-band grid (default) or the M-band grid.
 
     Returns
     -------
     numpy.ndarray
-        Shape (32,), rad.
+        Shape (detectors,), rad.
     """
-    return (np.arange(VIIRS_DETECTORS) - (VIIRS_DETECTORS - 1) / 2) * VIIRS_DETECTOR_RAD
+    return (np.arange(grid.detectors) - (grid.detectors - 1) / 2) * grid.detector_rad

@@ -48,6 +48,7 @@ EARTH_RADIUS_KM = 6371.0
 FINE_KM, FINE_N = 1.1, 2048
 COARSE_KM, COARSE_N = 4.4, 512
 T_ATM_K = 262.0
+SW_FROM_CM1 = 2000.0  # the short-wave atmosphere of transmittance() from here on
 LAPSE_K_PER_M = 6.5e-3
 LAND_DAY_K, LAND_NIGHT_K = 6.0, -5.0
 MAX_SLOPE = 0.4
@@ -554,7 +555,9 @@ def _locked(kernel: Callable[..., None], *args: Any) -> None:
 
 
 def transmittance(wavenumber_cm1: ArrayLike) -> np.ndarray:
-    """A simple clear-sky transmittance: a moist window with CO2 below 760 cm-1 and ozone near 1040 cm-1.
+    """A simple clear-sky transmittance: in the long wave a moist window with CO2 below 760 cm-1 and ozone
+    near 1040 cm-1 (more water at 12 um than at 11: M16 sees a warm clear scene colder than M15); in the
+    short wave (from :data:`SW_FROM_CM1`) the 4 um window, bounded by CO2 below 2395 cm-1.
 
     Parameters
     ----------
@@ -567,11 +570,14 @@ def transmittance(wavenumber_cm1: ArrayLike) -> np.ndarray:
         0..1.
     """
     nu = np.asarray(wavenumber_cm1, float)
-    k = 0.12 + 0.25 * ((nu - 900.0) / 150.0) ** 2
-    k += 4.0 / (1.0 + np.exp((nu - 740.0) / 8.0))
-    k += 1.2 * np.exp(-0.5 * ((nu - 1042.0) / 18.0) ** 2)
-    k += 0.08 * (1.0 + np.sin(nu * 2.1)) * np.exp(-0.5 * ((nu - 870.0) / 120.0) ** 2)
-    return np.exp(-k)
+    with np.errstate(over="ignore"):  # each formula is evaluated on both bands; np.where keeps its own
+        k = 0.12 + 0.25 * ((nu - 900.0) / 150.0) ** 2
+        k += 4.0 / (1.0 + np.exp((nu - 740.0) / 8.0))
+        k += 1.2 * np.exp(-0.5 * ((nu - 1042.0) / 18.0) ** 2)
+        k += 0.08 * (1.0 + np.sin(nu * 2.1)) * np.exp(-0.5 * ((nu - 870.0) / 120.0) ** 2)
+        # the short-wave window (VIIRS M13): a weak continuum, the CO2 band below 2395 cm-1, water above
+        k_sw = 0.08 + 0.1 * ((nu - 2500.0) / 100.0) ** 2 + 6.0 / (1.0 + np.exp((nu - 2395.0) / 6.0))
+    return np.exp(-np.where(nu < SW_FROM_CM1, k, k_sw))
 
 
 def spectra(wavenumber_cm1: ArrayLike, mean_planck: ArrayLike) -> np.ndarray:

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from monitor.core.errors import DataError
-from monitor.instrument.spectral import I5Band, apodize_hamming, i5_band, load_srf, planck_radiance
+from monitor.instrument.spectral import BandModel, apodize_hamming, i5_band, load_srf, planck_radiance
 
 
 @pytest.mark.parametrize("sat", ["npp", "j01", "j02"])
@@ -36,7 +36,7 @@ def test_hamming_keeps_smooth_spectra_and_out_of_table_is_nan():
     assert np.allclose(apodize_hamming(x)[1:-1], x[1:-1])
     assert np.isnan(i5_band("j01").radiance_from_bt(400.0))
     with pytest.raises(DataError, match="no I5 spectral response"):
-        I5Band("metop")
+        BandModel("metop")
 
 
 @pytest.mark.parametrize("sat", ["npp", "j01"])

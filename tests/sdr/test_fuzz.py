@@ -1,4 +1,5 @@
-"""Hostile granules: deterministic mutants of simulated files of all four products.
+"""Hostile granules: deterministic mutants of simulated files of every product read (CrIS GEO and SDR, VIIRS
+I5 and I-band GEO, VIIRS M13, M15 and M-band GEO).
 
 Every mutant either reads or raises the project's own ``GranuleError``; no other exception escapes the
 readers. A mutant that reads is compared with the intact file, number by number, as the assessment would
@@ -32,10 +33,19 @@ from monitor.sdr import CrisSdrGranule, GranuleError, ViirsSdrGranule, read_file
 from monitor.sdr.products import PRODUCTS
 from monitor.sdr.readers import read_metadata
 
-PER_PRODUCT = {"GCRSO": 700, "SCRIF": 700, "SVI05": 320, "GITCO": 320}  # 2040 mutants (-m slow)
+PER_PRODUCT = {  # 2640 mutants (-m slow)
+    "GCRSO": 700,
+    "SCRIF": 700,
+    "SVI05": 320,
+    "GITCO": 320,
+    "SVM15": 200,
+    "SVM13": 200,
+    "GMTCO": 200,
+}
 # the default suite: fewer mutants of the large VIIRS files (copying them is most of the time), still
 # every family of mutation on every product
-QUICK = {"GCRSO": 180, "SCRIF": 180, "SVI05": 27, "GITCO": 27}
+QUICK = {"GCRSO": 180, "SCRIF": 180, "SVI05": 27, "GITCO": 27, "SVM15": 18, "SVM13": 18, "GMTCO": 18}
+M_BANDS = ("I5", "M13", "M15", "M16")  # the case the M-band products' mutants come from
 FAMILIES = ("dtype", "shape", "value", "attribute", "structure", "bytes", "factors", "time", "physics")
 SILENT_SHARE = 0.02
 EXTREMES = (1e28, -1e28, np.inf, -np.inf, np.nan, 0.0, -307.0, 65535, -999.3, 7e9)
@@ -111,6 +121,14 @@ PHYSICS = {  # what once read silently, product by product
         "SCPosition of another time",
     ),
 }
+PHYSICS["SVM15"] = PHYSICS["SVI05"]  # the M-band products share the I-band ones' relations
+PHYSICS["GMTCO"] = PHYSICS["GITCO"]
+PHYSICS["SVM13"] = tuple(p for p in PHYSICS["SVI05"] if p != "BrightnessTemperature as uint8")
+
+
+def _base(cases, prefix: str) -> Path:
+    """The simulated case a product's mutants are made from."""
+    return cases.get(bands=M_BANDS)[0] if prefix.startswith(("SVM", "GM")) else cases.get()[0]
 
 
 def _physics(path: Path, prefix: str, h5, k: int) -> tuple[str, Path]:
@@ -330,6 +348,8 @@ def classify(prefix: str, family: str, intact: list, mutant: list) -> str:
             return "silent"
         ua, ub = _usable(a), _usable(b)
         for key in ua:
+            if key not in ub:  # an optional dataset (the CrIS SW spectra) deleted: data lost, not changed
+                continue
             x, y = ua[key], ub[key]
             if x.shape != y.shape:
                 return "silent"
@@ -353,11 +373,10 @@ def classify(prefix: str, family: str, intact: list, mutant: list) -> str:
 
 def run_mutants(cases, scratch, per_product) -> dict:
     """Every mutant of *per_product*, read and classified: {outcome: [(prefix, k, family, what), ...]}."""
-    base, _, _ = cases.get()
     outcomes = {"rejected": [], "harmless": [], "silent": [], "undetectable": []}
-    intact = {p: read_file(sorted(base.glob(f"{p}_*.h5"))[0]) for p in per_product}
+    intact = {p: read_file(sorted(_base(cases, p).glob(f"{p}_*.h5"))[0]) for p in per_product}
     for prefix, k, family in _mutants(per_product):
-        src = sorted(base.glob(f"{prefix}_*.h5"))[0]
+        src = sorted(_base(cases, prefix).glob(f"{prefix}_*.h5"))[0]
         dst = scratch / src.name
         shutil.copyfile(src, dst)
         rng = np.random.default_rng(1000 * k + len(prefix))
