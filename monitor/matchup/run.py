@@ -26,8 +26,8 @@ from monitor.core.result import AssessmentResult
 from monitor.instrument.spectral import band_model
 from monitor.matchup import fovs as placing
 from monitor.matchup.product import Matchup
-from monitor.matchup.weighted import N_SUMS, NPX, WL, WT, WT2, W, fov_sums
 from monitor.matchup.swaths import BandPixels, GridPixels, band_pixels, grid_pixels, windows
+from monitor.matchup.weighted import N_SUMS, NPX, WL, WT, WT2, W, fov_sums
 from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import CrisSdrGranule
 from monitor.sdr.pairing import GranuleFiles, plan
