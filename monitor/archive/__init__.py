@@ -13,9 +13,25 @@ from typing import Protocol
 
 from monitor.sdr.granules import GranuleRef
 from monitor.sdr.names import JpssName, parse_name
-from monitor.sdr.products import PRODUCTS
+from monitor.sdr.products import CRIS_PRODUCTS, VIIRS_GEO, VIIRS_SDR, prefixes
 
-ALL_PRODUCTS = tuple(PRODUCTS)
+ALL_PRODUCTS = CRIS_PRODUCTS + VIIRS_SDR + VIIRS_GEO  # what the assessment lists: CrIS, VIIRS I5
+
+
+def band_products(band: str) -> tuple[str, ...]:
+    """The products a VIIRS band needs listed: its SDR and its grid's geolocation.
+
+    Parameters
+    ----------
+    band : str
+        I5, M13, M15 or M16.
+
+    Returns
+    -------
+    tuple of str
+        Product prefixes, the preferred first of each kind.
+    """
+    return prefixes("viirs_sdr", band) + prefixes("viirs_geo", band)
 
 
 class SourceError(RuntimeError):

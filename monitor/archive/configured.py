@@ -28,5 +28,5 @@ def make_source(cfg: Config) -> Source:
         assert cfg.source.path is not None, "the configuration requires a path for a local source"
         return LocalSource(cfg.source.path)
     if kind == "simulated":
-        return SimulatedSource(cfg.state_dir / "simulated", cfg.source)
+        return SimulatedSource(cfg.state_dir / "simulated", cfg.source, cfg.viirs_bands)
     return NoddSource(cfg.source, Path(cfg.cache_dir))

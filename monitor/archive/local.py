@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import json
 import logging
 import os
 import shutil
@@ -106,11 +107,16 @@ class SimulatedSource(LocalSource):
         Where the simulated days are written.
     source_cfg : SourceConfig
         The ``source`` section (granules, profile, seed, retention).
+    viirs_bands : tuple of str, optional
+        The VIIRS bands simulated (I5, and the daily mapping's bands when it is on).
     """
 
-    def __init__(self, root: str | Path, source_cfg: SourceConfig) -> None:
+    def __init__(
+        self, root: str | Path, source_cfg: SourceConfig, viirs_bands: tuple[str, ...] = ("I5",)
+    ) -> None:
         super().__init__(root)
         self.cfg = source_cfg
+        self.viirs_bands = viirs_bands
         self._listed: dict[Path, float] = {}  # the days this source listed, and their time then
 
     def list_day(self, satellite: str, day: dt.date, products: Iterable[str]) -> list[ListedFile]:
@@ -135,9 +141,10 @@ class SimulatedSource(LocalSource):
         from monitor.simulate.case import simulate_case
 
         target = self.root / satellite / day.isoformat()
-        if (target / "truth.json").exists():
+        if (target / "truth.json").exists() and self._has_bands(target):
             os.utime(target)  # listed now: in use
         else:
+            shutil.rmtree(target, ignore_errors=True)  # a day simulated before a band was wanted
             LOG.info(
                 "simulating %d CrIS granules of %s on %s into %s", self.cfg.granules, satellite, day, target
             )
@@ -153,6 +160,7 @@ class SimulatedSource(LocalSource):
                     cris_bias_k=difference.bias_k,
                     cris_gain=difference.gain,
                     cris_nonlinear_k=difference.nonlinear_k,
+                    viirs_bands=self.viirs_bands,
                     should_stop=self.should_stop,
                 )
             except (
@@ -164,6 +172,14 @@ class SimulatedSource(LocalSource):
         self._listed[target] = target.stat().st_mtime
         self._forget_old_days(keep=target)
         return LocalSource(target).list_day(satellite, day, products)
+
+    def _has_bands(self, target: Path) -> bool:
+        """Whether the simulated day in *target* holds every VIIRS band this source simulates."""
+        try:
+            held = json.loads((target / "truth.json").read_text()).get("viirs_bands", ["I5"])
+        except (OSError, ValueError):
+            return False
+        return set(self.viirs_bands) <= set(held)
 
     def _forget_old_days(self, keep: Path) -> None:
         days = sorted(

@@ -21,6 +21,7 @@ import numpy as np
 
 from monitor.archive import ALL_PRODUCTS, ListedFile, Source, SourceError
 from monitor.assessment.assess import DayAssessment
+from monitor.assessment.daymap import map_day
 from monitor.assessment.scenes import Candidate, batch_decisions, next_batch, rank_scenes
 from monitor.config.assessment import AssessmentConfig
 from monitor.config.model import Config
@@ -29,6 +30,7 @@ from monitor.core.errors import DataError, StopRequested
 from monitor.core.result import AssessmentResult, DayPrecision, SceneDecision
 from monitor.core.vocabulary import DayStop, RunStatus
 from monitor.mapping import fingerprint as fpr
+from monitor.matchup import Matchup
 from monitor.sdr import read_file
 from monitor.sdr.engpkt import load_library
 from monitor.sdr.pairing import CasePlan, GranuleFiles, assemble, granule_files
@@ -264,6 +266,7 @@ class DayWork:
     timings: dict = field(default_factory=dict)
     counts: RunCounts = field(default_factory=RunCounts)
     precision: DayPrecision | None = None  # how far the batches went, and why they stopped
+    mapping: Matchup | None = None  # the day's CrIS FOVs mapped onto VIIRS (when mapping_dir is set)
 
 
 def compute_day(
@@ -351,14 +354,23 @@ def _compute_day(
             w.status = RunStatus.NO_DATA
             w.reason = "no usable scene: " + "; ".join(sorted({d.reason for d in w.decisions}))[:500]
             return w
+        cases: list[CasePlan] = []
         w.result, w.precision, decided = assess_in_batches(
-            cfg, source, satellite, day, ranked, t0, w.timings, stop, progress, assessor, beat
+            cfg, source, satellite, day, ranked, t0, w.timings, stop, progress, assessor, beat, cases
         )
         w.decisions += decided
         w.counts.selected = w.precision.granules
         w.counts.assessed = len(w.result.granules)
         if stop():
             raise StopRequested
+        if cfg.mapping_dir is not None and w.result.granules:
+            t1 = time.perf_counter()
+            beat.stage("map", "mapping the CrIS FOVs onto VIIRS")
+            try:
+                w.mapping = map_day(source, satellite, day, cases, w.result, tuple(cfg.mapping_bands), stop)
+            except (SourceError, DataError) as exc:  # the mapping is a product of the day, not its outcome
+                LOG.warning("the day's mapping failed: %s", exc)
+            w.timings["map"] = time.perf_counter() - t1
     except StopRequested:
         w.status, w.reason, w.result = RunStatus.INTERRUPTED, "stop requested", None
     except NoRoom as exc:
@@ -389,6 +401,7 @@ def assess_in_batches(
     progress: Callable[[object], None] | None,
     assessor: Assessor,
     beat: Heartbeat,
+    cases: list[CasePlan] | None = None,
 ) -> tuple[AssessmentResult, DayPrecision, list[SceneDecision]]:
     """Fetch and assess the ranked candidates in batches until the day's sigma reaches its target or a budget
     ends.
@@ -423,6 +436,8 @@ def assess_in_batches(
         What assesses the batches.
     beat : Heartbeat
         Hears each stage.
+    cases : list of CasePlan, optional
+        Gains each batch's plan as fetched (the day's mapping reads them again).
 
     Returns
     -------
@@ -456,6 +471,8 @@ def assess_in_batches(
                 len(sizes) + 1, len(case.cris), len(case.viirs_all),
             )  # fmt: skip
             estimate.add(case, progress or ProgressLines(f"{label}: assessed granules", len(case.cris)), stop)
+            if cases is not None:
+                cases.append(case)
             beat.stage("estimate", "estimating the day's offsets")
             result = estimate.result()
             t3 = time.perf_counter()

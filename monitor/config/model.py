@@ -19,12 +19,19 @@ from monitor.config.keys import FilePath, KeyProblem, Section, Url, key
 from monitor.config.outputs import ExportConfig, HttpConfig, StoreConfig
 from monitor.config.schedule import ScheduleConfig
 from monitor.config.source import SourceConfig
+from monitor.core.bands import BANDS
 from monitor.core.satellites import SATELLITES
 
 
 def _satellite(value: str) -> str:
     if value not in SATELLITES:
         raise ValueError(f"{value!r} is not one of {', '.join(SATELLITES)}")
+    return value
+
+
+def _band(value: str) -> str:
+    if value not in BANDS:
+        raise ValueError(f"{value!r} is not one of {', '.join(BANDS)}")
     return value
 
 
@@ -69,6 +76,15 @@ class Config(Section):
         "the server.",
     )
     dashboard_url: Url | None = key(None, "Link to the Grafana dashboard, added to every message.")
+    mapping_dir: FilePath | None = key(
+        None,
+        "Where the daily run writes each day's mapping (crisgeo map: every assessed CrIS FOV's VIIRS scene "
+        "and CrIS BT per band, on the day's assessed geolocation), as SATELLITE/SATELLITE_DAY.nc. None: no "
+        "mapping.",
+    )
+    mapping_bands: Annotated[list[Annotated[str, AfterValidator(_band)]], Field(min_length=1)] = key(
+        list(BANDS), "The VIIRS bands of the day's mapping (I5, M13, M15, M16)."
+    )
     _file: Path | None = PrivateAttr(default=None)
 
     @model_validator(mode="after")
@@ -76,6 +92,8 @@ class Config(Section):
         if len(set(self.satellites)) != len(self.satellites):
             raise KeyProblem("satellites", "a satellite is listed twice")
         _check_creatable(self.state_dir, "state_dir")
+        if self.mapping_dir is not None:
+            _check_creatable(self.mapping_dir, "mapping_dir")
         if self.store.sqlite is None:
             self.store.sqlite = self.state_dir / "crisgeo.sqlite"
         self.alerts.linked(
@@ -92,6 +110,12 @@ class Config(Section):
     def events_file(self) -> Path | None:  # numpydoc ignore=RT01
         """The events calendar (``alerts.events_file``): attribution of jumps, annotations, the report."""
         return self.alerts.events_file
+
+    @property
+    def viirs_bands(self) -> tuple[str, ...]:  # numpydoc ignore=RT01
+        """The VIIRS bands a day needs: I5 (the assessment's) and the mapping's when it is on."""
+        wanted = {"I5", *(self.mapping_bands if self.mapping_dir is not None else ())}
+        return tuple(b for b in BANDS if b in wanted)
 
     @property
     def cache_dir(self) -> Path:  # numpydoc ignore=RT01

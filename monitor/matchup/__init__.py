@@ -2,6 +2,6 @@
 band, as a product (``crisgeo map``). Not :mod:`monitor.mapping`, which derives CrIS mapping angles."""
 
 from monitor.matchup.product import VARIABLES, Matchup
-from monitor.matchup.run import MapCost, map_granules
+from monitor.matchup.run import MapCost, map_granules, map_plan
 
-__all__ = ["VARIABLES", "MapCost", "Matchup", "map_granules"]
+__all__ = ["VARIABLES", "MapCost", "Matchup", "map_granules", "map_plan"]

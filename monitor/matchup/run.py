@@ -30,7 +30,7 @@ from monitor.matchup.swaths import BandPixels, GridPixels, band_pixels, grid_pix
 from monitor.matchup.weighted import N_SUMS, NPX, WL, WT, WT2, W, fov_sums
 from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import CrisSdrGranule
-from monitor.sdr.pairing import GranuleFiles, plan
+from monitor.sdr.pairing import CasePlan, GranuleFiles, plan
 from monitor.sdr.readers import read_file
 
 KEPT_PER_GRID = 2  # VIIRS granules kept ready per band: a CrIS granule reaches at most two
@@ -40,7 +40,7 @@ KEPT_PER_GRID = 2  # VIIRS granules kept ready per band: a CrIS granule reaches 
 class MapCost:
     """What a mapping cost, CPU seconds (all threads) by stage: reading per band (``read_s``, the GEO
     counted with the first band of its grid), the rest per band (``map_s``: placing, searching, summing);
-    and the bytes of the files read per band."""
+    and the bytes read per band (the VIIRS files, the GEO with the first band of its grid)."""
 
     read_s: dict[str, float] = field(default_factory=dict)
     map_s: dict[str, float] = field(default_factory=dict)
@@ -61,9 +61,12 @@ class MapCost:
         table[band] = table.get(band, 0) + value
 
 
-def _size(ref: object) -> int:
+def _rchar() -> int:
+    """The bytes this process has read through system calls so far (Linux ``rchar``: files, through the
+    page cache, and sockets, which a granule read in place comes through); 0 where there is no such count."""
     try:
-        return os.path.getsize(str(ref))
+        with open("/proc/self/io") as io:
+            return next((int(line.split()[1]) for line in io if line.startswith("rchar:")), 0)
     except OSError:
         return 0
 
@@ -81,17 +84,16 @@ class _Viirs:
         key = (band, v.key)
         if key in self.bands:
             return self.bands[key]
-        t0 = time.process_time()
+        t0, read0 = time.process_time(), _rchar()
         detectors = BANDS[band].grid.detectors
         geo_key = str(v.geo)
         if geo_key not in self.grids:
             (geo,) = read_file(v.geo, kinds=("viirs_geo",))
             self.grids[geo_key] = grid_pixels(geo, detectors)
-            self.cost.add(self.cost.bytes_read, band, _size(v.geo))
             while len(self.grids) > 2 * KEPT_PER_GRID:
                 self.grids.popitem(last=False)
         (sdr,) = read_file(v.sdr, kinds=("viirs_sdr",))
-        self.cost.add(self.cost.bytes_read, band, _size(v.sdr))
+        self.cost.add(self.cost.bytes_read, band, _rchar() - read0)
         pixels = band_pixels(sdr, self.grids[geo_key], band, self.satellite)
         self.bands[key] = pixels
         while len(self.bands) > KEPT_PER_GRID * len(BANDS):
@@ -146,9 +148,43 @@ def map_granules(
     if not bands:
         raise DataError("no VIIRS band to map onto")
     case = plan(paths, bands)
-    cris = case.cris_all
-    if not cris:
+    if not case.cris_all:
         raise DataError("no CrIS granule (an SDR with its GEO) among " + ", ".join(map(str, paths)))
+    return map_plan(case, bands, offsets, should_stop, progress)
+
+
+def map_plan(
+    case: CasePlan,
+    bands: Sequence[str],
+    offsets: AssessmentResult | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> tuple[Matchup, MapCost]:
+    """Map every CrIS FOV of a paired plan (``cris_all``, or ``cris`` where that is empty) onto each band.
+
+    Parameters
+    ----------
+    case : CasePlan
+        The CrIS granules and, per band, the VIIRS granules (I5's in ``viirs_all``, the others' in
+        ``bands``).
+    bands : sequence of str
+        The VIIRS bands.
+    offsets : AssessmentResult, optional
+        A day's assessment (as :func:`map_granules`).
+    should_stop : callable, optional
+        Polled between CrIS granules; True ends the mapping with StopRequested.
+    progress : callable, optional
+        Called with (granules done, granules in all) after each CrIS granule.
+
+    Returns
+    -------
+    Matchup
+        The mapping.
+    MapCost
+        What it cost, by band.
+    """
+    bands = tuple(b for b in BANDS if b in bands)
+    cris = case.cris_all or case.cris
     if offsets is not None:
         if offsets.satellite != case.satellite:
             raise DataError(f"the offsets are {offsets.satellite}'s, the granules {case.satellite}'s")
@@ -240,7 +276,7 @@ def map_granules(
         latitude_deg=lat[:done_scans],
         longitude_deg=lon[:done_scans],
         values={k: v[:, :done_scans] for k, v in values.items()},
-        granules=[str(g.sdr) for g in cris],
+        granules=[g.sdr.name for g in cris],
         notes=notes,
     )
     return matchup, cost

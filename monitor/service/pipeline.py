@@ -13,6 +13,7 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 from monitor.archive import Source
 from monitor.assessment import (
@@ -176,6 +177,46 @@ def publish_changes(cfg: Config, store: Store, satellite: str) -> None:
         store.queue_lines(target_name(p), satellite, change_lines(p.measurement, changes))
 
 
+def mapping_path(mapping_dir: Path, satellite: str, day: dt.date) -> Path:
+    """Where a day's mapping is written: ``mapping_dir/SATELLITE/SATELLITE_DAY.nc``.
+
+    Parameters
+    ----------
+    mapping_dir : Path
+        The configuration's ``mapping_dir``.
+    satellite : str
+        The satellite's short name.
+    day : datetime.date
+        The UTC day.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
+    return mapping_dir / satellite / f"{satellite}_{day.isoformat()}.nc"
+
+
+def write_mapping(mapping_dir: Path, w: DayWork) -> None:
+    """Write a day's mapping (a full disk or a missing xarray is a warning: the day's results are stored).
+
+    Parameters
+    ----------
+    mapping_dir : Path
+        The configuration's ``mapping_dir``.
+    w : DayWork
+        The day, with its mapping.
+    """
+    assert w.mapping is not None
+    path = mapping_path(mapping_dir, w.satellite, w.day)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        w.mapping.write(path)
+        LOG.info("wrote the day's mapping %s", path)
+    except (OSError, ImportError, ValueError) as exc:
+        LOG.warning("the day's mapping was not written to %s: %s", path, exc)
+
+
 def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.date) -> RunOutcome:
     """Write what :func:`compute_day` produced under the ledger row *run_id*: the fingerprint, then the
     day's results and their outbox lines in one transaction (ok), or the empty, failed or interrupted
@@ -213,6 +254,8 @@ def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.dat
             queued = day_lines(cfg.store.publish, w.satellite, w.day, w.result)
             store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, queued, w.precision)
             publish_changes(cfg, store, w.satellite)
+            if w.mapping is not None and cfg.mapping_dir is not None:
+                write_mapping(cfg.mapping_dir, w)
         elif w.status == RunStatus.NO_DATA:
             s = cfg.schedule
             if w.day < no_data_horizon(s, today):
