@@ -3,6 +3,7 @@ relative link and anchor resolving, every ``crisgeo ...`` command line parsing w
 
 from __future__ import annotations
 
+import argparse
 import re
 import shlex
 from pathlib import Path
@@ -14,6 +15,8 @@ from monitor.cli.registry import UsageError
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+# where else a user meets a command line: the shipped configurations' comments and the unit
+SHIPPED = [*sorted((ROOT / "configs").rglob("*.yaml")), *sorted((ROOT / "systemd").glob("*"))]
 
 # what a manual for users does not say: how its work was organised
 FORBIDDEN = {
@@ -103,8 +106,15 @@ VALUES = {
 
 def _command_lines(page: Path) -> list[str]:
     text = page.read_text()
+    if page.suffix != ".md":  # a configuration's comment or a unit's Exec line: the rest of its line
+        text = re.sub(r"\\\n#?\s*", " ", text)  # a line continued in the next (comment) line
+        return [m.group(1).rstrip() for m in re.finditer(r"(?:^|[\s/=])(crisgeo [a-z][^\n#`]*)", text)]
     lines = re.findall(r"`(crisgeo [^`]+)`", text)
-    lines += [m.group(1) for m in re.finditer(r"^(?: {4,}|\t)(crisgeo .*)$", text, re.M)]
+    # a code block's command, with the lines indented under it that continue it
+    lines += [
+        " ".join(part.strip() for part in m.group(1).splitlines())
+        for m in re.finditer(r"^ {4}(crisgeo .*(?:\n {6,}\S.*)*)$", text, re.M)
+    ]
     return lines
 
 
@@ -145,3 +155,114 @@ def test_every_documented_command_parses(page):
         except (UsageError, SystemExit) as exc:
             refused.append(f"{line}: {exc}")
     assert refused == []
+
+
+def _subparser(parser, name: str):
+    action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return action.choices.get(name)
+
+
+def _options_named(line: str) -> list[tuple[str, list[str]]]:
+    """Every option a documented line names, optional parts included, with the literal values written after
+    it (each alternative of ``a|b``; placeholders in capitals are not literal)."""
+    line = re.split(r"\s{2,}", line.strip())[0]
+    words = re.findall(r"--?[A-Za-z][\w-]*|[^\s\[\]|]+(?:\|[^\s\[\]|]+)*", line.replace("...", ""))
+    out = []
+    for i, w in enumerate(words):
+        if not w.startswith("-"):
+            continue
+        name, _, inline = w.partition("=")
+        nxt = inline or (words[i + 1] if i + 1 < len(words) else "")
+        literal = [] if nxt.startswith("-") or re.search(r"[A-Z]", nxt) else nxt.split("|")
+        out.append((name, [v for v in literal if v]))
+    return out
+
+
+def _problems_of(parser, line: str) -> list[str]:
+    words = _normalised(line)
+    if len(words) < 2 or not re.fullmatch(r"[a-z][a-z-]*", words[0]):
+        return []
+    sub = _subparser(parser, words[0])
+    if sub is None:
+        return [f"{line}: no command {words[0]!r}"]
+    out = []
+    for name, values in _options_named(line):
+        action = sub._option_string_actions.get(name) or parser._option_string_actions.get(name)
+        if action is None:
+            out.append(f"{line}: {words[0]} has no option {name}")
+        elif action.help == argparse.SUPPRESS and name not in ("-v", "--verbose", "--log-format"):
+            out.append(f"{line}: {name} is a deprecated spelling")
+        elif action.choices is not None and values:
+            out += [
+                f"{line}: {name} {v!r} is not one of {list(action.choices)}"
+                for v in values
+                if v not in action.choices
+            ]
+    return out
+
+
+def test_the_option_check_sees_what_it_looks_for():
+    parser = build_parser()
+    assert _problems_of(parser, "crisgeo assess PATH... [--json OUT.json]")
+    assert _problems_of(parser, "crisgeo assess PATH... [--kernel top-hat|response]")
+    assert _problems_of(parser, "crisgeo reprocess --config F --since D --until D [--workers 8]")
+    assert _problems_of(parser, "crisgeo alerts silence --config F --until 7d")
+    assert _problems_of(parser, "crisgeo assess PATH... [--out R.json] [--kernel top-hat|footprint]") == []
+
+
+@pytest.mark.parametrize("page", PAGES + SHIPPED, ids=lambda p: p.name)
+def test_every_option_the_manual_names_exists_with_its_values(page):
+    parser = build_parser()
+    assert [p for line in _command_lines(page) for p in _problems_of(parser, line)] == []
+
+
+def _config_keys() -> set[str]:
+    from monitor.config.reference import reference
+
+    return set(re.findall(r"^\| `([a-z_.]+)`", reference(), re.M))
+
+
+def _keys_named(text: str) -> list[str]:
+    """The configuration keys a page names: ``section.key`` in backticks, and a bare ``key`` in backticks in
+    the same table cell or sentence as a ``section.key`` (``assessment.half_steps``, ``step_urad``)."""
+    sections = {k.split(".")[0] for k in _config_keys() if "." in k}
+    out = []
+    for row in re.findall(r"^\|.*\|$", text, re.M):  # a table's row: its first cell names keys
+        cell = row.split("|")[1]
+        dotted = [k for k in re.findall(r"`([a-z_]+(?:\.[a-z_0-9]+)+)`", cell) if k.split(".")[0] in sections]
+        if len(dotted) == 1:
+            section = dotted[0].split(".")[0]
+            out += [f"{section}.{k}" for k in re.findall(r"`([a-z]+_[a-z_]+)`", cell)]
+    named = re.findall(r"`([a-z_]+(?:\.[a-z_0-9]+)+)`", text)
+    out += [k for k in named if k.split(".")[0] in sections and k.rsplit(".", 1)[-1] not in _code_names()]
+    return out
+
+
+def _code_names() -> set[str]:
+    """The names the code defines (functions, modules): ``store.save_day`` names code, not a key."""
+    names = set()
+    for path in [*(ROOT / "monitor").rglob("*.py"), *(ROOT / "alerts").rglob("*.py")]:
+        names.add(path.stem)
+        names |= set(re.findall(r"^\s*def ([a-z_]\w*)", path.read_text(), re.M))
+    return names
+
+
+def test_the_key_check_sees_what_it_looks_for():
+    keys = _config_keys()
+    assert "assessment.step_urad" in keys
+    assert [k for k in _keys_named("| `assessment.half_steps`, `step_m` | 10 |") if k not in keys] == [
+        "assessment.step_m"
+    ]
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_every_configuration_key_the_manual_names_exists(page):
+    keys = _config_keys()
+    # a key's parent is a key too (alerts.email), and a mapping's entries are named by its parent
+    known = keys | {k.rsplit(".", 1)[0] for k in keys}
+    unknown = [
+        k
+        for k in _keys_named(page.read_text())
+        if k not in known and k.rsplit(".", 1)[0] not in {"source.buckets", "source.calibration"}
+    ]
+    assert unknown == []

@@ -82,7 +82,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
     for name in sorted(COMMANDS, key=ORDER.index):  # a command missing from ORDER fails here
         handler, help_text, arguments = COMMANDS[name]
-        sp = sub.add_parser(name, help=help_text, parents=[common])
+        # the subcommand's own --help opens with what it does
+        description = help_text[0].upper() + help_text[1:] + "."
+        sp = sub.add_parser(name, help=help_text, description=description, parents=[common])
         for names, options in arguments:
             sp.add_argument(*names, **options)
         sp.set_defaults(func=handler)

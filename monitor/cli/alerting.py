@@ -8,8 +8,7 @@ import datetime as dt
 from typing import TYPE_CHECKING
 
 from monitor.cli.registry import CONFIG, EXIT_FAIL, EXIT_OK, BadInput, arg, command, load, open_store
-from monitor.cli.types import iso_time, until
-from monitor.core.satellites import SATELLITES
+from monitor.cli.types import iso_time, satellite_name, until
 from monitor.core.vocabulary import Rule
 
 if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo starts fast
@@ -33,7 +32,7 @@ RULES = tuple(r.value for r in Rule)  # as strings: argparse prints its choices'
     ),
     CONFIG,
     arg("--rule", choices=RULES, help="silence: the rule (default: every rule)"),
-    arg("--satellite", choices=tuple(SATELLITES), help="silence: the satellite (default: every one)"),
+    arg("--satellite", type=satellite_name, metavar="S", help="silence: the satellite (default: every one)"),
     arg("--expires", type=until, help="silence: when it ends (ISO 8601, UTC) or how long from now (12h, 7d)"),
     arg("--until", dest="expires", type=until, help=argparse.SUPPRESS),  # the earlier name, kept for scripts
     arg("--reason", default="", help="silence: why (shown with the silence)"),
@@ -126,7 +125,8 @@ def cmd_alerts(args: argparse.Namespace) -> int:
     CONFIG,
     arg(
         "--satellite",
-        choices=tuple(SATELLITES),
+        type=satellite_name,
+        metavar="S",
         help="list, effects: only this satellite; add: the satellite",
     ),
     arg("--time", type=iso_time, help="add: when (ISO 8601, UTC)"),

@@ -13,6 +13,7 @@ from monitor.cli.registry import (
     CONFIG,
     EXIT_FAIL,
     EXIT_OK,
+    SATELLITE,
     BadInput,
     arg,
     command,
@@ -117,7 +118,7 @@ def _in_mission(sats: list[str], days: dict[str, dt.date | None]) -> None:
     "run",
     "one run of the daily job (the missed days, or --date), then exit",
     CONFIG,
-    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
+    SATELLITE,
     arg("--date", type=iso_day, help="the UTC day to (re)assess, YYYY-MM-DD"),
 )
 def cmd_run(args: argparse.Namespace) -> int:
@@ -170,7 +171,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     CONFIG,
     arg("--since", type=iso_day, required=True, help="first day, YYYY-MM-DD"),
     arg("--until", type=iso_day, required=True, help="last day, YYYY-MM-DD"),
-    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
+    SATELLITE,
     arg("--scheduler", help="address of a running Dask scheduler (tcp://HOST:8786); default a local cluster"),
     arg("--processes", type=whole(1), default=2, help="processes of the local Dask cluster (default 2)"),
     # the earlier name, kept for scripts
@@ -246,7 +247,7 @@ def cmd_daemon(args: argparse.Namespace) -> int:
     "status",
     "last run per satellite, latest per-FOR table, next run, outbox size; a Nagios plugin",
     CONFIG,
-    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
+    SATELLITE,
     arg("--json", action="store_true", help="machine-readable status"),
     arg(
         "-w",

@@ -10,6 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
+from monitor.cli.types import satellite_name
 from monitor.config.assessment import AssessmentConfig, FingerprintConfig
 from monitor.config.model import Config
 from monitor.core.vocabulary import Cost, Kernel
@@ -129,6 +130,13 @@ def arg(*names: str, **options: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
 
 
 CONFIG = arg("--config", help=f"configuration file (default: $CRISGEO_CONFIG, then {DEFAULT_CONFIG})")
+SATELLITE = arg(
+    "--satellite",
+    type=satellite_name,
+    metavar="S",
+    help="only this satellite: npp, j01, j02, or as users write them (snpp, noaa20, n20, noaa21, n21); "
+    "default every configured one",
+)
 
 
 # the options that are keys of the assessment section (checked by its model, :func:`options`)

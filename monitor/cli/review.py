@@ -8,6 +8,7 @@ from pathlib import Path
 from monitor.cli.registry import (
     CONFIG,
     EXIT_OK,
+    SATELLITE,
     BadInput,
     arg,
     command,
@@ -17,7 +18,6 @@ from monitor.cli.registry import (
     satellites_of,
 )
 from monitor.cli.types import iso_day
-from monitor.core.satellites import SATELLITES
 
 
 @command(
@@ -31,7 +31,7 @@ from monitor.core.satellites import SATELLITES
     ),
     arg("--format", choices=("netcdf", "csv"), help="netcdf or csv (default: from the suffix of --out)"),
     arg("--out", required=True, help="the file to write: FILE.nc (NetCDF) or FILE.csv"),
-    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
+    SATELLITE,
     arg("--since", type=iso_day, help="first day, YYYY-MM-DD"),
     arg("--until", type=iso_day, help="last day, YYYY-MM-DD"),
 )
@@ -91,7 +91,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     "the self-contained HTML trend report (one page per satellite)",
     CONFIG,
     arg("--out", help="output directory (default: report_dir of the configuration)"),
-    arg("--satellite", choices=tuple(SATELLITES), help="only this satellite (default: every configured one)"),
+    SATELLITE,
     arg("--since", type=iso_day, help="first day shown, YYYY-MM-DD"),
     arg("--until", type=iso_day, help="last day shown, YYYY-MM-DD"),
 )

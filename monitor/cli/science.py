@@ -23,11 +23,10 @@ from monitor.cli.registry import (
     options,
     unset,
 )
-from monitor.cli.types import band_list, band_values_k, iso_time, longitude, whole
+from monitor.cli.types import band_list, band_values_k, iso_time, longitude, satellite_name, whole
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.bands import BANDS
 from monitor.core.constants import N_FOV, PAPER_GRANULES
-from monitor.core.satellites import SATELLITES
 from monitor.instrument.footprint import SHAPES as FOOTPRINTS
 from monitor.simulate import CIRRUS_BASE_M, LAYOUTS
 from monitor.simulate.sun_synchronous import PASSES
@@ -40,7 +39,7 @@ if TYPE_CHECKING:  # the commands import what they run when they run it: crisgeo
     "simulate",
     "write simulated CrIS/VIIRS granules with an injected LOS error",
     arg("--out", required=True, help="output directory"),
-    arg("--satellite", choices=tuple(SATELLITES), default="j01", help="the satellite (default j01)"),
+    arg("--satellite", type=satellite_name, metavar="S", default="j01", help="the satellite (default j01)"),
     arg(
         "--granules",
         type=whole(1),

@@ -169,3 +169,25 @@ def band_values_k(text: str) -> dict[str, float]:
     if not out:
         raise argparse.ArgumentTypeError(f"{text!r}: no BAND=K given")
     return out
+
+
+def satellite_name(text: str) -> str:
+    """A satellite as users write it (``noaa20``, ``n20``, ``j01``, ``snpp``, ``NOAA-21`` ...).
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    str
+        The short name (npp, j01, j02); an argparse error otherwise.
+    """
+    from monitor.core.errors import DataError
+    from monitor.core.satellites import named
+
+    try:
+        return named(text)
+    except DataError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None

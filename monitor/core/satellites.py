@@ -62,6 +62,14 @@ class Satellite:
         """The UTC day of the launch."""
         return dt.datetime.fromtimestamp(self.launch_unix_s, dt.timezone.utc).date()
 
+    @property
+    def aliases(self) -> tuple[str, ...]:  # numpydoc ignore=RT01
+        """The names users write for it, lower case: its platform (j01), its name (noaa20) and its NODD
+        bucket's (n20)."""
+        return tuple(
+            dict.fromkeys((self.short, self.idps.lower(), _folded(self.name), self.bucket.split("-")[2]))
+        )
+
     def outside_mission(self, day: dt.date, today: dt.date) -> str | None:
         """Why a day can hold no data of this satellite.
 
@@ -119,3 +127,29 @@ def satellite(short: str) -> Satellite:
         return SATELLITES[short]
     except KeyError:
         raise DataError(f"unknown satellite {short!r} (known: {', '.join(SATELLITES)})") from None
+
+
+def _folded(text: str) -> str:
+    return text.lower().replace("-", "").replace("_", "").replace(" ", "")
+
+
+def named(text: str) -> str:
+    """The short name of the satellite a user names: ``noaa20``, ``NOAA-20``, ``n20`` and ``j01`` are all
+    ``j01``; ``snpp`` and ``npp`` are ``npp``; ``noaa21``, ``n21`` and ``j02`` are ``j02``.
+
+    Parameters
+    ----------
+    text : str
+        A satellite's name, any case, with or without a dash.
+
+    Returns
+    -------
+    str
+        Its short name; a DataError lists the names known.
+    """
+    key = _folded(text)
+    for s in SATELLITES.values():
+        if key in s.aliases:
+            return s.short
+    known = "; ".join(f"{s.short} ({', '.join(a for a in s.aliases if a != s.short)})" for s in SATELLITES.values())
+    raise DataError(f"{text!r} is not a satellite: {known}")

@@ -4,6 +4,7 @@ from pathlib import Path
 import pytest
 
 from monitor.cli import main
+from monitor.cli.registry import UsageError
 from monitor.simulate.case import simulate_case
 from tests.conftest import tree_with_truncated
 from tests.invoke import run_crisgeo
@@ -315,6 +316,30 @@ def test_every_option_and_argument_has_help():
         if not isinstance(a, argparse._HelpAction) and not a.help
     ]
     assert not missing
+
+
+def test_every_subcommands_help_opens_with_what_it_does():
+    _, sub = _subparsers()
+    for name, sp in sub.choices.items():
+        text = sp.format_help()
+        opening = text.split("\n\n")[1]  # after the usage
+        assert opening[0].isupper() and opening.rstrip().endswith("."), (name, opening)
+        assert not opening.startswith(("positional", "options")), name
+
+
+def test_satellite_takes_the_names_users_write(tmp_path):
+    parser, _ = _subparsers()
+    for given, short in (
+        ("noaa20", "j01"),
+        ("N20", "j01"),
+        ("NOAA-21", "j02"),
+        ("n21", "j02"),
+        ("snpp", "npp"),
+    ):
+        args = parser.parse_args(["status", "--satellite", given])
+        assert args.satellite == short, given
+    with pytest.raises((UsageError, SystemExit)):
+        parser.parse_args(["status", "--satellite", "noaa99"])
 
 
 def test_help_lists_the_daily_job_first_and_the_exit_codes():
