@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from monitor.cli.registry import (
@@ -50,7 +51,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     """
     from alerts.effects import change_effects
     from monitor.history.changes import all_changes
-    from monitor.service.outputs.export import Method, export, export_effects
+    from monitor.service.outputs.export import Method, NothingToExport, export, export_effects
 
     cfg = load(args)
     sats = satellites_of(cfg, args.satellite)
@@ -78,7 +79,10 @@ def cmd_export(args: argparse.Namespace) -> int:
             raise BadInput(
                 f"export needs the optional extra: pip install 'crisgeo-monitor[export]' ({exc})"
             ) from None
-        except ValueError as exc:  # NothingToExport, ExportFormatError, a calendar entry: named
+        except NothingToExport as exc:  # an empty period is an answer, not bad input
+            print(f"nothing to export: {exc}", file=sys.stderr)
+            return EXIT_OK
+        except ValueError as exc:  # ExportFormatError, a calendar entry: named
             raise BadInput(str(exc)) from None
         except OSError as exc:
             raise BadInput(f"--out {args.out}: {exc.strerror or exc}") from None
@@ -117,7 +121,18 @@ def cmd_report(args: argparse.Namespace) -> int:
     period(args.since, args.until)
     opts = options_from_config(cfg, [args.satellite] if args.satellite else None, args.since, args.until)
     t0 = time.perf_counter()
+    out = args.out or cfg.report_dir or "report"
     with open_store(cfg) as store:
-        index = build_report(store, args.out or cfg.report_dir or "report", opts)
+        if (args.since or args.until) and not any(
+            store.series(s, args.since, args.until) for s in opts.satellites
+        ):
+            # a period with no results would replace the live report with empty pages
+            print(
+                f"no results of {', '.join(opts.satellites)} in {args.since or 'the beginning'} .. "
+                f"{args.until or 'the end'}: the report in {Path(out).resolve()} is left as it was",
+                file=sys.stderr,
+            )
+            return EXIT_OK
+        index = build_report(store, out, opts)
     print(f"wrote {Path(index).resolve()} ({', '.join(opts.satellites)}) in {time.perf_counter() - t0:.1f} s")
     return EXIT_OK

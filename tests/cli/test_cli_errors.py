@@ -40,7 +40,6 @@ def _one_line(capsys) -> str:
             ["--out", "/nonexistent/dir/x.nc"],
             "--out /nonexistent/dir/x.nc: the folder /nonexistent/dir does not",
         ),
-        (["--since", "2027-01-01"], "no results of j01 in 2027-01-01 .. the end: nothing written"),
         (["--satellite", "npp"], "satellite 'npp' is not in the configuration (j01)"),
         (
             ["--since", "2025-03-09", "--until", "2025-03-02"],
@@ -60,6 +59,31 @@ def test_export_refuses_in_one_line_and_writes_nothing(config_with_history, tmp_
     line = _one_line(capsys)
     assert message in line and line.count(message.split(":")[0]) == 1  # its subject named once
     assert not out.exists() and not list(tmp_path.glob("*.part"))
+
+
+def test_nothing_to_export_is_an_answer_not_bad_input(config_with_history, tmp_path, capsys):
+    out = tmp_path / "x.nc"
+    assert (
+        main(["export", "--config", str(config_with_history), "--out", str(out), "--since", "2027-01-01"])
+        == 0
+    )
+    line = _one_line(capsys)
+    assert line.startswith("nothing to export: no results of j01 in 2027-01-01 .. the end")
+    assert not out.exists() and not list(tmp_path.glob("*.part"))
+
+
+def test_a_report_of_an_empty_period_leaves_the_live_report_untouched(config_with_history, tmp_path, capsys):
+    out = tmp_path / "report"
+    assert main(["report", "--config", str(config_with_history), "--out", str(out)]) == 0
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    assert any(p.suffix == ".png" for p in before)
+    capsys.readouterr()
+    assert (
+        main(["report", "--config", str(config_with_history), "--out", str(out), "--since", "2030-01-01"])
+        == 0
+    )
+    assert "is left as it was" in _one_line(capsys)
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
 
 
 def test_read_only_commands_never_create_a_store(tmp_path, capsys):
@@ -253,7 +277,7 @@ def test_check_config_speaks_to_the_operators_habits(tmp_path):
 @pytest.mark.parametrize(
     "argv,message",
     [
-        (["--satellite", "n21"], "argument --satellite: invalid choice: 'n21'"),
+        (["--satellite", "noaa99"], "argument --satellite: 'noaa99' is not a satellite"),
         (["--bogus"], "unrecognized arguments: --bogus"),
         (["-w", "abc"], "not a threshold range"),
         (["-t", "0.000001"], "no answer within 1e-06 s (-t)"),
