@@ -69,6 +69,9 @@ def result_text(result: AssessmentResult) -> str:
     span = f"{result.start} .. {result.end}" if result.start else "time range unknown"
     lines = [f"{who}{span}, {len(result.granules)} granules"]
     lines += for_table(result.fors)
-    lines += [f"skipped {s.item}: {s.reason}" for s in result.skipped]
+    # a granule's reason names its file already (FILE: FIELD: REASON): the file once
+    lines += [
+        f"skipped {s.reason if s.item in s.reason else f'{s.item}: {s.reason}'}" for s in result.skipped
+    ]
     lines += [f"note: {n}" for n in result.notes]  # e.g. why the km columns are empty (nan)
     return "\n".join(lines)

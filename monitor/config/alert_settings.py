@@ -193,16 +193,6 @@ class AlertSettings(RuleSettings):
     )
     _links: Links = PrivateAttr(default_factory=Links)
 
-    @model_validator(mode="after")
-    def _calendar_exists(self) -> AlertSettings:
-        if self.events_file is not None and not self.events_file.is_file():
-            # read as empty, a missing calendar would lose jump attribution without a word
-            raise KeyProblem(
-                "events_file",
-                f"{self.events_file} does not exist (copy configs/events.yaml there, or remove the key)",
-            )
-        return self
-
     def linked(self, links: Links) -> AlertSettings:
         """These settings, pointing their messages at the report and dashboard.
 

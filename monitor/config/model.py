@@ -92,6 +92,14 @@ class Config(Section):
         if len(set(self.satellites)) != len(self.satellites):
             raise KeyProblem("satellites", "a satellite is listed twice")
         _check_creatable(self.state_dir, "state_dir")
+        calendar = self.alerts.events_file
+        if calendar is not None and not calendar.is_file() and not _under(calendar, self.state_dir):
+            # read as empty, a missing calendar would lose jump attribution without a word; one under the
+            # state directory is the service's own, begun by the first `crisgeo events add`
+            raise KeyProblem(
+                "alerts.events_file",
+                f"{calendar} does not exist (copy configs/events.yaml there, or remove the key)",
+            )
         if self.mapping_dir is not None:
             _check_creatable(self.mapping_dir, "mapping_dir")
         if self.store.sqlite is None:
@@ -121,6 +129,10 @@ class Config(Section):
     def cache_dir(self) -> Path:  # numpydoc ignore=RT01
         """Where downloads are cached: ``state_dir/cache``."""
         return self.state_dir / "cache"
+
+
+def _under(path: Path, folder: Path) -> bool:
+    return path.resolve().is_relative_to(folder.resolve())
 
 
 def _check_creatable(path: Path, where: str) -> None:

@@ -151,5 +151,7 @@ def named(text: str) -> str:
     for s in SATELLITES.values():
         if key in s.aliases:
             return s.short
-    known = "; ".join(f"{s.short} ({', '.join(a for a in s.aliases if a != s.short)})" for s in SATELLITES.values())
+    known = "; ".join(
+        f"{s.short} ({', '.join(a for a in s.aliases if a != s.short)})" for s in SATELLITES.values()
+    )
     raise DataError(f"{text!r} is not a satellite: {known}")

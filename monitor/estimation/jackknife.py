@@ -54,6 +54,7 @@ scatter within the granule(s), and rho is not applied); fewer groups than that g
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -321,6 +322,8 @@ class Jackknife:
         t = np.asarray(replicates, float)
         g = np.sum(np.isfinite(t), axis=0)
         factor = np.vectorize(t_factor, otypes=[float])(g - 1.0)
-        with np.errstate(invalid="ignore", divide="ignore"):
+        with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
+            # a statistic no granule measured has no variance: NaN, below MIN_GRANULES anyway (no warning)
+            warnings.simplefilter("ignore", RuntimeWarning)
             se = np.sqrt((g - 1) * np.nanvar(t, axis=0))
             return np.where(g >= MIN_GRANULES, se * factor, np.nan)

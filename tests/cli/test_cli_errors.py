@@ -290,3 +290,17 @@ def test_status_usage_errors_and_its_timeout_are_nagios_unknown(config_with_hist
     out = capsys.readouterr().out.splitlines()
     assert code == 3 and len(out) == 1 and out[0].startswith("UNKNOWN - ") and message in out[0], out
     assert main(["report", "--config", str(config_with_history), "--satellite", "n21"]) == 2
+
+
+def test_the_demos_calendar_edits_stay_in_the_demos_state(tmp_path, capsys):
+    """`crisgeo events add` on the demo writes the demo's own calendar under its state, never the
+    calendar the project ships."""
+    shipped = ROOT / "configs" / "events.yaml"
+    before = shipped.read_bytes()
+    (tmp_path / "configs").mkdir()
+    demo = tmp_path / "configs" / "demo.yaml"
+    demo.write_text((ROOT / "configs" / "demo.yaml").read_text())
+    argv = ["events", "add", "--config", str(demo), "--satellite", "noaa20", "--time", "2026-01-01T00:00Z"]
+    assert main([*argv, "--instrument", "cris", "--description", "a test EP"]) == 0
+    assert "a test EP" in (tmp_path / "demo-state" / "events.yaml").read_text()
+    assert shipped.read_bytes() == before
