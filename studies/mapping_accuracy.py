@@ -7,7 +7,8 @@ VIIRS BT (``--viirs-band-bias-k``). Both are mapped with the default ``crisgeo m
 geolocation, nominal response). Per band, on the FOVs uniform in VIIRS (pixels' BT spread below
 ``UNIFORM_K``; M13 only on scenes warmer than 260 K): the median of CrIS minus VIIRS on the day without
 (``zero_median_k``), the median and rms scatter of its change between the two days, FOV by FOV
-(``shift_median_k``, ``shift_scatter_k``, against the injected ``-bias``). With ``--assess``, the day
+(``shift_median_k``, ``shift_scatter_k``, against the injected ``-bias``), and the rms scatter of the
+biased day's CrIS minus VIIRS about its median (``scatter_k``). With ``--assess``, the day
 without is also assessed (``crisgeo assess``) and mapped on its assessed geolocation and fitted response:
 the rms of CrIS minus VIIRS over every FOV about the uniform FOVs' median, assessed and operational.
 
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +34,7 @@ from monitor.simulate.case import simulate_case
 
 UNIFORM_K = 0.5
 BIAS_K = {"I5": 0.1, "M13": -0.2, "M15": 0.15, "M16": -0.1}
-KINDS = {  # name -> the simulator's parameters; the first is the project's default day
+KINDS: dict[str, dict[str, Any]] = {  # name -> the simulator's parameters; the first the default day
     "paper-flat": {},
     "random-flat": {"profile": "random", "seed": 11},
     "super-gaussian": {"cris_response": "super-gaussian", "seed": 12},
@@ -63,7 +65,9 @@ def run_kind(name: str, out: Path, granules: int, assess: bool, rows: str | None
     for tag, bias in (("zero", {}), ("biased", BIAS_K)):
         where = out / f"{name}-{tag}"
         if not (where / "truth.json").exists():
-            simulate_case(where, granules=granules, viirs_bands=tuple(BANDS), viirs_band_bias_k=bias, **params)
+            simulate_case(
+                where, granules=granules, viirs_bands=tuple(BANDS), viirs_band_bias_k=bias, **params
+            )
         days[tag] = where
     zero, _ = map_granules([days["zero"]])
     biased, _ = map_granules([days["biased"]])
@@ -85,6 +89,8 @@ def run_kind(name: str, out: Path, granules: int, assess: bool, rows: str | None
             "injected_k": -BIAS_K[band],
             "shift_median_k": round(float(np.median(shift)), 4),
             "shift_scatter_k": round(float(np.sqrt(np.mean((shift - np.median(shift)) ** 2))), 4),
+            # the biased day's own CrIS minus VIIRS on its uniform FOVs, about its median: noise and scene
+            "scatter_k": round(float(np.sqrt(np.mean((d1[keep1] - np.median(d1[keep1])) ** 2))), 4),
         }
         for label, m in (("operational", zero), ("assessed", assessed)):
             if m is None:
@@ -94,7 +100,9 @@ def run_kind(name: str, out: Path, granules: int, assess: bool, rows: str | None
             if BANDS[band].min_scene_k is not None:
                 b = m.bands.index(band)
                 every &= m.values["viirs_bt_k"][b] > BANDS[band].min_scene_k
-            row[f"rms_all_fovs_{label}_k"] = round(float(np.sqrt(np.mean((d[every] - np.median(d[keep])) ** 2))), 4)
+            row[f"rms_all_fovs_{label}_k"] = round(
+                float(np.sqrt(np.mean((d[every] - np.median(d[keep])) ** 2))), 4
+            )
         row["commit"] = commit()
         emit(row, rows)
 

@@ -470,6 +470,9 @@ def assess_in_batches(
                 "batch %d: assessing %d CrIS granule(s) against %d VIIRS granule(s)",
                 len(sizes) + 1, len(case.cris), len(case.viirs_all),
             )  # fmt: skip
+            begin = getattr(progress, "begin", None)  # a counter that shows totals learns the batch's
+            if begin is not None:
+                begin(len(case.cris))
             estimate.add(case, progress or ProgressLines(f"{label}: assessed granules", len(case.cris)), stop)
             if cases is not None:
                 cases.append(case)

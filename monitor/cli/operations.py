@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from monitor.cli.output import result_text
+from monitor.cli.progress import Progress
 from monitor.cli.registry import (
     CONFIG,
     EXIT_FAIL,
@@ -140,18 +141,11 @@ def cmd_run(args: argparse.Namespace) -> int:
     cfg = load(args, writes=True)
     sats = satellites_of(cfg, args.satellite)
     _in_mission(sats, {"--date": args.date})
-    bar = None
-    if sys.stderr.isatty():
-        from tqdm import tqdm
-
-        bar = tqdm(unit="granule", desc="assessing")
-    service = Service(cfg, progress=(lambda g: bar.update(1)) if bar else None)
-    service.handle_signals()
-    try:
+    # a bar with the batches' totals on a terminal; off it, the day's own lines (the journal's)
+    with Progress("assessing granules") as progress:
+        service = Service(cfg, progress=progress if progress.bar is not None else None)
+        service.handle_signals()
         outcomes = service.run_once(sats, args.date)
-    finally:
-        if bar is not None:
-            bar.close()
     for o in outcomes:
         print(f"{o.satellite} {o.day}: {o.status}" + (f" ({o.reason})" if o.reason else ""))
         if o.result is not None:

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from monitor.cli.output import result_text
+from monitor.cli.progress import Progress
 from monitor.cli.registry import (
     ASSESSMENT,
     CLOUDS,
@@ -165,7 +166,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     case.update({k: v for k, v in given.items() if v is not None})
     if args.true_ep:
         case.update(profile="ep", true_ep=ep_file(args.true_ep), ground_ep=ep_file(args.ground_ep))
-    truth = simulate_case(args.out, **case)
+    with Progress("simulating granules") as progress:
+        truth = simulate_case(args.out, progress=progress, **case)
     error = f"EP {args.true_ep} over {args.ground_ep}" if args.true_ep else f"profile {truth['profile']}"
     print(
         f"wrote {len(truth['files'])} files and truth.json to {args.out} "
@@ -231,7 +233,8 @@ def cmd_assess(args: argparse.Namespace) -> int:
     int
         The exit status.
     """
-    from monitor.assessment.assess import assess_paths
+    from monitor.assessment.assess import assess_plan
+    from monitor.sdr.pairing import plan
 
     base = load(args).assessment if args.config else ASSESSMENT
     given = {
@@ -254,7 +257,9 @@ def cmd_assess(args: argparse.Namespace) -> int:
 
         result = assess_collocations(collocations, cfg)
     else:
-        result = assess_paths(args.paths, cfg, workers=cfg.workers)
+        case = plan(args.paths)
+        with Progress("assessing granules", len(case.cris)) as progress:
+            result = assess_plan(case, cfg, progress, workers=cfg.workers)
     print(result_text(result))
     if args.out:
         Path(args.out).write_text(result.to_json())

@@ -956,6 +956,7 @@ def simulate_case(
     spec: SimulationSpec | None = None,
     viirs: bool = True,
     should_stop: Callable[[], bool] | None = None,
+    progress: Callable[[], None] | None = None,
     **parameters: Any,
 ) -> dict:
     """Write a case's granules into *out_dir* and ``truth.json``; return the truth document. The case is
@@ -974,6 +975,9 @@ def simulate_case(
         Also the VIIRS granules.
     should_stop : callable, optional
         Polled between granules and scans; True ends it with :class:`StopRequested`.
+    progress : callable, optional
+        Called after each granule written (CrIS, then each VIIRS grid's); if it has ``begin(total)``, that
+        is called first with the granules there will be.
     **parameters : object
         :class:`SimulationSpec`'s fields.
 
@@ -988,14 +992,21 @@ def simulate_case(
     sim = Simulator(spec)
     stop = should_stop or (lambda: False)
     files = []
+    done = progress or (lambda: None)
+    grids = [g for g in GRIDS.values() if any(BANDS[b].resolution == g.resolution for b in spec.viirs_bands)]
+    starts = sim.viirs_granule_starts() if viirs else np.zeros(0)
+    begin = getattr(progress, "begin", None)
+    if begin is not None:
+        begin(spec.granules + len(starts) * len(grids))
     for k in range(spec.granules):
         if stop():
             raise StopRequested
         files += sim.cris_granule(k, out)
-    if viirs:
-        for g0 in sim.viirs_granule_starts():
-            for grid in GRIDS.values():
-                files += sim.viirs_granule(float(g0), out, should_stop=stop, grid=grid)
+        done()
+    for g0 in starts:
+        for grid in grids:
+            files += sim.viirs_granule(float(g0), out, should_stop=stop, grid=grid)
+            done()
     truth = {
         "satellite": spec.satellite,
         "profile": spec.profile,
