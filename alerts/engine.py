@@ -238,6 +238,15 @@ def evaluate(
                                 ),
                             )
                         )
+            for kind, f in items:  # one line per alert, its name a field of its own (the journal's ALERT)
+                LOG.info(
+                    "%s %s (%s): %s",
+                    str(kind).upper(),
+                    f.fingerprint,
+                    f.severity,
+                    f.summary,
+                    extra={"alert": f.fingerprint},
+                )
             if items:
                 msg = build_message(store, sat, items, settings)
                 for channel in settings.channels:
