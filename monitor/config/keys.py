@@ -205,19 +205,31 @@ def check_listen(text: str) -> str:
 
 
 def env_secret(name: str | None) -> str | None:
-    """The value of the environment variable a ``*_env`` key names.
+    """The secret a ``*_env`` key names: the environment variable of that name, else the systemd credential
+    of that name (``LoadCredential=NAME:/path`` in the unit: the file ``$CREDENTIALS_DIRECTORY/NAME``,
+    systemd.exec(5)), its trailing newline removed.
 
     Parameters
     ----------
     name : str or None
-        The variable.
+        The variable (and credential) name.
 
     Returns
     -------
     str or None
-        Its value; None when unset or unnamed.
+        Its value; None when neither is set, or unnamed.
     """
-    return os.environ.get(name) if name else None
+    if not name:
+        return None
+    if name in os.environ:
+        return os.environ[name]
+    folder = os.environ.get("CREDENTIALS_DIRECTORY")
+    if folder and "/" not in name:
+        try:
+            return (Path(folder) / name).read_text().rstrip("\n")
+        except OSError:
+            return None
+    return None
 
 
 def redact_url(url: str) -> str:

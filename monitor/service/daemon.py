@@ -20,6 +20,7 @@ import os
 import signal
 import socket
 import threading
+import time
 from collections.abc import Callable, Iterable, Iterator
 from types import FrameType
 
@@ -30,7 +31,8 @@ from apscheduler.triggers.cron import CronTrigger
 from alerts.alertmanager import post_state
 from alerts.engine import deliver, evaluate
 from monitor.archive.configured import make_source
-from monitor.config.keys import parse_listen
+from monitor.config.file import load_config
+from monitor.config.keys import ConfigError, parse_listen
 from monitor.config.model import Config
 from monitor.core import logcontext
 from monitor.core.vocabulary import EventKind, RunStatus
@@ -381,6 +383,7 @@ class Service:
             )
             self.add_jobs(self.scheduler)
             self.handle_signals()
+            signal.signal(signal.SIGHUP, self._on_reload)  # systemctl reload: ExecReload sends it
             watchdog = self._start_watchdog()
             sd_notify("READY=1")
             sd_notify("STATUS=scheduled daily at " + sch.time_utc.strftime("%H:%M UTC"))
@@ -398,6 +401,59 @@ class Service:
                 if endpoint is not None:
                     endpoint.stop()
                 LOG.info("crisgeo daemon stopped")
+
+    def reload(self) -> bool:
+        """Read the configuration file again and put it in force: the scheduled jobs and the source follow
+        it, a day under way finishes with the one it began with. A file that does not load, or that changes
+        what only a restart can (``state_dir``, ``store.sqlite``, ``http.listen``), leaves the configuration
+        in force, and the log says why.
+
+        Returns
+        -------
+        bool
+            Whether the new configuration is in force.
+        """
+        path = self.cfg.path
+        if path is None:
+            LOG.warning("reload: the configuration was not read from a file; nothing to reload")
+            return False
+        try:
+            new = load_config(path)
+        except (ConfigError, OSError) as exc:
+            LOG.error("reload: %s; the configuration in force is kept", exc)
+            return False
+        fixed = [
+            key
+            for key, old_value, new_value in (
+                ("state_dir", self.cfg.state_dir, new.state_dir),
+                ("store.sqlite", self.cfg.store.sqlite, new.store.sqlite),
+                ("http.listen", self.cfg.http.listen, new.http.listen),
+            )
+            if old_value != new_value
+        ]
+        if fixed:
+            LOG.error(
+                "reload: %s changed, which only a restart applies (systemctl restart crisgeo); the "
+                "configuration in force is kept",
+                ", ".join(fixed),
+            )
+            return False
+        self.cfg, self.source = new, make_source(new)
+        if self.scheduler is not None:
+            self.scheduler.remove_all_jobs()
+            self.add_jobs(self.scheduler)
+        LOG.info(
+            "reload: %s in force (%s; daily at %s UTC)",
+            path,
+            ", ".join(new.satellites),
+            new.schedule.time_utc.strftime("%H:%M"),
+        )
+        return True
+
+    def _on_reload(self, signum: int, frame: FrameType | None) -> None:
+        sd_notify(f"RELOADING=1\nMONOTONIC_USEC={time.monotonic_ns() // 1000}")
+        self.reload()
+        sd_notify("READY=1")
 
     def _on_signal(self, signum: int, frame: FrameType | None) -> None:
         LOG.info("signal %d: stopping after the current step", signum)

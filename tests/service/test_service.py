@@ -244,6 +244,83 @@ def test_systemd_unit_verifies_without_any_warning(tmp_path):
     bad = tmp_path / "crisgeo-bad.service"
     bad.write_text(unit.read_text().replace("Restart=on-failure", "Restrat=on-failure"))
     assert "Unknown key" in _verify(bad).stderr  # the check above can fail
+    # the reload, the memory limit and the credentials the comments show are the unit's own keys
+    assert "ExecReload=/bin/kill -HUP $MAINPID" in text and "MemoryMax=" in text
+    examples = [line.lstrip("# ").strip() for line in text.splitlines() if "LoadCredential=" in line]
+    assert examples
+    creds = tmp_path / "crisgeo-creds.service"
+    creds.write_text(unit.read_text().replace("[Service]\n", "[Service]\n" + "\n".join(examples) + "\n"))
+    r = _verify(creds)
+    assert r.returncode == 0 and r.stderr.strip() == "", r.stderr
+
+
+def test_a_reload_puts_the_new_configuration_in_force_and_keeps_the_old_one_if_bad(tmp_path):
+    """SIGHUP (systemctl reload): a good file is in force for the next runs; a bad one is refused in the log,
+    naming the key, and the daemon goes on with the one in force."""
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    cfg = _config(tmp_path, empty)
+    log = tmp_path / "daemon.log"
+    with open(log, "w") as fh:
+        p = subprocess.Popen(
+            CRISGEO + ["daemon", "--config", str(cfg), "--listen", "off"], cwd=ROOT, stdout=fh, stderr=fh
+        )
+    try:
+        assert wait_for(lambda: "crisgeo daemon started" in log.read_text(), 60), log.read_text()
+        cfg.write_text(
+            cfg.read_text().replace(
+                "schedule: {catch_up_days: 2}", "schedule: {catch_up_days: 2, time_utc: '05:45'}"
+            )
+        )
+        p.send_signal(signal.SIGHUP)
+        assert wait_for(lambda: "daily at 05:45 UTC" in log.read_text(), 30), log.read_text()
+        good = cfg.read_text()
+        cfg.write_text(good.replace("time_utc: '05:45'", "time_utc: '25:99'"))
+        p.send_signal(signal.SIGHUP)
+        assert wait_for(lambda: "the configuration in force is kept" in log.read_text(), 30), log.read_text()
+        refused = [line for line in log.read_text().splitlines() if "in force is kept" in line]
+        assert "schedule.time_utc" in refused[0] and "ERROR" in refused[0]
+        assert p.poll() is None  # still running, on the configuration it had
+        p.send_signal(signal.SIGTERM)
+        assert p.wait(timeout=30) == 128 + signal.SIGTERM
+    finally:
+        if p.poll() is None:
+            p.kill()
+
+
+def test_a_secret_comes_from_a_systemd_credential_when_the_environment_has_none(tmp_path, monkeypatch):
+    from monitor.config.keys import env_secret
+
+    creds = tmp_path / "creds"
+    creds.mkdir()
+    (creds / "SMTP_PASSWORD").write_text("s3cret\n")
+    monkeypatch.setenv("CREDENTIALS_DIRECTORY", str(creds))
+    monkeypatch.delenv("SMTP_PASSWORD", raising=False)
+    assert env_secret("SMTP_PASSWORD") == "s3cret"
+    monkeypatch.setenv("SMTP_PASSWORD", "from-env")
+    assert env_secret("SMTP_PASSWORD") == "from-env"  # the environment first
+    assert env_secret("MISSING") is None and env_secret("../creds/SMTP_PASSWORD") is None
+
+
+@pytest.mark.skipif(
+    shutil.which("logrotate") is None, reason="logrotate not installed (Debian package logrotate)"
+)
+def test_the_alert_log_rotates_and_the_next_message_starts_a_new_file(tmp_path):
+    from alerts.channels import LogChannel
+
+    shipped = (ROOT / "systemd" / "crisgeo.logrotate").read_text()
+    alert_log = tmp_path / "alerts.log"
+    conf = tmp_path / "crisgeo.logrotate"
+    conf.write_text(shipped.replace("/var/log/crisgeo/alerts.log", str(alert_log)))
+    channel = LogChannel(alert_log)
+    channel.send({"subject": "first", "text": "first message"})
+    r = subprocess.run(
+        ["logrotate", "-f", "-s", str(tmp_path / "state"), str(conf)], capture_output=True, text=True
+    )
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "alerts.log.1").exists() and "first message" in (tmp_path / "alerts.log.1").read_text()
+    channel.send({"subject": "second", "text": "second message"})
+    assert "second message" in alert_log.read_text() and "first message" not in alert_log.read_text()
 
 
 @pytest.mark.servers
