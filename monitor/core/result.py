@@ -35,6 +35,8 @@ FLAG_UNCONVERGED = "unconverged"  # the footprint's alternation ran out of itera
 # the day's uniform scenes span too little BT to determine a CrIS-VIIRS gain: gain and curvature empty, the
 # bias the scenes' mean difference (monitor/estimation/intercal.py)
 FLAG_GAIN_UNDETERMINED = "gain_undetermined"
+# every flag a FOR may carry, in the order of their bits in the export (the reliability flags first)
+FLAGS = (*RELIABILITY_FLAGS, FLAG_TOP_HAT, FLAG_UNCONVERGED, FLAG_GAIN_UNDETERMINED)
 
 
 @dataclass(frozen=True)

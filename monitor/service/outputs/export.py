@@ -4,7 +4,7 @@ NetCDF or CSV.
 Dimensions ``time`` (the assessed day: its start, with ``time_bnds`` the whole UTC day; first and unlimited,
 so that daily files append along it) x ``scan_position`` (the CrIS field of regard, 1..30; a name Python
 accepts: ``ds.sel(scan_position=1)``); one variable per stored quantity with its unit, long name and ACDD
-``coverage_content_type``, the reliability flags as a CF bit mask (``flag_masks`` and ``flag_meanings``),
+``coverage_content_type``, every flag of the table as a CF bit mask (``flag_masks`` and ``flag_meanings``),
 the sign convention stated once (the global attribute ``sign_convention``), and the ACDD global attributes
 (title, summary, references to the method paper, history, date_created, time coverage, platform,
 instrument, source, id; institution, creator, license and the like from the ``export`` section of the
@@ -32,7 +32,7 @@ from alerts.effects import ChangeEffect
 from monitor.config.model import Config
 from monitor.config.outputs import ExportConfig
 from monitor.core.constants import DEFAULT_HALF_STEPS, N_FOR, SPEC_KM
-from monitor.core.result import RELIABILITY_FLAGS, ForOffset, measures
+from monitor.core.result import FLAGS, ForOffset, measures
 from monitor.core.satellites import satellite as satellite_info
 from monitor.history.records import History
 from monitor.service.store.sqlite import Store
@@ -46,7 +46,7 @@ SIGN_CONVENTION = (
     "error: the correction to add to the reported geolocation."
 )
 FORMATS = {".nc": "netcdf", ".nc4": "netcdf", ".csv": "csv"}  # the suffix of --out says the format
-FLAG_BITS = {name: 1 << i for i, name in enumerate(RELIABILITY_FLAGS)}
+FLAG_BITS = {name: 1 << i for i, name in enumerate(FLAGS)}  # every flag the table shows
 
 
 class ResultStore:

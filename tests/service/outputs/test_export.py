@@ -282,3 +282,25 @@ def test_the_defaults_state_the_default_grid_and_specification(store_with_days):
     _, store = store_with_days
     ds = to_xarray(store, "j01")
     assert "21 x 21 times per FOV" in ds.attrs["summary"] and "is 1.5 km" in ds.attrs["comment"]
+
+
+def test_the_export_carries_every_flag_the_table_shows(tmp_path):
+    """A FOR whose gain the day could not determine is flagged in the table: the export says so too."""
+    from dataclasses import replace
+
+    from monitor.core.result import FLAG_GAIN_UNDETERMINED, FLAG_TOP_HAT, FLAGS
+    from monitor.service.outputs.export import FLAG_BITS, to_xarray
+    from monitor.service.store.sqlite import Store
+    from monitor.simulate.history import day_result
+
+    assert set(FLAG_BITS) == set(FLAGS)
+    store = Store(tmp_path / "s.sqlite")
+    day = dt.date(2025, 3, 1)
+    result = day_result("j01", day, np.random.default_rng(1), 0.0, with_cube=False)
+    result.fors[11] = replace(result.fors[11], flags=(FLAG_GAIN_UNDETERMINED, FLAG_TOP_HAT))
+    store.save_day(store.begin_run("j01", day), "j01", day, result)
+    ds = to_xarray(store, "j01")
+    masks = dict(zip(ds.flags.attrs["flag_meanings"].split(), ds.flags.attrs["flag_masks"], strict=True))
+    value = int(ds.flags.sel(scan_position=12).values[0])
+    assert value == masks["gain_undetermined"] + masks["top_hat"]
+    assert int(ds.flags.sel(scan_position=13).values[0]) & masks["gain_undetermined"] == 0
