@@ -3,6 +3,7 @@ output that a pipe closed by its reader silences."""
 
 from __future__ import annotations
 
+import datetime as dt
 import os
 from typing import Any, TextIO
 
@@ -52,6 +53,27 @@ class PipedOutput:
         return getattr(self._stream, name)
 
 
+def utc_text(iso: str) -> str:
+    """A time as the service prints every time: ``2026-11-25T03:30:01Z`` (UTC, to the second).
+
+    Parameters
+    ----------
+    iso : str
+        An ISO 8601 time (UTC where it names no zone).
+
+    Returns
+    -------
+    str
+        The time, or the text as given where it is not one.
+    """
+    try:
+        when = dt.datetime.fromisoformat(iso.replace("Z", "+00:00"))
+    except ValueError:
+        return iso
+    when = when.replace(tzinfo=dt.timezone.utc) if when.tzinfo is None else when.astimezone(dt.timezone.utc)
+    return when.strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
 def result_text(result: AssessmentResult) -> str:
     """What ``crisgeo assess`` and ``crisgeo run`` print of an assessment.
 
@@ -66,7 +88,7 @@ def result_text(result: AssessmentResult) -> str:
         Its time span, the per-FOR table and its notes.
     """
     who = f"{result.satellite} " if result.satellite else ""
-    span = f"{result.start} .. {result.end}" if result.start else "time range unknown"
+    span = f"{utc_text(result.start)} .. {utc_text(result.end)}" if result.start else "time range unknown"
     lines = [f"{who}{span}, {len(result.granules)} granules"]
     lines += for_table(result.fors)
     # a granule's reason names its file already (FILE: FIELD: REASON): the file once

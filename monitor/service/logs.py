@@ -166,9 +166,9 @@ def journal_fields(record: logging.LogRecord, message: str) -> dict[str, str]:
         "PRIORITY": str(priority(record.levelno)),
         "SYSLOG_IDENTIFIER": IDENTIFIER,
         "LOGGER": record.name,
-        "CODE_FILE": record.pathname,
+        "CODE_FILE": str(record.pathname),
         "CODE_LINE": str(record.lineno),
-        "CODE_FUNC": record.funcName,
+        "CODE_FUNC": str(record.funcName or ""),
     }
     fields |= {k.upper(): str(v) for k, v in logcontext.fields().items()}
     alert = getattr(record, "alert", None)

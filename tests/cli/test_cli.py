@@ -16,10 +16,12 @@ def test_assess_writes_the_contract_json(cases, tmp_path, capsys, monkeypatch):
 
     out, _, result = cases.get()
     given = []
-    monkeypatch.setattr(assess, "assess_paths", lambda paths, cfg, workers: given.append(paths) or result)
+    monkeypatch.setattr(
+        assess, "assess_plan", lambda case, cfg, progress, workers: given.append(case) or result
+    )
     res = tmp_path / "r.json"
     assert main(["assess", str(out), "--out", str(res), "--workers", "1"]) == 0
-    assert given == [[str(out)]]
+    assert len(given) == 1 and len(given[0].cris) == 2  # the case's two granules, paired
     table = capsys.readouterr().out
     assert "FOR" in table and "d_beta" in table
     doc = json.loads(res.read_text())
@@ -79,7 +81,7 @@ def test_corrupt_granule_is_skipped_and_recorded(cases, tmp_path, capsys):
     reasons = " ".join(s["reason"] for s in doc["skipped"])
     assert geo.name in " ".join(s["item"] for s in doc["skipped"]) and "HDF5" in reasons
     printed = capsys.readouterr()
-    skipped = [line for line in printed.out.splitlines() if line.startswith("skipped")]
+    skipped = [line for line in printed.out.splitlines() if line.startswith("skipped") and geo.name in line]
     assert len(skipped) == 1 and skipped[0].count(geo.name) == 1, skipped  # the file named once
 
 
@@ -256,13 +258,35 @@ def test_under_systemd_lines_carry_their_priority_and_no_second_timestamp(tmp_pa
     cfg.write_text(
         f"satellites: [j01]\nstate_dir: {tmp_path / 'state'}\nsource: {{kind: local, path: {tmp_path}}}\n"
     )
-    r = run_crisgeo(
-        "run", "--config", cfg, "--date", "2024-06-01", env={**os.environ, "JOURNAL_STREAM": "8:1234"}
-    )
-    assert r.returncode == 0, r.stderr
-    log = [line for line in r.stderr.splitlines() if line.strip()]
+    import subprocess
+
+    from monitor.service import logs
+    from tests.invoke import CRISGEO, ROOT
+
+    err = tmp_path / "stderr"
+    with open(err, "w") as fh:  # the journal's stream: JOURNAL_STREAM names this stderr's device and inode
+        st = os.fstat(fh.fileno())
+        env = {**os.environ, "JOURNAL_STREAM": f"{st.st_dev}:{st.st_ino}"}
+        argv = [*CRISGEO, "run", "--config", str(cfg), "--date", "2024-06-01"]
+        r = subprocess.run(argv, stdout=subprocess.PIPE, stderr=fh, env=env, cwd=ROOT, timeout=300)
+    assert r.returncode == 0, err.read_text()
+    log = [line for line in err.read_text().splitlines() if line.strip()]
     prefixes = ("<6>INFO", "<4>WARNING", "<3>ERROR", "<7>DEBUG")
-    assert log and all(line.split()[0] in prefixes for line in log), log
+    assert all(line.split()[0] in prefixes for line in log), log
+    # without journald listening (none here, or a stale socket) every line comes this way
+    assert log or os.path.exists(logs.JOURNAL_SOCKET)
+
+
+def test_a_line_the_journal_socket_refuses_goes_to_stderr_with_its_priority(tmp_path, capsys):
+    import logging
+
+    from monitor.service.logs import JournalHandler
+
+    handler = JournalHandler(str(tmp_path / "no-journald"))
+    record = logging.LogRecord("monitor.x", logging.ERROR, __file__, 1, "the day failed", None, None)
+    handler.emit(record)
+    handler.close()
+    assert capsys.readouterr().err == "<3>ERROR monitor.x: the day failed\n"
 
 
 @pytest.mark.parametrize(
