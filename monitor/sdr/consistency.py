@@ -318,6 +318,9 @@ def check_relations(path: GranuleRef, product: Product, granule: Granule) -> Non
     key = MAIN_FIELD[product.kind]
     if isinstance(granule, CrisSdrGranule):
         check_spectra(path, f"{product.data_group}/{product.fields[key].dataset}", granule.radiance_lw)
+        if granule.radiance_sw is not None:
+            sw = product.fields["radiance_sw"].dataset
+            check_spectra(path, f"{product.data_group}/{sw}", granule.radiance_sw)
     if product.scans_reserved:
         check_viirs_scan_count(path, product, granule, key)
     if not isinstance(granule, (CrisGeoGranule, ViirsGeoGranule)):
