@@ -576,7 +576,7 @@ def transmittance(wavenumber_cm1: ArrayLike) -> np.ndarray:
         k += 1.2 * np.exp(-0.5 * ((nu - 1042.0) / 18.0) ** 2)
         k += 0.08 * (1.0 + np.sin(nu * 2.1)) * np.exp(-0.5 * ((nu - 870.0) / 120.0) ** 2)
         # the short-wave window (VIIRS M13): a weak continuum, the CO2 band below 2395 cm-1, water above
-        k_sw = 0.08 + 0.1 * ((nu - 2500.0) / 100.0) ** 2 + 6.0 / (1.0 + np.exp((nu - 2395.0) / 6.0))
+        k_sw = 0.01 + 0.1 * ((nu - 2500.0) / 100.0) ** 2 + 3.0 / (1.0 + np.exp((nu - 2395.0) / 6.0))
     return np.exp(-np.where(nu < SW_FROM_CM1, k, k_sw))
 
 
