@@ -200,11 +200,12 @@ def _bench_map(data: Path, assess_cpu_s: float) -> None:
     cpu0 = time.process_time()
     matchup, cost = map_granules([data], held)
     cpu = time.process_time() - cpu0
-    print(f"mapping onto {', '.join(held)}: {matchup.scans // 4} CrIS granules, {cpu:.1f} CPU-s in all")
+    n_cris = max(matchup.scans // 4, 1)
+    print(f"mapping onto {', '.join(held)}: {n_cris} CrIS granules, {cpu:.1f} CPU-s in all")
     for band in held:
-        mb = cost.bytes_read.get(band, 0) / 1e6
+        mb, read_s = cost.bytes_read.get(band, 0) / 1e6, cost.read_s.get(band, 0.0)
         print(
-            f"  {band:<4} read {cost.read_s.get(band, 0.0):6.2f} CPU-s ({mb:.0f} MB)   "
+            f"  {band:<4} read {read_s:6.2f} CPU-s ({mb:.0f} MB, {mb / n_cris:.1f} MB per CrIS granule)   "
             f"map {cost.map_s.get(band, 0.0):6.2f} CPU-s"
         )
     read, mapped = sum(cost.read_s.values()), sum(cost.map_s.values())

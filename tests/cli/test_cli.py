@@ -123,6 +123,27 @@ def test_bench_prints_every_stage_and_the_assessment_memory():
     assert "includes the simulation" not in out  # Linux resets the count after simulating
 
 
+def test_bench_map_prints_the_mappings_cpu_per_band_with_the_reading_apart():
+    import re
+
+    run = run_crisgeo("bench", "--granules", "1", "--workers", "1", "--kernel", "top-hat", "--map")
+    assert run.returncode == 0, run.stderr
+    out = run.stdout
+    assert "mapping onto I5, M13, M15, M16: 1 CrIS granules" in out
+    for band in ("I5", "M13", "M15", "M16"):
+        line = re.search(
+            rf"^  {band} +read +([0-9.]+) CPU-s \(([0-9]+) MB, ([0-9.]+) MB per CrIS granule\) +"
+            r"map +([0-9.]+)",
+            out,
+            re.M,
+        )
+        assert line is not None, (band, out)
+        assert float(line.group(1)) > 0 and int(line.group(2)) > 0 and float(line.group(4)) > 0
+    assert re.search(
+        r"against the assessment's [0-9.]+ CPU-s: [0-9.]+ with the reading, [0-9.]+ beyond it", out
+    )
+
+
 def test_version_and_verbose_after_the_subcommand(capsys):
 
     r = run_crisgeo("--version")
