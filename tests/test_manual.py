@@ -109,7 +109,7 @@ def _command_lines(page: Path) -> list[str]:
     if page.suffix != ".md":  # a configuration's comment or a unit's Exec line: the rest of its line
         text = re.sub(r"\\\n#?\s*", " ", text)  # a line continued in the next (comment) line
         return [m.group(1).rstrip() for m in re.finditer(r"(?:^|[\s/=])(crisgeo [a-z][^\n#`]*)", text)]
-    lines = re.findall(r"`(crisgeo [^`]+)`", text)
+    lines = [re.sub(r"\s*\n\s*", " ", m) for m in re.findall(r"`(crisgeo [^`]+)`", text)]  # wrapped
     # a code block's command, with the lines indented under it that continue it
     lines += [
         " ".join(part.strip() for part in m.group(1).splitlines())
