@@ -159,6 +159,11 @@ class ForOffset:
     )  # fmt: skip
 
     @property
+    def scan_position(self) -> int:  # numpydoc ignore=RT01
+        """The field of regard, 1..30 across the scan (the name the JSON, the export and the manual use)."""
+        return self.for_index
+
+    @property
     def d_alpha_pct_fov(self) -> float:  # numpydoc ignore=RT01
         """The in-track offset as a percentage of the FOV diameter."""
         return 100.0 * self.d_alpha_urad / FOV_DIAMETER_URAD
@@ -211,7 +216,8 @@ class ForOffset:
         )
 
     def to_dict(self) -> dict:
-        """The record as JSON-ready values: ``for``, the measured fields, the derived % of FOV and ``flags``.
+        """The record as JSON-ready values: ``scan_position`` (and ``for``, its earlier name), the measured
+        fields, the derived % of FOV and ``flags``.
 
         Returns
         -------
@@ -219,7 +225,8 @@ class ForOffset:
             NaN where nothing was measured.
         """
         d = asdict(self)
-        d["for"] = d.pop("for_index")
+        d["scan_position"] = d.pop("for_index")
+        d["for"] = d["scan_position"]  # the earlier name, kept for scripts that read it
         d["flags"] = list(self.flags)
         d["d_alpha_pct_fov"] = self.d_alpha_pct_fov
         d["d_beta_pct_fov"] = self.d_beta_pct_fov
@@ -232,7 +239,8 @@ class ForOffset:
         Parameters
         ----------
         d : dict
-            ``for``, ``flags`` and the measured fields; None is what was not measured (NaN, or 0 for a count).
+            ``scan_position`` (or ``for``), ``flags`` and the measured fields; None is what was not measured
+            (NaN, or 0 for a count).
 
         Returns
         -------
@@ -241,7 +249,8 @@ class ForOffset:
         """
         kw = {k: d[k] for k in MEASURED_FIELDS if k in d}
         kw = {k: (v if v is not None else 0 if k in COUNT_FIELDS else float("nan")) for k, v in kw.items()}
-        return cls(for_index=int(d["for"]), flags=tuple(d.get("flags", ())), **kw)
+        position = d["scan_position"] if "scan_position" in d else d["for"]
+        return cls(for_index=int(position), flags=tuple(d.get("flags", ())), **kw)
 
 
 def measures(record: type = ForOffset) -> tuple[Measure, ...]:

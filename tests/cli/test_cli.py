@@ -27,7 +27,8 @@ def test_assess_writes_the_contract_json(cases, tmp_path, capsys, monkeypatch):
     doc = json.loads(res.read_text())
     assert doc["satellite"] == "j01" and len(doc["fors"]) == 30 and len(doc["granules"]) == 2
     keys = {
-        "for",
+        "scan_position",
+        "for",  # the earlier name, kept for scripts
         "d_alpha_urad",
         "d_beta_urad",
         "sigma_alpha_urad",
