@@ -38,7 +38,7 @@ from monitor.core.constants import CALIBRATION_BIN_K, CALIBRATION_REFERENCE_K, S
 from monitor.core.result import RELIABILITY_FLAGS, DayPrecision, ForOffset, worst_for
 from monitor.core.satellites import SATELLITES
 from monitor.core.tables import FOR_COLUMNS, REPORT
-from monitor.core.vocabulary import Rule, RunStatus
+from monitor.core.vocabulary import DEFAULT_COST, Cost, Rule, RunStatus
 from monitor.history.changes import Change, all_changes
 from monitor.history.records import Alert, ForSeries, Run
 from monitor.service.outputs.report import plots
@@ -73,6 +73,7 @@ class ReportOptions:
     until: dt.date | None = None
     calendar: Path | None = None
     satellites: list = field(default_factory=list)
+    cost: Cost = DEFAULT_COST  # the configured assessment's cost, which the cost surface shows
 
 
 def options_from_config(
@@ -105,6 +106,7 @@ def options_from_config(
         until=until,
         calendar=cfg.events_file,
         satellites=list(satellites or cfg.satellites),
+        cost=cfg.assessment.cost,
     )
 
 
@@ -348,6 +350,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
             step,
             worst.d_alpha_urad,
             worst.d_beta_urad,
+            opts.cost,
             f"{title}: worst FOR {worst.for_index}, "
             f"{worst.worst_km:.2f} km" + (f" (run {runs[-1].id})" if runs else ""),
         )

@@ -21,6 +21,7 @@ import numpy as np  # noqa: E402
 from numpy.typing import ArrayLike  # noqa: E402
 
 from monitor.core.constants import FOV_DIAMETER_URAD, N_FOR  # noqa: E402
+from monitor.core.vocabulary import Cost  # noqa: E402
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -32,6 +33,14 @@ Marks = Sequence[tuple[dt.datetime, str, str]]  # known changes: (time, instrume
 FORS = np.arange(1, N_FOR + 1)
 DPI = 90
 CHANGE_COLOURS = {"cris": "tab:purple", "viirs": "tab:green", "common": "tab:brown"}
+
+
+# the colour bar of the cost surface: the paper's equation (8), or the residual of the regression the
+# service minimises by default (docs/science.md, "Cost and minimum")
+COST_LABEL = {
+    Cost.STDEV: "G = STDEV(BT_VIIRS - BT_CrIS) (K)",
+    Cost.REGRESSION: "G = residual STDEV of BT_VIIRS - BT_CrIS regressed on BT_CrIS (K)",
+}
 
 
 def _save(fig: Figure, path: Path) -> Path:
@@ -309,9 +318,11 @@ def cost_contour(
     step_urad: float,
     d_alpha_urad: float,
     d_beta_urad: float,
+    cost: Cost,
     title: str,
 ) -> Path:
-    """Cost surface G of one FOR over the 21 x 21 offsets with its minimum marked (figure 5c).
+    """Cost surface G of one FOR over the 21 x 21 offsets with its minimum marked (figure 5c), its colour
+    bar naming the cost.
 
     *cube_k* (2n+1, 2n+1): index i in-track, j cross-track; axes in urad.
 
@@ -327,6 +338,8 @@ def cost_contour(
         The grid's step, urad.
     d_alpha_urad, d_beta_urad : float
         The minimum, urad.
+    cost : Cost
+        The cost the assessment minimised (``assessment.cost``).
     title : str
         The figure's title.
 
@@ -340,7 +353,7 @@ def cost_contour(
     fig, ax = plt.subplots(figsize=(5.6, 4.8), constrained_layout=True)
     cs = ax.contourf(offsets, offsets, cube_k, levels=20, cmap="viridis")
     ax.contour(offsets, offsets, cube_k, levels=10, colors="white", linewidths=0.5, alpha=0.6)
-    fig.colorbar(cs, ax=ax, label="STDEV(BT_CrIS - BT_VIIRS) (K)")
+    fig.colorbar(cs, ax=ax, label=COST_LABEL[cost])
     i, j = np.unravel_index(np.nanargmin(cube_k), cube_k.shape)
     ax.plot(offsets[j], offsets[i], "r+", ms=16, mew=2, label="grid minimum")
     if np.isfinite(d_alpha_urad) and np.isfinite(d_beta_urad):
