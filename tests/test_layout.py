@@ -36,3 +36,19 @@ def test_every_module_the_page_names_exists():
         p.name for p in (ROOT / "studies").glob("*.py")
     }
     assert named - have == set()
+
+
+def test_no_test_writes_sql_outside_the_stores_own_tests():
+    """SQL lives in monitor/service/store/ and its tests; every other test goes through the store's API."""
+    import re
+
+    sql = re.compile(r"\.db\.execute|\bsqlite3\.connect|\bPRAGMA ")  # InfluxQL and PromQL are the servers' own
+    tests = ROOT / "tests"
+    found = [
+        f"{p.relative_to(ROOT)}:{i}"
+        for p in tests.rglob("*.py")
+        if not p.is_relative_to(tests / "service" / "store") and p.name != "test_layout.py"
+        for i, line in enumerate(p.read_text().splitlines(), 1)
+        if sql.search(line)
+    ]
+    assert found == []

@@ -222,18 +222,15 @@ def test_the_jump_rule_reads_its_kept_noise_and_fits_anew_once_an_earlier_day_is
     settings, now = AlertSettings(), dt.datetime.combine(days[-1], dt.time(6), UTC) + dt.timedelta(days=1)
     first = [f.fingerprint for f in findings_for(store, "j01", settings, now)]
     assert first == [f"jump:j01:{days[355]}"]
-    kept = store.db.execute("SELECT before, body FROM noise_fits WHERE quantity='jump'").fetchall()
-    assert kept and all(dt.date.fromisoformat(r["before"]) <= days[-1] for r in kept)
-    with store.transaction():
-        store.db.execute(
-            "UPDATE noise_fits SET body=json_replace(body, '$.scale', json_array(100.0, 100.0)) "
-            "WHERE quantity='jump'"
-        )
+    kept = store.noise_fits("j01", "jump")
+    assert kept and all(before <= days[-1] for before in kept)
+    for before, body in kept.items():  # each kept fit made 100 times too wide
+        store.keep_noise_fit("j01", "jump", before, {**body, "scale": [100.0, 100.0]})
     assert [f.fingerprint for f in findings_for(store, "j01", settings, now)] == []  # read back, not refitted
     again = days[200]
     store.save_day(
         store.begin_run("j01", again), "j01", again, day_result("j01", again, np.random.default_rng(1))
     )
-    left = store.db.execute("SELECT before FROM noise_fits WHERE quantity='jump'").fetchall()
-    assert all(dt.date.fromisoformat(r["before"]) <= again for r in left)
+    left = store.noise_fits("j01", "jump")
+    assert all(before <= again for before in left)
     assert [f.fingerprint for f in findings_for(store, "j01", settings, now)] == first

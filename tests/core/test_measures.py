@@ -41,13 +41,14 @@ def test_the_declaration_names_unit_and_meaning():
 
 def test_a_new_field_reaches_the_store_columns(tmp_path):
     with Store(tmp_path / "s.sqlite") as store:
-        have = {r[1] for r in store.db.execute("PRAGMA table_info(results)")}
+        have = set(store.result_column_types())
         assert {m.name for m in measures()} <= have  # every declared field has its column
-        added = result_columns(have, WithStrayLight)
-        assert added == ["ALTER TABLE results ADD COLUMN stray_light_k REAL"]
-        for stmt in added:
-            store.db.execute(stmt)
-        cols = {r[1]: r[2] for r in store.db.execute("PRAGMA table_info(results)")}
+        assert result_columns(have, WithStrayLight) == ["ALTER TABLE results ADD COLUMN stray_light_k REAL"]
+        assert store.add_result_columns(WithStrayLight) == [
+            "ALTER TABLE results ADD COLUMN stray_light_k REAL"
+        ]
+        assert store.add_result_columns(WithStrayLight) == []  # once
+        cols = store.result_column_types()
     assert cols["stray_light_k"] == "REAL" and cols["n_samples"] == "INTEGER"
 
 

@@ -73,7 +73,7 @@ def test_a_disk_filled_mid_run_ends_in_one_line_and_keeps_the_store(small_disk, 
     assert status == RunStatus.FAILED and "No space left on device" in reason, reason
     assert not list((mount / "state").rglob(DAY)), "a half-simulated day was left behind"
     with Store(db) as s:
-        assert s.db.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
+        assert s.integrity() == "ok"
         assert s.latest_day("j01") is None
     remount(1000)
     r = run_crisgeo("run", "--config", cfg, "--date", DAY, timeout=600)

@@ -12,6 +12,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Literal, Self
 
+from monitor.core.result import ForOffset
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.schema import MIGRATIONS, result_columns
 
@@ -130,11 +131,57 @@ class Database:
                 for stmt in filter(str.strip, MIGRATIONS[v].split(";")):
                     self.db.execute(stmt)
                 self.db.execute(f"PRAGMA user_version={v + 1}")
-        have = {r[1] for r in self.db.execute("PRAGMA table_info(results)")}
-        if added := result_columns(have):
+        self.add_result_columns()
+
+    def result_column_types(self) -> dict[str, str]:
+        """The columns of the per-FOR results and their SQL types, as the file holds them.
+
+        Returns
+        -------
+        dict
+            Column name to type (``REAL``, ``INTEGER``, ``TEXT``).
+        """
+        return {r[1]: r[2] for r in self.db.execute("PRAGMA table_info(results)")}
+
+    def add_result_columns(self, record: type = ForOffset) -> list[str]:
+        """Give the results a column for every field *record* declares that the file lacks (a new field of a
+        newer version; :func:`monitor.service.store.schema.result_columns`).
+
+        Parameters
+        ----------
+        record : type, optional
+            The per-FOR record whose declared fields the columns follow.
+
+        Returns
+        -------
+        list of str
+            The statements run (none when every field has its column).
+        """
+        added = result_columns(set(self.result_column_types()), record)
+        if added:
             with self.transaction():
                 for stmt in added:
                     self.db.execute(stmt)
+        return added
+
+    def integrity(self) -> str:
+        """SQLite's own check of the file (``PRAGMA integrity_check``): ``ok``, or what is wrong.
+
+        Returns
+        -------
+        str
+            ``ok`` for a sound file.
+        """
+        return "; ".join(str(r[0]) for r in self.db.execute("PRAGMA integrity_check"))
+
+    @property
+    def closed(self) -> bool:  # numpydoc ignore=RT01
+        """Whether the connection is closed."""
+        try:
+            self.db.execute("SELECT 1")
+        except sqlite3.ProgrammingError:
+            return True
+        return False
 
     def _now(self) -> str:
         return self.clock().astimezone(UTC).isoformat(timespec="seconds")

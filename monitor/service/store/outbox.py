@@ -68,6 +68,22 @@ class Outbox:
             )
         ]
 
+    def outbox_errors(self, target: str) -> list[str]:
+        """The last error of each point waiting for *target* (empty where it was never tried), oldest first.
+
+        Parameters
+        ----------
+        target : str
+            The time-series database.
+
+        Returns
+        -------
+        list of str
+            One per point waiting.
+        """
+        rows = self.db.execute("SELECT last_error FROM outbox WHERE target=? ORDER BY id", (target,))
+        return [r[0] or "" for r in rows]
+
     def outbox_size(self, target: str | None = None) -> int:
         """The number of points waiting (for *target*).
 

@@ -317,6 +317,27 @@ class Results:
         ).fetchone()
         return json.loads(r["body"]) if r else None
 
+    def noise_fits(self, satellite: str, quantity: str) -> dict[dt.date, dict]:
+        """Every noise fit of *quantity* kept for *satellite*, by the day it covers the days before.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        quantity : str
+            The quantity watched (its rule's name).
+
+        Returns
+        -------
+        dict
+            ``before`` to the fit as kept.
+        """
+        rows = self.db.execute(
+            "SELECT before, body FROM noise_fits WHERE satellite=? AND quantity=? ORDER BY before",
+            (satellite, quantity),
+        )
+        return {dt.date.fromisoformat(r["before"]): json.loads(r["body"]) for r in rows}
+
     def keep_noise_fit(self, satellite: str, quantity: str, before: dt.date, body: dict) -> None:
         """Keep the noise of *quantity* fitted on every day of *satellite* before *before*; storing a day
         before *before* drops it (:meth:`save_day`).

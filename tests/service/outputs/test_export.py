@@ -207,8 +207,6 @@ def test_the_format_follows_the_name_of_the_file(store_with_days, tmp_path, caps
 
 def test_the_notebook_store_opens_an_existing_store_and_closes_it(tmp_path):
     """``monitor.open_store``: the results as xarray over the SQLite store, which it closes after a block."""
-    import sqlite3
-
     from monitor import open_store
     from monitor.service.store.sqlite import Store
     from monitor.simulate.history import fill_store
@@ -218,8 +216,7 @@ def test_the_notebook_store_opens_an_existing_store_and_closes_it(tmp_path):
     with open_store(tmp_path / "s.sqlite") as nb:
         ds = nb.to_xarray("j01")
         assert ds.sizes["time"] == 2 and ds.sizes["scan_position"] == 30
-    with pytest.raises(sqlite3.ProgrammingError):
-        nb.store.db.execute("SELECT 1")
+    assert nb.store.closed
 
 
 def test_what_each_change_did_exports_as_cf_netcdf_and_csv(store_with_days, tmp_path):

@@ -77,7 +77,7 @@ def test_server_down_then_up_nothing_lost_nothing_twice(cases, tmp_path):
     store = Store(tmp_path / "s.sqlite")
     _queue(store, cfg, result, DAY)
     assert drain_outbox(store, [cfg])[target_name(cfg)] == (0, 30)  # down: points wait
-    error = store.db.execute("SELECT last_error FROM outbox").fetchone()[0]
+    error = store.outbox_errors(target_name(cfg))[0]
     assert error.startswith(f"http://127.0.0.1:{port}: ") and "Error" in error
     _queue(store, cfg, result, DAY + dt.timedelta(days=1))
     with victoria_metrics(tmp_path / "vm", port) as url:
