@@ -42,7 +42,9 @@ def test_no_test_writes_sql_outside_the_stores_own_tests():
     """SQL lives in monitor/service/store/ and its tests; every other test goes through the store's API."""
     import re
 
-    sql = re.compile(r"\.db\.execute|\bsqlite3\.connect|\bPRAGMA ")  # InfluxQL and PromQL are the servers' own
+    sql = re.compile(
+        r"\.db\.execute|\bsqlite3\.connect|\bPRAGMA "
+    )  # InfluxQL and PromQL are the servers' own
     tests = ROOT / "tests"
     found = [
         f"{p.relative_to(ROOT)}:{i}"

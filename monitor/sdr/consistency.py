@@ -58,6 +58,7 @@ from monitor.sdr.granules import (
     GranuleMeta,
     GranuleRef,
     ViirsGeoGranule,
+    ViirsSdrGranule,
 )
 from monitor.sdr.iet import iet_to_datetime
 from monitor.sdr.products import UINT16_FILL_MIN, Product
@@ -285,7 +286,8 @@ def check_raw_counts(path: GranuleRef, name: str, raw: np.ndarray) -> None:
 
 
 def check_spectra(path: GranuleRef, name: str, radiance: np.ndarray) -> None:
-    """CrIS: no FOV spectrum exactly zero in every channel.
+    """CrIS: no FOV spectrum exactly zero in every channel; the spectra mostly positive (a sign lost turns
+    them negative); and not one spectrum copied to every FOV (measured FOVs always differ).
 
     Parameters
     ----------
@@ -300,6 +302,48 @@ def check_spectra(path: GranuleRef, name: str, radiance: np.ndarray) -> None:
     if dead.any():
         raise GranuleError(
             path, name, f"the spectra of {int(dead.sum())} FOV(s) are exactly zero in every channel"
+        )
+    spectra = radiance.reshape(-1, radiance.shape[-1])
+    spectra = spectra[np.isfinite(spectra).all(axis=-1)]
+    if spectra.shape[0] < 2:
+        return
+    if np.median(spectra) < 0:
+        raise GranuleError(path, name, f"median radiance {np.median(spectra):.3g}: the spectra are negative")
+    if np.all(spectra == spectra[0]):
+        raise GranuleError(path, name, f"every one of {spectra.shape[0]} FOVs holds the same spectrum")
+
+
+# A real scene (and the simulator's) changes little from one pixel to the next along a row against its
+# spread over the granule; shuffled pixels or noise change as much as the whole spread.
+STRUCTURE_RATIO = 0.5
+
+
+def check_structure(path: GranuleRef, name: str, bt_k: np.ndarray) -> None:
+    """VIIRS: neighbouring pixels along a row resemble each other, as a scene's do: the median step between
+    neighbours is a small part of the interquartile range of the granule's values.
+
+    Parameters
+    ----------
+    path : GranuleRef
+        The file, named in an error.
+    name : str
+        The dataset.
+    bt_k : numpy.ndarray
+        The band's BT, K, rows x columns.
+    """
+    step = np.abs(np.diff(bt_k[::8], axis=1))  # every eighth row: enough, and cheap
+    step = step[np.isfinite(step)]
+    values = bt_k[::8][np.isfinite(bt_k[::8])]
+    if step.size < 1000 or values.size < 1000:
+        return
+    q25, q75 = np.percentile(values, [25, 75])
+    spread = q75 - q25
+    if spread > 0 and np.median(step) > STRUCTURE_RATIO * spread:
+        raise GranuleError(
+            path,
+            name,
+            f"neighbouring pixels differ by {np.median(step):.2f} K (median) against a spread of "
+            f"{spread:.2f} K: no scene looks like that (shuffled or noise)",
         )
 
 
@@ -323,6 +367,8 @@ def check_relations(path: GranuleRef, product: Product, granule: Granule) -> Non
             check_spectra(path, f"{product.data_group}/{sw}", granule.radiance_sw)
     if product.scans_reserved:
         check_viirs_scan_count(path, product, granule, key)
+    if isinstance(granule, ViirsSdrGranule):
+        check_structure(path, f"{product.data_group}/{product.fields[key].dataset}", granule.bt_k)
     if not isinstance(granule, (CrisGeoGranule, ViirsGeoGranule)):
         return
     has_data = np.isfinite(granule.lat_rad).reshape(len(granule.start_time_us), -1).any(axis=1)  # per scan
@@ -353,6 +399,14 @@ def check_for_times(path: GranuleRef, product: Product, granule: Granule) -> Non
     name = f"{product.data_group}/FORTime"
     if t is None:  # VIIRS GEO: per-scan times only; SDR files: their times are their GEO's
         return
+    if isinstance(granule, CrisGeoGranule):
+        # a FOR that has positions has a time: without one its FOVs would be dropped without a word
+        placed = np.isfinite(granule.lat_rad).any(axis=-1)
+        untimed = placed & (t <= 0)
+        if untimed.any():
+            raise GranuleError(
+                path, name, f"{int(untimed.sum())} FOR(s) geolocated without a time (values {t[untimed][:3]})"
+            )
     t = t.ravel()
     t = t[t > 0]
     lo, hi = granule.meta.start_iet_us - 10_000_000, granule.meta.end_iet_us + 10_000_000

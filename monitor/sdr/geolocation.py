@@ -67,6 +67,14 @@ def check_ephemeris(path: GranuleRef, product: Product, granule: GeoGranule, has
             f"speed {bad:.0f} m/s, not the {SPEED_LIMITS_M_S[0]:.0f}..{SPEED_LIMITS_M_S[1]:.0f} m/s of "
             f"{sat.name}",
         )
+    # the velocity points where the spacecraft goes: from one scan's position towards the next's
+    pos, vel = granule.sc_position_m[has_data], granule.sc_velocity_m_s[has_data]
+    ahead = np.sum(0.5 * (vel[1:] + vel[:-1]) * np.diff(pos, axis=0), axis=-1)
+    ahead = ahead[np.isfinite(ahead)]
+    if ahead.size and np.any(ahead <= 0):
+        raise GranuleError(
+            path, f"{g}/SCVelocity", "the velocity points away from the next scan's position (a sign lost)"
+        )
     att = granule.sc_attitude_rad[has_data] / ARCSEC_RAD
     att = att[np.isfinite(att).all(axis=-1)]
     name = f"{g}/SCAttitude"

@@ -140,7 +140,8 @@ def _granule_meta(path: GranuleRef, h5: h5py.File, product: Product, k: int, pla
 def _check_raw(path: GranuleRef, name: str, raw: np.ndarray | h5py.Dataset, f: Field, rows: int) -> None:
     """Dtype family and full shape of a dataset (an array, or an HDF5 dataset not yet read) against the
     product table."""
-    kinds = {"float": "f", "scaled": "uf", "time": "i", "flags": "u"}[f.kind]
+    # a scaled field is stored as counts (uint16): a float there would be scaled as counts, silently wrong
+    kinds = {"float": "f", "scaled": "u", "time": "i", "flags": "u"}[f.kind]
     if (
         raw.dtype.kind not in kinds
         or raw.dtype.itemsize < {"f": 4, "u": 2 if f.kind == "scaled" else 1, "i": 1}[raw.dtype.kind]

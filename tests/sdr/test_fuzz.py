@@ -92,6 +92,10 @@ PHYSICS = {  # what once read silently, product by product
         "scans cut off",
         "relabelled S-NPP",
         "SCPosition of another time",
+        "FORTime 0",
+        "FORTime -1",
+        "FORTime fill",
+        "SCVelocity negated",
     ),
     "SCRIF": (
         "Ending_Time before the start",
@@ -99,6 +103,8 @@ PHYSICS = {  # what once read silently, product by product
         "scans cut off",
         "relabelled S-NPP",
         "N_Beginning_Orbit_Number of S-NPP",
+        "ES_RealLW negated",
+        "ES_RealLW constant",
     ),
     "SVI05": (
         "N_Ending_Time_IET before the start",
@@ -108,6 +114,9 @@ PHYSICS = {  # what once read silently, product by product
         "N_Beginning_Time_IET a float",
         "N_Granule_ID of the next granule",
         "relabelled S-NPP",
+        "BrightnessTemperature shuffled",
+        "BrightnessTemperature noise",
+        "BrightnessTemperature as float",
     ),
     "GITCO": (
         "MidTime fill",
@@ -123,7 +132,7 @@ PHYSICS = {  # what once read silently, product by product
 }
 PHYSICS["SVM15"] = PHYSICS["SVI05"]  # the M-band products share the I-band ones' relations
 PHYSICS["GMTCO"] = PHYSICS["GITCO"]
-PHYSICS["SVM13"] = tuple(p for p in PHYSICS["SVI05"] if p != "BrightnessTemperature as uint8")
+PHYSICS["SVM13"] = tuple(p for p in PHYSICS["SVI05"] if "as uint8" not in p and "as float" not in p)
 
 
 def _base(cases, prefix: str) -> Path:
@@ -151,6 +160,31 @@ def _physics(path: Path, prefix: str, h5, k: int) -> tuple[str, Path]:
             set_ds("MidTime", lambda t: t[::-1].copy())
         else:
             set_ds("MidTime", lambda t: np.full_like(t, value))
+    elif what.startswith("FORTime"):
+        value = {"FORTime 0": 0, "FORTime -1": -1, "FORTime fill": -993}[what]
+        set_ds("FORTime", lambda t: np.full_like(t, value))
+    elif what == "SCVelocity negated":
+        set_ds("SCVelocity", lambda a: -a)
+    elif what == "ES_RealLW negated":
+        set_ds("ES_RealLW", lambda a: -a)
+    elif what == "ES_RealLW constant":
+        set_ds("ES_RealLW", lambda a: np.broadcast_to(a[0, 0, 0], a.shape).copy())
+    elif what == "BrightnessTemperature shuffled":
+        set_ds(
+            "BrightnessTemperature",
+            lambda a: np.random.default_rng(k).permutation(a.ravel()).reshape(a.shape),
+        )
+    elif what == "BrightnessTemperature noise":
+
+        def noise(a):
+            fill = a >= 65528 if a.dtype.kind == "u" else a < -999
+            lo, hi = np.percentile(a[~fill], [1, 99])
+            return np.where(fill, a, np.random.default_rng(k).uniform(lo, hi, a.shape)).astype(a.dtype)
+
+        set_ds("BrightnessTemperature", noise)
+    elif what == "BrightnessTemperature as float":
+        name = f"{group}/BrightnessTemperature"
+        _replace(h5, name, h5[name][()].astype(np.float32))
     elif what == "StartTime -1":
         set_ds("StartTime", lambda t: np.full_like(t, -1))
     elif what.endswith("constant"):
