@@ -499,7 +499,7 @@ def estimate(
     start, apart = None, (0.0, 0.0)
     if s.fov is not None:
         # the rows apart on the surface through the response the unaligned rows find: the top-hat cone's
-        # rows disagree where the response is narrower than the cone (5 % narrower: 15 urad RMS, not 5)
+        # rows disagree where the response is narrower than the cone (studies/footprint.md)
         _, start, d0 = _estimate(s, cost, contrast)
         apart = rows_apart(s if start is None else replace(s, d_k=d0), cost, contrast)
         s = aligned(s, apart)

@@ -18,8 +18,8 @@ cone scaled to the width the FOR's response reads, :func:`matched_cone`; the val
 grid points, and would pull f to where the rows' turns lie on the grid) is least: a wrong scale leaves each
 cloud edge turned by an amount that grows with its height, which no single turn of a row can undo. Each row
 has its own turn because an error of the EP's FOV positions turns the rows apart, the same for every scene, as
-the parallax of one cloud height does: one turn for the whole FOR would take a lift for it (a case whose rows
-were 250 urad apart chose f = 1.9 for a truth of ~1.3).
+the parallax of one cloud height does: one turn for the whole FOR would take a lift for it
+(studies/clouds-with-height.md).
 f is searched on :data:`FRACTIONS` and refined by the parabola through the least three; it stays within
 them (0 where the cost prefers no lift).
 

@@ -31,7 +31,6 @@ from monitor.sdr.granules import CrisGeoGranule
 from monitor.sdr.products import PRODUCTS
 
 GEO = PRODUCTS["GCRSO"]
-FILL_F32 = -999.3  # IDPS float32 "missing" fill
 _REWRITTEN = {
     "Latitude": ("lat_rad", np.degrees),
     "Longitude": ("lon_rad", np.degrees),

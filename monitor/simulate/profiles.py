@@ -29,21 +29,6 @@ def paper_profile() -> tuple[np.ndarray, np.ndarray]:
     return d_alpha, d_beta
 
 
-def paper_ssm_error_urad() -> tuple[np.ndarray, np.ndarray]:
-    """A paper-like error as scene-mirror angle changes (urad): (d_crosstrack_roll, d_intrack_pitch) (30,).
-
-    The cross-track roll grows to 1000 urad at FOR 30 (the ~1000 urad end-of-scan changes of section 4),
-    the in-track pitch follows a yaw-like ramp from +250 urad at FOR 1 to -250 urad at FOR 30.
-
-    Returns
-    -------
-    d_crosstrack_roll_urad, d_intrack_pitch_urad : numpy.ndarray
-        Shape (30,).
-    """
-    k = np.arange(1, N_FOR + 1)
-    return -1000.0 * np.clip((k - 10) / 20.0, 0.0, None) ** 2, 250.0 * (15.5 - k) / 14.5
-
-
 def random_profile(seed: int) -> tuple[np.ndarray, np.ndarray]:
     """A smooth random profile within about +-1500 urad (low-order polynomials in scan position).
 
