@@ -70,6 +70,7 @@ def test_wheel_installs_the_shipped_files(tmp_path):
         "configs/ep/j01_nominal.yaml",
         "configs/prometheus/crisgeo-rules.yml",
         "systemd/crisgeo.service",
+        "systemd/crisgeo.logrotate",
         "README.md",
         "docs/configuration.md",
     ):
