@@ -117,7 +117,9 @@ class JsonFormatter(logging.Formatter):
         return json.dumps(doc)
 
 
-JOURNAL_SOCKET = "/run/systemd/journal/socket"  # journald's native protocol (systemd-journald.service(8))
+# journald's native protocol (systemd-journald.service(8)); CRISGEO_JOURNAL_SOCKET names another place (a
+# container with the host's journald socket mounted elsewhere)
+JOURNAL_SOCKET = os.environ.get("CRISGEO_JOURNAL_SOCKET", "/run/systemd/journal/socket")
 IDENTIFIER = "crisgeo"
 
 
@@ -257,7 +259,7 @@ def setup(verbose: bool, log_format: str) -> None:
         handler.setFormatter(JsonFormatter())
     elif journal_is_stderr():
         if os.path.exists(JOURNAL_SOCKET):
-            handler = JournalHandler()
+            handler = JournalHandler(JOURNAL_SOCKET)
         else:
             handler.setFormatter(JournalFormatter())
     else:

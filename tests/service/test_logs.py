@@ -12,6 +12,7 @@ import time
 
 import pytest
 
+from benchmarks.servers import wait_for
 from monitor.core import logcontext
 from monitor.service import logs
 from tests.invoke import ROOT
@@ -25,10 +26,9 @@ def captured(monkeypatch):
     buffer = io.StringIO()
 
     def setup(fmt, journal=False):
-        if journal:
-            monkeypatch.setenv("JOURNAL_STREAM", "8:1234")
-        else:
-            monkeypatch.delenv("JOURNAL_STREAM", raising=False)
+        # stderr is the journal's stream, and no journald listens: the lines carry their priority
+        monkeypatch.setattr(logs, "journal_is_stderr", lambda: journal)
+        monkeypatch.setattr(logs, "JOURNAL_SOCKET", "/nonexistent/journal/socket")
         logs.setup(False, fmt)
         root.handlers[0].stream = buffer
         return buffer
@@ -97,25 +97,27 @@ def test_the_daemon_under_systemd_marks_a_failed_run_as_an_error_and_does_not_fl
         "source: {kind: nodd, endpoint: 'http://127.0.0.1:9/{bucket}', retries: 0, timeout_s: 2}\n"
         "http: {listen: 'off'}\n"
     )
-    env = {**os.environ, "JOURNAL_STREAM": "8:1234", "PYTHONPATH": str(ROOT)}
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "monitor.cli", "daemon", "--config", str(cfg)],
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-        cwd=ROOT,
-    )
-    lines = []
-    deadline = time.monotonic() + 60
-    try:
-        for line in proc.stderr:  # until the failed run is logged (the catch-up runs at start)
-            lines.append(line.rstrip("\n"))
-            if ": failed (" in line or time.monotonic() > deadline:
-                break
+    err = tmp_path / "stderr"
+    with open(err, "w") as fh:  # the journal's stream: JOURNAL_STREAM names this stderr; no journald listens
+        st = os.fstat(fh.fileno())
+        env = {
+            **os.environ,
+            "JOURNAL_STREAM": f"{st.st_dev}:{st.st_ino}",
+            "CRISGEO_JOURNAL_SOCKET": str(tmp_path / "no-journald"),
+            "PYTHONPATH": str(ROOT),
+        }
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "monitor.cli", "daemon", "--config", str(cfg)],
+            stderr=fh,
+            env=env,
+            cwd=ROOT,
+        )
+    try:  # until the failed run is logged (the catch-up runs at start)
+        assert wait_for(lambda: ": failed (" in err.read_text(), 60), err.read_text()
     finally:
         proc.send_signal(signal.SIGTERM)
-        _, rest = proc.communicate(timeout=60)
-    lines += rest.splitlines()
+        proc.wait(timeout=60)
+    lines = err.read_text().splitlines()
     failed = [line for line in lines if ": failed (" in line]
     assert failed and all(line.startswith("<3>ERROR") for line in failed), lines
     assert all(line.startswith("<") for line in lines if line.strip()), lines
