@@ -78,9 +78,9 @@ class Config(Section):
     dashboard_url: Url | None = key(None, "Link to the Grafana dashboard, added to every message.")
     mapping_dir: FilePath | None = key(
         None,
-        "Where the daily run writes each day's mapping (crisgeo map: every assessed CrIS FOV's VIIRS scene "
-        "and CrIS BT per band, on the day's assessed geolocation), as SATELLITE/SATELLITE_DAY.nc. None: no "
-        "mapping.",
+        "Where the daily run writes each day's mapping, as the command crisgeo map writes it (every assessed "
+        "CrIS FOV's VIIRS scene and CrIS BT per band, on the day's assessed geolocation), as "
+        "SATELLITE/SATELLITE_DAY.nc. None: no mapping.",
     )
     mapping_bands: Annotated[list[Annotated[str, AfterValidator(_band)]], Field(min_length=1)] = key(
         list(BANDS), "The VIIRS bands of the day's mapping (I5, M13, M15, M16)."
