@@ -1,8 +1,8 @@
 """The geolocation a genuine granule obeys: its ephemeris, its lines of sight, its pixels on the ground.
 
-The orbit radius and speed of the named satellite, an attitude small, smooth and measured; a CrIS FOV's
-ground point plus its range along zenith and azimuth closing on the spacecraft (Wang et al. 2017, section
-2.2, run backwards); a VIIRS scan's middle pixel below the spacecraft; neighbouring VIIRS pixels close on
+The orbit radius and speed of the named satellite, an attitude small, smooth and measured (it changes from
+scan to scan); a CrIS FOV's ground point plus its range along zenith and azimuth closing on the spacecraft
+(Wang et al. 2017, section 2.2, run backwards); a VIIRS scan's middle pixel below the spacecraft; neighbouring VIIRS pixels close on
 the ground. A corrupt granule fails one of them with ``FILE: FIELD: REASON``
 (:func:`monitor.sdr.consistency.check_relations` runs them).
 """
@@ -95,6 +95,11 @@ def check_ephemeris(path: GranuleRef, product: Product, granule: GeoGranule, has
             )
         if not att.any():
             raise GranuleError(path, name, "exactly zero in every scan: not a measured attitude")
+        # a measured attitude jitters (tenths of an arcsec) from scan to scan: identical values are a copy
+        if len(att) > 2 and (att == att[0]).all():
+            raise GranuleError(
+                path, name, f"the same {att[0].tolist()} arcsec in all {len(att)} scans: not a measured attitude"
+            )
 
 
 def check_line_of_sight(path: GranuleRef, product: Product, granule: CrisGeoGranule) -> None:

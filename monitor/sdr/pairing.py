@@ -2,7 +2,8 @@
 the other VIIRS bands (M13, M15, M16 with their M-band GEO) paired where asked for.
 
 Pairing is by file name (``plat_d_t_e_b``, which an SDR and its GEO share) and, for VIIRS coverage,
-by time. Files that cannot be used are returned with their reason, never dropped silently.
+by time. Of several copies of a granule (reprocessed, a later creation time) the newest that reads is used.
+Files that cannot be used are returned with their reason, never dropped silently.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from monitor.sdr.granule_error import GranuleError
 from monitor.sdr.granules import GranuleMeta, GranuleRef, as_ref
 from monitor.sdr.names import parse_name
 from monitor.sdr.products import CRIS_GEO, CRIS_SDR, VIIRS_GEO, VIIRS_SDR, prefixes
-from monitor.sdr.readers import read_metadata
+from monitor.sdr.readers import read_file, read_metadata
 
 COVER_MARGIN = dt.timedelta(seconds=10)
 CONTIGUOUS = dt.timedelta(seconds=5)  # VIIRS granules this close in time form one continuous swath
@@ -154,7 +155,7 @@ def plan(paths: Sequence[str | os.PathLike[str]], bands: Sequence[str] = ("I5",)
     if not files:
         raise PlanError(f"no .h5 files in {', '.join(map(str, paths))}")
     skipped: list[tuple[str, str]] = []
-    by_prefix: ByPrefix = defaultdict(dict)
+    copies: defaultdict[tuple[str, str], list[tuple[Path, GranuleMeta]]] = defaultdict(list)
     platforms: defaultdict[str, int] = defaultdict(int)
     for path in files:
         name = parse_name(path.name)
@@ -171,9 +172,7 @@ def plan(paths: Sequence[str | os.PathLike[str]], bands: Sequence[str] = ("I5",)
             key = (
                 f"{meta.platform}_{meta.granule_id}" if len(metas) > len(name.products) else name.granule_key
             )
-            prev = by_prefix[meta.product].get(key)
-            if prev is None or prev[0].name < path.name:  # the newest creation time wins
-                by_prefix[meta.product][key] = (path, meta)
+            copies[(meta.product, key)].append((path, meta))
     if len(platforms) > 1:
         raise PlanError(
             "mixed satellites: " + ", ".join(f"{p} ({n} files)" for p, n in sorted(platforms.items()))
@@ -184,6 +183,11 @@ def plan(paths: Sequence[str | os.PathLike[str]], bands: Sequence[str] = ("I5",)
             + "; ".join(s[1] if s[0] in s[1] else f"{s[0]}: {s[1]}" for s in skipped[:3])
         )
     satellite = next(iter(platforms))
+    by_prefix: ByPrefix = defaultdict(dict)
+    for (product, key), found in copies.items():
+        chosen = newest_readable(found, skipped)
+        if chosen is not None:
+            by_prefix[product][key] = chosen
     cris = _pair(by_prefix, CRIS_SDR, CRIS_GEO, skipped)
     viirs = _pair(by_prefix, VIIRS_SDR, VIIRS_GEO, skipped)
     result = assemble(satellite, cris, viirs, skipped)
@@ -193,6 +197,41 @@ def plan(paths: Sequence[str | os.PathLike[str]], bands: Sequence[str] = ("I5",)
             paired = _pair(by_prefix, prefixes("viirs_sdr", band), prefixes("viirs_geo", band), skipped)
             result.bands[band] = sorted(paired, key=lambda g: g.start)
     return result
+
+
+def newest_readable(
+    copies: list[tuple[Path, GranuleMeta]], skipped: list[tuple[str, str]]
+) -> tuple[Path, GranuleMeta] | None:
+    """Of the copies of one granule (reprocessed files differ in their creation time, ``_c...``), the newest
+    that reads; each copy left out joins *skipped* with why. A lone copy is taken as it is (it is read in
+    full later, by the assessment), so only duplicates cost a read here.
+
+    Parameters
+    ----------
+    copies : list of (Path, GranuleMeta)
+        The files holding the granule, with its metadata in each.
+    skipped : list
+        Files left out, with why.
+
+    Returns
+    -------
+    (Path, GranuleMeta) or None
+        The copy to use; None when no copy reads.
+    """
+    if len(copies) == 1:
+        return copies[0]
+    chosen = None
+    for path, meta in sorted(copies, key=lambda c: c[0].name, reverse=True):
+        if chosen is not None:
+            skipped.append((str(path), f"an older copy of granule {meta.granule_id}: {chosen[0].name} is used"))
+            continue
+        try:
+            read_file(path)
+        except GranuleError as exc:
+            skipped.append((str(path), f"{exc} (an older copy of the granule is tried)"))
+            continue
+        chosen = (path, meta)
+    return chosen
 
 
 def assemble(satellite: str, cris: list, viirs: list, skipped: list) -> CasePlan:

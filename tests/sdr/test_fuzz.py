@@ -11,7 +11,8 @@ number):
   should have refused it (at most 2 % of the mutants that should be refused, ``SILENT_SHARE``);
 * **undetectable**: a sparse edit of values within the field's physical range (fewer than 2 % of them, by
   the value or bit-flip families); IDPS files carry no checksums, so no relation between fields refuses
-  it. Counted apart, and reported.
+  it. Counted apart, and reported. An attitude's sign is of this kind too, and harmless to the offsets
+  (tested apart).
 
 A sample of mutants is assessed next to the intact files: the result either names the mutant in its
 skipped list, or equals the intact result on every unflagged FOR (1 urad).
@@ -87,6 +88,7 @@ PHYSICS = {  # what once read silently, product by product
         "SatelliteRange constant",
         "SCAttitude zero",
         "SCAttitude x1000",
+        "SCAttitude constant",
         "N_Granule_ID empty",
         "N_Granule_ID of the next granule",
         "scans cut off",
@@ -124,6 +126,7 @@ PHYSICS = {  # what once read silently, product by product
         "MidTime reversed",
         "SCAttitude zero",
         "SCAttitude noise",
+        "SCAttitude constant",
         "N_Granule_ID of the next granule",
         "relabelled S-NPP",
         "Latitude constant",
@@ -482,3 +485,30 @@ def test_assessment_names_the_mutant_or_keeps_its_numbers(cases, tmp_path, prefi
     for a, b in zip(result.fors, intact.fors, strict=True):
         if a.reliable and b.reliable:
             assert abs(a.d_alpha_urad - b.d_alpha_urad) <= 1 and abs(a.d_beta_urad - b.d_beta_urad) <= 1, what
+
+
+def test_a_negated_attitude_moves_no_offset(cases, tmp_path):
+    """An attitude's sign is undetectable in one granule (real roll, pitch and yaw are a few tenths of an
+    arcsec either side of zero, jittering by as much from scan to scan), and harmless: the offsets are
+    perturbations of the line of sight in the body frame, put back on the ground through the same rotation, so
+    a sign error of a few urad in that rotation leaves them as the intact day's within 1 urad (the tolerance
+    of the assessment's sample above)."""
+    base, _, intact = cases.get()
+    work = tmp_path / "data"
+    work.mkdir()
+    for f in base.glob("*.h5"):
+        if f.name.startswith("GCRSO"):
+            shutil.copyfile(f, work / f.name)
+            with h5py.File(work / f.name, "r+") as h5:
+                name = f"{PRODUCTS['GCRSO'].data_group}/SCAttitude"
+                h5[name][...] = -h5[name][()]
+        else:
+            (work / f.name).symlink_to(f)
+    result = assess_paths([work], AssessmentConfig())
+    assert not result.skipped
+    moved = [
+        max(abs(a.d_alpha_urad - b.d_alpha_urad), abs(a.d_beta_urad - b.d_beta_urad))
+        for a, b in zip(result.fors, intact.fors, strict=True)
+        if a.reliable and b.reliable
+    ]
+    assert len(moved) >= 20 and max(moved) <= 1, max(moved)
