@@ -23,7 +23,7 @@ import requests
 
 from monitor.config.alert_settings import AlertSettings
 from monitor.core.vocabulary import Severity
-from monitor.history.records import History
+from monitor.history.records import AlertBook
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
@@ -45,13 +45,13 @@ def timestamp(t: dt.datetime) -> str:
     return t.astimezone(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
 
 
-def alertmanager_alerts(store: History, settings: AlertSettings, now: dt.datetime) -> list[dict]:
+def alertmanager_alerts(store: AlertBook, settings: AlertSettings, now: dt.datetime) -> list[dict]:
     """The Alertmanager API v2 alert objects of the service's current state (see the module docstring).
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertBook
+        The alerts' book in the store.
     settings : AlertSettings
         The ``alerts`` section.
     now : datetime.datetime
@@ -105,14 +105,14 @@ def alertmanager_alerts(store: History, settings: AlertSettings, now: dt.datetim
     return out
 
 
-def post_state(store: History, settings: AlertSettings, now: dt.datetime | None = None) -> int | None:
+def post_state(store: AlertBook, settings: AlertSettings, now: dt.datetime | None = None) -> int | None:
     """Post the alert state to Alertmanager; the number of alerts posted, or None when the post failed
     (logged: the next evaluation posts the state again). Never raises.
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertBook
+        The alerts' book in the store.
     settings : AlertSettings
         The ``alerts`` section.
     now : datetime.datetime, optional

@@ -16,11 +16,13 @@ import time
 from collections.abc import Callable
 from email.message import EmailMessage
 from pathlib import Path
+from typing import Protocol
 
 import requests
 
 from monitor.config.alert_settings import AlertSettings, EmailSettings, SlackSettings
 from monitor.config.keys import env_secret
+from monitor.history.records import Message
 
 LOG = logging.getLogger(__name__)
 
@@ -59,20 +61,18 @@ class LogChannel:
     def __init__(self, path: Path):
         self.path = Path(path)
 
-    def send(self, msg: dict) -> None:
-        """Append *message* to the log file.
+    def send(self, msg: Message) -> None:
+        """Append *msg* to the log file.
 
         Parameters
         ----------
-        msg : dict
-            The message (subject, text, ...).
+        msg : Message
+            The message.
         """
         self.path.parent.mkdir(parents=True, exist_ok=True)
         with open(self.path, "a") as fh:
-            fh.write(
-                f"--- {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} {msg['subject']}\n"
-            )
-            fh.write(msg["text"].rstrip() + "\n")
+            fh.write(f"--- {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} {msg.subject}\n")
+            fh.write(msg.text.rstrip() + "\n")
 
 
 class EmailChannel:
@@ -89,25 +89,24 @@ class EmailChannel:
     def __init__(self, settings: EmailSettings) -> None:
         self.s = settings
 
-    def send(self, msg: dict) -> None:
-        """Send *message* as a multipart e-mail; raises on failure (the queue retries).
+    def send(self, msg: Message) -> None:
+        """Send *msg* as a multipart e-mail with its attachments; raises on failure (the queue retries).
 
         Parameters
         ----------
-        msg : dict
+        msg : Message
             The message.
         """
         s = self.s
         m = EmailMessage()
-        m["Subject"] = msg["subject"]
+        m["Subject"] = msg.subject
         m["From"] = s.sender
         m["To"] = ", ".join(s.to)
-        m.set_content(msg["text"])
-        m.add_alternative(msg["html"], subtype="html")
-        for path in msg.get("attachments", []):
-            p = Path(path)
-            if p.is_file():
-                m.add_attachment(p.read_bytes(), maintype="image", subtype="png", filename=p.name)
+        m.set_content(msg.text)
+        m.add_alternative(msg.html, subtype="html")
+        for a in msg.attachments:
+            maintype, _, subtype = a.mime_type.partition("/")
+            m.add_attachment(a.content, maintype=maintype, subtype=subtype, filename=a.filename)
         user, password = env_secret(s.username_env), env_secret(s.password_env)
         try:
             with smtplib.SMTP(s.host, s.port, timeout=s.timeout_s) as smtp:
@@ -148,22 +147,20 @@ class SlackChannel:
         self.s = settings
         self.sleep = sleep
 
-    def send(self, msg: dict) -> None:
-        """Post *message* to the webhook; raises on failure (the queue retries).
+    def send(self, msg: Message) -> None:
+        """Post *msg* to the webhook; raises on failure (the queue retries).
 
         Parameters
         ----------
-        msg : dict
+        msg : Message
             The message.
         """
         url = env_secret(self.s.webhook_env)
         if not url:
             raise Permanent(f"Slack webhook: environment variable {self.s.webhook_env} is not set")
         payload = {
-            "text": msg["text"][:3500],
-            "blocks": [
-                {"type": "section", "text": {"type": "mrkdwn", "text": b[:2900]}} for b in msg["blocks"]
-            ],
+            "text": msg.text[:3500],
+            "blocks": [{"type": "section", "text": {"type": "mrkdwn", "text": b[:2900]}} for b in msg.blocks],
         }
         delay = 1.0
         for attempt in range(self.s.retries + 1):
@@ -196,7 +193,15 @@ class SlackChannel:
         raise Transient("Slack: retries exhausted")
 
 
-def make_channels(settings: AlertSettings) -> dict:
+class Channel(Protocol):
+    """A way a message leaves the service: :meth:`send` raises :class:`Transient` or :class:`Permanent`."""
+
+    name: str
+
+    def send(self, msg: Message) -> None: ...
+
+
+def make_channels(settings: AlertSettings) -> dict[str, Channel]:
     """The channels the settings configure, by name.
 
     Parameters
@@ -206,10 +211,10 @@ def make_channels(settings: AlertSettings) -> dict:
 
     Returns
     -------
-    dict
+    dict of str to Channel
         {name: channel}.
     """
-    out: dict[str, LogChannel | EmailChannel | SlackChannel] = {}
+    out: dict[str, Channel] = {}
     if settings.log:
         out["log"] = LogChannel(settings.log)
     if settings.email:

@@ -3,6 +3,10 @@
 Lifecycle (Alertmanager's conventions): an alert is notified when it starts firing, repeated while it
 fires (every ``repeat_hours``), and notified when it resolves. Silenced alerts keep their state but
 send nothing. Everything a run decides is committed before any channel is tried.
+
+The engine reads the store as a :class:`~monitor.history.records.History` and writes to it through its
+:class:`~monitor.history.records.AlertBook`; what a message attaches (the trend plot) is handed to it as
+data by whoever calls it (:data:`Attach`), so the alerts know nothing of the report.
 """
 
 from __future__ import annotations
@@ -10,13 +14,13 @@ from __future__ import annotations
 import datetime as dt
 import html
 import logging
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from alerts.alertmanager import post_state
-from alerts.channels import Permanent, Transient, make_channels
+from alerts.channels import Channel, Permanent, Transient, make_channels
 from alerts.rules import (
     CALIBRATION,
     GEOLOCATION,
@@ -32,19 +36,24 @@ from monitor.config.alert_settings import AlertSettings
 from monitor.core.tables import Column, text_table
 from monitor.core.vocabulary import AlertStatus, DeliveryStatus, Notice, Severity
 from monitor.history.changes import all_changes
-from monitor.history.records import Alert, History, Silence
+from monitor.history.records import Alert, AlertBook, AlertStore, Attachment, History, Message, Silence
 
 LOG = logging.getLogger(__name__)
 UTC = dt.timezone.utc
+Attach = Callable[[str], Sequence[Attachment]]
+"""What a satellite's message attaches, asked for only when a message is built (e-mail attaches it)."""
+Notified = tuple[Notice, Finding]  # a finding and why it is sent now (firing, repeat, resolved)
 
 
-def findings_for(store: History, satellite: str, settings: AlertSettings, now: dt.datetime) -> list:
+def findings_for(
+    store: AlertStore, satellite: str, settings: AlertSettings, now: dt.datetime
+) -> list[Finding]:
     """Every rule's findings for *satellite* at *now*.
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertStore
+        The store's records (the jump rule keeps its noise fits in it).
     satellite : str
         The satellite's short name.
     settings : AlertSettings
@@ -92,7 +101,13 @@ def _trend(store: History, satellite: str, days: int = 7) -> list[str]:
     return lines
 
 
-def build_message(store: History, satellite: str, items: list, settings: AlertSettings) -> dict:
+def build_message(
+    store: History,
+    satellite: str,
+    items: Sequence[Notified],
+    settings: AlertSettings,
+    attachments: Sequence[Attachment] = (),
+) -> Message:
     """One message for a satellite: every alert that started, repeats or resolved, with evidence.
 
     Parameters
@@ -101,15 +116,17 @@ def build_message(store: History, satellite: str, items: list, settings: AlertSe
         The store's records.
     satellite : str
         The satellite's short name.
-    items : list
+    items : sequence of (Notice, Finding)
         The alerts that started, repeat or resolved, with their notices.
     settings : AlertSettings
         The ``alerts`` section.
+    attachments : sequence of Attachment, optional
+        What an e-mail attaches.
 
     Returns
     -------
-    dict
-        The message: subject, text, ...
+    Message
+        The message every channel sends.
     """
     counts: dict[str, int] = {}
     for kind, _ in items:
@@ -151,18 +168,13 @@ def build_message(store: History, satellite: str, items: list, settings: AlertSe
     if trend or where:
         blocks.append(_slack_escape("\n".join(["trend:"] + trend + where)))
     body = "\n".join(text)
-    # the report is regenerated between evaluation and delivery; the e-mail attaches the plot if it exists
-    # then
-    attachments = (
-        [str(settings.links.report_dir / satellite / "trend.png")] if settings.links.report_dir else []
+    return Message(
+        subject,
+        body,
+        f"<html><body><h3>{html.escape(subject)}</h3><pre>{html.escape(body)}</pre></body></html>",
+        tuple(blocks),
+        tuple(attachments),
     )
-    return {
-        "subject": subject,
-        "text": body,
-        "html": f"<html><body><h3>{html.escape(subject)}</h3><pre>{html.escape(body)}</pre></body></html>",
-        "blocks": blocks,
-        "attachments": attachments,
-    }
 
 
 def _slack_escape(s: str) -> str:
@@ -170,24 +182,30 @@ def _slack_escape(s: str) -> str:
 
 
 def evaluate(
-    store: History, settings: AlertSettings, satellites: Iterable[str], now: dt.datetime | None = None
-) -> list:
+    store: AlertStore,
+    settings: AlertSettings,
+    satellites: Iterable[str],
+    now: dt.datetime | None = None,
+    attach: Attach | None = None,
+) -> list[tuple[str, Message]]:
     """Update alert state from the rules and queue the messages; returns [(satellite, message)] queued.
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertStore
+        The store's records, and the alerts' book in it.
     settings : AlertSettings
         The ``alerts`` section.
     satellites : iterable of str
         The satellites.
     now : datetime.datetime, optional
         Now, UTC; the clock's by default.
+    attach : callable, optional
+        What a satellite's message attaches (:data:`Attach`); nothing by default.
 
     Returns
     -------
-    list
+    list of (str, Message)
         (satellite, message) queued.
     """
     now = now or dt.datetime.now(UTC)
@@ -196,10 +214,10 @@ def evaluate(
     queued = []
     for sat in satellites:
         found = findings_for(store, sat, settings, now)
-        items = []
+        items: list[Notified] = []
         with store.transaction():
             for f in found:
-                prev = state.get(f.fingerprint)
+                prev = state.get(f.alert_id)
                 quiet = state.silenced(f.rule, sat, now) is not None
                 kind: Notice | None
                 if (
@@ -218,12 +236,12 @@ def evaluate(
                 # a finding of severity info (a step below the practical size) is recorded, never sent
                 notify = kind is not None and not quiet and f.severity != Severity.INFO
                 state.upsert(f, now, notified=notify)
-                if notify:
+                if notify and kind is not None:
                     items.append((kind, f))
-            current = {f.fingerprint for f in found}
+            current = {f.alert_id for f in found}
             for prev in state.firing(sat):
-                if prev.fingerprint not in current:
-                    state.resolve(prev.fingerprint, now)
+                if prev.alert_id not in current:
+                    state.resolve(prev.alert_id, now)
                     if state.silenced(prev.rule, sat, now) is None and prev.severity != Severity.INFO:
                         items.append(
                             (
@@ -231,7 +249,7 @@ def evaluate(
                                 Finding(
                                     prev.rule,
                                     sat,
-                                    prev.severity or "",
+                                    prev.severity or Severity.WARNING,
                                     f"resolved: {prev.summary}",
                                     [],
                                     prev.grp or "",
@@ -242,13 +260,13 @@ def evaluate(
                 LOG.info(
                     "%s %s (%s): %s",
                     str(kind).upper(),
-                    f.fingerprint,
+                    f.alert_id,
                     f.severity,
                     f.summary,
-                    extra={"alert": f.fingerprint},
+                    extra={"alert": f.alert_id},
                 )
             if items:
-                msg = build_message(store, sat, items, settings)
+                msg = build_message(store, sat, items, settings, attach(sat) if attach else ())
                 for channel in settings.channels:
                     state.enqueue(channel, sat, msg, now)
                 queued.append((sat, msg))
@@ -283,7 +301,10 @@ class DeliveryCounts:
 
 
 def deliver(
-    store: History, settings: AlertSettings, now: dt.datetime | None = None, channels: dict | None = None
+    store: AlertBook,
+    settings: AlertSettings,
+    now: dt.datetime | None = None,
+    channels: dict[str, Channel] | None = None,
 ) -> DeliveryCounts:
     """Try every due delivery once; the counts by outcome. Never raises for a channel.
 
@@ -333,20 +354,26 @@ def deliver(
 
 
 def evaluate_and_deliver(
-    store: History, settings: AlertSettings, satellites: Iterable[str], now: dt.datetime | None = None
+    store: AlertStore,
+    settings: AlertSettings,
+    satellites: Iterable[str],
+    now: dt.datetime | None = None,
+    attach: Attach | None = None,
 ) -> DeliveryCounts:
     """Evaluate the rules, queue, deliver; the counts (queued, sent, to retry, failed).
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertStore
+        The store's records, and the alerts' book in it.
     settings : AlertSettings
         The ``alerts`` section.
     satellites : iterable of str
         The satellites.
     now : datetime.datetime, optional
         Now, UTC; the clock's by default.
+    attach : callable, optional
+        What a satellite's message attaches (:data:`Attach`); nothing by default.
 
     Returns
     -------
@@ -354,7 +381,7 @@ def evaluate_and_deliver(
         The counts.
     """
     now = now or dt.datetime.now(UTC)
-    queued = evaluate(store, settings, satellites, now)
+    queued = evaluate(store, settings, satellites, now, attach)
     counts = deliver(store, settings, now)
     counts.queued = len(queued)
     counts.held = held_back(store, settings, now)
@@ -362,14 +389,14 @@ def evaluate_and_deliver(
     return counts
 
 
-def held_back(store: History, settings: AlertSettings, now: dt.datetime) -> tuple[str, ...]:
+def held_back(store: AlertBook, settings: AlertSettings, now: dt.datetime) -> tuple[str, ...]:
     """The alerts firing, sent before *now* and not silenced, that the repeat interval keeps from being sent
     again at *now*: each as ``id (sent T, again from T')``.
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertBook
+        The alerts' book in the store.
     settings : AlertSettings
         The ``alerts`` section.
     now : datetime.datetime
@@ -389,7 +416,7 @@ def held_back(store: History, settings: AlertSettings, now: dt.datetime) -> tupl
         sent = dt.datetime.fromisoformat(a.last_notified)
         if sent < now < sent + repeat:
             out.append(
-                f"{a.fingerprint} (sent {sent:%Y-%m-%d %H:%M}, again from {sent + repeat:%Y-%m-%d %H:%M} UTC)"
+                f"{a.alert_id} (sent {sent:%Y-%m-%d %H:%M}, again from {sent + repeat:%Y-%m-%d %H:%M} UTC)"
             )
     return tuple(out)
 
@@ -409,7 +436,8 @@ class AlertView:
             "severity": a.severity,
             "rule": a.rule,
             "satellite": a.satellite,
-            "fingerprint": a.fingerprint,
+            "alert_id": a.alert_id,
+            "fingerprint": a.alert_id,  # the name before 1.1, kept for scripts (Alertmanager's word for it)
             "started": a.started,
             "resolved": a.resolved,
             "summary": a.summary,
@@ -466,20 +494,20 @@ class AlertsView:
 ALERT_COLUMNS = (
     Column("status", "shown", "", 9, align="<"),
     Column("severity", lambda v: v.alert.severity or "", "", 8, align="<"),
-    Column("alert", "alert.fingerprint", "", 28, align="<"),
+    Column("alert", "alert.alert_id", "", 28, align="<"),
     Column("since", lambda v: v.alert.started or "", "", 25, align="<"),
     Column("resolved", lambda v: v.alert.resolved or "", "", 25, align="<"),
     Column("summary", lambda v: v.alert.summary or "", "", 0, align="<"),
 )
 
 
-def alerts_view(store: History, now: dt.datetime) -> AlertsView:
+def alerts_view(store: AlertBook, now: dt.datetime) -> AlertsView:
     """The :class:`AlertsView` of the store at *now*.
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertBook
+        The alerts' book in the store.
     now : datetime.datetime
         Now, UTC.
 

@@ -21,6 +21,7 @@ import requests
 from alerts.alertmanager import timestamp
 from alerts.channels import Permanent, Transient, make_channels
 from monitor.config.alert_settings import AlertSettings
+from monitor.history.records import Message
 
 ALERTMANAGER_MINUTES = 5  # how long the test alert stays in Alertmanager
 PROBED = ("email", "slack", "alertmanager")  # the channels a test message goes through
@@ -62,7 +63,7 @@ def configured(settings: AlertSettings) -> list[str]:
     return [c for c in PROBED if c in have]
 
 
-def probe_message(now: dt.datetime, prefix: str) -> dict:
+def probe_message(now: dt.datetime, prefix: str) -> Message:
     """The message: marked TEST in its subject and first line, saying that nothing is wrong.
 
     Parameters
@@ -74,7 +75,7 @@ def probe_message(now: dt.datetime, prefix: str) -> dict:
 
     Returns
     -------
-    dict
+    Message
         The message.
     """
     host = socket.gethostname()
@@ -83,13 +84,12 @@ def probe_message(now: dt.datetime, prefix: str) -> dict:
         f"TEST: a test notification of crisgeo on {host}, sent {now:%Y-%m-%d %H:%M:%S} UTC by "
         "`crisgeo alerts test`. No alert is firing because of it; nothing needs doing."
     )
-    return {
-        "subject": subject,
-        "text": text,
-        "html": f"<html><body><h3>{html.escape(subject)}</h3><p>{html.escape(text)}</p></body></html>",
-        "blocks": [f"*TEST* {text}"],
-        "attachments": [],
-    }
+    return Message(
+        subject,
+        text,
+        f"<html><body><h3>{html.escape(subject)}</h3><p>{html.escape(text)}</p></body></html>",
+        (f"*TEST* {text}",),
+    )
 
 
 def probe(
@@ -135,14 +135,14 @@ def probe(
     return out
 
 
-def _alertmanager(settings: AlertSettings, msg: dict, now: dt.datetime) -> None:
+def _alertmanager(settings: AlertSettings, msg: Message, now: dt.datetime) -> None:
     """Post the test alert (labels ``test="true"``, ending in :data:`ALERTMANAGER_MINUTES`)."""
     am = settings.alertmanager
     assert am is not None
     ends = now + dt.timedelta(minutes=ALERTMANAGER_MINUTES)
     alert = {
         "labels": {"alertname": "crisgeo_test", "service": "crisgeo", "severity": "none", "test": "true"},
-        "annotations": {"summary": msg["subject"], "description": msg["text"]},
+        "annotations": {"summary": msg.subject, "description": msg.text},
         "startsAt": timestamp(now),
         "endsAt": timestamp(ends),
     }

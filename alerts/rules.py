@@ -2,13 +2,14 @@
 sigmas, :mod:`alerts.steps`, named after the known change they follow), stale data, failed runs.
 
 Each rule turns what the store holds into findings, one per satellite (and per jump). A finding is
-identified by rule + satellite + group, which is what the alert state tracks.
+identified by rule + satellite + group (its ``alert_id``), which is what the alert state tracks.
 """
 
 from __future__ import annotations
 
 import datetime as dt
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -18,7 +19,7 @@ from monitor.config.alert_settings import RuleSettings
 from monitor.core.constants import N_FOR
 from monitor.core.vocabulary import DONE, SCHEDULER_KINDS, EventKind, Rule, RunStatus, Severity
 from monitor.history.changes import Change
-from monitor.history.records import History, last_success
+from monitor.history.records import AlertStore, History, last_success
 
 UTC = dt.timezone.utc
 CHANGED = {"cris": "CrIS", "viirs": "VIIRS", "common": "CrIS/VIIRS common"}
@@ -89,19 +90,20 @@ CALIBRATION = Watched(
 
 @dataclass
 class Finding:
-    """What a rule found: rule, satellite, severity, summary, detail lines, group."""
+    """What a rule found: rule, satellite, severity, summary, detail lines, group, and what the rule measured
+    (*data*: a step's size, its attribution, for the report and the Alertmanager labels)."""
 
     rule: str
     satellite: str
-    severity: str
+    severity: Severity
     summary: str
-    lines: list = field(default_factory=list)
+    lines: list[str] = field(default_factory=list)
     group: str = ""
-    data: dict = field(default_factory=dict)
+    data: dict[str, Any] = field(default_factory=dict)
 
     @property
-    def fingerprint(self) -> str:  # numpydoc ignore=RT01
-        """rule:satellite, and :group where there is one: the identity the alert state tracks."""
+    def alert_id(self) -> str:  # numpydoc ignore=RT01
+        """rule:satellite, and :group where there is one: the alert's identity, tracked by the alert state."""
         return ":".join(p for p in (self.rule, self.satellite, self.group) if p)
 
 
@@ -202,7 +204,7 @@ class KeptFits:
     daily evaluation reads its replay window, not the whole history. The fits not kept are fitted from one
     read of the history, however many are missing."""
 
-    store: History
+    store: AlertStore
     satellite: str
     watched: Watched
     _history: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (ordinals, values, sigmas)
@@ -235,7 +237,7 @@ class KeptFits:
 
 
 def jump_findings(
-    store: History,
+    store: AlertStore,
     satellite: str,
     changes: list[Change],
     s: RuleSettings,
@@ -248,8 +250,8 @@ def jump_findings(
 
     Parameters
     ----------
-    store : History
-        The store's records.
+    store : AlertStore
+        The store's records (the noise fits are kept in it).
     satellite : str
         The satellite's short name.
     changes : list of Change

@@ -120,8 +120,8 @@ def digest(store: Store, settings: AlertSettings, now: dt.datetime) -> tuple[lis
         SHA-256 of what they say, 12 hex digits.
     """
     found = [f for sat in SATELLITES for f in findings_for(store, sat, settings, now)]
-    said = json.dumps([[f.fingerprint, f.severity, f.summary, f.lines] for f in found])
-    return [f.fingerprint for f in found], hashlib.sha256(said.encode()).hexdigest()[:12]
+    said = json.dumps([[f.alert_id, f.severity, f.summary, f.lines] for f in found])
+    return [f.alert_id for f in found], hashlib.sha256(said.encode()).hexdigest()[:12]
 
 
 def measure(work: Path, years: int) -> dict:

@@ -44,7 +44,7 @@ from monitor.core.result import AssessmentResult, ForOffset
 from monitor.core.vocabulary import Rule
 from monitor.estimation.intercal import NO_FIT
 from monitor.estimation.offsets import NAN4, for_offset
-from monitor.history.records import ForSeries, History
+from monitor.history.records import AlertStore, ForSeries
 from monitor.service.store.sqlite import Store
 from monitor.simulate.profiles import paper_profile
 
@@ -186,7 +186,7 @@ def findings_by_day(case: Case, seed: int, first: int, last: int) -> tuple[list[
         for t in range(first, last + 1):
             store.today = t
             # the rules read only what MemoryHistory has (series, latest day, runs, events, granules)
-            found = findings_for(cast(History, store), "j01", cfg, now + dt.timedelta(days=t + 1))
+            found = findings_for(cast(AlertStore, store), "j01", cfg, now + dt.timedelta(days=t + 1))
             out.append((t, [f for f in found if f.rule == rule]))
     return out, moved
 

@@ -1,17 +1,19 @@
 """What the store gives back, typed: its rows as records, and the interfaces the alerts program against.
 
 The store (:mod:`monitor.service.store`) writes and reads SQLite; whoever reads history through it (the alert
-rules, the report, the CLI) receives these records, and the alerts see the store only as a :class:`History`
-with an :class:`AlertLedger` (so that ``alerts`` needs nothing of ``monitor`` above this floor).
+rules, the report, the CLI) receives these records. The alerts read the store as a :class:`History` and write
+to it through an :class:`AlertBook` alone (their ledger, their noise fits), so that ``alerts`` needs nothing
+of ``monitor`` above this floor; what they queue for a channel is a :class:`Message`.
 """
 
 from __future__ import annotations
 
+import base64
 import datetime as dt
 import json
 from collections.abc import Sequence
 from contextlib import AbstractContextManager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -31,7 +33,7 @@ class FindingRecord(Protocol):
     """What the alert ledger records of a rule's finding (:class:`alerts.rules.Finding`, a floor above)."""
 
     @property  # numpydoc ignore=RT01
-    def fingerprint(self) -> str: ...
+    def alert_id(self) -> str: ...
     @property  # numpydoc ignore=RT01
     def rule(self) -> str: ...
     @property  # numpydoc ignore=RT01
@@ -39,11 +41,85 @@ class FindingRecord(Protocol):
     @property  # numpydoc ignore=RT01
     def group(self) -> str: ...
     @property  # numpydoc ignore=RT01
-    def severity(self) -> str: ...
+    def severity(self) -> Severity: ...
     @property  # numpydoc ignore=RT01
     def summary(self) -> str: ...
     @property  # numpydoc ignore=RT01
-    def lines(self) -> list: ...
+    def lines(self) -> list[str]: ...
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """A file a message carries (an e-mail attaches it): its name, its bytes and their MIME type."""
+
+    filename: str
+    content: bytes
+    mime_type: str = "image/png"
+
+
+@dataclass(frozen=True)
+class Message:
+    """One notification for a satellite, as every channel sends it: the subject, the plain text, its HTML
+    form (e-mail), its Slack blocks (mrkdwn, already escaped), and what an e-mail attaches."""
+
+    subject: str
+    text: str
+    html: str
+    blocks: tuple[str, ...] = ()
+    attachments: tuple[Attachment, ...] = field(default=())
+
+    def to_json(self) -> str:
+        """The message as the delivery queue keeps it (attachments in base64).
+
+        Returns
+        -------
+        str
+            JSON.
+        """
+        return json.dumps(
+            {
+                "subject": self.subject,
+                "text": self.text,
+                "html": self.html,
+                "blocks": list(self.blocks),
+                "attachments": [
+                    {
+                        "filename": a.filename,
+                        "mime_type": a.mime_type,
+                        "base64": base64.b64encode(a.content).decode(),
+                    }
+                    for a in self.attachments
+                ],
+            }
+        )
+
+    @classmethod
+    def from_json(cls, body: str) -> "Message":
+        """The message of a queued delivery's body.
+
+        Parameters
+        ----------
+        body : str
+            JSON as :meth:`to_json` writes it.
+
+        Returns
+        -------
+        Message
+            The message.
+        """
+        d = json.loads(body)
+        return cls(
+            d["subject"],
+            d["text"],
+            d.get("html", ""),
+            tuple(d.get("blocks", ())),
+            # a version before 1.1 queued the report's path instead of the bytes: such a message goes without
+            tuple(
+                Attachment(a["filename"], base64.b64decode(a["base64"]), a["mime_type"])
+                for a in d.get("attachments", ())
+                if isinstance(a, dict)
+            ),
+        )
 
 
 class Row(Protocol):
@@ -70,10 +146,10 @@ def iso(t: dt.datetime) -> str:
 
 @dataclass(frozen=True)
 class Alert:
-    """One alert: identified by *fingerprint* (rule:satellite[:group]); *status* firing or resolved; times ISO
+    """One alert: identified by *alert_id* (rule:satellite[:group]); *status* firing or resolved; times ISO
     8601 UTC; *lines* the finding's detail lines."""
 
-    fingerprint: str
+    alert_id: str
     rule: str
     satellite: str
     grp: str | None
@@ -83,7 +159,7 @@ class Alert:
     last_notified: str | None
     resolved: str | None
     summary: str | None
-    lines: list
+    lines: list[str]
 
     @classmethod
     def from_row(cls, r: Row) -> "Alert":
@@ -99,7 +175,8 @@ class Alert:
         Alert
             The record.
         """
-        d = {k: r[k] for k in cls.__dataclass_fields__}
+        d = {k: r[k] for k in cls.__dataclass_fields__ if k != "alert_id"}
+        d["alert_id"] = r["fingerprint"]  # the store's column keeps its first name
         d["lines"] = json.loads(r["lines"] or "[]")
         d["status"] = AlertStatus(d["status"])
         d["severity"] = Severity(d["severity"]) if d["severity"] else None
@@ -136,14 +213,14 @@ class Silence:
 
 @dataclass(frozen=True)
 class Delivery:
-    """A queued notification: *body* the message (subject, text, ...), *status* pending, sending, sent or
-    failed, after *attempts* tries; times ISO 8601 UTC."""
+    """A queued notification: *body* the message, *status* pending, sending, sent or failed, after *attempts*
+    tries; times ISO 8601 UTC."""
 
     id: int
     channel: str
     satellite: str | None
     subject: str
-    body: dict
+    body: Message
     created: str
     status: DeliveryStatus
     attempts: int
@@ -169,7 +246,7 @@ class Delivery:
         return cls(
             **{
                 **d,
-                "body": json.loads(d["body"]),
+                "body": Message.from_json(d["body"]),
                 "attempts": int(d["attempts"] or 0),
                 "status": DeliveryStatus(d["status"]),
             }
@@ -365,14 +442,14 @@ class AlertLedger(Protocol):
     """The alert state, silences and delivery queue
     (:class:`monitor.service.store.alert_state.AlertState`)."""
 
-    def get(self, fingerprint: str) -> Alert | None: ...
+    def get(self, alert_id: str) -> Alert | None: ...
     def firing(self, satellite: str | None = None) -> list[Alert]: ...
     def all(self) -> list[Alert]: ...
     def upsert(self, finding: FindingRecord, now: dt.datetime, notified: bool) -> None: ...
-    def resolve(self, fingerprint: str, now: dt.datetime) -> None: ...
+    def resolve(self, alert_id: str, now: dt.datetime) -> None: ...
     def silenced(self, rule: str, satellite: str, now: dt.datetime) -> Silence | None: ...
     def silences(self, now: dt.datetime) -> list[Silence]: ...
-    def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime) -> None: ...
+    def enqueue(self, channel: str, satellite: str, message: Message, now: dt.datetime) -> None: ...
     def due(self, now: dt.datetime) -> list[Delivery]: ...
     def claim(self, delivery_id: int, now: dt.datetime, lease_s: float = 600.0) -> bool: ...
     def deliveries(self, status: DeliveryStatus | None = None) -> list[Delivery]: ...
@@ -387,12 +464,11 @@ class AlertLedger(Protocol):
 
 
 class History(Protocol):
-    """What the alert rules and the export read of the store (:class:`monitor.service.store.sqlite.Store`)."""
+    """What the alert rules, the report and the export read of the store
+    (:class:`monitor.service.store.sqlite.Store`); nothing here writes."""
 
     path: Path  # the store's file
 
-    def alert_state(self) -> AlertLedger: ...
-    def transaction(self) -> AbstractContextManager[Any]: ...
     def runs(self, satellite: str | None = None) -> list[Run]: ...
     def runs_since_success(self, satellite: str) -> list[Run]: ...
     def events(self, kind: EventKind | None = None) -> list[Event]: ...
@@ -406,8 +482,20 @@ class History(Protocol):
         fields: Sequence[str] | None = None,
     ) -> ForSeries: ...
     def noise_fit(self, satellite: str, quantity: str, before: dt.date) -> dict | None: ...
-    def keep_noise_fit(self, satellite: str, quantity: str, before: dt.date, body: dict) -> None: ...
     def granules(
         self, satellite: str, day: dt.date | None = None, since: dt.date | None = None
     ) -> list[GranuleRow]: ...
     def fingerprint(self, satellite: str, before: dt.date) -> tuple[dt.date, dict] | None: ...
+
+
+class AlertBook(Protocol):
+    """What the alerts write to the store, and through nothing else: their ledger (state, silences, the
+    delivery queue) and the jump rule's noise fits, in the store's transactions."""
+
+    def alert_state(self) -> AlertLedger: ...
+    def transaction(self) -> AbstractContextManager[Any]: ...
+    def keep_noise_fit(self, satellite: str, quantity: str, before: dt.date, body: dict) -> None: ...
+
+
+class AlertStore(History, AlertBook, Protocol):
+    """The store as the alert engine is handed it: the history it reads and the book it writes."""

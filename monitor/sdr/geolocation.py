@@ -2,9 +2,9 @@
 
 The orbit radius and speed of the named satellite, an attitude small, smooth and measured (it changes from
 scan to scan); a CrIS FOV's ground point plus its range along zenith and azimuth closing on the spacecraft
-(Wang et al. 2017, section 2.2, run backwards); a VIIRS scan's middle pixel below the spacecraft; neighbouring VIIRS pixels close on
-the ground. A corrupt granule fails one of them with ``FILE: FIELD: REASON``
-(:func:`monitor.sdr.consistency.check_relations` runs them).
+(Wang et al. 2017, section 2.2, run backwards); a VIIRS scan's middle pixel below the spacecraft;
+neighbouring VIIRS pixels close on the ground. A corrupt granule fails one of them with
+``FILE: FIELD: REASON`` (:func:`monitor.sdr.consistency.check_relations` runs them).
 """
 
 from __future__ import annotations
@@ -98,7 +98,9 @@ def check_ephemeris(path: GranuleRef, product: Product, granule: GeoGranule, has
         # a measured attitude jitters (tenths of an arcsec) from scan to scan: identical values are a copy
         if len(att) > 2 and (att == att[0]).all():
             raise GranuleError(
-                path, name, f"the same {att[0].tolist()} arcsec in all {len(att)} scans: not a measured attitude"
+                path,
+                name,
+                f"the same {att[0].tolist()} arcsec in all {len(att)} scans: not a measured attitude",
             )
 
 

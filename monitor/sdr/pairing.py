@@ -223,7 +223,9 @@ def newest_readable(
     chosen = None
     for path, meta in sorted(copies, key=lambda c: c[0].name, reverse=True):
         if chosen is not None:
-            skipped.append((str(path), f"an older copy of granule {meta.granule_id}: {chosen[0].name} is used"))
+            skipped.append(
+                (str(path), f"an older copy of granule {meta.granule_id}: {chosen[0].name} is used")
+            )
             continue
         try:
             read_file(path)

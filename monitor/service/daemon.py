@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import datetime as dt
+import functools
 import logging
 import os
 import signal
@@ -28,20 +29,20 @@ from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_MAX_INSTANCES, EVENT_J
 from apscheduler.schedulers.blocking import BlockingScheduler
 from apscheduler.triggers.cron import CronTrigger
 
-from alerts.alertmanager import post_state
-from alerts.engine import deliver, evaluate
+from alerts.engine import evaluate_and_deliver
 from monitor.archive.configured import make_source
 from monitor.config.file import load_config
 from monitor.config.keys import ConfigError, parse_listen
 from monitor.config.model import Config
 from monitor.core import logcontext
 from monitor.core.vocabulary import EventKind, RunStatus
+from monitor.history.records import Attachment
 from monitor.service import allocator
 from monitor.service.endpoint import Endpoint
 from monitor.service.health import Health
 from monitor.service.lock import InstanceLock
 from monitor.service.outputs.metrics import ServiceMetrics
-from monitor.service.outputs.timeseries import drain_outbox
+from monitor.service.outputs.timeseries import Drained, drain_outbox
 from monitor.service.pipeline import RunOutcome, days_to_run, run_day
 from monitor.service.store.sqlite import Store
 from monitor.version import __version__
@@ -160,8 +161,8 @@ class Service:
             allocator.release_freed_memory()
 
     def _after_run(self, store: Store, outcome: RunOutcome) -> None:
-        """After every run: evaluate the alert rules, regenerate the report (it shows the alerts, the
-        e-mails attach its trend plot), deliver what is queued."""
+        """After every run: evaluate the alert rules and deliver what is queued (the e-mails attach the
+        trend plot), then regenerate the report (it shows the alerts)."""
         self.check_alerts(store, report=not self.stop_event.is_set())  # stopping: the next run rewrites it
 
     def regenerate_report(self, store: Store) -> None:
@@ -184,9 +185,38 @@ class Service:
         except Exception:  # noqa: BLE001 - matplotlib, disk or data surprises are logged, not fatal
             LOG.exception("report: could not regenerate %s", self.cfg.report_dir)
 
+    def trend_attachment(self, store: Store, satellite: str) -> tuple[Attachment, ...]:
+        """What an alert message of *satellite* attaches: the report's trend plot, drawn from the store
+        (nothing when the service writes no report, or when the plot cannot be drawn: the message goes
+        without it).
+
+        Parameters
+        ----------
+        store : Store
+            The service's store.
+        satellite : str
+            The satellite's short name.
+
+        Returns
+        -------
+        tuple of Attachment
+            The plot, or nothing.
+        """
+        if not self.cfg.report_dir:
+            return ()
+        from monitor.service.outputs.report.html import options_from_config, trend_attachment
+
+        try:
+            return trend_attachment(store, satellite, options_from_config(self.cfg))
+        except Exception:  # noqa: BLE001 - a plot never holds back an alert
+            LOG.exception(
+                "alerts: could not draw the trend plot of %s; the message goes without it", satellite
+            )
+            return ()
+
     def check_alerts(self, store: Store | None = None, report: bool = False) -> None:
-        """Evaluate the alert rules for every satellite and deliver the queue (regenerating the report in
-        between when *report*); a broken channel never stops the service.
+        """Evaluate the alert rules for every satellite and deliver the queue (then regenerate the report,
+        when *report*); a broken channel never stops the service.
 
         Parameters
         ----------
@@ -199,34 +229,37 @@ class Service:
         own = store is None
         store = store or self.store()
         try:
-            settings = self.cfg.alerts
-            queued = evaluate(store, settings, self.cfg.satellites)
-            if report:
-                self.regenerate_report(store)
-            counts = deliver(store, settings)
-            counts.queued = len(queued)
-            post_state(store, settings)
+            counts = evaluate_and_deliver(
+                store,
+                self.cfg.alerts,
+                self.cfg.satellites,
+                attach=functools.partial(self.trend_attachment, store),
+            )
             if counts.queued or counts.sent or counts.failed:
                 LOG.info("alerts: %s", counts.text())
+            if report:
+                self.regenerate_report(store)
         finally:
             if own:  # the hourly timer: hand back what the evaluation freed
                 store.close()
                 allocator.release_freed_memory()
 
-    def drain_outbox(self) -> dict:
+    def drain_outbox(self) -> dict[str, Drained]:
         """Send the time-series points waiting in the outbox (after an outage they need not wait for the
-        next daily run); returns {target: (sent, left)}.
+        next daily run).
 
         Returns
         -------
-        dict
-            Per target, (sent, left).
+        dict of str to Drained
+            Per target, the points sent and left.
         """
 
         with self.store() as store:
             report = drain_outbox(store, self.cfg.store.publish)
-            if any(sent for sent, _ in report.values()):
-                LOG.info("outbox: %s", report)
+            if any(d.sent for d in report.values()):
+                LOG.info(
+                    "outbox: %s", "; ".join(f"{t}: {d.sent} sent, {d.left} left" for t, d in report.items())
+                )
             return report
 
     def recover(self) -> None:

@@ -52,7 +52,7 @@ def test_alerts_are_posted_routed_and_resolved(tmp_path, receiver):
         assert post_state(store, settings) == 1
         assert len(requests.get(am + "/api/v2/alerts", timeout=10).json()) == 1
         resolved = dt.datetime.now(dt.timezone.utc)
-        state.resolve(finding.fingerprint, resolved)
+        state.resolve(finding.alert_id, resolved)
         assert post_state(store, settings, resolved) == 1
         assert wait_for(lambda: "resolved" in statuses(receiver), 30), receiver.received
         active = requests.get(am + "/api/v2/alerts", params={"active": "true"}, timeout=10).json()

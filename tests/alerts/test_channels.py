@@ -1,19 +1,20 @@
+import dataclasses
 import email
 
 import pytest
 
 from alerts.channels import EmailChannel, Permanent, SlackChannel, Transient
 from monitor.config.alert_settings import EmailSettings, SlackSettings
+from monitor.history.records import Attachment, Message
 from tests.alerts.conftest import PASSWORD, USER
 from tests.invoke import run_crisgeo
 
-MSG = {
-    "subject": "[crisgeo] j01 CRITICAL: 1 firing - spec",
-    "text": "FOR 30: total 4.51 km\nspec 1.5 km",
-    "html": "<pre>FOR 30: total 4.51 km</pre>",
-    "blocks": ["*FIRING spec*\nFOR 30 <4.5 km> & more"],
-    "attachments": [],
-}
+MSG = Message(
+    "[crisgeo] j01 CRITICAL: 1 firing - spec",
+    "FOR 30: total 4.51 km\nspec 1.5 km",
+    "<pre>FOR 30: total 4.51 km</pre>",
+    ("*FIRING spec*\nFOR 30 <4.5 km> & more",),
+)
 
 
 def _email(port, cafile, **kw):
@@ -35,18 +36,18 @@ def test_email_over_starttls_with_login_arrives_intact_once(smtp_server, monkeyp
     inbox, port, cafile = smtp_server
     monkeypatch.setenv("T_SMTP_USER", USER)
     monkeypatch.setenv("T_SMTP_PASS", PASSWORD)
-    png = tmp_path / "trend.png"
-    png.write_bytes(b"\x89PNG\r\n\x1a\n" + b"0" * 100)
-    EmailChannel(_email(port, cafile)).send(dict(MSG, attachments=[str(png)]))
+    png = Attachment("trend.png", b"\x89PNG\r\n\x1a\n" + b"0" * 100)
+    EmailChannel(_email(port, cafile)).send(dataclasses.replace(MSG, attachments=(png,)))
     assert len(inbox.messages) == 1
     env = inbox.messages[0]
     assert env.mail_from == "crisgeo@test" and env.rcpt_tos == ["sdr@test"]
     m = email.message_from_bytes(env.content)
-    assert m["Subject"] == MSG["subject"]
+    assert m["Subject"] == MSG.subject
     parts = {p.get_content_type(): p for p in m.walk()}
-    assert parts["text/plain"].get_payload(decode=True).decode().replace("\r\n", "\n").strip() == MSG["text"]
+    assert parts["text/plain"].get_payload(decode=True).decode().replace("\r\n", "\n").strip() == MSG.text
     assert "<pre>" in parts["text/html"].get_payload(decode=True).decode()
-    assert parts["image/png"].get_payload(decode=True) == png.read_bytes()
+    assert parts["image/png"].get_payload(decode=True) == png.content
+    assert parts["image/png"].get_filename() == "trend.png"
     assert PASSWORD.encode() not in env.content
 
 
@@ -132,7 +133,7 @@ def test_concurrent_deliveries_send_a_message_once(webhook, tmp_path, monkeypatc
     path = tmp_path / "s.sqlite"
     now = dt.datetime(2026, 1, 1, tzinfo=dt.timezone.utc)
     store = Store(path)
-    AlertState(store).enqueue("slack", "j01", {"subject": "s", "text": "t", "blocks": []}, now)
+    AlertState(store).enqueue("slack", "j01", Message("s", "t", ""), now)
     store.close()
     both_saw_it = threading.Barrier(2, timeout=30)
     real_due = AlertState.due
@@ -181,7 +182,7 @@ def test_verbose_logs_never_show_the_webhook(webhook, tmp_path):
     AlertState(store).enqueue(
         "slack",
         "j01",
-        {"subject": "s", "text": "t", "blocks": []},
+        Message("s", "t", ""),
         dt.datetime.now(dt.timezone.utc) - dt.timedelta(minutes=1),
     )
     store.close()

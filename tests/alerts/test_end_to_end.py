@@ -62,9 +62,11 @@ alerts:
     assert "report: https://crisgeo.test/report/j01/" in body and str(tmp_path) not in body
     assert "FOR 30" in webhook.received[0]["text"]
     assert "https://crisgeo.test/report/j01/" in json.dumps(webhook.received[0])
-    # the report was regenerated before the message left: it shows the alert, the e-mail carries its plot
+    # the report, regenerated after the evaluation, shows the alert; the e-mail carries the trend plot,
+    # handed to the engine as data (drawn from the store, not read from the report's folder)
     assert "FOR 30" in (tmp_path / "report" / "j01" / "index.html").read_text()
-    assert [p.get_filename() for p in m.iter_attachments()] == ["trend.png"]
+    (plot,) = m.iter_attachments()
+    assert plot.get_filename() == "trend.png" and plot.get_content().startswith(b"\x89PNG")
     assert webhook.url not in (tmp_path / "alerts.log").read_text()
 
     assert service.run("j01", DAY1).status == "ok"  # the same day again: nothing new

@@ -201,8 +201,8 @@ def test_a_step_at_an_ep_upload_is_paged_once_naming_it_and_a_small_one_only_rec
             sent += [(i, m) for _, m in evaluate(big, cfg, ["j01"], now)]
             assert evaluate(small, cfg, ["j01"], now) == []
     (first, message), *_ = sent
-    assert 80 <= first <= 82 and "step from " + str(upload) in message["text"]
-    assert "EP v116" in message["text"] and "no known change" not in message["text"]
+    assert 80 <= first <= 82 and "step from " + str(upload) in message.text
+    assert "EP v116" in message.text and "no known change" not in message.text
     (alert,) = [a for a in big.alert_state().all() if a.rule == "jump"]
     assert alert.grp == str(upload) and alert.severity == "warning"
     (recorded,) = [a for a in small.alert_state().all() if a.rule == "jump" and a.grp == str(upload)]
@@ -220,17 +220,17 @@ def test_the_jump_rule_reads_its_kept_noise_and_fits_anew_once_an_earlier_day_is
     days = fill_store(Store(tmp_path / "fresh.sqlite"), ["j01"], DAY, 365, step_day=355, step_urad=60.0)
     store = Store(tmp_path / "fresh.sqlite")
     settings, now = AlertSettings(), dt.datetime.combine(days[-1], dt.time(6), UTC) + dt.timedelta(days=1)
-    first = [f.fingerprint for f in findings_for(store, "j01", settings, now)]
+    first = [f.alert_id for f in findings_for(store, "j01", settings, now)]
     assert first == [f"jump:j01:{days[355]}"]
     kept = store.noise_fits("j01", "jump")
     assert kept and all(before <= days[-1] for before in kept)
     for before, body in kept.items():  # each kept fit made 100 times too wide
         store.keep_noise_fit("j01", "jump", before, {**body, "scale": [100.0, 100.0]})
-    assert [f.fingerprint for f in findings_for(store, "j01", settings, now)] == []  # read back, not refitted
+    assert [f.alert_id for f in findings_for(store, "j01", settings, now)] == []  # read back, not refitted
     again = days[200]
     store.save_day(
         store.begin_run("j01", again), "j01", again, day_result("j01", again, np.random.default_rng(1))
     )
     left = store.noise_fits("j01", "jump")
     assert all(before <= again for before in left)
-    assert [f.fingerprint for f in findings_for(store, "j01", settings, now)] == first
+    assert [f.alert_id for f in findings_for(store, "j01", settings, now)] == first

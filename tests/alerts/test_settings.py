@@ -92,6 +92,6 @@ def test_the_subject_prefix_marks_every_message(tmp_path):
     finding = Finding("stale", "j01", "warning", "no successful assessment for 40 h")
     with Store(tmp_path / "s.sqlite") as store:
         message = build_message(store, "j01", [("firing", finding)], settings)
-        assert message["subject"].startswith("[crisgeo test] j01 WARNING")
+        assert message.subject.startswith("[crisgeo test] j01 WARNING")
         default = build_message(store, "j01", [("firing", finding)], AlertSettings())
-        assert default["subject"].startswith("[crisgeo] j01")
+        assert default.subject.startswith("[crisgeo] j01")

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from benchmarks.servers import wait_for
+from monitor.history.records import Message
 from monitor.service.store.sqlite import Store
 from tests.invoke import CRISGEO, ROOT, run_crisgeo
 
@@ -313,13 +314,13 @@ def test_the_alert_log_rotates_and_the_next_message_starts_a_new_file(tmp_path):
     conf = tmp_path / "crisgeo.logrotate"
     conf.write_text(shipped.replace("/var/log/crisgeo/alerts.log", str(alert_log)))
     channel = LogChannel(alert_log)
-    channel.send({"subject": "first", "text": "first message"})
+    channel.send(Message("first", "first message", ""))
     r = subprocess.run(
         ["logrotate", "-f", "-s", str(tmp_path / "state"), str(conf)], capture_output=True, text=True
     )
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "alerts.log.1").exists() and "first message" in (tmp_path / "alerts.log.1").read_text()
-    channel.send({"subject": "second", "text": "second message"})
+    channel.send(Message("second", "second message", ""))
     assert "second message" in alert_log.read_text() and "first message" not in alert_log.read_text()
 
 

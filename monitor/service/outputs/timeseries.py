@@ -26,6 +26,7 @@ import datetime as dt
 import logging
 import math
 from collections.abc import Iterable
+from typing import NamedTuple
 
 import requests
 from influxdb_client import InfluxDBClient, Point, WritePrecision
@@ -253,7 +254,14 @@ WRITERS: dict[str, type[Influx2Writer] | type[Influx1Writer]] = {
 }
 
 
-def drain_outbox(store: Store, publish_cfgs: list[PublishConfig], batch: int = 5000) -> dict:
+class Drained(NamedTuple):
+    """What one drain of the outbox did for a target: points sent, points left waiting."""
+
+    sent: int
+    left: int
+
+
+def drain_outbox(store: Store, publish_cfgs: list[PublishConfig], batch: int = 5000) -> dict[str, Drained]:
     """Send every queued point to its server; returns {target: (sent, left)}. Never raises for a server.
 
     Parameters
@@ -267,8 +275,8 @@ def drain_outbox(store: Store, publish_cfgs: list[PublishConfig], batch: int = 5
 
     Returns
     -------
-    dict
-        {target: (sent, left)}.
+    dict of str to Drained
+        Per target, the points sent and left.
     """
     report = {}
     for cfg in publish_cfgs:
@@ -295,5 +303,5 @@ def drain_outbox(store: Store, publish_cfgs: list[PublishConfig], batch: int = 5
                 sent += len(rows)
         finally:
             writer.close()
-        report[target] = (sent, store.outbox_size(target))
+        report[target] = Drained(sent, store.outbox_size(target))
     return report

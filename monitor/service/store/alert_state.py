@@ -9,7 +9,7 @@ from contextlib import AbstractContextManager
 from typing import Any, Protocol
 
 from monitor.core.vocabulary import AlertStatus, DeliveryStatus
-from monitor.history.records import Alert, Delivery, FindingRecord, Silence, iso
+from monitor.history.records import Alert, Delivery, FindingRecord, Message, Silence, iso
 
 
 class SilenceError(ValueError):
@@ -26,7 +26,7 @@ class Database(Protocol):
 
 
 class AlertState:
-    """Alert rows keyed by fingerprint (rule:satellite:group), silences and queued deliveries.
+    """Alert rows keyed by the alert's identity (rule:satellite:group), silences and queued deliveries.
 
     Parameters
     ----------
@@ -38,12 +38,12 @@ class AlertState:
         self.store = store
         self.db = store.db
 
-    def get(self, fingerprint: str) -> Alert | None:
-        """The alert row of *fingerprint* (rule:satellite:group), or None.
+    def get(self, alert_id: str) -> Alert | None:
+        """The alert row of *alert_id* (rule:satellite:group), or None.
 
         Parameters
         ----------
-        fingerprint : str
+        alert_id : str
             rule:satellite:group.
 
         Returns
@@ -51,7 +51,7 @@ class AlertState:
         Alert or None
             The row.
         """
-        r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (fingerprint,)).fetchone()
+        r = self.db.execute("SELECT * FROM alert_state WHERE fingerprint=?", (alert_id,)).fetchone()
         return Alert.from_row(r) if r else None
 
     def firing(self, satellite: str | None = None) -> list[Alert]:
@@ -95,13 +95,13 @@ class AlertState:
         notified : bool
             Stamp the notification time.
         """
-        prev = self.get(finding.fingerprint)
+        prev = self.get(finding.alert_id)
         started = prev.started if prev and prev.status == AlertStatus.FIRING else iso(now)
         last = iso(now) if notified else (prev.last_notified if prev else None)
         self.db.execute(
             "INSERT OR REPLACE INTO alert_state VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             (
-                finding.fingerprint,
+                finding.alert_id,
                 finding.rule,
                 finding.satellite,
                 finding.group,
@@ -115,19 +115,19 @@ class AlertState:
             ),
         )
 
-    def resolve(self, fingerprint: str, now: dt.datetime) -> None:
+    def resolve(self, alert_id: str, now: dt.datetime) -> None:
         """Mark an alert resolved at *now*.
 
         Parameters
         ----------
-        fingerprint : str
+        alert_id : str
             rule:satellite:group.
         now : datetime.datetime
             Now, UTC.
         """
         self.db.execute(
             "UPDATE alert_state SET status=?, resolved=? WHERE fingerprint=?",
-            (AlertStatus.RESOLVED, iso(now), fingerprint),
+            (AlertStatus.RESOLVED, iso(now), alert_id),
         )
 
     # -- silences
@@ -221,8 +221,8 @@ class AlertState:
         ]
 
     # -- delivery queue
-    def enqueue(self, channel: str, satellite: str, message: dict, now: dt.datetime) -> None:
-        """Queue *message* (subject, text, ...) for delivery on *channel*.
+    def enqueue(self, channel: str, satellite: str, message: Message, now: dt.datetime) -> None:
+        """Queue *message* for delivery on *channel*.
 
         Parameters
         ----------
@@ -230,8 +230,8 @@ class AlertState:
             ``email``, ``slack``, ``alertmanager``.
         satellite : str
             The satellite's short name.
-        message : dict
-            Subject, text, ...
+        message : Message
+            The notification.
         now : datetime.datetime
             Now, UTC.
         """
@@ -241,8 +241,8 @@ class AlertState:
             (
                 channel,
                 satellite,
-                message["subject"],
-                json.dumps(message),
+                message.subject,
+                message.to_json(),
                 iso(now),
                 DeliveryStatus.PENDING,
                 iso(now),

@@ -7,6 +7,7 @@ import pytest
 
 from alerts.rules import Finding
 from monitor.core.vocabulary import EventKind
+from monitor.history.records import Attachment, Message
 from monitor.service.store.alert_state import AlertState, SilenceError
 from monitor.service.store.schema import MIGRATIONS
 from monitor.service.store.sqlite import Store
@@ -23,8 +24,8 @@ def test_alert_lifecycle_keeps_its_start(tmp_path):
         (row,) = state.firing("j01")
         assert row.started == T0.isoformat() and row.last_notified == T0.isoformat()
         assert state.firing("npp") == []
-        state.resolve(f.fingerprint, T0 + dt.timedelta(days=1))
-        assert state.firing() == [] and state.get(f.fingerprint).status == "resolved"
+        state.resolve(f.alert_id, T0 + dt.timedelta(days=1))
+        assert state.firing() == [] and state.get(f.alert_id).status == "resolved"
 
 
 def test_silence_matches_rule_and_satellite_until_it_ends(tmp_path):
@@ -56,13 +57,23 @@ def test_a_silence_needs_a_reason_and_a_future_end_and_lifts_only_what_is_in_for
 def test_a_delivery_is_claimed_once_and_retried_after_its_lease(tmp_path):
     with Store(tmp_path / "s.sqlite") as store:
         state = AlertState(store)
-        state.enqueue("slack", "j01", {"subject": "s", "text": "t"}, T0)
+        state.enqueue("slack", "j01", Message("s", "t", ""), T0)
         (d,) = state.due(T0)
         assert state.claim(d.id, T0) and not state.claim(d.id, T0)  # a second sender gets nothing
         assert state.due(T0 + dt.timedelta(seconds=599)) == []
         assert [x.id for x in state.due(T0 + dt.timedelta(seconds=601))] == [d.id]  # the sender died
         state.mark(d.id, "sent", T0)
         assert state.deliveries("sent")[0].attempts == 1 and state.due(T0 + dt.timedelta(days=1)) == []
+
+
+def test_a_queued_message_comes_back_whole_with_its_attachment(tmp_path):
+    png = Attachment("trend.png", bytes(range(256)) * 4)
+    msg = Message("[crisgeo] j01 WARNING", "FOR 30\nmore", "<pre>FOR 30</pre>", ("*FIRING*",), (png,))
+    with Store(tmp_path / "s.sqlite") as store:
+        state = AlertState(store)
+        state.enqueue("email", "j01", msg, T0)
+        (d,) = state.due(T0)
+        assert d.body == msg and d.subject == msg.subject
 
 
 def test_a_store_of_schema_2_with_the_old_alert_tables_keeps_its_alerts(tmp_path):
@@ -84,7 +95,7 @@ def test_a_store_of_schema_2_with_the_old_alert_tables_keeps_its_alerts(tmp_path
     with Store(path) as store:
         assert store.schema_version == len(MIGRATIONS)
         (alert,) = AlertState(store).firing("j01")
-        assert alert.summary == "old" and alert.fingerprint == "spec:j01"  # no trailing separator
+        assert alert.summary == "old" and alert.alert_id == "spec:j01"  # no trailing separator
         tables = {r[0] for r in store.db.execute("SELECT name FROM sqlite_master WHERE type='table'")}
         assert "alert_meta" not in tables and {"silences", "deliveries"} <= tables
         (event,) = store.events(EventKind.RUN_FAILED)

@@ -24,6 +24,7 @@ import html
 import json
 import logging
 import os
+import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,7 +41,7 @@ from monitor.core.satellites import SATELLITES
 from monitor.core.tables import FOR_COLUMNS, REPORT
 from monitor.core.vocabulary import DEFAULT_COST, Cost, Rule, RunStatus
 from monitor.history.changes import Change, all_changes
-from monitor.history.records import Alert, ForSeries, Run
+from monitor.history.records import Alert, Attachment, ForSeries, Run
 from monitor.service.outputs.report import plots
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
@@ -226,6 +227,16 @@ def _precision(p: DayPrecision | None) -> str:
     return f"<p>Precision of the latest run: {_e(p.text())}.</p>"
 
 
+def _in_period(changes: Iterable[Change], opts: ReportOptions) -> list[Change]:
+    """The known changes within the report's period."""
+    return [
+        c
+        for c in changes
+        if (opts.since is None or c.time.date() >= opts.since)
+        and (opts.until is None or c.time.date() <= opts.until)
+    ]
+
+
 def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions) -> dict:
     """Write ``out/<satellite>/`` and return a summary for the index.
 
@@ -250,12 +261,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
     name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
     series = store.series(satellite, opts.since, opts.until)
     known = all_changes(store, satellite, opts.calendar)
-    changes = [
-        c
-        for c in known
-        if (opts.since is None or c.time.date() >= opts.since)
-        and (opts.until is None or c.time.date() <= opts.until)
-    ]
+    changes = _in_period(known, opts)
     state = AlertState(store)
     firing = state.firing(satellite)
     alerts = [a for a in state.all() if a.satellite == satellite and a.started]
@@ -320,21 +326,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         marks,
         span,
     )
-    started = [_alert_day(a, store.runs(satellite)) for a in alerts]
-    alert_days = sorted(
-        {dt.datetime.combine(d, dt.time()) for d in started if d is not None and days[0] <= d <= days[-1]}
-    )
-    plots.trend_lines(
-        sat_dir / "trend.png",
-        days,
-        opts.trend_fors,
-        arrays["in_track_km"],
-        arrays["cross_track_km"],
-        opts.spec_km,
-        marks,
-        alert_days,
-        span,
-    )
+    _trend(store, satellite, series, marks, alerts, opts, span, sat_dir / "trend.png")
     calibration_html = _calibration(store, satellite, name, series, marks, span, sat_dir)
     stored = store.cost_cube(satellite, latest)
     cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
@@ -450,6 +442,66 @@ def _calibration(
         f"{CALIBRATION_REFERENCE_K:g} K), fitted over the FOR's samples; the trend shows the median over "
         "the reliable FORs and their quartiles. A step fires the calibration_jump alert.</p>"
     )
+
+
+def _trend(
+    store: Store,
+    satellite: str,
+    series: ForSeries,
+    marks: plots.Marks,
+    alerts: Sequence[Alert],
+    opts: ReportOptions,
+    span: str,
+    path: Path,
+) -> Path:
+    """``trend.png``: the chosen FORs over the period, with the known changes and the days alerts started."""
+    days = series.days
+    started = [_alert_day(a, store.runs(satellite)) for a in alerts]
+    alert_days = sorted(
+        {dt.datetime.combine(d, dt.time()) for d in started if d is not None and days[0] <= d <= days[-1]}
+    )
+    return plots.trend_lines(
+        path,
+        days,
+        opts.trend_fors,
+        series.values["in_track_km"],
+        series.values["cross_track_km"],
+        opts.spec_km,
+        marks,
+        alert_days,
+        span,
+    )
+
+
+def trend_attachment(store: Store, satellite: str, opts: ReportOptions) -> tuple[Attachment, ...]:
+    """The report's trend plot of *satellite* as an alert e-mail attaches it (none without data): drawn from
+    the store as it stands, so an alert that has just started is marked on it.
+
+    Parameters
+    ----------
+    store : Store
+        The store.
+    satellite : str
+        The satellite's short name.
+    opts : ReportOptions
+        The report's options (its period, its chosen FORs).
+
+    Returns
+    -------
+    tuple of Attachment
+        ``trend.png``, or nothing.
+    """
+    series = store.series(satellite, opts.since, opts.until)
+    if not len(series):
+        return ()
+    name = f"{SATELLITES[satellite].name if satellite in SATELLITES else satellite} ({satellite})"
+    changes = _in_period(all_changes(store, satellite, opts.calendar), opts)
+    marks = [(c.time.replace(tzinfo=None), c.instrument, c.description) for c in changes]
+    alerts = [a for a in AlertState(store).all() if a.satellite == satellite and a.started]
+    span = f"{name}, {series.days[0].isoformat()} .. {series.days[-1].isoformat()} ({len(series)} days)"
+    with tempfile.TemporaryDirectory(prefix="crisgeo-trend-") as tmp:
+        path = _trend(store, satellite, series, marks, alerts, opts, span, Path(tmp) / "trend.png")
+        return (Attachment("trend.png", path.read_bytes(), "image/png"),)
 
 
 def _drop_figures_except(sat_dir: Path, keep: set) -> None:
