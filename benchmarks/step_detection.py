@@ -43,7 +43,7 @@ from monitor.core.constants import N_FOR
 from monitor.core.result import AssessmentResult, ForOffset
 from monitor.core.vocabulary import Rule
 from monitor.estimation.intercal import NO_FIT
-from monitor.estimation.offsets import NAN4, for_offset
+from monitor.estimation.offsets import Ground, Pair, Widths, for_offset
 from monitor.history.records import AlertStore, ForSeries
 from monitor.service.store.sqlite import Store
 from monitor.simulate.profiles import paper_profile
@@ -261,14 +261,15 @@ def store_check(years: int) -> int:
                     for_offset(
                         k + 1,
                         100,
-                        (y[t, k, 0], y[t, k, 1]),
-                        (s[t, k, 0], s[t, k, 1]),
-                        NAN4,
-                        (0.1, 0.2),
+                        Pair(y[t, k, 0], y[t, k, 1], s[t, k, 0], s[t, k, 1]),
+                        Ground(),
+                        0.1,
+                        0.2,
                         NO_FIT,
-                        NAN4,
-                        NAN4,
-                        (np.nan, np.nan),
+                        Widths(),
+                        Pair(),
+                        np.nan,
+                        np.nan,
                         (),
                     )  # fmt: skip
                     for k in range(N_FOR)

@@ -197,10 +197,15 @@ def cost_and_offsets(
         per_for = PerFor(lambda k: blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f))
         m_per_k = f * probe_m_per_k
     used = samples if pairs is None else pairs[0]
+    # parallax.sensitivity's order: FOR alpha, beta; rows alpha, beta
+    sigma_alpha, sigma_beta, sigma_rows_alpha, sigma_rows_beta = (np.nan_to_num(spread) * cfg.step_urad).T
     lift = DayLift(
         m_per_k,
-        np.nan_to_num(spread) * cfg.step_urad,
         np.array([_cold_height_km(_cris_k(used, k), m_per_k) for k in range(N_FOR)]),
+        sigma_alpha,
+        sigma_beta,
+        sigma_rows_alpha,
+        sigma_rows_beta,
     )
     day = day_offsets(
         per_for,

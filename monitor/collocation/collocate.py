@@ -169,7 +169,7 @@ def view_reach_rad(
 
 
 def _window_half_sizes(
-    piece: SwathPiece, col0: np.ndarray, range_m: np.ndarray, cos_zen: np.ndarray, rho: float
+    piece: SwathPiece, col0: np.ndarray, range_m: np.ndarray, cos_zen: np.ndarray, reach_angle_rad: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Row and column half-widths (pixels) of the search window around each FOV centre pixel.
 
@@ -178,8 +178,8 @@ def _window_half_sizes(
     """
     cz = np.maximum(cos_zen, 0.2)
     relief = piece.max_height_m * np.sqrt(1.0 - cz * cz) / cz
-    d_track = rho * range_m + relief
-    d_scan = rho * range_m / cz + relief
+    d_track = reach_angle_rad * range_m + relief
+    d_scan = reach_angle_rad * range_m / cz + relief
     adv = piece.advance_m[col0]
     det = piece.det_step_m[col0]
     overlap = np.clip(1.0 - adv / (VIIRS_DETECTORS * det), 0.0, 1.0)
@@ -450,7 +450,7 @@ def cone_sums(
             f"perturbation grid of {m} x {m} steps of {offsets_rad[1] - offsets_rad[0]:.3g} rad: n^2 s "
             f"exceeds {MAX_GRID_SPREAD_RAD} rad, beyond the compiled kernel's index guess"
         )
-    rho = reach_rad(offsets_rad, radii_rad)
+    reach_angle_rad = reach_rad(offsets_rad, radii_rad)  # how far from the LOS a cone reaches
     los0 = los_ecef(mat, alpha_rad, beta_rad)
     t = wgs84.intersect_ellipsoid(sat_m, los0)
     ok_fov = np.isfinite(t)
@@ -467,7 +467,7 @@ def cone_sums(
     whole = np.zeros((nf, len(radii_rad)), np.complex128)
     # a pixel this close to the LOS lies in every perturbed cone of a disc: the grid's reach (as the
     # search's) from the disc's edge; 2 where the grid reaches farther than the disc
-    spread = rho - max(radii_rad)
+    spread = reach_angle_rad - max(radii_rad)
     edge = np.asarray(radii_rad[::-1], np.float64) - spread
     cos_whole = np.where(edge > 0, np.cos(edge), 2.0)
     rendered_pieces = sum(p.rendered is not None for p in swath.pieces)
@@ -485,13 +485,14 @@ def cone_sums(
         if piece.rendered is not None:
             rendered, (view, view_w) = piece.rendered, _views(piece.view_alpha_rad, alpha_rad)
         row0, col0, dist = piece.nearest(centre)
-        hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, rho)
+        hr, hc, reach_m = _window_half_sizes(piece, col0, rng, cz, reach_angle_rad)
         # a FOV whose cones cannot reach this granule's nearest usable block skips it
         far = ~ok_fov | (dist > reach_m + 2 * BLOCK_PX * piece.col_spacing_m[col0] + piece.advance_m[col0])
         with KERNEL_LOCK, numba.parallel_chunksize(FOVS_PER_TASK):
             _accumulate(
                 piece.ecef_m, piece.radiance, piece.area_vec_m2, piece.block_centre_m, piece.block_radius_m,
-                sat_m, mat, los0, rho * 1.01, tan_a, tan_b, box, row0 // BLOCK_PX, col0 // BLOCK_PX,
+                sat_m, mat, los0, reach_angle_rad * 1.01, tan_a, tan_b, box,
+                row0 // BLOCK_PX, col0 // BLOCK_PX,
                 np.where(far, -1, hr // BLOCK_PX + 1), hc // BLOCK_PX + 1, ring_g2, cos_whole, order,
                 rendered, view, view_w, acc, acc_rendered, whole, whole_rendered,
             )  # fmt: skip

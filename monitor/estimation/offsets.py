@@ -31,7 +31,36 @@ from monitor.estimation import jackknife
 from monitor.estimation.estimate import ForEstimate, ForSamples, estimate
 from monitor.estimation.intercal import NO_FIT, Intercalibration, difference_bins, reach_steps
 
-NAN4 = (np.nan,) * 4
+
+@dataclass(frozen=True)
+class Pair:
+    """A FOR's two angles in the spacecraft body frame (alpha in-track, beta cross-track) with their sigmas,
+    urad: the offsets, or the FOV rows ahead minus behind."""
+
+    alpha_urad: float = np.nan
+    beta_urad: float = np.nan
+    sigma_alpha_urad: float = np.nan
+    sigma_beta_urad: float = np.nan
+
+
+@dataclass(frozen=True)
+class Ground:
+    """A FOR's offsets on the ground, in-track and cross-track, with their sigmas, km."""
+
+    in_track_km: float = np.nan
+    cross_track_km: float = np.nan
+    sigma_in_track_km: float = np.nan
+    sigma_cross_track_km: float = np.nan
+
+
+@dataclass(frozen=True)
+class Widths:
+    """The full widths of a FOR's fitted response at 50 % and at 10 % of its peak, with their sigmas, urad."""
+
+    at_50_urad: float = np.nan
+    sigma_at_50_urad: float = np.nan
+    at_10_urad: float = np.nan
+    sigma_at_10_urad: float = np.nan
 
 
 def floor_urad(
@@ -65,15 +94,18 @@ def floor_urad(
 class DayLift:
     """The day's parallax lift as the FORs' records carry it (:mod:`monitor.estimation.parallax`): the lift
     a VIIRS pixel got per K colder than its clear-sky neighbourhood (m/K; NaN: not collocated lifted), the
-    sigma the lift's own uncertainty adds to each FOR (urad, (N_FOR, 4): FOR alpha, beta; rows alpha,
-    beta) and the height each FOR's cold scenes were put at (km, (N_FOR,))."""
+    height each FOR's cold scenes were put at (km), and the sigma the lift's own uncertainty adds to each
+    FOR's offsets and FOV rows (urad). Arrays of shape (N_FOR,)."""
 
     m_per_k: float
-    spread_urad: np.ndarray
     height_km: np.ndarray
+    sigma_alpha_urad: np.ndarray
+    sigma_beta_urad: np.ndarray
+    sigma_rows_alpha_urad: np.ndarray
+    sigma_rows_beta_urad: np.ndarray
 
 
-NO_LIFT = DayLift(np.nan, np.zeros((N_FOR, 4)), np.full(N_FOR, np.nan))
+NO_LIFT = DayLift(np.nan, np.full(N_FOR, np.nan), *np.zeros((4, N_FOR)))
 
 
 @dataclass(frozen=True)
@@ -94,14 +126,15 @@ KmOf = Callable[[int, float, float], tuple[float, float, np.ndarray]]
 def for_offset(
     for_index: int,
     n_samples: int,
-    turn_urad: tuple[float, float],
-    sigma_urad: tuple[float, float],
-    ground_km: tuple[float, float, float, float],
-    cost_k: tuple[float, float],
+    turn: Pair,
+    ground: Ground,
+    cost_min_k: float,
+    cost_zero_k: float,
     cal: Intercalibration,
-    response_urad: Sequence[float],
-    rows_urad: Sequence[float],
-    lift: tuple[float, float],
+    widths: Widths,
+    rows: Pair,
+    lift_m_per_k: float,
+    lift_height_km: float,
     flags: Iterable[str],
 ) -> ForOffset:
     """The record of one FOR from its parts; non-finite parts stay NaN (nothing was measured there).
@@ -112,22 +145,22 @@ def for_offset(
         The FOR, 1..30.
     n_samples : int
         The FOVs in its cost.
-    turn_urad : tuple of float
-        The offsets (d_alpha, d_beta), urad, spacecraft body frame.
-    sigma_urad : tuple of float
-        Their final sigmas, urad.
-    ground_km : tuple of float
+    turn : Pair
+        The offsets (d_alpha, d_beta) and their final sigmas, urad, spacecraft body frame.
+    ground : Ground
         The in-track and cross-track errors on the ground and their sigmas, km.
-    cost_k : tuple of float
+    cost_min_k, cost_zero_k : float
         The cost at the minimum and at no turn, K.
     cal : Intercalibration
         The CrIS-VIIRS intercalibration at the optimum.
-    response_urad : sequence of float
-        The response's full width at 50 % and its sigma, at 10 % and its sigma, urad.
-    rows_urad : sequence of float
+    widths : Widths
+        The fitted response's full widths and their sigmas, urad.
+    rows : Pair
         The FOV rows ahead minus behind, alpha and beta, and their sigmas, urad.
-    lift : tuple of float
-        The day's lift, m/K, and the height it gives the FOR's cold scenes, km.
+    lift_m_per_k : float
+        The day's lift, m/K.
+    lift_height_km : float
+        The height the lift gives the FOR's cold scenes, km.
     flags : iterable of str
         The FOR's flags.
 
@@ -136,37 +169,36 @@ def for_offset(
     ForOffset
         The record.
     """
-    it, ct, s_it, s_ct = ground_km
     return ForOffset(
         for_index=for_index,
-        d_alpha_urad=float(turn_urad[0]),
-        d_beta_urad=float(turn_urad[1]),
-        sigma_alpha_urad=float(sigma_urad[0]),
-        sigma_beta_urad=float(sigma_urad[1]),
-        in_track_km=float(it),
-        cross_track_km=float(ct),
-        total_km=float(np.hypot(it, ct)),
-        sigma_in_track_km=float(s_it),
-        sigma_cross_track_km=float(s_ct),
+        d_alpha_urad=float(turn.alpha_urad),
+        d_beta_urad=float(turn.beta_urad),
+        sigma_alpha_urad=float(turn.sigma_alpha_urad),
+        sigma_beta_urad=float(turn.sigma_beta_urad),
+        in_track_km=float(ground.in_track_km),
+        cross_track_km=float(ground.cross_track_km),
+        total_km=float(np.hypot(ground.in_track_km, ground.cross_track_km)),
+        sigma_in_track_km=float(ground.sigma_in_track_km),
+        sigma_cross_track_km=float(ground.sigma_cross_track_km),
         n_samples=int(n_samples),
-        cost_min_k=float(cost_k[0]),
-        cost_zero_k=float(cost_k[1]),
+        cost_min_k=float(cost_min_k),
+        cost_zero_k=float(cost_zero_k),
         bias_k=cal.bias_k,
         sigma_bias_k=cal.sigma_bias_k,
         gain_pct=cal.gain_pct,
         sigma_gain_pct=cal.sigma_gain_pct,
         curvature_k=cal.curvature_k,
         sigma_curvature_k=cal.sigma_curvature_k,
-        response_width_50_urad=float(response_urad[0]),
-        sigma_response_width_50_urad=float(response_urad[1]),
-        response_width_10_urad=float(response_urad[2]),
-        sigma_response_width_10_urad=float(response_urad[3]),
-        fov_rows_alpha_urad=float(rows_urad[0]),
-        fov_rows_beta_urad=float(rows_urad[1]),
-        sigma_fov_rows_alpha_urad=float(rows_urad[2]),
-        sigma_fov_rows_beta_urad=float(rows_urad[3]),
-        parallax_m_per_k=float(lift[0]),
-        parallax_height_km=float(lift[1]),
+        response_width_50_urad=float(widths.at_50_urad),
+        sigma_response_width_50_urad=float(widths.sigma_at_50_urad),
+        response_width_10_urad=float(widths.at_10_urad),
+        sigma_response_width_10_urad=float(widths.sigma_at_10_urad),
+        fov_rows_alpha_urad=float(rows.alpha_urad),
+        fov_rows_beta_urad=float(rows.beta_urad),
+        sigma_fov_rows_alpha_urad=float(rows.sigma_alpha_urad),
+        sigma_fov_rows_beta_urad=float(rows.sigma_beta_urad),
+        parallax_m_per_k=float(lift_m_per_k),
+        parallax_height_km=float(lift_height_km),
         flags=tuple(sorted(set(flags))),
     )
 
@@ -239,7 +271,7 @@ def day_offsets(
         for e in estimates
         if e is not None and e.granules is not None and e.replicates is not None
     ]
-    rho = jackknife.adjacent_correlation(series, follows) if follows is not None else 0.0
+    correlation = jackknife.adjacent_correlation(series, follows) if follows is not None else 0.0
     cone_error_urad = _cone_error_urad(estimates, step_urad)
     fors = []
     pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
@@ -249,26 +281,32 @@ def day_offsets(
         x = y = sig_a = sig_b = np.nan
         g = np.full((m, m), np.nan)
         cal = NO_FIT
-        widths = list(NAN4)
-        rows = list(NAN4)  # ahead minus behind: alpha, beta, and their sigmas (urad)
-        spread = lift.spread_urad[k]
+        widths = Widths()
+        rows = Pair()  # ahead minus behind
         best = estimates[k]
         if best is not None:
+            # every sigma of the FOR from the same replicates: the same count of independent granules
+            factor = (
+                1.0
+                if best.granules is None
+                else jackknife.correlation_factor(len(best.granules), correlation)
+            )
             if best.footprint is not None:
                 fp = best.footprint
-                widths = [
-                    w / URAD
-                    for w in (fp.width_50_rad, fp.sigma_width_50_rad, fp.width_10_rad, fp.sigma_width_10_rad)
-                ]
-            # every sigma of the FOR from the same replicates: the same count of independent granules
-            factor = 1.0 if best.granules is None else jackknife.correlation_factor(len(best.granules), rho)
+                widths = Widths(
+                    fp.width_50_rad / URAD,
+                    factor * (fp.sigma_width_50_rad / URAD),
+                    fp.width_10_rad / URAD,
+                    factor * (fp.sigma_width_10_rad / URAD),
+                )
             g, x, y, cal = best.cost, best.x, best.y, best.intercalibration.sigmas_scaled(factor)
-            widths[1], widths[3] = factor * widths[1], factor * widths[3]
-            rows_sigma = (factor * v * step_urad for v in best.rows_sigma)
-            rows = [
-                *(v * step_urad for v in best.rows),
-                *(float(np.hypot(v, s)) for v, s in zip(rows_sigma, spread[2:], strict=True)),
-            ]
+            (row_a, row_b), (row_sa, row_sb) = best.rows, best.rows_sigma
+            rows = Pair(
+                row_a * step_urad,
+                row_b * step_urad,
+                float(np.hypot(factor * row_sa * step_urad, lift.sigma_rows_alpha_urad[k])),
+                float(np.hypot(factor * row_sb * step_urad, lift.sigma_rows_beta_urad[k])),
+            )
             if cal.gain_undetermined:
                 flags.append(FLAG_GAIN_UNDETERMINED)
             cube[k] = g
@@ -281,35 +319,41 @@ def day_offsets(
             if used != cfg.kernel:
                 flags.append(FLAG_TOP_HAT)
             floor = floor_urad(cfg, used, cone_error_urad)
-            sig_a = float(np.hypot(np.hypot(factor * best.sigma[0] * step_urad, floor[0]), spread[0]))
-            sig_b = float(np.hypot(np.hypot(factor * best.sigma[1] * step_urad, floor[1]), spread[1]))
+            sig_a = float(
+                np.hypot(np.hypot(factor * best.sigma[0] * step_urad, floor[0]), lift.sigma_alpha_urad[k])
+            )
+            sig_b = float(
+                np.hypot(np.hypot(factor * best.sigma[1] * step_urad, floor[1]), lift.sigma_beta_urad[k])
+            )
             if max(sig_a, sig_b) > cfg.max_sigma_urad:
                 flags.append(FLAG_UNCERTAIN)
         d_alpha, d_beta = x * step_urad, y * step_urad
-        ground = NAN4
+        ground = Ground()
         if km is not None:
             it, ct, jac = km(k, d_alpha * URAD, d_beta * URAD)
             s_it = s_ct = np.nan
             if np.isfinite(sig_a):
                 s_it = float(np.hypot(jac[0, 0] * sig_a, jac[0, 1] * sig_b) * URAD)
                 s_ct = float(np.hypot(jac[1, 0] * sig_a, jac[1, 1] * sig_b) * URAD)
-            ground = (it, ct, s_it, s_ct)
-        cost = (float(np.nanmin(g)), float(g[m // 2, m // 2])) if n >= 3 else (np.nan, np.nan)
-        height = lift.height_km[k]
+            ground = Ground(it, ct, s_it, s_ct)
+        cost_min_k, cost_zero_k = (
+            (float(np.nanmin(g)), float(g[m // 2, m // 2])) if n >= 3 else (np.nan, np.nan)
+        )
         fors.append(
             for_offset(
                 k + 1,
                 n,
-                (d_alpha, d_beta),
-                (sig_a, sig_b),
+                Pair(d_alpha, d_beta, sig_a, sig_b),
                 ground,
-                cost,
+                cost_min_k,
+                cost_zero_k,
                 cal,
                 widths,
                 rows,
-                (lift.m_per_k, height),
+                lift.m_per_k,
+                lift.height_km[k],
                 flags,
-            )  # fmt: skip
+            )
         )
     bins = difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True))) if pooled else []
-    return DayEstimate(fors, cube, bins, rho)
+    return DayEstimate(fors, cube, bins, correlation)

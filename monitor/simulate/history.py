@@ -21,7 +21,7 @@ from monitor.core.constants import (
 )
 from monitor.core.result import FLAG_FLAT, AssessmentResult, DifferenceBin
 from monitor.estimation.intercal import Intercalibration
-from monitor.estimation.offsets import NAN4, for_offset
+from monitor.estimation.offsets import Ground, Pair, Widths, for_offset
 from monitor.simulate.profiles import paper_profile
 
 KM_PER_URAD = 0.00083  # at nadir; enough for a picture
@@ -65,19 +65,20 @@ def day_result(
         # the intercalibration: bias and its sigma, gain and its sigma, curvature and its sigma
         bias, gain = float(BIAS_K + rng.normal(0, 0.02)), float(GAIN_PCT + rng.normal(0, 0.05))
         cal = Intercalibration(bias, 0.01, gain, 0.03, CURVATURE_K, 0.03)
-        ground = (it, ct, 0.01, 0.012 * stretch[k])
+        ground = Ground(it, ct, 0.01, 0.012 * stretch[k])
         fors.append(
             for_offset(
                 k + 1,
                 500,
-                (d_alpha[k], d_beta[k]),
-                (12.0, 14.0),
+                Pair(d_alpha[k], d_beta[k], 12.0, 14.0),
                 ground,
-                (0.8, 1.2),
+                0.8,
+                1.2,
                 cal,
-                NAN4,
-                NAN4,
-                (np.nan, np.nan),
+                Widths(),
+                Pair(),
+                np.nan,
+                np.nan,
                 flags,
             )  # fmt: skip
         )

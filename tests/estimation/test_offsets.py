@@ -22,8 +22,9 @@ STEP_URAD = STEP_RAD * 1e6
 def test_every_part_lands_in_its_field():
     cal = Intercalibration(0.1, 0.01, 2.0, 0.2, 0.3, 0.03)
     f = offsets.for_offset(
-        7, 120, (10.0, -20.0), (3.0, 4.0), (0.01, -0.02, 0.002, 0.003), (0.5, 0.9), cal,
-        (16000.0, 80.0, 24000.0, 90.0), (-150.0, 5.0, 40.0, 9.0), (180.0, 2.5), ["flat", "flat"],
+        7, 120, offsets.Pair(10.0, -20.0, 3.0, 4.0), offsets.Ground(0.01, -0.02, 0.002, 0.003), 0.5, 0.9, cal,
+        offsets.Widths(16000.0, 80.0, 24000.0, 90.0), offsets.Pair(-150.0, 5.0, 40.0, 9.0), 180.0, 2.5,
+        ["flat", "flat"],
     )  # fmt: skip
     assert (f.for_index, f.n_samples, f.d_alpha_urad, f.d_beta_urad) == (7, 120, 10.0, -20.0)
     assert (f.sigma_alpha_urad, f.sigma_beta_urad, f.cost_min_k, f.cost_zero_k) == (3.0, 4.0, 0.5, 0.9)
@@ -46,9 +47,9 @@ def test_the_lifts_spread_is_in_every_sigma_and_the_km_sigmas_follow():
     s = _samples(footprint.super_gaussian(), n=160)
     cfg = AssessmentConfig(min_samples=10, max_sigma_urad=100.0)
     (bare,) = offsets.day_offsets([s], cfg, STEP_URAD, _jacobian).fors
-    spread = np.zeros((N_FOR, 4))
-    spread[0] = (300.0, 40.0, 50.0, 60.0)
-    lift = offsets.DayLift(150.0, spread, np.full(N_FOR, 2.0))
+    spread = np.zeros((4, N_FOR))
+    spread[:, 0] = (300.0, 40.0, 50.0, 60.0)
+    lift = offsets.DayLift(150.0, np.full(N_FOR, 2.0), *spread)
     (lifted,) = offsets.day_offsets([s], cfg, STEP_URAD, _jacobian, lift=lift).fors
     assert lifted.sigma_alpha_urad == pytest.approx(np.hypot(bare.sigma_alpha_urad, 300.0))
     assert lifted.sigma_beta_urad == pytest.approx(np.hypot(bare.sigma_beta_urad, 40.0))
