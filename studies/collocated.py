@@ -2,7 +2,7 @@
 
 The assessment collocates a day batch by batch (:class:`monitor.assessment.DayAssessment`); a study takes
 its samples from the same class, with the probe's lift, the renderer and the prepared pieces it varies passed
-as arguments.
+through the assessment's one seam for studies (:class:`monitor.assessment.seam.Variation`).
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from pathlib import Path
 from monitor.assessment import DayAssessment
 from monitor.assessment.estimates import GranuleSamples
 from monitor.assessment.inputs import PieceVariant
+from monitor.assessment.seam import Variation
 from monitor.collocation import render
 from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan
@@ -34,7 +35,8 @@ def collocated(
     cfg = (cfg or AssessmentConfig()).model_copy(update={"parallax": bool(lift_m_per_k)})
     satellite = json.loads((case / "truth.json").read_text())["satellite"]
     probe = lift_m_per_k or 1.0
-    day = DayAssessment(satellite, cfg, workers, probe, renderer=renderer, piece_variant=piece_variant)
+    variation = Variation(renderer=renderer, piece=piece_variant, probe_m_per_k=probe)
+    day = DayAssessment(satellite, cfg, workers, variation)
     _DAYS.append(day)
     day.add(plan([case]))
     return day.samples

@@ -23,15 +23,14 @@ from the ideal views ("ideal"), with the bounds' fields of
 VIIRS's own BT| over the rendered pixels (a check that the scene is the case's: VIIRS's own view is within
 7 mrad of the centre's, so most pixels differ by the noise alone). With ``--sweep`` the row also holds the
 errors as the service assesses the case when each ray takes the BT of the pixel its column's sweep meets,
-not of its own place across the track ("sweep": :func:`monitor.collocation.render.rendered_bt` with
-``across=False``); with ``--no-ideal`` it holds the service's assessments alone (no "ideal", no tracing).
+not of its own place across the track ("sweep": :func:`monitor.collocation.render.swept_bt`); with
+``--no-ideal`` it holds the service's assessments alone (no "ideal", no tracing).
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime as dt
-import functools
 import inspect
 import json
 import time
@@ -141,7 +140,7 @@ def measure(case: Path, workers: int, sweep: bool = False, ideal_views: bool = T
         diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
         row["ideal"] = _scores(at, truth)
     if sweep:
-        renderer = functools.partial(render.rendered_bt, across=False)
+        renderer = render.swept_bt
         both = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=renderer)
         row["sweep"] = _scores(cost_and_offsets(both, cfg, satellite=truth["satellite"]), truth)
     if ideal_views:
@@ -155,7 +154,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("cases", nargs="+", type=Path)
     p.add_argument("--workers", type=int, default=2)
-    p.add_argument("--sweep", action="store_true", help="also assess with the sweep alone (across=False)")
+    p.add_argument("--sweep", action="store_true", help="also assess with the sweep alone (render.swept_bt)")
     p.add_argument("--no-ideal", action="store_true", help="the service's assessments alone, no ideal views")
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()

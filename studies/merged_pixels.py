@@ -28,6 +28,7 @@ import numpy as np
 
 from benchmarks.provenance import emit
 from monitor.assessment import DayAssessment
+from monitor.assessment.seam import Variation
 from monitor.collocation.collocate import warm_up
 from monitor.collocation.swath import SwathPiece
 from monitor.config.assessment import AssessmentConfig
@@ -109,7 +110,7 @@ def assessed(case: Path, tolerance_k: float, workers: int) -> tuple[AssessmentRe
     satellite = json.loads((case / "truth.json").read_text())["satellite"]
     merged = Merged(tolerance_k, i5_band(satellite))
     timings: dict[str, float] = {}
-    with DayAssessment(satellite, AssessmentConfig(), workers, piece_variant=merged) as day:
+    with DayAssessment(satellite, AssessmentConfig(), workers, Variation(piece=merged)) as day:
         day.add(plan([case]), timings=timings)
         result = day.result()
     return result, merged.merged / max(merged.quads, 1), timings.get("collocation", float("nan"))

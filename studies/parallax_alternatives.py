@@ -24,6 +24,7 @@ import numpy as np
 
 from benchmarks.provenance import commit, emit
 from monitor.assessment.estimates import cost_and_offsets, paired
+from monitor.assessment.seam import Variation
 from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult
@@ -88,8 +89,9 @@ def alternatives(case: Path, leave_out_above_km: list[float], workers: int) -> l
     ]
     rows[1]["m_per_k"] = PROBE_M_PER_K
     for above_km in leave_out_above_km:
-        # the assessment blends each FOR through the blend it is given: the samples are thinned there
-        result = cost_and_offsets(both, cfg, satellite=sat, blend=without_high_clouds(above_km))
+        # the assessment blends each FOR through the seam's blend: the samples are thinned there
+        variation = Variation(blend=without_high_clouds(above_km))
+        result = cost_and_offsets(both, cfg, satellite=sat, variation=variation)
         rows.append(
             {**base, "alternative": f"learnt, clouds above {above_km:g} km left out", **errors(result, truth)}
         )

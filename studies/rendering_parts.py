@@ -2,7 +2,7 @@
 the rendering, and how far each view's rendering lies across the track from the truth.
 
 Each call of the renderer is made once: the service's rendering
-(:func:`monitor.collocation.render.rendered_bt`, with what each ray met,
+(:func:`monitor.collocation.render.rendered_met`: the rendering with what each ray met,
 :class:`~monitor.collocation.render.Met`), the simulator's views of the same GEO points
 (:class:`studies.ideal_views.IdealViews`) and VIIRS's own BT are kept in the cache directory, keyed by the
 call's inputs. Then, for each *part*, the rendering is given the simulator's view there and the
@@ -73,10 +73,8 @@ class Parts:
         h.update(repr((a.arguments["scans"], a.arguments["columns"], float(a.arguments["m_per_k"]))).encode())
         files = {name: self.cache / f"{h.hexdigest()[:16]}_{name}.npy" for name in ("r", "kind", "i", "b")}
         if not files["r"].exists():
-            met = np.empty(
-                (len(np.asarray(a.arguments["cris_alpha_rad"])), *np.shape(a.arguments["bt_k"])), np.uint8
-            )
-            np.save(files["r"], render.rendered_bt(*a.args, **{**a.kwargs, "met": met}))
+            rendered, met = render.rendered_met(*a.args, **a.kwargs)
+            np.save(files["r"], rendered)
             np.save(files["kind"], met)
         if not files["b"].exists():
             np.save(files["b"], np.asarray(a.arguments["bt_k"], np.float32))

@@ -17,7 +17,6 @@ the case's law, and the curve less its least, K.
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 from pathlib import Path
 
@@ -61,7 +60,7 @@ def measure(case: Path, workers: int, sweep: bool) -> list[dict]:
     band = i5_band(truth["satellite"])
     renderings = {"across": render.rendered_bt}
     if sweep:
-        renderings["sweep"] = functools.partial(render.rendered_bt, across=False)
+        renderings["sweep"] = render.swept_bt
     rows = []
     for name, renderer in renderings.items():
         p0, p1 = paired(collocated(case, cfg, workers, PROBE_M_PER_K, renderer=renderer))
@@ -87,7 +86,7 @@ def measure(case: Path, workers: int, sweep: bool) -> list[dict]:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("cases", nargs="+", type=Path)
-    p.add_argument("--sweep", action="store_true", help="also the sweep alone (across=False)")
+    p.add_argument("--sweep", action="store_true", help="also the sweep alone (render.swept_bt)")
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--rows", help="append the JSON rows to this file")
     args = p.parse_args()

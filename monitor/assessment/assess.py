@@ -23,7 +23,6 @@ from monitor.assessment.estimates import GranuleSamples, cost_and_offsets
 from monitor.assessment.inputs import (
     KERNELS,
     GranuleInputs,
-    PieceVariant,
     SwathCache,
     Timings,
     load_swath,
@@ -32,9 +31,9 @@ from monitor.assessment.inputs import (
     scan_spans,
     stage,
 )
+from monitor.assessment.seam import SERVICE, Variation
 from monitor.assessment.spool import Spool
-from monitor.collocation import collocate, render, swath
-from monitor.collocation.lift import PROBE_M_PER_K
+from monitor.collocation import collocate, swath
 from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import FOV_HALF_ANGLE_RAD
@@ -198,8 +197,7 @@ def collocate_run(
     should_stop: StopCheck = None,
     timings: Timings = None,
     lift_m_per_k: float = 0.0,
-    renderer: render.Renderer = render.rendered_bt,
-    piece_variant: PieceVariant | None = None,
+    variation: Variation = SERVICE,
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
     """Collocate a time-ordered run of CrIS granules, and in the same pass their rendering at a lift.
 
@@ -224,11 +222,9 @@ def collocate_run(
     lift_m_per_k : float, optional
         With a lift, the pixels also stand this many m per K above their GEO points, rendered as each CrIS
         FOV row sees them (:mod:`monitor.collocation.render`).
-    renderer : Renderer, optional
-        What renders them (:func:`monitor.collocation.render.rendered_bt`).
-    piece_variant : callable, optional
-        A study's change to each VIIRS granule as it is prepared
-        (:class:`~monitor.assessment.inputs.SwathCache`); None: the pieces as prepared.
+    variation : Variation, optional
+        What a study varies: the renderer, the VIIRS granules as prepared (:mod:`monitor.assessment.seam`);
+        the service's by default.
 
     Returns
     -------
@@ -239,7 +235,9 @@ def collocate_run(
     """
     band = i5_band(satellite)
     spans = scan_spans(cris, viirs)
-    cache = SwathCache(spans=spans, lift_m_per_k=lift_m_per_k, renderer=renderer, piece_variant=piece_variant)
+    cache = SwathCache(
+        spans=spans, lift_m_per_k=lift_m_per_k, renderer=variation.renderer, piece=variation.piece
+    )
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
 
@@ -309,14 +307,8 @@ class DayAssessment:
         The assessment's configuration; the defaults when None.
     workers : int, optional
         Threads of the compiled VIIRS preparation and collocation.
-    probe_m_per_k : float, optional
-        With the parallax correction, the lift (m per K of I5 BT below the clear sky) of the second, rendered
-        collocation from which the day's lift is found (:mod:`monitor.estimation.parallax`).
-    renderer : Renderer, optional
-        What renders the VIIRS pixels as each CrIS FOV row sees them
-        (:func:`monitor.collocation.render.rendered_bt`).
-    piece_variant : callable, optional
-        A study's change to each VIIRS granule as it is prepared; None (the service): none.
+    variation : Variation, optional
+        What a study varies (:mod:`monitor.assessment.seam`); the service's by default.
     """
 
     def __init__(
@@ -324,12 +316,10 @@ class DayAssessment:
         satellite: str,
         cfg: AssessmentConfig | None = None,
         workers: int = 1,
-        probe_m_per_k: float = PROBE_M_PER_K,
-        renderer: render.Renderer = render.rendered_bt,
-        piece_variant: PieceVariant | None = None,
+        variation: Variation = SERVICE,
     ) -> None:
         self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
-        self.probe_m_per_k, self.renderer, self.piece_variant = probe_m_per_k, renderer, piece_variant
+        self.variation = variation
         self.samples: list[GranuleSamples] = []
         self.skipped: list[tuple[str, str]] = []
         self._spool = Spool()
@@ -369,12 +359,13 @@ class DayAssessment:
         """
         cfg = self.cfg
         run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
-        # with the parallax correction, also the pixels at the probe's height per K, rendered, in the same
-        # pass (monitor.estimation.parallax chooses the day's)
-        lift_m_per_k = self.probe_m_per_k if cfg.parallax else 0.0
+        # with the parallax correction (the one place the setting is read), also the pixels at the probe's
+        # height per K, rendered, in the same pass: monitor.estimation.parallax chooses the day's lift from
+        # the two wherever every granule was rendered
+        lift_m_per_k = self.variation.probe_m_per_k if cfg.parallax else 0.0
         with parallel_threads(self.workers):
             samples, skipped = collocate_run(
-                *run, progress, should_stop, timings, lift_m_per_k, self.renderer, self.piece_variant
+                *run, progress, should_stop, timings, lift_m_per_k, self.variation
             )
         self.skipped += list(case.skipped) + skipped
         self.samples += [s.kept_in(self._spool) for s in samples]
@@ -406,7 +397,7 @@ class DayAssessment:
             )
         in_time = sorted(self.samples, key=lambda s: (s.info.start, s.key))
         with stage(timings, "cost"):
-            return cost_and_offsets(in_time, cfg, skipped, self.satellite, self.probe_m_per_k)
+            return cost_and_offsets(in_time, cfg, skipped, self.satellite, self.variation)
 
 
 def assess_plan(

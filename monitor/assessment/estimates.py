@@ -15,8 +15,8 @@ from typing import overload
 import numpy as np
 
 from monitor.assessment.inputs import KERNELS, offsets_rad
+from monitor.assessment.seam import SERVICE, Variation
 from monitor.assessment.spool import OnDisk, Spool
-from monitor.collocation.lift import PROBE_M_PER_K
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
 from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
@@ -24,7 +24,6 @@ from monitor.estimation import parallax
 from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
 from monitor.estimation.offsets import DayLift, day_offsets
-from monitor.estimation.parallax import Blend
 from monitor.geometry.ground import offset_km
 from monitor.instrument.spectral import BandModel, i5_band
 
@@ -140,15 +139,14 @@ def cost_and_offsets(
     cfg: AssessmentConfig,
     skipped: Sequence[tuple[str, str]] | None = None,
     satellite: str = "",
-    probe_m_per_k: float = PROBE_M_PER_K,
-    blend: Blend = parallax.blend,
+    variation: Variation = SERVICE,
 ) -> AssessmentResult:
     """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*.
 
-    When *cfg* asks for the parallax correction and every granule was also collocated with the VIIRS
-    pixels standing at the probe's height (:attr:`GranuleSamples.rendered`: rendered as each FOV row sees
-    them, :mod:`monitor.collocation.render`), the day's lift is chosen by the cost
-    (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it.
+    When every granule was also collocated with the VIIRS pixels standing at the probe's height
+    (:attr:`GranuleSamples.rendered`: rendered as each FOV row sees them, :mod:`monitor.collocation.render`;
+    :class:`~monitor.assessment.DayAssessment` does so with the parallax correction), the day's lift is
+    chosen by the cost (:mod:`monitor.estimation.parallax`) and the offsets are estimated at it.
 
     Parameters
     ----------
@@ -160,11 +158,9 @@ def cost_and_offsets(
         Granules left out and why, carried into the result.
     satellite : str, optional
         The satellite's short name (``j01``); by default the first granule's platform.
-    probe_m_per_k : float, optional
-        The lift (m per K of I5 BT) the rendered collocation was made at.
-    blend : callable, optional
-        How a FOR's two collocations are combined at the day's fraction of the probe
-        (:func:`monitor.estimation.parallax.blend`).
+    variation : Variation, optional
+        What a study varies: the probe's lift the rendered collocation was made at, how a FOR's two
+        collocations are combined (:mod:`monitor.assessment.seam`); the service's by default.
 
     Returns
     -------
@@ -176,7 +172,7 @@ def cost_and_offsets(
     m_per_k = np.nan
     spread = np.zeros((N_FOR, 4))  # the sigma (steps) the day's lift adds: FOR alpha, beta; rows alpha, beta
     rendered = bool(samples) and all(s.rendered is not None for s in samples)
-    pairs = paired(samples) if cfg.parallax and rendered else None
+    pairs = paired(samples) if rendered else None
     if pairs is not None:
         s0, s1 = pairs
         cones0, cones1 = zip(
@@ -186,7 +182,7 @@ def cost_and_offsets(
             ),
             strict=True,
         )
-        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost, probe_m_per_k)
+        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost, variation.probe_m_per_k)
         if cfg.uncertainty and np.isfinite(sigma_f):
             spread = np.array(
                 [
@@ -194,8 +190,10 @@ def cost_and_offsets(
                     for a, b in zip(cones0, cones1, strict=True)
                 ]
             )
-        per_for = PerFor(lambda k: blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f))
-        m_per_k = f * probe_m_per_k
+        per_for = PerFor(
+            lambda k: variation.blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
+        )
+        m_per_k = f * variation.probe_m_per_k
     used = samples if pairs is None else pairs[0]
     # parallax.sensitivity's order: FOR alpha, beta; rows alpha, beta
     sigma_alpha, sigma_beta, sigma_rows_alpha, sigma_rows_beta = (np.nan_to_num(spread) * cfg.step_urad).T

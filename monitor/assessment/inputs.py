@@ -93,9 +93,9 @@ class SwathCache:
     the IET span (us) of the VIIRS scans that the run's CrIS granules need (:func:`scan_spans`). With
     *lift_m_per_k* (m per K colder than the clear-sky reference: :mod:`monitor.collocation.lift`), every
     piece holds what each CrIS FOV row sees of its pixels standing at that height
-    (*renderer*, :func:`monitor.collocation.render.rendered_bt` unless a study gives another); with 0, the
-    pixels' own radiance. *piece_variant*, None in the service, is a study's change to each piece as it
-    is prepared (the pixels the cone kernel sees)."""
+    (*renderer*: :func:`monitor.collocation.render.rendered_bt`, or a study's through
+    :class:`monitor.assessment.seam.Variation`); with 0, the pixels' own radiance. *piece*, None in the
+    service, is a study's change to each piece as it is prepared (the pixels the cone kernel sees)."""
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
@@ -104,7 +104,7 @@ class SwathCache:
     spans: dict = field(default_factory=dict)
     lift_m_per_k: float = 0.0
     renderer: render.Renderer = render.rendered_bt
-    piece_variant: PieceVariant | None = None
+    piece: PieceVariant | None = None
 
 
 def _widen(span: Span | None, other: Span | None) -> Span | None:
@@ -363,8 +363,8 @@ def piece(
             sat_m=geo.sc_position_m, view_rad=reach_rad, scan_start_us=geo.start_time_us, span_us=run_span,
             seen_bt_k=seen, view_alpha_rad=render.VIEW_ALPHA_RAD,
         )  # fmt: skip
-    if cache.piece_variant is not None:
-        piece = cache.piece_variant(piece)
+    if cache.piece is not None:
+        piece = cache.piece(piece)
     while len(cache.pieces) >= cache.keep:
         cache.pieces.pop(next(iter(cache.pieces)))
     cache.pieces[v.key] = piece

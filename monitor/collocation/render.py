@@ -36,13 +36,15 @@ between scans, and the bow-tie's smile puts a scan's outer detectors a few hundr
 out), and a CrIS ray is tilted across the track against VIIRS's. So a ray takes the BT of what it meets at
 its own place across the track (:func:`monitor.collocation.views.view_tangents_across`), linearly between
 the two columns of the met pixel's row about that place, up to :data:`ACROSS_COLUMNS` columns aside (a pixel
-of the next or the last scan at one column index lies about two columns aside where the scans overlap);
-without that (``across=False``) it takes the met pixel's own, and where scans overlap a top's BT comes from
-a pixel a column or two aside. A
-granule's first and last rows are rendered without the next granule's pixels.
+of the next or the last scan at one column index lies about two columns aside where the scans overlap).
+A granule's first and last rows are rendered without the next granule's pixels.
 
-A study can put another rendering in this one's place (:class:`Renderer`: the assessment takes it as an
-argument); ``studies/render_truth.py`` measures this one against the simulator's own views.
+:func:`rendered_bt` is the assessment's rendering. Two building blocks beside it are for studies:
+:func:`swept_bt`, the sweep alone (each ray takes the met pixel's own BT, and where scans overlap a top's BT
+comes from a pixel a column or two aside), and :func:`rendered_met`, the rendering with what each ray met
+(:class:`Met`). A study puts another rendering in this one's place through the assessment's one seam for
+studies (:class:`monitor.assessment.seam.Variation`); ``studies/render_truth.py`` measures this one against
+the simulator's own views.
 """
 
 from __future__ import annotations
@@ -71,7 +73,7 @@ ACROSS_COLUMNS = 3
 
 
 class Met(enum.IntEnum):
-    """What a ray met (the *met* output of :func:`rendered_bt`): its own pixel's top, the top of another
+    """What a ray met (:func:`rendered_met`): its own pixel's top, the top of another
     pixel of its scan or of another scan (at one column index, where scans overlap), or a wall; NOTHING where
     no ray was rendered."""
 
@@ -83,9 +85,8 @@ class Met(enum.IntEnum):
 
 
 class Renderer(Protocol):
-    """What renders a VIIRS granule as CrIS FOV rows see it: :func:`rendered_bt`'s signature. The
-    assessment takes one as an argument (:class:`monitor.assessment.DayAssessment`), so that a study can
-    put another rendering, or a truth, in its place."""
+    """What renders a VIIRS granule as CrIS FOV rows see it: :func:`rendered_bt`'s signature, so that a study
+    can put another rendering, or a truth, in its place (:class:`monitor.assessment.seam.Variation`)."""
 
     def __call__(
         self,
@@ -115,16 +116,13 @@ def rendered_bt(
     m_per_k: float,
     scans: slice = slice(None),
     columns: slice = slice(None),
-    across: bool = True,
-    met: np.ndarray | None = None,
 ) -> np.ndarray:
     """The BT a CrIS ray at each in-track angle sees on its way to each GEO point of a VIIRS granule.
 
-    :func:`~monitor.collocation.views.view_tangents`, then :func:`render_height_field`,
-    :data:`COLUMNS_PER_PASS` columns at a time. The clear-sky reference is the whole granule's. With
-    *across* (the default), each ray takes its BT at its own position across the track
-    (:func:`~monitor.collocation.views.view_tangents_across`; a pass then renders :data:`ACROSS_COLUMNS`
-    columns more either side, so that its edge columns have their neighbours).
+    :func:`~monitor.collocation.views.view_tangents_across`, then :func:`render_height_field`,
+    :data:`COLUMNS_PER_PASS` columns at a time (each pass renders :data:`ACROSS_COLUMNS` columns more either
+    side, so that its edge columns have their neighbours). The clear-sky reference is the whole granule's.
+    Each ray takes its BT at its own position across the track.
 
     Parameters
     ----------
@@ -146,11 +144,6 @@ def rendered_bt(
         The scans to render (step 1).
     columns : slice, optional
         The columns to render.
-    across : bool, optional
-        Take each ray's BT at its own position across the track (False: the met pixel's, the sweep alone).
-    met : numpy.ndarray, optional
-        Filled with what each ray met (:class:`Met`), uint8, the output's shape: a study's view of the
-        rendering.
 
     Returns
     -------
@@ -158,6 +151,128 @@ def rendered_bt(
         BT, K, float32, shape (len(cris_alpha_rad), rows, cols); NaN outside *scans* and *columns* and where
         unusable.
     """
+    return _render(
+        lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k, scans, columns,
+        across=True, met=None,
+    )  # fmt: skip
+
+
+def swept_bt(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    bt_k: np.ndarray,
+    good: np.ndarray,
+    sat_m: np.ndarray,
+    velocity_m_s: np.ndarray,
+    cris_alpha_rad: np.ndarray,
+    m_per_k: float,
+    scans: slice = slice(None),
+    columns: slice = slice(None),
+) -> np.ndarray:
+    """:func:`rendered_bt` with the sweep alone: each ray takes the BT of the pixel it meets, not of its own
+    place across the track (:func:`~monitor.collocation.views.view_tangents`).
+
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    bt_k : numpy.ndarray
+        The pixels' I5 BT, K, shape (rows, cols).
+    good : numpy.ndarray
+        Where a pixel is usable.
+    sat_m, velocity_m_s : numpy.ndarray
+        Each scan's spacecraft position (m) and velocity (m/s) at its middle, ECEF, shape (nscan, 3).
+    cris_alpha_rad : numpy.ndarray
+        The CrIS views' in-track angles in the spacecraft body frame, rad, positive ahead.
+    m_per_k : float
+        The lift: each pixel stands this many m per K colder than its clear-sky reference
+        (:func:`monitor.collocation.lift.height_above_m`).
+    scans : slice, optional
+        The scans to render (step 1).
+    columns : slice, optional
+        The columns to render.
+
+    Returns
+    -------
+    numpy.ndarray
+        BT, K, float32, shape (len(cris_alpha_rad), rows, cols); NaN outside *scans* and *columns* and where
+        unusable.
+    """
+    return _render(
+        lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k, scans, columns,
+        across=False, met=None,
+    )  # fmt: skip
+
+
+def rendered_met(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    bt_k: np.ndarray,
+    good: np.ndarray,
+    sat_m: np.ndarray,
+    velocity_m_s: np.ndarray,
+    cris_alpha_rad: np.ndarray,
+    m_per_k: float,
+    scans: slice = slice(None),
+    columns: slice = slice(None),
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`rendered_bt`, and what each ray met (:class:`Met`): a study's view of the rendering.
+
+    Parameters
+    ----------
+    lat_rad, lon_rad, height_m : numpy.ndarray
+        The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
+        (rows, cols) of 32-detector scans.
+    bt_k : numpy.ndarray
+        The pixels' I5 BT, K, shape (rows, cols).
+    good : numpy.ndarray
+        Where a pixel is usable.
+    sat_m, velocity_m_s : numpy.ndarray
+        Each scan's spacecraft position (m) and velocity (m/s) at its middle, ECEF, shape (nscan, 3).
+    cris_alpha_rad : numpy.ndarray
+        The CrIS views' in-track angles in the spacecraft body frame, rad, positive ahead.
+    m_per_k : float
+        The lift: each pixel stands this many m per K colder than its clear-sky reference
+        (:func:`monitor.collocation.lift.height_above_m`).
+    scans : slice, optional
+        The scans to render (step 1).
+    columns : slice, optional
+        The columns to render.
+
+    Returns
+    -------
+    bt_k : numpy.ndarray
+        As :func:`rendered_bt` returns it.
+    met : numpy.ndarray
+        What each ray met (:class:`Met`), uint8, the same shape.
+    """
+    met = np.empty((len(cris_alpha_rad), *np.shape(bt_k)), np.uint8)
+    bt = _render(
+        lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k, scans, columns,
+        across=True, met=met,
+    )  # fmt: skip
+    return bt, met
+
+
+def _render(
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    bt_k: np.ndarray,
+    good: np.ndarray,
+    sat_m: np.ndarray,
+    velocity_m_s: np.ndarray,
+    cris_alpha_rad: np.ndarray,
+    m_per_k: float,
+    scans: slice,
+    columns: slice,
+    across: bool,
+    met: np.ndarray | None,
+) -> np.ndarray:
+    """:func:`rendered_bt` (*across*) or :func:`swept_bt`, filling *met* where given."""
     rows, cols = np.shape(bt_k)
     out = np.empty((len(cris_alpha_rad), rows, cols), np.float32)
     usable = np.asarray(good, bool) & np.isfinite(bt_k)

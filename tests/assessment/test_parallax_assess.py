@@ -12,6 +12,7 @@ import pytest
 
 from monitor.assessment.assess import DayAssessment
 from monitor.assessment.estimates import cost_and_offsets
+from monitor.assessment.seam import Variation
 from monitor.config.assessment import AssessmentConfig
 from monitor.sdr.pairing import plan
 from monitor.simulate.case import simulate_case
@@ -26,11 +27,12 @@ def _rows_urad(result):
 @pytest.mark.slow
 def test_the_rendered_collocation_takes_the_rows_parallax_away(tmp_path):
     simulate_case(tmp_path, granules=3, profile="paper", seed=3, cloud_heights="lapse:6.5")
-    with DayAssessment("j01", probe_m_per_k=LAW_M_PER_K) as both:  # both collocations, in one pass
+    with DayAssessment("j01", variation=Variation(probe_m_per_k=LAW_M_PER_K)) as both:  # in one pass
         both.add(plan([tmp_path]))
         samples = both.samples
     _check_wiring(samples)
-    raw_rows = _rows_urad(cost_and_offsets(samples, AssessmentConfig(parallax=False), satellite="j01"))
+    at_geo = [replace(s, rendered=None) for s in samples]
+    raw_rows = _rows_urad(cost_and_offsets(at_geo, AssessmentConfig(parallax=False), satellite="j01"))
     assert np.nanmedian(raw_rows) < -120  # the parallax of tops ~8-14 km: the rows ahead turned back
     rows = _rows_urad(
         cost_and_offsets([s.rendered for s in samples], AssessmentConfig(parallax=False), satellite="j01")
@@ -41,22 +43,24 @@ def test_the_rendered_collocation_takes_the_rows_parallax_away(tmp_path):
 
 def test_both_collocations_come_from_one_pass_and_the_unrendered_one_is_the_plain_assessment(cases):
     """The wiring of the rendered collocation on the flat default case (the science is the slow test
-    above, on clouds with height): every sample carries its rendered twin, the day takes one scale, and
-    without the parallax correction the rendered twins are never read."""
+    above, on clouds with height): every sample carries its rendered twin and the day takes one scale;
+    without the parallax correction nothing is rendered, and the day is the one at the GEO points."""
     out, _, _ = cases.get()
-    with DayAssessment("j01", probe_m_per_k=LAW_M_PER_K) as both:
+    with DayAssessment("j01", variation=Variation(probe_m_per_k=LAW_M_PER_K)) as both:
         both.add(plan([out]))
         _check_wiring(both.samples)
+        cfg = AssessmentConfig(parallax=False)
+        at_geo = cost_and_offsets([replace(s, rendered=None) for s in both.samples], cfg, satellite="j01")
+    with DayAssessment("j01", cfg) as plain:
+        plain.add(plan([out]))
+        assert all(s.rendered is None for s in plain.samples)
+        raw = plain.result()
+    assert np.all(np.isnan([f.parallax_m_per_k for f in raw.fors]))
+    assert [f.to_dict() for f in raw.fors] == [f.to_dict() for f in at_geo.fors]
 
 
 def _check_wiring(samples):
     assert all(s.rendered is not None and s.rendered.key == s.key for s in samples)
-    day = cost_and_offsets(samples, AssessmentConfig(), satellite="j01", probe_m_per_k=LAW_M_PER_K)
+    probe = Variation(probe_m_per_k=LAW_M_PER_K)
+    day = cost_and_offsets(samples, AssessmentConfig(), satellite="j01", variation=probe)
     assert len({f.parallax_m_per_k for f in day.fors}) == 1  # one scale for the day
-    cfg = AssessmentConfig(parallax=False)
-    raw = cost_and_offsets(samples, cfg, satellite="j01")  # at their GEO points: the rendered ones unread
-    assert np.all(np.isnan([f.parallax_m_per_k for f in raw.fors]))
-    assert [f.to_dict() for f in raw.fors] == [
-        f.to_dict()
-        for f in cost_and_offsets([replace(s, rendered=None) for s in samples], cfg, satellite="j01").fors
-    ]

@@ -4,7 +4,7 @@ ray march through the column the pixels were drawn from, and each ray at its own
 import numpy as np
 import pytest
 
-from monitor.collocation.render import Met, render_height_field, rendered_bt
+from monitor.collocation.render import Met, render_height_field, rendered_bt, rendered_met, swept_bt
 from monitor.collocation.views import Across, view_tangents
 from tests.collocation.test_lift import scan_geometry
 
@@ -247,17 +247,15 @@ def test_across_the_track_flat_scenes_and_parts_render_as_before():
     good = np.ones(lat.shape, bool)
     alphas = np.array([-0.0191, 0.0, 0.0191])
     flat = rendered_bt(lat, lon, h, np.full(lat.shape, 280.0, np.float32), good, sat[None], v[None], alphas,
-                       M_PER_K, across=True)  # fmt: skip
+                       M_PER_K)  # fmt: skip
     assert np.all(flat == 280.0)
     bt = np.full(lat.shape, 295.0, np.float32)
     bt[10:21] = 230.0 + 20.0 * (np.arange(lat.shape[1]) % 2)  # the band's BT alternates across the track
-    whole = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, across=True)
-    part = rendered_bt(
-        lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, columns=slice(100, 300), across=True
-    )
+    whole = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K)
+    part = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, columns=slice(100, 300))
     assert np.all(np.isnan(part[:, :, :100])) and np.all(np.isnan(part[:, :, 300:]))
     np.testing.assert_allclose(part[:, :, 100:300], whole[:, :, 100:300], atol=0.01)
-    plain = rendered_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K, across=False)
+    plain = swept_bt(lat, lon, h, bt, good, sat[None], v[None], alphas, M_PER_K)
     assert np.nanmax(np.abs(whole - plain)) > 0.01  # the cross-track position moves some rays' values
 
 
@@ -284,18 +282,17 @@ def test_what_each_ray_met_is_told():
 
 
 def test_a_granule_tells_what_its_rays_met():
-    """Through :func:`rendered_bt`: every rendered ray is told, the rest NOTHING; a flat granule's rays all
+    """Through :func:`rendered_met`: every rendered ray is told, the rest NOTHING; a flat granule's rays all
     meet their own pixel, and a cloud band's edge shows the rows ahead and behind its walls."""
     lat, lon, h, _, sat, v = scan_geometry()
     good = np.ones(lat.shape, bool)
     alphas = np.array([-0.0191, 0.0, 0.0191])
-    met = np.empty((3, *lat.shape), np.uint8)
     flat = np.full(lat.shape, 280.0, np.float32)
     orbit = (sat[None], v[None], alphas, M_PER_K)
-    rendered_bt(lat, lon, h, flat, good, *orbit, columns=slice(100, 300), met=met)
+    _, met = rendered_met(lat, lon, h, flat, good, *orbit, columns=slice(100, 300))
     assert np.all(met[:, :, 100:300] == Met.OWN_TOP) and np.all(met[:, :, :100] == Met.NOTHING)
     bt = np.full(lat.shape, 295.0, np.float32)
     bt[10:21] = 230.0
-    seen = rendered_bt(lat, lon, h, bt, good, *orbit, met=met)
+    seen, met = rendered_met(lat, lon, h, bt, good, *orbit)
     np.testing.assert_array_equal(seen, rendered_bt(lat, lon, h, bt, good, *orbit))
     assert np.any(met[0] == Met.WALL) and np.any(met[2] == Met.WALL) and not np.any(met[1] == Met.WALL)
