@@ -12,7 +12,7 @@ import datetime as dt
 import logging
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from monitor.archive import Source
@@ -41,17 +41,44 @@ LOG = logging.getLogger(__name__)
 
 @dataclass
 class RunOutcome:
-    """What one satellite-day run did: status and reason, the result, seconds per stage, counts."""
+    """What one satellite-day run did: the day as computed (:class:`~monitor.assessment.DayWork`, the one
+    type that carries it from the science to the store), the ledger's run, and the status and reason as
+    recorded (an empty day becomes final past its horizon)."""
 
-    satellite: str
-    day: dt.date
-    status: RunStatus
-    reason: str | None = None
+    work: DayWork
     run_id: int | None = None
-    result: AssessmentResult | None = None
-    timings: dict = field(default_factory=dict)
-    counts: RunCounts = field(default_factory=RunCounts)
-    precision: DayPrecision | None = None
+    status: RunStatus = RunStatus.OK
+    reason: str | None = None
+
+    @property
+    def satellite(self) -> str:  # numpydoc ignore=RT01
+        """The satellite's short name."""
+        return self.work.satellite
+
+    @property
+    def day(self) -> dt.date:  # numpydoc ignore=RT01
+        """The UTC day."""
+        return self.work.day
+
+    @property
+    def result(self) -> AssessmentResult | None:  # numpydoc ignore=RT01
+        """The day's result (an ok run's)."""
+        return self.work.result
+
+    @property
+    def timings(self) -> dict:  # numpydoc ignore=RT01
+        """Seconds per stage."""
+        return self.work.timings
+
+    @property
+    def counts(self) -> RunCounts:  # numpydoc ignore=RT01
+        """Granules listed, selected, assessed; files and bytes fetched."""
+        return self.work.counts
+
+    @property
+    def precision(self) -> DayPrecision | None:  # numpydoc ignore=RT01
+        """How far the batches went, and why they stopped."""
+        return self.work.precision
 
     def summary(self) -> str:
         """The one line a run leaves in the log.
@@ -247,9 +274,7 @@ def record_day(cfg: Config, store: Store, run_id: int, w: DayWork, today: dt.dat
                 record_fingerprint(cfg, store, w.satellite, w.day, w.fingerprint)
             except (DataError, OSError, ValueError) as exc:
                 LOG.warning("fingerprint of %s %s not recorded: %s", w.satellite, w.day, exc)
-        out = RunOutcome(
-            w.satellite, w.day, w.status, w.reason, run_id, w.result, w.timings, w.counts, w.precision
-        )
+        out = RunOutcome(w, run_id, w.status, w.reason)
         if w.status == RunStatus.OK and w.result is not None:  # an ok day always has its result
             queued = day_lines(cfg.store.publish, w.satellite, w.day, w.result)
             store.save_day(run_id, w.satellite, w.day, w.result, w.decisions, queued, w.precision)
