@@ -47,8 +47,8 @@ from monitor.core.constants import VIIRS_DETECTORS
 from monitor.geometry import frames, wgs84
 from monitor.simulate.case import SimulationSpec, Simulator
 from studies.collocated import collocated
-from studies.lift_decision import _scores, case_fields
-from studies.render_truth import _band_bt, _view_time
+from studies.lift_decision import case_fields, scores
+from studies.render_truth import band_bt, view_time
 
 SCENE_FIELDS = (
     "satellite", "granules", "seed", "profile", "orbit_pass", "pass_lon_deg", "terrain", "cloud_heights",
@@ -108,12 +108,12 @@ class IdealViews:
             seen = np.empty(len(iy), np.float32)
             for c0 in range(0, len(iy), CHUNK):
                 c = slice(c0, c0 + CHUNK)
-                t_view = _view_time(self.sim, p[c], t_guess[c], float(alpha))
+                t_view = view_time(self.sim, p[c], t_guess[c], float(alpha))
                 r_view, _, _ = self.sim.state(t_view)
                 scene = self.sim.scene
                 _, v_lat, v_lon, _ = scene.intersect(r_view, frames.unit(p[c] - r_view), unix_s=t_view)
                 temp = scene.temperature_k(v_lat, v_lon, scene.height_m(v_lat, v_lon), t_view)
-                seen[c] = _band_bt(self.sim, temp) + self.rng.normal(0.0, noise, len(temp))
+                seen[c] = band_bt(self.sim, temp) + self.rng.normal(0.0, noise, len(temp))
             out[j, iy, ix] = seen
             if alpha == 0.0:
                 self.centre_diff_k.append(np.abs(seen - bt_k[iy, ix]))
@@ -129,8 +129,8 @@ def measure(case: Path, workers: int, sweep: bool = False, ideal_views: bool = T
     plain = cfg.model_copy(update={"parallax": False})
     samples = collocated(case, cfg, workers, PROBE_M_PER_K)
     default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
-    row = {**case_fields(case, truth), "granules": truth["granules"], "default": _scores(default, truth)}
-    row["no_parallax"] = _scores(
+    row = {**case_fields(case, truth), "granules": truth["granules"], "default": scores(default, truth)}
+    row["no_parallax"] = scores(
         cost_and_offsets(paired(samples)[0], plain, satellite=truth["satellite"]), truth
     )
     if ideal_views:
@@ -138,11 +138,11 @@ def measure(case: Path, workers: int, sweep: bool = False, ideal_views: bool = T
         again = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=ideal)  # the truth for the rendering
         at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
         diff = np.concatenate(ideal.centre_diff_k) if ideal.centre_diff_k else np.full(1, np.nan)
-        row["ideal"] = _scores(at, truth)
+        row["ideal"] = scores(at, truth)
     if sweep:
         renderer = render.swept_bt
         both = collocated(case, cfg, workers, PROBE_M_PER_K, renderer=renderer)
-        row["sweep"] = _scores(cost_and_offsets(both, cfg, satellite=truth["satellite"]), truth)
+        row["sweep"] = scores(cost_and_offsets(both, cfg, satellite=truth["satellite"]), truth)
     if ideal_views:
         centre = (np.nanmedian(diff), np.nanpercentile(diff, 99))
         row["centre_view_k"] = [round(float(v), 2) for v in centre]

@@ -102,8 +102,8 @@ def decision(
     if offsets:
         plain = cfg.model_copy(update={"parallax": False})
         default = cost_and_offsets(samples, cfg, satellite=truth["satellite"])
-        row["default"] = _scores(default, truth)
-        row["no_parallax"] = _scores(cost_and_offsets(pairs[0], plain, satellite=truth["satellite"]), truth)
+        row["default"] = scores(default, truth)
+        row["no_parallax"] = scores(cost_and_offsets(pairs[0], plain, satellite=truth["satellite"]), truth)
         passes = {
             "at_lift": default.fors[0].parallax_m_per_k if at_lift else np.nan,
             "at_law": row["law_m_per_k"] if at_law and row["law_m_per_k"] is not None else np.nan,
@@ -112,7 +112,7 @@ def decision(
             if np.isfinite(lift) and lift > 0:
                 again = collocated(case, cfg, workers, lift)
                 at = cost_and_offsets(paired(again)[1], plain, satellite=truth["satellite"])
-                row[name] = _scores(at, truth) | {"lift_m_per_k": round(float(lift), 1)}
+                row[name] = scores(at, truth) | {"lift_m_per_k": round(float(lift), 1)}
     return row
 
 
@@ -129,7 +129,7 @@ def case_fields(case: Path, truth: dict) -> dict:
     }
 
 
-def _scores(result: AssessmentResult, truth: dict) -> dict:
+def scores(result: AssessmentResult, truth: dict) -> dict:
     """The day's errors against *truth* (module docstring), in-track and cross-track pairs."""
     fors = result.fors
     err = np.array([[f.d_alpha_urad - t["d_alpha_urad"], f.d_beta_urad - t["d_beta_urad"]]

@@ -35,7 +35,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult
 from monitor.instrument.spectral import BandModel, i5_band
 from monitor.sdr.pairing import plan
-from studies.lift_decision import _scores, case_fields
+from studies.lift_decision import case_fields, scores
 
 
 def _quads(a: np.ndarray) -> np.ndarray:
@@ -153,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
                 round(float(np.nanmedian([getattr(f, k) for f in result.fors])), 1)
                 for k in ("sigma_alpha_urad", "sigma_beta_urad")
             ]}  # fmt: skip
-            emit(row | _scores(result, truth) | _moved(result, exact), args.rows)
+            emit(row | scores(result, truth) | _moved(result, exact), args.rows)
     return 0
 
 

@@ -65,12 +65,12 @@ CLOUD_M = 1000.0  # the truth's rays that meet something higher than this count 
 WALLS_AS_STRETCHES = 1e30  # m per K: a wall renders as its stretch's own field (no depth term)
 
 
-def _band_bt(sim: Simulator, temp_k: np.ndarray) -> np.ndarray:
+def band_bt(sim: Simulator, temp_k: np.ndarray) -> np.ndarray:
     """VIIRS I5 BT (K) of emitting temperatures *temp_k* through the simulator's atmosphere."""
     return sim.band.bt_from_radiance(np.interp(temp_k, T_BINS_K, sim.band_table))
 
 
-def _view_time(sim: Simulator, p: np.ndarray, t: np.ndarray, alpha: float) -> np.ndarray:
+def view_time(sim: Simulator, p: np.ndarray, t: np.ndarray, alpha: float) -> np.ndarray:
     """When the spacecraft sees ECEF points *p* (N, 3) at in-track SBF angle *alpha*: a secant search from
     the VIIRS times *t*."""
 
@@ -165,7 +165,7 @@ def measure(
     shape = (scans * VIIRS_DETECTORS, VIIRS_COLUMNS)
     hit_p = (origin + hit_dist[..., None] * los).reshape(*shape, 3)
     lat, lon, hit_m, times = (np.asarray(v).reshape(shape) for v in (lat, lon, hit_m, t3))
-    bt = _band_bt(sim, temp).reshape(shape)
+    bt = band_bt(sim, temp).reshape(shape)
     good = ~np.tile(ins.viirs_bowtie_deleted(), (scans, 1)) & np.isfinite(lat)
     sat, vel = sim.orbit.state_ecef(scan_start + ins.VIIRS_EARTH_VIEW_S / 2)
     x, b, a, traced = views.view_tangents_across(lat, lon, np.zeros(shape), good, sat, vel, ALPHA_RAD)
@@ -201,11 +201,11 @@ def measure(
     row["across"] = across
     row |= {"m_per_k": m_per_k, "render_s": render_s} | ({"heights": heights} if heights else {})
     for j, alpha in enumerate(ALPHA_RAD):
-        t_view = _view_time(sim, p, times[good], alpha)
+        t_view = view_time(sim, p, times[good], alpha)
         r_view, _, _ = sim.state(t_view)
         _, v_lat, v_lon, v_hit = sim.scene.intersect(r_view, frames.unit(p - r_view), unix_s=t_view)
         v_h = sim.scene.height_m(v_lat, v_lon)
-        truth = _band_bt(sim, sim.scene.temperature_k(v_lat, v_lon, v_h, t_view))
+        truth = band_bt(sim, sim.scene.temperature_k(v_lat, v_lon, v_h, t_view))
         e = next_column[good]
         cols = np.einsum("nk,nk->n", source[j][good] - wgs84.geodetic_to_ecef(v_lat, v_lon, v_hit), e)
         cols = cols / np.einsum("nk,nk->n", e, e)

@@ -46,7 +46,7 @@ from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_DETECTORS
 from studies.collocated import collocated
 from studies.ideal_views import RENDERED_BT, IdealViews, simulator_of
-from studies.lift_decision import _scores, case_fields
+from studies.lift_decision import case_fields, scores
 
 TWELFTHS = 12
 
@@ -158,7 +158,7 @@ def measure(case: Path, lift_m_per_k: float, cache: Path, parts: list[str], work
         samples = collocated(case, cfg, workers, lift_m_per_k, renderer=renderer)
         result = cost_and_offsets(paired(samples)[1], plain, satellite=truth["satellite"])
         yield {**case_fields(case, truth), "granules": truth["granules"], "lift_m_per_k": lift_m_per_k,
-               "part": part, "scores": _scores(result, truth)}  # fmt: skip
+               "part": part, "scores": scores(result, truth)}  # fmt: skip
 
 
 def main() -> None:

@@ -1,6 +1,6 @@
 """The harnesses and the studies stand on the product: they call its public functions only, and they never
-assign into it (what a study varies, it passes as an argument). mypy and the import contracts check the
-rest in .ci/run."""
+assign into it (what a study varies, it passes through the seam for studies, monitor.assessment.seam). A
+study uses another study's public names only. mypy and the import contracts check the rest in .ci/run."""
 
 import ast
 from pathlib import Path
@@ -9,12 +9,14 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _private_uses(source: str) -> list[str]:
-    """Names starting with one underscore imported from, or read off, a module of the product."""
+    """Names starting with one underscore imported from, or read off, a module of the product or a study."""
     tree = ast.parse(source)
     modules = {}
     found = []
     for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(("monitor", "alerts")):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+            ("monitor", "alerts", "studies")
+        ):
             for a in node.names:
                 if a.name.startswith("_"):
                     found.append(f"{node.module}.{a.name}")
@@ -87,8 +89,9 @@ def test_no_harness_or_study_assigns_into_the_product():
 def test_the_check_sees_a_private_call():
     assert _private_uses("from monitor.assessment.assess import _x\n") == ["monitor.assessment.assess._x"]
     assert _private_uses("from monitor.simulate import case as sim\nsim._y()\n") == ["sim._y"]
+    assert _private_uses("from studies.lift_decision import _s\n") == ["studies.lift_decision._s"]
 
 
-def test_no_harness_or_study_calls_a_private_function_of_the_product():
+def test_no_harness_or_study_calls_a_private_function_of_the_product_or_of_a_study():
     found = {p.name: _private_uses(p.read_text()) for p in _scripts()}
     assert not {k: v for k, v in found.items() if v}
