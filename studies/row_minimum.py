@@ -7,7 +7,7 @@ as the value of the quadratic through its 3 x 3 at the sub-step minimum
 (:func:`monitor.estimation.cost.minimum_value`, the service's), for the rendering with each ray at its own
 place across the track (the service's) and, with ``--sweep``, for the sweep alone: whether the grid's
 minimum shapes the curve, and so the lift, by where the rows' turns lie on the grid
-(studies/clouds-with-height.md, "Each row's minimum between grid points"). One JSON row per rendering and
+(studies/clouds-with-height.md, section 4). One JSON row per rendering and
 minimum: f at the curve's least (refined by the parabola through the least three), the lift in m per K,
 the case's law, and the curve less its least, K.
 

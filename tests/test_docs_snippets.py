@@ -52,8 +52,14 @@ def test_the_documented_silence_is_in_the_future_and_parses():
 
 
 def test_the_docs_link_only_to_files_that_exist():
-    """Every relative link and image of README.md and docs/*.md resolves from the file's own folder."""
-    for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+    """Every relative link and image of README.md, docs/*.md and the studies' reports and records resolves
+    from the file's own folder."""
+    pages = [
+        ROOT / "README.md",
+        *sorted((ROOT / "docs").glob("*.md")),
+        *sorted((ROOT / "studies").rglob("*.md")),
+    ]
+    for page in pages:
         for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text()):
             if "://" not in target and not target.startswith("mailto:"):
                 assert (page.parent / target).exists(), f"{page.name}: {target}"

@@ -62,8 +62,7 @@ def test_the_reference_is_the_warmest_3x3_mean_within_reach_to_the_pixel_edges(s
 def test_a_deck_tens_of_km_wide_stands_at_its_height_in_its_middle():
     """A 60 km deck (160 pixels at 375 m) of 230 K in 295 K clear sky: its middle, 30 km from clear sky,
     takes the clear sky as its reference (within +-40 pixels it took its own 230 K and stood on the
-    ground: simulated decks' tops stood kilometres too low, studies/clouds-with-height.md, "The clear-sky
-    reference")."""
+    ground: simulated decks' tops stood kilometres too low, studies/clouds-with-height.md, section 5)."""
     bt = np.full((64, 400), 295.0, np.float32)
     bt[:, 120:280] = 230.0
     ref = reference_k(bt, np.ones(bt.shape, bool))

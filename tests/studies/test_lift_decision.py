@@ -1,7 +1,7 @@
 """The lift decision on a flat-cloud day whose texture and footprint differ from the days the rule was
 chosen on: it declines the lift, so the day's offsets are those of ``parallax=False``.
 Slow (~2 min: a sharp-edged day samples each CrIS cone at 4096 points); the held-back grid is
-studies/clouds-with-height.md "The lift decision on held-back days"."""
+studies/clouds-with-height.md, sections 3-4."""
 
 import numpy as np
 import pytest
