@@ -575,7 +575,7 @@ def swath_piece(
     else:
         advance = det_step * VIIRS_DETECTORS
     r_idx, c_idx = np.nonzero(np.isfinite(radius))
-    # unbalanced with large leaves: the same nearest blocks, a faster build (studies/speed-and-memory.md)
+    # unbalanced with large leaves: the same nearest blocks, a faster build (studies/rows/, the speed record)
     tree = cKDTree(centre[r_idx, c_idx], leafsize=64, balanced_tree=False, compact_nodes=False)
     return SwathPiece(
         pos,
