@@ -397,7 +397,9 @@ class DayAssessment:
             )
         in_time = sorted(self.samples, key=lambda s: (s.info.start, s.key))
         with stage(timings, "cost"):
-            return cost_and_offsets(in_time, cfg, skipped, self.satellite, self.variation)
+            return cost_and_offsets(
+                in_time, cfg, skipped, self.satellite, self.variation, self._spool.kept_samples
+            )
 
 
 def assess_plan(

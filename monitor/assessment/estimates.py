@@ -10,7 +10,6 @@ from __future__ import annotations
 import datetime as dt
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import overload
 
 import numpy as np
 
@@ -18,12 +17,10 @@ from monitor.assessment.inputs import KERNELS, offsets_rad
 from monitor.assessment.seam import SERVICE, Variation
 from monitor.assessment.spool import OnDisk, Spool
 from monitor.config.assessment import AssessmentConfig
-from monitor.core.constants import N_FOR
 from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
-from monitor.estimation import parallax
+from monitor.estimation.day import DaySamples, estimate_day, in_memory
 from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
-from monitor.estimation.offsets import DayLift, day_offsets
 from monitor.geometry.ground import offset_km
 from monitor.instrument.spectral import BandModel, i5_band
 
@@ -140,6 +137,7 @@ def cost_and_offsets(
     skipped: Sequence[tuple[str, str]] | None = None,
     satellite: str = "",
     variation: Variation = SERVICE,
+    keep: Callable[[ForSamples], ForSamples] = in_memory,
 ) -> AssessmentResult:
     """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*.
 
@@ -161,6 +159,9 @@ def cost_and_offsets(
     variation : Variation, optional
         What a study varies: the probe's lift the rendered collocation was made at, how a FOR's two
         collocations are combined (:mod:`monitor.assessment.seam`); the service's by default.
+    keep : callable, optional
+        Where each FOR's built samples wait while the day's lift is sought (the day's spool); in memory by
+        default.
 
     Returns
     -------
@@ -168,50 +169,19 @@ def cost_and_offsets(
         Per-FOR offsets (urad, km), sigmas, flags and the day's lift.
     """
     band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
-    per_for: Sequence[ForSamples] = PerFor(lambda k: for_samples(samples, k, cfg, band))
-    m_per_k = np.nan
-    spread = np.zeros((N_FOR, 4))  # the sigma (steps) the day's lift adds: FOR alpha, beta; rows alpha, beta
     rendered = bool(samples) and all(s.rendered is not None for s in samples)
-    pairs = paired(samples) if rendered else None
-    if pairs is not None:
-        s0, s1 = pairs
-        cones0, cones1 = zip(
-            *(
-                parallax.matched_cone(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), cfg.cost)
-                for k in range(N_FOR)
-            ),
-            strict=True,
-        )
-        f, sigma_f = parallax.day_lift(list(cones0), list(cones1), cfg.cost, variation.probe_m_per_k)
-        if cfg.uncertainty and np.isfinite(sigma_f):
-            spread = np.array(
-                [
-                    np.abs(parallax.sensitivity(a, b, f, cfg.cost)) * sigma_f if len(a) >= 3 else np.zeros(4)
-                    for a, b in zip(cones0, cones1, strict=True)
-                ]
-            )
-        per_for = PerFor(
-            lambda k: variation.blend(for_samples(s0, k, cfg, band), for_samples(s1, k, cfg, band), f)
-        )
-        m_per_k = f * variation.probe_m_per_k
-    used = samples if pairs is None else pairs[0]
-    # parallax.sensitivity's order: FOR alpha, beta; rows alpha, beta
-    sigma_alpha, sigma_beta, sigma_rows_alpha, sigma_rows_beta = (np.nan_to_num(spread) * cfg.step_urad).T
-    lift = DayLift(
-        m_per_k,
-        np.array([_cold_height_km(_cris_k(used, k), m_per_k) for k in range(N_FOR)]),
-        sigma_alpha,
-        sigma_beta,
-        sigma_rows_alpha,
-        sigma_rows_beta,
-    )
-    day = day_offsets(
-        per_for,
+    at_geo, at_probe = paired(samples) if rendered else (samples, None)
+    day = estimate_day(
+        DaySamples(
+            lambda k: for_samples(at_geo, k, cfg, band),
+            None if at_probe is None else lambda k: for_samples(at_probe, k, cfg, band),
+            lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
+            follows_in_time([_seconds(s.info.start) for s in samples]),
+            variation.probe_m_per_k,
+            variation.blend,
+            keep,
+        ),
         cfg,
-        cfg.step_urad,
-        lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
-        follows_in_time([_seconds(s.info.start) for s in samples]),
-        lift,
     )
     starts = [s.info.start for s in samples]
     ends = [s.info.end for s in samples]
@@ -266,43 +236,3 @@ def _cris_k(samples: list[GranuleSamples], k: int) -> np.ndarray:
     return np.concatenate([s.bt_cris_k[:, k][s.usable[:, k]] for s in samples] or [np.empty(0)]).astype(
         np.float64
     )
-
-
-def _cold_height_km(cris_k: np.ndarray, m_per_k: float) -> float:
-    """The height (km) the correction puts a FOR's cold scenes at: *m_per_k* times its CrIS BT's 95th
-    minus 5th percentile (NaN without samples or correction)."""
-    if len(cris_k) < 3 or not np.isfinite(m_per_k):
-        return np.nan
-    return float(m_per_k * np.subtract(*np.percentile(cris_k, [95, 5])) / 1000.0)
-
-
-class PerFor(Sequence[ForSamples]):
-    """The 30 FORs' samples, each built when indexed (read from the day's spool, blended).
-
-    One FOR of a long day is in memory at a time, not the day
-    (:func:`~monitor.estimation.offsets.day_offsets`).
-
-    Parameters
-    ----------
-    build : callable
-        Builds FOR k's (0-based) samples.
-    """
-
-    def __init__(self, build: Callable[[int], ForSamples]) -> None:
-        self._build = build
-
-    def __len__(self) -> int:
-        return N_FOR
-
-    @overload
-    def __getitem__(self, k: int) -> ForSamples: ...
-
-    @overload
-    def __getitem__(self, k: slice) -> list[ForSamples]: ...
-
-    def __getitem__(self, k: int | slice) -> ForSamples | list[ForSamples]:
-        if isinstance(k, slice):
-            return [self._build(i) for i in range(N_FOR)[k]]
-        if not -N_FOR <= k < N_FOR:
-            raise IndexError(k)
-        return self._build(k % N_FOR)
