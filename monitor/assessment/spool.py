@@ -2,10 +2,10 @@
 
 A granule's VIIRS BT through every perturbed cone and, with the footprint kernel, its radiance per annulus
 (twice that with the rendered collocation of the parallax correction) would, over a long day, outgrow the
-memory a day may have (docs/performance.md). The estimate needs them one FOR at a time (a thirtieth of
-each granule), so a :class:`DayAssessment <monitor.assessment.assess.DayAssessment>` writes each
-granule's arrays to a temporary directory as it is collocated, and each read maps the file, copies the slice
-asked for and unmaps it: resident memory holds one FOR of the day, not the day. While the day's lift is sought, each FOR's
+memory a day may have (docs/performance.md). The estimate needs them one FOR at a time (a thirtieth of each
+granule), so a :class:`DayAssessment <monitor.assessment.assess.DayAssessment>` writes each granule's arrays
+to a temporary directory as it is collocated, and each read maps the file, copies the slice asked for and
+unmaps it: resident memory holds one FOR of the day, not the day. While the day's lift is sought, each FOR's
 samples, once built, wait here too (:meth:`Spool.kept_samples`). The directory is made with :mod:`tempfile`
 (``TMPDIR``; it should be on disk, not a RAM disk) and removed when the day is done or the process exits.
 """
