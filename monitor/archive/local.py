@@ -99,7 +99,7 @@ class SimulatedSource(LocalSource):
     ``source.retention_days`` most recently listed days are kept, and any another run listed in the last
     :data:`IN_USE_S` (e.g. another reprocessing worker may still read it); a day this source listed itself,
     and nobody since, is done with once the next is listed: a catch-up of months would otherwise fill the
-    disk, ~0.36 GB a day of three granules.
+    disk.
 
     Parameters
     ----------

@@ -99,7 +99,7 @@ class SwathCache:
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
-    # a third kept would be one no granule of a time-ordered run needs again (~250 MB at the peak)
+    # a third kept would be one no granule of a time-ordered run needs again, at the peak's cost
     keep: int = 2
     spans: dict = field(default_factory=dict)
     lift_m_per_k: float = 0.0

@@ -1,13 +1,12 @@
 """The C allocator, set for an assessment's large short-lived arrays (glibc; elsewhere nothing changes).
 
-An assessment allocates and frees some 600 MB per VIIRS granule (read, checked, prepared, collocated).
+An assessment allocates and frees hundreds of MB per VIIRS granule (read, checked, prepared, collocated).
 glibc serves every allocation above 32 MB from fresh pages that the kernel zeroes at first touch and takes
-back at free, so each granule pays for zeroing them again: 1.5-2 CPU-s of system time in a 14-granule
-assessment, a quarter of a second to half a second of its wall time on two cores. Served from the heap and
-not trimmed at every free, freed memory is reused as it is; :func:`release_freed_memory` hands what is
-free back to the system after a job (the daemon then idles until the next day). Reprocessing's Dask
-workers set it at each satellite-day (:func:`monitor.service.reprocess.day_task`) and keep the memory between
-days (their peak, ~2 GB): Dask's own setting (MALLOC_TRIM_THRESHOLD_ = 64 KiB) would return it at every free.
+back at free, so each granule would pay for zeroing them again, in system time. Served from the heap and not
+trimmed at every free, freed memory is reused as it is; :func:`release_freed_memory` hands what is free back
+to the system after a job (the daemon then idles until the next day). Reprocessing's Dask workers set it at
+each satellite-day (:func:`monitor.service.reprocess.day_task`) and keep the memory between days (their peak:
+docs/performance.md): Dask's own setting (MALLOC_TRIM_THRESHOLD_ = 64 KiB) would return it at every free.
 """
 
 from __future__ import annotations

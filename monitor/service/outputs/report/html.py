@@ -48,7 +48,8 @@ from monitor.service.store.sqlite import Store
 
 UTC = dt.timezone.utc
 LOG = logging.getLogger(__name__)
-# a satellite's page with its figures inside: 0.6 MB for 400 days (7 figures); mail servers commonly take 10
+# a satellite's page with its figures inside stays well under this for a year and more (docs/operations.md,
+# "The HTML report"); mail servers commonly take 10 MB and more
 PAGE_BUDGET_BYTES = 1_000_000
 CSS = """
 body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:1.5em auto;max-width:1100px;color:#222}
