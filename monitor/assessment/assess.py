@@ -397,9 +397,7 @@ class DayAssessment:
             )
         in_time = sorted(self.samples, key=lambda s: (s.info.start, s.key))
         with stage(timings, "cost"):
-            return cost_and_offsets(
-                in_time, cfg, skipped, self.satellite, self.variation, self._spool.kept_samples
-            )
+            return cost_and_offsets(in_time, cfg, skipped, self.satellite, self.variation, self._spool.parked)
 
 
 def assess_plan(

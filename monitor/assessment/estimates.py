@@ -18,7 +18,7 @@ from monitor.assessment.seam import SERVICE, Variation
 from monitor.assessment.spool import OnDisk, Spool
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
-from monitor.estimation.day import DaySamples, estimate_day, in_memory
+from monitor.estimation.day import DaySamples, Parked, estimate_day, in_memory
 from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
 from monitor.geometry.ground import offset_km
@@ -137,7 +137,7 @@ def cost_and_offsets(
     skipped: Sequence[tuple[str, str]] | None = None,
     satellite: str = "",
     variation: Variation = SERVICE,
-    keep: Callable[[ForSamples], ForSamples] = in_memory,
+    keep: Callable[[ForSamples], Parked] = in_memory,
 ) -> AssessmentResult:
     """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*.
 
@@ -160,8 +160,8 @@ def cost_and_offsets(
         What a study varies: the probe's lift the rendered collocation was made at, how a FOR's two
         collocations are combined (:mod:`monitor.assessment.seam`); the service's by default.
     keep : callable, optional
-        Where each FOR's built samples wait while the day's lift is sought (the day's spool); in memory by
-        default.
+        Where each FOR's built samples wait while the day's lift is sought (the day's spool,
+        :meth:`Spool.parked <monitor.assessment.spool.Spool.parked>`); in memory by default.
 
     Returns
     -------

@@ -6,13 +6,14 @@ memory a day may have (docs/performance.md). The estimate needs them one FOR at 
 granule), so a :class:`DayAssessment <monitor.assessment.assess.DayAssessment>` writes each granule's arrays
 to a temporary directory as it is collocated, and each read maps the file, copies the slice asked for and
 unmaps it: resident memory holds one FOR of the day, not the day. While the day's lift is sought, each FOR's
-samples, once built, wait here too (:meth:`Spool.kept_samples`). The directory is made with :mod:`tempfile`
+samples, once built, wait here too (:meth:`Spool.parked`). The directory is made with :mod:`tempfile`
 (``TMPDIR``; it should be on disk, not a RAM disk) and removed when the day is done or the process exits.
 """
 
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -63,9 +64,9 @@ class Spool:
             raise AssessmentError(f"{path}: cannot keep the day's collocated samples on disk: {exc}") from exc
         return OnDisk(path, array.shape)
 
-    def kept_samples(self, s: ForSamples) -> ForSamples:
-        """A FOR's samples with their surfaces (and annuli) written to the spool and mapped back read-only:
-        the day's lift is sought before any FOR is estimated at it, and the FORs wait here meanwhile.
+    def parked(self, s: ForSamples) -> Callable[[], ForSamples]:
+        """A FOR's samples with their surfaces (and annuli) written to the spool: the day's lift is sought
+        before any FOR is estimated at it, and the FORs wait here meanwhile, out of memory.
 
         Parameters
         ----------
@@ -74,14 +75,17 @@ class Spool:
 
         Returns
         -------
-        ForSamples
-            The same samples, their large arrays read from disk when used.
+        callable
+            Reads the same samples back into memory, whole, when called.
         """
-        annuli = None if s.annuli_rad is None else self._mapped(s.annuli_rad)
-        return replace(s, d_k=self._mapped(s.d_k), annuli_rad=annuli)
+        surface = self.keep(s.d_k)
+        annuli = None if s.annuli_rad is None else self.keep(s.annuli_rad)
+        light = replace(s, d_k=np.empty((0,)), annuli_rad=None)
 
-    def _mapped(self, array: np.ndarray) -> np.ndarray:
-        return np.load(self.keep(array).path, mmap_mode="r")
+        def back() -> ForSamples:
+            return replace(light, d_k=surface[...], annuli_rad=None if annuli is None else annuli[...])
+
+        return back
 
     def close(self) -> None:
         """Remove the directory and every array in it."""

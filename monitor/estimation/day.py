@@ -7,8 +7,9 @@ chooses the day's lift from the cost where there is a rendering (:mod:`monitor.e
 estimates every FOR at it (:mod:`monitor.estimation.offsets`; Wang et al. 2017, sections 2.3-2.4).
 
 Each FOR's samples are built once. The lift needs every FOR's samples before any FOR can be estimated at it,
-so the first pass keeps each FOR's two collocations through :attr:`DaySamples.keep` (the assessment's spool:
-on disk, one FOR in memory at a time) and the second blends them at the day's lift.
+so the first pass puts each FOR's two collocations aside through :attr:`DaySamples.keep` (the assessment's
+spool: on disk, one FOR in memory at a time) and the second reads them back and blends them at the day's
+lift.
 """
 
 from __future__ import annotations
@@ -26,10 +27,11 @@ from monitor.estimation.estimate import ForSamples
 from monitor.estimation.offsets import NO_LIFT, DayEstimate, DayLift, KmOf, day_offsets
 
 BuildFor = Callable[[int], ForSamples]  # FOR k's (0-based) samples over the day
+Parked = Callable[[], ForSamples]  # a FOR's samples put aside, handed back when called
 
 
-def in_memory(s: ForSamples) -> ForSamples:
-    """*s* as it is: a FOR's samples kept in memory for the second pass (a short day's way).
+def in_memory(s: ForSamples) -> Parked:
+    """*s* put aside in memory for the second pass (a short day's way).
 
     Parameters
     ----------
@@ -38,10 +40,10 @@ def in_memory(s: ForSamples) -> ForSamples:
 
     Returns
     -------
-    ForSamples
-        The same.
+    callable
+        Hands *s* back.
     """
-    return s
+    return lambda: s
 
 
 @dataclass(frozen=True)
@@ -65,7 +67,8 @@ class DaySamples:
         How a FOR's two collocations combine at a fraction of the probe's lift
         (:func:`monitor.estimation.parallax.blend`; a study's through :mod:`monitor.assessment.seam`).
     keep : callable
-        Where a FOR's built samples wait for the second pass (by default in memory).
+        Puts a FOR's built samples aside for the second pass and returns what hands them back (by default
+        they wait in memory).
     """
 
     at_geo: BuildFor
@@ -74,7 +77,7 @@ class DaySamples:
     follows: np.ndarray
     probe_m_per_k: float
     blend: parallax.Blend = parallax.blend
-    keep: Callable[[ForSamples], ForSamples] = in_memory
+    keep: Callable[[ForSamples], Parked] = in_memory
 
 
 def estimate_day(day: DaySamples, cfg: AssessmentConfig) -> DayEstimate:
@@ -124,7 +127,7 @@ def estimate_day(day: DaySamples, cfg: AssessmentConfig) -> DayEstimate:
         sigma_rows_alpha,
         sigma_rows_beta,
     )
-    per_for = PerFor(lambda k: day.blend(*kept[k], f))
+    per_for = PerFor(lambda k: day.blend(kept[k][0](), kept[k][1](), f))
     return day_offsets(per_for, cfg, cfg.step_urad, day.km, day.follows, lift)
 
 
