@@ -18,7 +18,7 @@ from monitor.assessment.seam import SERVICE, Variation
 from monitor.assessment.spool import OnDisk, Spool
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
-from monitor.estimation.day import DaySamples, Parked, estimate_day, in_memory
+from monitor.estimation.day_estimate import DaySamples, Parked, estimate_day, in_memory
 from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
 from monitor.geometry.ground import offset_km

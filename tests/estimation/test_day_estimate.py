@@ -8,7 +8,7 @@ import numpy as np
 from monitor.assessment.spool import Spool
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import N_FOR
-from monitor.estimation.day import DaySamples, PerFor, estimate_day
+from monitor.estimation.day_estimate import DaySamples, PerFor, estimate_day
 from monitor.estimation.offsets import NO_LIFT, day_offsets
 from monitor.instrument import footprint
 from tests.estimation.test_estimate import STEP_RAD, _samples
@@ -20,7 +20,9 @@ CFG = AssessmentConfig(min_samples=10, step_urad=STEP_RAD * 1e6)
 def _day(keep=None):
     s0 = _samples(footprint.super_gaussian(), n=48, seed=3)
     # the rendered twin: the same FOVs, their surfaces moved a little, as a lift would move them
-    s1 = replace(s0, d_k=s0.d_k + 0.05 * np.linspace(-1, 1, s0.d_k.shape[-1]), annuli_rad=s0.annuli_rad * 1.001)
+    s1 = replace(
+        s0, d_k=s0.d_k + 0.05 * np.linspace(-1, 1, s0.d_k.shape[-1]), annuli_rad=s0.annuli_rad * 1.001
+    )
     built = {"at_geo": 0, "rendered": 0}
 
     def build(which, s):
@@ -31,9 +33,7 @@ def _day(keep=None):
         return one
 
     extra = {} if keep is None else {"keep": keep}
-    day = DaySamples(
-        build("at_geo", s0), build("rendered", s1), _jacobian, np.zeros(4, bool), 260.0, **extra
-    )
+    day = DaySamples(build("at_geo", s0), build("rendered", s1), _jacobian, np.zeros(4, bool), 260.0, **extra)
     return day, built, s0
 
 
