@@ -105,7 +105,7 @@ def collocate_granule(
     )  # fmt: skip
     pieces = load_swath(viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs, inputs.span_us)
     with stage(timings, "collocation"):
-        cones = _collocate_fors(pieces, geo, fg, valid, fill, cfg, band, should_stop)
+        cones = _collocate_fors(pieces, geo, fg, valid, fill, cfg, should_stop)
     found = [_per_fov(c, fg, cfg, band) for c in (cones, cones.rendered) if c is not None]
     usable = [
         valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
@@ -151,7 +151,6 @@ def _collocate_fors(
     valid: np.ndarray,
     fill: dict,
     cfg: AssessmentConfig,
-    band: BandModel,
     should_stop: StopCheck = None,
 ) -> collocate.ConeSums:
     """The cone sums of every FOV of the granule (in one call of the parallel kernel), and of what each

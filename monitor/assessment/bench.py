@@ -76,9 +76,7 @@ def bytes_read() -> int | None:
     return None
 
 
-def _pyresample_reference(
-    case: CasePlan, cfg: AssessmentConfig, max_granules: int = 1
-) -> tuple[float, int] | None:
+def _pyresample_reference(case: CasePlan, cfg: AssessmentConfig) -> tuple[float, int] | None:
     """Time the zero-offset and all-perturbation collocation with pyresample's radius neighbour search.
 
     For each perturbed LOS the ground point is computed and pyresample finds the VIIRS pixels within

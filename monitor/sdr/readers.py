@@ -172,7 +172,7 @@ def _check_values(path: GranuleRef, name: str, data: np.ndarray, f: Field) -> No
             raise GranuleError(path, name, f"vector length {bad:.6g} outside {f.norm[0]:g}..{f.norm[1]:g}")
 
 
-def _clean(path: GranuleRef, dataset: str, raw: np.ndarray, f: Field) -> np.ndarray:
+def _clean(raw: np.ndarray, f: Field) -> np.ndarray:
     if f.kind == "float":
         # Per-scan and per-FOV fields become float64; VIIRS pixel arrays and spectra stay float32 (memory).
         wide = raw.dtype == np.float64 or (raw.ndim < 4 and f.per != "row")
@@ -268,7 +268,7 @@ def _product_granules(
         raw = _read_array(path, h5, name, f, int(bounds[-1] * per), kept if f.per == "row" else None)
         if f.kind == "scaled" and raw.dtype.kind == "u":
             consistency.check_raw_counts(path, name, raw)
-        data = _clean(path, name, raw, f)
+        data = _clean(raw, f)
         fac = _factors(path, h5, group, f, n_gran) if f.factors else None
         parts = []
         for k in range(n_gran):
@@ -511,7 +511,7 @@ def read_viirs_geo_scan(path: str | os.PathLike[str] | GranuleRef, scan: int) ->
             start = (scan % (rows // product.rows_per_scan)) * product.rows_per_scan
             raw = h5[name][start : start + product.rows_per_scan]
             _check_raw(path, name, raw, f, product.rows_per_scan)
-            data = _clean(path, name, raw, f)
+            data = _clean(raw, f)
             _check_values(path, name, data, f)
             out.append(data * f.to_si if f.to_si != 1.0 else data)
         if "height_m" in product.fields:

@@ -153,14 +153,14 @@ class Service:
                 LOG.log(level.get(out.status, logging.INFO), "%s", out.summary())
                 if self.metrics is not None:
                     self.metrics.record(out)
-                self._after_run(store, out)
+                self._after_run(store)
                 return out
         finally:
             # after the report and the alerts too: what they freed (their share grows with the history
             # they plot) would otherwise stay with the daemon until the next day
             allocator.release_freed_memory()
 
-    def _after_run(self, store: Store, outcome: RunOutcome) -> None:
+    def _after_run(self, store: Store) -> None:
         """After every run: evaluate the alert rules and deliver what is queued (the e-mails attach the
         trend plot), then regenerate the report (it shows the alerts)."""
         self.check_alerts(store, report=not self.stop_event.is_set())  # stopping: the next run rewrites it

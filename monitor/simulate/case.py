@@ -502,7 +502,6 @@ class Simulator:
             lat,
             lon,
             spec.aux["cris"],
-            "CrIS-SDR-GEO",
         )
         geo = {
             "FORTime": for_iet,
@@ -823,7 +822,6 @@ class Simulator:
             np.radians(lat_out[valid][::97]),
             np.radians(lon_out[valid][::97]),
             spec.aux["viirs"],
-            PRODUCTS[geo_prefix].collection,
         )
         per_scan = {
             "StartTime": start_iet,
@@ -906,7 +904,6 @@ class Simulator:
         lat: np.ndarray,
         lon: np.ndarray,
         aux: Sequence[str],
-        coll: str,
     ) -> dict:
         p = self.spec.satellite
         lat_d, lon_d = np.degrees(lat), np.degrees(lon)
