@@ -22,14 +22,18 @@ import numpy as np
 from alerts.alertmanager import post_state
 from alerts.channels import Channel, Permanent, Transient, make_channels
 from alerts.rules import (
+    BAND_WATCHES,
     CALIBRATION,
     GEOLOCATION,
     Finding,
+    attribute_bands,
     failure_finding,
     jump_findings,
     processing_change_findings,
+    radiometry_finding,
     spec_finding,
     stale_finding,
+    watched_series,
 )
 from alerts.steps import replay_reach
 from monitor.config.alert_settings import AlertSettings
@@ -71,6 +75,7 @@ def findings_for(
         f
         for f in (
             spec_finding(store, satellite, s),
+            radiometry_finding(store, satellite, s),
             stale_finding(store, satellite, s, now),
             failure_finding(store, satellite),
         )
@@ -81,8 +86,20 @@ def findings_for(
         # the changes the jump rule's replay can meet (alerts.steps.replay_reach), however long the history
         reach = dt.timedelta(replay_reach(GEOLOCATION.rules(s)) + 1)
         changes = all_changes(store, satellite, settings.events_file, since=latest - reach)
-        out += jump_findings(store, satellite, changes, s)
-        out += jump_findings(store, satellite, changes, s, CALIBRATION)
+        geolocation = jump_findings(store, satellite, changes, s)
+        out += geolocation + jump_findings(store, satellite, changes, s, CALIBRATION)
+        recent = latest - reach
+        measured = {
+            w.band for w in BAND_WATCHES if np.isfinite(watched_series(store, satellite, w, recent)[1]).any()
+        }
+        bands = [
+            f
+            for w in BAND_WATCHES
+            if w.band in measured
+            for f in jump_findings(store, satellite, changes, s, w)
+        ]
+        attribute_bands(bands, geolocation, measured, s)
+        out += bands
     out += processing_change_findings(store, satellite, s, latest or now.date())
     return out
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from monitor.archive import ALL_PRODUCTS, ListedFile, Source, SourceError
 from monitor.assessment.assess import DayAssessment
-from monitor.assessment.daymap import map_day
+from monitor.assessment.daymap import map_day, with_bands
 from monitor.assessment.scenes import Candidate, batch_decisions, next_batch, rank_scenes
 from monitor.config.assessment import AssessmentConfig
 from monitor.config.model import Config
@@ -363,13 +363,17 @@ def _compute_day(
         w.counts.assessed = len(w.result.granules)
         if stop():
             raise StopRequested
-        if cfg.mapping_dir is not None and w.result.granules:
+        if w.result.granules:
             t1 = time.perf_counter()
             beat.stage("map", "mapping the CrIS FOVs onto VIIRS")
+            mapped = {*cfg.assessment.bands, *(cfg.mapping_bands if cfg.mapping_dir is not None else ())}
             try:
-                w.mapping = map_day(source, satellite, day, cases, w.result, tuple(cfg.mapping_bands), stop)
-            except (SourceError, DataError) as exc:  # the mapping is a product of the day, not its outcome
+                matchup = map_day(source, satellite, day, cases, w.result, tuple(mapped), stop)
+                w.result = with_bands(w.result, matchup, cfg.assessment)
+                w.mapping = matchup if cfg.mapping_dir is not None else None
+            except (SourceError, DataError) as exc:  # the bands are a product of the day, not its outcome
                 LOG.warning("the day's mapping failed: %s", exc)
+                w.result.notes.append(f"no CrIS minus VIIRS per band: the mapping failed: {exc}")
             w.timings["map"] = time.perf_counter() - t1
     except StopRequested:
         w.status, w.reason, w.result = RunStatus.INTERRUPTED, "stop requested", None

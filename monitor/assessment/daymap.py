@@ -1,5 +1,7 @@
 """The day's mapping: the CrIS granules a day assessed, mapped onto the configured VIIRS bands on the
-day's own offsets (``mapping_dir``, ``mapping_bands``; :mod:`monitor.matchup`).
+day's own offsets (``assessment.bands``, and ``mapping_bands`` where ``mapping_dir`` is set;
+:mod:`monitor.matchup`), and the day's CrIS minus VIIRS per band read from it
+(:mod:`monitor.matchup.radiometry`).
 
 The I5 granules are those the assessment fetched; each other band's granules are listed from the source
 and fetched for the same VIIRS granules (an M-band file shares its I-band file's
@@ -14,9 +16,11 @@ import logging
 from collections.abc import Callable
 
 from monitor.archive import ListedFile, Source, SourceError, band_products
+from monitor.config.assessment import AssessmentConfig
 from monitor.core.errors import DataError
 from monitor.core.result import AssessmentResult
 from monitor.matchup import Matchup, map_plan
+from monitor.matchup.radiometry import Uniformity, day_radiometry, with_radiometry
 from monitor.sdr.pairing import CasePlan, GranuleFiles, granule_files
 from monitor.sdr.products import prefixes
 
@@ -95,3 +99,24 @@ def map_day(
         len(cris), ", ".join(bands), sum(cost.read_s.values()), sum(cost.map_s.values()),
     )  # fmt: skip
     return matchup
+
+
+def with_bands(result: AssessmentResult, matchup: Matchup, cfg: AssessmentConfig) -> AssessmentResult:
+    """The day's *result* with CrIS minus VIIRS in each of ``assessment.bands``, read from its mapping.
+
+    Parameters
+    ----------
+    result : AssessmentResult
+        The day's assessment.
+    matchup : Matchup
+        Its granules mapped on its offsets, in (at least) the configured bands.
+    cfg : AssessmentConfig
+        The assessment's configuration (``bands``, ``uniform_std_k``, ``min_coverage``).
+
+    Returns
+    -------
+    AssessmentResult
+        A copy with ``cris_minus_viirs_k_<BAND>`` and its sigma per FOR, and the bins.
+    """
+    uniform = Uniformity(cfg.uniform_std_k, cfg.min_coverage)
+    return with_radiometry(result, day_radiometry(matchup, uniform, tuple(cfg.bands)))

@@ -234,6 +234,8 @@ def cmd_assess(args: argparse.Namespace) -> int:
         The exit status.
     """
     from monitor.assessment.assess import assess_plan
+    from monitor.assessment.daymap import with_bands
+    from monitor.matchup import map_granules
     from monitor.sdr.pairing import plan
 
     base = load(args).assessment if args.config else ASSESSMENT
@@ -260,6 +262,9 @@ def cmd_assess(args: argparse.Namespace) -> int:
         case = plan(args.paths)
         with Progress("assessing granules", len(case.cris)) as progress:
             result = assess_plan(case, cfg, progress, workers=cfg.workers)
+        if result.granules:
+            matchup, _ = map_granules(args.paths, tuple(cfg.bands), offsets=result)
+            result = with_bands(result, matchup, cfg)
     print(result_text(result))
     if args.out:
         Path(args.out).write_text(result.to_json())

@@ -64,8 +64,15 @@ class RuleSettings(Section):
     min_bias_jump_k: float = key(
         0.05,
         "Smallest step of the daily CrIS-VIIRS BT bias at 280 K (pooled over the FORs that found it) that "
-        "the calibration_jump rule pages (a VIIRS LUT or CrIS calibration change); a smaller one is "
-        "recorded. Half the 0.1 K step it must see.",
+        "the calibration_jump rule pages (a VIIRS LUT or CrIS calibration change), and of each band's "
+        "daily CrIS minus VIIRS difference; a smaller one is recorded. Half the 0.1 K step it must see.",
+        0.0,
+        100.0,
+    )
+    radiometry_limit_k: float = key(
+        0.5,
+        "A FOR whose daily CrIS minus VIIRS difference in a band (cris_minus_viirs_k_<BAND>) is beyond this "
+        "in magnitude pages, as the specification does: critical where it is beyond it by 2 sigma, K.",
         0.0,
         100.0,
     )

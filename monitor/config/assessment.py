@@ -7,10 +7,11 @@ from typing import Annotated, Any
 
 from pydantic import (
     BeforeValidator,
+    Field,
     model_validator,
 )
 
-from monitor.config.keys import FilePath, KeyProblem, Section, key
+from monitor.config.keys import Band, FilePath, KeyProblem, Section, key
 from monitor.core.constants import (
     DEFAULT_HALF_STEPS,
     DEFAULT_STEP_URAD,
@@ -132,6 +133,20 @@ class AssessmentConfig(Section):
         "with the day's height scale chosen by the cost: clouds with height seen by CrIS's FOV rows from "
         "another angle (the pixels rendered as each row sees them, collocated in the same pass; off: "
         "pixels at their GEO points).",
+    )
+
+    bands: Annotated[list[Band], Field(min_length=1)] = key(
+        ["I5"],
+        "The VIIRS bands CrIS is compared with radiometrically each day (I5, M13, M15, M16): per band and "
+        "FOR, CrIS minus VIIRS over the FOVs uniform in VIIRS, on the assessed geolocation "
+        "(cris_minus_viirs_k_<BAND>). The offsets are I5's whatever this lists.",
+    )
+    uniform_std_k: float = key(
+        0.5,
+        "A FOV is uniform in a band, and counts in its CrIS minus VIIRS, where the response-weighted "
+        "standard deviation of its VIIRS pixels' BT (their noise included) is at most this, K.",
+        0.01,
+        10.0,
     )
 
     @property

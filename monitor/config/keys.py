@@ -22,6 +22,8 @@ from pydantic import (
     WithJsonSchema,
 )
 
+from monitor.core.bands import BANDS
+
 
 class ConfigError(ValueError):
     """A configuration problem, naming the key."""
@@ -119,6 +121,15 @@ EnvName = Annotated[
 
 
 Address = Annotated[str, AfterValidator(_no_nul), AfterValidator(_address)]
+
+
+def _band(value: str) -> str:
+    if value not in BANDS:
+        raise ValueError(f"{value!r} is not one of {', '.join(BANDS)}")
+    return value
+
+
+Band = Annotated[str, AfterValidator(_band), WithJsonSchema({"type": "string", "enum": list(BANDS)})]
 
 
 TimeOfDay = Annotated[

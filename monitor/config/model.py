@@ -15,7 +15,7 @@ from pydantic import (
 
 from monitor.config.alert_settings import AlertSettings, Links
 from monitor.config.assessment import AssessmentConfig, FingerprintConfig, SceneConfig
-from monitor.config.keys import FilePath, KeyProblem, Section, Url, key
+from monitor.config.keys import Band, FilePath, KeyProblem, Section, Url, key
 from monitor.config.outputs import ExportConfig, HttpConfig, StoreConfig
 from monitor.config.schedule import ScheduleConfig
 from monitor.config.source import SourceConfig
@@ -26,12 +26,6 @@ from monitor.core.satellites import SATELLITES
 def _satellite(value: str) -> str:
     if value not in SATELLITES:
         raise ValueError(f"{value!r} is not one of {', '.join(SATELLITES)}")
-    return value
-
-
-def _band(value: str) -> str:
-    if value not in BANDS:
-        raise ValueError(f"{value!r} is not one of {', '.join(BANDS)}")
     return value
 
 
@@ -82,7 +76,7 @@ class Config(Section):
         "CrIS FOV's VIIRS scene and CrIS BT per band, on the day's assessed geolocation), as "
         "SATELLITE/SATELLITE_DAY.nc. None: no mapping.",
     )
-    mapping_bands: Annotated[list[Annotated[str, AfterValidator(_band)]], Field(min_length=1)] = key(
+    mapping_bands: Annotated[list[Band], Field(min_length=1)] = key(
         list(BANDS), "The VIIRS bands of the day's mapping (I5, M13, M15, M16)."
     )
     _file: Path | None = PrivateAttr(default=None)
@@ -121,8 +115,9 @@ class Config(Section):
 
     @property
     def viirs_bands(self) -> tuple[str, ...]:  # numpydoc ignore=RT01
-        """The VIIRS bands a day needs: I5 (the assessment's) and the mapping's when it is on."""
-        wanted = {"I5", *(self.mapping_bands if self.mapping_dir is not None else ())}
+        """The VIIRS bands a day needs: I5 (the assessment's), the radiometry's (``assessment.bands``) and
+        the mapping's when it is on."""
+        wanted = {"I5", *self.assessment.bands, *(self.mapping_bands if self.mapping_dir is not None else ())}
         return tuple(b for b in BANDS if b in wanted)
 
     @property

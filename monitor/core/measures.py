@@ -43,6 +43,11 @@ RESPONSE_WIDTH = Family(
     "Latest full width of the CrIS FOV spatial response fitted per FOR, at a level of its peak",
     "level",
 )
+CRIS_MINUS_VIIRS = Family(
+    "crisgeo_for_cris_minus_viirs_kelvin",
+    "Latest CrIS minus VIIRS BT per FOR and VIIRS band, the mean over the FOVs uniform in VIIRS",
+    "band",
+)
 FOV_ROWS = Family(
     "crisgeo_for_fov_rows_offset_radians",
     "Latest offset of the FOV rows ahead (FOVs 7-9) minus the rows behind (FOVs 1-3) per FOR",
@@ -57,8 +62,10 @@ class Measure:
     """A measured per-FOR field, as :class:`ForOffset` declares it: its name (ending in its unit), its unit
     as CF writes it, its meaning; whether it tells the quality of a measurement (an uncertainty, a cost)
     rather than being one; whether the time series carries it; where ``/metrics`` publishes it (a family
-    and the value of its label), if it does. The export, the text tables' units, ``/metrics``, the time
-    series and the store's columns all derive from these (:func:`measures`)."""
+    and the value of its label), if it does; the VIIRS band it belongs to, for a field measured per band
+    (``cris_minus_viirs_k_M15``: its quantity ``cris_minus_viirs_k`` in band ``M15``). The export, the text
+    tables' units, ``/metrics``, the time series and the store's columns all derive from these
+    (:func:`measures`)."""
 
     name: str
     kind: type
@@ -67,6 +74,12 @@ class Measure:
     quality: bool = False
     series: bool = True
     metric: tuple[Family, str] | None = None
+    band: str | None = None
+
+    @property
+    def quantity(self) -> str:  # numpydoc ignore=RT01
+        """The name without its band (``cris_minus_viirs_k`` of ``cris_minus_viirs_k_M15``)."""
+        return self.name if self.band is None else self.name.removesuffix(f"_{self.band}")
 
     @property
     def to_base_unit(self) -> float:  # numpydoc ignore=RT01
@@ -81,6 +94,7 @@ def measured(
     quality: bool = False,
     series: bool = True,
     metric: tuple[Family, str] | None = None,
+    band: str | None = None,
 ) -> Any:
     """Declare a measured field of :class:`ForOffset` (or of a record extending it).
 
@@ -98,11 +112,20 @@ def measured(
         Whether the time series carries it.
     metric : tuple of (Family, str), optional
         The ``/metrics`` family that publishes it, and its label value there.
+    band : str, optional
+        The VIIRS band of a field measured per band; its name ends in ``_<band>``.
 
     Returns
     -------
     dataclasses.Field
         The field, its :class:`Measure` in its metadata.
     """
-    spec = {"unit": unit, "meaning": meaning, "quality": quality, "series": series, "metric": metric}
+    spec = {
+        "unit": unit,
+        "meaning": meaning,
+        "quality": quality,
+        "series": series,
+        "metric": metric,
+        "band": band,
+    }
     return field(default=default, metadata={"measure": spec})

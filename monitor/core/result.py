@@ -7,6 +7,7 @@ import math
 import typing
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field, fields
+from typing import Any
 
 import numpy as np
 
@@ -14,6 +15,7 @@ from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DI
 from monitor.core.measures import (
     CALIBRATION_BIAS,
     CALIBRATION_GAIN,
+    CRIS_MINUS_VIIRS,
     FOV_ROWS,
     OFFSET_METERS,
     OFFSET_RADIANS,
@@ -21,7 +23,7 @@ from monitor.core.measures import (
     Measure,
     measured,
 )
-from monitor.core.vocabulary import DayStop, Decision
+from monitor.core.vocabulary import BinnedBy, DayStop, Decision
 
 FLAG_FEW_SAMPLES = "few_samples"  # fewer FOVs than the minimum: no estimate worth trusting
 FLAG_EDGE = "edge"  # the grid minimum is on the border of the perturbation grid
@@ -57,6 +59,23 @@ class SpecBreach:
 
 NAN = float("nan")
 SIGMA = "uncertainty (1 sigma) of the"
+UNIFORM = "mean over the day's FOVs uniform in VIIRS, on the assessed geolocation"
+
+
+def _difference(band: str) -> Any:
+    """The declaration of a band's CrIS minus VIIRS difference (:mod:`monitor.matchup.radiometry`)."""
+    return measured(
+        "K",
+        f"CrIS minus VIIRS {band} brightness temperature, {UNIFORM}",
+        NAN,
+        metric=(CRIS_MINUS_VIIRS, band),
+        band=band,
+    )
+
+
+def _difference_sigma(band: str) -> Any:
+    """The declaration of the sigma of a band's CrIS minus VIIRS difference."""
+    return measured("K", f"{SIGMA} CrIS minus VIIRS {band} difference", NAN, quality=True, band=band)
 
 
 @dataclass(frozen=True)
@@ -157,6 +176,17 @@ class ForOffset:
         "km", "height the parallax correction put the FOR's cold scenes at: its lift per K times its "
         "CrIS BT's 95th minus 5th percentile", NAN, quality=True,
     )  # fmt: skip
+
+    # CrIS minus VIIRS per band over the FOVs uniform in VIIRS (monitor.matchup.radiometry); NaN in a band
+    # not configured (assessment.bands)
+    cris_minus_viirs_k_I5: float = _difference("I5")
+    sigma_cris_minus_viirs_k_I5: float = _difference_sigma("I5")
+    cris_minus_viirs_k_M13: float = _difference("M13")
+    sigma_cris_minus_viirs_k_M13: float = _difference_sigma("M13")
+    cris_minus_viirs_k_M15: float = _difference("M15")
+    sigma_cris_minus_viirs_k_M15: float = _difference_sigma("M15")
+    cris_minus_viirs_k_M16: float = _difference("M16")
+    sigma_cris_minus_viirs_k_M16: float = _difference_sigma("M16")
 
     @property
     def scan_position(self) -> int:  # numpydoc ignore=RT01
@@ -291,6 +321,53 @@ class DifferenceBin:
 
 
 @dataclass(frozen=True)
+class RadiometryBin:
+    """CrIS minus VIIRS BT in one VIIRS *band* over the day's FOVs uniform in VIIRS that fall in one bin
+    (:mod:`monitor.matchup.radiometry`): *by* FOV (*key* ``1``..``9``), scene temperature (*key* the bin's
+    lower edge, K, of the VIIRS BT) or node (*key* ``ascending`` or ``descending``); the FOVs it holds, their
+    mean difference and its jackknife sigma (K)."""
+
+    band: str
+    by: BinnedBy
+    key: str
+    n: int
+    mean_k: float
+    sigma_k: float
+
+    def to_dict(self) -> dict:
+        """The bin as JSON-ready values (None where nothing was measured).
+
+        Returns
+        -------
+        dict
+            Its fields.
+        """
+        d = {**asdict(self), "by": str(self.by)}
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> RadiometryBin:
+        """A bin of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            Its fields.
+
+        Returns
+        -------
+        RadiometryBin
+            The bin.
+        """
+        nan = float("nan")
+        return cls(
+            d["band"], BinnedBy(d["by"]), str(d["key"]), int(d["n"]),
+            nan if d["mean_k"] is None else float(d["mean_k"]),
+            nan if d["sigma_k"] is None else float(d["sigma_k"]),
+        )  # fmt: skip
+
+
+@dataclass(frozen=True)
 class GranuleInfo:
     """One assessed CrIS granule: its ID and times (ISO 8601), its files and the VIIRS files that covered it,
     the FOVs with geolocation and the FOVs used, and the processing metadata of its CrIS GEO and of the
@@ -347,6 +424,7 @@ class AssessmentResult:
     cost_cube_k: np.ndarray | None = None  # (30, 2n+1, 2n+1), index i in-track, j cross-track
     difference_bins: list[DifferenceBin] = field(default_factory=list)  # the FORs refined, pooled
     notes: list[str] = field(default_factory=list)  # how the inputs were read, where that is not granules
+    radiometry: list[RadiometryBin] = field(default_factory=list)  # CrIS minus VIIRS per band, binned
 
     def day_sigma_urad(self) -> float | None:
         """The day's precision, the one number a precision target is held to.
@@ -394,6 +472,7 @@ class AssessmentResult:
             "fors": [f.to_dict() for f in self.fors],
             "difference_bins": [asdict(b) for b in self.difference_bins],
             "notes": self.notes,
+            "radiometry": [b.to_dict() for b in self.radiometry],
         }
         if with_cube and self.cost_cube_k is not None:
             d["cost_cube_k"] = np.round(self.cost_cube_k, 5).tolist()
@@ -441,6 +520,7 @@ class AssessmentResult:
             cost_cube_k=None if cube is None else np.asarray(cube, float),
             difference_bins=[DifferenceBin(**b) for b in d.get("difference_bins", [])],
             notes=list(d.get("notes", [])),
+            radiometry=[RadiometryBin.from_dict(b) for b in d.get("radiometry", [])],
         )
 
     @classmethod

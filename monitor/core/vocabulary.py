@@ -48,7 +48,10 @@ class Rule(StrEnum):
 
     SPEC = "spec"  # an error beyond the specification
     JUMP = "jump"  # a step in the offsets, attributed to a known change where there is one
-    CALIBRATION_JUMP = "calibration_jump"  # a step in the CrIS-VIIRS BT bias, attributed the same way
+    CALIBRATION_JUMP = (
+        "calibration_jump"  # a step in a band's CrIS-VIIRS BT difference, attributed the same way
+    )
+    RADIOMETRY = "radiometry"  # a band's CrIS-VIIRS BT difference beyond its limit
     STALE = "stale"  # no successful assessment for too long
     FAILURE = "failure"  # failed or missed runs
     PROCESSING = "processing"  # a change seen in the GEO files' LOS fingerprint
@@ -84,6 +87,14 @@ class DeliveryStatus(StrEnum):
     SENDING = "sending"  # claimed by a sender (a lease: a sender that died leaves it to be tried again)
     SENT = "sent"
     FAILED = "failed"  # for good: a configuration error, or the channel is gone
+
+
+class BinnedBy(StrEnum):
+    """What a day's CrIS minus VIIRS differences are binned by (``RadiometryBin``, monitor/core/result.py)."""
+
+    FOV = "fov"  # the CrIS FOV, 1..9
+    SCENE = "scene_k"  # the scene's VIIRS BT, in bins of 10 K
+    NODE = "node"  # the orbit's ascending or descending node
 
 
 class Kernel(StrEnum):

@@ -72,7 +72,8 @@ class Matchup:
     latitude_deg: np.ndarray  # (scan, 30, 9)
     longitude_deg: np.ndarray
     values: dict[str, np.ndarray]  # name -> (band, scan, 30, 9)
-    granules: list[str] = field(default_factory=list)
+    granules: list[str] = field(default_factory=list)  # the CrIS SDR files mapped, in time order
+    granule_of_scan: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))  # index in granules
     notes: list[str] = field(default_factory=list)
 
     @property

@@ -203,6 +203,8 @@ def map_plan(
     times = np.zeros((nscan, N_FOR), np.int64)
     lat, lon = np.full((nscan, N_FOR, N_FOV), np.nan), np.full((nscan, N_FOR, N_FOV), np.nan)
     notes = [f"{item}: {why}" for item, why in case.skipped]
+    granule_of_scan = np.zeros(nscan, np.int32)
+    mapped: list[str] = []
     done_scans = 0
     for gi, g in enumerate(cris):
         if should_stop is not None and should_stop():
@@ -215,6 +217,8 @@ def map_plan(
             continue
         n = geo.lat_rad.shape[0]
         rows = slice(done_scans, done_scans + n)
+        granule_of_scan[rows] = len(mapped)
+        mapped.append(g.sdr.name)
         placed = placing.place(geo, fors)
         ok = (placed.valid & sdr.good).ravel()
         times[rows] = geo.for_time_us
@@ -276,7 +280,8 @@ def map_plan(
         latitude_deg=lat[:done_scans],
         longitude_deg=lon[:done_scans],
         values={k: v[:, :done_scans] for k, v in values.items()},
-        granules=[g.sdr.name for g in cris],
+        granules=mapped,
+        granule_of_scan=granule_of_scan[:done_scans],
         notes=notes,
     )
     return matchup, cost

@@ -32,6 +32,7 @@ from alerts.effects import ChangeEffect
 from monitor.config.model import Config
 from monitor.config.outputs import ExportConfig
 from monitor.core.constants import DEFAULT_HALF_STEPS, N_FOR, SPEC_KM
+from monitor.core.measures import Measure
 from monitor.core.result import FLAGS, ForOffset, measures
 from monitor.core.satellites import satellite as satellite_info
 from monitor.history.records import History
@@ -130,6 +131,16 @@ class Method:
         return f"{n} x {n}"
 
 
+def _attrs(m: Measure, meaning: str | None = None) -> dict:
+    """A variable's attributes from its field's declaration (*meaning*: its long name, where not the
+    declaration's)."""
+    return {
+        "units": m.unit,
+        "long_name": meaning or m.meaning,
+        "coverage_content_type": "qualityInformation" if m.quality else "physicalMeasurement",
+    }
+
+
 def to_xarray(
     store: History,
     satellite: str,
@@ -170,23 +181,33 @@ def to_xarray(
     bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int8])
     flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
     days = np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]")
+    declared = measures(record)
+    bands = tuple(dict.fromkeys(m.band for m in declared if m.band is not None))
     coords = {"time": days, "scan_position": np.arange(1, N_FOR + 1, dtype=np.int16)}
+    if bands:
+        coords["band"] = np.array(bands, dtype=object)
     dims = ("time", "scan_position")  # time first and unlimited: daily files append along it
-    ds = xr.Dataset(
-        {
-            m.name: (
-                dims,
-                series.values[m.name].astype(np.int32 if m.kind is int else np.float64),
-                {
-                    "units": m.unit,
-                    "long_name": m.meaning,
-                    "coverage_content_type": "qualityInformation" if m.quality else "physicalMeasurement",
-                },
-            )
-            for m in measures(record)
-        },
-        coords=coords,
-    )
+    variables: dict[str, tuple[tuple[str, ...], np.ndarray, dict]] = {
+        m.name: (dims, series.values[m.name].astype(np.int32 if m.kind is int else np.float64), _attrs(m))
+        for m in declared
+        if m.band is None
+    }
+    # a field measured per band is one variable on the band dimension, named without its band
+    for quantity in dict.fromkeys(m.quantity for m in declared if m.band is not None):
+        per_band = {m.band: m for m in declared if m.band is not None and m.quantity == quantity}
+        first = per_band[next(iter(per_band))]
+        stacked = np.stack(
+            [
+                series.values[per_band[b].name] if b in per_band else np.full(flags.shape, np.nan)
+                for b in bands
+            ],
+            axis=-1,
+        )
+        meaning = first.meaning.replace(f" {first.band} ", " ")
+        variables[quantity] = ((*dims, "band"), stacked.astype(np.float64), _attrs(first, meaning))
+    ds = xr.Dataset(variables, coords=coords)
+    if bands:
+        ds["band"].attrs.update(long_name="VIIRS band", coverage_content_type="coordinate")
     ds["time_bnds"] = (("time", "nv"), np.stack([days, days + np.timedelta64(1, "D")], axis=-1))
     ds["flags"] = (
         dims,

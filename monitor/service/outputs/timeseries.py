@@ -8,6 +8,10 @@ Measurement ``cris_geolocation`` (configurable), one point per satellite, day an
   :func:`monitor.core.result.measures`), named as declared (a float, or an integer: n_samples); boolean
   field: reliable
 
+The fields measured per VIIRS band go to ``cris_geolocation_band``, one point per satellite, day, FOR and
+band: tags ``satellite``, ``for`` and ``band`` (I5, M13, M15, M16), fields named without the band
+(``cris_minus_viirs_k``, ``sigma_cris_minus_viirs_k``).
+
 Known changes (calendar, metadata, fingerprint) go to ``cris_geolocation_change`` (see :func:`change_lines`),
 re-sent after every run, for the dashboards' annotations.
 
@@ -42,6 +46,9 @@ from monitor.service.store.sqlite import Store
 LOG = logging.getLogger(__name__)
 
 
+BAND_SUFFIX = "_band"  # the measurement of the fields measured per VIIRS band: cris_geolocation_band
+
+
 class PublishError(RuntimeError):
     """The time-series server did not accept a batch; the points stay in the outbox."""
 
@@ -63,18 +70,31 @@ def result_lines(measurement: str, satellite: str, day: dt.date, fors: Iterable[
     Returns
     -------
     list of str
-        Line-protocol points, one per FOR.
+        Line-protocol points: one per FOR, and one per FOR and band measured.
     """
     when = dt.datetime(day.year, day.month, day.day, tzinfo=dt.timezone.utc)
     lines = []
     for f in fors:
         p = Point(measurement).tag("satellite", satellite).tag("for", f"{f.for_index:02d}")
+        per_band: dict[str, Point] = {}
         for m in measures(type(f)):
             value = getattr(f, m.name)
-            if m.series and value is not None and math.isfinite(value):
+            if not (m.series and value is not None and math.isfinite(value)):
+                continue
+            if m.band is None:
                 p = p.field(m.name, m.kind(value))
+            else:
+                if m.band not in per_band:
+                    per_band[m.band] = (
+                        Point(f"{measurement}{BAND_SUFFIX}")
+                        .tag("satellite", satellite)
+                        .tag("for", f"{f.for_index:02d}")
+                        .tag("band", m.band)
+                    )
+                per_band[m.band] = per_band[m.band].field(m.quantity, m.kind(value))
         p = p.field("reliable", bool(f.reliable))
         lines.append(p.time(when, WritePrecision.S).to_line_protocol())
+        lines += [b.time(when, WritePrecision.S).to_line_protocol() for b in per_band.values()]
     return lines
 
 
