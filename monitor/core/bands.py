@@ -70,7 +70,8 @@ GRIDS = {
 
 @dataclass(frozen=True)
 class ViirsBand:
-    """One VIIRS band CrIS shares: its grid, SDR product, spectral response file tag and CrIS band.
+    """One VIIRS band CrIS shares: its grid, SDR product, spectral response file tag, CrIS band and nominal
+    central wavelength.
 
     ``min_scene_k`` is the scene brightness temperature below which CrIS's noise in the band's CrIS band
     swamps a comparison (M13: the short-wave band's NEdN at cold scenes); None where every scene serves.
@@ -84,6 +85,7 @@ class ViirsBand:
     cris_band: str  # "LW" or "SW": the CrIS band that holds the VIIRS band
     bt_scaled: bool  # uint16 with BrightnessTemperatureFactors (M13: float32)
     quality_dataset: str
+    centre_um: float  # the band's nominal central wavelength, um
     min_scene_k: float | None = None
 
     @property
@@ -95,10 +97,10 @@ class ViirsBand:
 BANDS = {
     b.name: b
     for b in (
-        ViirsBand("I5", "I", "SVI05", "VIIRS-I5-SDR", "i05", "LW", True, "QF1_VIIRSIBANDSDR"),
-        ViirsBand("M13", "M", "SVM13", "VIIRS-M13-SDR", "m13", "SW", False, "QF1_VIIRSMBANDSDR", 260.0),
-        ViirsBand("M15", "M", "SVM15", "VIIRS-M15-SDR", "m15", "LW", True, "QF1_VIIRSMBANDSDR"),
-        ViirsBand("M16", "M", "SVM16", "VIIRS-M16-SDR", "m16", "LW", True, "QF1_VIIRSMBANDSDR"),
+        ViirsBand("I5", "I", "SVI05", "VIIRS-I5-SDR", "i05", "LW", True, "QF1_VIIRSIBANDSDR", 11.45),
+        ViirsBand("M13", "M", "SVM13", "VIIRS-M13-SDR", "m13", "SW", False, "QF1_VIIRSMBANDSDR", 4.05, 260.0),
+        ViirsBand("M15", "M", "SVM15", "VIIRS-M15-SDR", "m15", "LW", True, "QF1_VIIRSMBANDSDR", 10.763),
+        ViirsBand("M16", "M", "SVM16", "VIIRS-M16-SDR", "m16", "LW", True, "QF1_VIIRSMBANDSDR", 12.013),
     )
 }
 DEFAULT_BANDS = ("I5",)  # the assessment's band; the others when asked for

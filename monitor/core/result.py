@@ -368,6 +368,69 @@ class RadiometryBin:
 
 
 @dataclass(frozen=True)
+class DifferenceMap:
+    """CrIS minus VIIRS BT (K) at every FOV of one CrIS *granule* in one VIIRS *band*, where the day's
+    assessed geolocation puts the FOVs: arrays (scans, 30, 9), NaN where a FOV was not mapped; *uniform*
+    marks the FOVs the day's difference counts (:mod:`monitor.matchup.radiometry`)."""
+
+    band: str
+    granule: str
+    latitude_deg: np.ndarray
+    longitude_deg: np.ndarray
+    difference_k: np.ndarray
+    uniform: np.ndarray
+
+    def to_dict(self) -> dict:
+        """The map as JSON-ready values: degrees to 4 decimals, K to 3, None where not mapped.
+
+        Returns
+        -------
+        dict
+            Its fields, the arrays as nested lists.
+        """
+
+        def listed(a: np.ndarray, digits: int) -> list:
+            return np.where(np.isfinite(a), np.round(a, digits), np.nan).astype(object).tolist()
+
+        out = {
+            "band": self.band,
+            "granule": self.granule,
+            "latitude_deg": listed(self.latitude_deg, 4),
+            "longitude_deg": listed(self.longitude_deg, 4),
+            "difference_k": listed(self.difference_k, 3),
+            "uniform": self.uniform.astype(bool).tolist(),
+        }
+        return json.loads(json.dumps(out).replace("NaN", "null"))
+
+    @classmethod
+    def from_dict(cls, d: dict) -> DifferenceMap:
+        """A map of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            Its fields.
+
+        Returns
+        -------
+        DifferenceMap
+            The map.
+        """
+
+        def array(v: list) -> np.ndarray:
+            return np.array(v, dtype=float)  # None is NaN
+
+        return cls(
+            d["band"],
+            d["granule"],
+            array(d["latitude_deg"]),
+            array(d["longitude_deg"]),
+            array(d["difference_k"]),
+            np.array(d["uniform"], bool),
+        )
+
+
+@dataclass(frozen=True)
 class GranuleInfo:
     """One assessed CrIS granule: its ID and times (ISO 8601), its files and the VIIRS files that covered it,
     the FOVs with geolocation and the FOVs used, and the processing metadata of its CrIS GEO and of the
@@ -425,6 +488,7 @@ class AssessmentResult:
     difference_bins: list[DifferenceBin] = field(default_factory=list)  # the FORs refined, pooled
     notes: list[str] = field(default_factory=list)  # how the inputs were read, where that is not granules
     radiometry: list[RadiometryBin] = field(default_factory=list)  # CrIS minus VIIRS per band, binned
+    difference_maps: list[DifferenceMap] = field(default_factory=list)  # one granule's FOVs per band
 
     def day_sigma_urad(self) -> float | None:
         """The day's precision, the one number a precision target is held to.
@@ -473,6 +537,7 @@ class AssessmentResult:
             "difference_bins": [asdict(b) for b in self.difference_bins],
             "notes": self.notes,
             "radiometry": [b.to_dict() for b in self.radiometry],
+            "difference_maps": [m.to_dict() for m in self.difference_maps],
         }
         if with_cube and self.cost_cube_k is not None:
             d["cost_cube_k"] = np.round(self.cost_cube_k, 5).tolist()
@@ -521,6 +586,7 @@ class AssessmentResult:
             difference_bins=[DifferenceBin(**b) for b in d.get("difference_bins", [])],
             notes=list(d.get("notes", [])),
             radiometry=[RadiometryBin.from_dict(b) for b in d.get("radiometry", [])],
+            difference_maps=[DifferenceMap.from_dict(m) for m in d.get("difference_maps", [])],
         )
 
     @classmethod

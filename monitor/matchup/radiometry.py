@@ -30,7 +30,7 @@ import numpy as np
 
 from monitor.core.bands import BANDS
 from monitor.core.constants import N_FOR, N_FOV
-from monitor.core.result import AssessmentResult, RadiometryBin
+from monitor.core.result import AssessmentResult, DifferenceMap, RadiometryBin
 from monitor.core.vocabulary import BinnedBy
 from monitor.estimation.jackknife import MIN_GRANULES, granule_runs, t_factor
 from monitor.matchup.product import Matchup
@@ -61,10 +61,12 @@ class BandDifference:
 
 @dataclass(frozen=True)
 class DayRadiometry:
-    """The day's comparison in every band mapped, and its bins (:class:`RadiometryBin`)."""
+    """The day's comparison in every band mapped, its bins (:class:`RadiometryBin`), and every FOV of the
+    granule with the most uniform FOVs in each band (:class:`DifferenceMap`)."""
 
     bands: tuple[BandDifference, ...]
     bins: tuple[RadiometryBin, ...]
+    maps: tuple[DifferenceMap, ...]
 
 
 def _groups(matchup: Matchup) -> np.ndarray:
@@ -154,7 +156,8 @@ def day_radiometry(matchup: Matchup, uniform: Uniformity, bands: tuple[str, ...]
     for_key = np.broadcast_to(np.arange(N_FOR)[None, :, None], shape)
     fov_key = np.broadcast_to(np.arange(N_FOV)[None, None, :], shape)
     node_key = np.broadcast_to(np.where(ascending(matchup), 0, 1)[:, None, None], shape)
-    per_band, bins = [], []
+    per_band, bins, maps = [], [], []
+    granule = np.asarray(matchup.granule_of_scan)
     for b, band in enumerate(matchup.bands):
         if band not in bands:
             continue
@@ -171,6 +174,19 @@ def day_radiometry(matchup: Matchup, uniform: Uniformity, bands: tuple[str, ...]
                 keep &= scene > BANDS[band].min_scene_k
         mean, sigma, n = _jackknifed(d, keep, for_key, N_FOR, group)
         per_band.append(BandDifference(band, mean, sigma, n))
+        if keep.any():
+            g = int(np.argmax(np.bincount(granule[np.nonzero(keep)[0]], minlength=len(matchup.granules))))
+            at = granule == g
+            maps.append(
+                DifferenceMap(
+                    band,
+                    matchup.granules[g],
+                    matchup.latitude_deg[at],
+                    matchup.longitude_deg[at],
+                    d[at],
+                    keep[at],
+                )
+            )
         scene_key = np.where(keep, np.floor(np.nan_to_num(scene) / SCENE_BIN_K), 0).astype(int)
         low = int(scene_key[keep].min()) if keep.any() else 0
         n_scene = int(scene_key[keep].max()) - low + 1 if keep.any() else 1
@@ -186,7 +202,7 @@ def day_radiometry(matchup: Matchup, uniform: Uniformity, bands: tuple[str, ...]
                 for i, label in enumerate(labels)
                 if c[i] > 0
             ]
-    return DayRadiometry(tuple(per_band), tuple(bins))
+    return DayRadiometry(tuple(per_band), tuple(bins), tuple(maps))
 
 
 def with_radiometry(result: AssessmentResult, radiometry: DayRadiometry) -> AssessmentResult:
@@ -202,7 +218,7 @@ def with_radiometry(result: AssessmentResult, radiometry: DayRadiometry) -> Asse
     Returns
     -------
     AssessmentResult
-        A copy carrying them.
+        A copy carrying them, and the difference maps.
     """
     fors = []
     for k, f in enumerate(result.fors):
@@ -211,4 +227,4 @@ def with_radiometry(result: AssessmentResult, radiometry: DayRadiometry) -> Asse
             values[f"cris_minus_viirs_k_{band.band}"] = float(band.mean_k[k])
             values[f"sigma_cris_minus_viirs_k_{band.band}"] = float(band.sigma_k[k])
         fors.append(replace(f, **values))
-    return replace(result, fors=fors, radiometry=list(radiometry.bins))
+    return replace(result, fors=fors, radiometry=list(radiometry.bins), difference_maps=list(radiometry.maps))

@@ -7,6 +7,7 @@ step at a given day), written through the store's own ``save_day`` like real run
 from __future__ import annotations
 
 import datetime as dt
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -27,13 +28,22 @@ from monitor.simulate.profiles import paper_profile
 KM_PER_URAD = 0.00083  # at nadir; enough for a picture
 # CrIS - VIIRS: a small bias, gain and curvature, as the seeds' intercalibration shows
 BIAS_K, GAIN_PCT, CURVATURE_K = 0.15, -0.3, 0.1
+# CrIS - VIIRS per band over uniform FOVs (K): a level within the UW intercomparison's 100 mK, and each
+# band's per-FOR sigma on a day (the noise drawn is the sigma stated)
+BAND_LEVEL_K = {"I5": 0.05, "M13": -0.04, "M15": 0.03, "M16": -0.02}
+BAND_SIGMA_K = {"I5": 0.02, "M13": 0.04, "M15": 0.015, "M16": 0.015}
 
 
 def day_result(
-    satellite: str, day: dt.date, rng: np.random.Generator, step_urad: float = 0.0, with_cube: bool = True
+    satellite: str,
+    day: dt.date,
+    rng: np.random.Generator,
+    step_urad: float = 0.0,
+    with_cube: bool = True,
+    band_step_k: dict[str, float] | None = None,
 ) -> AssessmentResult:
     """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR
-    21-30.
+    21-30; CrIS minus VIIRS in every band at its level with its noise, *band_step_k* added.
 
     Parameters
     ----------
@@ -47,12 +57,15 @@ def day_result(
         Added cross-track at FOR 21-30, urad.
     with_cube : bool, optional
         With a cost cube.
+    band_step_k : dict, optional
+        Band to K added to its CrIS minus VIIRS at every FOR.
 
     Returns
     -------
     AssessmentResult
         The result.
     """
+    steps = band_step_k or {}
     d_alpha, d_beta = paper_profile()
     d_alpha = 0.3 * d_alpha + rng.normal(0, 15, N_FOR)
     d_beta = 0.3 * d_beta + rng.normal(0, 15, N_FOR) + np.where(np.arange(N_FOR) >= 20, step_urad, 0.0)
@@ -82,6 +95,11 @@ def day_result(
                 flags,
             )  # fmt: skip
         )
+        bands: dict[str, Any] = {}
+        for b, level in BAND_LEVEL_K.items():
+            bands[f"cris_minus_viirs_k_{b}"] = level + steps.get(b, 0.0) + rng.normal(0, BAND_SIGMA_K[b])
+            bands[f"sigma_cris_minus_viirs_k_{b}"] = BAND_SIGMA_K[b]
+        fors[-1] = replace(fors[-1], **bands)
     cube = None
     if with_cube:
         off = (np.arange(2 * DEFAULT_HALF_STEPS + 1) - DEFAULT_HALF_STEPS) * DEFAULT_STEP_URAD

@@ -16,7 +16,7 @@ optional extra: ``pip install 'crisgeo-monitor[export]'``.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Self
+from typing import TYPE_CHECKING, Any, Self
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -31,6 +31,7 @@ import numpy as np
 from alerts.effects import ChangeEffect
 from monitor.config.model import Config
 from monitor.config.outputs import ExportConfig
+from monitor.core.bands import BANDS
 from monitor.core.constants import DEFAULT_HALF_STEPS, N_FOR, SPEC_KM
 from monitor.core.measures import Measure
 from monitor.core.result import FLAGS, ForOffset, measures
@@ -182,10 +183,12 @@ def to_xarray(
     flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
     days = np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]")
     declared = measures(record)
-    bands = tuple(dict.fromkeys(m.band for m in declared if m.band is not None))
-    coords = {"time": days, "scan_position": np.arange(1, N_FOR + 1, dtype=np.int16)}
+    # the bands by wavelength: a CF coordinate variable is numeric and monotonic, the names are its labels
+    bands = tuple(sorted({m.band for m in declared if m.band is not None}, key=lambda b: BANDS[b].centre_um))
+    coords: dict[str, Any] = {"time": days, "scan_position": np.arange(1, N_FOR + 1, dtype=np.int16)}
     if bands:
-        coords["band"] = np.array(bands, dtype=object)
+        coords["band"] = np.array([BANDS[b].centre_um for b in bands])
+        coords["band_name"] = ("band", np.array(bands, dtype=object), {"long_name": "VIIRS band"})
     dims = ("time", "scan_position")  # time first and unlimited: daily files append along it
     variables: dict[str, tuple[tuple[str, ...], np.ndarray, dict]] = {
         m.name: (dims, series.values[m.name].astype(np.int32 if m.kind is int else np.float64), _attrs(m))
@@ -207,7 +210,13 @@ def to_xarray(
         variables[quantity] = ((*dims, "band"), stacked.astype(np.float64), _attrs(first, meaning))
     ds = xr.Dataset(variables, coords=coords)
     if bands:
-        ds["band"].attrs.update(long_name="VIIRS band", coverage_content_type="coordinate")
+        ds["band"].attrs.update(
+            standard_name="sensor_band_central_radiation_wavelength",
+            units="um",
+            long_name="VIIRS band's nominal central wavelength (band_name: its name)",
+            coverage_content_type="coordinate",
+        )
+        ds["band"].encoding["_FillValue"] = None  # a coordinate variable has no missing values
     ds["time_bnds"] = (("time", "nv"), np.stack([days, days + np.timedelta64(1, "D")], axis=-1))
     ds["flags"] = (
         dims,
@@ -520,6 +529,17 @@ def _target(out: str | Path, fmt: str | None) -> tuple[Path, str]:
     return out, fmt or str(by_suffix)
 
 
+def _band_columns(ds: xr.Dataset) -> xr.Dataset:
+    """*ds* with each variable on the band dimension as a variable per band (``cris_minus_viirs_k_M15``,
+    the stored name): a table keeps a row per day and FOR."""
+    if "band" not in ds.dims:
+        return ds
+    stacked = [v for v in ds.data_vars if "band" in ds[v].dims]
+    names = [str(n) for n in ds["band_name"].values]
+    wide = {f"{v}_{b}": ds[v].isel(band=i, drop=True) for v in stacked for i, b in enumerate(names)}
+    return ds.drop_vars([*stacked, "band", "band_name"]).assign(wide)
+
+
 def _write(ds: xr.Dataset, out: Path, fmt: str, unlimited: str, drop: tuple[str, ...] = ()) -> Path:
     """*ds* to *out* through a partial file (a reader never sees half of it), the dimension *unlimited*
     first and unlimited in NetCDF (later files append along it); CSV without the *drop* variables (bounds,
@@ -528,6 +548,6 @@ def _write(ds: xr.Dataset, out: Path, fmt: str, unlimited: str, drop: tuple[str,
     if fmt == "netcdf":
         ds.to_netcdf(tmp, engine="h5netcdf", unlimited_dims=[unlimited])
     else:
-        ds.drop_vars(list(drop)).to_dataframe().reset_index().to_csv(tmp, index=False)
+        ds.drop_vars(list(drop)).pipe(_band_columns).to_dataframe().reset_index().to_csv(tmp, index=False)
     tmp.replace(out)
     return out

@@ -20,7 +20,9 @@ from monitor.core.result import (
     AssessmentResult,
     DayPrecision,
     DifferenceBin,
+    DifferenceMap,
     ForOffset,
+    RadiometryBin,
     SceneDecision,
 )
 from monitor.core.vocabulary import RunStatus
@@ -81,7 +83,10 @@ class Results:
         """
         d = day.isoformat()
         with self.transaction():
-            for table in ("results", "granules", "selection", "cost_cubes", "skipped", "difference_bins"):
+            for table in (
+                "results", "granules", "selection", "cost_cubes", "skipped", "difference_bins",
+                "radiometry_bins", "difference_maps",
+            ):  # fmt: skip
                 self.db.execute(f"DELETE FROM {table} WHERE satellite=? AND day=?", (satellite, d))
             # the noise fitted on days that include this one is fitted anew when next needed
             self.db.execute("DELETE FROM noise_fits WHERE satellite=? AND before > ?", (satellite, d))
@@ -129,6 +134,16 @@ class Results:
                 self.db.execute(
                     "INSERT INTO difference_bins VALUES (?, ?, ?, ?, ?, ?, ?)",
                     (satellite, d, run_id, b.low_k, b.n, _num(b.mean_k), _num(b.std_k)),
+                )
+            for r in result.radiometry:
+                self.db.execute(
+                    "INSERT INTO radiometry_bins VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    (satellite, d, run_id, r.band, str(r.by), r.key, r.n, _num(r.mean_k), _num(r.sigma_k)),
+                )
+            for m in result.difference_maps:
+                self.db.execute(
+                    "INSERT INTO difference_maps VALUES (?, ?, ?, ?, ?)",
+                    (satellite, d, run_id, m.band, json.dumps(m.to_dict())),
                 )
             for s in result.skipped:
                 self.db.execute(
@@ -219,6 +234,48 @@ class Results:
             )
             for r in rows
         ]
+
+    def radiometry_bins(self, satellite: str, day: dt.date) -> list[RadiometryBin]:
+        """CrIS minus VIIRS per band, binned by FOV, scene temperature and node, on *satellite*'s *day*.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+
+        Returns
+        -------
+        list of RadiometryBin
+            The bins, by band and binning.
+        """
+        rows = self.db.execute(
+            "SELECT * FROM radiometry_bins WHERE satellite=? AND day=? ORDER BY band, binned_by, rowid",
+            (satellite, day.isoformat()),
+        ).fetchall()
+        return [RadiometryBin.from_dict({**dict(r), "by": r["binned_by"]}) for r in rows]
+
+    def difference_maps(self, satellite: str, day: dt.date) -> list[DifferenceMap]:
+        """Every FOV's CrIS minus VIIRS of one granule per band on *satellite*'s *day*.
+
+        Parameters
+        ----------
+        satellite : str
+            The satellite's short name.
+        day : datetime.date
+            The UTC day.
+
+        Returns
+        -------
+        list of DifferenceMap
+            One per band compared.
+        """
+        rows = self.db.execute(
+            "SELECT body FROM difference_maps WHERE satellite=? AND day=? ORDER BY rowid",
+            (satellite, day.isoformat()),
+        ).fetchall()
+        return [DifferenceMap.from_dict(json.loads(r["body"])) for r in rows]
 
     def latest_day(self, satellite: str) -> dt.date | None:
         """The latest day with results for *satellite*, or None.

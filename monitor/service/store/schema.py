@@ -81,6 +81,16 @@ MIGRATIONS = [
         satellite TEXT NOT NULL, quantity TEXT NOT NULL, before TEXT NOT NULL, body TEXT NOT NULL,
         PRIMARY KEY (satellite, quantity, before));
     """,
+    # CrIS minus VIIRS per band, binned (by FOV, scene temperature, node), and one granule's FOVs per band
+    """
+    CREATE TABLE radiometry_bins (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, band TEXT NOT NULL,
+        binned_by TEXT NOT NULL, key TEXT NOT NULL, n INTEGER, mean_k REAL, sigma_k REAL,
+        PRIMARY KEY (satellite, day, band, binned_by, key));
+    CREATE TABLE difference_maps (
+        satellite TEXT NOT NULL, day TEXT NOT NULL, run_id INTEGER NOT NULL, band TEXT NOT NULL,
+        body TEXT NOT NULL, PRIMARY KEY (satellite, day, band));
+    """,
 ]
 
 

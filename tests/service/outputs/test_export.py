@@ -50,7 +50,8 @@ def test_netcdf_export_reads_back_with_xarray(store_with_days, tmp_path):
     )
     ds = xr.open_dataset(out, engine="h5netcdf")
     assert (
-        ds.sizes == {"time": 8, "scan_position": 30, "nv": 2} and str(ds.time.values[0])[:10] == "2025-03-03"
+        ds.sizes == {"time": 8, "scan_position": 30, "nv": 2, "band": 4}
+        and str(ds.time.values[0])[:10] == "2025-03-03"
     )
     day = dt.date(2025, 3, 5)
     want = {f.for_index: f for f in store.day_result("j01", day)}
@@ -64,6 +65,16 @@ def test_netcdf_export_reads_back_with_xarray(store_with_days, tmp_path):
     assert got.gain_pct.sel(scan_position=3).item() == pytest.approx(want[3].gain_pct)
     assert ds.bias_k.attrs["units"] == "K" and ds.gain_pct.attrs["units"] == "percent"
     assert np.isfinite(ds.sigma_bias_k).all() and np.isfinite(ds.sigma_gain_pct).all()
+    # CrIS minus VIIRS per band: one variable on the band dimension, each band's stored column in it
+    assert list(ds.band_name.values) == ["M13", "M15", "I5", "M16"]  # by wavelength, the coordinate
+    assert ds.band.attrs["units"] == "um" and (np.diff(ds.band.values) > 0).all()
+    got = got.swap_dims(band="band_name")
+    assert ds.cris_minus_viirs_k.dims == ("time", "scan_position", "band")
+    assert ds.cris_minus_viirs_k.attrs["units"] == "K" and "M15" not in ds.cris_minus_viirs_k.attrs["long_name"]
+    for band in ("I5", "M15"):
+        stored = getattr(want[4], f"cris_minus_viirs_k_{band}")
+        assert got.cris_minus_viirs_k.sel(scan_position=4, band_name=band).item() == pytest.approx(stored)
+    assert "cris_minus_viirs_k_M15" not in ds and np.isfinite(ds.sigma_cris_minus_viirs_k).all()
     meanings = ds.flags.attrs["flag_meanings"].split()
     masks = dict(zip(meanings, ds.flags.attrs["flag_masks"], strict=True))
     bits = ds.flags.transpose("time", "scan_position").values

@@ -42,7 +42,7 @@ from monitor.core.tables import FOR_COLUMNS, REPORT
 from monitor.core.vocabulary import DEFAULT_COST, Cost, Rule, RunStatus
 from monitor.history.changes import Change, all_changes
 from monitor.history.records import Alert, Attachment, ForSeries, Run
-from monitor.service.outputs.report import plots
+from monitor.service.outputs.report import per_band, plots
 from monitor.service.store.alert_state import AlertState
 from monitor.service.store.sqlite import Store
 
@@ -329,10 +329,12 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
     )
     _trend(store, satellite, series, marks, alerts, opts, span, sat_dir / "trend.png")
     calibration_html = _calibration(store, satellite, name, series, marks, span, sat_dir)
+    bands_html = per_band.band_section(store, satellite, name, series, marks, sat_dir, _img)
     stored = store.cost_cube(satellite, latest)
     cost_html = "<p class=note>No cost cube stored for the latest run.</p>"
     figures = {"latest_km.png", "latest_urad.png", "heatmap.png", "trend.png"}
     figures |= {f for f in ("calibration_bins.png", "calibration_trend.png") if f in calibration_html}
+    figures |= {f for f in per_band.FIGURES if f in bands_html}
     if stored is not None and worst is not None:
         cube, step = stored
         runs = [r for r in store.runs(satellite) if r.day == latest.isoformat() and r.status == RunStatus.OK]
@@ -378,6 +380,7 @@ def satellite_page(store: Store, satellite: str, out: Path, opts: ReportOptions)
         "red triangles: alerts.</p>",
         "<h2>Cost surface of the worst FOR</h2>" + cost_html,
         "<h2>CrIS-VIIRS intercalibration</h2>" + calibration_html,
+        "<h2>CrIS minus VIIRS per band</h2>" + bands_html,
         "<h2>Latest values</h2>" + _latest_table(fors, opts.spec_km),
         "<h2>Known changes</h2>" + _changes_table(changes),
         "<h2>What each known change did</h2><p class=note>Per FOR and direction: the offsets over the "
