@@ -20,17 +20,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from alerts.alertmanager import post_state
+from alerts.band_rules import BAND_WATCHES, attribute_bands, radiometry_finding
 from alerts.channels import Channel, Permanent, Transient, make_channels
 from alerts.rules import (
-    BAND_WATCHES,
     CALIBRATION,
     GEOLOCATION,
     Finding,
-    attribute_bands,
     failure_finding,
     jump_findings,
     processing_change_findings,
-    radiometry_finding,
     spec_finding,
     stale_finding,
     watched_series,

@@ -234,3 +234,59 @@ def test_the_jump_rule_reads_its_kept_noise_and_fits_anew_once_an_earlier_day_is
     left = store.noise_fits("j01", "jump")
     assert all(before <= again for before in left)
     assert [f.alert_id for f in findings_for(store, "j01", settings, now)] == first
+
+
+def _bands_day(rng, levels_k, sigma_k=0.02):
+    """30 FORs with CrIS minus VIIRS in each band of *levels_k* at its level plus noise of *sigma_k*."""
+    fors = []
+    for k in range(1, 31):
+        values = {}
+        for band, level in levels_k.items():
+            values[f"cris_minus_viirs_k_{band}"] = float(level + rng.normal(0.0, sigma_k))
+            values[f"sigma_cris_minus_viirs_k_{band}"] = sigma_k
+        fors.append(dataclasses.replace(_for(k, 0.1, 0.2), **values))
+    return fors
+
+
+def test_a_band_beyond_the_radiometry_limit_pages_as_the_spec_does(tmp_path):
+    s = Store(tmp_path / "s.sqlite")
+    rng = np.random.default_rng(5)
+    fors = _bands_day(rng, {"I5": 0.05, "M15": 0.02})
+    fors[9] = dataclasses.replace(fors[9], cris_minus_viirs_k_M15=0.8)  # beyond 0.5 K by 2 sigma: critical
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors))
+    (f,) = [
+        x for x in findings_for(s, "j01", AlertSettings(), dt.datetime.now(UTC)) if x.rule == "radiometry"
+    ]
+    assert f.severity == "critical" and f.data == {"day": DAY.isoformat(), "bands": ["M15"], "fors": [10]}
+    assert "M15 FOR 10: CrIS minus VIIRS +0.800" in f.lines[0]
+    fors[9] = dataclasses.replace(fors[9], cris_minus_viirs_k_M15=0.52)  # within 2 sigma of it: a warning
+    s.save_day(s.begin_run("j01", DAY), "j01", DAY, _result(fors))
+    assert findings_for(s, "j01", AlertSettings(), dt.datetime.now(UTC))[0].severity == "warning"
+    quiet = AlertSettings(radiometry_limit_k=1.0)
+    assert not [x for x in findings_for(s, "j01", quiet, dt.datetime.now(UTC)) if x.rule == "radiometry"]
+
+
+@pytest.mark.parametrize("moved", [("M15",), ("I5", "M15", "M16")])
+def test_a_step_in_one_band_is_viirs_and_in_every_lw_band_cris(tmp_path, moved):
+    """40 days of four bands (scatter 0.02 K, as their sigmas say), 0.1 K more in *moved* from day 35, no
+    calendar entry, the offsets steady: each moved band pages a calibration_jump of its own, told VIIRS's
+    where one band moved and CrIS's where every band of CrIS's long-wave band did."""
+    s = Store(tmp_path / "s.sqlite")
+    rng = np.random.default_rng(11)
+    days = [DAY + dt.timedelta(days=i) for i in range(40)]
+    levels = {"I5": 0.05, "M13": -0.04, "M15": 0.03, "M16": -0.02}
+    for i, day in enumerate(days):
+        step = {b: (0.1 if b in moved and i >= 34 else 0.0) for b in levels}
+        fors = _bands_day(rng, {b: v + step[b] for b, v in levels.items()})
+        s.save_day(s.begin_run("j01", day), "j01", day, _result(fors))
+    found = [
+        x
+        for x in findings_for(s, "j01", AlertSettings(), dt.datetime.now(UTC))
+        if x.rule == "calibration_jump"
+    ]
+    assert sorted(f.data["band"] for f in found) == sorted(moved)
+    assert len({f.alert_id for f in found}) == len(found)  # one alert per band
+    for f in found:
+        assert f.severity == "warning" and abs(f.data["size"] - 0.1) < 0.03
+        assert f.data["evidence"] == ("viirs" if len(moved) == 1 else "cris"), f.lines
+        assert ("VIIRS's" if len(moved) == 1 else "CrIS's") in f.summary
