@@ -20,7 +20,6 @@ from monitor.cli.registry import (
     arg,
     command,
     ep_file,
-    load,
     options,
     unset,
 )
@@ -191,6 +190,20 @@ def _footprint(names: Sequence[str] | None) -> Response | tuple[Response, ...] |
         raise BadInput(f"--footprint: {exc}") from None
 
 
+def _assessment_in(path: str) -> AssessmentConfig:
+    """The ``assessment`` section of the configuration file *path*, the others unread; a problem is bad
+    input naming the file and the key."""
+    from monitor.config.file import section_in_file
+    from monitor.config.keys import ConfigError
+
+    try:
+        section = section_in_file(path, "assessment")
+    except ConfigError as exc:
+        raise BadInput(str(exc)) from None
+    assert isinstance(section, AssessmentConfig)
+    return section
+
+
 @command(
     "assess",
     "assess CrIS geolocation against VIIRS I5 for the granules given",
@@ -238,7 +251,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
     from monitor.matchup import map_granules
     from monitor.sdr.pairing import plan
 
-    base = load(args).assessment if args.config else ASSESSMENT
+    base = _assessment_in(args.config) if args.config else ASSESSMENT
     given = {
         "half_steps": args.steps,
         "step_urad": args.step_urad,

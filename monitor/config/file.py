@@ -48,6 +48,36 @@ def load_config(path: str | Path) -> Config:
     return cfg
 
 
+def section_in_file(path: str | Path, name: str) -> BaseModel:
+    """One section of a configuration file, checked as the whole file checks it; the other sections are
+    not read (``crisgeo assess --config`` needs the assessment's settings, not the service's folders).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    name : str
+        The section (``assessment``).
+
+    Returns
+    -------
+    pydantic.BaseModel
+        The section (its defaults where the file has none); any problem a :class:`ConfigError` naming the
+        file and the key.
+    """
+    path = Path(path)
+    doc = read_yaml(path)
+    if not isinstance(doc, dict):
+        raise ConfigError(f"{path}: expected a mapping at the top level")
+    values = doc.get(name) or {}
+    if not isinstance(values, dict):
+        raise ConfigError(f"{path}: {name}: expected a mapping, got {values!r}")
+    try:
+        return section_of(name, **values)
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: {exc}") from None
+
+
 def section_of(name: str, **values: Any) -> BaseModel:
     """A section of the configuration from values alone (the command line's options), checked as a file's.
 

@@ -13,7 +13,7 @@ from benchmarks.servers import influxdb1, influxql
 from monitor.history.changes import Change
 from monitor.service.outputs.timeseries import change_lines, result_lines
 from monitor.service.store.sqlite import Store
-from monitor.simulate.history import fill_store
+from monitor.simulate.history import BAND_LEVEL_K, fill_store
 
 pytestmark = pytest.mark.servers  # starts real servers, daemons or tools (see pyproject markers)
 
@@ -90,7 +90,7 @@ def test_every_panel_query(influx, dashboard):
         for t in panel["targets"]:
             assert t["rawQuery"] and t["datasource"]["uid"] == "${datasource}"
             series = influxql(influx, "crisgeo", _macros(t["query"]))
-            tags = sorted(s["tags"]["for"] for s in series)
+            tags = sorted(s["tags"].get("for", "") for s in series)
             if panel["type"] == "heatmap":
                 assert tags == [f"{k:02d}" for k in range(1, 31)]
                 # flagged results are left out: each FOR has a value on each of its reliable days only
@@ -99,6 +99,13 @@ def test_every_panel_query(influx, dashboard):
                 if "cross_track_km" in t["query"]:  # the injected step at day 40 shows in FOR 30
                     times = sorted(cross)
                     assert cross[times[-15]] - cross[times[5]] > 0.5
+            elif panel["type"] == "timeseries" and "cris_geolocation_band" in t["query"]:
+                # CrIS minus VIIRS per band: a line per band, each day's median near the history's level
+                bands = sorted(s["tags"]["band"] for s in series)
+                assert bands == ["I5", "M13", "M15", "M16"], bands
+                for s in series:
+                    level = BAND_LEVEL_K[s["tags"]["band"]]
+                    assert all(abs(v[1] - level) < 0.05 for v in s["values"]), s["tags"]
             elif panel["type"] == "timeseries":
                 assert tags == ["01", "15", "30"]
                 assert all(len(s["values"]) == reliable["j01"][int(s["tags"]["for"])] for s in series)
@@ -128,7 +135,7 @@ def test_every_query_names_the_measurement_and_the_satellite(dashboard):
     ]
     for q in queries:
         assert (
-            re.search(r'FROM "cris_geolocation(_change)?"', q)
+            re.search(r'FROM "cris_geolocation(_change|_band)?"', q)
             and "/^$satellite$/" in q
             and "$timeFilter" in q
         )

@@ -4,6 +4,7 @@ difference is known: the same scenes simulated with and without a per-band diffe
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from monitor.core.vocabulary import BinnedBy
 from monitor.matchup import map_granules
 from monitor.matchup.radiometry import Uniformity, ascending, day_radiometry, with_radiometry
 from monitor.simulate.case import simulate_case
+from tests.invoke import run_crisgeo
 from tests.matchup.test_run import _truth_result
 
 ALL = tuple(BANDS)
@@ -87,3 +89,21 @@ def test_the_result_carries_each_band_and_reads_back_from_its_json(twin):
     assert [b.to_dict() for b in back.radiometry] == [b.to_dict() for b in result.radiometry]
     assert back.difference_maps[0].band == "I5"
     assert np.array_equal(back.difference_maps[0].uniform, result.difference_maps[0].uniform)
+
+
+def test_assess_with_the_production_configuration_compares_every_band(cases, tmp_path):
+    """``crisgeo assess --config configs/monitor.yaml`` reads only its assessment section (the service's
+    folders need not exist here) and writes each band's difference per FOR."""
+    case = cases.get(bands=ALL)[0]
+    out = tmp_path / "r.json"
+    config = Path(__file__).parents[2] / "configs" / "monitor.yaml"
+    done = run_crisgeo("assess", case, "--config", config, "--out", out)
+    assert done.returncode == 0, done.stderr
+    fors = json.loads(out.read_text())["fors"]
+    for band in ALL:
+        values = [
+            f[f"cris_minus_viirs_k_{band}"] for f in fors if f[f"cris_minus_viirs_k_{band}"] is not None
+        ]
+        assert len(values) >= (15 if band == "M13" else 20) and abs(np.median(values)) < 0.1, (
+            band
+        )  # M13: warm only
