@@ -104,6 +104,5 @@ def test_assess_with_the_production_configuration_compares_every_band(cases, tmp
         values = [
             f[f"cris_minus_viirs_k_{band}"] for f in fors if f[f"cris_minus_viirs_k_{band}"] is not None
         ]
-        assert len(values) >= (15 if band == "M13" else 20) and abs(np.median(values)) < 0.1, (
-            band
-        )  # M13: warm only
+        # a two-granule day: most FORs have enough uniform FOVs (M13 counts warm scenes only)
+        assert len(values) >= 15 and abs(np.median(values)) < 0.1, band
