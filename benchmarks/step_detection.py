@@ -39,6 +39,7 @@ import numpy as np
 from alerts.engine import evaluate, findings_for
 from benchmarks.provenance import commit, emit
 from monitor.config.alert_settings import AlertSettings
+from monitor.core.bands import BANDS
 from monitor.core.constants import N_FOR
 from monitor.core.result import AssessmentResult, ForOffset
 from monitor.core.vocabulary import Rule
@@ -46,6 +47,7 @@ from monitor.estimation.intercal import NO_FIT
 from monitor.estimation.offsets import Ground, Pair, Widths, for_offset
 from monitor.history.records import AlertStore, ForSeries
 from monitor.service.store.sqlite import Store
+from monitor.simulate.history import BAND_LEVEL_K, BAND_SIGMA_K
 from monitor.simulate.profiles import paper_profile
 
 START = dt.date(2025, 1, 1)
@@ -69,7 +71,9 @@ class Case:
     fors: str = "all"
     direction: int = 0
     change: str = "none"
-    quantity: str = "los"  # or "bias": the CrIS-VIIRS bias (sigma, size in K)
+    quantity: str = (
+        "los"  # or "bias": the CrIS-VIIRS bias; or a band: its CrIS minus VIIRS (sigma, size in K)
+    )
     los_step_urad: float = 0.0  # for the bias: the LOS's own step on the same day (all FORs, in-track)
 
 
@@ -79,6 +83,8 @@ def history(case: Case, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarra
     scale, shared, lag1 = NOISES[case.noise]
     alpha, beta = paper_profile()
     level = np.stack([alpha, beta], axis=-1) / 3.0 if case.quantity == "los" else np.full((N_FOR, 1), -0.155)
+    if case.quantity in BANDS:
+        level = np.full((N_FOR, 1), BAND_LEVEL_K[case.quantity])
     g = rng.standard_normal((DAYS, 1, level.shape[-1]))
     h = rng.standard_normal((DAYS, N_FOR, level.shape[-1]))
     e = np.sqrt(shared) * g + np.sqrt(1.0 - shared) * h
@@ -101,10 +107,15 @@ class MemoryHistory:
     those find nothing)."""
 
     def __init__(
-        self, y: np.ndarray, s: np.ndarray, bias: tuple[np.ndarray, np.ndarray] | None = None
+        self,
+        y: np.ndarray,
+        s: np.ndarray,
+        bias: tuple[np.ndarray, np.ndarray] | None = None,
+        band: tuple[str, np.ndarray, np.ndarray] | None = None,
     ) -> None:
         self.y, self.s, self.today = y, s, 0
         self.bias = bias  # (bias, sigma) (DAYS, N_FOR) K, or none
+        self.band = band  # (band, its CrIS minus VIIRS, sigma) (DAYS, N_FOR) K, or none
         self.days = [START + dt.timedelta(days=i) for i in range(len(y))]
         self.fits: dict[tuple[str, str, dt.date], dict] = {}  # the noise fits the store would keep
 
@@ -134,6 +145,12 @@ class MemoryHistory:
             "bias_k": nan if self.bias is None else self.bias[0][a:n],
             "sigma_bias_k": nan if self.bias is None else self.bias[1][a:n],
         }
+        for b in BANDS:
+            values[f"cris_minus_viirs_k_{b}"] = values[f"sigma_cris_minus_viirs_k_{b}"] = nan
+        if self.band is not None:
+            band, diff, sigma = self.band
+            values[f"cris_minus_viirs_k_{band}"] = diff[a:n]
+            values[f"sigma_cris_minus_viirs_k_{band}"] = sigma[a:n]
         return ForSeries(self.days[a:n], values, np.empty(0), np.ones((max(n - a, 0), N_FOR), bool))
 
     def noise_fit(self, satellite: str, quantity: str, before: dt.date) -> dict | None:
@@ -177,6 +194,10 @@ def findings_by_day(case: Case, seed: int, first: int, last: int) -> tuple[list[
         ly, ls, _ = history(Case(120.0, "white", case.los_step_urad), rng)
         store = MemoryHistory(ly, ls, (y[..., 0], s[..., 0]))
         rule = Rule.CALIBRATION_JUMP
+    elif case.quantity in BANDS:  # one band's CrIS minus VIIRS, beside the LOS stepping on its own
+        ly, ls, _ = history(Case(120.0, "white", case.los_step_urad), rng)
+        store = MemoryHistory(ly, ls, band=(case.quantity, y[..., 0], s[..., 0]))
+        rule = Rule.CALIBRATION_JUMP
     else:
         store = MemoryHistory(y, s)
     out = []
@@ -199,7 +220,7 @@ def fdr_year(job: tuple[Case, int]) -> dict:
     start = START + dt.timedelta(days=FIRST_EVALUATION)
     for t, found in days:
         for f in found:  # the first evaluation replays the weeks before it at once: not a daily one
-            if dt.date.fromisoformat(f.group) >= start:
+            if dt.date.fromisoformat(f.data["split"]) >= start:
                 first_seen.setdefault(f.group, (t, f.severity))
     return {"episodes": len(first_seen), "paged": sum(v[1] == "warning" for v in first_seen.values()),
             "years": (DAYS - FIRST_EVALUATION) / 365.0}  # fmt: skip
@@ -213,7 +234,7 @@ def detect_trial(job: tuple[Case, int]) -> dict:
     split = START + dt.timedelta(days=STEP_DAY)
     first = paged = None
     for t, found in days:
-        near = [f for f in found if abs((dt.date.fromisoformat(f.group) - split).days) <= 1]
+        near = [f for f in found if abs((dt.date.fromisoformat(f.data["split"]) - split).days) <= 1]
         if near and first is None:
             first = (t, near[0])
         loud = [f for f in near if f.severity == "warning"]
@@ -224,7 +245,7 @@ def detect_trial(job: tuple[Case, int]) -> dict:
     last = [f for f in days[-1][1] if f.group == first[1].group]
     errors: list[float] = []
     if last:
-        label = "bias" if case.quantity == "bias" else ("in-track", "cross-track")[case.direction]
+        label = case.quantity if case.quantity != "los" else ("in-track", "cross-track")[case.direction]
         fors = last[0].data["fors"][label]
         truth = np.zeros(N_FOR)
         truth[moved] = case.size
@@ -236,7 +257,7 @@ def detect_trial(job: tuple[Case, int]) -> dict:
     return {
         "found": True,
         "delay_days": first[0] - STEP_DAY,
-        "date_error_days": (dt.date.fromisoformat(f.group) - split).days,
+        "date_error_days": (dt.date.fromisoformat(f.data["split"]) - split).days,
         "paged": paged is not None and paged[0] - STEP_DAY <= 2,
         "names_change": f.data["change"] is not None,
         "errors": errors,
@@ -285,7 +306,9 @@ def store_check(years: int) -> int:
 
 
 FDR_CASES = [Case(5.0, "white"), Case(120.0, "white"), Case(120.0, "scale1.3"), Case(120.0, "correlated"),
-             Case(0.007, "correlated", quantity="bias", los_step_urad=300.0)]  # fmt: skip
+             Case(0.007, "correlated", quantity="bias", los_step_urad=300.0),
+             *(Case(BAND_SIGMA_K[b], "correlated", quantity=b, los_step_urad=300.0)
+               for b in BANDS)]  # fmt: skip
 
 
 def detect_cases() -> list[Case]:
@@ -307,6 +330,8 @@ def detect_cases() -> list[Case]:
     out += [Case(0.007, "correlated", 0.1, "all", 0, "none", "bias"),
             Case(0.007, "correlated", 0.1, "all", 0, "at", "bias"),
             Case(0.007, "correlated", 0.0, "all", 0, "at", "bias", 300.0)]  # fmt: skip
+    # each band's CrIS minus VIIRS at its per-FOR sigma of the simulated history, a 0.1 K step in it
+    out += [Case(BAND_SIGMA_K[b], "correlated", 0.1, "all", 0, "none", b) for b in BANDS]
     return out
 
 
@@ -321,7 +346,7 @@ def main(argv: list[str] | None = None) -> int:
         "--only",
         action="append",
         metavar="QUANTITY:NOISE:SIGMA",
-        help="fdr: only these cases (e.g. los:scale1.3:120)",
+        help="fdr and detect: only these cases (e.g. los:scale1.3:120, M15:correlated:0.015)",
     )
     args = ap.parse_args(argv)
     if args.mode == "store":
@@ -345,6 +370,8 @@ def main(argv: list[str] | None = None) -> int:
                 emit(row, args.rows)
         else:
             for case in detect_cases():
+                if args.only and f"{case.quantity}:{case.noise}:{case.sigma:g}" not in args.only:
+                    continue
                 trials = list(pool.map(detect_trial, [(case, 5000 + i) for i in range(args.trials)]))
                 found = [t for t in trials if t["found"]]
                 errors = np.array([e for t in found for e in t["errors"]])
