@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from monitor.core.bands import BANDS
-from monitor.core.result import AssessmentResult
+from monitor.core.result import AssessmentResult, measures
 from monitor.core.vocabulary import BinnedBy
 from monitor.matchup import map_granules
 from monitor.matchup.radiometry import Uniformity, ascending, day_radiometry, with_radiometry
@@ -24,14 +24,25 @@ INJECTED_K = {"I5": -0.3, "M13": 0.05, "M15": 0.12, "M16": -0.08}
 UNIFORM = Uniformity(0.5, 0.97)
 
 
+CRIS_BIAS_K = 0.2  # CrIS's BT raised in every channel
+
+
 @pytest.fixture(scope="module")
 def twin(tmp_path_factory):
-    """A three-granule day simulated twice, with and without a calibration difference in every band
-    (a random profile and seed, not the shared cases')."""
+    """A three-granule day simulated three times: as it is, with a calibration difference in every VIIRS
+    band, and with CrIS's BT raised in every channel (a random profile and seed, not the shared cases')."""
     out = {}
-    for name, bias in (("plain", {}), ("biased", INJECTED_K)):
+    for name, bias, cris in (("plain", {}, 0.0), ("biased", INJECTED_K, 0.0), ("cris", {}, CRIS_BIAS_K)):
         d = tmp_path_factory.mktemp(name)
-        simulate_case(d, granules=3, seed=21, profile="random", viirs_bands=ALL, viirs_band_bias_k=bias)
+        simulate_case(
+            d,
+            granules=3,
+            seed=21,
+            profile="random",
+            viirs_bands=ALL,
+            viirs_band_bias_k=bias,
+            cris_bias_k=cris,
+        )
         truth = _truth_result(d)
         matchup, _ = map_granules([d], ALL, offsets=truth)
         out[name] = (truth, matchup)
@@ -52,6 +63,27 @@ def test_each_band_reads_its_injected_difference_with_an_honest_sigma(twin):
         ok = np.isfinite(b.mean_k) & np.isfinite(b.sigma_k)
         inside += list(np.abs(b.mean_k[ok] - (level - INJECTED_K[b.band])) <= 2 * b.sigma_k[ok])
     assert np.mean(inside) >= 0.9, np.mean(inside)
+
+
+def test_a_cris_bias_is_read_the_same_in_every_band(twin):
+    plain = day_radiometry(twin["plain"][1], UNIFORM, ALL)
+    raised = day_radiometry(twin["cris"][1], UNIFORM, ALL)
+    read = {
+        b.band: float(np.nanmedian(b.mean_k - p.mean_k))
+        for p, b in zip(plain.bands, raised.bands, strict=True)
+    }
+    assert all(abs(v - CRIS_BIAS_K) < 0.03 for v in read.values()), read
+
+
+def test_the_bands_leave_the_offsets_as_they_were(twin):
+    truth, matchup = twin["biased"]
+    result = with_radiometry(truth, day_radiometry(matchup, UNIFORM, ALL))
+    banded = {m.name for m in measures() if m.band is not None}
+    for before, after in zip(truth.fors, result.fors, strict=True):
+        a, b = before.to_dict(), after.to_dict()
+        assert {k: v for k, v in a.items() if k not in banded} == {
+            k: v for k, v in b.items() if k not in banded
+        }
 
 
 def test_m13_counts_only_warm_scenes_and_the_bins_cover_fov_scene_and_node(twin):

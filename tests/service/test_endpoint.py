@@ -161,6 +161,14 @@ def test_metrics_after_a_run(served):
             abs(got[f.for_index] - scale * getattr(f, name)) < 1e-9 for f in fors if f.for_index in got
         )
         assert len(got) == sum(np.isfinite(getattr(f, name)) for f in fors)
+    # CrIS minus VIIRS per band (the daily run compares I5 by default), a band label
+    got = {
+        int(s.labels["for"]): s.value
+        for s in _samples(fams["crisgeo_for_cris_minus_viirs_kelvin"], satellite="j01", band="I5")
+    }
+    assert got and all(
+        abs(got[f.for_index] - f.cris_minus_viirs_k_I5) < 1e-9 for f in fors if f.for_index in got
+    )
     # the CrIS response's widths, in radians (Prometheus' base unit), where the day fitted one
     for level, name in (("0.5", "response_width_50_urad"), ("0.1", "response_width_10_urad")):
         got = {

@@ -1,5 +1,6 @@
 """Publishing against real servers on loopback: VictoriaMetrics (v2 write API) and InfluxDB 1.x (/write)."""
 
+import dataclasses
 import datetime as dt
 
 import pytest
@@ -31,6 +32,15 @@ def test_lines_have_fixed_types_and_skip_non_finite(cases):
     (line,) = result_lines("m", "j01", DAY, [broken])
     assert line.startswith("m,for=01,satellite=j01 ") and "sigma_alpha_urad" not in line
     assert "n_samples=72i" in line and "reliable=true" in line and line.endswith(" 1717200000")
+
+
+def test_a_band_s_fields_go_to_their_own_points_with_a_band_tag(cases):
+    _, _, result = cases.get()
+    f = dataclasses.replace(result.fors[0], cris_minus_viirs_k_M15=0.12, sigma_cris_minus_viirs_k_M15=0.01)
+    main, band = result_lines("m", "j01", DAY, [f])
+    assert "cris_minus_viirs" not in main
+    assert band.startswith("m_band,band=M15,for=01,satellite=j01 ") and band.endswith(" 1717200000")
+    assert "cris_minus_viirs_k=0.12" in band and "sigma_cris_minus_viirs_k=0.01" in band
 
 
 @pytest.mark.servers
