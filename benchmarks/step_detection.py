@@ -56,6 +56,9 @@ STEP_DAY = 200
 UTC = dt.timezone.utc
 NOISES = {"white": (1.0, 0.0, 0.0), "scale1.3": (1.3, 0.0, 0.0), "correlated": (1.0, 0.5, 0.3)}
 ONE_DAY = dt.timedelta(days=1)
+# a band's per-FOR CrIS minus VIIRS sigma on a simulated day (3-6 granules: 0.002-0.004 K, every band),
+# rounded up (studies/radiometry-per-band.md)
+DAY_BAND_SIGMA_K = 0.005
 FIRST_EVALUATION = 45  # days of history before the rules are first evaluated
 
 
@@ -307,6 +310,7 @@ def store_check(years: int) -> int:
 
 FDR_CASES = [Case(5.0, "white"), Case(120.0, "white"), Case(120.0, "scale1.3"), Case(120.0, "correlated"),
              Case(0.007, "correlated", quantity="bias", los_step_urad=300.0),
+             *(Case(DAY_BAND_SIGMA_K, "correlated", quantity=b, los_step_urad=300.0) for b in BANDS),
              *(Case(BAND_SIGMA_K[b], "correlated", quantity=b, los_step_urad=300.0)
                for b in BANDS)]  # fmt: skip
 
@@ -330,7 +334,9 @@ def detect_cases() -> list[Case]:
     out += [Case(0.007, "correlated", 0.1, "all", 0, "none", "bias"),
             Case(0.007, "correlated", 0.1, "all", 0, "at", "bias"),
             Case(0.007, "correlated", 0.0, "all", 0, "at", "bias", 300.0)]  # fmt: skip
-    # each band's CrIS minus VIIRS at its per-FOR sigma of the simulated history, a 0.1 K step in it
+    # each band's CrIS minus VIIRS, a 0.1 K step in it: at the per-FOR sigma a simulated day states
+    # (DAY_BAND_SIGMA_K), and at the larger ones of the simulated history (BAND_SIGMA_K)
+    out += [Case(DAY_BAND_SIGMA_K, "correlated", 0.1, "all", 0, "none", b) for b in BANDS]
     out += [Case(BAND_SIGMA_K[b], "correlated", 0.1, "all", 0, "none", b) for b in BANDS]
     return out
 
