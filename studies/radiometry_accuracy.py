@@ -28,6 +28,7 @@ from monitor.assessment.daymap import with_bands
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.bands import BANDS
 from monitor.core.result import AssessmentResult
+from monitor.instrument.footprint import shape
 from monitor.matchup import map_granules
 from monitor.simulate.case import simulate_case
 from studies.mapping_accuracy import KINDS
@@ -36,8 +37,12 @@ INJECTED_K = {"I5": 0.3, "M13": -0.05, "M15": -0.12, "M16": 0.08}  # added to VI
 ALL = tuple(BANDS)
 
 
-def _day(out: Path, params: dict, granules: int, bias: dict[str, float]) -> AssessmentResult:
+def _day(out: Path, kind: dict, granules: int, bias: dict[str, float]) -> AssessmentResult:
     """Simulate, assess and compare one day in every band, with the default configuration."""
+    params = dict(kind)
+    response = params.pop("cris_response", None)
+    if response is not None:
+        params["cris_response"] = shape(str(response))
     simulate_case(out, granules=granules, viirs_bands=ALL, viirs_band_bias_k=bias, **params)
     cfg = AssessmentConfig(bands=list(ALL))
     result = assess_paths([out], cfg, workers=2)
