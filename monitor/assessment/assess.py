@@ -36,12 +36,14 @@ from monitor.assessment.spool import Spool
 from monitor.collocation import collocate, swath
 from monitor.compiled.threads import parallel_threads
 from monitor.config.assessment import AssessmentConfig
+from monitor.core.bands import BANDS
 from monitor.core.constants import FOV_HALF_ANGLE_RAD
 from monitor.core.errors import AssessmentError, StopRequested
-from monitor.core.result import AssessmentResult, GranuleInfo
+from monitor.core.result import SECOND_BAND, AssessmentResult, GranuleInfo
+from monitor.estimation.band_pair import with_second_band
 from monitor.geometry.ep_model import FOV5
 from monitor.geometry.inverse import FovGeometry
-from monitor.instrument.spectral import BandModel, i5_band
+from monitor.instrument.spectral import BandModel, band_model
 from monitor.sdr import (
     CrisGeoGranule,
     GranuleError,
@@ -197,6 +199,7 @@ def collocate_run(
     timings: Timings = None,
     lift_m_per_k: float = 0.0,
     variation: Variation = SERVICE,
+    band: str = "I5",
 ) -> tuple[list[GranuleSamples], list[tuple[str, str]]]:
     """Collocate a time-ordered run of CrIS granules, and in the same pass their rendering at a lift.
 
@@ -224,6 +227,8 @@ def collocate_run(
     variation : Variation, optional
         What a study varies: the renderer, the VIIRS granules as prepared (:mod:`monitor.assessment.seam`);
         the service's by default.
+    band : str, optional
+        The VIIRS band collocated: I5, or a long-wave M band (M15) with its M-band GEO in *viirs*.
 
     Returns
     -------
@@ -232,10 +237,14 @@ def collocate_run(
     skipped : list of (str, str)
         The granules that failed, with their reasons.
     """
-    band = i5_band(satellite)
+    model = band_model(satellite, band)
     spans = scan_spans(cris, viirs)
     cache = SwathCache(
-        spans=spans, lift_m_per_k=lift_m_per_k, renderer=variation.renderer, piece=variation.piece
+        spans=spans,
+        lift_m_per_k=lift_m_per_k,
+        renderer=variation.renderer,
+        piece=variation.piece,
+        detectors=BANDS[band].grid.detectors,
     )
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end
@@ -245,7 +254,7 @@ def collocate_run(
         is computed (h5py, numpy and the compiled kernels release the interpreter to each other)."""
         prepared = set(cache.pieces) | ({v.key for v in viirs[cris[i - 1].key]} if i else set())
         return pool.submit(
-            read_inputs, cris[i], viirs[cris[i].key], viirs_all, band, cfg, prepared, reading, cache.spans
+            read_inputs, cris[i], viirs[cris[i].key], viirs_all, model, cfg, prepared, reading, cache.spans
         )
 
     with cf.ThreadPoolExecutor(1, thread_name_prefix="crisgeo-read") as pool:
@@ -265,7 +274,7 @@ def collocate_run(
                         g,
                         viirs[g.key],
                         cfg,
-                        band,
+                        model,
                         cache,
                         timings,
                         viirs_all,
@@ -308,6 +317,9 @@ class DayAssessment:
         Threads of the compiled VIIRS preparation and collocation.
     variation : Variation, optional
         What a study varies (:mod:`monitor.assessment.seam`); the service's by default.
+    band : str, optional
+        The VIIRS band the geolocation is assessed in: I5 (the offsets), or M15 (the offsets read in a
+        second band, on the M grid: :data:`monitor.core.bands.GRIDS`). A band of CrIS's long-wave band.
     """
 
     def __init__(
@@ -316,9 +328,12 @@ class DayAssessment:
         cfg: AssessmentConfig | None = None,
         workers: int = 1,
         variation: Variation = SERVICE,
+        band: str = "I5",
     ) -> None:
+        if BANDS[band].cris_band != "LW":
+            raise ValueError(f"band {band}: the geolocation is assessed in a band of CrIS's long-wave band")
         self.satellite, self.cfg, self.workers = satellite, cfg or AssessmentConfig(), workers
-        self.variation = variation
+        self.variation, self.band = variation, band
         self.samples: list[GranuleSamples] = []
         self.skipped: list[tuple[str, str]] = []
         self._spool = Spool()
@@ -357,16 +372,21 @@ class DayAssessment:
             Collects seconds per stage (read, geometry, parallax, spectral, collocation, cost).
         """
         cfg = self.cfg
-        run = (case.cris, case.viirs, case.viirs_all, self.satellite, cfg)
+        cris, viirs, viirs_all, uncovered = case.cris, case.viirs, case.viirs_all, []
+        if self.band != "I5":  # the CrIS granules I5 pairs, each with the band's granules that cover it
+            viirs, viirs_all = {g.key: case.cover(g, self.band) for g in cris}, case.bands.get(self.band, [])
+            uncovered = [(g.key, f"no VIIRS {self.band} granule covers it") for g in cris if not viirs[g.key]]
+            cris = [g for g in cris if viirs[g.key]]
+        run = (cris, viirs, viirs_all, self.satellite, cfg)
         # with the parallax correction (the one place the setting is read), also the pixels at the probe's
         # height per K, rendered, in the same pass: monitor.estimation.parallax chooses the day's lift from
         # the two wherever every granule was rendered
         lift_m_per_k = self.variation.probe_m_per_k if cfg.parallax else 0.0
         with parallel_threads(self.workers):
             samples, skipped = collocate_run(
-                *run, progress, should_stop, timings, lift_m_per_k, self.variation
+                *run, progress, should_stop, timings, lift_m_per_k, self.variation, self.band
             )
-        self.skipped += list(case.skipped) + skipped
+        self.skipped += list(case.skipped) + uncovered + skipped
         self.samples += [s.kept_in(self._spool) for s in samples]
         if should_stop is not None and should_stop():  # an interruption, not bad data: no cost stage either
             raise StopRequested
@@ -396,7 +416,9 @@ class DayAssessment:
             )
         in_time = sorted(self.samples, key=lambda s: (s.info.start, s.key))
         with stage(timings, "cost"):
-            return cost_and_offsets(in_time, cfg, skipped, self.satellite, self.variation, self._spool.parked)
+            return cost_and_offsets(
+                in_time, cfg, skipped, self.satellite, self.variation, self._spool.parked, self.band
+            )
 
 
 def assess_plan(
@@ -433,6 +455,51 @@ def assess_plan(
     with DayAssessment(case.satellite, cfg, workers) as day:
         day.add(case, progress, should_stop, timings)
         return day.result(timings)
+
+
+def in_second_band(
+    case: CasePlan,
+    result: AssessmentResult,
+    cfg: AssessmentConfig,
+    should_stop: StopCheck = None,
+    timings: Timings = None,
+) -> AssessmentResult:
+    """The day's I5 *result* with its offsets read in M15 too, where ``assessment.bands`` lists M15.
+
+    The CrIS granules of *case* are assessed again against their M15 granules (``case.bands``), as in I5
+    (:class:`DayAssessment`, band M15), and paired with the I5 offsets
+    (:func:`monitor.estimation.band_pair.with_second_band`).
+
+    Parameters
+    ----------
+    case : CasePlan
+        The day's assessed CrIS granules, with their M15 granules in ``bands``.
+    result : AssessmentResult
+        The day's I5 assessment.
+    cfg : AssessmentConfig
+        The assessment's configuration.
+    should_stop : callable, optional
+        Polled before each granule; True ends it with :class:`StopRequested`.
+    timings : dict, optional
+        Collects seconds per stage.
+
+    Returns
+    -------
+    AssessmentResult
+        *result* with the M15 offsets and the difference; unchanged where M15 is not configured; with a note
+        where M15 leaves too little to assess.
+    """
+    if SECOND_BAND not in cfg.bands:
+        return result
+    with DayAssessment(case.satellite, cfg, cfg.workers, band=SECOND_BAND) as day:
+        day.add(case, None, should_stop, timings)
+        try:
+            second = day.result(timings)
+        except AssessmentError as exc:
+            return replace(result, notes=[*result.notes, f"no offsets in {SECOND_BAND}: {exc}"])
+    known = {s.item for s in result.skipped}
+    notes = [f"{SECOND_BAND}: {s.item} skipped: {s.reason}" for s in second.skipped if s.item not in known]
+    return replace(with_second_band(result, second), notes=[*result.notes, *notes])
 
 
 def assess_paths(

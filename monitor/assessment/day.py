@@ -20,14 +20,14 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from monitor.archive import ALL_PRODUCTS, ListedFile, Source, SourceError
-from monitor.assessment.assess import DayAssessment
-from monitor.assessment.daymap import map_day, with_bands
+from monitor.assessment.assess import DayAssessment, in_second_band
+from monitor.assessment.daymap import band_plan, map_day, with_bands
 from monitor.assessment.scenes import Candidate, batch_decisions, next_batch, rank_scenes
 from monitor.config.assessment import AssessmentConfig
 from monitor.config.model import Config
 from monitor.core import logcontext
 from monitor.core.errors import DataError, StopRequested
-from monitor.core.result import AssessmentResult, DayPrecision, SceneDecision
+from monitor.core.result import SECOND_BAND, AssessmentResult, DayPrecision, SceneDecision
 from monitor.core.vocabulary import DayStop, RunStatus
 from monitor.mapping import fingerprint as fpr
 from monitor.matchup import Matchup
@@ -368,13 +368,20 @@ def _compute_day(
             beat.stage("map", "mapping the CrIS FOVs onto VIIRS")
             mapped = {*cfg.assessment.bands, *(cfg.mapping_bands if cfg.mapping_dir is not None else ())}
             try:
-                matchup = map_day(source, satellite, day, cases, w.result, tuple(mapped), stop)
+                plan = band_plan(source, satellite, day, cases, tuple(sorted(mapped)))
+                matchup = map_day(plan, w.result, tuple(mapped), stop)
                 w.result = with_bands(w.result, matchup, cfg.assessment)
                 w.mapping = matchup if cfg.mapping_dir is not None else None
+                w.timings["map"] = time.perf_counter() - t1
+                if SECOND_BAND in cfg.assessment.bands:
+                    t1 = time.perf_counter()
+                    beat.stage(SECOND_BAND, f"assessing the geolocation in {SECOND_BAND}")
+                    w.result = in_second_band(plan, w.result, cfg.assessment, stop)
+                    w.timings[SECOND_BAND] = time.perf_counter() - t1
             except (SourceError, DataError) as exc:  # the bands are a product of the day, not its outcome
                 LOG.warning("the day's mapping failed: %s", exc)
                 w.result.notes.append(f"no CrIS minus VIIRS per band: the mapping failed: {exc}")
-            w.timings["map"] = time.perf_counter() - t1
+                w.timings["map"] = time.perf_counter() - t1
     except StopRequested:
         w.status, w.reason, w.result = RunStatus.INTERRUPTED, "stop requested", None
     except NoRoom as exc:

@@ -49,16 +49,14 @@ def _band_granules(
     return sorted(out, key=lambda g: g.start)
 
 
-def map_day(
+def band_plan(
     source: Source,
     satellite: str,
     day: dt.date,
     cases: list[CasePlan],
-    result: AssessmentResult,
     bands: tuple[str, ...],
-    should_stop: Callable[[], bool] | None = None,
-) -> Matchup:
-    """Map the day's assessed CrIS granules onto *bands*, on the day's offsets and fitted response.
+) -> CasePlan:
+    """The day's assessed CrIS granules with their I5 granules and, fetched, each other band's.
 
     Parameters
     ----------
@@ -70,17 +68,13 @@ def map_day(
         The UTC day.
     cases : list of CasePlan
         The day's batches as the assessment fetched them.
-    result : AssessmentResult
-        The day's estimate.
     bands : tuple of str
         The VIIRS bands.
-    should_stop : callable, optional
-        Polled between granules.
 
     Returns
     -------
-    Matchup
-        The day's mapping.
+    CasePlan
+        The plan; a band granule that cannot be had is in its ``skipped``.
     """
     skipped: list[tuple[str, str]] = []
     cris = sorted({g.key: g for c in cases for g in c.cris}.values(), key=lambda g: g.start)
@@ -93,10 +87,37 @@ def map_day(
         keys = {g.key for g in viirs}
         for band in others:
             plan.bands[band] = _band_granules(source, listing, band, keys, skipped)
+    return plan
+
+
+def map_day(
+    plan: CasePlan,
+    result: AssessmentResult,
+    bands: tuple[str, ...],
+    should_stop: Callable[[], bool] | None = None,
+) -> Matchup:
+    """Map the day's assessed CrIS granules onto *bands*, on the day's offsets and fitted response.
+
+    Parameters
+    ----------
+    plan : CasePlan
+        The day's granules in every band (:func:`band_plan`).
+    result : AssessmentResult
+        The day's estimate.
+    bands : tuple of str
+        The VIIRS bands.
+    should_stop : callable, optional
+        Polled between granules.
+
+    Returns
+    -------
+    Matchup
+        The day's mapping.
+    """
     matchup, cost = map_plan(plan, bands, result, should_stop)
     LOG.info(
         "mapped %d CrIS granule(s) onto %s: %.1f CPU-s reading, %.1f CPU-s mapping",
-        len(cris), ", ".join(bands), sum(cost.read_s.values()), sum(cost.map_s.values()),
+        len(plan.cris), ", ".join(bands), sum(cost.read_s.values()), sum(cost.map_s.values()),
     )  # fmt: skip
     return matchup
 

@@ -17,12 +17,13 @@ from monitor.assessment.inputs import KERNELS, offsets_rad
 from monitor.assessment.seam import SERVICE, Variation
 from monitor.assessment.spool import OnDisk, Spool
 from monitor.config.assessment import AssessmentConfig
-from monitor.core.result import AssessmentResult, GranuleInfo, Skipped
+from monitor.core.result import AssessmentResult, ForReplicates, GranuleInfo, Skipped
 from monitor.estimation.day_estimate import DaySamples, Parked, estimate_day, in_memory
 from monitor.estimation.estimate import ForSamples
 from monitor.estimation.jackknife import follows_in_time, uncertainty_note
+from monitor.estimation.offsets import OffsetReplicates
 from monitor.geometry.ground import offset_km
-from monitor.instrument.spectral import BandModel, i5_band
+from monitor.instrument.spectral import BandModel, band_model
 
 
 @dataclass
@@ -100,7 +101,7 @@ def for_samples(
     cfg : AssessmentConfig
         The assessment's configuration.
     band : BandModel, optional
-        The satellite's I5 band, for the footprint kernel's annuli.
+        The collocated band, for the footprint kernel's annuli.
 
     Returns
     -------
@@ -138,6 +139,7 @@ def cost_and_offsets(
     satellite: str = "",
     variation: Variation = SERVICE,
     keep: Callable[[ForSamples], Parked] = in_memory,
+    band: str = "I5",
 ) -> AssessmentResult:
     """The cost cube, per-FOR minimum, jackknife uncertainty and km offsets of collocated *samples*.
 
@@ -162,19 +164,21 @@ def cost_and_offsets(
     keep : callable, optional
         Where each FOR's built samples wait while the day's lift is sought (the day's spool,
         :meth:`Spool.parked <monitor.assessment.spool.Spool.parked>`); in memory by default.
+    band : str, optional
+        The VIIRS band the samples were collocated in (I5, or M15).
 
     Returns
     -------
     AssessmentResult
         Per-FOR offsets (urad, km), sigmas, flags and the day's lift.
     """
-    band = i5_band(satellite or samples[0].info.cris_meta["platform"]) if samples else None
+    model = band_model(satellite or samples[0].info.cris_meta["platform"], band) if samples else None
     rendered = bool(samples) and all(s.rendered is not None for s in samples)
     at_geo, at_probe = paired(samples) if rendered else (samples, None)
     day = estimate_day(
         DaySamples(
-            lambda k: for_samples(at_geo, k, cfg, band),
-            None if at_probe is None else lambda k: for_samples(at_probe, k, cfg, band),
+            lambda k: for_samples(at_geo, k, cfg, model),
+            None if at_probe is None else lambda k: for_samples(at_probe, k, cfg, model),
             lambda k, d_alpha_rad, d_beta_rad: _ground_km(samples, k, d_alpha_rad, d_beta_rad),
             follows_in_time([_seconds(s.info.start) for s in samples]),
             variation.probe_m_per_k,
@@ -197,7 +201,15 @@ def cost_and_offsets(
         cost_cube_k=day.cost_cube_k,
         difference_bins=day.difference_bins,
         notes=[uncertainty_note(len(samples), day.correlation)],
+        replicates=[None if r is None else _by_granule(r, samples) for r in day.replicates],
     )
+
+
+def _by_granule(r: OffsetReplicates, samples: list[GranuleSamples]) -> ForReplicates:
+    """A FOR's replicates with the granules they leave out named by granule id."""
+    ids = [s.info.granule_id for s in samples]
+    groups = tuple((ids[int(a)], ids[int(b)]) for a, b in r.granules)
+    return ForReplicates(groups, r.urad[:, 0].copy(), r.urad[:, 1].copy(), r.factor)
 
 
 def _seconds(iso: str) -> float:

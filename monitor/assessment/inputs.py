@@ -13,6 +13,7 @@ import numpy as np
 
 from monitor.collocation import collocate, reach, render, swath
 from monitor.config.assessment import AssessmentConfig
+from monitor.core.constants import VIIRS_DETECTORS
 from monitor.core.vocabulary import Kernel
 from monitor.geometry.inverse import FovGeometry, granule_geometry
 from monitor.geometry.perturb import perturbation_grid
@@ -95,7 +96,8 @@ class SwathCache:
     piece holds what each CrIS FOV row sees of its pixels standing at that height
     (*renderer*: :func:`monitor.collocation.render.rendered_bt`, or a study's through
     :class:`monitor.assessment.seam.Variation`); with 0, the pixels' own radiance. *piece*, None in the
-    service, is a study's change to each piece as it is prepared (the pixels the cone kernel sees)."""
+    service, is a study's change to each piece as it is prepared (the pixels the cone kernel sees).
+    *detectors*: the rows of a scan of the band's grid."""
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
@@ -105,6 +107,7 @@ class SwathCache:
     lift_m_per_k: float = 0.0
     renderer: render.Renderer = render.rendered_bt
     piece: PieceVariant | None = None
+    detectors: int = VIIRS_DETECTORS
 
 
 def _widen(span: Span | None, other: Span | None) -> Span | None:
@@ -234,7 +237,7 @@ def read_inputs(
     viirs_all : list of GranuleFiles
         Every VIIRS granule of the run.
     band : BandModel
-        The satellite's I5 band.
+        The assessed band (I5, or M15 on the M grid).
     cfg : AssessmentConfig
         The assessment's configuration.
     prepared : iterable of str
@@ -313,7 +316,7 @@ def piece(
     viirs_all : list of GranuleFiles
         Every VIIRS granule of the run.
     band : BandModel
-        The satellite's I5 band.
+        The assessed band (I5, or M15 on the M grid).
     cache : SwathCache
         The run's prepared granules.
     view_rad : float
@@ -349,19 +352,19 @@ def piece(
             # what the piece keeps, and a scan either side: a ray's stretches lie within ~1 km of its foot
             scans, columns = reach.kept_pixels(
                 geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m, reach_rad,
-                geo.start_time_us, run_span,
+                geo.start_time_us, run_span, cache.detectors,
             )  # fmt: skip
             first, stop, _ = scans.indices(len(geo.sc_position_m))
             seen = cache.renderer(
                 geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, geo.sc_position_m,
                 geo.sc_velocity_m_s, render.VIEW_ALPHA_RAD, cache.lift_m_per_k,
-                slice(max(first - 1, 0), stop + 1), columns,
+                slice(max(first - 1, 0), stop + 1), columns, cache.detectors,
             )  # fmt: skip
     with stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
             sat_m=geo.sc_position_m, view_rad=reach_rad, scan_start_us=geo.start_time_us, span_us=run_span,
-            seen_bt_k=seen, view_alpha_rad=render.VIEW_ALPHA_RAD,
+            seen_bt_k=seen, view_alpha_rad=render.VIEW_ALPHA_RAD, detectors=cache.detectors,
         )  # fmt: skip
     if cache.piece is not None:
         piece = cache.piece(piece)
@@ -390,7 +393,7 @@ def load_swath(
     viirs_all : list of GranuleFiles
         Every VIIRS granule of the run.
     band : BandModel
-        The satellite's I5 band.
+        The assessed band (I5, or M15 on the M grid).
     cache : SwathCache
         The run's prepared granules.
     view_rad : float

@@ -246,7 +246,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
     int
         The exit status.
     """
-    from monitor.assessment.assess import assess_plan
+    from monitor.assessment.assess import assess_plan, in_second_band
     from monitor.assessment.daymap import with_bands
     from monitor.matchup import map_granules
     from monitor.sdr.pairing import plan
@@ -272,12 +272,12 @@ def cmd_assess(args: argparse.Namespace) -> int:
 
         result = assess_collocations(collocations, cfg)
     else:
-        case = plan(args.paths)
+        case = plan(args.paths, bands=tuple(cfg.bands))
         with Progress("assessing granules", len(case.cris)) as progress:
             result = assess_plan(case, cfg, progress, workers=cfg.workers)
         if result.granules:
             matchup, _ = map_granules(args.paths, tuple(cfg.bands), offsets=result)
-            result = with_bands(result, matchup, cfg)
+            result = in_second_band(case, with_bands(result, matchup, cfg), cfg)
     print(result_text(result))
     if args.out:
         Path(args.out).write_text(result.to_json())

@@ -182,8 +182,9 @@ def _window_half_sizes(
     d_scan = reach_angle_rad * range_m / cz + relief
     adv = piece.advance_m[col0]
     det = piece.det_step_m[col0]
-    overlap = np.clip(1.0 - adv / (VIIRS_DETECTORS * det), 0.0, 1.0)
-    half_rows = np.ceil(d_track / (adv / VIIRS_DETECTORS) + VIIRS_DETECTORS * overlap + 8).astype(np.int64)
+    n = piece.detectors
+    overlap = np.clip(1.0 - adv / (n * det), 0.0, 1.0)
+    half_rows = np.ceil(d_track / (adv / n) + n * overlap + 8).astype(np.int64)
     half_cols = np.ceil(d_scan / piece.col_spacing_m[col0] + 4).astype(np.int64)
     return half_rows, half_cols, np.maximum(d_track, d_scan)
 

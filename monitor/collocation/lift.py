@@ -12,9 +12,9 @@ How high. A cloud's top is colder than the clear surface around it by about its 
     H = kappa * max(T_ref - BT, 0)
 
 above its GEO point, where T_ref is the neighbourhood's clear-sky reference: the warmest BT within
-+-:data:`REFERENCE_HALF_PX` pixels (~37 km; a 3 x 3 mean first, so that one noisy pixel does not set it).
-The reach is set by the decks, not by the cone: a deck's middle beyond the reach of clear sky would be its
-own reference and stand too low (docs/science.md, "Clouds with height").
++-:data:`REFERENCE_HALF_PX` I-band pixels (~37 km; half as many M-band pixels; a 3 x 3 mean first, so that one
+noisy pixel does not set it). The reach is set by the decks, not by the cone: a deck's middle beyond the reach
+of clear sky would be its own reference and stand too low (docs/science.md, "Clouds with height").
 kappa (m per K) is not assumed: the assessment collocates at kappa = 0 and at :data:`PROBE_M_PER_K`, and
 chooses the day's kappa from its own cost (:mod:`monitor.estimation.parallax`).
 
@@ -227,7 +227,7 @@ def scan_points(
     lat, lon, h : numpy.ndarray
         The granule's GEO: latitude and longitude (rad), height (m), shape (rows, cols).
     mask : numpy.ndarray
-        Which pixels of the scan to write, shape (32, cols).
+        Which pixels of the scan to write, shape (detectors, cols).
     row0 : int
         The scan's first row.
     sat : numpy.ndarray
@@ -236,7 +236,7 @@ def scan_points(
         Its ECEF velocity, m/s, shape (3,).
     point : numpy.ndarray
         Written: per pixel the GEO point (ECEF, m), the ellipsoid's normal there and the scan angle (rad) seen
-        from the spacecraft, shape (32, cols, 7).
+        from the spacecraft, shape (detectors, cols, 7).
 
     Returns
     -------

@@ -16,11 +16,16 @@ from numpy.typing import ArrayLike
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.geometry import wgs84
 
-BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of VIIRS_DETECTORS)
+BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of either grid's detectors)
 
 
 def view_columns(
-    lat_rad: np.ndarray, lon_rad: np.ndarray, height_m: np.ndarray, sat_m: np.ndarray, view_rad: float
+    lat_rad: np.ndarray,
+    lon_rad: np.ndarray,
+    height_m: np.ndarray,
+    sat_m: np.ndarray,
+    view_rad: float,
+    detectors: int = VIIRS_DETECTORS,
 ) -> slice:
     """The columns holding every pixel seen within *view_rad* of nadir.
 
@@ -32,11 +37,13 @@ def view_columns(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     sat_m : numpy.ndarray
         Each scan's spacecraft position, ECEF, m, shape (nscan, 3); NaN ignored.
     view_rad : float
         The view angle from the geocentric nadir, rad.
+    detectors : int, optional
+        The rows of a scan (the grid's detectors).
 
     Returns
     -------
@@ -45,7 +52,7 @@ def view_columns(
     """
     scans = np.unique(np.r_[np.arange(0, len(sat_m), 4), len(sat_m) - 1])
     sat = np.asarray(sat_m, float)[scans]
-    mid = scans * VIIRS_DETECTORS + VIIRS_DETECTORS // 2
+    mid = scans * detectors + detectors // 2
     los = wgs84.geodetic_to_ecef(lat_rad[mid], lon_rad[mid], height_m[mid]) - sat[:, None, :]
     nadir = -sat / np.linalg.norm(sat, axis=-1, keepdims=True)
     with np.errstate(invalid="ignore"):
@@ -85,6 +92,7 @@ def kept_pixels(
     view_rad: float = math.inf,
     scan_start_us: np.ndarray | None = None,
     span_us: tuple[float, float] | None = None,
+    detectors: int = VIIRS_DETECTORS,
 ) -> tuple[slice, slice]:
     """The scans and the columns of a granule that :func:`monitor.collocation.swath.swath_piece` keeps.
 
@@ -92,7 +100,7 @@ def kept_pixels(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     sat_m : numpy.ndarray, optional
         Each scan's spacecraft position, ECEF, m, shape (nscan, 3).
     view_rad : float, optional
@@ -101,6 +109,8 @@ def kept_pixels(
         Each scan's start time, IET us.
     span_us : tuple of float, optional
         The span (t0, t1) the CrIS granules reach, IET us.
+    detectors : int, optional
+        The rows of a scan (the grid's detectors).
 
     Returns
     -------
@@ -113,7 +123,8 @@ def kept_pixels(
         scans = scans_between(scan_start_us, *span_us)
     columns = slice(None)
     if sat_m is not None and view_rad < math.pi / 2:
-        first, stop, _ = scans.indices(np.shape(lat_rad)[0] // VIIRS_DETECTORS)
-        r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
-        columns = view_columns(lat_rad[r], lon_rad[r], height_m[r], np.asarray(sat_m)[first:stop], view_rad)
+        first, stop, _ = scans.indices(np.shape(lat_rad)[0] // detectors)
+        r = slice(first * detectors, stop * detectors)
+        sat = np.asarray(sat_m)[first:stop]
+        columns = view_columns(lat_rad[r], lon_rad[r], height_m[r], sat, view_rad, detectors)
     return scans, columns

@@ -56,7 +56,7 @@ from typing import Protocol
 import numba
 import numpy as np
 
-from monitor.collocation.lift import height_above_m, reference_k, running_max
+from monitor.collocation.lift import REFERENCE_HALF_PX, height_above_m, reference_k, running_max
 from monitor.collocation.views import TANGENT_STEP, Across, view_tangents, view_tangents_across
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
@@ -101,6 +101,7 @@ class Renderer(Protocol):
         m_per_k: float,
         scans: slice = ...,
         columns: slice = ...,
+        detectors: int = ...,
     ) -> np.ndarray: ...
 
 
@@ -116,6 +117,7 @@ def rendered_bt(
     m_per_k: float,
     scans: slice = slice(None),
     columns: slice = slice(None),
+    detectors: int = VIIRS_DETECTORS,
 ) -> np.ndarray:
     """The BT a CrIS ray at each in-track angle sees on its way to each GEO point of a VIIRS granule.
 
@@ -128,9 +130,9 @@ def rendered_bt(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     bt_k : numpy.ndarray
-        The pixels' I5 BT, K, shape (rows, cols).
+        The pixels' band BT, K, shape (rows, cols).
     good : numpy.ndarray
         Where a pixel is usable.
     sat_m, velocity_m_s : numpy.ndarray
@@ -144,6 +146,8 @@ def rendered_bt(
         The scans to render (step 1).
     columns : slice, optional
         The columns to render.
+    detectors : int, optional
+        The rows of a scan (the grid's detectors: :data:`monitor.core.bands.GRIDS`).
 
     Returns
     -------
@@ -153,7 +157,7 @@ def rendered_bt(
     """
     return _render(
         lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k, scans, columns,
-        across=True, met=None,
+        detectors, across=True, met=None,
     )  # fmt: skip
 
 
@@ -169,6 +173,7 @@ def swept_bt(
     m_per_k: float,
     scans: slice = slice(None),
     columns: slice = slice(None),
+    detectors: int = VIIRS_DETECTORS,
 ) -> np.ndarray:
     """:func:`rendered_bt` with the sweep alone: each ray takes the BT of the pixel it meets, not of its own
     place across the track (:func:`~monitor.collocation.views.view_tangents`).
@@ -177,9 +182,9 @@ def swept_bt(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     bt_k : numpy.ndarray
-        The pixels' I5 BT, K, shape (rows, cols).
+        The pixels' band BT, K, shape (rows, cols).
     good : numpy.ndarray
         Where a pixel is usable.
     sat_m, velocity_m_s : numpy.ndarray
@@ -193,6 +198,8 @@ def swept_bt(
         The scans to render (step 1).
     columns : slice, optional
         The columns to render.
+    detectors : int, optional
+        The rows of a scan (the grid's detectors: :data:`monitor.core.bands.GRIDS`).
 
     Returns
     -------
@@ -202,7 +209,7 @@ def swept_bt(
     """
     return _render(
         lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k, scans, columns,
-        across=False, met=None,
+        detectors, across=False, met=None,
     )  # fmt: skip
 
 
@@ -218,6 +225,7 @@ def rendered_met(
     m_per_k: float,
     scans: slice = slice(None),
     columns: slice = slice(None),
+    detectors: int = VIIRS_DETECTORS,
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`rendered_bt`, and what each ray met (:class:`Met`): a study's view of the rendering.
 
@@ -225,9 +233,9 @@ def rendered_met(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     bt_k : numpy.ndarray
-        The pixels' I5 BT, K, shape (rows, cols).
+        The pixels' band BT, K, shape (rows, cols).
     good : numpy.ndarray
         Where a pixel is usable.
     sat_m, velocity_m_s : numpy.ndarray
@@ -241,6 +249,8 @@ def rendered_met(
         The scans to render (step 1).
     columns : slice, optional
         The columns to render.
+    detectors : int, optional
+        The rows of a scan (the grid's detectors: :data:`monitor.core.bands.GRIDS`).
 
     Returns
     -------
@@ -252,7 +262,7 @@ def rendered_met(
     met = np.empty((len(cris_alpha_rad), *np.shape(bt_k)), np.uint8)
     bt = _render(
         lat_rad, lon_rad, height_m, bt_k, good, sat_m, velocity_m_s, cris_alpha_rad, m_per_k, scans, columns,
-        across=True, met=met,
+        detectors, across=True, met=met,
     )  # fmt: skip
     return bt, met
 
@@ -269,6 +279,7 @@ def _render(
     m_per_k: float,
     scans: slice,
     columns: slice,
+    detectors: int,
     across: bool,
     met: np.ndarray | None,
 ) -> np.ndarray:
@@ -276,10 +287,11 @@ def _render(
     rows, cols = np.shape(bt_k)
     out = np.empty((len(cris_alpha_rad), rows, cols), np.float32)
     usable = np.asarray(good, bool) & np.isfinite(bt_k)
-    reference = reference_k(bt_k, usable)  # over the whole granule: it looks 100 pixels around
+    # over the whole granule, as far around on the ground on either grid (an M pixel spans two I pixels)
+    reference = reference_k(bt_k, usable, REFERENCE_HALF_PX * detectors // VIIRS_DETECTORS)
     height = height_above_m(bt_k, usable, reference, m_per_k)
-    first, stop, _ = scans.indices(rows // VIIRS_DETECTORS)
-    r = slice(first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS)
+    first, stop, _ = scans.indices(rows // detectors)
+    r = slice(first * detectors, stop * detectors)
     c_first, c_stop, _ = columns.indices(cols)
     c_stop = max(c_stop, c_first)
     # what the passes do not write: the passes write every pixel of r and [c_first, c_stop)
@@ -298,9 +310,9 @@ def _render(
         geo = (lat_rad[r, traced], lon_rad[r, traced], height_m[r, traced], usable[r, traced])
         orbit = (sat_m[first:stop], velocity_m_s[first:stop], cris_alpha_rad, lo)
         if across:
-            x, b, a, sideways = view_tangents_across(*geo, *orbit)
+            x, b, a, sideways = view_tangents_across(*geo, *orbit, detectors=detectors)
         else:
-            (x, b, a), sideways = view_tangents(*geo, *orbit), None
+            (x, b, a), sideways = view_tangents(*geo, *orbit, detectors=detectors), None
         shape = (len(cris_alpha_rad), r.stop - r.start, drawn.stop - drawn.start)
         kind = None if met is None else np.empty(shape, np.uint8)
         seen = render_height_field(
@@ -313,6 +325,7 @@ def _render(
             sideways,
             slice(drawn.start - lo, drawn.stop - lo),
             kind,
+            detectors,
         )
         inner = slice(part.start - drawn.start, part.stop - drawn.start)
         out[:, r, part] = seen[:, :, inner]
@@ -331,6 +344,7 @@ def render_height_field(
     across: Across | None = None,
     columns: slice = slice(None),
     met: np.ndarray | None = None,
+    detectors: int = VIIRS_DETECTORS,
 ) -> np.ndarray:
     """What a CrIS ray at each in-track tangent sees on its way to each GEO point: the module's sweep.
 
@@ -359,6 +373,8 @@ def render_height_field(
         The columns rendered (step 1); the others are not read.
     met : numpy.ndarray, optional
         Filled with what each ray met (:class:`Met`), uint8, the output's shape.
+    detectors : int, optional
+        The rows of a scan: whether a ray met its own scan or another.
 
     Returns
     -------
@@ -379,7 +395,7 @@ def render_height_field(
         sideways = [np.ascontiguousarray(v, np.float64) for v in (across.geo_m, across.unit)]
         sideways += [np.ascontiguousarray(v, np.float32) for v in (across.viirs_tan, across.cris_tan)]
     with KERNEL_LOCK:
-        _sweep(x, *fields, float(m_per_k), *sideways, c_lo, c_hi, seen, kind)
+        _sweep(x, *fields, float(m_per_k), *sideways, c_lo, c_hi, seen, kind, detectors)
     if met is not None:
         met[...] = kind
     return seen
@@ -448,6 +464,7 @@ def _sweep(
     c_hi: int,
     out: np.ndarray,
     kind: np.ndarray,
+    det: int,
 ) -> None:
     """Fill *out* (:func:`render_height_field`: columns c_lo to c_hi; across the track where *geo* has
     rows; and *kind* with what each ray met, :class:`Met`, where it has rows), one column a task:
@@ -520,7 +537,7 @@ def _sweep(
                         kind[v, r0, c - c_lo] = Met.WALL
                     elif rs[best] == r0:
                         kind[v, r0, c - c_lo] = Met.OWN_TOP
-                    elif rs[best] // VIIRS_DETECTORS == r0 // VIIRS_DETECTORS:
+                    elif rs[best] // det == r0 // det:
                         kind[v, r0, c - c_lo] = Met.SCAN_TOP
                     else:
                         kind[v, r0, c - c_lo] = Met.OTHER_SCAN_TOP

@@ -1,4 +1,5 @@
-"""VIIRS I5 granules prepared for the cone test: pixel points, band radiance, solid-angle weights, blocks.
+"""VIIRS granules prepared for the cone test: pixel points, band radiance, solid-angle weights, blocks. I5 on
+the I grid (32-detector scans), or M15 on the M grid (16-detector scans: :data:`monitor.core.bands.GRIDS`).
 
 Pixels where they are. A terrain-corrected (GITCO) pixel is the 3-D point where its line of sight meets
 the terrain: (lat, lon, Height). Put at h = 0 instead, a pixel on terrain of height h seen from CrIS at
@@ -65,7 +66,7 @@ SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smal
 
 @dataclass
 class SwathPiece:
-    """One VIIRS granule (rows of 32-detector scans) ready for collocation.
+    """One VIIRS granule (scans of *detectors* rows: 32 on the I grid, 16 on the M) ready for collocation.
 
     ecef_m (rows, cols, 3) float32 (0.5 m resolution) of the 3-D pixel points; radiance (rows, cols) the
     pixels' I5 band radiance mW/(m2 sr cm-1), NaN where unusable; *rendered* (views, rows, cols), when the
@@ -98,6 +99,7 @@ class SwathPiece:
     span_us: tuple = (-math.inf, math.inf)
     rendered: np.ndarray | None = None
     view_alpha_rad: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    detectors: int = VIIRS_DETECTORS
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -169,11 +171,11 @@ def _ecef(lat: np.ndarray, lon: np.ndarray, h: np.ndarray, out: np.ndarray) -> N
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _scan_ends(scan: np.ndarray, first: np.ndarray, last: np.ndarray, step: np.ndarray) -> None:
     """First and last valid detector positions (float64 (cols, 3), NaN where the column has none) of one
-    scan (32, cols, 3) and the detector step between them (m)."""
+    scan (detectors, cols, 3) and the detector step between them (m)."""
     for c in range(scan.shape[1]):
         i0 = -1
         i1 = -1
-        for d in range(VIIRS_DETECTORS):
+        for d in range(scan.shape[0]):
             if math.isfinite(scan[d, c, 0]):
                 if i0 < 0:
                     i0 = d
@@ -194,6 +196,7 @@ def _scan_ends(scan: np.ndarray, first: np.ndarray, last: np.ndarray, step: np.n
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _locate_scan(
     k: int,
+    det: int,
     lat: np.ndarray,
     lon: np.ndarray,
     h: np.ndarray,
@@ -208,12 +211,13 @@ def _locate_scan(
     last: np.ndarray,
     step: np.ndarray,
 ) -> None:
-    """Pass 1 for scan k: pixel points, band radiance from BT (linear in the uniform BT table, NaN outside
-    it or where not *good*), and the scan's ends (slot k + 1; 0 and nscan + 1 are the halos)."""
+    """Pass 1 for scan k (of *det* detectors): pixel points, band radiance from BT (linear in the uniform BT
+    table, NaN outside it or where not *good*), and the scan's ends (slot k + 1; 0 and nscan + 1 are the
+    halos)."""
     cols = lat.shape[1]
-    sl = slice(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS)
+    sl = slice(k * det, (k + 1) * det)
     _ecef(lat[sl], lon[sl], h[sl], pos[sl])
-    for r in range(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS):
+    for r in range(k * det, (k + 1) * det):
         for c in range(cols):
             radiance[r, c] = _band_radiance(bt[r, c], table, t_min_k, t_step_k) if good[r, c] else np.nan
     _scan_ends(pos[sl], first[k + 1], last[k + 1], step[k + 1])
@@ -252,6 +256,7 @@ def _views_radiance(
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _locate(
+    det: int,
     lat: np.ndarray,
     lon: np.ndarray,
     h: np.ndarray,
@@ -267,8 +272,10 @@ def _locate(
     step: np.ndarray,
 ) -> None:
     """Pass 1 (:func:`_locate_scan`), scans in parallel."""
-    for k in numba.prange(lat.shape[0] // VIIRS_DETECTORS):
-        _locate_scan(k, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step)
+    for k in numba.prange(lat.shape[0] // det):
+        _locate_scan(
+            k, det, lat, lon, h, bt, good, table, t_min_k, t_step_k, pos, radiance, first, last, step
+        )
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -340,6 +347,7 @@ def _load_row(pos: np.ndarray, r: int, inside: bool, out: np.ndarray) -> None:
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _weigh_scan(
     k: int,
+    det: int,
     pos: np.ndarray,
     h: np.ndarray,
     radiance: np.ndarray,
@@ -352,7 +360,7 @@ def _weigh_scan(
     radius: np.ndarray,
     top: np.ndarray,
 ) -> None:
-    """Pass 2 for scan k: vector footprints with the scan overlap removed (into *area*),
+    """Pass 2 for scan k (of *det* detectors): vector footprints with the scan overlap removed (into *area*),
     radiance NaN where either is unusable, the bounding sphere (centre, radius + 1 m for the float32
     rounding) of each block's usable pixels (NaN where it has none), and the height of the scan's highest
     usable pixel (top[k], m).
@@ -370,11 +378,11 @@ def _weigh_scan(
     foot = np.empty((3, cols))
     lo = np.empty((nbc, 3))  # the bounding box of each block of the current band of BLOCK_PX rows
     hi = np.empty((nbc, 3))
-    for r in range(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS):
-        d = r - k * VIIRS_DETECTORS
+    for r in range(k * det, (k + 1) * det):
+        d = r - k * det
         _load_row(pos, r - 1, d > 0, prev)
         _load_row(pos, r, True, here)
-        _load_row(pos, r + 1, d + 1 < VIIRS_DETECTORS, after)
+        _load_row(pos, r + 1, d + 1 < det, after)
         if d % BLOCK_PX == 0:
             lo[:] = np.inf
             hi[:] = -np.inf
@@ -418,6 +426,7 @@ def _weigh_scan(
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def _weigh(
+    det: int,
     pos: np.ndarray,
     h: np.ndarray,
     radiance: np.ndarray,
@@ -431,8 +440,8 @@ def _weigh(
     top: np.ndarray,
 ) -> None:
     """Pass 2 (:func:`_weigh_scan`), scans in parallel."""
-    for k in numba.prange(radiance.shape[0] // VIIRS_DETECTORS):
-        _weigh_scan(k, pos, h, radiance, first, last, step, have, area, centre, radius, top)
+    for k in numba.prange(radiance.shape[0] // det):
+        _weigh_scan(k, det, pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
 
 def _np_half_diff(p: np.ndarray, axis: int) -> np.ndarray:
@@ -469,6 +478,7 @@ def swath_piece(
     span_us: tuple[float, float] | None = None,
     seen_bt_k: np.ndarray | None = None,
     view_alpha_rad: np.ndarray | None = None,
+    detectors: int = VIIRS_DETECTORS,
 ) -> SwathPiece:
     """Prepare one VIIRS granule's geolocation and I5 BT for collocation.
 
@@ -476,9 +486,9 @@ def swath_piece(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     bt_k : numpy.ndarray
-        The pixels' I5 BT, K, shape (rows, cols).
+        The pixels' band BT, K, shape (rows, cols).
     good : numpy.ndarray
         Where a pixel is usable.
     band : BandTable
@@ -501,6 +511,8 @@ def swath_piece(
         height: :func:`monitor.collocation.render.rendered_bt`), K, shape (views, rows, cols).
     view_alpha_rad : numpy.ndarray, optional
         The in-track SBF angles of *seen_bt_k*, rad, shape (views,).
+    detectors : int, optional
+        The rows of a scan: the grid's detectors (:data:`monitor.core.bands.GRIDS`).
 
     Returns
     -------
@@ -508,15 +520,16 @@ def swath_piece(
         The 3-D pixel points, their band radiance and solid-angle weights (module docstring), and the
         rendered views' radiance when given.
     """
-    scans, kept = kept_pixels(lat_rad, lon_rad, height_m, sat_m, view_rad, scan_start_us, span_us)
+    det = detectors
+    scans, kept = kept_pixels(lat_rad, lon_rad, height_m, sat_m, view_rad, scan_start_us, span_us, det)
     if scans != slice(None) and scan_start_us is not None:
         first, stop, _ = scans.indices(len(scan_start_us))
-        r0, r1 = first * VIIRS_DETECTORS, stop * VIIRS_DETECTORS
+        r0, r1 = first * det, stop * det
         geo = (lat_rad, lon_rad, height_m)
         if first > 0:
-            before = tuple(a[r0 - VIIRS_DETECTORS : r0] for a in geo)
+            before = tuple(a[r0 - det : r0] for a in geo)
         if r1 < np.shape(lat_rad)[0]:
-            after = tuple(a[r1 : r1 + VIIRS_DETECTORS] for a in geo)
+            after = tuple(a[r1 : r1 + det] for a in geo)
         lat_rad, lon_rad, height_m, bt_k, good = (a[r0:r1] for a in (*geo, bt_k, good))
         seen_bt_k = None if seen_bt_k is None else seen_bt_k[:, r0:r1]
         sat_m = None if sat_m is None else sat_m[first:stop]
@@ -535,7 +548,7 @@ def swath_piece(
     # the kernels read the kept columns in place (a copy of them costs more than the strided reads)
     lat, lon, h = (np.asarray(a, f32) for a in (lat_rad, lon_rad, height_m))
     rows, cols = lat.shape
-    nscan = rows // VIIRS_DETECTORS
+    nscan = rows // det
     pos = np.empty((rows, cols, 3), f32)
     radiance = np.empty((rows, cols), f32)
     ends_first = np.full((nscan + 2, cols, 3), np.nan)  # each scan's first and last row
@@ -546,7 +559,7 @@ def swath_piece(
     t_min, t_step, table = band.radiance_table
     bt, good = np.asarray(bt_k, f32), np.asarray(good, bool)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
-        _locate(lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, ends_first, ends_last, step)
+        _locate(det, lat, lon, h, bt, good, table, t_min, t_step, pos, radiance, ends_first, ends_last, step)
     for slot, halo in ((0, before), (nscan + 1, after)):
         if halo is not None:
             hp = np.empty(np.shape(halo[0]) + (3,), f32)
@@ -558,7 +571,7 @@ def swath_piece(
     radius = np.empty(centre.shape[:2])
     top = np.zeros(nscan)  # the highest usable pixel of each scan, m (0: none above the ellipsoid)
     with KERNEL_LOCK, numba.parallel_chunksize(SCANS_PER_TASK):
-        _weigh(pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
+        _weigh(det, pos, h, radiance, ends_first, ends_last, step, have, area, centre, radius, top)
     views, angles = None, np.zeros(0)
     if seen_bt_k is not None and view_alpha_rad is not None:
         angles = np.asarray(view_alpha_rad, np.float64)
@@ -566,14 +579,14 @@ def swath_piece(
         with KERNEL_LOCK:
             _views_radiance(seen_bt_k, radiance, table, t_min, t_step, views)
 
-    scan = pos.reshape(nscan, VIIRS_DETECTORS, cols, 3)
+    scan = pos.reshape(nscan, det, cols, 3)
     mid = scan[nscan // 2]
     col_spacing = _fill_nan(np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=1), axis=-1), axis=0))
     det_step = np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=0), axis=-1), axis=0)
     if nscan > 1:
         advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
     else:
-        advance = det_step * VIIRS_DETECTORS
+        advance = det_step * det
     r_idx, c_idx = np.nonzero(np.isfinite(radius))
     # unbalanced with large leaves: the same nearest blocks, a faster build (studies/rows/, the speed record)
     tree = cKDTree(centre[r_idx, c_idx], leafsize=64, balanced_tree=False, compact_nodes=False)
@@ -596,4 +609,5 @@ def swath_piece(
         covered_us,
         views,
         angles,
+        det,
     )

@@ -34,6 +34,7 @@ def view_tangents(
     velocity_m_s: np.ndarray,
     cris_alpha_rad: np.ndarray,
     first_column: int = 0,
+    detectors: int = VIIRS_DETECTORS,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The along-track coordinate and in-track tangents of the VIIRS and CrIS rays to each pixel's GEO point.
 
@@ -50,7 +51,7 @@ def view_tangents(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     good : numpy.ndarray
         Where a pixel is usable.
     sat_m, velocity_m_s : numpy.ndarray
@@ -59,6 +60,8 @@ def view_tangents(
         The CrIS views' in-track angles in the spacecraft body frame, rad, positive ahead.
     first_column : int
         The granule column of the first column given, so that a part is traced as in the whole.
+    detectors : int, optional
+        The rows of a scan (the grid's detectors: :data:`monitor.core.bands.GRIDS`).
 
     Returns
     -------
@@ -72,7 +75,7 @@ def view_tangents(
         column per unit of height towards the spacecraft, positive along +x; shape (views, rows, cols).
     """
     x, b, a, _ = _traced(
-        lat_rad, lon_rad, height_m, good, sat_m, velocity_m_s, cris_alpha_rad, first_column, False
+        lat_rad, lon_rad, height_m, good, sat_m, velocity_m_s, cris_alpha_rad, first_column, False, detectors
     )
     return x, b, a
 
@@ -111,6 +114,7 @@ def view_tangents_across(
     velocity_m_s: np.ndarray,
     cris_alpha_rad: np.ndarray,
     first_column: int = 0,
+    detectors: int = VIIRS_DETECTORS,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Across]:
     """:func:`view_tangents`, and where the rays lie across the track.
 
@@ -123,7 +127,7 @@ def view_tangents_across(
     ----------
     lat_rad, lon_rad, height_m : numpy.ndarray
         The granule's GEO: geodetic latitude and longitude (rad) and height above the ellipsoid (m), shape
-        (rows, cols) of 32-detector scans.
+        (rows, cols) of scans of *detectors* rows.
     good : numpy.ndarray
         Where a pixel is usable.
     sat_m, velocity_m_s : numpy.ndarray
@@ -132,6 +136,8 @@ def view_tangents_across(
         The CrIS views' in-track angles in the spacecraft body frame, rad, positive ahead.
     first_column : int
         The granule column of the first column given, so that a part is traced as in the whole.
+    detectors : int, optional
+        The rows of a scan (the grid's detectors: :data:`monitor.core.bands.GRIDS`).
 
     Returns
     -------
@@ -142,7 +148,7 @@ def view_tangents_across(
         tangent traced and interpolated as the in-track one.
     """
     x, b, a, across = _traced(
-        lat_rad, lon_rad, height_m, good, sat_m, velocity_m_s, cris_alpha_rad, first_column, True
+        lat_rad, lon_rad, height_m, good, sat_m, velocity_m_s, cris_alpha_rad, first_column, True, detectors
     )
     assert across is not None
     return x, b, a, across
@@ -158,6 +164,7 @@ def _traced(
     cris_alpha_rad: np.ndarray,
     first_column: int,
     with_across: bool,
+    detectors: int,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Across | None]:
     """:func:`_tangents` into new arrays (NaN where no tangent is traced); the :class:`Across` with
     *with_across*."""
@@ -180,7 +187,7 @@ def _traced(
     tan_alpha = np.tan(np.asarray(cris_alpha_rad, np.float64))
     with KERNEL_LOCK:
         _tangents(
-            *geo, np.ascontiguousarray(good, np.bool_), sat, vel, tan_alpha, first_column, x, b, a,
+            *geo, np.ascontiguousarray(good, np.bool_), sat, vel, tan_alpha, first_column, detectors, x, b, a,
             across.geo_m, across.unit, across.viirs_tan, across.cris_tan,
         )  # fmt: skip
     return x, b, a, across if with_across else None
@@ -190,15 +197,16 @@ def _traced(
 def _scan_normal(
     point: np.ndarray, good: np.ndarray, s: np.ndarray, v: np.ndarray, order: float
 ) -> np.ndarray:
-    """The SBF's x axis during one scan: the normal of the plane VIIRS's centre detectors (15 and 16)
-    sweep, from their lines of sight at the scan's two farthest columns (the spacecraft at each pixel's
-    time), turned towards the velocity. VIIRS scans the SBF's y-z plane; the SBF is yawed against the
-    ECEF velocity (~3.5 degrees at the equator), which at a 50 degree scan angle is ~70 mrad in-track.
-    NaN when no column holds both."""
+    """The SBF's x axis during one scan: the normal of the plane VIIRS's two centre detectors (15 and 16 of
+    the I grid's 32, 7 and 8 of the M grid's 16) sweep, from their lines of sight at the scan's two farthest
+    columns (the spacecraft at each pixel's time), turned towards the velocity. VIIRS scans the SBF's y-z
+    plane; the SBF is yawed against the ECEF velocity (~3.5 degrees at the equator), which at a 50 degree
+    scan angle is ~70 mrad in-track. NaN when no column holds both."""
     out = np.full(3, np.nan)
+    lo, hi = good.shape[0] // 2 - 1, good.shape[0] // 2
     first, last = -1, -1
     for c in range(good.shape[1]):
-        if good[15, c] and good[16, c]:
+        if good[lo, c] and good[hi, c]:
             last = c
             if first < 0:
                 first = c
@@ -207,7 +215,7 @@ def _scan_normal(
     rays = np.empty((2, 3))
     for n, c in enumerate((first, last)):
         ray = np.zeros(3)
-        for i in (15, 16):
+        for i in (lo, hi):
             q = point[i, c]
             d = q[:3] - (s + v * (order * q[6] / ROTATION_RAD_S))
             ray += d / math.sqrt(d @ d)
@@ -227,6 +235,7 @@ def _tangents(
     vel: np.ndarray,
     tan_alpha: np.ndarray,
     first_column: int,
+    det: int,
     x: np.ndarray,
     b: np.ndarray,
     a: np.ndarray,
@@ -240,28 +249,28 @@ def _tangents(
     (:func:`view_tangents_across`). Every element is written: NaN where no tangent is traced."""
     cols = lat.shape[1]
     with_across = geo.shape[0] > 0
-    nscan = lat.shape[0] // VIIRS_DETECTORS
+    nscan = lat.shape[0] // det
     for k in numba.prange(nscan):  # NaN first, each scan by its own thread
-        _unset(k * VIIRS_DETECTORS, (k + 1) * VIIRS_DETECTORS, x, b, a, geo, across, b_across, a_across)
-    _unset(nscan * VIIRS_DETECTORS, lat.shape[0], x, b, a, geo, across, b_across, a_across)  # a part scan
+        _unset(k * det, (k + 1) * det, x, b, a, geo, across, b_across, a_across)
+    _unset(nscan * det, lat.shape[0], x, b, a, geo, across, b_across, a_across)  # a part scan
     axis0 = np.full(3, np.nan)
-    for k in range(lat.shape[0] // VIIRS_DETECTORS):  # the first scan with an SBF: x's axis
+    for k in range(lat.shape[0] // det):  # the first scan with an SBF: x's axis
         if np.all(np.isfinite(sat[k])) and np.all(np.isfinite(vel[k])):
-            point = np.empty((VIIRS_DETECTORS, cols, 7))
-            rows = good[k * VIIRS_DETECTORS : (k + 1) * VIIRS_DETECTORS]
-            order = scan_points(lat, lon, h, rows, k * VIIRS_DETECTORS, sat[k], vel[k], point)
+            point = np.empty((det, cols, 7))
+            rows = good[k * det : (k + 1) * det]
+            order = scan_points(lat, lon, h, rows, k * det, sat[k], vel[k], point)
             if order != 0.0:
                 axis0 = _scan_normal(point, rows, sat[k], vel[k], order)
                 if np.all(np.isfinite(axis0)):
                     break
     if not np.all(np.isfinite(axis0)):
         return
-    for k in numba.prange(lat.shape[0] // VIIRS_DETECTORS):
+    for k in numba.prange(lat.shape[0] // det):
         if not (np.all(np.isfinite(sat[k])) and np.all(np.isfinite(vel[k]))):
             continue
-        row0 = k * VIIRS_DETECTORS
-        rows = good[row0 : row0 + VIIRS_DETECTORS]
-        point = np.empty((VIIRS_DETECTORS, cols, 7))
+        row0 = k * det
+        rows = good[row0 : row0 + det]
+        point = np.empty((det, cols, 7))
         order = scan_points(lat, lon, h, rows, row0, sat[k], vel[k], point)
         if order == 0.0:
             continue
@@ -274,7 +283,7 @@ def _tangents(
         xs0, xs1, xs2 = xs[0], xs[1], xs[2]
         s0, s1, s2 = s[0], s[1], s[2]
         v0, v1, v2 = v[0], v[1], v[2]
-        for i in range(VIIRS_DETECTORS):
+        for i in range(det):
             last = -1  # the last column of this detector with a tangent of its own
             for c in range(cols):
                 if not rows[i, c]:

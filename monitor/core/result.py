@@ -38,8 +38,13 @@ FLAG_UNCONVERGED = "unconverged"  # the footprint's alternation ran out of itera
 # the day's uniform scenes span too little BT to determine a CrIS-VIIRS gain: gain and curvature empty, the
 # bias the scenes' mean difference (monitor/estimation/intercal.py)
 FLAG_GAIN_UNDETERMINED = "gain_undetermined"
-# every flag a FOR may carry, in the order of their bits in the export (the reliability flags first)
-FLAGS = (*RELIABILITY_FLAGS, FLAG_TOP_HAT, FLAG_UNCONVERGED, FLAG_GAIN_UNDETERMINED)
+# the offsets read in M15 differ from I5's by more than 3 sigmas of their paired difference: a VIIRS
+# band-to-band or geolocation-product matter, not CrIS's (the I5 offset stays usable)
+FLAG_BANDS_DIFFER = "bands_differ"
+# every flag a FOR may carry, in the order of their bits in the export (the reliability flags first; a new
+# flag takes the next bit)
+FLAGS = (*RELIABILITY_FLAGS, FLAG_TOP_HAT, FLAG_UNCONVERGED, FLAG_GAIN_UNDETERMINED, FLAG_BANDS_DIFFER)
+SECOND_BAND = "M15"  # the band the geolocation is read in besides I5, where assessment.bands lists it
 
 
 @dataclass(frozen=True)
@@ -77,6 +82,27 @@ def _difference(band: str) -> Any:
 def _difference_sigma(band: str) -> Any:
     """The declaration of the sigma of a band's CrIS minus VIIRS difference."""
     return measured("K", f"{SIGMA} CrIS minus VIIRS {band} difference", NAN, quality=True, band=band)
+
+
+@dataclass(frozen=True)
+class ForReplicates:
+    """One FOR's delete-a-group jackknife replicates of its offsets (:mod:`monitor.estimation.jackknife`).
+
+    Attributes
+    ----------
+    groups : tuple of (str, str)
+        The first and last granule (granule ids) each replicate leaves out.
+    alpha_urad, beta_urad : numpy.ndarray
+        Each replicate's in-track and cross-track offset, urad, shape (G,).
+    factor : float
+        What the day's correlation of consecutive granules makes of the FOR's sigmas
+        (:func:`~monitor.estimation.jackknife.correlation_factor`).
+    """
+
+    groups: tuple[tuple[str, str], ...]
+    alpha_urad: np.ndarray
+    beta_urad: np.ndarray
+    factor: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -188,6 +214,21 @@ class ForOffset:
     sigma_cris_minus_viirs_k_M15: float = _difference_sigma("M15")
     cris_minus_viirs_k_M16: float = _difference("M16")
     sigma_cris_minus_viirs_k_M16: float = _difference_sigma("M16")
+
+    # the offsets assessed in M15 as in I5 (on the M grid), where assessment.bands lists M15, and M15 minus
+    # I5 with the sigma of their paired jackknife replicates (the same granules leave out both)
+    d_alpha_urad_M15: float = measured("urad", "in-track LOS offset assessed in VIIRS M15", NAN)
+    d_beta_urad_M15: float = measured("urad", "cross-track LOS offset assessed in VIIRS M15", NAN)
+    sigma_alpha_urad_M15: float = measured("urad", f"{SIGMA} in-track offset in M15", NAN, quality=True)
+    sigma_beta_urad_M15: float = measured("urad", f"{SIGMA} cross-track offset in M15", NAN, quality=True)
+    m15_minus_i5_alpha_urad: float = measured("urad", "in-track LOS offset in M15 minus that in I5", NAN)
+    m15_minus_i5_beta_urad: float = measured("urad", "cross-track LOS offset in M15 minus that in I5", NAN)
+    sigma_m15_minus_i5_alpha_urad: float = measured(
+        "urad", f"{SIGMA} in-track M15 minus I5 offset (paired jackknife)", NAN, quality=True
+    )
+    sigma_m15_minus_i5_beta_urad: float = measured(
+        "urad", f"{SIGMA} cross-track M15 minus I5 offset (paired jackknife)", NAN, quality=True
+    )
 
     @property
     def scan_position(self) -> int:  # numpydoc ignore=RT01
@@ -380,6 +421,9 @@ class AssessmentResult:
     notes: list[str] = field(default_factory=list)  # how the inputs were read, where that is not granules
     radiometry: list[RadiometryBin] = field(default_factory=list)  # CrIS minus VIIRS per band, binned
     difference_maps: list[DifferenceMap] = field(default_factory=list)  # one granule's FOVs per band
+    # per FOR, the offsets' jackknife replicates (None where there are none): what pairs two bands' offsets;
+    # the day's own, never written (to_dict) nor read back
+    replicates: list[ForReplicates | None] = field(default_factory=list, repr=False, compare=False)
 
     def day_sigma_urad(self) -> float | None:
         """The day's precision, the one number a precision target is held to.

@@ -319,11 +319,28 @@ class Jackknife:
             The jackknife's standard error times t_factor(G - 1), in the statistic's unit; NaN replicates are
             left out, G counting those that remain (NaN below MIN_GRANULES).
         """
-        t = np.asarray(replicates, float)
-        g = np.sum(np.isfinite(t), axis=0)
-        factor = np.vectorize(t_factor, otypes=[float])(g - 1.0)
-        with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
-            # a statistic no granule measured has no variance: NaN, below MIN_GRANULES anyway (no warning)
-            warnings.simplefilter("ignore", RuntimeWarning)
-            se = np.sqrt((g - 1) * np.nanvar(t, axis=0))
-            return np.where(g >= MIN_GRANULES, se * factor, np.nan)
+        return replicate_sigma(replicates)
+
+
+def replicate_sigma(replicates: np.ndarray) -> np.ndarray:
+    """The sigma of a statistic from its delete-a-group replicates, its groups independent.
+
+    Parameters
+    ----------
+    replicates : numpy.ndarray
+        The G replicates along axis 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        The jackknife's standard error times t_factor(G - 1), in the statistic's unit; NaN replicates are left
+        out, G counting those that remain (NaN below MIN_GRANULES).
+    """
+    t = np.asarray(replicates, float)
+    g = np.sum(np.isfinite(t), axis=0)
+    factor = np.vectorize(t_factor, otypes=[float])(g - 1.0)
+    with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
+        # a statistic no granule measured has no variance: NaN, below MIN_GRANULES anyway (no warning)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        se = np.sqrt((g - 1) * np.nanvar(t, axis=0))
+        return np.where(g >= MIN_GRANULES, se * factor, np.nan)

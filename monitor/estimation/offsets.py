@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -109,6 +109,17 @@ NO_LIFT = DayLift(np.nan, np.full(N_FOR, np.nan), *np.zeros((4, N_FOR)))
 
 
 @dataclass(frozen=True)
+class OffsetReplicates:
+    """One FOR's jackknife replicates of its offsets: the first and last granule each leaves out (indices
+    into the day's granules in time order, shape (G, 2)), its offsets (urad, alpha and beta, shape (G, 2)),
+    and the factor the day's correlation of consecutive granules makes of its sigmas."""
+
+    granules: np.ndarray
+    urad: np.ndarray
+    factor: float
+
+
+@dataclass(frozen=True)
 class DayEstimate:
     """The 30 FORs' offsets of a day, their cost surfaces (30, m, m; NaN where none), the CrIS - VIIRS
     difference in BT bins pooled over the FORs refined (the paper's Figure 15) and the correlation of
@@ -118,6 +129,7 @@ class DayEstimate:
     cost_cube_k: np.ndarray
     difference_bins: list[DifferenceBin]
     correlation: float = 0.0  # of consecutive granules' replicates (jackknife.adjacent_correlation)
+    replicates: list[OffsetReplicates | None] = field(default_factory=list)  # per FOR, where it has them
 
 
 KmOf = Callable[[int, float, float], tuple[float, float, np.ndarray]]
@@ -274,6 +286,7 @@ def day_offsets(
     correlation = jackknife.adjacent_correlation(series, follows) if follows is not None else 0.0
     cone_error_urad = _cone_error_urad(estimates, step_urad)
     fors = []
+    replicates: list[OffsetReplicates | None] = [None] * len(cris)
     pooled: list[tuple] = []  # (CrIS BT, VIIRS BT) at the optimum of each refined FOR
     for k, cris_k in enumerate(cris):
         n = len(cris_k)
@@ -327,6 +340,8 @@ def day_offsets(
             )
             if max(sig_a, sig_b) > cfg.max_sigma_urad:
                 flags.append(FLAG_UNCERTAIN)
+            if best.granules is not None and best.replicates is not None:
+                replicates[k] = OffsetReplicates(best.granules, best.replicates * step_urad, factor)
         d_alpha, d_beta = x * step_urad, y * step_urad
         ground = Ground()
         if km is not None:
@@ -356,4 +371,4 @@ def day_offsets(
             )
         )
     bins = difference_bins(*(np.concatenate(v) for v in zip(*pooled, strict=True))) if pooled else []
-    return DayEstimate(fors, cube, bins, correlation)
+    return DayEstimate(fors, cube, bins, correlation, replicates)
