@@ -139,7 +139,9 @@ class AssessmentConfig(Section):
         ["I5"],
         "The VIIRS bands CrIS is compared with radiometrically each day (I5, M13, M15, M16): per band and "
         "FOR, CrIS minus VIIRS over the FOVs uniform in VIIRS, on the assessed geolocation "
-        "(cris_minus_viirs_k_<BAND>). The offsets are I5's whatever this lists.",
+        "(cris_minus_viirs_k_<BAND>). The offsets are I5's; with M15 listed, the day is also assessed in "
+        "M15 (d_alpha_urad_M15, ..., and M15 minus I5 with its paired sigma, flagged bands_differ beyond 3 "
+        "sigmas).",
     )
     uniform_std_k: float = key(
         0.5,

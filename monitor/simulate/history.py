@@ -32,6 +32,8 @@ BIAS_K, GAIN_PCT, CURVATURE_K = 0.15, -0.3, 0.1
 # band's per-FOR sigma on a day (the noise drawn is the sigma stated)
 BAND_LEVEL_K = {"I5": 0.05, "M13": -0.04, "M15": 0.03, "M16": -0.02}
 BAND_SIGMA_K = {"I5": 0.02, "M13": 0.04, "M15": 0.015, "M16": 0.015}
+# the offsets read in M15: I5's with the paired difference's noise, and M15's own sigma (urad)
+M15_MINUS_I5_SIGMA_URAD, M15_SIGMA_URAD = 10.0, 20.0
 
 
 def day_result(
@@ -43,7 +45,8 @@ def day_result(
     band_step_k: dict[str, float] | None = None,
 ) -> AssessmentResult:
     """One day's result: the paper profile scaled down, noise, and *step_urad* added cross-track at FOR
-    21-30; CrIS minus VIIRS in every band at its level with its noise, *band_step_k* added.
+    21-30; CrIS minus VIIRS in every band at its level with its noise, *band_step_k* added; the offsets read
+    in M15 about I5's.
 
     Parameters
     ----------
@@ -71,6 +74,8 @@ def day_result(
     d_beta = 0.3 * d_beta + rng.normal(0, 15, N_FOR) + np.where(np.arange(N_FOR) >= 20, step_urad, 0.0)
     scan = np.abs(np.linspace(-48.3, 48.3, N_FOR))
     stretch = 1.0 / np.cos(np.radians(scan)) ** 2
+    # M15's own draws, apart from the day's stream (the other fields' noise stays what it was)
+    m15 = np.random.default_rng([day.toordinal(), 15]).normal(0, M15_MINUS_I5_SIGMA_URAD, (N_FOR, 2))
     fors = []
     for k in range(N_FOR):
         it, ct = d_alpha[k] * KM_PER_URAD, d_beta[k] * KM_PER_URAD * stretch[k]
@@ -99,7 +104,18 @@ def day_result(
         for b, level in BAND_LEVEL_K.items():
             bands[f"cris_minus_viirs_k_{b}"] = level + steps.get(b, 0.0) + rng.normal(0, BAND_SIGMA_K[b])
             bands[f"sigma_cris_minus_viirs_k_{b}"] = BAND_SIGMA_K[b]
-        fors[-1] = replace(fors[-1], **bands)
+        fors[-1] = replace(
+            fors[-1],
+            **bands,
+            d_alpha_urad_M15=d_alpha[k] + m15[k, 0],
+            d_beta_urad_M15=d_beta[k] + m15[k, 1],
+            sigma_alpha_urad_M15=M15_SIGMA_URAD,
+            sigma_beta_urad_M15=M15_SIGMA_URAD,
+            m15_minus_i5_alpha_urad=m15[k, 0],
+            m15_minus_i5_beta_urad=m15[k, 1],
+            sigma_m15_minus_i5_alpha_urad=M15_MINUS_I5_SIGMA_URAD,
+            sigma_m15_minus_i5_beta_urad=M15_MINUS_I5_SIGMA_URAD,
+        )
     cube = None
     if with_cube:
         off = (np.arange(2 * DEFAULT_HALF_STEPS + 1) - DEFAULT_HALF_STEPS) * DEFAULT_STEP_URAD

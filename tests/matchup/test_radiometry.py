@@ -138,3 +138,13 @@ def test_assess_with_the_production_configuration_compares_every_band(cases, tmp
         ]
         # a two-granule day: most FORs have enough uniform FOVs (M13 counts warm scenes only)
         assert len(values) >= 15 and abs(np.median(values)) < 0.1, band
+    # and the geolocation read in M15 beside I5's: the same turn within the two bands' sigmas
+    read = [f for f in fors if f["d_alpha_urad_M15"] is not None and f["sigma_alpha_urad"] is not None]
+    assert len(read) >= 25
+    apart = [
+        abs(f[f"d_{a}_urad_M15"] - f[f"d_{a}_urad"])
+        / np.hypot(f[f"sigma_{a}_urad_M15"], f[f"sigma_{a}_urad"])
+        for f in read
+        for a in ("alpha", "beta")
+    ]
+    assert np.median(apart) < 1.5

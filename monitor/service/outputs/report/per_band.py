@@ -1,6 +1,7 @@
 """The report's CrIS minus VIIRS per VIIRS band (:mod:`monitor.matchup.radiometry`): the latest day against
 FOR and against scene temperature, the trend of each band, and one granule's difference map per band with
-the FOR edges drawn (the figure the STAR slides show for M15).
+the FOR edges drawn (the figure the STAR slides show for M15); and the offsets read in M15 beside I5's
+(:mod:`monitor.estimation.band_pair`).
 
 The figures take plain arrays and records; :func:`band_section` reads the store and returns the HTML.
 """
@@ -18,14 +19,14 @@ import numpy as np
 
 from monitor.core.bands import BANDS
 from monitor.core.constants import N_FOR
-from monitor.core.result import DifferenceMap, ForOffset, RadiometryBin
+from monitor.core.result import FLAG_BANDS_DIFFER, SECOND_BAND, DifferenceMap, ForOffset, RadiometryBin
 from monitor.core.vocabulary import BinnedBy
 from monitor.history.records import ForSeries
 from monitor.service.outputs.report import plots
 from monitor.service.store.sqlite import Store
 
 COLOURS = {"I5": "tab:blue", "M13": "tab:purple", "M15": "tab:orange", "M16": "tab:green"}
-FIGURES = ("band_fors.png", "band_scenes.png", "band_trend.png", "band_maps.png")
+FIGURES = ("band_fors.png", "band_scenes.png", "band_trend.png", "band_maps.png", "band_offsets.png")
 
 
 def _measured(fors: Sequence[ForOffset]) -> list[str]:
@@ -66,6 +67,53 @@ def fors_figure(path: Path, fors: Sequence[ForOffset], bands: Sequence[str], tit
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, ncol=len(bands))
     ax.set_title(title, fontsize=10)
+    return plots._save(fig, path)
+
+
+def offsets_figure(path: Path, fors: Sequence[ForOffset], title: str) -> Path:
+    """The offsets read in M15 beside I5's per FOR (2-sigma bars), and M15 minus I5 with the 2-sigma bars of
+    the paired jackknife, the FORs flagged ``bands_differ`` ringed.
+
+    Parameters
+    ----------
+    path : Path
+        The PNG to write.
+    fors : sequence of ForOffset
+        The day's FORs.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The file.
+    """
+    fig, axes = plt.subplots(2, 2, figsize=(10, 5.6), sharex=True, constrained_layout=True)
+    k = np.array([f.for_index for f in fors])
+    flagged = np.array([FLAG_BANDS_DIFFER in f.flags for f in fors])
+    for col, (axis, words) in enumerate((("alpha", "in-track"), ("beta", "cross-track"))):
+        top, bottom = axes[0, col], axes[1, col]
+        for dx, band, suffix in ((-0.1, "I5", ""), (0.1, SECOND_BAND, f"_{SECOND_BAND}")):
+            v = np.array([getattr(f, f"d_{axis}_urad{suffix}") for f in fors])
+            s = np.array([getattr(f, f"sigma_{axis}_urad{suffix}") for f in fors])
+            top.errorbar(k + dx, v, yerr=2 * np.nan_to_num(s), fmt="o-", ms=3, capsize=2, color=COLOURS[band],
+                         label=band)  # fmt: skip
+        d = np.array([getattr(f, f"m15_minus_i5_{axis}_urad") for f in fors])
+        s = np.array([getattr(f, f"sigma_m15_minus_i5_{axis}_urad") for f in fors])
+        bottom.axhline(0.0, color="0.5", lw=0.8)
+        bottom.errorbar(k, d, yerr=2 * np.nan_to_num(s), fmt="o", ms=3, capsize=2, color="0.2")
+        bottom.scatter(k[flagged], d[flagged], s=70, facecolors="none", edgecolors="tab:red",
+                       label="bands_differ")  # fmt: skip
+        top.set_title(f"{words} offset (urad)", fontsize=9)
+        bottom.set_title(f"{SECOND_BAND} minus I5, {words} (urad)", fontsize=9)
+        bottom.set_xlabel("FOR")
+        for ax in (top, bottom):
+            ax.grid(alpha=0.3)
+            ax.set_xlim(0.5, N_FOR + 0.5)
+        top.legend(fontsize=8)
+        if flagged.any():
+            bottom.legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
     return plots._save(fig, path)
 
 
@@ -248,6 +296,11 @@ def band_section(
     if trend:
         trend_figure(sat_dir / FIGURES[2], series.days, trend, marks, f"{name}: CrIS - VIIRS per band")
         out.append(img(sat_dir / FIGURES[2], "CrIS minus VIIRS per band over time"))
+    if any(np.isfinite(f.d_alpha_urad_M15) for f in fors):
+        offsets_figure(
+            sat_dir / FIGURES[4], fors, f"{day}: the offsets read in I5 and in {SECOND_BAND} (2 sigma)"
+        )
+        out.append(img(sat_dir / FIGURES[4], f"LOS offsets in I5 and {SECOND_BAND} against FOR"))
     maps = store.difference_maps(satellite, latest)
     if maps:
         granules = ", ".join(sorted({m.granule for m in maps}))
@@ -258,5 +311,8 @@ def band_section(
         "averaged over the FOV, over the day's FOVs uniform in VIIRS (M13 on scenes above 260 K), on the "
         "assessed geolocation; bars are 2 sigma from the granule jackknife. The map shows every FOV of one "
         "granule, the uniform ones ringed, grey lines the FOR edges. A level beyond "
-        "alerts.radiometry_limit_k pages (radiometry), a step pages as a calibration_jump.</p>"
+        "alerts.radiometry_limit_k pages (radiometry), a step pages as a calibration_jump. The offsets "
+        f"read in {SECOND_BAND} (where assessment.bands lists it) are assessed as I5's; their difference "
+        "has the paired jackknife's sigma (both bands see the same granules), and a FOR where it exceeds 3 "
+        "sigmas is flagged bands_differ: VIIRS's band-to-band registration or geolocation, not CrIS's.</p>"
     )

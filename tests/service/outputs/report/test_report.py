@@ -173,8 +173,8 @@ def test_report_in_headless_chromium(store, tmp_path):
             assert all(ok and width > 0 for _, ok, width in images), images
             if page != "index.html":
                 # km, urad, heat map, trend, cost, intercalibration x 2, CrIS minus VIIRS per band x 2 (the
-                # synthetic history stores no bins or maps)
-                assert len(images) == 9
+                # synthetic history stores no bins or maps), the offsets in I5 and M15
+                assert len(images) == 10
             errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
             assert not errors, errors
         # the page alone, as a mail attachment opens it: every figure is inside it, within the budget
@@ -186,7 +186,7 @@ def test_report_in_headless_chromium(store, tmp_path):
         images = driver.execute_script(
             "return Array.from(document.images).map(i => [i.src.slice(0, 22), i.complete, i.naturalWidth]);"
         )
-        assert len(images) == 9 and all(
+        assert len(images) == 10 and all(
             src == "data:image/png;base64," and ok and width > 0 for src, ok, width in images
         ), images
         shot = tmp_path / "report_j01.png"
