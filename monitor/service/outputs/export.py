@@ -179,8 +179,8 @@ def to_xarray(
 
     method = method or Method()
     series = store.series(satellite, since, until)
-    bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int8])
-    flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int8)
+    bits = np.vectorize(lambda f: sum(FLAG_BITS.get(x, 0) for x in f), otypes=[np.int16])
+    flags = bits(series.flags) if series.flags.size else np.zeros(series.flags.shape, np.int16)
     days = np.array([np.datetime64(d.isoformat(), "ns") for d in series.days], dtype="datetime64[ns]")
     declared = measures(record)
     # the bands by wavelength: a CF coordinate variable is numeric and monotonic, the names are its labels
@@ -223,7 +223,7 @@ def to_xarray(
         flags,
         {
             "long_name": "reliability flags (any set: not reliable)",
-            "flag_masks": np.array(list(FLAG_BITS.values()), np.int8),
+            "flag_masks": np.array(list(FLAG_BITS.values()), np.int16),
             "flag_meanings": " ".join(FLAG_BITS),
             "coverage_content_type": "qualityInformation",
         },
