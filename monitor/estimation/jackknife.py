@@ -255,6 +255,30 @@ def uncertainty_note(granules: int, rho: float) -> str:
     )
 
 
+def replicate_sigma(replicates: np.ndarray) -> np.ndarray:
+    """The sigma of a statistic from its delete-a-group replicates, its groups independent.
+
+    Parameters
+    ----------
+    replicates : numpy.ndarray
+        The G replicates along axis 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        The jackknife's standard error times t_factor(G - 1), in the statistic's unit; NaN replicates are left
+        out, G counting those that remain (NaN below MIN_GRANULES).
+    """
+    t = np.asarray(replicates, float)
+    g = np.sum(np.isfinite(t), axis=0)
+    factor = np.vectorize(t_factor, otypes=[float])(g - 1.0)
+    with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
+        # a statistic no granule measured has no variance: NaN, below MIN_GRANULES anyway (no warning)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        se = np.sqrt((g - 1) * np.nanvar(t, axis=0))
+        return np.where(g >= MIN_GRANULES, se * factor, np.nan)
+
+
 @dataclass(frozen=True)
 class Jackknife:
     """Delete-one-group replicates over N samples: *counts* (G, N) weighs each sample 1 in each replicate
@@ -305,42 +329,5 @@ class Jackknife:
         """
         return len(self.counts)
 
-    def sigma(self, replicates: np.ndarray) -> np.ndarray:
-        """The sigma of a statistic from its replicates, its groups independent.
-
-        Parameters
-        ----------
-        replicates : numpy.ndarray
-            The G replicates along axis 0.
-
-        Returns
-        -------
-        numpy.ndarray
-            The jackknife's standard error times t_factor(G - 1), in the statistic's unit; NaN replicates are
-            left out, G counting those that remain (NaN below MIN_GRANULES).
-        """
-        return replicate_sigma(replicates)
-
-
-def replicate_sigma(replicates: np.ndarray) -> np.ndarray:
-    """The sigma of a statistic from its delete-a-group replicates, its groups independent.
-
-    Parameters
-    ----------
-    replicates : numpy.ndarray
-        The G replicates along axis 0.
-
-    Returns
-    -------
-    numpy.ndarray
-        The jackknife's standard error times t_factor(G - 1), in the statistic's unit; NaN replicates are left
-        out, G counting those that remain (NaN below MIN_GRANULES).
-    """
-    t = np.asarray(replicates, float)
-    g = np.sum(np.isfinite(t), axis=0)
-    factor = np.vectorize(t_factor, otypes=[float])(g - 1.0)
-    with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
-        # a statistic no granule measured has no variance: NaN, below MIN_GRANULES anyway (no warning)
-        warnings.simplefilter("ignore", RuntimeWarning)
-        se = np.sqrt((g - 1) * np.nanvar(t, axis=0))
-        return np.where(g >= MIN_GRANULES, se * factor, np.nan)
+    # the sigma of a statistic from the replicates (their groups independent): :func:`replicate_sigma`
+    sigma = staticmethod(replicate_sigma)

@@ -222,7 +222,7 @@ def to_xarray(
         dims,
         flags,
         {
-            "long_name": "reliability flags (any set: not reliable)",
+            "long_name": "flags (any of the first four set: not reliable)",
             "flag_masks": np.array(list(FLAG_BITS.values()), np.int16),
             "flag_meanings": " ".join(FLAG_BITS),
             "coverage_content_type": "qualityInformation",
