@@ -38,3 +38,26 @@ def test_a_bad_band_in_the_configuration_is_refused_in_one_line(tmp_path):
     )
     done = run_crisgeo("check-config", "--config", cfg)
     assert done.returncode == 2 and "mapping_bands" in done.stderr and "M14" in done.stderr
+
+
+def test_the_daily_run_stores_the_offsets_read_in_m15(tmp_path):
+    """With M15 in assessment.bands the day is assessed in M15 too, and the store keeps its offsets."""
+    import sqlite3
+
+    cfg = tmp_path / "c.yaml"
+    state = tmp_path / "state"
+    cfg.write_text(
+        f"satellites: [j01]\nstate_dir: {state}\n"
+        "source: {kind: simulated, granules: 1}\nscenes: {keep: 1}\nassessment: {bands: [I5, M15]}\n"
+    )
+    done = run_crisgeo("run", "--config", cfg, "--date", DAY)
+    assert done.returncode in (0, 2), done.stderr
+    (db,) = state.rglob("*.sqlite")
+    with sqlite3.connect(db) as con:
+        rows = con.execute(
+            "SELECT d_alpha_urad, d_alpha_urad_M15, m15_minus_i5_alpha_urad FROM results"
+        ).fetchall()
+    assert len(rows) == 30
+    read = [(a, m, d) for a, m, d in rows if a is not None and m is not None]
+    assert len(read) >= 20
+    assert all(abs(m - a - d) < 1e-6 for a, m, d in read)
