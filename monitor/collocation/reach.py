@@ -1,5 +1,5 @@
 """Which pixels of a VIIRS granule a CrIS granule can reach: the scans observed in its time span and the
-columns seen within its view angle of nadir.
+columns seen within its view angle of nadir; and the spacings that size the search around a FOV.
 
 A CrIS granule (32 s) needs about a third of one VIIRS granule's scans and, within the CrIS swath's
 +-48.3 deg, not the VIIRS columns beyond it: :mod:`monitor.collocation.swath` prepares only these, with
@@ -12,10 +12,12 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.ndimage import minimum_filter1d
 
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.geometry import wgs84
 
+SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smallest within +-200 columns
 BLOCK_PX = 4  # pixels are searched in BLOCK_PX x BLOCK_PX blocks (a divisor of either grid's detectors)
 
 
@@ -128,3 +130,55 @@ def kept_pixels(
         sat = np.asarray(sat_m)[first:stop]
         columns = view_columns(lat_rad[r], lon_rad[r], height_m[r], sat, view_rad, detectors)
     return scans, columns
+
+
+def _np_half_diff(p: np.ndarray, axis: int) -> np.ndarray:
+    """Half the difference of the two neighbours along *axis* (numpy), one-sided where one is missing."""
+    fwd = np.full_like(p, np.nan)
+    bwd = np.full_like(p, np.nan)
+    n = p.shape[axis]
+    a, b = [slice(None)] * p.ndim, [slice(None)] * p.ndim
+    a[axis], b[axis] = slice(0, n - 1), slice(1, n)
+    np.subtract(p[tuple(b)], p[tuple(a)], out=fwd[tuple(a)])
+    bwd[tuple(b)] = fwd[tuple(a)]
+    both = (fwd + bwd) * 0.5
+    return np.where(np.isfinite(both), both, np.where(np.isfinite(fwd), fwd, bwd))
+
+
+def _fill_nan(a: ArrayLike) -> np.ndarray:
+    a = np.asarray(a, float)
+    ok = np.isfinite(a)
+    return np.interp(np.arange(len(a)), np.nonzero(ok)[0], a[ok]) if not ok.all() else a
+
+
+def search_spacings(pos_m: np.ndarray, detectors: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What sizes a prepared granule's search windows, per column, from its middle scan.
+
+    Parameters
+    ----------
+    pos_m : numpy.ndarray
+        The pixels' 3-D points, ECEF, m, shape (rows, cols, 3) of scans of *detectors* rows.
+    detectors : int
+        The rows of a scan.
+
+    Returns
+    -------
+    col_spacing_m : numpy.ndarray
+        The smallest column spacing within +-200 columns (:data:`SPACING_WINDOW_COLS`), m.
+    advance_m : numpy.ndarray
+        The along-track advance of a scan, m (the detectors' span with one scan).
+    det_step_m : numpy.ndarray
+        The detector step, m.
+    """
+    rows, cols, _ = pos_m.shape
+    nscan = rows // detectors
+    scan = pos_m.reshape(nscan, detectors, cols, 3)
+    mid = scan[nscan // 2]
+    col_spacing = _fill_nan(np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=1), axis=-1), axis=0))
+    det_step = np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=0), axis=-1), axis=0)
+    if nscan > 1:
+        advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
+    else:
+        advance = det_step * detectors
+    spacing = minimum_filter1d(col_spacing, SPACING_WINDOW_COLS, mode="nearest")
+    return spacing, _fill_nan(advance), _fill_nan(det_step)

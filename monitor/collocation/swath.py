@@ -31,12 +31,10 @@ from typing import Protocol
 
 import numba
 import numpy as np
-from numpy.typing import ArrayLike
-from scipy.ndimage import minimum_filter1d
 from scipy.spatial import cKDTree
 
 from monitor.collocation.geodesy import ecef_m
-from monitor.collocation.reach import BLOCK_PX, kept_pixels
+from monitor.collocation.reach import BLOCK_PX, kept_pixels, search_spacings
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import VIIRS_DETECTORS
 
@@ -61,7 +59,6 @@ class BandTable(Protocol):
 # the passes' threads take scans one at a time as they come free, not in equal shares fixed in advance:
 # the read-ahead thread takes turns on the cores, and a share fixed in advance waits for the slowest
 SCANS_PER_TASK = 1
-SPACING_WINDOW_COLS = 401  # the column spacing used around a column is the smallest within +-200 columns
 
 
 @dataclass
@@ -444,25 +441,6 @@ def _weigh(
         _weigh_scan(k, det, pos, h, radiance, first, last, step, have, area, centre, radius, top)
 
 
-def _np_half_diff(p: np.ndarray, axis: int) -> np.ndarray:
-    """Half the difference of the two neighbours along *axis* (numpy), one-sided where one is missing."""
-    fwd = np.full_like(p, np.nan)
-    bwd = np.full_like(p, np.nan)
-    n = p.shape[axis]
-    a, b = [slice(None)] * p.ndim, [slice(None)] * p.ndim
-    a[axis], b[axis] = slice(0, n - 1), slice(1, n)
-    np.subtract(p[tuple(b)], p[tuple(a)], out=fwd[tuple(a)])
-    bwd[tuple(b)] = fwd[tuple(a)]
-    both = (fwd + bwd) * 0.5
-    return np.where(np.isfinite(both), both, np.where(np.isfinite(fwd), fwd, bwd))
-
-
-def _fill_nan(a: ArrayLike) -> np.ndarray:
-    a = np.asarray(a, float)
-    ok = np.isfinite(a)
-    return np.interp(np.arange(len(a)), np.nonzero(ok)[0], a[ok]) if not ok.all() else a
-
-
 def swath_piece(
     lat_rad: np.ndarray,
     lon_rad: np.ndarray,
@@ -579,14 +557,7 @@ def swath_piece(
         with KERNEL_LOCK:
             _views_radiance(seen_bt_k, radiance, table, t_min, t_step, views)
 
-    scan = pos.reshape(nscan, det, cols, 3)
-    mid = scan[nscan // 2]
-    col_spacing = _fill_nan(np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=1), axis=-1), axis=0))
-    det_step = np.nanmedian(np.linalg.norm(_np_half_diff(mid, axis=0), axis=-1), axis=0)
-    if nscan > 1:
-        advance = np.nanmedian(np.linalg.norm(scan[nscan // 2] - scan[nscan // 2 - 1], axis=-1), axis=0)
-    else:
-        advance = det_step * det
+    col_spacing, advance, det_step = search_spacings(pos, det)
     r_idx, c_idx = np.nonzero(np.isfinite(radius))
     # unbalanced with large leaves: the same nearest blocks, a faster build (studies/rows/, the speed record)
     tree = cKDTree(centre[r_idx, c_idx], leafsize=64, balanced_tree=False, compact_nodes=False)
@@ -596,9 +567,9 @@ def swath_piece(
         area,
         centre,
         radius,
-        minimum_filter1d(col_spacing, SPACING_WINDOW_COLS, mode="nearest"),
-        _fill_nan(advance),
-        _fill_nan(det_step),
+        col_spacing,
+        advance,
+        det_step,
         max(float(top.max()), 0.0),
         tree,
         r_idx * BLOCK_PX,

@@ -1,6 +1,7 @@
 """The day's CrIS minus VIIRS per band beyond its per-FOR fields: the bins (by FOV, scene temperature, node)
 and one granule's difference map per band, as :mod:`monitor.matchup.radiometry` makes them and the result,
-the store and the report carry them."""
+the store and the report carry them; and each FOR's jackknife replicates, which pair the offsets read in two
+bands (:mod:`monitor.estimation.band_pair`)."""
 
 from __future__ import annotations
 
@@ -121,3 +122,24 @@ class DifferenceMap:
             array(d["difference_k"]),
             np.array(d["uniform"], bool),
         )
+
+
+@dataclass(frozen=True)
+class ForReplicates:
+    """One FOR's delete-a-group jackknife replicates of its offsets (:mod:`monitor.estimation.jackknife`).
+
+    Attributes
+    ----------
+    groups : tuple of (str, str)
+        The first and last granule (granule ids) each replicate leaves out.
+    alpha_urad, beta_urad : numpy.ndarray
+        Each replicate's in-track and cross-track offset, urad, shape (G,).
+    factor : float
+        What the day's correlation of consecutive granules makes of the FOR's sigmas
+        (:func:`~monitor.estimation.jackknife.correlation_factor`).
+    """
+
+    groups: tuple[tuple[str, str], ...]
+    alpha_urad: np.ndarray
+    beta_urad: np.ndarray
+    factor: float = 1.0

@@ -129,3 +129,46 @@ def measured(
         "band": band,
     }
     return field(default=default, metadata={"measure": spec})
+
+
+NAN = float("nan")
+SIGMA = "uncertainty (1 sigma) of the"
+UNIFORM = "mean over the day's FOVs uniform in VIIRS, on the assessed geolocation"
+
+
+def difference_of(band: str) -> Any:
+    """The declaration of a band's CrIS minus VIIRS difference (:mod:`monitor.matchup.radiometry`).
+
+    Parameters
+    ----------
+    band : str
+        The VIIRS band.
+
+    Returns
+    -------
+    dataclasses.Field
+        The field (:func:`measured`).
+    """
+    return measured(
+        "K",
+        f"CrIS minus VIIRS {band} brightness temperature, {UNIFORM}",
+        NAN,
+        metric=(CRIS_MINUS_VIIRS, band),
+        band=band,
+    )
+
+
+def difference_sigma_of(band: str) -> Any:
+    """The declaration of the sigma of a band's CrIS minus VIIRS difference.
+
+    Parameters
+    ----------
+    band : str
+        The VIIRS band.
+
+    Returns
+    -------
+    dataclasses.Field
+        The field (:func:`measured`).
+    """
+    return measured("K", f"{SIGMA} CrIS minus VIIRS {band} difference", NAN, quality=True, band=band)

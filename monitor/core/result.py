@@ -7,21 +7,23 @@ import math
 import typing
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any
 
 import numpy as np
 
-from monitor.core.band_records import DifferenceMap, RadiometryBin
+from monitor.core.band_records import DifferenceMap, ForReplicates, RadiometryBin
 from monitor.core.constants import DEFAULT_HALF_STEPS, DEFAULT_STEP_URAD, FOV_DIAMETER_URAD
 from monitor.core.measures import (
     CALIBRATION_BIAS,
     CALIBRATION_GAIN,
-    CRIS_MINUS_VIIRS,
     FOV_ROWS,
+    NAN,
     OFFSET_METERS,
     OFFSET_RADIANS,
     RESPONSE_WIDTH,
+    SIGMA,
     Measure,
+    difference_of,
+    difference_sigma_of,
     measured,
 )
 from monitor.core.vocabulary import DayStop, Decision
@@ -61,48 +63,6 @@ class SpecBreach:
     def beyond_doubt(self) -> bool:  # numpydoc ignore=RT01
         """The breach holds beyond the uncertainty: |error| - 2 sigma is still beyond the specification."""
         return math.isfinite(self.sigma_km) and abs(self.error_km) - 2 * self.sigma_km > self.spec_km
-
-
-NAN = float("nan")
-SIGMA = "uncertainty (1 sigma) of the"
-UNIFORM = "mean over the day's FOVs uniform in VIIRS, on the assessed geolocation"
-
-
-def _difference(band: str) -> Any:
-    """The declaration of a band's CrIS minus VIIRS difference (:mod:`monitor.matchup.radiometry`)."""
-    return measured(
-        "K",
-        f"CrIS minus VIIRS {band} brightness temperature, {UNIFORM}",
-        NAN,
-        metric=(CRIS_MINUS_VIIRS, band),
-        band=band,
-    )
-
-
-def _difference_sigma(band: str) -> Any:
-    """The declaration of the sigma of a band's CrIS minus VIIRS difference."""
-    return measured("K", f"{SIGMA} CrIS minus VIIRS {band} difference", NAN, quality=True, band=band)
-
-
-@dataclass(frozen=True)
-class ForReplicates:
-    """One FOR's delete-a-group jackknife replicates of its offsets (:mod:`monitor.estimation.jackknife`).
-
-    Attributes
-    ----------
-    groups : tuple of (str, str)
-        The first and last granule (granule ids) each replicate leaves out.
-    alpha_urad, beta_urad : numpy.ndarray
-        Each replicate's in-track and cross-track offset, urad, shape (G,).
-    factor : float
-        What the day's correlation of consecutive granules makes of the FOR's sigmas
-        (:func:`~monitor.estimation.jackknife.correlation_factor`).
-    """
-
-    groups: tuple[tuple[str, str], ...]
-    alpha_urad: np.ndarray
-    beta_urad: np.ndarray
-    factor: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -206,14 +166,14 @@ class ForOffset:
 
     # CrIS minus VIIRS per band over the FOVs uniform in VIIRS (monitor.matchup.radiometry); NaN in a band
     # not configured (assessment.bands)
-    cris_minus_viirs_k_I5: float = _difference("I5")
-    sigma_cris_minus_viirs_k_I5: float = _difference_sigma("I5")
-    cris_minus_viirs_k_M13: float = _difference("M13")
-    sigma_cris_minus_viirs_k_M13: float = _difference_sigma("M13")
-    cris_minus_viirs_k_M15: float = _difference("M15")
-    sigma_cris_minus_viirs_k_M15: float = _difference_sigma("M15")
-    cris_minus_viirs_k_M16: float = _difference("M16")
-    sigma_cris_minus_viirs_k_M16: float = _difference_sigma("M16")
+    cris_minus_viirs_k_I5: float = difference_of("I5")
+    sigma_cris_minus_viirs_k_I5: float = difference_sigma_of("I5")
+    cris_minus_viirs_k_M13: float = difference_of("M13")
+    sigma_cris_minus_viirs_k_M13: float = difference_sigma_of("M13")
+    cris_minus_viirs_k_M15: float = difference_of("M15")
+    sigma_cris_minus_viirs_k_M15: float = difference_sigma_of("M15")
+    cris_minus_viirs_k_M16: float = difference_of("M16")
+    sigma_cris_minus_viirs_k_M16: float = difference_sigma_of("M16")
 
     # the offsets assessed in M15 as in I5 (on the M grid), where assessment.bands lists M15, and M15 minus
     # I5 with the sigma of their paired jackknife replicates (the same granules leave out both)
@@ -224,10 +184,10 @@ class ForOffset:
     m15_minus_i5_alpha_urad: float = measured("urad", "in-track LOS offset in M15 minus that in I5", NAN)
     m15_minus_i5_beta_urad: float = measured("urad", "cross-track LOS offset in M15 minus that in I5", NAN)
     sigma_m15_minus_i5_alpha_urad: float = measured(
-        "urad", f"{SIGMA} in-track M15 minus I5 offset (paired jackknife)", NAN, quality=True
+        "urad", f"{SIGMA} in-track M15 minus I5", NAN, quality=True
     )
     sigma_m15_minus_i5_beta_urad: float = measured(
-        "urad", f"{SIGMA} cross-track M15 minus I5 offset (paired jackknife)", NAN, quality=True
+        "urad", f"{SIGMA} cross-track M15 minus I5", NAN, quality=True
     )
 
     @property

@@ -1,9 +1,14 @@
-"""The daily run writes the day's mapping on its own offsets when the configuration asks for it."""
+"""The daily run writes the day's mapping on its own offsets when the configuration asks for it, and stores
+the offsets read in M15 where it lists M15."""
 
 from __future__ import annotations
 
+import datetime as dt
+import math
+
 import pytest
 
+from monitor.service.store.sqlite import Store
 from tests.invoke import run_crisgeo
 
 xr = pytest.importorskip("xarray")
@@ -42,8 +47,6 @@ def test_a_bad_band_in_the_configuration_is_refused_in_one_line(tmp_path):
 
 def test_the_daily_run_stores_the_offsets_read_in_m15(tmp_path):
     """With M15 in assessment.bands the day is assessed in M15 too, and the store keeps its offsets."""
-    import sqlite3
-
     cfg = tmp_path / "c.yaml"
     state = tmp_path / "state"
     cfg.write_text(
@@ -53,11 +56,8 @@ def test_the_daily_run_stores_the_offsets_read_in_m15(tmp_path):
     done = run_crisgeo("run", "--config", cfg, "--date", DAY)
     assert done.returncode in (0, 2), done.stderr
     (db,) = state.rglob("*.sqlite")
-    with sqlite3.connect(db) as con:
-        rows = con.execute(
-            "SELECT d_alpha_urad, d_alpha_urad_M15, m15_minus_i5_alpha_urad FROM results"
-        ).fetchall()
-    assert len(rows) == 30
-    read = [(a, m, d) for a, m, d in rows if a is not None and m is not None]
+    fors = Store(db).day_result("j01", dt.date.fromisoformat(DAY))
+    assert len(fors) == 30
+    read = [f for f in fors if math.isfinite(f.d_alpha_urad) and math.isfinite(f.d_alpha_urad_M15)]
     assert len(read) >= 20
-    assert all(abs(m - a - d) < 1e-6 for a, m, d in read)
+    assert all(abs(f.d_alpha_urad_M15 - f.d_alpha_urad - f.m15_minus_i5_alpha_urad) < 1e-6 for f in read)
