@@ -245,6 +245,7 @@ def collocate_run(
         renderer=variation.renderer,
         piece=variation.piece,
         detectors=BANDS[band].grid.detectors,
+        split=BANDS[band].grid.cone_split,
     )
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end

@@ -25,7 +25,9 @@ class ViirsGrid:
 
     ``bowtie`` lists, per group of detector rows, the output samples deleted on board at each end of the
     row (the bow-tie deletion); ``geo_prefixes`` the GEO products on this grid, the preferred (terrain
-    corrected, the only one NOAA's archive carries) first.
+    corrected, the only one NOAA's archive carries) first. ``cone_split``: the cone collocation splits each
+    pixel into cone_split x cone_split sub-pixels (:mod:`monitor.collocation.subpixels`), so that the cones'
+    edges move at the I grid's pitch on either grid.
     """
 
     resolution: str
@@ -37,6 +39,7 @@ class ViirsGrid:
     bowtie: tuple[tuple[tuple[int, ...], int], ...]
     geo_prefixes: tuple[str, ...]
     geo_collections: tuple[str, ...]
+    cone_split: int
 
 
 GRIDS = {
@@ -52,6 +55,7 @@ GRIDS = {
             (((0, 1, 30, 31), 2016), ((2, 3, 28, 29), 1280)),
             ("GITCO", "GIMGO"),
             ("VIIRS-IMG-GEO-TC", "VIIRS-IMG-GEO"),
+            1,
         ),
         ViirsGrid(
             "M",
@@ -63,6 +67,7 @@ GRIDS = {
             (((0, 15), 1008), ((1, 14), 640)),
             ("GMTCO", "GMODO"),
             ("VIIRS-MOD-GEO-TC", "VIIRS-MOD-GEO"),
+            2,
         ),
     )
 }

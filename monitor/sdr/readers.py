@@ -476,8 +476,8 @@ def read_metadata(path: str | os.PathLike[str] | GranuleRef) -> list[GranuleMeta
 
 
 def read_viirs_geo_scan(path: str | os.PathLike[str] | GranuleRef, scan: int) -> tuple[np.ndarray, ...]:
-    """(lat_rad, lon_rad, height_m) of one 32-row scan of a VIIRS GEO file (negative *scan* counts from the
-    end); height_m is zero for the ellipsoid product.
+    """(lat_rad, lon_rad, height_m) of one scan (32 rows on the I grid, 16 on the M) of a VIIRS GEO file
+    (negative *scan* counts from the end); height_m is zero for the ellipsoid product.
 
     Parameters
     ----------
