@@ -107,7 +107,7 @@ def collocate_granule(
     )  # fmt: skip
     pieces = load_swath(viirs, viirs_all, band, cache, inputs.view_rad, timings, inputs.viirs, inputs.span_us)
     with stage(timings, "collocation"):
-        cones = _collocate_fors(pieces, geo, fg, valid, fill, cfg, should_stop)
+        cones = _collocate_fors(pieces, geo, fg, valid, fill, cfg, should_stop, cache.smoothed_cones)
     found = [_per_fov(c, fg, cfg, band) for c in (cones, cones.rendered) if c is not None]
     usable = [
         valid & sdr.good & np.isfinite(bt_cris) & (coverage >= cfg.min_coverage)
@@ -154,9 +154,11 @@ def _collocate_fors(
     fill: dict,
     cfg: AssessmentConfig,
     should_stop: StopCheck = None,
+    smooth: bool = False,
 ) -> collocate.ConeSums:
     """The cone sums of every FOV of the granule (in one call of the parallel kernel), and of what each
-    sees rendered when the pieces are (:attr:`monitor.collocation.sums.ConeSums.rendered`)."""
+    sees rendered when the pieces are (:attr:`monitor.collocation.sums.ConeSums.rendered`); smoothed over
+    neighbouring perturbations when *smooth* (the M grid)."""
     if should_stop is not None and should_stop():
         raise StopRequested
     return collocate.cone_sums(
@@ -169,6 +171,7 @@ def _collocate_fors(
         KERNELS[cfg.kernel],
         fov_range_m=np.where(valid, geo.range_m, 1e6).ravel(),
         fov_cos_zen=np.cos(fill["zenith_rad"]).ravel(),
+        smooth=smooth,
     )
 
 
@@ -245,7 +248,7 @@ def collocate_run(
         renderer=variation.renderer,
         piece=variation.piece,
         detectors=BANDS[band].grid.detectors,
-        split=BANDS[band].grid.cone_split,
+        smoothed_cones=BANDS[band].grid.smoothed_cones,
     )
     samples, skipped = [], []
     reading: dict[str, float] = {}  # the read-ahead thread's seconds, added to *timings* at the end

@@ -7,11 +7,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from monitor.collocation import collocate, reach, render, subpixels, swath
+from monitor.collocation import collocate, reach, render, swath
 from monitor.config.assessment import AssessmentConfig
 from monitor.core.constants import VIIRS_DETECTORS
 from monitor.core.vocabulary import Kernel
@@ -97,8 +97,8 @@ class SwathCache:
     (*renderer*: :func:`monitor.collocation.render.rendered_bt`, or a study's through
     :class:`monitor.assessment.seam.Variation`); with 0, the pixels' own radiance. *piece*, None in the
     service, is a study's change to each piece as it is prepared (the pixels the cone kernel sees).
-    *detectors*: the rows of a scan of the band's grid; *split*: the sub-pixels each pixel is split into along
-    each axis before collocation (the grid's ``cone_split``: :mod:`monitor.collocation.subpixels`)."""
+    *detectors*: the rows of a scan of the band's grid; *smoothed_cones*: the grid's cone sums are smoothed
+    over neighbouring perturbations (:func:`monitor.collocation.sums.smoothed`)."""
 
     pieces: dict = field(default_factory=dict)
     # a CrIS granule's scans with their margins (32 + 2 x 16 s) reach at most two VIIRS granules (86 s):
@@ -109,7 +109,7 @@ class SwathCache:
     renderer: render.Renderer = render.rendered_bt
     piece: PieceVariant | None = None
     detectors: int = VIIRS_DETECTORS
-    split: int = 1
+    smoothed_cones: bool = False
 
 
 def _widen(span: Span | None, other: Span | None) -> Span | None:
@@ -299,39 +299,6 @@ def _run_span(spans: dict[str, Span], key: str, span_us: Span | None) -> Span | 
     return _widen(spans.get(key), span_us) if span_us is not None else None
 
 
-def split_pixels(raw: RawViirs, detectors: int, n: int) -> RawViirs:
-    """A VIIRS granule as read, its pixels split into n x n sub-pixels (:mod:`monitor.collocation.subpixels`).
-
-    Parameters
-    ----------
-    raw : RawViirs
-        The GEO, the SDR and the neighbours' adjacent scans (:func:`read_viirs`).
-    detectors : int
-        The rows of a scan of the granule's grid.
-    n : int
-        Sub-pixels per pixel along each axis.
-
-    Returns
-    -------
-    RawViirs
-        The same granule on scans of detectors x n rows: geolocation between neighbouring pixels, BT and
-        quality flags each sub-pixel its pixel's.
-    """
-    geo, sdr, before, after = raw
-    assert geo.height_m is not None  # zeros for the ellipsoid product (ViirsGeoGranule)
-    lat, lon, height = subpixels.split_geolocation(geo.lat_rad, geo.lon_rad, geo.height_m, detectors, n)
-    halo_before, halo_after = (
-        None if halo is None else subpixels.split_geolocation(halo[0], halo[1], halo[2], detectors, n)
-        for halo in (before, after)
-    )
-    return (
-        replace(geo, lat_rad=lat, lon_rad=lon, height_m=height),
-        replace(sdr, bt_k=subpixels.split_values(sdr.bt_k, n), qf1=subpixels.split_values(sdr.qf1, n)),
-        halo_before,
-        halo_after,
-    )
-
-
 def piece(
     v: GranuleFiles,
     viirs_all: list[GranuleFiles],
@@ -378,12 +345,8 @@ def piece(
     if raw is None:
         with stage(timings, "read"):
             raw = read_viirs(v, viirs_all, run_span)
-    if cache.split > 1:
-        with stage(timings, "geometry"):
-            raw = split_pixels(raw, cache.detectors, cache.split)
     geo, sdr, halo_before, halo_after = raw
     assert geo.height_m is not None  # zeros for the ellipsoid product (ViirsGeoGranule)
-    detectors = cache.detectors * cache.split
     reach_rad = view_rad + collocate.VIEW_MARGIN_RAD
     seen = None
     if cache.lift_m_per_k:
@@ -391,19 +354,19 @@ def piece(
             # what the piece keeps, and a scan either side: a ray's stretches lie within ~1 km of its foot
             scans, columns = reach.kept_pixels(
                 geo.lat_rad, geo.lon_rad, geo.height_m, geo.sc_position_m, reach_rad,
-                geo.start_time_us, run_span, detectors,
+                geo.start_time_us, run_span, cache.detectors,
             )  # fmt: skip
             first, stop, _ = scans.indices(len(geo.sc_position_m))
             seen = cache.renderer(
                 geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, geo.sc_position_m,
                 geo.sc_velocity_m_s, render.VIEW_ALPHA_RAD, cache.lift_m_per_k,
-                slice(max(first - 1, 0), stop + 1), columns, detectors,
+                slice(max(first - 1, 0), stop + 1), columns, cache.detectors,
             )  # fmt: skip
     with stage(timings, "geometry"):
         piece = swath.swath_piece(
             geo.lat_rad, geo.lon_rad, geo.height_m, sdr.bt_k, sdr.good, band, halo_before, halo_after,
             sat_m=geo.sc_position_m, view_rad=reach_rad, scan_start_us=geo.start_time_us, span_us=run_span,
-            seen_bt_k=seen, view_alpha_rad=render.VIEW_ALPHA_RAD, detectors=detectors,
+            seen_bt_k=seen, view_alpha_rad=render.VIEW_ALPHA_RAD, detectors=cache.detectors,
         )  # fmt: skip
     if cache.piece is not None:
         piece = cache.piece(piece)

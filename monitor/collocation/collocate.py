@@ -38,7 +38,7 @@ import numba
 import numpy as np
 
 from monitor.collocation import render
-from monitor.collocation.sums import ConeSums, cone_sums_of
+from monitor.collocation.sums import ConeSums, cone_sums_of, smoothed
 from monitor.collocation.swath import BLOCK_PX, SwathPiece, ViirsSwath, swath_piece
 from monitor.compiled.threads import KERNEL_LOCK
 from monitor.core.constants import FOV_HALF_ANGLE_RAD, MAX_GRID_SPREAD_RAD, VIIRS_DETECTORS
@@ -405,6 +405,7 @@ def cone_sums(
     radii_rad: tuple[float, ...] = TOP_HAT,
     fov_range_m: np.ndarray | None = None,
     fov_cos_zen: np.ndarray | None = None,
+    smooth: bool = False,
 ) -> ConeSums:
     """Solid-angle weighted VIIRS radiance sums in nested discs about every perturbed LOS of a batch of FOVs.
 
@@ -433,6 +434,10 @@ def cone_sums(
         Each FOV's range to the ground, m, for the search's reach.
     fov_cos_zen : numpy.ndarray, optional
         The cosine of each FOV's zenith angle, for the search's reach.
+    smooth : bool, optional
+        Smooth the sums over neighbouring perturbations (:func:`monitor.collocation.sums.smoothed`): for a
+        grid whose pixels are wider than the perturbation step (``smoothed_cones`` of
+        :data:`monitor.core.bands.GRIDS`).
 
     Returns
     -------
@@ -501,7 +506,8 @@ def cone_sums(
     rendered_sums = None
     if len(acc_rendered):
         rendered_sums = cone_sums_of(acc_rendered, whole_rendered, solid, radii_rad)
-    return replace(cone_sums_of(acc, whole, solid, radii_rad), rendered=rendered_sums)
+    cones = replace(cone_sums_of(acc, whole, solid, radii_rad), rendered=rendered_sums)
+    return smoothed(cones) if smooth else cones
 
 
 def warm_up() -> float:

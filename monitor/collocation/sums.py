@@ -1,9 +1,19 @@
 """The cone sums a collocation returns: the solid-angle weighted VIIRS sums in nested discs about every
-perturbed LOS, made from the difference arrays the kernel fills (:mod:`monitor.collocation.collocate`)."""
+perturbed LOS, made from the difference arrays the kernel fills (:mod:`monitor.collocation.collocate`).
+
+Smoothed over the perturbations. A cone counts a pixel whole when its centre lies inside (Wang et al. 2016),
+so as the LOS is perturbed the cone's mean jumps by a pixel's share each time its edge crosses a pixel
+centre. On the I grid a pixel is one perturbation step wide; on the M grid it is two, and a cone holds a
+quarter as many: the jumps are larger, and where the scene leaves the cost shallow the minimum moves with
+them (studies/second-band.md). Averaging each perturbation's sums with its neighbours', weights 1/4, 1/2,
+1/4 along each axis, is the cone test made on each pixel spread over its centre and one step either side
+(the perturbations are shifts of the cone, a pixel's shift the opposite one): the edge then moves through a
+pixel gradually instead of at once, at the cost of a blur of one step in a cone of some 19 steps' radius.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
@@ -92,6 +102,40 @@ class ConeSums:
         w = np.diff(self.weights, axis=1, prepend=0.0)
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(w > 0, s / w, np.nan).astype(np.float32)
+
+
+def _tent(a: np.ndarray) -> np.ndarray:
+    """*a* (..., m, m) averaged along its last two axes with weights 1/4, 1/2, 1/4, the edges repeated."""
+    for axis in (-2, -1):
+        pad = [(0, 0)] * a.ndim
+        pad[axis] = (1, 1)
+        p = np.pad(a, pad, mode="edge")
+        m = a.shape[axis]
+        a = 0.25 * (
+            np.take(p, np.arange(m), axis=axis)
+            + 2.0 * np.take(p, np.arange(1, m + 1), axis=axis)
+            + np.take(p, np.arange(2, m + 2), axis=axis)
+        )
+    return a
+
+
+def smoothed(cones: ConeSums) -> ConeSums:
+    """The cone sums averaged over each perturbation and its neighbours (module docstring).
+
+    Parameters
+    ----------
+    cones : ConeSums
+        Sums over a (2n+1) x (2n+1) perturbation grid.
+
+    Returns
+    -------
+    ConeSums
+        The sums and weights of every disc, and of the rendered views, each perturbation's with weight 1/2
+        along each axis and its two neighbours' with 1/4 (at the grid's edge, itself in the missing one's
+        place); the discs' solid angles unchanged.
+    """
+    rendered = None if cones.rendered is None else smoothed(cones.rendered)
+    return replace(cones, sums=_tent(cones.sums), weights=_tent(cones.weights), rendered=rendered)
 
 
 def cone_sums_of(

@@ -25,9 +25,9 @@ class ViirsGrid:
 
     ``bowtie`` lists, per group of detector rows, the output samples deleted on board at each end of the
     row (the bow-tie deletion); ``geo_prefixes`` the GEO products on this grid, the preferred (terrain
-    corrected, the only one NOAA's archive carries) first. ``cone_split``: the cone collocation splits each
-    pixel into cone_split x cone_split sub-pixels (:mod:`monitor.collocation.subpixels`), so that the cones'
-    edges move at the I grid's pitch on either grid.
+    corrected, the only one NOAA's archive carries) first. ``smoothed_cones``: the grid's pixels are wider
+    than the perturbation step, and the cone sums are smoothed over neighbouring perturbations
+    (:func:`monitor.collocation.sums.smoothed`).
     """
 
     resolution: str
@@ -39,7 +39,7 @@ class ViirsGrid:
     bowtie: tuple[tuple[tuple[int, ...], int], ...]
     geo_prefixes: tuple[str, ...]
     geo_collections: tuple[str, ...]
-    cone_split: int
+    smoothed_cones: bool
 
 
 GRIDS = {
@@ -55,7 +55,7 @@ GRIDS = {
             (((0, 1, 30, 31), 2016), ((2, 3, 28, 29), 1280)),
             ("GITCO", "GIMGO"),
             ("VIIRS-IMG-GEO-TC", "VIIRS-IMG-GEO"),
-            1,
+            False,
         ),
         ViirsGrid(
             "M",
@@ -67,7 +67,7 @@ GRIDS = {
             (((0, 15), 1008), ((1, 14), 640)),
             ("GMTCO", "GMODO"),
             ("VIIRS-MOD-GEO-TC", "VIIRS-MOD-GEO"),
-            2,
+            True,
         ),
     )
 }

@@ -1,5 +1,5 @@
-"""The geolocation assessed in M15 as in I5: the cones collocated on the M grid (its pixels split), a day
-without M15 kept."""
+"""The geolocation assessed in M15 as in I5: the cones collocated on the M grid (their sums smoothed over the
+perturbations), a day without M15 kept."""
 
 from __future__ import annotations
 
@@ -57,8 +57,8 @@ def _roughness_k(samples):
 
 
 def test_the_m_grid_cones_move_as_smoothly_as_the_i_grids(four_bands):
-    """Split into sub-pixels, the M grid's cones gain and lose pixels in steps as fine as the I grid's: the
-    perturbed cones' BT is no rougher than I5's (whole M pixels make it about four times as rough)."""
+    """Smoothed over the perturbations, the M grid's cones gain and lose pixels no more abruptly than the I
+    grid's: the perturbed cones' BT is no rougher than I5's (unsmoothed, about four times as rough)."""
     rough_i5 = _roughness_k(_collocated(four_bands, "I5"))
     rough_m15 = _roughness_k(_collocated(four_bands, "M15"))
     assert 0 < rough_m15 < 1.5 * rough_i5
